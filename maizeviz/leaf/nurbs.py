@@ -1,0 +1,292 @@
+"""Global NURBS surface interpolation through leaf point grids (The NURBS Book, A9.4).
+
+Parameters by averaged chord length (or centripetal) over rows and columns, knot vectors by
+averaging (eq. 9.8), control points from one collocation solve per direction with every
+right-hand side at once. Weights are 1 (the non-rational case the paper uses); evaluation still
+divides by the weighted basis, so a surface with other weights evaluates correctly.
+
+Every function works on a batch of leaves of the same grid shape at once (leading axis L):
+a canopy's 1,500 leaves are fitted with a few dozen numpy calls, not 1,500 Python loops.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import BSpline
+
+from maizeviz.errors import LeafError
+
+
+def basis_matrix(x: np.ndarray, knots: np.ndarray, degree: int) -> np.ndarray:
+    """Dense B-spline basis values (The NURBS Book A2.2, vectorised over leaves and points).
+
+    Parameters
+    ----------
+    x : (L, A) float64 in [0, 1]
+    knots : (L, K) float64, clamped
+    degree : int
+
+    Returns
+    -------
+    (L, A, K - degree - 1) float64; rows sum to 1.
+    """
+    x = np.asarray(x, dtype=np.float64)
+    nbatch, npts = x.shape
+    nctrl = knots.shape[1] - degree - 1
+    span = (x[:, :, None] >= knots[:, None, :]).sum(axis=2) - 1
+    np.maximum(span, degree, out=span)
+    np.minimum(span, nctrl - 1, out=span)                         # (L, A); x = 1 -> last span
+    li = np.arange(nbatch)[:, None, None]
+    # knots t[span - degree + 1] .. t[span + degree], gathered once: (L, A, 2 degree)
+    kk = knots[li, span[:, :, None] + np.arange(1 - degree, degree + 1)]
+    left = [None] + [x - kk[:, :, degree - j] for j in range(1, degree + 1)]
+    right = [None] + [kk[:, :, degree - 1 + j] - x for j in range(1, degree + 1)]
+    vals = [np.ones_like(x)]
+    for j in range(1, degree + 1):
+        saved = 0.0
+        new = []
+        for r in range(j):
+            temp = vals[r] / (right[r + 1] + left[j - r])
+            new.append(saved + right[r + 1] * temp)
+            saved = left[j - r] * temp
+        new.append(saved)
+        vals = new
+    out = np.zeros((nbatch, npts, nctrl))
+    first = np.arange(nbatch * npts).reshape(nbatch, npts) * nctrl + span - degree
+    flat = out.reshape(-1)
+    for r in range(degree + 1):
+        flat[first + r] = vals[r]
+    return out
+
+
+def data_parameters(points: np.ndarray, method: str = "chord") -> tuple[np.ndarray, np.ndarray]:
+    """Averaged parameters of the rows (u) and columns (v) of grids (The NURBS Book 9.2.5).
+
+    Zero-length rows or columns (a collapsed tip) are left out of the average.
+
+    Parameters
+    ----------
+    points : (L, m, n, 3) or (m, n, 3) float64
+    method : "chord" or "centripetal"
+
+    Returns
+    -------
+    u : (L, m) float64, v : (L, n) float64 (no leading axis for a single grid); each runs
+    from 0 to 1 and is NaN for a grid whose points all coincide.
+    """
+    if method not in ("chord", "centripetal"):
+        raise ValueError(f"parameter method must be 'chord' or 'centripetal', not {method!r}")
+    single = points.ndim == 3
+    pts = points[None] if single else points
+
+    def along(p):  # parameters along axis 1, averaged over axis 2
+        d = np.linalg.norm(np.diff(p, axis=1), axis=3)
+        if method == "centripetal":
+            d = np.sqrt(d)
+        total = d.sum(axis=1)                                       # (L, n)
+        ok = total > 0
+        cum = np.cumsum(d, axis=1) / np.where(ok, total, 1.0)[:, None, :]
+        count = ok.sum(axis=1)
+        t = (cum * ok[:, None, :]).sum(axis=2) / np.where(count, count, np.nan)[:, None]
+        t = np.concatenate([np.zeros((len(p), 1)), t], axis=1)
+        t[:, -1] = np.where(count > 0, 1.0, np.nan)
+        return t
+
+    u = along(pts)
+    v = along(pts.transpose(0, 2, 1, 3))
+    return (u[0], v[0]) if single else (u, v)
+
+
+def averaged_knots(params: np.ndarray, degree: int) -> np.ndarray:
+    """Clamped knot vectors by averaging (The NURBS Book eq. 9.8).
+
+    (L, n) -> (L, n + degree + 1), or (n,) -> (n + degree + 1,).
+    """
+    single = params.ndim == 1
+    p = params[None] if single else params
+    nb, n = p.shape
+    c = np.concatenate([np.zeros((nb, 1)), np.cumsum(p, axis=1)], axis=1)
+    j = np.arange(1, n - degree)                        # interior knots j = 1 .. n-1-degree
+    inner = (c[:, j + degree] - c[:, j]) / degree
+    out = np.concatenate([np.zeros((nb, degree + 1)), inner, np.ones((nb, degree + 1))], axis=1)
+    return out[0] if single else out
+
+
+def refine_parameters(params: np.ndarray, k: int) -> np.ndarray:
+    """The data parameters plus ``k`` evenly spaced ones between each consecutive pair.
+
+    (..., n) -> (..., (n - 1)(k + 1) + 1); every data parameter is kept, so every digitized
+    point becomes a mesh vertex.
+    """
+    if k < 0:
+        raise ValueError(f"interpolation count must be >= 0, got {k}")
+    frac = np.arange(k + 1) / (k + 1)
+    inner = params[..., :-1, None] + np.diff(params, axis=-1)[..., None] * frac
+    inner = inner.reshape(*params.shape[:-1], -1)
+    return np.concatenate([inner, params[..., -1:]], axis=-1)
+
+
+@dataclass(frozen=True)
+class NurbsSurfaces:
+    """L tensor-product NURBS surfaces of equal degrees and control grid shape over [0, 1]^2.
+
+    Attributes
+    ----------
+    degree_u, degree_v : int
+    knots_u : (L, nu + degree_u + 1) float64
+    knots_v : (L, nv + degree_v + 1) float64
+    control : (L, nu, nv, 3) float64, cm
+    weights : (L, nu, nv) float64
+    params_u : (L, m) float64
+        Parameters of the data rows (the digitized cross-sections): 0 at the collar, 1 at the tip.
+    params_v : (L, n) float64
+        Parameters of the data columns: 0 and 1 at the margins.
+    """
+
+    degree_u: int
+    degree_v: int
+    knots_u: np.ndarray
+    knots_v: np.ndarray
+    control: np.ndarray
+    weights: np.ndarray
+    params_u: np.ndarray
+    params_v: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.control)
+
+    def __getitem__(self, i) -> "NurbsSurfaces":
+        i = np.atleast_1d(np.arange(len(self))[i])
+        return NurbsSurfaces(self.degree_u, self.degree_v, self.knots_u[i], self.knots_v[i],
+                             self.control[i], self.weights[i], self.params_u[i], self.params_v[i])
+
+    def _homogeneous(self) -> np.ndarray:
+        w = self.weights[..., None]
+        return np.concatenate([self.control * w, w], axis=3)       # (L, nu, nv, 4)
+
+    def evaluate_grid(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Points at every (u[l, a], v[l, b]).
+
+        Parameters
+        ----------
+        u : (L, A) or (A,) float, v : (L, B) or (B,) float, in [0, 1]
+
+        Returns
+        -------
+        (L, A, B, 3) float64, cm
+        """
+        nb = len(self)
+        u = np.broadcast_to(np.clip(u, 0.0, 1.0), (nb, np.shape(u)[-1]))
+        v = np.broadcast_to(np.clip(v, 0.0, 1.0), (nb, np.shape(v)[-1]))
+        bu = basis_matrix(u, self.knots_u, self.degree_u)           # (L, A, nu)
+        bv = basis_matrix(v, self.knots_v, self.degree_v)           # (L, B, nv)
+        rational = not np.all(self.weights == 1.0)
+        hom = self._homogeneous() if rational else self.control
+        nu, nv, nc = hom.shape[1:]
+        na, nbv = bu.shape[1], bv.shape[1]
+        t = (bu @ hom.reshape(nb, nu, nv * nc)).reshape(nb, na, nv, nc)          # (L, A, nv, c)
+        t = t.transpose(0, 2, 1, 3).reshape(nb, nv, na * nc)
+        out = (bv @ t).reshape(nb, nbv, na, nc).transpose(0, 2, 1, 3)          # (L, A, B, c)
+        return out[..., :3] / out[..., 3:] if rational else np.ascontiguousarray(out)
+
+    def evaluate(self, u, v) -> np.ndarray:
+        """Points at pairs (u[k], v[k]) on the first surface: (K,), (K,) -> (K, 3) cm."""
+        return self._at(u, v)[0]
+
+    def _at(self, u, v, derivative: bool = False):
+        u = np.clip(np.asarray(u, dtype=np.float64).ravel(), 0.0, 1.0)
+        v = np.clip(np.asarray(v, dtype=np.float64).ravel(), 0.0, 1.0)
+        hom = self._homogeneous()[0]
+        bu = basis_matrix(u[None], self.knots_u[:1], self.degree_u)[0]
+        bv = basis_matrix(v[None], self.knots_v[:1], self.degree_v)[0]
+        a = np.einsum("ki,ijc,kj->kc", bu, hom, bv)
+        p = a[:, :3] / a[:, 3:]
+        if not derivative:
+            return p, None, None
+        su = BSpline(self.knots_u[0], hom, self.degree_u).derivative()(u)              # (K, nv, 4)
+        sv = BSpline(self.knots_v[0], hom.transpose(1, 0, 2), self.degree_v).derivative()(v)
+        au = np.einsum("kjc,kj->kc", su, bv)
+        av = np.einsum("kic,ki->kc", sv, bu)
+        w = a[:, 3:]
+        return p, (au[:, :3] - au[:, 3:] * p) / w, (av[:, :3] - av[:, 3:] * p) / w
+
+    def derivatives(self, u, v) -> tuple[np.ndarray, np.ndarray]:
+        """dS/du and dS/dv of the first surface at pairs (K,), (K,) -> two (K, 3), cm."""
+        _, du, dv = self._at(u, v, derivative=True)
+        return du, dv
+
+    def normals(self, u, v) -> np.ndarray:
+        """Unit normals dS/du x dS/dv of the first surface at pairs (K,), (K,) -> (K, 3).
+
+        With the column convention of SCIENCE.md (col 0 = right margin seen from above, tip
+        ahead) they point out of the upper (adaxial) face. Where the surface is degenerate
+        (a collapsed tip) the normal is taken just inside the leaf.
+        """
+        u = np.clip(np.asarray(u, dtype=np.float64).ravel(), 0.0, 1.0)
+        v = np.clip(np.asarray(v, dtype=np.float64).ravel(), 0.0, 1.0)
+        du, dv = self.derivatives(u, v)
+        n = np.cross(du, dv)
+        length = np.linalg.norm(n, axis=1)
+        scale = np.linalg.norm(du, axis=1) * np.linalg.norm(dv, axis=1)
+        bad = length <= 1e-9 * np.maximum(scale, 1e-300)
+        if bad.any():
+            uu = np.where(u[bad] > 0.5, u[bad] - 1e-4, u[bad] + 1e-4)
+            du2, dv2 = self.derivatives(uu, v[bad])
+            n[bad] = np.cross(du2, dv2)
+            length[bad] = np.linalg.norm(n[bad], axis=1)
+        return n / np.where(length > 0, length, 1.0)[:, None]
+
+
+def fit_surfaces(points: np.ndarray, degree_u: int = 3, degree_v: int = 3,
+                 method: str = "chord", keys=None) -> NurbsSurfaces:
+    """Interpolate a NURBS surface through every point of each grid.
+
+    Parameters
+    ----------
+    points : (L, m, n, 3) or (m, n, 3) float64, cm
+        Leaf grids of one shape; m >= 2, n >= 2.
+    degree_u, degree_v : int
+        Requested degrees; lowered to m - 1 and n - 1 where there are too few points.
+    method : "chord" (default) or "centripetal"
+    keys : sequence of (plant, leaf), optional
+        Ids of the grids, to name a leaf in an error.
+
+    Raises
+    ------
+    LeafError
+        For the first grid whose rows or columns coincide (singular collocation matrix).
+    """
+    points = np.asarray(points, dtype=np.float64)
+    if points.ndim == 3:
+        points = points[None]
+    nb, m, n = points.shape[:3]
+    keys = list(keys) if keys is not None else [(-1, -1)] * nb
+    if m < 2 or n < 2:
+        raise LeafError(*keys[0], f"grid {m}x{n}: needs at least 2 rows and 2 cols")
+    pu = max(1, min(degree_u, m - 1))
+    pv = max(1, min(degree_v, n - 1))
+    u, v = data_parameters(points, method)
+    for name, t in (("row", u), ("col", v)):
+        step = np.diff(t, axis=1)
+        bad = ~(step > 1e-12).all(axis=1)
+        if bad.any():
+            leaf = int(np.argmax(bad))
+            k = int(np.nanargmin(np.where(np.isnan(step[leaf]), -1, step[leaf])))
+            raise LeafError(*keys[leaf], f"{name}s {k} and {k + 1} coincide; cannot interpolate "
+                                         f"(merge or remove the repeated {name})")
+    ku = averaged_knots(u, pu)
+    kv = averaged_knots(v, pv)
+    nu = basis_matrix(u, ku, pu)                                     # (L, m, m)
+    nv = basis_matrix(v, kv, pv)                                     # (L, n, n)
+    r = np.linalg.solve(nu, points.reshape(nb, m, n * 3)).reshape(nb, m, n, 3)
+    c = np.linalg.solve(nv, r.transpose(0, 2, 1, 3).reshape(nb, n, m * 3)).reshape(nb, n, m, 3)
+    control = np.ascontiguousarray(c.transpose(0, 2, 1, 3))
+    return NurbsSurfaces(pu, pv, ku, kv, control, np.ones((nb, m, n)), u, v)
+
+
+def fit_surface(points: np.ndarray, degree_u: int = 3, degree_v: int = 3,
+                method: str = "chord", plant: int = -1, leaf: int = -1) -> NurbsSurfaces:
+    """One leaf: :func:`fit_surfaces` on an (m, n, 3) grid; the result has L = 1."""
+    return fit_surfaces(np.asarray(points)[None], degree_u, degree_v, method, [(plant, leaf)])

@@ -1,0 +1,86 @@
+"""Triangle meshes of leaves: a structured grid of vertices split into triangles.
+
+Every mesh level of maizeviz (dense reference, standard, simplified) is a grid of vertices
+over the leaf's (u, v) parameter lines, so one triangulation serves all of them. Each quad
+(i, j) - (i+1, j) - (i+1, j+1) - (i, j+1) gives two triangles wound so that their normal is
+dS/du x dS/dv: the upper face under the column convention of SCIENCE.md. Zero-area triangles
+(at a collapsed tip) are dropped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+
+@lru_cache(maxsize=256)
+def grid_faces(a: int, b: int) -> np.ndarray:
+    """Triangles of an a x b vertex grid (row-major vertex ids): (2 (a-1)(b-1), 3) int32."""
+    idx = np.arange(a * b, dtype=np.int32).reshape(a, b)
+    p00, p10 = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()
+    p11, p01 = idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+    tri = np.empty((2 * len(p00), 3), dtype=np.int32)
+    tri[0::2] = np.column_stack([p00, p10, p11])
+    tri[1::2] = np.column_stack([p00, p11, p01])
+    tri.setflags(write=False)
+    return tri
+
+
+def triangle_areas_normals(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Areas (F,) cm2 and unit normals (F, 3) of triangles; works with a leading batch axis."""
+    v0 = np.take(vertices, faces[..., 0], axis=-2)
+    e1 = np.take(vertices, faces[..., 1], axis=-2) - v0
+    e2 = np.take(vertices, faces[..., 2], axis=-2) - v0
+    cross = np.cross(e1, e2)
+    twice = np.linalg.norm(cross, axis=-1)
+    normals = cross / np.where(twice > 0, twice, 1.0)[..., None]
+    return 0.5 * twice, normals
+
+
+@dataclass(frozen=True)
+class LeafMesh:
+    """A leaf's triangle mesh at one level.
+
+    Attributes
+    ----------
+    vertices : (a, b, 3) float64, cm
+        Vertex grid over parameter lines ``u`` (along the midrib) and ``v`` (across).
+    u : (a,) float64, v : (b,) float64
+        Surface parameters of the grid lines.
+    faces : (F, 3) int32
+        Triangles into ``vertices.reshape(-1, 3)``, zero-area ones removed, upper face out.
+    level : str
+        Human label of the level ("K=4", "standard", "8 triangles").
+    plant, leaf : int
+    """
+
+    vertices: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    faces: np.ndarray
+    level: str = ""
+    plant: int = -1
+    leaf: int = -1
+
+    @property
+    def points(self) -> np.ndarray:
+        """(a * b, 3) float64, cm: the vertices as a flat list, indexed by ``faces``."""
+        return self.vertices.reshape(-1, 3)
+
+    @property
+    def n_triangles(self) -> int:
+        return len(self.faces)
+
+
+def mesh_grid(vertices: np.ndarray, u: np.ndarray, v: np.ndarray, level: str = "",
+              plant: int = -1, leaf: int = -1) -> LeafMesh:
+    """Triangulate a vertex grid (a, b, 3) and drop zero-area triangles."""
+    a, b = vertices.shape[:2]
+    faces = grid_faces(a, b)
+    flat = vertices.reshape(-1, 3)
+    area, _ = triangle_areas_normals(flat, faces)
+    scale = np.ptp(flat, axis=0).max() if len(flat) else 0.0
+    keep = area > 1e-10 * max(scale, 1e-12) ** 2
+    return LeafMesh(vertices, u, v, faces[keep] if not keep.all() else faces, level, plant, leaf)
