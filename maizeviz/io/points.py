@@ -96,6 +96,7 @@ def read_points(path: str | Path) -> PointsTable:
 
 def parse_points(text: str, source: str = "<memory>") -> PointsTable:
     """Parse the text of a points CSV file; see :func:`read_points`."""
+    text = text.lstrip("\ufeff")
     if not text.strip():
         raise PointsFileError(f"{source}: the file is empty")
     first = text.lstrip().splitlines()[0]

@@ -35,7 +35,10 @@ def basis_matrix(x: np.ndarray, knots: np.ndarray, degree: int) -> np.ndarray:
     x = np.asarray(x, dtype=np.float64)
     nbatch, npts = x.shape
     nctrl = knots.shape[1] - degree - 1
-    span = (x[:, :, None] >= knots[:, None, :]).sum(axis=2) - 1
+    if nbatch == 1:
+        span = np.searchsorted(knots[0], x[0], side="right")[None] - 1
+    else:
+        span = (x[:, :, None] >= knots[:, None, :]).sum(axis=2) - 1
     np.maximum(span, degree, out=span)
     np.minimum(span, nctrl - 1, out=span)                         # (L, A); x = 1 -> last span
     li = np.arange(nbatch)[:, None, None]
@@ -178,18 +181,17 @@ class NurbsSurfaces:
         (L, A, B, 3) float64, cm
         """
         nb = len(self)
-        u = np.broadcast_to(np.clip(u, 0.0, 1.0), (nb, np.shape(u)[-1]))
-        v = np.broadcast_to(np.clip(v, 0.0, 1.0), (nb, np.shape(v)[-1]))
+        u = np.broadcast_to(np.minimum(np.maximum(u, 0.0), 1.0), (nb, np.shape(u)[-1]))
+        v = np.broadcast_to(np.minimum(np.maximum(v, 0.0), 1.0), (nb, np.shape(v)[-1]))
         bu = basis_matrix(u, self.knots_u, self.degree_u)           # (L, A, nu)
         bv = basis_matrix(v, self.knots_v, self.degree_v)           # (L, B, nv)
         rational = not np.all(self.weights == 1.0)
-        hom = self._homogeneous() if rational else self.control
-        nu, nv, nc = hom.shape[1:]
+        hom = self._homogeneous() if rational else self.control    # (L, nu, nv, c)
+        nu, nc = hom.shape[1], hom.shape[3]
         na, nbv = bu.shape[1], bv.shape[1]
-        t = (bu @ hom.reshape(nb, nu, nv * nc)).reshape(nb, na, nv, nc)          # (L, A, nv, c)
-        t = t.transpose(0, 2, 1, 3).reshape(nb, nv, na * nc)
-        out = (bv @ t).reshape(nb, nbv, na, nc).transpose(0, 2, 1, 3)          # (L, A, B, c)
-        return out[..., :3] / out[..., 3:] if rational else np.ascontiguousarray(out)
+        d = bv[:, None] @ hom                                            # (L, nu, B, c)
+        out = (bu @ d.reshape(nb, nu, nbv * nc)).reshape(nb, na, nbv, nc)  # (L, A, B, c)
+        return out[..., :3] / out[..., 3:] if rational else out
 
     def evaluate(self, u, v) -> np.ndarray:
         """Points at pairs (u[k], v[k]) on the first surface: (K,), (K,) -> (K, 3) cm."""

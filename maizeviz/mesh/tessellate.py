@@ -74,13 +74,28 @@ class LeafMesh:
         return len(self.faces)
 
 
+def degenerate_faces(vertices: np.ndarray, rel_tol: float = 1e-9) -> np.ndarray:
+    """Mask (2 (a-1)(b-1),) of the triangles of a vertex grid (a, b, 3) with a zero-length edge.
+
+    On a grid, a triangle has zero area where two of its corners coincide (a collapsed tip
+    row); checking the grid edges once is much cheaper than computing every area.
+    """
+    h = np.diff(vertices, axis=1)
+    h = np.einsum("ijk,ijk->ij", h, h)                                  # (a, b-1) squared
+    w = np.diff(vertices, axis=0)
+    w = np.einsum("ijk,ijk->ij", w, w)                                  # (a-1, b)
+    tol = rel_tol**2 * max(h.max(initial=0.0), w.max(initial=0.0), 1e-300)
+    h0, w0 = h <= tol, w <= tol
+    bad = np.empty((vertices.shape[0] - 1, vertices.shape[1] - 1, 2), dtype=bool)
+    bad[..., 0] = h0[1:] | w0[:, :-1]          # (p00, p10, p11): edges p10-p11 and p00-p10
+    bad[..., 1] = h0[:-1] | w0[:, 1:]          # (p00, p11, p01): edges p00-p01 and p11-p01
+    return bad.reshape(-1)
+
+
 def mesh_grid(vertices: np.ndarray, u: np.ndarray, v: np.ndarray, level: str = "",
               plant: int = -1, leaf: int = -1) -> LeafMesh:
     """Triangulate a vertex grid (a, b, 3) and drop zero-area triangles."""
     a, b = vertices.shape[:2]
     faces = grid_faces(a, b)
-    flat = vertices.reshape(-1, 3)
-    area, _ = triangle_areas_normals(flat, faces)
-    scale = np.ptp(flat, axis=0).max() if len(flat) else 0.0
-    keep = area > 1e-10 * max(scale, 1e-12) ** 2
-    return LeafMesh(vertices, u, v, faces[keep] if not keep.all() else faces, level, plant, leaf)
+    bad = degenerate_faces(vertices)
+    return LeafMesh(vertices, u, v, faces[~bad] if bad.any() else faces, level, plant, leaf)

@@ -1,0 +1,5 @@
+import sys
+
+from maizeviz.cli import main
+
+sys.exit(main())
