@@ -121,7 +121,7 @@ class PlantShape:
     height: float = 245.0
     top_insertion: float = 200.0
     max_length: float = 100.0
-    max_width: float = 10.5
+    max_width: float = 11.6
     max_rank: float = 11.0
     azimuth_deg: float = 90.0
     phyllotaxy_sd_deg: float = 15.0
@@ -172,3 +172,25 @@ def example_leaf(rows: int = 13, cols: int = 5, seed: int = 0, **kwargs) -> np.n
     """A realistic 90 cm ear-leaf grid (rows, cols, 3) for tests and benchmarks."""
     shape = replace(LeafShape(), **kwargs)
     return leaf_points(shape, rows, cols, rng=np.random.default_rng(seed))
+
+
+def block_grids(rows: int = 3, plants_per_row: int = 3, row_spacing: float = 60.0,
+                plant_spacing: float = 30.0, seed: int = 0, plant: PlantShape = PlantShape(),
+                grid_rows: int = 13, grid_cols: int = 5) -> list[LeafGrid]:
+    """A digitized block: rows along y at x = (i + 1/2) row_spacing, plants at
+    y = (j + 1/2) plant_spacing, stalks off their nominal place by about 1 cm, leaves facing
+    across the row (azimuth 0 +- 25 deg), plant ids 1.. row by row as a technician walks them.
+    """
+    rng = np.random.default_rng(seed)
+    out = []
+    pid = 1
+    for i in range(rows):
+        for j in range(plants_per_row):
+            base = ((i + 0.5) * row_spacing + rng.normal(0, 1.0),
+                    (j + 0.5) * plant_spacing + rng.normal(0, 1.0), 0.0)
+            shape = replace(plant, azimuth_deg=float(rng.normal(0.0, 25.0)),
+                            leaves=int(plant.leaves + rng.integers(-1, 2)),
+                            max_length=float(plant.max_length * rng.normal(1.0, 0.03)))
+            out += plant_grids(pid, shape, base, grid_rows, grid_cols, rng=rng)
+            pid += 1
+    return out

@@ -1,0 +1,346 @@
+"""Where plants stand: the paper's tiling of a digitized block, or a layout file.
+
+Field coordinates are centimetres, z up; by default x = east and y = north, and rows run along
+y: ``row_spacing`` is the distance between rows along x (60 cm in the paper), ``plant_spacing``
+the distance between plants of a row along y (30 cm). Each plant owns a cell of
+row spacing x plant spacing centred on its stalk base; the ground of a canopy is the union of
+its cells (tiling) or the field rectangle (layout file).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from maizeviz.errors import MaizevizError
+
+LAYOUT_SCHEMA = 1
+
+
+class LayoutError(MaizevizError):
+    """A layout that cannot be used; the message names the field."""
+
+
+@dataclass(frozen=True)
+class Placement:
+    """One plant standing in the canopy.
+
+    Attributes
+    ----------
+    plant : int
+        Id of the digitized plant (in the points file) that stands here.
+    x, y : float, cm
+        Where its stalk base stands.
+    azimuth_deg : float
+        Rotation about its stalk, counter-clockwise seen from above, applied to the digitized
+        plant.
+    tile : tuple[int, int]
+        Tile index (0, 0 is the digitized block itself) when the canopy comes from tiling.
+    """
+
+    plant: int
+    x: float
+    y: float
+    azimuth_deg: float = 0.0
+    tile: tuple = (0, 0)
+
+
+@dataclass(frozen=True)
+class CanopyLayout:
+    """Placements plus the ground they stand on.
+
+    Attributes
+    ----------
+    placements : tuple[Placement, ...]
+    cells : (k, 4) float64, cm
+        Ground rectangles x0, y0, x1, y1 whose union is the ground area.
+    row_spacing, plant_spacing : float, cm
+    north_deg : float
+        Angle from north to the field's +y axis, clockwise (0: y points north, x east).
+    centre_cells : (j, 4) float64, cm
+        Cells of the central tile (or of the whole field), the default light sample area.
+    warnings : tuple[str, ...]
+    """
+
+    placements: tuple
+    cells: np.ndarray
+    row_spacing: float
+    plant_spacing: float
+    north_deg: float = 0.0
+    centre_cells: np.ndarray = field(default_factory=lambda: np.empty((0, 4)))
+    warnings: tuple = ()
+
+    @property
+    def ground_area_cm2(self) -> float:
+        return union_area(self.cells)
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        """x0, y0, x1, y1 of the ground (cm)."""
+        c = self.cells
+        return float(c[:, 0].min()), float(c[:, 1].min()), float(c[:, 2].max()), float(c[:, 3].max())
+
+    @property
+    def centre_bounds(self) -> tuple[float, float, float, float]:
+        c = self.centre_cells if len(self.centre_cells) else self.cells
+        return float(c[:, 0].min()), float(c[:, 1].min()), float(c[:, 2].max()), float(c[:, 3].max())
+
+
+def union_area(rects: np.ndarray) -> float:
+    """Exact area of the union of axis-aligned rectangles (k, 4) x0, y0, x1, y1 (cm2).
+
+    Coordinate compression: the distinct x and y edges cut the plane into cells, each either
+    inside some rectangle or not.
+    """
+    rects = np.asarray(rects, dtype=np.float64).reshape(-1, 4)
+    if not len(rects):
+        return 0.0
+    xs = np.unique(rects[:, [0, 2]])
+    ys = np.unique(rects[:, [1, 3]])
+    cx = 0.5 * (xs[:-1] + xs[1:])
+    cy = 0.5 * (ys[:-1] + ys[1:])
+    covered = np.zeros((len(cx), len(cy)), dtype=bool)
+    for x0, y0, x1, y1 in rects:
+        covered |= ((cx > x0) & (cx < x1))[:, None] & ((cy > y0) & (cy < y1))[None, :]
+    return float((np.diff(xs)[:, None] * np.diff(ys)[None, :])[covered].sum())
+
+
+def _cell(x, y, row_spacing, plant_spacing):
+    return [x - row_spacing / 2, y - plant_spacing / 2, x + row_spacing / 2, y + plant_spacing / 2]
+
+
+def _check_spacing(row_spacing, plant_spacing):
+    for name, v in (("--row-spacing", row_spacing), ("--plant-spacing", plant_spacing)):
+        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+            raise LayoutError(f"{name} must be a positive number of cm, got {v}")
+
+
+def parse_shape(text: str, what: str) -> tuple[int, int]:
+    """``"3x3"`` -> (3, 3); both factors whole numbers >= 1."""
+    parts = str(text).lower().replace(" ", "").split("x")
+    try:
+        a, b = (int(p) for p in parts)
+    except ValueError:
+        raise LayoutError(f"{what} must look like 3x3, got '{text}'") from None
+    if a < 1 or b < 1:
+        raise LayoutError(f"{what} must be at least 1x1, got '{text}'")
+    return a, b
+
+
+def _clusters(values: np.ndarray, spacing: float) -> np.ndarray:
+    """Cluster index of each value: values closer than half a spacing in sorted order share one."""
+    order = np.argsort(values)
+    breaks = np.concatenate([[0], np.cumsum(np.diff(values[order]) > spacing / 2)])
+    out = np.empty(len(values), dtype=int)
+    out[order] = breaks
+    return out
+
+
+def block_lattice(bases: dict[int, tuple[float, float]], row_spacing: float,
+                  plant_spacing: float) -> tuple[tuple[int, int], dict[int, tuple[float, float]]]:
+    """Rows x plants per row of a digitized block, and each plant's lattice position (cm).
+
+    Stalks closer than half a row spacing along x share a row, and likewise along y; the
+    lattice is regular at the nominal spacings and placed where it best fits the stalks, so
+    digitizing noise in the stalk positions leaves no gap or overlap between cells.
+    """
+    ids = list(bases)
+    xy = np.array([bases[i] for i in ids], dtype=np.float64).reshape(-1, 2)
+    rx = _clusters(xy[:, 0], row_spacing)
+    ry = _clusters(xy[:, 1], plant_spacing)
+    # a regular lattice at the nominal spacings, placed where it fits the stalks best
+    mx = (xy[:, 0] - rx * row_spacing).mean() + np.arange(rx.max() + 1) * row_spacing
+    my = (xy[:, 1] - ry * plant_spacing).mean() + np.arange(ry.max() + 1) * plant_spacing
+    return (len(mx), len(my)), {i: (float(mx[a]), float(my[b])) for i, a, b in zip(ids, rx, ry)}
+
+
+def infer_block(bases: dict[int, tuple[float, float]], row_spacing: float,
+                plant_spacing: float) -> tuple[int, int]:
+    """Rows x plants per row of a digitized block from its stalk positions (cm)."""
+    return block_lattice(bases, row_spacing, plant_spacing)[0]
+
+
+def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
+                 row_spacing: float = 60.0, plant_spacing: float = 30.0,
+                 block: tuple[int, int] | None = None, north_deg: float = 0.0) -> CanopyLayout:
+    """Repeat a digitized block ``tile`` = (A, B) times (A along x across rows, B along y).
+
+    Parameters
+    ----------
+    bases : {plant id: (x, y) cm}
+        Stalk base of every digitized plant in field coordinates.
+    block : (rows, plants per row), optional
+        Shape of the digitized block; inferred from ``bases`` when not given.
+
+    The tiles are translations of the block footprint by (rows x row_spacing) along x and
+    (plants x plant_spacing) along y, centred on the digitized block, which stays tile (0, 0).
+    """
+    _check_spacing(row_spacing, plant_spacing)
+    if not bases:
+        raise LayoutError("no plant to lay out")
+    a, b = tile
+    if a < 1 or b < 1:
+        raise LayoutError(f"--tile must be at least 1x1, got {a}x{b}")
+    warnings = []
+    inferred, lattice = block_lattice(bases, row_spacing, plant_spacing)
+    if block is None:
+        block = inferred
+        warnings.append(f"block inferred from stalk positions: {block[0]} rows x {block[1]} "
+                        f"plants per row ({len(bases)} plants)")
+    elif block[0] * block[1] != len(bases):
+        warnings.append(f"--block {block[0]}x{block[1]} has {block[0] * block[1]} places but the "
+                        f"file has {len(bases)} plants")
+    step_x, step_y = block[0] * row_spacing, block[1] * plant_spacing
+    placements, cells, centre = [], [], []
+    for ti in range(a):
+        for tj in range(b):
+            key = (ti - (a - 1) // 2, tj - (b - 1) // 2)
+            dx, dy = key[0] * step_x, key[1] * step_y
+            for pid, (x, y) in sorted(bases.items()):
+                placements.append(Placement(pid, x + dx, y + dy, 0.0, key))
+                lx, ly = lattice[pid]
+                c = _cell(lx + dx, ly + dy, row_spacing, plant_spacing)
+                cells.append(c)
+                if key == (0, 0):
+                    centre.append(c)
+    cells = np.array(cells)
+    overlap = _overlaps(np.array(centre))
+    if overlap:
+        warnings.append(f"digitized plants {overlap} stand closer than the spacing: their "
+                        "cells overlap")
+    return CanopyLayout(tuple(placements), cells, float(row_spacing), float(plant_spacing),
+                        north_deg, np.array(centre), tuple(warnings))
+
+
+def _overlaps(cells: np.ndarray) -> str:
+    if len(cells) < 2:
+        return ""
+    area = union_area(cells)
+    total = float(np.sum((cells[:, 2] - cells[:, 0]) * (cells[:, 3] - cells[:, 1])))
+    return f"({total - area:.0f} cm2 counted twice)" if total - area > 1e-6 * total else ""
+
+
+# ------------------------------------------------------------------------- layout files
+def _number(obj, key, where, default=None, positive=False):
+    if key not in obj:
+        if default is None:
+            raise LayoutError(f"{where}: '{key}' is missing")
+        return default
+    v = obj[key]
+    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        raise LayoutError(f"{where}: '{key}' must be a number, got {json.dumps(v)[:40]}")
+    if positive and v <= 0:
+        raise LayoutError(f"{where}: '{key}' must be positive, got {v}")
+    return float(v)
+
+
+def load_layout(path: str | Path, plants: set[int] | None = None) -> CanopyLayout:
+    """Read a layout file (schema in the README).
+
+    Parameters
+    ----------
+    plants : set of int, optional
+        Ids of the digitized plants available; a position naming another is an error.
+
+    Raises
+    ------
+    LayoutError
+        Naming the field that is wrong.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise LayoutError(f"{path}: no such layout file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise LayoutError(f"{path}: cannot be read ({exc})") from None
+    if len(text) > 20_000_000:
+        raise LayoutError(f"{path}: {len(text)} bytes is too large for a layout file")
+    try:
+        data = json.loads(text)
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise LayoutError(f"{path}: not valid JSON ({exc})") from None
+    return layout_from_dict(data, plants, str(path))
+
+
+def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout") -> CanopyLayout:
+    """Validate a layout document (already parsed JSON); see :func:`load_layout`."""
+    if not isinstance(data, dict):
+        raise LayoutError(f"{source}: a layout is a JSON object")
+    version = data.get("maizeviz_layout")
+    if version != LAYOUT_SCHEMA:
+        raise LayoutError(f"{source}: 'maizeviz_layout' is {json.dumps(version)}; this version of "
+                          f"maizeviz reads schema {LAYOUT_SCHEMA}")
+    rs = _number(data, "row_spacing", source, positive=True)
+    ps = _number(data, "plant_spacing", source, positive=True)
+    north = _number(data, "north_deg", source, default=0.0)
+    fld = data.get("field")
+    if not isinstance(fld, dict):
+        raise LayoutError(f"{source}: 'field' must be an object {{x0, y0, x1, y1}} in cm")
+    x0, y0, x1, y1 = (_number(fld, k, f"{source}: field") for k in ("x0", "y0", "x1", "y1"))
+    if x1 <= x0 or y1 <= y0:
+        raise LayoutError(f"{source}: field must have x1 > x0 and y1 > y0")
+    rows = data.get("rows")
+    if not isinstance(rows, list) or not rows:
+        raise LayoutError(f"{source}: 'rows' must be a non-empty list")
+    seed = int(_number(data, "seed", source, default=0.0))
+    rng = np.random.default_rng(seed)
+    placements, cells, warnings = [], [], []
+    for i, row in enumerate(rows):
+        where = f"{source}: rows[{i}]"
+        if not isinstance(row, dict):
+            raise LayoutError(f"{where} must be an object {{x, plants}}")
+        x = _number(row, "x", where)
+        plist = row.get("plants")
+        if not isinstance(plist, list):
+            raise LayoutError(f"{where}: 'plants' must be a list")
+        for j, pos in enumerate(plist):
+            w = f"{where}.plants[{j}]"
+            if not isinstance(pos, dict):
+                raise LayoutError(f"{w} must be an object {{y, plant}}")
+            y = _number(pos, "y", w)
+            pid = pos.get("plant")
+            if isinstance(pid, bool) or not isinstance(pid, int):
+                raise LayoutError(f"{w}: 'plant' must be an integer plant id")
+            if plants is not None and pid not in plants:
+                raise LayoutError(f"{w}: plant {pid} is not in the points file "
+                                  f"(it has {', '.join(map(str, sorted(plants)))})")
+            az = _number(pos, "azimuth_deg", w, default=0.0)
+            jitter = _number(pos, "jitter_cm", w, default=0.0)
+            if jitter < 0:
+                raise LayoutError(f"{w}: 'jitter_cm' must be >= 0")
+            px, py = x, y
+            if jitter > 0:
+                r, t = jitter * np.sqrt(rng.random()), 2 * np.pi * rng.random()
+                px, py = x + r * np.cos(t), y + r * np.sin(t)
+            if not (x0 <= px <= x1 and y0 <= py <= y1):
+                warnings.append(f"{w}: plant at ({px:.1f}, {py:.1f}) cm stands outside the field")
+            placements.append(Placement(pid, px, py, az, (0, 0)))
+            cells.append(_cell(x, y, rs, ps))
+    overlap = _overlaps(np.array(cells))
+    if overlap:
+        warnings.append(f"{source}: some positions are closer than the spacing {overlap}")
+    field_rect = np.array([[x0, y0, x1, y1]])
+    return CanopyLayout(tuple(placements), field_rect, rs, ps, north, field_rect, tuple(warnings))
+
+
+def layout_to_dict(layout: CanopyLayout) -> dict:
+    """A layout document (schema :data:`LAYOUT_SCHEMA`) for a layout, rows grouped by x."""
+    x0, y0, x1, y1 = layout.bounds
+    rows: dict[float, list] = {}
+    for p in layout.placements:
+        rows.setdefault(round(p.x, 6), []).append(
+            {"y": round(p.y, 6), "plant": p.plant, "azimuth_deg": p.azimuth_deg})
+    return {"maizeviz_layout": LAYOUT_SCHEMA, "row_spacing": layout.row_spacing,
+            "plant_spacing": layout.plant_spacing, "north_deg": layout.north_deg,
+            "field": {"x0": x0, "y0": y0, "x1": x1, "y1": y1},
+            "rows": [{"x": x, "plants": ps} for x, ps in sorted(rows.items())]}
+
+
+def save_layout(path: str | Path, layout: CanopyLayout) -> None:
+    """Write a layout file."""
+    Path(path).write_text(json.dumps(layout_to_dict(layout), indent=1))

@@ -1,0 +1,173 @@
+"""A canopy: every placed plant's leaf meshes in field coordinates, with ids per triangle.
+
+Each digitized leaf is meshed once per level and then copied, rotated and moved to every place
+its plant stands, so rebuilding an 81-plant canopy at a new level costs the meshing of the 9
+digitized plants plus array copies.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import dataclass
+
+import numpy as np
+
+from maizeviz.canopy.layout import CanopyLayout
+from maizeviz.errors import MaizevizError
+from maizeviz.leaf.reconstruct import Leaf, Level, mesh_leaves
+
+STALK_RADIUS_CM = 1.2
+STALK_SIDES = 8
+
+
+def plant_bases(leaves: list[Leaf]) -> dict[int, tuple[float, float]]:
+    """Stalk base (x, y) in cm of each digitized plant: the median of its leaves' collar
+    midrib points (the insertions) seen from above."""
+    collars = defaultdict(list)
+    for lf in leaves:
+        pts = lf.grid.points
+        collars[lf.grid.plant].append(pts[0, pts.shape[1] // 2, :2])
+    return {p: tuple(float(c) for c in np.median(np.array(v), axis=0)) for p, v in collars.items()}
+
+
+def plant_tops(leaves: list[Leaf]) -> dict[int, float]:
+    """Height (cm) of the highest leaf insertion of each plant: where the stalk mesh ends."""
+    tops = defaultdict(float)
+    for lf in leaves:
+        pts = lf.grid.points
+        tops[lf.grid.plant] = max(tops[lf.grid.plant], float(pts[0, pts.shape[1] // 2, 2]))
+    return dict(tops)
+
+
+@dataclass(frozen=True)
+class Canopy:
+    """Triangles of a canopy at one level.
+
+    Attributes
+    ----------
+    vertices : (V, 3) float64, cm
+    faces : (F, 3) int64
+    face_instance : (F,) int32
+        Index of the placement (plant standing in the canopy) each triangle belongs to.
+    face_plant : (F,) int32
+        Digitized plant id.
+    face_leaf : (F,) int32
+        Leaf rank.
+    layout : CanopyLayout
+    level : str
+    stalk_vertices : (S, 3) float64, stalk_faces : (G, 3) int64
+        Stalk cylinders for views; not leaves, not in the leaf measures.
+    leaves_per_instance : (P,) int32
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    face_instance: np.ndarray
+    face_plant: np.ndarray
+    face_leaf: np.ndarray
+    layout: CanopyLayout
+    level: str
+    stalk_vertices: np.ndarray
+    stalk_faces: np.ndarray
+    leaves_per_instance: np.ndarray
+
+    @property
+    def n_triangles(self) -> int:
+        return len(self.faces)
+
+    @property
+    def n_plants(self) -> int:
+        return len(self.layout.placements)
+
+    @property
+    def n_leaves(self) -> int:
+        return int(self.leaves_per_instance.sum())
+
+
+def _rotation(deg):
+    t = np.radians(deg)
+    c, s = np.cos(t), np.sin(t)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def stalk_mesh(height: float, radius: float = STALK_RADIUS_CM, sides: int = STALK_SIDES):
+    """An open cylinder from z = 0 to ``height`` about the z axis: (2 sides, 3), (2 sides, 3)."""
+    t = np.linspace(0, 2 * np.pi, sides, endpoint=False)
+    ring = np.column_stack([radius * np.cos(t), radius * np.sin(t), np.zeros(sides)])
+    top = ring + [0, 0, height]
+    verts = np.vstack([ring, top])
+    i = np.arange(sides)
+    j = (i + 1) % sides
+    faces = np.vstack([np.column_stack([i, j, j + sides]), np.column_stack([i, j + sides, i + sides])])
+    return verts, faces.astype(np.int64)
+
+
+def build_canopy(leaves: list[Leaf], layout: CanopyLayout, level: Level,
+                 preserve_area: bool = True, progress=None) -> Canopy:
+    """Place every plant of ``layout`` with its leaves meshed at ``level``.
+
+    Parameters
+    ----------
+    leaves : all fitted leaves of the digitized plants (field coordinates, cm)
+    progress : callable(done, total) -> bool | None, optional
+        Called as work advances (meshing, then placing); returning ``False`` cancels with
+        :class:`InterruptedError`. Plain Python, so a GUI worker or a terminal bar can drive it.
+    """
+    by_plant = defaultdict(list)
+    for lf in leaves:
+        by_plant[lf.grid.plant].append(lf)
+    missing = sorted({p.plant for p in layout.placements} - set(by_plant))
+    if missing:
+        raise MaizevizError(f"the layout places plant(s) {', '.join(map(str, missing))}, which "
+                            "the points file does not have")
+    used = sorted({p.plant for p in layout.placements})
+    source = [lf for p in used for lf in by_plant[p]]
+    n_place = len(layout.placements)
+    total = len(source) + n_place
+
+    def mesh_progress(done, _total):
+        if progress is not None:
+            return progress(done, total)
+        return None
+
+    meshes = mesh_leaves(source, level, preserve_area, mesh_progress)
+    bases = plant_bases(source)
+    tops = plant_tops(source)
+
+    # one local mesh per digitized plant, relative to its stalk base
+    local = {}
+    k = 0
+    for p in used:
+        n = len(by_plant[p])
+        ms = meshes[k:k + n]
+        k += n
+        offs = np.cumsum([0] + [m.points.shape[0] for m in ms])
+        verts = np.concatenate([m.points for m in ms]) - [bases[p][0], bases[p][1], 0.0]
+        faces = np.concatenate([m.faces.astype(np.int64) + o for m, o in zip(ms, offs)])
+        leaf_ids = np.concatenate([np.full(len(m.faces), m.leaf, np.int32) for m in ms])
+        local[p] = (verts, faces, leaf_ids, len(ms))
+
+    vparts, fparts, inst, plant_ids, leaf_ids, nleaves = [], [], [], [], [], []
+    svparts, sfparts = [], []
+    v_off = s_off = 0
+    for i, pl in enumerate(layout.placements):
+        verts, faces, lids, nl = local[pl.plant]
+        moved = verts @ _rotation(pl.azimuth_deg).T + [pl.x, pl.y, 0.0]
+        vparts.append(moved)
+        fparts.append(faces + v_off)
+        v_off += len(verts)
+        inst.append(np.full(len(faces), i, np.int32))
+        plant_ids.append(np.full(len(faces), pl.plant, np.int32))
+        leaf_ids.append(lids)
+        nleaves.append(nl)
+        sv, sf = stalk_mesh(tops[pl.plant])
+        svparts.append(sv + [pl.x, pl.y, 0.0])
+        sfparts.append(sf + s_off)
+        s_off += len(sv)
+        if progress is not None and (i % 9 == 8 or i == n_place - 1):
+            if progress(len(source) + i + 1, total) is False:
+                raise InterruptedError("canopy build cancelled")
+    return Canopy(np.concatenate(vparts), np.concatenate(fparts), np.concatenate(inst),
+                  np.concatenate(plant_ids), np.concatenate(leaf_ids), layout, level.label,
+                  np.concatenate(svparts), np.concatenate(sfparts),
+                  np.array(nleaves, dtype=np.int32))
