@@ -57,7 +57,7 @@ class CanopyLayout:
     ----------
     placements : tuple[Placement, ...]
     cells : (k, 4) float64, cm
-        Ground rectangles x0, y0, x1, y1 whose union is the ground area.
+        Ground rectangles x0, y0, x1, y1 whose union is the ground.
     row_spacing, plant_spacing : float, cm
     north_deg : float
         Angle from north to the field's +y axis, clockwise (0: y points north, x east).
@@ -73,10 +73,13 @@ class CanopyLayout:
     north_deg: float = 0.0
     centre_cells: np.ndarray = field(default_factory=lambda: np.empty((0, 4)))
     warnings: tuple = ()
+    ground_area: float | None = None
 
     @property
     def ground_area_cm2(self) -> float:
-        return union_area(self.cells)
+        """Area of the ground (cm2): the union of the cells; for a tiling, exactly the number
+        of tiles times the block footprint (tiles are disjoint translations of it)."""
+        return self.ground_area if self.ground_area is not None else union_area(self.cells)
 
     @property
     def bounds(self) -> tuple[float, float, float, float]:
@@ -106,7 +109,7 @@ def union_area(rects: np.ndarray) -> float:
     covered = np.zeros((len(cx), len(cy)), dtype=bool)
     for x0, y0, x1, y1 in rects:
         covered |= ((cx > x0) & (cx < x1))[:, None] & ((cy > y0) & (cy < y1))[None, :]
-    return float((np.diff(xs)[:, None] * np.diff(ys)[None, :])[covered].sum())
+    return math.fsum((np.diff(xs)[:, None] * np.diff(ys)[None, :])[covered])
 
 
 def _cell(x, y, row_spacing, plant_spacing):
@@ -213,7 +216,8 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
         warnings.append(f"digitized plants {overlap} stand closer than the spacing: their "
                         "cells overlap")
     return CanopyLayout(tuple(placements), cells, float(row_spacing), float(plant_spacing),
-                        north_deg, np.array(centre), tuple(warnings))
+                        north_deg, np.array(centre), tuple(warnings),
+                        a * b * union_area(np.array(centre)))
 
 
 def _overlaps(cells: np.ndarray) -> str:
