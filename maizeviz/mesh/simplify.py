@@ -31,19 +31,21 @@ def count_triangles(n_rows: int, n_cols: int, tip_collapsed: bool) -> int:
 def _segment_distance(p, a, b):
     """Distance of points p from segments a-b, all (..., 3) -> (...)."""
     ab = b - a
+    ap = p - a
     denom = np.einsum("...k,...k->...", ab, ab)
-    t = np.einsum("...k,...k->...", p - a, ab) / np.where(denom > 0, denom, 1.0)
-    t = np.clip(t, 0.0, 1.0)
-    return np.linalg.norm(p - (a + t[..., None] * ab), axis=-1)
+    t = np.einsum("...k,...k->...", ap, ab) / np.where(denom > 0, denom, 1.0)
+    t = np.minimum(np.maximum(t, 0.0), 1.0)
+    d = ap - t[..., None] * ab
+    return np.sqrt(np.einsum("...k,...k->...", d, d))
 
 
 def _split_errors(grid: np.ndarray, kept: np.ndarray) -> np.ndarray:
     """For each index along axis 0 of ``grid`` (m, n, 3): the largest distance of its points
     from the chords between the kept indices around it (0 where kept)."""
     m = grid.shape[0]
-    ks = np.flatnonzero(kept)
-    hi = ks[np.clip(np.searchsorted(ks, np.arange(m), side="left"), 0, len(ks) - 1)]
-    lo = ks[np.clip(np.searchsorted(ks, np.arange(m), side="right") - 1, 0, len(ks) - 1)]
+    idx = np.arange(m)
+    lo = np.maximum.accumulate(np.where(kept, idx, 0))
+    hi = np.minimum.accumulate(np.where(kept, idx, m - 1)[::-1])[::-1]
     err = _segment_distance(grid, grid[lo], grid[hi]).max(axis=1)
     err[kept] = 0.0
     return err
@@ -62,24 +64,24 @@ def _greedy(grid, rows, cols, budget, tip_collapsed):
 
     Returns the largest distance (cm) of a data point from the chords when it stops.
     """
-    m, n = grid.shape[:2]
+    gridt = grid.transpose(1, 0, 2)
+    row_all = _split_errors(grid, rows)
+    col_all = _split_errors(gridt, cols)
     while True:
         row_fits = count_triangles(rows.sum() + 1, cols.sum(), tip_collapsed) <= budget
         col_fits = count_triangles(rows.sum(), cols.sum() + 1, tip_collapsed) <= budget
-        row_err = _split_errors(grid, rows)
-        col_err = _split_errors(grid.transpose(1, 0, 2), cols)
-        residual = max(row_err.max(), col_err.max())
-        if not row_fits:
-            row_err[:] = 0.0
-        if not col_fits:
-            col_err[:] = 0.0
+        residual = max(row_all.max(), col_all.max())
+        row_err = row_all if row_fits else np.zeros_like(row_all)
+        col_err = col_all if col_fits else np.zeros_like(col_all)
         i, j = int(np.argmax(row_err)), int(np.argmax(col_err))
         if max(row_err[i], col_err[j]) <= 1e-9:
             return residual
         if row_err[i] >= col_err[j]:
             rows[i] = True
+            row_all = _split_errors(grid, rows)     # row errors depend on the kept rows only
         else:
             cols[j] = True
+            col_all = _split_errors(gridt, cols)
 
 
 def select_lines(grid: np.ndarray, budget: int, tip_collapsed: bool) -> Selection:
