@@ -141,8 +141,8 @@ def plant_leaf_shapes(plant: PlantShape, base=(0.0, 0.0, 0.0),
     wsd = np.where(r < plant.max_rank, 4.5, 7.0)
     width = plant.max_width * (0.3 + 0.7 * np.exp(-0.5 * ((r - plant.max_rank) / wsd) ** 2))
     width = width * rng.normal(1.0, 0.04, n)
-    insertion = 55.0 - 30.0 * rel + rng.normal(0, 4, n)
-    curvature = 45.0 + 40.0 * (1 - rel) + rng.normal(0, 8, n)
+    insertion = 40.0 - 20.0 * rel + rng.normal(0, 4, n)
+    curvature = 20.0 + 30.0 * (1 - rel) + rng.normal(0, 8, n)
     azimuth = (plant.azimuth_deg + 180.0 * (r % 2) + rng.normal(0, plant.phyllotaxy_sd_deg, n))
     bx, by, bz = base
     return [LeafShape(length=float(length[i]), width=float(width[i]),
@@ -179,8 +179,9 @@ def block_grids(rows: int = 3, plants_per_row: int = 3, row_spacing: float = 60.
                 plant_spacing: float = 30.0, seed: int = 0, plant: PlantShape = PlantShape(),
                 grid_rows: int = 13, grid_cols: int = 5) -> list[LeafGrid]:
     """A digitized block: rows along y at x = (i + 1/2) row_spacing, plants at
-    y = (j + 1/2) plant_spacing, stalks off their nominal place by about 1 cm, leaves facing
-    across the row (azimuth 0 +- 25 deg), plant ids 1.. row by row as a technician walks them.
+    y = (j + 1/2) plant_spacing, stalks off their nominal place by about 1 cm, each plant's
+    leaf plane turned at random (field maize shows no strong preference at 60 x 30 cm), plant
+    ids 1.. row by row as a technician walks them.
     """
     rng = np.random.default_rng(seed)
     out = []
@@ -189,7 +190,7 @@ def block_grids(rows: int = 3, plants_per_row: int = 3, row_spacing: float = 60.
         for j in range(plants_per_row):
             base = ((i + 0.5) * row_spacing + rng.normal(0, 1.0),
                     (j + 0.5) * plant_spacing + rng.normal(0, 1.0), 0.0)
-            shape = replace(plant, azimuth_deg=float(rng.normal(0.0, 25.0)),
+            shape = replace(plant, azimuth_deg=float(rng.uniform(0.0, 360.0)),
                             leaves=int(plant.leaves + rng.integers(-1, 2)),
                             max_length=float(plant.max_length * rng.normal(1.0, 0.03)))
             out += plant_grids(pid, shape, base, grid_rows, grid_cols, rng=rng)

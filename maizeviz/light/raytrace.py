@@ -19,6 +19,14 @@ except ImportError as _exc:  # pragma: no cover - exercised only without embreex
 from maizeviz.errors import MaizevizError
 
 
+def _writable(a) -> np.ndarray:
+    """float32, C-contiguous and writable, as embreex's typed memoryviews require."""
+    a = np.asarray(a)
+    if a.dtype == np.float32 and a.flags.c_contiguous and a.flags.writeable:
+        return a
+    return np.array(a, dtype=np.float32, order="C")
+
+
 class RayScene:
     """An Embree scene over triangles (V, 3) cm and faces (F, 3); ray queries by numpy arrays.
 
@@ -37,15 +45,22 @@ class RayScene:
         # commit now: the lazy first build is not thread-safe
         self._scene.run(np.zeros((1, 3), np.float32), np.array([[0, 0, 1]], np.float32))
 
-    def first_hit(self, origins: np.ndarray, directions: np.ndarray):
-        """Nearest triangle along each ray: (N, 3), (N, 3) -> ids (N,) int32 (-1: none), t (N,)."""
-        out = self._scene.run(np.ascontiguousarray(origins, np.float32),
-                              np.ascontiguousarray(directions, np.float32), output=True)
+    def first_hit(self, origins: np.ndarray, directions: np.ndarray, tfar=None):
+        """Nearest triangle along each ray within ``tfar`` (default: unbounded).
+
+        (N, 3), (N, 3), (N,) -> ids (N,) int32 (-1: none), distances (N,) float32.
+        """
+        o = _writable(origins)
+        d = _writable(directions)
+        dists = None
+        if tfar is not None:
+            dists = _writable(np.broadcast_to(np.asarray(tfar, np.float32), (len(o),)))
+        out = self._scene.run(o, d, dists=dists, output=True)
         return out["primID"], out["tfar"]
 
     def occluded(self, origins: np.ndarray, directions: np.ndarray, tfar: np.ndarray | float):
         """True where a triangle lies on the ray between 0 and ``tfar``: (N,) bool."""
-        o = np.ascontiguousarray(origins, np.float32)
-        d = np.ascontiguousarray(directions, np.float32)
-        t = np.broadcast_to(np.asarray(tfar, np.float32), (len(o),)).copy()
+        o = _writable(origins)
+        d = _writable(directions)
+        t = _writable(np.broadcast_to(np.asarray(tfar, np.float32), (len(o),)))
         return self._scene.run(o, d, dists=t, query="OCCLUDED") >= 0
