@@ -124,7 +124,7 @@ class PlantShape:
     max_width: float = 12.5
     max_rank: float = 11.0
     azimuth_deg: float = 90.0
-    phyllotaxy_sd_deg: float = 15.0
+    phyllotaxy_sd_deg: float = 30.0
 
 
 def plant_leaf_shapes(plant: PlantShape, base=(0.0, 0.0, 0.0),

@@ -75,6 +75,18 @@ class Canopy:
     def n_triangles(self) -> int:
         return len(self.faces)
 
+    @classmethod
+    def from_triangles(cls, vertices: np.ndarray, faces: np.ndarray, layout: CanopyLayout,
+                       face_leaf: np.ndarray | None = None, level: str = "") -> "Canopy":
+        """A canopy of given triangles (V, 3) cm / (F, 3), all belonging to the layout's first
+        placement; for analytic test scenes and imported meshes."""
+        n = len(faces)
+        leaf = np.arange(1, n + 1, dtype=np.int32) if face_leaf is None else face_leaf
+        return cls(np.asarray(vertices, np.float64), np.asarray(faces, np.int64),
+                   np.zeros(n, np.int32), np.full(n, layout.placements[0].plant, np.int32),
+                   np.asarray(leaf, np.int32), layout, level, np.empty((0, 3)),
+                   np.empty((0, 3), np.int64), np.array([len(np.unique(leaf))], np.int32))
+
     @property
     def n_plants(self) -> int:
         return len(self.layout.placements)

@@ -89,6 +89,13 @@ class LightResult:
     seconds: dict = field(default_factory=dict)
     warnings: tuple = ()
     level: str = ""
+    density: float = 0.0
+    direction: np.ndarray | None = None
+
+    def crossings(self, height: float) -> np.ndarray:
+        """Where each ray crosses the plane at ``height`` (N, 2) cm (ray grid order)."""
+        ground, _ = ray_grid(self.rect, self.density)
+        return ground + self.direction[:2] * (height / self.direction[2])
 
 
 def ray_grid(rect, density: float) -> tuple[np.ndarray, float]:
@@ -303,7 +310,7 @@ def trace_light(canopy: Canopy, req: LightRequest, progress=None,
                                   np.empty(0, np.int32), minlength=nf).astype(np.int64)
         seconds["second"] = time.perf_counter() - t2
     return LightResult(req.sun, heights, transmission, n, rect, ray_area, first_z, first_hits,
-                       second_hits, seconds, tuple(warnings), canopy.level)
+                       second_hits, seconds, tuple(warnings), canopy.level, req.density, s)
 
 
 def leaf_light(canopy: Canopy, result: LightResult) -> list[dict]:
@@ -311,7 +318,8 @@ def leaf_light(canopy: Canopy, result: LightResult) -> list[dict]:
 
     ``*_intercepted_cm2`` is the rays' horizontal footprint (ray count x cell area: the share of
     the sample rectangle's sunlight the leaf takes); ``*_area_cm2`` is the leaf surface lit,
-    count x footprint x cos(zenith) / |n . s| per triangle, capped at the triangle's area.
+    count x footprint x cos(zenith) / |n . s| summed over the leaf's triangles, capped at the
+    leaf's area (one ray on a grazing triangle stands for more than the triangle).
     """
     if result.first_hits is None:
         raise MaizevizError("hit classes were not traced")
@@ -325,8 +333,9 @@ def leaf_light(canopy: Canopy, result: LightResult) -> list[dict]:
     keys = canopy.face_instance.astype(np.int64) * 10_000 + canopy.face_leaf
     first = result.first_hits[:nf]
     second = result.second_hits[:nf]
-    lit1 = np.minimum(first * beam / np.maximum(cos_inc, 1e-9), area)
-    lit2 = np.minimum(second * beam / np.maximum(cos_inc, 1e-9), area)
+    # a grazing triangle can collect a ray "worth" more than its area; cap by leaf below
+    lit1 = first * beam / np.maximum(cos_inc, 1e-6)
+    lit2 = second * beam / np.maximum(cos_inc, 1e-6)
     touched = np.unique(keys[(first > 0) | (second > 0)])
     order = np.argsort(keys, kind="stable")
     sk = keys[order]
@@ -334,12 +343,13 @@ def leaf_light(canopy: Canopy, result: LightResult) -> list[dict]:
         a, b = np.searchsorted(sk, key, "left"), np.searchsorted(sk, key, "right")
         idx = order[a:b]
         inst = int(key // 10_000)
+        leaf_area = float(area[idx].sum())
         rows.append({"instance": inst + 1, "plant": int(canopy.face_plant[idx[0]]),
                      "leaf": int(key % 10_000), "x_cm": canopy.layout.placements[inst].x,
                      "y_cm": canopy.layout.placements[inst].y,
-                     "leaf_area_cm2": float(area[idx].sum()),
-                     "sunlit_area_cm2": float(lit1[idx].sum()),
-                     "second_class_area_cm2": float(lit2[idx].sum()),
+                     "leaf_area_cm2": leaf_area,
+                     "sunlit_area_cm2": min(float(lit1[idx].sum()), leaf_area),
+                     "second_class_area_cm2": min(float(lit2[idx].sum()), leaf_area),
                      "sunlit_intercepted_cm2": float(first[idx].sum() * result.ray_area_cm2),
                      "second_class_intercepted_cm2": float(second[idx].sum() * result.ray_area_cm2)})
     return rows

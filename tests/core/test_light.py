@@ -1,0 +1,273 @@
+"""Direct light through real Embree: analytic scenes, Beer-Lambert, bad requests, the CLI."""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from maizeviz.canopy.layout import layout_from_dict
+from maizeviz.canopy.scene import Canopy
+from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
+from maizeviz.errors import MaizevizError
+from maizeviz.light.sun import Sun, sun_at
+from maizeviz.light.transmission import (LightRequest, beer_lambert, leaf_light, ray_grid,
+                                         trace_light)
+
+BLOCK = "resources/block3x3.csv"
+
+
+def plot(x0=0, y0=0, x1=100, y1=100):
+    return layout_from_dict({"maizeviz_layout": 1, "row_spacing": 60, "plant_spacing": 30,
+                             "field": {"x0": x0, "y0": y0, "x1": x1, "y1": y1},
+                             "rows": [{"x": (x0 + x1) / 2, "plants": [{"y": (y0 + y1) / 2,
+                                                                        "plant": 1}]}]})
+
+
+def squares(specs):
+    """Horizontal squares (x0, y0, size, z) -> vertices, faces (2 triangles each, upper face up)."""
+    v, f = [], []
+    for k, (x, y, a, z) in enumerate(specs):
+        v += [[x, y, z], [x + a, y, z], [x + a, y + a, z], [x, y + a, z]]
+        f += [[4 * k, 4 * k + 1, 4 * k + 2], [4 * k, 4 * k + 2, 4 * k + 3]]
+    return np.array(v, float), np.array(f)
+
+
+def canopy_of(specs, layout=None):
+    v, f = squares(specs)
+    leaf = np.repeat(np.arange(1, len(specs) + 1), 2)
+    return Canopy.from_triangles(v, f, layout or plot(), leaf)
+
+
+def test_vertical_sun_shades_exactly_the_overlap():
+    c = canopy_of([(30, 40, 20, 80)])                      # 20 x 20 cm leaf at 80 cm
+    req = LightRequest(Sun(0, 0), heights_cm=(0, 50, 79.9, 80.1, 100), density=4,
+                       rect=(20, 20, 60, 60))              # overlap: x 30..50, y 40..60 = 400
+    r = trace_light(c, req)
+    expect = 1 - 400 / 1600
+    assert r.transmission[0] == pytest.approx(expect, abs=1e-12)
+    assert r.transmission[:3] == pytest.approx([expect] * 3, abs=1e-12)
+    assert list(r.transmission[3:]) == [1.0, 1.0]
+    rows = leaf_light(c, r)
+    assert rows[0]["sunlit_area_cm2"] == pytest.approx(400, rel=1e-9)
+    assert rows[0]["second_class_area_cm2"] == 0
+
+
+def test_45_degree_sun_shifts_the_shadow():
+    # sun from the east (azimuth 90) at 45 deg: the shadow of a leaf at 30 cm falls 30 cm west
+    c = canopy_of([(60, 40, 20, 30)])
+    r = trace_light(c, LightRequest(Sun(45, 90), heights_cm=(0,), density=16,
+                                    rect=(20, 30, 60, 70)))
+    # shadow x 30..50, y 40..60, fully inside the 40 x 40 rectangle
+    assert r.transmission[0] == pytest.approx(1 - 400 / 1600, abs=2e-3)
+    # a rectangle east of the shadow sees full sun
+    r2 = trace_light(c, LightRequest(Sun(45, 90), heights_cm=(0,), density=16,
+                                     rect=(52, 30, 90, 70)))
+    assert r2.transmission[0] == 1.0
+
+
+def test_stacked_leaves_direct_and_second_class_areas():
+    c = canopy_of([(20, 20, 40, 100), (30, 30, 40, 60), (10, 10, 10, 20)])
+    r = trace_light(c, LightRequest(Sun(0, 0), heights_cm=(0,), density=4, rect=(0, 0, 100, 100)))
+    rows = {row["leaf"]: row for row in leaf_light(c, r)}
+    assert rows[1]["sunlit_area_cm2"] == pytest.approx(1600, rel=1e-9)        # top: all direct
+    assert rows[1]["second_class_area_cm2"] == 0
+    # middle: 30..70 overlaps the top 20..60 over 30 x 30 -> 900 second class, 700 direct
+    assert rows[2]["sunlit_area_cm2"] == pytest.approx(700, rel=1e-9)
+    assert rows[2]["second_class_area_cm2"] == pytest.approx(900, rel=1e-9)
+    assert rows[3]["sunlit_area_cm2"] == pytest.approx(100, rel=1e-9)
+    assert r.transmission[0] == pytest.approx(1 - (1600 + 700 + 100) / 10000, abs=1e-12)
+
+
+def test_tilted_leaf_sunlit_area_is_its_surface_area():
+    # a 20 x 20 leaf tilted 60 deg about the x axis, vertical sun: lit area = the leaf's area
+    t = math.radians(60)
+    v = np.array([[40, 40, 50], [60, 40, 50], [60, 40 + 20 * math.cos(t), 50 + 20 * math.sin(t)],
+                  [40, 40 + 20 * math.cos(t), 50 + 20 * math.sin(t)]])
+    c = Canopy.from_triangles(v, np.array([[0, 1, 2], [0, 2, 3]]), plot(), np.array([1, 1]))
+    r = trace_light(c, LightRequest(Sun(0, 0), heights_cm=(0,), density=25,
+                                    rect=(30, 30, 70, 70)))
+    row = leaf_light(c, r)[0]
+    assert row["sunlit_area_cm2"] == pytest.approx(400, rel=0.02)
+    assert row["sunlit_intercepted_cm2"] == pytest.approx(200, rel=0.02)   # its shadow
+
+
+@pytest.mark.parametrize("lai", [0.5, 2.0, 4.0])
+def test_random_horizontal_leaves_transmit_exp_minus_lai(lai):
+    rng = np.random.default_rng(int(lai * 10))
+    side, a = 300.0, 6.0
+    # centres uniform over the plot extended by a leaf, so density is uniform inside
+    n = int(round(lai * (side + a) ** 2 / a**2))
+    xy = rng.uniform(-a, side, (n, 2))
+    z = rng.uniform(10, 200, n)
+    c = canopy_of([(x, y, a, h) for (x, y), h in zip(xy, z)], plot(0, 0, side, side))
+    r = trace_light(c, LightRequest(Sun(0, 0), heights_cm=(0, 105), density=1,
+                                    rect=(0, 0, side, side)))
+    assert r.transmission[0] == pytest.approx(math.exp(-lai), abs=0.02)
+    # half the leaves lie above 105 cm: T(105) ~ exp(-lai * 95 / 190)
+    assert r.transmission[1] == pytest.approx(math.exp(-lai * 95 / 190), abs=0.03)
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.floats(0, 70), st.floats(0, 360), st.integers(0, 2**31), st.booleans())
+def test_transmission_monotone_and_bounded(zenith, azimuth, seed, periodic):
+    rng = np.random.default_rng(seed)
+    n = 60
+    specs = [(x, y, s, h) for x, y, s, h in zip(rng.uniform(0, 90, n), rng.uniform(0, 90, n),
+                                                  rng.uniform(2, 15, n), rng.uniform(5, 150, n))]
+    c = canopy_of(specs)
+    heights = tuple(np.linspace(0, 200, 9))
+    r = trace_light(c, LightRequest(Sun(zenith, azimuth), heights, density=1,
+                                    rect=(20, 20, 80, 80), periodic=periodic, classes=False))
+    t = r.transmission
+    assert np.all((0 <= t) & (t <= 1))
+    assert np.all(np.diff(t) >= 0), "transmission increased going down"
+    assert t[-1] == 1.0
+
+
+def test_periodic_field_stops_rays_that_leave_the_plot():
+    rng = np.random.default_rng(3)
+    n = 400
+    specs = [(x, y, 8, h) for x, y, h in zip(rng.uniform(-8, 100, n), rng.uniform(-8, 100, n),
+                                             rng.uniform(5, 150, n))]
+    c = canopy_of(specs)
+    low = Sun(65, 180)
+    open_ = trace_light(c, LightRequest(low, (0,), 1, (30, 30, 70, 70), periodic=False))
+    wrapped = trace_light(c, LightRequest(low, (0,), 1, (30, 30, 70, 70), periodic=True))
+    assert any("overestimated" in w for w in open_.warnings)
+    assert not wrapped.warnings
+    assert wrapped.transmission[0] < 0.5 * open_.transmission[0]
+
+
+def test_beer_lambert_from_mesh():
+    c = canopy_of([(0, 0, 50, 100), (50, 50, 50, 20)])
+    t, g, lai = beer_lambert(c, Sun(0, 0), [0, 50, 150])
+    assert g == pytest.approx(1.0)
+    assert lai == pytest.approx([0.5, 0.25, 0.0])
+    assert t == pytest.approx(np.exp(-lai))
+
+
+def test_sun_from_pvlib_beijing():
+    s = sun_at("2005-08-01", "12:00", 39.9, 116.4, "Asia/Shanghai")
+    assert s.zenith_deg == pytest.approx(22.35, abs=0.02)
+    assert s.azimuth_deg == pytest.approx(166.95, abs=0.02)
+    noon = sun_at("2005-08-01", None, 39.9, 116.4, "Asia/Shanghai", solar_noon=True)
+    assert noon.azimuth_deg == pytest.approx(180, abs=0.01)
+    assert "12:20:4" in noon.when
+    d = Sun(30, 90).direction()
+    assert d == pytest.approx([0.5, 0, math.cos(math.radians(30))])
+    assert Sun(30, 90).direction(north_deg=90) == pytest.approx([0, 0.5, math.cos(math.radians(30))])
+
+
+@pytest.mark.parametrize("make, match", [
+    (lambda: Sun(95, 0), "below the horizon"),
+    (lambda: sun_at("2005-08-01", "23:00", 39.9, 116.4, "Asia/Shanghai"), "below the horizon"),
+    (lambda: sun_at("2005-13-01", "12:00", 39.9, 116.4, "UTC"), "YYYY-MM-DD"),
+    (lambda: sun_at("2005-08-01", "12:00", 39.9, 116.4, "Mars/Olympus"), "time zone"),
+    (lambda: sun_at("2005-08-01", "12:00", 99, 116.4, "UTC"), "latitude"),
+])
+def test_bad_suns(make, match):
+    with pytest.raises(MaizevizError, match=match):
+        make()
+
+
+@pytest.mark.parametrize("req, match", [
+    (dict(rect=(200, 200, 300, 300)), "not inside the plot"),
+    (dict(rect=(50, 50, 40, 60)), "x1 > x0"),
+    (dict(density=0), "--density must be > 0"),
+    (dict(density=1e7), "rays.*limit"),
+    (dict(heights_cm=(-5,)), "heights must be >= 0"),
+    (dict(heights_cm=()), "at least one height"),
+])
+def test_bad_requests(req, match):
+    c = canopy_of([(30, 40, 20, 80)])
+    base = dict(sun=Sun(10, 0), heights_cm=(0,), density=1, rect=(10, 10, 90, 90))
+    base.update(req)
+    with pytest.raises(MaizevizError, match=match):
+        trace_light(c, LightRequest(**base))
+
+
+def test_heights_above_canopy_fine_and_empty_canopy_refused():
+    c = canopy_of([(30, 40, 20, 80)])
+    r = trace_light(c, LightRequest(Sun(10, 0), (0, 500), 1, (10, 10, 90, 90)))
+    assert r.transmission[1] == 1.0 and any("above the canopy top" in w for w in r.warnings)
+    empty = Canopy.from_triangles(np.zeros((0, 3)), np.zeros((0, 3), int), plot(), np.zeros(0))
+    with pytest.raises(MaizevizError, match="empty"):
+        trace_light(empty, LightRequest(Sun(10, 0)))
+
+
+def test_threads_give_the_same_answer_and_cancel_works(monkeypatch):
+    import maizeviz.light.transmission as tr
+    monkeypatch.setattr(tr, "CHUNK", 1000)
+    rng = np.random.default_rng(1)
+    c = canopy_of([(x, y, 10, h) for x, y, h in zip(rng.uniform(0, 90, 80), rng.uniform(0, 90, 80),
+                                                    rng.uniform(5, 150, 80))])
+    req = dict(sun=Sun(30, 200), heights_cm=(0, 50, 100), density=4, rect=(0, 0, 100, 100))
+    one = trace_light(c, LightRequest(**req, threads=1))
+    two = trace_light(c, LightRequest(**req, threads=2))
+    assert np.array_equal(one.transmission, two.transmission)
+    assert np.array_equal(one.first_hits, two.first_hits)
+    seen = []
+    with pytest.raises(InterruptedError):
+        trace_light(c, LightRequest(**req), progress=lambda d, t: seen.append(d) or d < 3)
+    assert seen[-1] == 3
+
+
+def test_ray_grid_density():
+    pts, cell = ray_grid((0, 0, 180, 90), 4)
+    assert len(pts) == 180 * 90 * 4 and cell == pytest.approx(0.25)
+
+
+def test_cli_light_json_heatmaps_and_csv(tmp_path, capsys):
+    out = tmp_path / "maps"
+    leafcsv, plantcsv = tmp_path / "leaf.csv", tmp_path / "plant.csv"
+    code = main(["light", BLOCK, "--tile", "3x3", "--triangles", "36", "--date", "2005-08-01",
+                 "--time", "12:00", "--lat", "39.9", "--lon", "116.4", "--tz", "Asia/Shanghai",
+                 "--heights", "0,100,225", "--density", "1", "--json", "--heatmaps", str(out),
+                 "--check", "--periodic", "--leaf-light", str(leafcsv), "--plant-light",
+                 str(plantcsv)])
+    cap = capsys.readouterr()
+    assert code == EXIT_OK, cap.err
+    assert "sun: zenith 22.3" in cap.err
+    data = json.loads(cap.out)
+    assert data["sun"]["zenith_deg"] == pytest.approx(22.35, abs=0.02)
+    t = data["transmission"]
+    assert 0.02 < t[0] < 0.12 and t[0] <= t[1] <= t[2] <= 1
+    assert data["rays"] == 180 * 90
+    assert set(data["seconds"]) >= {"scene", "trace"}
+    assert len(data["beer_lambert"]["transmission"]) == 3
+    pngs = sorted(out.glob("*.png"))
+    assert len(pngs) == 3 and all(p.stat().st_size > 10_000 for p in pngs)
+    rows = (out / "transmission_36_triangles_h0cm.csv").read_text().splitlines()
+    assert rows[0].startswith("x_cm,y_cm,height_cm,transmission,rays") and len(rows) == 36 * 18 + 1
+    leaf_lines = leafcsv.read_text().splitlines()
+    assert "sunlit_area_cm2" in leaf_lines[0] and len(leaf_lines) > 20
+    assert "leaves_lit" in plantcsv.read_text().splitlines()[0]
+
+
+def test_cli_light_levels_and_explicit_sun(capsys):
+    code = main(["light", BLOCK, "--tile", "3x3", "--sun-zenith", "30", "--sun-azimuth", "180",
+                 "--levels", "standard,36,4", "--density", "0.5", "--heights", "0,150"])
+    out = capsys.readouterr().out
+    assert code == EXIT_OK
+    assert "standard" in out and "36 triangles" in out and "4 triangles" in out
+    assert "trace s" in out
+
+
+@pytest.mark.parametrize("argv, says", [
+    (["--sun-zenith", "95", "--sun-azimuth", "0"], "below the horizon"),
+    (["--sun-zenith", "30"], "both"),
+    ([], "where is the sun"),
+    (["--sun-zenith", "30", "--sun-azimuth", "0", "--date", "2005-08-01"], "not both"),
+    (["--sun-zenith", "30", "--sun-azimuth", "0", "--density", "0"], "density"),
+    (["--sun-zenith", "30", "--sun-azimuth", "0", "--rect", "1,2,3"], "--rect needs 4"),
+    (["--sun-zenith", "30", "--sun-azimuth", "0", "--rect", "900,0,1000,50"], "not inside"),
+    (["--sun-zenith", "30", "--sun-azimuth", "0", "--heights", "0,abc"], "--heights"),
+    (["--date", "2005-08-01", "--time", "23:30", "--lat", "39.9", "--lon", "116.4", "--tz",
+      "Asia/Shanghai"], "below the horizon"),
+])
+def test_cli_light_bad_input(capsys, argv, says):
+    assert main(["light", BLOCK, *argv]) == EXIT_FAIL
+    err = capsys.readouterr().err
+    assert says in err and "Traceback" not in err
