@@ -58,6 +58,13 @@ class RayScene:
         out = self._scene.run(o, d, dists=dists, output=True)
         return out["primID"], out["tfar"]
 
+    def distance(self, origins: np.ndarray, directions: np.ndarray, tfar):
+        """Distance to the nearest triangle within ``tfar``; ``tfar`` itself where none (N,)."""
+        o = _writable(origins)
+        d = _writable(directions)
+        t = _writable(np.broadcast_to(np.asarray(tfar, np.float32), (len(o),)))
+        return self._scene.run(o, d, dists=t, query="DISTANCE")
+
     def occluded(self, origins: np.ndarray, directions: np.ndarray, tfar: np.ndarray | float):
         """True where a triangle lies on the ray between 0 and ``tfar``: (N,) bool."""
         o = _writable(origins)

@@ -98,16 +98,25 @@ class LightResult:
         return ground + self.direction[:2] * (height / self.direction[2])
 
 
-def ray_grid(rect, density: float) -> tuple[np.ndarray, float]:
-    """Cell-centre points (N, 2) cm of a regular grid over ``rect`` and the cell area (cm2)."""
+def _grid_shape(rect, density: float) -> tuple[int, int]:
     x0, y0, x1, y1 = rect
     step = 1.0 / math.sqrt(density)
-    nx = max(1, int(round((x1 - x0) / step)))
-    ny = max(1, int(round((y1 - y0) / step)))
-    xs = x0 + (np.arange(nx) + 0.5) * (x1 - x0) / nx
-    ys = y0 + (np.arange(ny) + 0.5) * (y1 - y0) / ny
-    gx, gy = np.meshgrid(xs, ys, indexing="ij")          # row-major: neighbours stay together
-    return np.column_stack([gx.ravel(), gy.ravel()]), (x1 - x0) * (y1 - y0) / (nx * ny)
+    return max(1, int(round((x1 - x0) / step))), max(1, int(round((y1 - y0) / step)))
+
+
+def ray_grid(rect, density: float, start: int = 0, stop: int | None = None):
+    """Cell-centre points (N, 2) cm of a regular grid over ``rect`` and the cell area (cm2).
+
+    Points run row-major (x slow, y fast) so that neighbouring rays stay together; ``start``
+    and ``stop`` select a slice of them without building the rest.
+    """
+    x0, y0, x1, y1 = rect
+    nx, ny = _grid_shape(rect, density)
+    i, j = np.divmod(np.arange(start, nx * ny if stop is None else stop), ny)
+    pts = np.empty((len(i), 2))
+    pts[:, 0] = x0 + (i + 0.5) * ((x1 - x0) / nx)
+    pts[:, 1] = y0 + (j + 0.5) * ((y1 - y0) / ny)
+    return pts, (x1 - x0) * (y1 - y0) / (nx * ny)
 
 
 def check_request(canopy: Canopy, req: LightRequest) -> tuple[tuple, list[str]]:
@@ -161,19 +170,20 @@ def check_request(canopy: Canopy, req: LightRequest) -> tuple[tuple, list[str]]:
 
 
 def ray_count(rect, density) -> int:
-    x0, y0, x1, y1 = rect
-    step = 1.0 / math.sqrt(density)
-    return max(1, int(round((x1 - x0) / step))) * max(1, int(round((y1 - y0) / step)))
+    nx, ny = _grid_shape(rect, density)
+    return nx * ny
 
 
 class _Tracer:
     """Follows rays down through the scene, wrapping them across the plot when periodic."""
 
-    def __init__(self, scene: RayScene, down: np.ndarray, bounds, periodic: bool):
+    def __init__(self, scene: RayScene, down: np.ndarray, bounds, periodic: bool, size: int):
         self.scene = scene
         self.down = down.astype(np.float64)
         self.bounds = bounds
         self.periodic = periodic
+        # one writable float32 direction buffer, sliced per chunk (embreex needs writable input)
+        self.dirs = np.tile(down.astype(np.float32), (max(size, 1), 1))
 
     def _exit(self, org):
         """Distance along ``down`` to where each ray leaves the plot's vertical prism."""
@@ -192,32 +202,41 @@ class _Tracer:
         org[:, 1] = y0 + np.mod(org[:, 1] - y0, y1 - y0)
         return org
 
-    def trace(self, org: np.ndarray, length: np.ndarray):
+    def _query(self, org, length, ids):
+        dirs = self.dirs[: len(org)]
+        if ids:
+            prim, t = self.scene.first_hit(org, dirs, length)
+            return prim, t, prim >= 0
+        t = self.scene.distance(org, dirs, length)
+        return None, t, t < np.asarray(length, np.float32)
+
+    def trace(self, org: np.ndarray, length: np.ndarray, ids: bool = True):
         """First hit of rays from ``org`` (N, 3) along ``down`` within ``length`` (N,) cm.
 
-        Returns triangle ids (N,) int32, -1 where none, and hit distances (N,) float64.
+        Returns triangle ids (N,) int32, -1 where none (None unless ``ids``), hit distances
+        (N,) float64 (inf where none).
         """
         n = len(org)
-        prim = np.full(n, -1, dtype=np.int32)
+        prim = np.full(n, -1, dtype=np.int32) if ids else None
         dist = np.full(n, np.inf)
-        dirs = np.broadcast_to(self.down.astype(np.float32), (n, 3))
         if not self.periodic:
-            ids, t = self.scene.first_hit(org, dirs, length)
-            hit = ids >= 0
-            prim[hit] = ids[hit]
+            p, t, hit = self._query(org, length, ids)
+            if ids:
+                prim[hit] = p[hit]
             dist[hit] = t[hit]
             return prim, dist
         todo = np.arange(n)
-        org = self._wrap(org.astype(np.float64).copy())
+        org = self._wrap(org.astype(np.float64))
         done = np.zeros(n)
         remaining = length.astype(np.float64).copy()
         for _ in range(10_000):
             if not len(todo):
                 break
             seg = np.minimum(self._exit(org), remaining)
-            ids, t = self.scene.first_hit(org, dirs[: len(todo)], seg)
-            hit = (ids >= 0) & (t <= seg)
-            prim[todo[hit]] = ids[hit]
+            p, t, hit = self._query(org, seg, ids)
+            hit &= t <= seg
+            if ids:
+                prim[todo[hit]] = p[hit]
             dist[todo[hit]] = done[hit] + t[hit]
             go = ~hit & (remaining - seg > 1e-6)
             todo, org = todo[go], org[go] + seg[go, None] * self.down
@@ -243,34 +262,50 @@ def trace_light(canopy: Canopy, req: LightRequest, progress=None,
     scene = RayScene(verts, faces)
     build_s = time.perf_counter() - t0
 
+    t1 = time.perf_counter()                             # tracing: ray grid to T(h)
     s = req.sun.direction(canopy.layout.north_deg)
     down = -s
-    ground, ray_area = ray_grid(rect, req.density)
-    n = len(ground)
+    nx, ny = _grid_shape(rect, req.density)
+    n = nx * ny
+    ray_area = (rect[2] - rect[0]) * (rect[3] - rect[1]) / n
+    heights = np.asarray(req.heights_cm, dtype=np.float64)
+    h32 = heights.astype(np.float32)
     top = float(verts[:, 2].max()) + 1.0
     reach = top / s[2]                                   # distance from the top plane to ground
-    tracer = _Tracer(scene, down, canopy.layout.bounds, req.periodic)
+    tracer = _Tracer(scene, down, canopy.layout.bounds, req.periodic, min(n, CHUNK))
     first_z = np.empty(n, dtype=np.float32)
     first_prim = np.empty(n, dtype=np.int32) if req.classes else None
     chunks = [(a, min(a + CHUNK, n)) for a in range(0, n, CHUNK)]
     total = len(chunks) * (2 if req.classes else 1)
     done = 0
 
+    # ray origins on the top plane, built per chunk by slicing (x slow, y fast, as ray_grid)
+    dx, dy = (rect[2] - rect[0]) / nx, (rect[3] - rect[1]) / ny
+    xs_top = (rect[0] + (np.arange(nx) + 0.5) * dx + s[0] * reach).astype(np.float32)
+    ys_top = np.tile((rect[1] + (np.arange(ny) + 0.5) * dy + s[1] * reach).astype(np.float32),
+                     min(n, CHUNK) // ny + 2)
+
     def first(a, b):
-        org = np.empty((b - a, 3))
-        org[:, :2] = ground[a:b] + s[:2] * reach
+        org = np.empty((b - a, 3), dtype=np.float32)
+        i0, j0 = divmod(a, ny)
+        i1 = (b - 1) // ny + 1
+        org[:, 0] = np.repeat(xs_top[i0:i1], ny)[j0:j0 + b - a]
+        org[:, 1] = ys_top[j0:j0 + b - a]
         org[:, 2] = top
-        prim, dist = tracer.trace(org, np.full(b - a, reach))
-        first_z[a:b] = np.where(prim >= 0, top - dist * s[2], -np.inf)
+        prim, dist = tracer.trace(org, np.full(b - a, reach, np.float32), ids=req.classes)
+        z = first_z[a:b]
+        z[:] = top - dist * s[2]                             # -inf where nothing was hit
         if first_prim is not None:
             first_prim[a:b] = prim
+        # rays whose first hit lies below h have reached h unobstructed
+        return np.array([np.count_nonzero(z < h) for h in h32])
 
     def second(a, b):
         sel = np.flatnonzero(first_prim[a:b] >= 0)
         zf = first_z[a:b][sel].astype(np.float64)
         org = np.empty((len(sel), 3))
         dist_first = (top - zf) / s[2]
-        org[:, :2] = ground[a:b][sel] + (reach - dist_first - SECOND_HIT_EPS)[:, None] * s[:2]
+        org[:, :2] = ray_grid(rect, req.density, a, b)[0][sel] + (reach - dist_first - SECOND_HIT_EPS)[:, None] * s[:2]
         org[:, 2] = zf - SECOND_HIT_EPS * s[2]
         prim, _ = tracer.trace(org, np.maximum(reach - dist_first - SECOND_HIT_EPS, 0.0))
         return prim[prim >= 0]
@@ -292,13 +327,8 @@ def trace_light(canopy: Canopy, req: LightRequest, progress=None,
                 raise
         return out
 
-    t1 = time.perf_counter()
-    run(first)
+    transmission = np.sum(run(first), axis=0) / n
     trace_s = time.perf_counter() - t1
-    heights = np.asarray(req.heights_cm, dtype=np.float64)
-    zs = np.sort(first_z.astype(np.float64))
-    # rays whose first hit lies below h have reached h unobstructed
-    transmission = np.searchsorted(zs, heights, side="left") / n
     seconds = {"build": build_s, "trace": trace_s}
     first_hits = second_hits = None
     if req.classes:
