@@ -1,6 +1,7 @@
 """Canopy layout, tiling arithmetic, canopy measures, layout files, synth and import."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,7 +16,7 @@ from maizeviz.leaf.grid import LeafGrid
 from maizeviz.leaf.reconstruct import Level, fit_leaves, measure, mesh_leaf
 from maizeviz.synth import PlantShape, block_grids, plant_grids
 
-PHENO = "../shared/data/phenotrack3d/1649057232.json.gz"
+PHENO = str(Path(__file__).resolve().parents[2] / "resources/phenotrack3d/1649057232.json.gz")
 
 
 def flat_leaf(plant, leaf, x0, y0, length, width, z, rows=4, cols=3, stalk=None):

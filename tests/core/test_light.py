@@ -1,6 +1,7 @@
 """Direct light through real Embree: analytic scenes, Beer-Lambert, bad requests, the CLI."""
 
 import json
+from pathlib import Path
 import math
 
 import numpy as np
@@ -15,7 +16,7 @@ from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import (LightRequest, beer_lambert, leaf_light, ray_grid,
                                          trace_light)
 
-BLOCK = "resources/block3x3.csv"
+BLOCK = str(Path(__file__).resolve().parents[2] / "resources/block3x3.csv")
 
 
 def plot(x0=0, y0=0, x1=100, y1=100):
