@@ -541,6 +541,147 @@ def _suffixed(path, level):
     return p.with_name(f"{p.stem}_{tag}{p.suffix}")
 
 
+# --------------------------------------------------------------------------------- record
+def _add_record(sub):
+    p = sub.add_parser(
+        "record", help="digitize with a Polhemus FASTRAK: stylus presses become points",
+        description="Record stylus presses from a FASTRAK as points of plants, leaves and "
+                    "cross-sections. Every point is on disk (fsync) before it is reported. "
+                    "Controls, one per line on standard input: n next leaf, p next plant, "
+                    "r end the row early (tip), u undo the last point, q finish.")
+    p.add_argument("--port", required=True, help="serial port, e.g. /dev/ttyUSB0")
+    p.add_argument("--out", required=True, help="points CSV to append to")
+    p.add_argument("--cols", type=int, default=5,
+                   help="points per cross-section, margin to margin (default 5)")
+    p.add_argument("--resume", action="store_true", help="continue --out where it stopped")
+    p.add_argument("--baud", type=int, default=115200, help="baud rate (default 115200)")
+    p.add_argument("--reference-station", type=int, choices=(2, 3, 4), metavar="N",
+                   help="a receiver fixed to the stalk: points are re-expressed in its frame")
+    p.add_argument("--answer-timeout", type=float, default=1.0, metavar="S",
+                   help="seconds to wait for each reply of the unit (default 1)")
+    p.set_defaults(run=_run_record)
+
+
+def _run_record(args) -> int:
+    import queue
+    import signal
+    import threading
+
+    from maizeviz.digitizer.port import FastrakPort, PortLost
+    from maizeviz.digitizer.session import Session
+
+    session = Session(args.out, args.cols, args.resume, args.reference_station)
+    if args.resume:
+        q0 = session.pos
+        _say(f"resuming {args.out}: {session.count.points} points on disk; next point is plant "
+             f"{q0.plant} leaf {q0.leaf} row {q0.row} col {q0.col}")
+    port = FastrakPort(args.port, args.baud, args.answer_timeout)
+    stations = (1,) if args.reference_station is None else (1, args.reference_station)
+    try:
+        config = port.configure(stations)
+    except MaizevizError:
+        session.close()
+        port.close()
+        raise
+    for w in config.warnings:
+        _say(f"warning: {w}")
+    events: queue.Queue = queue.Queue()
+    port.start_reader(events.put)
+
+    def read_stdin():
+        try:
+            for line in sys.stdin:
+                events.put(("control", line))
+        except (OSError, ValueError):
+            pass
+
+    if sys.stdin is not None and not sys.stdin.closed:
+        threading.Thread(target=read_stdin, daemon=True, name="controls").start()
+    stop = {"signal": None}
+
+    def on_signal(signum, _frame):
+        stop["signal"] = signum
+        events.put(("signal", signum))
+
+    old = signal.signal(signal.SIGTERM, on_signal)
+    print(f"ready on {args.port}: press the stylus; controls n, p, r, u, q + Enter", flush=True)
+    code = EXIT_OK
+    try:
+        while True:
+            try:
+                ev = events.get(timeout=0.5)
+            except queue.Empty:
+                continue
+            if isinstance(ev, tuple) and ev[0] == "signal":
+                code = 128 + ev[1]
+                break
+            if isinstance(ev, tuple) and ev[0] == "control":
+                msg = session.control(ev[1]) if ev[1].strip() else None
+                if msg == "quit":
+                    break
+                if msg:
+                    print(msg, flush=True)
+                continue
+            if isinstance(ev, PortLost):
+                _say(f"error: {ev.message}; every point reported recorded is on disk")
+                code = EXIT_FAIL
+                break
+            msg = session.on_event(ev)
+            if msg:
+                print(msg, flush=True)
+    except KeyboardInterrupt:
+        code = 130
+    finally:
+        signal.signal(signal.SIGTERM, old)
+        port.close()
+        session.close()
+        print(session.summary(), flush=True)
+    return code
+
+
+def _add_sim(sub):
+    p = sub.add_parser(
+        "fastrak-sim", help="a pretend FASTRAK on a pseudo-terminal (prints its path)",
+        description="Open a pseudo-terminal that behaves like a FASTRAK and, with --replay, "
+                    "press the stylus at every point of a points file once a recorder has "
+                    "configured it.")
+    p.add_argument("--replay", metavar="CSV", help="points file to replay as stylus presses")
+    p.add_argument("--pace", type=float, default=1.0, metavar="S",
+                   help="seconds between presses (default 1.0; the unit ignores < 0.333)")
+    p.add_argument("--reference", action="store_true",
+                   help="a second receiver on the stalk (station 2) that sways while replaying")
+    p.add_argument("--faults", action="store_true",
+                   help="inject garbled bytes, truncated records, BIT errors and finally pull "
+                        "the port")
+    p.add_argument("--noise", type=float, default=0.08, help="position noise, cm (default 0.08)")
+    p.add_argument("--seed", type=int, default=0)
+    p.set_defaults(run=_run_sim)
+
+
+def _run_sim(args) -> int:
+    from maizeviz.digitizer.replay import replay_points
+    from maizeviz.digitizer.simulator import FastrakSimulator
+
+    stations = (1, 2) if args.reference else (1,)
+    with FastrakSimulator(stations, args.noise, args.seed) as sim:
+        print(f"FASTRAK simulator on {sim.path}", flush=True)
+        if not args.replay:
+            print("no --replay: answering commands until Ctrl-C", flush=True)
+            try:
+                while True:
+                    time.sleep(1)
+            except KeyboardInterrupt:
+                return EXIT_OK
+        print(f"waiting for a recorder: maizeviz record --port {sim.path} --out OUT.csv",
+              flush=True)
+        try:
+            replay_points(sim, args.replay, pace=args.pace, faults=args.faults,
+                          sway=args.reference, say=lambda m: print(m, flush=True))
+        except KeyboardInterrupt:
+            return 130
+    return EXIT_OK
+
+
 # ---------------------------------------------------------------------------------- synth
 def _add_synth(sub):
     p = sub.add_parser(
@@ -632,6 +773,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_leaf(sub)
     _add_canopy(sub)
     _add_light(sub)
+    _add_record(sub)
+    _add_sim(sub)
     _add_synth(sub)
     _add_import(sub)
     return parser

@@ -1,7 +1,9 @@
 """Read and write the digitized points format.
 
 CSV with a header; required columns ``plant,leaf,row,col,x,y,z`` (any order, any case), other
-columns are kept as text in :attr:`PointsTable.extra`. ``x, y, z`` are centimetres, z up.
+columns are kept as text in :attr:`PointsTable.extra`. A ``status`` column (written by
+``maizeviz record``) is honoured: ``undone`` lines take back the latest recording of that
+point, and control lines (``next_leaf``, ``next_plant``, ``end_row``) carry no point. ``x, y, z`` are centimetres, z up.
 A row whose ids cannot be read is reported and skipped; a row whose coordinates cannot be read
 marks its leaf as bad (the leaf is refused later with the line number), so one bad press never
 takes the other leaves down with it.
@@ -123,11 +125,24 @@ def parse_points(text: str, source: str = "<memory>") -> PointsTable:
     ids, xyz, lines, problems = [], [], [], []
     extra = {h: [] for h in extra_names}
     bad_leaves: dict = {}
+    status_col = header.index("status") if "status" in header else None
+    undone = []                                   # (ids, line) taken back by the technician
     for lineno, fields in enumerate(reader, start=header_line + 1):
         if not any(f.strip() for f in fields):
             continue
         if len(fields) < len(header):
             fields = fields + [""] * (len(header) - len(fields))
+        if status_col is not None:
+            status = fields[status_col].strip().lower()
+            if status == "undone":
+                try:
+                    undone.append((tuple(_parse_int(fields[index[c]]) for c in ID_COLUMNS),
+                                   len(ids)))
+                except ValueError:
+                    problems.append(f"line {lineno}: unreadable undo line; skipped")
+                continue
+            if status not in ("", "recorded", "ok"):
+                continue                          # session controls carry no point
         try:
             plant = _parse_int(fields[index["plant"]])
             leaf = _parse_int(fields[index["leaf"]])
@@ -163,6 +178,17 @@ def parse_points(text: str, source: str = "<memory>") -> PointsTable:
             lines.append(lineno)
             for h, i in extra_index.items():
                 extra[h].append(fields[i].strip())
+    if undone:                                    # drop each undone point (its latest recording)
+        keep = np.ones(len(ids), dtype=bool)
+        for key, before in undone:
+            for k in range(before - 1, -1, -1):
+                if keep[k] and ids[k] == key:
+                    keep[k] = False
+                    break
+        ids = [v for v, k in zip(ids, keep) if k]
+        xyz = [v for v, k in zip(xyz, keep) if k]
+        lines = [v for v, k in zip(lines, keep) if k]
+        extra = {h: [v for v, k in zip(vals, keep) if k] for h, vals in extra.items()}
     if not ids and not bad_leaves:
         if problems:
             raise PointsFileError(f"{source}: no readable point; first problem: {problems[0]}")
