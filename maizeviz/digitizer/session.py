@@ -89,6 +89,8 @@ class Session:
             raise SessionError(f"{p} already holds points; use --resume to continue it, or "
                                "another --out")
         folder = p.parent if str(p.parent) else Path(".")
+        if folder.exists() and not folder.is_dir():
+            raise SessionError(f"{folder} is a file, not a folder; cannot write {p.name} in it")
         try:
             free = shutil.disk_usage(folder).free
         except OSError:
