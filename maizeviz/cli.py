@@ -14,6 +14,7 @@ import time
 import traceback
 
 from maizeviz.errors import LeafError, MaizevizError
+from maizeviz.leaf.reconstruct import DEFAULT_LEVELS
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_PARTIAL = 0, 1, 2, 3
 
@@ -29,15 +30,7 @@ def _add_leaf(sub):
         description="Fit a NURBS surface through every leaf of a points file and mesh it at "
                     "the chosen complexity. Areas in cm2, lengths in cm.")
     p.add_argument("points", help="points CSV (plant,leaf,row,col,x,y,z in cm)")
-    lv = p.add_mutually_exclusive_group()
-    lv.add_argument("--interp", type=int, metavar="K",
-                    help="K points interpolated between data points (0 = standard mesh; "
-                         "default 4, the paper's reference mesh)")
-    lv.add_argument("--triangles", type=int, metavar="N",
-                    help="at most N triangles per leaf (inverse multi-line segment splitting)")
-    lv.add_argument("--levels", nargs="?", const="K4,K1,standard,36,8,4,3", metavar="LIST",
-                    help="compare levels per leaf, the paper's Table 1 "
-                         "(default K4,K1,standard,36,8,4,3)")
+    _add_level_options(p, DEFAULT_LEVELS)
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--export", metavar="PATH",
                    help="write the meshes: .ply .obj .vtk .vtu .vtp .stl (plant/leaf ids kept "
@@ -45,9 +38,6 @@ def _add_leaf(sub):
     p.add_argument("--degree", type=int, default=3, help="NURBS degree in u and v (default 3)")
     p.add_argument("--params", choices=("chord", "centripetal"), default="chord",
                    help="data parameters (default chord length)")
-    p.add_argument("--no-preserve-area", dest="preserve_area", action="store_false",
-                   help="below the standard mesh, do not widen cross-sections to keep the "
-                        "smooth surface's area")
     p.add_argument("--strict", action="store_true",
                    help="stop at the first bad leaf instead of skipping it")
     p.set_defaults(run=_run_leaf)
@@ -87,25 +77,11 @@ def _fmt_table(headers, rows) -> str:
 
 def _run_leaf(args) -> int:
     from maizeviz.io.export import export_meshes
-    from maizeviz.leaf.reconstruct import Level, measure, mesh_leaves, parse_levels
+    from maizeviz.leaf.reconstruct import measure, mesh_leaves
 
-    if args.levels is not None:
-        try:
-            levels = parse_levels(args.levels)
-        except ValueError as exc:
-            raise MaizevizError(str(exc)) from None
-        if args.export:
-            raise MaizevizError("--export writes one level: use it with --interp or --triangles")
-    elif args.triangles is not None:
-        if args.triangles < 1:
-            raise MaizevizError(f"--triangles must be >= 1, got {args.triangles}")
-        levels = [Level(triangles=args.triangles)]
-    else:
-        k = 4 if args.interp is None else args.interp
-        if k < 0:
-            raise MaizevizError(f"--interp must be >= 0, got {k}")
-        levels = [Level(interp=k)]
-
+    levels = _levels_from(args)
+    if args.export and len(levels) > 1:
+        raise MaizevizError("--export writes one level: use it with --interp or --triangles")
     leaves, skipped = load_leaves(args.points, args.strict, args.degree, args.params)
     per_level = []
     for level in levels:

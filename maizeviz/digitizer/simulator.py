@@ -74,6 +74,8 @@ class FastrakSimulator:
         self.error_letter = " "
         self.last_press = -1e9
         self.press_gap = press_gap_s
+        self.streaming = True                   # continuous output not paused by the stylus
+        self.stylus_down_until = -1.0
         self.records_sent = 0
         self.presses = 0
         self.commands: list[str] = []
@@ -108,10 +110,13 @@ class FastrakSimulator:
             return False
         self.last_press = now
         self.presses += 1
-        if self.point_mode and not self.continuous:
-            self._emit_all(stylus=1)
-        elif self.point_mode:
-            self.continuous = not self.continuous
+        if self.point_mode:
+            if self.continuous:
+                self.streaming = not self.streaming     # a press toggles the stream
+            else:
+                self._emit_all(stylus=1)                # a press acts like P
+        else:
+            self.stylus_down_until = now + 0.1          # mouse mode: only item 16 shows it
         return True
 
     # ---------------------------------------------------------------------- faults
@@ -186,7 +191,9 @@ class FastrakSimulator:
                     out.append("".join(f"{np.clip(v, -999.99, 999.99):7.2f}" for v in vals).encode())
         return b"".join(out)
 
-    def _emit_all(self, stylus: int = 0) -> None:
+    def _emit_all(self, stylus: int | None = None) -> None:
+        if stylus is None:
+            stylus = int(time.monotonic() < self.stylus_down_until)
         self._write(b"".join(self._record(s, stylus) for s in sorted(self.active)))
         self.records_sent += len(self.active)
 
@@ -240,6 +247,7 @@ class FastrakSimulator:
             self._emit_all()
         elif c == "C":
             self.continuous = True
+            self.streaming = True
         elif c == "c":
             self.continuous = False
         elif c == "F" and not self.ignore_format:
@@ -253,9 +261,9 @@ class FastrakSimulator:
         elif c == "S":
             self._write(self._status(min(self.active) if self.active else 1))
         elif c == "W":
-            self.__init_defaults()
+            self._reset()
         elif c == "\x19":
-            self.__init_defaults()
+            self._reset()
             time.sleep(0.05)
         elif c in "Bb":
             pass
@@ -293,7 +301,7 @@ class FastrakSimulator:
         else:
             self._write(self._error(repr(cmd), -99))
 
-    def __init_defaults(self):
+    def _reset(self):
         self.binary = False
         self.centimetres = False
         self.continuous = False
@@ -330,7 +338,7 @@ class FastrakSimulator:
                         continue
                     else:
                         self._handle(ch)
-            if self.continuous and not self.silent and self.active:
+            if self.continuous and self.streaming and not self.silent and self.active:
                 now = time.monotonic()
                 if now >= next_tick:
                     # 120 Hz shared among the active stations: one frame per 1/120 s per station

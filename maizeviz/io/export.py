@@ -109,53 +109,46 @@ def _write_meshio(path, pts, faces, plant, leaf):
     mesh.write(path, binary=True)
 
 
-def export_meshes(path: str | Path, meshes) -> Path:
-    """Write meshes to ``path``; the format follows the extension (see :data:`FORMATS`).
+def write_mesh(path: str | Path, points: np.ndarray, faces: np.ndarray, plant: np.ndarray,
+               leaf: np.ndarray) -> Path:
+    """Write triangles with per-triangle plant and leaf ids; the format follows the extension.
+
+    Parameters
+    ----------
+    points : (V, 3) float64, cm; faces : (F, 3) int; plant, leaf : (F,) int32
 
     Raises
     ------
     MaizevizError
-        Unknown extension, nothing to write, or the file cannot be written.
+        Unknown extension, or the file cannot be written.
     """
     path = Path(path)
     ext = path.suffix.lower()
     if ext not in FORMATS:
         raise MaizevizError(f"{path}: unknown mesh format '{ext or '(none)'}'; "
                             f"use one of {', '.join(FORMATS)}")
-    pts, faces, plant, leaf = merge_meshes(meshes)
     writer = {".ply": _write_ply, ".obj": _write_obj, ".vtp": _write_vtp}.get(ext, _write_meshio)
     try:
-        writer(path, pts, faces, plant, leaf)
+        writer(path, points, faces, plant, leaf)
     except OSError as exc:
         raise MaizevizError(f"{path}: cannot write ({exc.strerror or exc})") from None
     return path
+
+
+def export_meshes(path: str | Path, meshes) -> Path:
+    """Write leaf meshes to ``path`` (see :data:`FORMATS`), plant and leaf ids per triangle."""
+    return write_mesh(path, *merge_meshes(meshes))
 
 
 def export_canopy(path: str | Path, canopy) -> Path:
-    """Write a canopy's leaves (cell data plant = digitized plant id x 1000 + placement index
-    is not used: ``plant`` is the placement index + 1, ``leaf`` the rank) and its stalks
-    (leaf id 0)."""
-    from types import SimpleNamespace
-
-    parts = [SimpleNamespace(points=canopy.vertices, faces=canopy.faces, plant=0, leaf=0)]
-    pts, faces, _, _ = merge_meshes(parts)
-    plant = canopy.face_instance.astype(np.int32) + 1
+    """Write a canopy: its leaves (``plant`` = placement number from 1, ``leaf`` = rank) and
+    its stalk cylinders (``leaf`` = 0)."""
+    plant = (canopy.face_instance + 1).astype(np.int32)
     leaf = canopy.face_leaf.astype(np.int32)
-    n = len(pts)
-    pts = np.vstack([pts, canopy.stalk_vertices])
-    faces = np.vstack([faces, canopy.stalk_faces + n])
     per_stalk = len(canopy.stalk_faces) // max(canopy.n_plants, 1)
+    points = np.vstack([canopy.vertices, canopy.stalk_vertices])
+    faces = np.vstack([canopy.faces, canopy.stalk_faces + len(canopy.vertices)])
     plant = np.concatenate([plant, np.repeat(np.arange(1, canopy.n_plants + 1, dtype=np.int32),
                                              per_stalk)])
     leaf = np.concatenate([leaf, np.zeros(len(canopy.stalk_faces), np.int32)])
-    path = Path(path)
-    ext = path.suffix.lower()
-    if ext not in FORMATS:
-        raise MaizevizError(f"{path}: unknown mesh format '{ext or '(none)'}'; "
-                            f"use one of {', '.join(FORMATS)}")
-    writer = {".ply": _write_ply, ".obj": _write_obj, ".vtp": _write_vtp}.get(ext, _write_meshio)
-    try:
-        writer(path, pts, faces, plant, leaf)
-    except OSError as exc:
-        raise MaizevizError(f"{path}: cannot write ({exc.strerror or exc})") from None
-    return path
+    return write_mesh(path, points, faces, plant, leaf)

@@ -344,3 +344,47 @@ def test_session_resume_after_controls(tmp_path):
     bad.write_text("hello,world\n1,2\n")
     with pytest.raises(SessionError, match="cannot resume"):
         Session(bad, cols=2, resume=True)
+
+
+def test_stylus_modes_and_continuous_output():
+    """Point mode: a press acts like P; continuous: records stream at 120 Hz / stations and a
+    press toggles the stream; mouse mode: the press shows only in the stylus item."""
+    from maizeviz.digitizer import protocol as fp
+    with FastrakSimulator(stations=(1, 2), noise_cm=0.0, press_gap_s=0.0) as sim:
+        port = FastrakPort(sim.path, answer_timeout=0.5)
+        port.configure((1, 2))
+        q = port.start_reader()
+        sim.press([1, 2, 3])
+        got = [q.get(timeout=5), q.get(timeout=5)]
+        assert [r.station for r in got] == [1, 2] and got[0].stylus == 1
+        port._send(fp.START_CONTINUOUS)
+        time.sleep(1.0)
+        port._send(fp.STOP_CONTINUOUS)
+        time.sleep(0.2)
+        n = q.qsize()
+        assert 40 <= n <= 140                       # 60 frames/s x 2 stations for 1 s
+        while not q.empty():
+            q.get()
+        port._send(fp.stylus_mode(1, False))        # mouse mode
+        time.sleep(0.1)
+        sim.press([4, 5, 6])                         # no record in polled mouse mode
+        time.sleep(0.3)
+        assert q.empty()
+        sim.press([4, 5, 6])
+        port._send(fp.POLL)
+        rec = q.get(timeout=5)
+        assert rec.stylus == 1 and rec.position == pytest.approx([4, 5, 6], abs=0.02)
+        port.close()
+
+
+def test_reconnect_reopens_and_reconfigures():
+    with FastrakSimulator(press_gap_s=0.0, noise_cm=0.0) as sim:
+        port = FastrakPort(sim.path, answer_timeout=0.5)
+        port.configure()
+        sim.centimetres = False                     # as after a power cycle
+        cfg = port.reconnect(attempts=2, wait=0.1)
+        assert cfg.centimetres and sim.centimetres
+        q = port.start_reader()
+        sim.press([7, 8, 9])
+        assert q.get(timeout=5).position == pytest.approx([7, 8, 9], abs=0.02)
+        port.close()
