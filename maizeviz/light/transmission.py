@@ -196,6 +196,18 @@ class _Tracer:
                 t = np.minimum(t, (edge - org[:, k]) / d)
         return np.maximum(t, 0.0)
 
+    def _cross(self, org):
+        """Rays that reached a plot edge re-enter through the opposite one."""
+        x0, y0, x1, y1 = self.bounds
+        for k, lo, hi in ((0, x0, x1), (1, y0, y1)):
+            d = self.down[k]
+            tol = 1e-7 * (hi - lo)
+            if d > 0:
+                org[org[:, k] >= hi - tol, k] -= hi - lo
+            elif d < 0:
+                org[org[:, k] <= lo + tol, k] += hi - lo
+        return org
+
     def _wrap(self, org):
         x0, y0, x1, y1 = self.bounds
         org[:, 0] = x0 + np.mod(org[:, 0] - x0, x1 - x0)
@@ -242,7 +254,9 @@ class _Tracer:
             todo, org = todo[go], org[go] + seg[go, None] * self.down
             done = done[go] + seg[go]
             remaining = remaining[go] - seg[go]
-            org = self._wrap(org)
+            org = self._cross(org)
+        if len(todo):  # pragma: no cover - a ray advances by at least one plot crossing a step
+            raise MaizevizError(f"periodic tracing left {len(todo)} rays unfinished")
         return prim, dist
 
 

@@ -141,6 +141,19 @@ def test_periodic_field_stops_rays_that_leave_the_plot():
     assert wrapped.transmission[0] < 0.5 * open_.transmission[0]
 
 
+@pytest.mark.parametrize("azimuth", [90.0, 270.0, 0.0, 180.0])
+def test_periodic_rays_wrap_in_every_direction(azimuth):
+    """A horizontal strip over half of a periodic plot, low sun: T(0) is exactly one half,
+    whichever plot edge the rays leave by (rays stuck on an edge would count as sunlit)."""
+    along_x = azimuth in (90.0, 270.0)
+    v = np.array([[0, 0, 10], [50, 0, 10], [50, 100, 10], [0, 100, 10]], float)
+    if not along_x:
+        v = v[:, [1, 0, 2]]
+    c = Canopy.from_triangles(v, np.array([[0, 1, 2], [0, 2, 3]]), plot(), np.array([1, 1]))
+    r = trace_light(c, LightRequest(Sun(80, azimuth), (0,), 1, (0, 0, 100, 100), periodic=True))
+    assert r.transmission[0] == pytest.approx(0.5, abs=0.011)
+
+
 def test_beer_lambert_from_mesh():
     c = canopy_of([(0, 0, 50, 100), (50, 50, 50, 20)])
     t, g, lai = beer_lambert(c, Sun(0, 0), [0, 50, 150])
