@@ -498,7 +498,8 @@ def _run_light(args) -> int:
             omega = math.log(t0) / math.log(b0) if 0 < t0 < 1 and 0 < b0 < 1 else float("nan")
             print(f"Beer-Lambert with G = {bl['G']:.3f} and L(h) from the {records[0]['level']} "
                   f"mesh; effective clumping at {heights[0]:g} cm: ln T / ln T_BL = {omega:.2f} "
-                  "(1: random foliage; row crops 0.7-1, so traced T sits a little above)")
+                  "(1: random foliage; below 1: clumped, T above Beer-Lambert, as in most row "
+                  "crops (0.7-1); above 1: more regular than random)")
         print()
         t_ref = records[0]["seconds"]["scene"] + records[0]["seconds"]["trace"]
         print(_fmt_table(
