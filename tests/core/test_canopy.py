@@ -284,3 +284,14 @@ def test_import_phenomenal_bad_files(tmp_path, capsys):
     empty.write_text('{"voxel_organs": []}')
     assert main(["import-phenomenal", str(empty), "--out", str(tmp_path / "o.csv")]) == EXIT_FAIL
     assert "no leaf could be imported" in capsys.readouterr().err
+
+
+def test_huge_layout_refused_and_large_one_fast():
+    rows = [{"x": 30.0 * i, "plants": [{"y": 30.0 * j, "plant": 1} for j in range(1001)]}
+            for i in range(100)]
+    with pytest.raises(LayoutError, match="at most 100000"):
+        layout_from_dict(_doc(rows=rows), plants={1})
+    big = layout_from_dict(_doc(rows=[{"x": 60.0 * i, "plants": [{"y": 30.0 * j, "plant": 1}
+                                                                  for j in range(200)]}
+                                      for i in range(100)]), plants={1})
+    assert len(big.placements) == 20000 and not any("closer" in w for w in big.warnings)
