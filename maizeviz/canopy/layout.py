@@ -313,7 +313,7 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
         raise LayoutError(f"{source}: {count} plants; a layout holds at most {MAX_PLANTS}")
     seed = int(_number(data, "seed", source, default=0.0))
     rng = np.random.default_rng(seed)
-    placements, cells, warnings = [], [], []
+    placements, cells, warnings, outside = [], [], [], []
     for i, row in enumerate(rows):
         where = f"{source}: rows[{i}]"
         if not isinstance(row, dict):
@@ -342,9 +342,12 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
                 r, t = jitter * np.sqrt(rng.random()), 2 * np.pi * rng.random()
                 px, py = x + r * np.cos(t), y + r * np.sin(t)
             if not (x0 <= px <= x1 and y0 <= py <= y1):
-                warnings.append(f"{w}: plant at ({px:.1f}, {py:.1f}) cm stands outside the field")
+                outside.append(f"{w}: plant at ({px:.1f}, {py:.1f}) cm")
             placements.append(Placement(pid, px, py, az, (0, 0)))
             cells.append(_cell(x, y, rs, ps))
+    if outside:
+        more = f" and {len(outside) - 1} more" if len(outside) > 1 else ""
+        warnings.append(f"{outside[0]} stands outside the field{more}")
     overlap = _overlaps(np.array(cells))
     if overlap:
         warnings.append(f"{source}: some positions are closer than the spacing {overlap}")

@@ -295,3 +295,4 @@ def test_huge_layout_refused_and_large_one_fast():
                                                                   for j in range(200)]}
                                       for i in range(100)]), plants={1})
     assert len(big.placements) == 20000 and not any("closer" in w for w in big.warnings)
+    assert len(big.warnings) == 1 and "and 19990 more" in big.warnings[0]
