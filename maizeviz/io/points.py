@@ -98,6 +98,13 @@ def read_points(path: str | Path) -> PointsTable:
 
 def parse_points(text: str, source: str = "<memory>") -> PointsTable:
     """Parse the text of a points CSV file; see :func:`read_points`."""
+    try:
+        return _parse(text, source)
+    except csv.Error as exc:                       # a field over csv's size limit, a NUL...
+        raise PointsFileError(f"{source}: not a readable CSV file ({exc})") from None
+
+
+def _parse(text: str, source: str) -> PointsTable:
     text = text.lstrip("\ufeff")
     if not text.strip():
         raise PointsFileError(f"{source}: the file is empty")

@@ -139,6 +139,11 @@ def test_same_row_col_twice_is_refused_with_lines():
     assert "row 1, col 1 appears twice" in str(errors[0]) and "lines" in str(errors[0])
 
 
+def test_hostile_csv_field(write_csv):
+    with pytest.raises(PointsFileError, match="not a readable CSV"):
+        read_points(write_csv("plant,leaf,row,col,x,y,z\n1,1,0,0,\"" + "9" * 200000 + "\",0,0\n"))
+
+
 def test_semicolon_and_bom():
     text = "\ufeffplant;leaf;row;col;x;y;z\n1;1;0;0;0;0;0\n1;1;0;1;1;0;0\n1;1;1;0;0;4;0\n1;1;1;1;1;4;0\n"
     grids, errors = build_grids(parse_points(text))
