@@ -757,12 +757,32 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _no_command(parser, argv) -> int:
+    """No subcommand: the desktop app where there is a screen, else the headless report."""
+    rest = [a for a in argv if a != "--debug"]
+    try:
+        from app.main import has_screen, run
+    except ImportError as exc:                     # the GUI packages are not installed
+        _say(f"note: the desktop app is unavailable ({exc}); running the headless report")
+        has_screen, run = (lambda: False), None
+    if has_screen():
+        return run(rest)
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[1] / "resources" / "block3x3.csv"
+    _say("no screen (DISPLAY is not set): the headless report on the bundled example follows; "
+         "for the window run 'xvfb-run -a maizeviz --screenshot app.png' or use a desktop")
+    return main(["canopy", str(example), "--tile", "3x3", "--levels"])
+
+
 def main(argv=None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
-    if args.command is None:
-        parser.print_help()
-        return EXIT_OK
+    tokens = list(sys.argv[1:] if argv is None else argv)
+    commands = set(parser._subparsers._group_actions[0].choices)
+    first = next((t for t in tokens if t != "--debug"), None)
+    if first not in commands and first not in ("-h", "--help"):
+        return _no_command(parser, tokens)           # the app, with its own options
+    args = parser.parse_args(tokens)
     debug = args.debug or bool(os.environ.get("MAIZEVIZ_DEBUG"))
     try:
         return args.run(args)

@@ -139,3 +139,16 @@ def test_core_imports_no_qt_or_pyvista():
             "print(','.join(bad)); sys.exit(1 if bad else 0)")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stdout
+
+
+def test_no_command_without_screen_runs_the_headless_report():
+    import os
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    proc = subprocess.run([sys.executable, "-m", "maizeviz"], capture_output=True, text=True,
+                          env=env, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert "no screen" in proc.stderr
+    assert "4 triangles, widths unscaled" in proc.stdout and "LAI" in proc.stdout
+    helped = subprocess.run([sys.executable, "-m", "maizeviz", "--help"], capture_output=True,
+                            text=True, env=env)
+    assert helped.returncode == 0 and "canopy" in helped.stdout

@@ -1,0 +1,60 @@
+"""Start the desktop app: ``maizeviz`` (or ``python -m app``).
+
+``--screenshot PNG`` builds the canopy, computes light once, saves a picture of the window and
+quits: the way to look at the app on a machine without a screen (under ``xvfb-run``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+
+def has_screen() -> bool:
+    """True where Qt can open a window (an X server or Wayland, or macOS/Windows)."""
+    if sys.platform in ("darwin", "win32"):
+        return True
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def run(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="maizeviz", description="The maizeviz desktop app.")
+    ap.add_argument("points", nargs="?", help="points CSV (default: the bundled 3x3 block)")
+    ap.add_argument("--tile", type=int, default=3, choices=(1, 3, 5))
+    ap.add_argument("--screenshot", metavar="PNG", help="save the window and quit")
+    args = ap.parse_args(argv)
+    os.environ.setdefault("QT_API", "pyside6")
+    from PySide6.QtCore import QTimer
+    from PySide6.QtWidgets import QApplication
+
+    from app.main_window import EXAMPLE, MainWindow
+
+    app = QApplication.instance() or QApplication([sys.argv[0]])
+    app.setApplicationName("maizeviz")
+    window = MainWindow(args.points or EXAMPLE, args.tile)
+    window.show()
+    code = {"value": 0}
+    if args.screenshot:
+        def shoot():
+            window.grab().save(args.screenshot)
+            print(f"saved {args.screenshot}")
+            window.close()
+            app.quit()
+
+        def fail(msg):
+            print(f"error: {msg}", file=sys.stderr)
+            code["value"] = 1
+            window.close()
+            app.quit()
+
+        window.canopy_shown.connect(lambda _: window.compute_light())
+        window.light_shown.connect(lambda: QTimer.singleShot(500, shoot))
+        window.failed.connect(fail)
+        QTimer.singleShot(180_000, lambda: fail("timed out"))
+    app.exec()
+    return code["value"]
+
+
+if __name__ == "__main__":
+    sys.exit(run())

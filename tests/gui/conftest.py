@@ -1,0 +1,43 @@
+"""GUI tests: a real window under Xvfb (pytest-xvfb starts it), driven with pytest-qt."""
+
+import os
+import tempfile
+import threading
+
+import pytest
+
+os.environ.setdefault("QT_API", "pyside6")
+os.environ["XDG_CONFIG_HOME"] = tempfile.mkdtemp(prefix="maizeviz-settings-")
+
+
+@pytest.fixture
+def window(qtbot):
+    """A main window on the bundled example; closed (viewport included) after the test."""
+    from app.main_window import EXAMPLE, MainWindow
+
+    made = []
+
+    def make(points=EXAMPLE, tile=3):
+        w = MainWindow(points, tile)
+        w.show()
+        qtbot.waitExposed(w)
+        made.append(w)
+        return w
+
+    yield make
+    for w in made:
+        w.close()
+
+
+@pytest.fixture(autouse=True)
+def no_leftover_threads(qtbot):
+    """Fail a test that leaves a worker thread running (leftovers crash later tests)."""
+    before = {t.ident for t in threading.enumerate()}
+    yield
+    from PySide6.QtCore import QThreadPool
+    pool = QThreadPool.globalInstance()
+    pool.waitForDone(10_000)
+    assert pool.activeThreadCount() == 0, "a worker is still running after the test"
+    extra = [t for t in threading.enumerate() if t.ident not in before and t.is_alive()
+             and not t.daemon]
+    assert not extra, f"threads left running: {extra}"
