@@ -31,12 +31,22 @@ def test_fast_slider_moves_show_only_the_last_level(window, qtbot):
     qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait()
     shown = []
     w.canopy_shown.connect(shown.append)
+    # moves within the debounce interval coalesce into one rebuild
     for stop in ("standard", "16", "8", "K1", "4"):
         w.slider.setValue(LEVELS.index(stop))
-        qtbot.wait(20)
     qtbot.waitUntil(lambda: bool(shown) and shown[-1] == "4 triangles", timeout=TIMEOUT)
-    qtbot.wait(500)
-    assert shown == ["4 triangles"]
+    # rebuilds started back to back: the superseded one's result is dropped
+    w.slider.blockSignals(True)
+    w.slider.setValue(LEVELS.index("K2"))
+    w.rebuild()
+    w.slider.setValue(LEVELS.index("8"))
+    w.rebuild()
+    w.slider.blockSignals(False)
+    qtbot.waitUntil(lambda: shown[-1] == "8 triangles", timeout=TIMEOUT)
+    from PySide6.QtCore import QThreadPool
+    QThreadPool.globalInstance().waitForDone(TIMEOUT)
+    qtbot.wait(200)
+    assert shown == ["4 triangles", "8 triangles"]
 
 
 def test_compute_light(window, qtbot):
