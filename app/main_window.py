@@ -63,6 +63,7 @@ class MainWindow(QMainWindow):
         self._build_canopy_panel(tile)
         self._build_light_panel()
         self._build_messages()
+        self._build_digitizer()
         self.progress = QProgressBar()
         self.progress.setMaximumWidth(240)
         self.statusBar().addPermanentWidget(self.progress)
@@ -163,6 +164,15 @@ class MainWindow(QMainWindow):
         dock.setObjectName("light")
         dock.setWidget(box)
         self.addDockWidget(Qt.RightDockWidgetArea, dock)
+
+    def _build_digitizer(self) -> None:
+        from app.digitizer_panel import DigitizerPanel
+
+        self.digitizer = DigitizerPanel(self.viewport)
+        dock = QDockWidget("Digitizer", self)
+        dock.setObjectName("digitizer")
+        dock.setWidget(self.digitizer)
+        self.addDockWidget(Qt.LeftDockWidgetArea, dock)
 
     def _build_messages(self) -> None:
         self.messages = QPlainTextEdit(readOnly=True)
@@ -333,6 +343,7 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------------ close
     def closeEvent(self, event) -> None:
+        self.digitizer.stop("window closed")
         for job in self._jobs.values():
             job.cancel.set()
         for worker in list(self._workers):

@@ -27,7 +27,29 @@ class Viewport(QtInteractor):
         self.add_axes()
         self._framed = False
 
+    def hide_canopy(self) -> None:
+        """Make room for a digitizing session."""
+        for name in ("canopy", "stalks", "ground"):
+            self.remove_actor(name, render=False)
+        self._framed = False
+
+    def show_leaf_surfaces(self, meshes, points) -> None:
+        """Digitized points (N, 3) and leaf meshes (LeafMesh list) of the plant being digitized."""
+        for name in [n for n in self.actors if str(n).startswith("leafsurf")]:
+            self.remove_actor(name, render=False)
+        for k, m in enumerate(meshes):
+            self.add_mesh(_polydata(m.points, m.faces), name=f"leafsurf{k}", color="yellowgreen",
+                          show_edges=True, edge_color="darkgreen")
+        self.add_mesh(pv.PolyData(np.asarray(points, np.float32)), name="digitized",
+                      color="red", render_points_as_spheres=True, point_size=9)
+        if not self._framed:
+            self.reset_camera()
+            self._framed = True
+        self.render()
+
     def show_canopy(self, canopy) -> None:
+        for name in [n for n in self.actors if str(n).startswith("leafsurf")] + ["digitized"]:
+            self.remove_actor(name, render=False)
         leaves = _polydata(canopy.vertices, canopy.faces)
         leaves.cell_data["leaf rank"] = canopy.face_leaf
         self.add_mesh(leaves, name="canopy", scalars="leaf rank", cmap="summer",

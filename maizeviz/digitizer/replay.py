@@ -48,6 +48,8 @@ def replay_points(sim, path, pace: float = 1.0, faults: bool = False, sway: bool
     last_leaf_start = int(np.flatnonzero(np.any(ids[:, :2] != ids[-1, :2], axis=1)).max() + 1) \
         if len(ids) and np.any(ids[:, :2] != ids[-1, :2]) else len(ids)
     for k, (key, p) in enumerate(zip(ids, xyz)):
+        if sim.closed:
+            break
         leaf = (int(key[0]), int(key[1]))
         if leaf != last_leaf:
             say("type p (next plant) in the recorder" if leaf[0] != last_leaf[0]
@@ -74,8 +76,11 @@ def replay_points(sim, path, pace: float = 1.0, faults: bool = False, sway: bool
             say("fault: that press was out of the motion box; pressing again")
             time.sleep(max(pace, 0.34))
         while not sim.press(p, plant_frame=sway):
+            if sim.closed:
+                return made
             time.sleep(0.05)
         made += 1
         time.sleep(max(pace, 0.34))
-    say("replay done: type q in the recorder")
+    if not sim.closed:
+        say("replay done: type q in the recorder")
     return made

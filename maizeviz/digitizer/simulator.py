@@ -128,6 +128,11 @@ class FastrakSimulator:
         """BIT error letter of the following records (' ' for none)."""
         self.error_letter = letter
 
+    @property
+    def closed(self) -> bool:
+        """True once the port has vanished or the simulator was closed."""
+        return self._stop.is_set()
+
     def vanish(self) -> None:
         """The port disappears (USB adapter pulled): the master side closes."""
         self._stop.set()
