@@ -64,6 +64,7 @@ class MainWindow(QMainWindow):
         self._build_light_panel()
         self._build_messages()
         self._build_digitizer()
+        self._build_layout_editor()
         self.progress = QProgressBar()
         self.progress.setMaximumWidth(240)
         self.statusBar().addPermanentWidget(self.progress)
@@ -174,6 +175,28 @@ class MainWindow(QMainWindow):
         dock.setWidget(self.digitizer)
         self.addDockWidget(Qt.LeftDockWidgetArea, dock)
 
+    def _build_layout_editor(self) -> None:
+        from app.layout_panel import LayoutPanel
+
+        self.layout_panel = LayoutPanel()
+        self.layout_panel.applied.connect(self._on_layout)
+        self.layout_panel.problem.connect(self.say)
+        dock = QDockWidget("Canopy layout", self)
+        dock.setObjectName("layout")
+        dock.setWidget(self.layout_panel)
+        self.addDockWidget(Qt.LeftDockWidgetArea, dock)
+        self.tabifyDockWidget(self.findChild(QDockWidget, "digitizer"), dock)
+
+    def _on_layout(self, layout) -> None:
+        from dataclasses import replace
+
+        if self.loaded is None:
+            return
+        self.loaded = replace(self.loaded, layout=layout)
+        self.rows.clear()
+        self.say(f"layout applied: {len(layout.placements)} plants")
+        self.rebuild()
+
     def _build_messages(self) -> None:
         self.messages = QPlainTextEdit(readOnly=True)
         self.messages.setMaximumBlockCount(500)
@@ -255,8 +278,10 @@ class MainWindow(QMainWindow):
             self.say(f"note: {w}")
         for e in loaded.skipped:
             self.say(f"skipped: {e}")
-        self.say(f"{len(loaded.leaves)} leaves of {len({lf.grid.plant for lf in loaded.leaves})} "
-                 f"plants; {len(loaded.layout.placements)} plants in the canopy")
+        plants = {lf.grid.plant for lf in loaded.leaves}
+        self.say(f"{len(loaded.leaves)} leaves of {len(plants)} plants; "
+                 f"{len(loaded.layout.placements)} plants in the canopy")
+        self.layout_panel.show_layout(loaded.layout, plants)
         self.rebuild()
 
     def _on_slider(self, _value: int) -> None:
