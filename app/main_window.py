@@ -185,7 +185,9 @@ class MainWindow(QMainWindow):
         dock.setObjectName("layout")
         dock.setWidget(self.layout_panel)
         self.addDockWidget(Qt.LeftDockWidgetArea, dock)
-        self.tabifyDockWidget(self.findChild(QDockWidget, "digitizer"), dock)
+        digitizer = self.findChild(QDockWidget, "digitizer")
+        self.tabifyDockWidget(digitizer, dock)
+        digitizer.raise_()
 
     def _on_layout(self, layout) -> None:
         from dataclasses import replace
