@@ -42,7 +42,6 @@ def replay_points(sim, path, pace: float = 1.0, faults: bool = False, sway: bool
     if wait:
         wait_for_recorder(sim)
     say(f"replaying {len(ids)} points from {path}")
-    rng = np.random.default_rng(0)
     made = 0
     last_leaf = tuple(ids[0, :2]) if len(ids) else None
     last_leaf_start = int(np.flatnonzero(np.any(ids[:, :2] != ids[-1, :2], axis=1)).max() + 1) \
