@@ -16,9 +16,7 @@ from PySide6.QtCore import QObject, Signal
 from maizeviz.canopy.layout import tiled_layout
 from maizeviz.canopy.measures import measure_canopy
 from maizeviz.canopy.scene import build_canopy, plant_bases
-from maizeviz.io.points import read_points
-from maizeviz.leaf.grid import build_grids
-from maizeviz.leaf.reconstruct import fit_leaves, parse_level
+from maizeviz.leaf.reconstruct import parse_level, read_leaves
 from maizeviz.light.transmission import LightRequest, trace_light
 
 
@@ -52,14 +50,12 @@ class Loaded:
 
 def load_points(path: str, tile=(3, 3), row_spacing=60.0, plant_spacing=30.0) -> Loaded:
     """Read, grid and fit a points file and tile it (the paper's canopy by default)."""
-    table = read_points(path)
-    grids, skipped = build_grids(table)
-    leaves, fit_skipped = fit_leaves(grids)
-    if not leaves:
+    found = read_leaves(path)
+    if not found.leaves:
         raise ValueError(f"{path}: no leaf could be reconstructed")
-    layout = tiled_layout(plant_bases(leaves), tile, row_spacing, plant_spacing)
-    return Loaded(path, leaves, skipped + fit_skipped, layout,
-                  tuple(table.problems) + layout.warnings)
+    layout = tiled_layout(plant_bases(found.leaves), tile, row_spacing, plant_spacing)
+    return Loaded(path, found.leaves, found.skipped, layout,
+                  tuple(found.problems) + tuple(found.notes) + layout.warnings)
 
 
 @dataclass(frozen=True)

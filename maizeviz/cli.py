@@ -44,27 +44,18 @@ def _add_leaf(sub):
 
 
 def load_leaves(path, strict=False, degree=3, method="chord"):
-    """Read, grid and fit a points file; report problems on stderr.
+    """Read, grid and fit a points file, saying skipped lines and repairs on stderr.
 
     Returns (leaves, skipped errors).
     """
-    from maizeviz.io.points import read_points
-    from maizeviz.leaf.grid import build_grids
-    from maizeviz.leaf.reconstruct import fit_leaves
+    from maizeviz.leaf.reconstruct import read_leaves
 
-    if degree < 1:
-        raise MaizevizError(f"--degree must be >= 1, got {degree}")
-    table = read_points(path)
-    for problem in table.problems:
-        _say(f"warning: {table.source}: {problem}")
-    if strict and table.problems:
-        raise MaizevizError(f"{table.source}: {table.problems[0]}")
-    grids, errors = build_grids(table, strict=strict)
-    for g in grids:
-        for note in g.notes:
-            _say(f"note: plant {g.plant}, leaf {g.leaf}: {note}")
-    leaves, fit_errors = fit_leaves(grids, degree, method, strict=strict)
-    return leaves, errors + fit_errors
+    found = read_leaves(path, strict, degree, method)
+    for problem in found.problems:
+        _say(f"warning: {problem}")
+    for note in found.notes:
+        _say(f"note: {note}")
+    return found.leaves, found.skipped
 
 
 def _fmt_table(headers, rows) -> str:
@@ -399,7 +390,8 @@ def _write_rows(path, rows):
 def _run_light(args) -> int:
     from maizeviz.canopy.scene import build_canopy
     from maizeviz.light.heatmap import write_heatmaps
-    from maizeviz.light.transmission import LightRequest, beer_lambert, leaf_light, trace_light
+    from maizeviz.light.transmission import (LightRequest, beer_lambert, leaf_light, plant_light,
+                                             trace_light)
 
     levels = _levels_from(args)
     sun = _sun_from(args)
@@ -457,20 +449,8 @@ def _run_light(args) -> int:
                 _write_rows(args.leaf_light if len(levels) == 1 else
                             _suffixed(args.leaf_light, level), rows)
             if args.plant_light:
-                per = {}
-                for r in rows:
-                    k = r["instance"]
-                    d = per.setdefault(k, {"instance": k, "plant": r["plant"], "x_cm": r["x_cm"],
-                                           "y_cm": r["y_cm"], "level": level.label, "leaves_lit": 0,
-                                           "sunlit_area_cm2": 0.0, "second_class_area_cm2": 0.0,
-                                           "sunlit_intercepted_cm2": 0.0,
-                                           "second_class_intercepted_cm2": 0.0})
-                    d["leaves_lit"] += 1
-                    for key in ("sunlit_area_cm2", "second_class_area_cm2",
-                                "sunlit_intercepted_cm2", "second_class_intercepted_cm2"):
-                        d[key] += r[key]
                 _write_rows(args.plant_light if len(levels) == 1 else
-                            _suffixed(args.plant_light, level), list(per.values()))
+                            _suffixed(args.plant_light, level), plant_light(rows))
         records.append(rec)
 
     if args.json:

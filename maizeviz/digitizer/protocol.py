@@ -141,48 +141,18 @@ def binary_length(items) -> int:
     return 3 + sum(ITEMS[i][1] for i in items)
 
 
-def parse_ascii_record(line: bytes, items) -> Record:
-    """A type-0 ASCII record (with its CR LF) under output list ``items``.
-
-    Raises
-    ------
-    ValueError
-        When the length or a field does not fit.
-    """
-    if len(line) != ascii_length(items):
-        raise ValueError(f"{len(line)} bytes, expected {ascii_length(items)}")
-    text = line.decode("ascii")
-    station = int(text[1])
+def _parse_record(data: bytes, items, binary: bool) -> Record:
+    """Walk the output list over one record; only how a value is decoded differs by format."""
+    expected = binary_length(items) if binary else ascii_length(items)
+    if len(data) != expected:
+        raise ValueError(f"{len(data)} bytes, expected {expected}")
+    if not binary:
+        data.decode("ascii")                              # text records are ASCII throughout
     pos = 3
     values, stylus = {}, None
     for item in items:
-        width, _, count = ITEMS[item]
-        chunk = text[pos:pos + width]
-        pos += width
-        if item == 16:
-            c = chunk.strip()[-1:] if chunk.strip() else ""
-            if c not in ("0", "1"):
-                raise ValueError(f"stylus field {chunk!r}")
-            stylus = int(c)
-        elif item == 1:
-            if chunk != "\r\n":
-                raise ValueError("no CR LF where item 1 ends the record")
-        elif count:
-            step = width // count
-            values[item] = tuple(_field(chunk[k * step:(k + 1) * step]) for k in range(count))
-    return Record(station, text[2], values.get(2) or values.get(52),
-                  values.get(4) or values.get(54), stylus, values)
-
-
-def parse_binary_record(data: bytes, items) -> Record:
-    """A type-0 binary record: header, little-endian float32 per value, raw CR LF / stylus."""
-    if len(data) != binary_length(items):
-        raise ValueError(f"{len(data)} bytes, expected {binary_length(items)}")
-    station = data[1] - 0x30
-    pos = 3
-    values, stylus = {}, None
-    for item in items:
-        _, size, count = ITEMS[item]
+        ascii_width, binary_size, count = ITEMS[item]
+        size = binary_size if binary else ascii_width
         chunk = data[pos:pos + size]
         pos += size
         if item == 16:
@@ -193,10 +163,30 @@ def parse_binary_record(data: bytes, items) -> Record:
         elif item == 1:
             if chunk != b"\r\n":
                 raise ValueError("no CR LF where item 1 ends the record")
-        elif count:
+        elif count and binary:
             values[item] = struct.unpack(f"<{count}f", chunk)
-    return Record(station, chr(data[2]), values.get(2) or values.get(52),
+        elif count:
+            step = size // count
+            values[item] = tuple(_field(chunk[k * step:(k + 1) * step].decode("ascii"))
+                                 for k in range(count))
+    return Record(data[1] - 0x30, chr(data[2]), values.get(2) or values.get(52),
                   values.get(4) or values.get(54), stylus, values)
+
+
+def parse_ascii_record(line: bytes, items) -> Record:
+    """A type-0 ASCII record (with its CR LF) under output list ``items``.
+
+    Raises
+    ------
+    ValueError
+        When the length or a field does not fit.
+    """
+    return _parse_record(line, items, binary=False)
+
+
+def parse_binary_record(data: bytes, items) -> Record:
+    """A type-0 binary record: header, little-endian float32 per value, raw CR LF / stylus."""
+    return _parse_record(data, items, binary=True)
 
 
 def parse_reply(line: bytes):

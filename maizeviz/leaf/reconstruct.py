@@ -10,11 +10,13 @@ from __future__ import annotations
 import re
 from collections import defaultdict
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
-from maizeviz.errors import LeafError
-from maizeviz.leaf.grid import LeafGrid
+from maizeviz.errors import LeafError, MaizevizError
+from maizeviz.io.points import read_points
+from maizeviz.leaf.grid import LeafGrid, build_grids
 from maizeviz.leaf.nurbs import NurbsSurfaces, fit_surfaces, refine_parameters
 from maizeviz.mesh import measures
 from maizeviz.mesh.simplify import simplify
@@ -87,6 +89,19 @@ class Leaf:
     def key(self) -> tuple[int, int]:
         return self.grid.key
 
+    @cached_property
+    def reference_area_cm2(self) -> float:
+        """Area (cm2) of the paper's reference mesh (K = 4); computed once per leaf, so a
+        complexity slider does not pay for it at every rebuild."""
+        pts, u, v = _sample(self.surface, REFERENCE_K)
+        return measures.area(mesh_grid(pts[0], u[0], v[0]))
+
+    @cached_property
+    def deviation_samples(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The smooth surface sampled at K = 8: points (A, B, 3) cm, u (A,), v (B,)."""
+        pts, u, v = _sample(self.surface, DEVIATION_K)
+        return pts[0], u[0], v[0]
+
 
 def fit_leaves(grids: list[LeafGrid], degree: int = 3, method: str = "chord",
                strict: bool = False) -> tuple[list[Leaf], list[LeafError]]:
@@ -116,6 +131,37 @@ def fit_leaves(grids: list[LeafGrid], degree: int = 3, method: str = "chord",
                         raise
                     errors.append(exc)
     return [result[i] for i in sorted(result)], errors
+
+
+@dataclass(frozen=True)
+class LeavesFromFile:
+    """What :func:`read_leaves` found: fitted leaves, refused leaves, skipped lines, repairs."""
+
+    leaves: list
+    skipped: list
+    problems: list
+    notes: list
+
+
+def read_leaves(path, strict: bool = False, degree: int = 3,
+                method: str = "chord") -> LeavesFromFile:
+    """Read, grid and fit a points file: the first stage of every command and of the app.
+
+    Raises
+    ------
+    MaizevizError
+        The file cannot be read; with ``strict``, also the first skipped line or bad leaf.
+    """
+    if degree < 1:
+        raise MaizevizError(f"--degree must be >= 1, got {degree}")
+    table = read_points(path)
+    problems = [f"{table.source}: {p}" for p in table.problems]
+    if strict and problems:
+        raise MaizevizError(problems[0])
+    grids, errors = build_grids(table, strict=strict)
+    notes = [f"plant {g.plant}, leaf {g.leaf}: {n}" for g in grids for n in g.notes]
+    leaves, fit_errors = fit_leaves(grids, degree, method, strict=strict)
+    return LeavesFromFile(leaves, errors + fit_errors, problems, notes)
 
 
 def _sample(surfaces: NurbsSurfaces, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -154,14 +200,11 @@ def mesh_leaves(leaves: list[Leaf], level: Level, preserve_area: bool = True,
                 out[i] = mesh_grid(pts[k], u[k], v[k], level.label, g.plant, g.leaf)
             tick(len(idx))
             continue
-        targets = [None] * len(idx)
-        if preserve_area:
-            ref, u, v = _sample(surf, REFERENCE_K)
-            targets = [measures.area(mesh_grid(ref[k], u[k], v[k])) for k in range(len(idx))]
         for k, i in enumerate(idx):
             g = leaves[i].grid
+            target = leaves[i].reference_area_cm2 if preserve_area else None
             out[i] = simplify(g.points, surf.params_u[k], surf.params_v[k], level.triangles,
-                              g.tip_collapsed, targets[k], g.plant, g.leaf)
+                              g.tip_collapsed, target, g.plant, g.leaf)
             tick(1)
     return out
 
@@ -212,12 +255,10 @@ def measure(leaf: Leaf, mesh: LeafMesh) -> LeafMeasures:
     The reference area is the paper's reference mesh (K = 4); the deviation is measured from
     the surface sampled at K = 8.
     """
-    ref_pts, ru, rv = _sample(leaf.surface, REFERENCE_K)
-    dev_pts, du, dv = _sample(leaf.surface, DEVIATION_K)
     m, n = leaf.grid.shape
     return LeafMeasures(
         plant=leaf.grid.plant, leaf=leaf.grid.leaf, rows=m, cols=n, level=mesh.level,
         triangles=mesh.n_triangles, area_cm2=measures.area(mesh),
         projected_area_cm2=measures.projected_area(mesh),
-        max_deviation_cm=measures.max_deviation(mesh, dev_pts[0], du[0], dv[0]),
-        reference_area_cm2=measures.area(mesh_grid(ref_pts[0], ru[0], rv[0])))
+        max_deviation_cm=measures.max_deviation(mesh, *leaf.deviation_samples),
+        reference_area_cm2=leaf.reference_area_cm2)

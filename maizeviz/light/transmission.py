@@ -19,6 +19,7 @@ import math
 import time
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -92,10 +93,14 @@ class LightResult:
     density: float = 0.0
     direction: np.ndarray | None = None
 
+    @cached_property
+    def ground_xy(self) -> np.ndarray:
+        """Where each ray meets the ground (N, 2) cm, in ray grid order."""
+        return ray_grid(self.rect, self.density)[0]
+
     def crossings(self, height: float) -> np.ndarray:
         """Where each ray crosses the plane at ``height`` (N, 2) cm (ray grid order)."""
-        ground, _ = ray_grid(self.rect, self.density)
-        return ground + self.direction[:2] * (height / self.direction[2])
+        return self.ground_xy + self.direction[:2] * (height / self.direction[2])
 
 
 def _grid_shape(rect, density: float) -> tuple[int, int]:
@@ -397,6 +402,22 @@ def leaf_light(canopy: Canopy, result: LightResult) -> list[dict]:
                      "sunlit_intercepted_cm2": float(first[idx].sum() * result.ray_area_cm2),
                      "second_class_intercepted_cm2": float(second[idx].sum() * result.ray_area_cm2)})
     return rows
+
+
+def plant_light(rows: list[dict]) -> list[dict]:
+    """:func:`leaf_light` rows summed per plant standing in the canopy (one row per placement)."""
+    sums = ("sunlit_area_cm2", "second_class_area_cm2", "sunlit_intercepted_cm2",
+            "second_class_intercepted_cm2")
+    per: dict[int, dict] = {}
+    for r in rows:
+        d = per.setdefault(r["instance"], {
+            "instance": r["instance"], "plant": r["plant"], "x_cm": r["x_cm"], "y_cm": r["y_cm"],
+            **({"level": r["level"]} if "level" in r else {}), "leaves_lit": 0,
+            **{k: 0.0 for k in sums}})
+        d["leaves_lit"] += 1
+        for k in sums:
+            d[k] += r[k]
+    return list(per.values())
 
 
 def beer_lambert(canopy: Canopy, sun: Sun, heights_cm) -> tuple[np.ndarray, float, np.ndarray]:
