@@ -1,5 +1,5 @@
 import sys
 
-from app.main import run
+from maizeviz_app.main import run
 
 sys.exit(run())

@@ -9,7 +9,6 @@ arrive.
 
 from __future__ import annotations
 
-import queue
 import threading
 import time
 from pathlib import Path
@@ -20,10 +19,11 @@ from PySide6.QtWidgets import (QCheckBox, QFileDialog, QFormLayout, QHBoxLayout,
                                QLineEdit, QListWidget, QPushButton, QSpinBox, QVBoxLayout,
                                QWidget)
 
-from maizeviz.digitizer.port import FastrakPort, PortLost
+from maizeviz.digitizer.port import FastrakPort
+from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import Session
-
-EXAMPLE = Path(__file__).resolve().parents[1] / "resources" / "block3x3.csv"
+from maizeviz.errors import MaizevizError
+from maizeviz.resources import example_points
 
 
 class DigitizerPanel(QWidget):
@@ -35,13 +35,11 @@ class DigitizerPanel(QWidget):
     def __init__(self, viewport=None, parent=None):
         super().__init__(parent)
         self.viewport = viewport
-        self.port: FastrakPort | None = None
-        self.session: Session | None = None
+        self.recorder: Recorder | None = None
         self.sim = None
         self._replay: threading.Thread | None = None
-        self._events: queue.Queue = queue.Queue()
         self._settings = QSettings("maizeviz", "maizeviz")
-        self.demo_file = EXAMPLE
+        self.demo_file = example_points()
         self.demo_pace = 0.5
 
         lay = QVBoxLayout(self)
@@ -117,6 +115,10 @@ class DigitizerPanel(QWidget):
         for b in self.control_buttons:
             b.setEnabled(running)
 
+    @property
+    def session(self) -> Session | None:
+        return self.recorder.session if self.recorder is not None else None
+
     def _show_state(self) -> None:
         if self.session is None:
             return
@@ -129,11 +131,10 @@ class DigitizerPanel(QWidget):
         """Open the session file, then the port (or a simulator), then start reading."""
         ref = 2 if self.reference.isChecked() else None
         try:
-            self.session = Session(self.out_edit.text(), self.cols.value(),
-                                   self.resume.isChecked(), ref)
-        except Exception as exc:  # noqa: BLE001 - a slot must not let an exception escape
+            session = Session(self.out_edit.text(), self.cols.value(), self.resume.isChecked(),
+                              ref)
+        except MaizevizError as exc:
             self._say(f"error: {exc}")
-            self.session = None
             return
         port_name = self.port_edit.text()
         if demo:
@@ -142,10 +143,11 @@ class DigitizerPanel(QWidget):
             self.sim = FastrakSimulator(stations=(1, 2) if ref else (1,))
             port_name = self.sim.path
             self._say(f"demo: simulated FASTRAK on {port_name}")
+        port = FastrakPort(port_name, self.baud.value(), answer_timeout=1.0)
+        self.recorder = Recorder(session, port)
         try:
-            self.port = FastrakPort(port_name, self.baud.value(), answer_timeout=1.0)
-            cfg = self.port.configure((1,) if ref is None else (1, ref))
-        except Exception as exc:  # noqa: BLE001
+            cfg = port.configure((1,) if ref is None else (1, ref))
+        except MaizevizError as exc:
             self._say(f"error: {exc}")
             self.stop("could not connect")
             return
@@ -153,12 +155,12 @@ class DigitizerPanel(QWidget):
             self._say(f"warning: {w}")
         if not demo:
             self._settings.setValue("port", port_name)
-        self.port.start_reader(self._events.put)
+        self.recorder.start()
         if self.viewport is not None:
             self.viewport.hide_canopy()
         self.timer.start()
         self._set_running(True)
-        self._say(f"recording to {self.session.path}")
+        self._say(f"recording to {session.path}")
         self._show_state()
         if demo:
             self._start_replay(ref is not None)
@@ -166,12 +168,15 @@ class DigitizerPanel(QWidget):
     def _start_replay(self, sway: bool) -> None:
         from maizeviz.digitizer.replay import replay_points
 
+        recorder = self.recorder
+        assert recorder is not None
+
         def say(msg):
             for key in ("n", "p", "q"):
                 if f"type {key} " in msg:
-                    self._events.put(("control", key))
+                    recorder.control(key)
                     return
-            self._events.put(("say", msg))
+            recorder.say(msg)
 
         sim, path, pace = self.sim, self.demo_file, self.demo_pace
 
@@ -179,54 +184,36 @@ class DigitizerPanel(QWidget):
             try:
                 replay_points(sim, path, pace=pace, sway=sway, say=say, wait=False)
             except Exception as exc:  # noqa: BLE001 - reported in the panel
-                self._events.put(("say", f"demo stopped: {exc}"))
+                recorder.say(f"demo stopped: {exc}")
 
         self._replay = threading.Thread(target=run, name="fastrak-demo", daemon=True)
         self._replay.start()
 
     def control(self, key: str) -> None:
-        if self.session is None:
-            return
-        msg = self.session.control(key)
-        if msg == "quit":
-            self.stop("finished")
-            return
-        self._say(msg)
-        self._show_state()
+        """A technician's control (n, p, r, u, q), handled at the next drain."""
+        if self.recorder is not None:
+            self.recorder.control(key)
+            self._drain()
 
     def _drain(self) -> None:
-        """Handle what the reader queued since the last tick (GUI thread)."""
+        """Handle what the reader and the controls queued since the last tick (GUI thread)."""
+        if self.recorder is None:
+            return
         changed = False
-        for _ in range(2000):
-            try:
-                ev = self._events.get_nowait()
-            except queue.Empty:
-                break
-            if isinstance(ev, tuple):
-                if ev[0] == "control":
-                    self.control(ev[1])
-                else:
-                    self._say(ev[1])
-                continue
-            if isinstance(ev, PortLost):
-                self._say(f"error: {ev.message}; every recorded point is on disk")
-                self.stop("port lost")
-                return
-            if self.session is None:
-                return
-            try:
-                msg = self.session.on_event(ev)
-            except Exception as exc:  # noqa: BLE001 - disk full and the like
-                self._say(f"error: {exc}")
-                self.stop("cannot write")
-                return
-            if msg:
-                self._say(msg)
-                changed = changed or msg.startswith("recorded")
+        for update in self.recorder.poll(limit=2000):
+            if update.message and update.kind != "finished":
+                self._say(("error: " if update.kind in ("lost", "failed") else "")
+                          + update.message)
+            changed = changed or update.kind in ("recorded", "control")
         if changed:
             self._show_state()
             self._draw_leaf()
-            self.recorded.emit(self.session.count.points)
+            if self.session is not None:
+                self.recorded.emit(self.session.count.points)
+        final = self.recorder.final
+        if final is not None:
+            self.stop({"finished": "finished", "lost": "port lost",
+                       "failed": "cannot write"}.get(final.kind, final.kind))
 
     def _draw_leaf(self) -> None:
         """The plant being digitized: its points, and a surface through each leaf's complete
@@ -235,7 +222,8 @@ class DigitizerPanel(QWidget):
             return
         from maizeviz.errors import LeafError
         from maizeviz.leaf.grid import grid_from_rows
-        from maizeviz.leaf.reconstruct import Leaf, Level, mesh_leaf
+        from maizeviz.leaf.fit import Leaf
+        from maizeviz.mesh.levels import Level, mesh_leaf
         from maizeviz.leaf.nurbs import fit_surface
 
         plant = self.session.history[-1][0].plant
@@ -264,20 +252,20 @@ class DigitizerPanel(QWidget):
 
     def stop(self, why: str = "stopped") -> None:
         self.timer.stop()
-        if self.port is not None:
-            self.port.close()
-            self.port = None
+        recorder, self.recorder = self.recorder, None
+        if recorder is not None and recorder.port is not None:
+            recorder.port.close()
         if self.sim is not None:
             self.sim.close()
             self.sim = None
         if self._replay is not None:
             self._replay.join(timeout=5)
             self._replay = None
-        if self.session is not None:
-            self._say(self.session.summary())
-            self.counts.setText(self.session.summary())
-            self.session.close()
-            self.session = None
+        if recorder is not None:
+            summary = recorder.session.summary()
+            self._say(summary)
+            self.counts.setText(summary)
+            recorder.close()
         self.where.setText(f"not recording ({why})")
         self._set_running(False)
         self.stopped.emit(why)

@@ -9,11 +9,15 @@ from __future__ import annotations
 
 import json
 
+from maizeviz.errors import MaizevizError
+from maizeviz.io.atomic import write_text
+
 from PySide6.QtCore import Signal
 from PySide6.QtWidgets import (QFileDialog, QHBoxLayout, QLabel, QPushButton, QTableWidget,
                                QTableWidgetItem, QVBoxLayout, QWidget)
 
-from maizeviz.canopy.layout import LayoutError, layout_from_dict, layout_to_dict, load_layout
+from maizeviz.canopy.layout import (LayoutError, Placement, layout_from_dict, layout_to_dict,
+                                    load_layout)
 
 COLUMNS = ("x cm", "y cm", "plant", "azimuth °")
 
@@ -61,10 +65,9 @@ class LayoutPanel(QWidget):
 
     def document(self) -> dict:
         """The table as a layout document (raises LayoutError naming the cell)."""
-        doc = layout_to_dict(self.layout_)
-        rows: dict[float, list] = {}
+        placements = []
         for i in range(self.table.rowCount()):
-            vals = []
+            vals: list[float] = []
             for j, name in enumerate(COLUMNS):
                 item = self.table.item(i, j)
                 text = item.text().strip() if item is not None else ""
@@ -73,9 +76,8 @@ class LayoutPanel(QWidget):
                 except ValueError:
                     raise LayoutError(f"row {i + 1}, {name}: '{text}' is not a number") from None
             x, y, plant, az = vals
-            rows.setdefault(x, []).append({"y": y, "plant": plant, "azimuth_deg": az})
-        doc["rows"] = [{"x": x, "plants": ps} for x, ps in sorted(rows.items())]
-        return doc
+            placements.append(Placement(int(plant), x, y, az))
+        return layout_to_dict(self.layout_, placements)
 
     def apply(self) -> None:
         if self.layout_ is None:
@@ -117,8 +119,7 @@ class LayoutPanel(QWidget):
         try:
             doc = self.document()
             layout_from_dict(doc, self.plants, "layout table")
-            with open(path, "w") as fh:
-                json.dump(doc, fh, indent=1)
-        except (LayoutError, OSError) as exc:
+            write_text(path, json.dumps(doc, indent=1) + "\n")
+        except MaizevizError as exc:
             self.problem.emit(f"cannot save the layout: {exc}")
 

@@ -1,4 +1,5 @@
-"""Start the desktop app: ``maizeviz`` (or ``python -m app``).
+"""Start the desktop app: ``maizeviz`` (through the ``maizeviz.gui`` entry point) or
+``python -m maizeviz_app``.
 
 ``--screenshot PNG`` builds the canopy, computes light once, saves a picture of the window and
 quits: the way to look at the app on a machine without a screen (under ``xvfb-run``).
@@ -9,16 +10,10 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+from collections.abc import Sequence
 
 
-def has_screen() -> bool:
-    """True where Qt can open a window (an X server or Wayland, or macOS/Windows)."""
-    if sys.platform in ("darwin", "win32"):
-        return True
-    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
-
-
-def run(argv=None) -> int:
+def run(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="maizeviz", description="The maizeviz desktop app.")
     ap.add_argument("points", nargs="?", help="points CSV (default: the bundled 3x3 block)")
     ap.add_argument("--tile", type=int, default=3, choices=(1, 3, 5))
@@ -28,21 +23,22 @@ def run(argv=None) -> int:
     from PySide6.QtCore import QTimer
     from PySide6.QtWidgets import QApplication
 
-    from app.main_window import EXAMPLE, MainWindow
+    from maizeviz.resources import example_points
+    from maizeviz_app.main_window import MainWindow
 
     app = QApplication.instance() or QApplication([sys.argv[0]])
     app.setApplicationName("maizeviz")
-    window = MainWindow(args.points or EXAMPLE, args.tile)
+    window = MainWindow(args.points or example_points(), args.tile)
     window.show()
     code = {"value": 0}
     if args.screenshot:
-        def shoot():
+        def shoot() -> None:
             window.grab().save(args.screenshot)
             print(f"saved {args.screenshot}")
             window.close()
             app.quit()
 
-        def fail(msg):
+        def fail(msg: str) -> None:
             print(f"error: {msg}", file=sys.stderr)
             code["value"] = 1
             window.close()

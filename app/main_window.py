@@ -20,22 +20,19 @@ from PySide6.QtWidgets import (QCheckBox, QComboBox, QDockWidget, QDoubleSpinBox
                                QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
 from superqt.utils import create_worker
 
-from app import workers
-from app.viewport import Viewport
+from maizeviz.canopy.measures import TABLE2_COLUMNS, table2_row
+from maizeviz.errors import MaizevizError
+from maizeviz.light.request import LightRequest
 from maizeviz.light.sun import Sun, sun_at
-from maizeviz.light.transmission import LightRequest
-
-#: The complexity slider's stops, fine to coarse.
-LEVELS = ("K4", "K2", "K1", "standard", "36", "16", "8", "4")
-EXAMPLE = Path(__file__).resolve().parents[1] / "resources" / "block3x3.csv"
+from maizeviz.mesh.levels import COMPLEXITY_STOPS as LEVELS
+from maizeviz.mesh.levels import parse_level
+from maizeviz.resources import example_points
+from maizeviz_app import workers
+from maizeviz_app.viewport import Viewport
 
 
 def _label(level: str) -> str:
-    if level == "standard":
-        return "standard mesh (data points only)"
-    if level.startswith("K"):
-        return f"K = {level[1:]} points between data points"
-    return f"at most {level} triangles per leaf"
+    return parse_level(level).description
 
 
 class MainWindow(QMainWindow):
@@ -72,7 +69,7 @@ class MainWindow(QMainWindow):
         self._debounce.timeout.connect(self.rebuild)
         self.failed.connect(lambda _: self.light_button.setEnabled(True))
         self._settings = QSettings("maizeviz", "maizeviz")
-        self.load(points or self._settings.value("last_points", str(EXAMPLE)))
+        self.load(points or self._settings.value("last_points", str(example_points())))
 
     # ------------------------------------------------------------------------ panels
     def _build_canopy_panel(self, tile: int) -> None:
@@ -109,10 +106,8 @@ class MainWindow(QMainWindow):
         g.addWidget(QLabel("fine (K=4)  ←→  coarse (4 triangles)"))
         g.addWidget(self.level_label)
         lay.addWidget(group)
-        self.table = QTableWidget(0, 7)
-        self.table.setHorizontalHeaderLabels(["level", "triangles", "leaf area m²",
-                                              "projected m²", "ground cover m²", "LAI",
-                                              "build s"])
+        self.table = QTableWidget(0, len(TABLE2_COLUMNS))
+        self.table.setHorizontalHeaderLabels([h for _, h in TABLE2_COLUMNS])
         self.table.verticalHeader().setVisible(False)
         lay.addWidget(QLabel("canopy measures per level (the paper's Table 2)"))
         lay.addWidget(self.table, 1)
@@ -167,7 +162,7 @@ class MainWindow(QMainWindow):
         self.addDockWidget(Qt.RightDockWidgetArea, dock)
 
     def _build_digitizer(self) -> None:
-        from app.digitizer_panel import DigitizerPanel
+        from maizeviz_app.digitizer_panel import DigitizerPanel
 
         self.digitizer = DigitizerPanel(self.viewport)
         dock = QDockWidget("Digitizer", self)
@@ -176,7 +171,7 @@ class MainWindow(QMainWindow):
         self.addDockWidget(Qt.LeftDockWidgetArea, dock)
 
     def _build_layout_editor(self) -> None:
-        from app.layout_panel import LayoutPanel
+        from maizeviz_app.layout_panel import LayoutPanel
 
         self.layout_panel = LayoutPanel()
         self.layout_panel.applied.connect(self._on_layout)
@@ -300,11 +295,9 @@ class MainWindow(QMainWindow):
         self.canopy = built.canopy
         self.viewport.show_canopy(built.canopy)
         m = built.measures
-        label = built.level + ("" if self.preserve.isChecked() or "triangles" not in built.level
-                               else ", widths unscaled")
-        self.rows[label] = [label, f"{m.triangles:,}", f"{m.leaf_area_m2:.2f}",
-                            f"{m.projected_area_m2:.2f}", f"{m.ground_cover_m2:.2f}",
-                            f"{m.lai:.2f}", f"{built.build_s:.2f}"]
+        label = parse_level(self.level).variant_label(self.preserve.isChecked())
+        row = table2_row(m, built.build_s, label)
+        self.rows[label] = [row[k] for k, _ in TABLE2_COLUMNS]
         self.table.setRowCount(len(self.rows))
         for r, values in enumerate(self.rows.values()):
             for c, v in enumerate(values):
@@ -341,14 +334,14 @@ class MainWindow(QMainWindow):
             req = LightRequest(Sun(self.zenith.value(), self.azimuth.value()), heights,
                                self.density.value(), None, self.periodic.isChecked(), 2,
                                classes=False)
-        except Exception as exc:  # noqa: BLE001 - bad input is said, not raised
+        except (MaizevizError, ValueError) as exc:  # bad input is said, not raised
             self.say(f"error: {exc}")
             return
         self.light_button.setEnabled(False)
         self._run("light", workers.light, self.canopy, req, on_done=self._on_lit)
 
     def _on_lit(self, lit: workers.Lit) -> None:
-        from maizeviz.light.heatmap import transmission_map
+        from maizeviz.light.heatmap import heatmap_figure, transmission_map
 
         self.light_button.setEnabled(True)
         r = lit.result
@@ -362,10 +355,8 @@ class MainWindow(QMainWindow):
             + ("".join(f"\n⚠ {w}" for w in r.warnings)))
         for w in r.warnings:
             self.say(f"warning: {w}")
-        xe, ye, t, _ = transmission_map(r, float(r.heights_cm[0]), 5.0)
-        self.heatmap.setPixmap(_heatmap_pixmap(xe, ye, t, f"transmission at "
-                                               f"{r.heights_cm[0]:g} cm: "
-                                               f"{r.transmission[0]:.3f}"))
+        tmap = transmission_map(r, float(r.heights_cm[0]), 5.0)
+        self.heatmap.setPixmap(_heatmap_pixmap(heatmap_figure(tmap, r, width_in=4.6, dpi=90)))
         self.light_shown.emit()
 
     # ------------------------------------------------------------------------ close
@@ -385,22 +376,9 @@ class MainWindow(QMainWindow):
         super().closeEvent(event)
 
 
-def _heatmap_pixmap(xe, ye, t, title) -> QPixmap:
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(4.6, 2.6), dpi=90)
-    ax = fig.add_subplot()
-    im = ax.pcolormesh(xe, ye, t.T, vmin=0, vmax=1, cmap="viridis")
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (cm)")
-    ax.set_ylabel("y (cm)")
-    ax.set_title(title, fontsize=9)
-    fig.colorbar(im, ax=ax, shrink=0.8)
-    fig.tight_layout()
+def _heatmap_pixmap(fig) -> QPixmap:
     buf = io.BytesIO()
     fig.savefig(buf, format="png")
     pix = QPixmap()
     pix.loadFromData(buf.getvalue(), "PNG")
     return pix
-
-

@@ -13,11 +13,13 @@ from dataclasses import dataclass, field
 
 from PySide6.QtCore import QObject, Signal
 
-from maizeviz.canopy.layout import tiled_layout
+from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.measures import measure_canopy
-from maizeviz.canopy.scene import build_canopy, plant_bases
-from maizeviz.leaf.reconstruct import parse_level, read_leaves
-from maizeviz.light.transmission import LightRequest, trace_light
+from maizeviz.canopy.scene import build_canopy
+from maizeviz.leaf.fit import read_leaves
+from maizeviz.light.request import LightRequest
+from maizeviz.light.transmission import trace_light
+from maizeviz.mesh.levels import parse_level
 
 
 class Progress(QObject):
@@ -51,9 +53,7 @@ class Loaded:
 def load_points(path: str, tile=(3, 3), row_spacing=60.0, plant_spacing=30.0) -> Loaded:
     """Read, grid and fit a points file and tile it (the paper's canopy by default)."""
     found = read_leaves(path)
-    if not found.leaves:
-        raise ValueError(f"{path}: no leaf could be reconstructed")
-    layout = tiled_layout(plant_bases(found.leaves), tile, row_spacing, plant_spacing)
+    layout = layout_for(found.leaves, tile, row_spacing, plant_spacing)
     return Loaded(path, found.leaves, found.skipped, layout,
                   tuple(found.problems) + tuple(found.notes) + layout.warnings)
 

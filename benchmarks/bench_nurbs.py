@@ -19,9 +19,10 @@ from geomdl import fitting
 
 from maizeviz.leaf.grid import LeafGrid
 from maizeviz.leaf.nurbs import fit_surface, refine_parameters
-from maizeviz.leaf.reconstruct import Level, fit_leaves, mesh_leaves
+from maizeviz.leaf.fit import fit_leaves
+from maizeviz.mesh.levels import Level, mesh_leaves
 from maizeviz.mesh.tessellate import mesh_grid
-from maizeviz.synth import LeafShape, leaf_points
+from maizeviz.leaf.synth import LeafShape, leaf_points
 
 
 def best_of(fn, repeat, number=1):

@@ -12,7 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from maizeviz.io.phenomenal import leaf_traits, load_phenomenal
-from maizeviz.synth import PlantShape, plant_leaf_shapes
+from maizeviz.leaf.synth import PlantShape, plant_leaf_shapes
 
 DEFAULT = Path(__file__).resolve().parents[1] / "resources/phenotrack3d/1649057232.json.gz"
 

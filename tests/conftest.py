@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from maizeviz.synth import example_leaf
+from maizeviz.leaf.synth import example_leaf
 
 
 @pytest.fixture

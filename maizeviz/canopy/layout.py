@@ -11,12 +11,15 @@ from __future__ import annotations
 
 import json
 import math
+from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from maizeviz.errors import MaizevizError
+from maizeviz.io.atomic import write_text
+from maizeviz.leaf.fit import Leaf
 
 LAYOUT_SCHEMA = 1
 #: Plants a layout may hold (a hectare at 60 x 30 cm is about 55,000).
@@ -119,21 +122,35 @@ def _cell(x, y, row_spacing, plant_spacing):
 
 
 def _check_spacing(row_spacing, plant_spacing):
-    for name, v in (("--row-spacing", row_spacing), ("--plant-spacing", plant_spacing)):
+    for name, v in (("row_spacing", row_spacing), ("plant_spacing", plant_spacing)):
         if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-            raise LayoutError(f"{name} must be a positive number of cm, got {v}")
+            raise LayoutError(f"{name.replace('_', ' ')} must be a positive number of cm, got {v}",
+                              quantity=name)
 
 
-def parse_shape(text: str, what: str) -> tuple[int, int]:
-    """``"3x3"`` -> (3, 3); both factors whole numbers >= 1."""
+def parse_shape(text: str, quantity: str = "tile") -> tuple[int, int]:
+    """``"3x3"`` -> (3, 3); both factors whole numbers >= 1 (``quantity`` names the input in
+    messages: "tile", "block", "plants")."""
+    what = quantity.replace("_", " ")
     parts = str(text).lower().replace(" ", "").split("x")
     try:
         a, b = (int(p) for p in parts)
     except ValueError:
-        raise LayoutError(f"{what} must look like 3x3, got '{text}'") from None
+        raise LayoutError(f"{what} must look like 3x3, got '{text}'", quantity=quantity) from None
     if a < 1 or b < 1:
-        raise LayoutError(f"{what} must be at least 1x1, got '{text}'")
+        raise LayoutError(f"{what} must be at least 1x1, got '{text}'", quantity=quantity)
     return a, b
+
+
+def plant_bases(leaves: list[Leaf]) -> dict[int, tuple[float, float]]:
+    """Stalk base (x, y) in cm of each digitized plant: the median of its leaves' collar
+    midrib points (the insertions) seen from above."""
+    collars: dict[int, list[np.ndarray]] = defaultdict(list)
+    for lf in leaves:
+        pts = lf.grid.points
+        collars[lf.grid.plant].append(pts[0, pts.shape[1] // 2, :2])
+    return {p: (float(np.median([c[0] for c in v])), float(np.median([c[1] for c in v])))
+            for p, v in collars.items()}
 
 
 def _clusters(values: np.ndarray, spacing: float) -> np.ndarray:
@@ -163,12 +180,6 @@ def block_lattice(bases: dict[int, tuple[float, float]], row_spacing: float,
     return (len(mx), len(my)), {i: (float(mx[a]), float(my[b])) for i, a, b in zip(ids, rx, ry)}
 
 
-def infer_block(bases: dict[int, tuple[float, float]], row_spacing: float,
-                plant_spacing: float) -> tuple[int, int]:
-    """Rows x plants per row of a digitized block from its stalk positions (cm)."""
-    return block_lattice(bases, row_spacing, plant_spacing)[0]
-
-
 def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
                  row_spacing: float = 60.0, plant_spacing: float = 30.0,
                  block: tuple[int, int] | None = None, north_deg: float = 0.0) -> CanopyLayout:
@@ -189,7 +200,7 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
         raise LayoutError("no plant to lay out")
     a, b = tile
     if a < 1 or b < 1:
-        raise LayoutError(f"--tile must be at least 1x1, got {a}x{b}")
+        raise LayoutError(f"tile must be at least 1x1, got {a}x{b}", quantity="tile")
     warnings = []
     inferred, lattice = block_lattice(bases, row_spacing, plant_spacing)
     if block is None:
@@ -197,8 +208,8 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
         warnings.append(f"block inferred from stalk positions: {block[0]} rows x {block[1]} "
                         f"plants per row ({len(bases)} plants)")
     elif block[0] * block[1] != len(bases):
-        warnings.append(f"--block {block[0]}x{block[1]} has {block[0] * block[1]} places but the "
-                        f"file has {len(bases)} plants")
+        warnings.append(f"the block {block[0]}x{block[1]} has {block[0] * block[1]} places but "
+                        f"the file has {len(bases)} plants")
     step_x, step_y = block[0] * row_spacing, block[1] * plant_spacing
     placements, cells, centre = [], [], []
     for ti in range(a):
@@ -357,19 +368,43 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
     return CanopyLayout(tuple(placements), field_rect, rs, ps, north, field_rect, tuple(warnings))
 
 
-def layout_to_dict(layout: CanopyLayout) -> dict:
-    """A layout document (schema :data:`LAYOUT_SCHEMA`) for a layout, rows grouped by x."""
+def rows_of(placements: list[Placement] | tuple[Placement, ...]) -> list[dict]:
+    """Placements grouped into the rows of a layout document, by x (to 1e-6 cm), sorted by x;
+    values are kept exactly as they are."""
+    rows: dict[float, list[dict]] = {}
+    xs: dict[float, float] = {}
+    for p in placements:
+        key = round(p.x, 6)
+        xs.setdefault(key, p.x)
+        rows.setdefault(key, []).append(
+            {"y": p.y, "plant": p.plant, "azimuth_deg": p.azimuth_deg})
+    return [{"x": xs[k], "plants": ps} for k, ps in sorted(rows.items())]
+
+
+def layout_to_dict(layout: CanopyLayout,
+                   placements: list[Placement] | tuple[Placement, ...] | None = None) -> dict:
+    """A layout document (schema :data:`LAYOUT_SCHEMA`) for a layout, or for other
+    ``placements`` on the same field and spacings (an edited layout)."""
     x0, y0, x1, y1 = layout.bounds
-    rows: dict[float, list] = {}
-    for p in layout.placements:
-        rows.setdefault(round(p.x, 6), []).append(
-            {"y": round(p.y, 6), "plant": p.plant, "azimuth_deg": p.azimuth_deg})
     return {"maizeviz_layout": LAYOUT_SCHEMA, "row_spacing": layout.row_spacing,
             "plant_spacing": layout.plant_spacing, "north_deg": layout.north_deg,
             "field": {"x0": x0, "y0": y0, "x1": x1, "y1": y1},
-            "rows": [{"x": x, "plants": ps} for x, ps in sorted(rows.items())]}
+            "rows": rows_of(layout.placements if placements is None else placements)}
 
 
 def save_layout(path: str | Path, layout: CanopyLayout) -> None:
-    """Write a layout file."""
-    Path(path).write_text(json.dumps(layout_to_dict(layout), indent=1))
+    """Write a layout file (atomically)."""
+    write_text(path, json.dumps(layout_to_dict(layout), indent=1) + "\n")
+
+
+def layout_for(leaves: list[Leaf], tile: tuple[int, int] = (1, 1), row_spacing: float = 60.0,
+               plant_spacing: float = 30.0, block: tuple[int, int] | None = None,
+               layout_file: str | Path | None = None) -> CanopyLayout:
+    """Where the digitized plants of ``leaves`` stand: a layout file if given, else the
+    digitized block tiled ``tile`` times (the paper's 3 x 3)."""
+    plants = {lf.grid.plant for lf in leaves}
+    if not plants:
+        raise LayoutError("no leaf could be reconstructed; the canopy is empty")
+    if layout_file is not None:
+        return load_layout(layout_file, plants)
+    return tiled_layout(plant_bases(leaves), tile, row_spacing, plant_spacing, block)

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.light.raytrace import RayScene
+from maizeviz.errors import MaizevizError
+from maizeviz.mesh.raytrace import RayScene
 from maizeviz.mesh.tessellate import triangle_areas_normals
 
 #: Pixel edge (cm) of the vertical-ray grid that measures ground cover.
@@ -32,10 +33,24 @@ class CanopyMeasures:
     def lai(self) -> float:
         return self.leaf_area_m2 / self.ground_area_m2
 
-    def as_dict(self) -> dict:
-        d = dict(self.__dict__)
+    def as_dict(self) -> dict[str, float | int | str]:
+        d: dict[str, float | int | str] = dict(self.__dict__)
         d["lai"] = self.lai
         return d
+
+
+#: The paper's Table 2 as maizeviz shows it: (key of a :func:`table2_row`, column header).
+TABLE2_COLUMNS = (("level", "level"), ("triangles", "triangles"),
+                  ("leaf_area_m2", "leaf area m²"), ("projected_area_m2", "projected m²"),
+                  ("ground_cover_m2", "ground cover m²"), ("lai", "LAI"), ("build_s", "build s"))
+
+
+def table2_row(m: CanopyMeasures, build_s: float, label: str | None = None) -> dict[str, str]:
+    """One row of Table 2, formatted for people (areas to 0.01 m2, seconds to 0.01 s)."""
+    return {"level": label or m.level, "triangles": f"{m.triangles:,}",
+            "leaf_area_m2": f"{m.leaf_area_m2:.2f}", "projected_area_m2": f"{m.projected_area_m2:.2f}",
+            "ground_cover_m2": f"{m.ground_cover_m2:.2f}", "lai": f"{m.lai:.2f}",
+            "build_s": f"{build_s:.2f}"}
 
 
 def ground_cover(canopy: Canopy, resolution: float = COVER_RESOLUTION_CM,
@@ -47,8 +62,9 @@ def ground_cover(canopy: Canopy, resolution: float = COVER_RESOLUTION_CM,
     fall outside the plot are not counted. The error is about one pixel row along each
     shadow's outline.
     """
-    if resolution <= 0:
-        raise ValueError(f"cover resolution must be > 0 cm, got {resolution}")
+    if not resolution > 0:
+        raise MaizevizError(f"the ground-cover pixel must be > 0 cm, got {resolution}",
+                            quantity="cover_resolution")
     if canopy.n_triangles == 0:
         return 0.0
     scene = scene or RayScene(canopy.vertices, canopy.faces)
@@ -92,6 +108,5 @@ def measure_canopy(canopy: Canopy, cover_resolution: float = COVER_RESOLUTION_CM
         cover_resolution_cm=cover_resolution)
 
 
-def _with(canopy, verts, faces):
-    from dataclasses import replace
+def _with(canopy: Canopy, verts: np.ndarray, faces: np.ndarray) -> Canopy:
     return replace(canopy, vertices=verts, faces=faces)

@@ -12,27 +12,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from maizeviz.canopy.layout import CanopyLayout
+from maizeviz.canopy.layout import CanopyLayout, plant_bases
 from maizeviz.errors import MaizevizError
-from maizeviz.leaf.reconstruct import Leaf, Level, mesh_leaves
+from maizeviz.leaf.fit import Leaf
+from maizeviz.mesh.levels import Level, mesh_leaves
+from maizeviz.progress import ProgressCallback, report, scaled
 
 STALK_RADIUS_CM = 1.2
 STALK_SIDES = 8
 
 
-def plant_bases(leaves: list[Leaf]) -> dict[int, tuple[float, float]]:
-    """Stalk base (x, y) in cm of each digitized plant: the median of its leaves' collar
-    midrib points (the insertions) seen from above."""
-    collars = defaultdict(list)
-    for lf in leaves:
-        pts = lf.grid.points
-        collars[lf.grid.plant].append(pts[0, pts.shape[1] // 2, :2])
-    return {p: tuple(float(c) for c in np.median(np.array(v), axis=0)) for p, v in collars.items()}
-
-
 def plant_tops(leaves: list[Leaf]) -> dict[int, float]:
     """Height (cm) of the highest leaf insertion of each plant: where the stalk mesh ends."""
-    tops = defaultdict(float)
+    tops: dict[int, float] = defaultdict(float)
     for lf in leaves:
         pts = lf.grid.points
         tops[lf.grid.plant] = max(tops[lf.grid.plant], float(pts[0, pts.shape[1] // 2, 2]))
@@ -115,17 +107,16 @@ def stalk_mesh(height: float, radius: float = STALK_RADIUS_CM, sides: int = STAL
 
 
 def build_canopy(leaves: list[Leaf], layout: CanopyLayout, level: Level,
-                 preserve_area: bool = True, progress=None) -> Canopy:
+                 preserve_area: bool = True, progress: ProgressCallback | None = None) -> Canopy:
     """Place every plant of ``layout`` with its leaves meshed at ``level``.
 
     Parameters
     ----------
     leaves : all fitted leaves of the digitized plants (field coordinates, cm)
-    progress : callable(done, total) -> bool | None, optional
-        Called as work advances (meshing, then placing); returning ``False`` cancels with
-        :class:`InterruptedError`. Plain Python, so a GUI worker or a terminal bar can drive it.
+    progress : called as work advances (meshing, then placing); returning ``False`` cancels
+        with :class:`InterruptedError` (see :mod:`maizeviz.progress`).
     """
-    by_plant = defaultdict(list)
+    by_plant: dict[int, list[Leaf]] = defaultdict(list)
     for lf in leaves:
         by_plant[lf.grid.plant].append(lf)
     missing = sorted({p.plant for p in layout.placements} - set(by_plant))
@@ -137,12 +128,7 @@ def build_canopy(leaves: list[Leaf], layout: CanopyLayout, level: Level,
     n_place = len(layout.placements)
     total = len(source) + n_place
 
-    def mesh_progress(done, _total):
-        if progress is not None:
-            return progress(done, total)
-        return None
-
-    meshes = mesh_leaves(source, level, preserve_area, mesh_progress)
+    meshes = mesh_leaves(source, level, preserve_area, scaled(progress, 0, total))
     bases = plant_bases(source)
     tops = plant_tops(source)
 
@@ -176,9 +162,8 @@ def build_canopy(leaves: list[Leaf], layout: CanopyLayout, level: Level,
         svparts.append(sv + [pl.x, pl.y, 0.0])
         sfparts.append(sf + s_off)
         s_off += len(sv)
-        if progress is not None and (i % 9 == 8 or i == n_place - 1):
-            if progress(len(source) + i + 1, total) is False:
-                raise InterruptedError("canopy build cancelled")
+        if i % 9 == 8 or i == n_place - 1:
+            report(progress, len(source) + i + 1, total, "canopy build")
     return Canopy(np.concatenate(vparts), np.concatenate(fparts), np.concatenate(inst),
                   np.concatenate(plant_ids), np.concatenate(leaf_ids), layout, level.label,
                   np.concatenate(svparts), np.concatenate(sfparts),

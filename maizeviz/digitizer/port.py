@@ -1,6 +1,6 @@
 """The FASTRAK on a serial port (pyserial, no Qt): start-up, configuration, a reader thread.
 
-Start-up follows FASTRAK.md: stop streaming, flush, ask for status (with retries, since a unit
+Start-up follows docs/fastrak.md: stop streaming, flush, ask for status (with retries, since a unit
 just re-initialised stays silent for about 10 s), then centimetres, ASCII, the output list of
 each station (with the stylus switch on station 1) and the stylus in point mode, and read the
 status back. A unit that keeps answering in inches or binary is not fought: the parser follows

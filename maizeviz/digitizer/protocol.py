@@ -1,4 +1,4 @@
-"""Polhemus FASTRAK serial protocol, pure: commands to bytes, bytes to records (FASTRAK.md).
+"""Polhemus FASTRAK serial protocol, pure: commands to bytes, bytes to records (docs/fastrak.md).
 
 Nothing here touches a port. :class:`RecordParser` is fed raw bytes as they arrive and
 returns events: :class:`Record` (type-0 data), :class:`Status`, :class:`ErrorReply`,

@@ -2,7 +2,7 @@
 
 The simulator owns the master side of a pty pair; a driver opens the slave path with pyserial
 exactly as it would open ``/dev/ttyUSB0``, so the real POSIX serial code path (termios,
-timeouts, ``read_until``) is exercised. It speaks the commands of FASTRAK.md (``P c C F f U u
+timeouts, ``read_until``) is exercised. It speaks the commands of docs/fastrak.md (``P c C F f U u
 S O l e H N B b o ^Y W``), ASCII and binary records, inches (the default) and centimetres,
 stations on and off, stylus presses in point and track modes (a press within 333 ms of the
 previous one is ignored, as the unit does), status and error replies, and continuous output at
@@ -85,10 +85,6 @@ class FastrakSimulator:
         self._thread.start()
 
     # ---------------------------------------------------------------- the outside world
-    def place_stylus(self, point_cm) -> None:
-        """Move the stylus tip to a world position (cm)."""
-        self.stylus = np.asarray(point_cm, dtype=np.float64)
-
     def move_reference(self, position_cm, angles_deg) -> None:
         """Move the reference receiver (station 2, fixed to the stalk)."""
         self.reference = Pose(np.asarray(position_cm, float), np.asarray(angles_deg, float))

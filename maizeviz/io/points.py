@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from maizeviz.errors import PointsFileError
+from maizeviz.io.atomic import atomic_open
 
 REQUIRED = ("plant", "leaf", "row", "col", "x", "y", "z")
 ID_COLUMNS = ("plant", "leaf", "row", "col")
@@ -212,14 +213,15 @@ def _parse(text: str, source: str) -> PointsTable:
 
 
 def write_points(path: str | Path, grids, decimals: int = 3) -> None:
-    """Write point grids in the points format (one line per point, tip rows written once).
+    """Write point grids in the points format (one line per point, tip rows written once),
+    atomically.
 
     Parameters
     ----------
-    grids : iterable of LeafGrid
+    grids : iterable of leaf grids (``plant``, ``leaf``, ``points`` (m, n, 3) cm,
+        ``tip_collapsed``), e.g. :class:`maizeviz.leaf.grid.LeafGrid`
     """
-    path = Path(path)
-    with path.open("w", newline="") as fh:
+    with atomic_open(path, "w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(REQUIRED)
         for g in grids:

@@ -1,23 +1,48 @@
-"""Transmission maps: one PNG and one CSV per height (matplotlib's Agg canvas, no GUI)."""
+"""Transmission maps: binned transmission over a sample plane, as a matplotlib figure, PNG and
+CSV (matplotlib's Agg canvas: no GUI toolkit; the app shows the same figure)."""
 
 from __future__ import annotations
 
 import csv
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from maizeviz.errors import MaizevizError
+from maizeviz.io.atomic import atomic_open, atomic_path
+from maizeviz.light.transmission import LightResult
+
+if TYPE_CHECKING:                                   # matplotlib is imported when drawing
+    from matplotlib.figure import Figure
 
 
-def transmission_map(result, height: float, bin_cm: float = 5.0):
-    """Binned transmission at ``height`` over where the rays cross that plane.
+@dataclass(frozen=True)
+class TransmissionMap:
+    """Transmission binned over a sample plane.
 
-    Returns x edges (a+1,), y edges (b+1,) cm, transmission (a, b) (NaN in empty bins) and
-    ray counts (a, b).
+    Attributes
+    ----------
+    height_cm : the plane's height
+    x_edges : (a + 1,) cm; y_edges : (b + 1,) cm
+    transmission : (a, b), NaN in bins no ray crossed
+    rays : (a, b) int, rays per bin
+    total : transmission of the whole plane
     """
-    if bin_cm <= 0:
-        raise MaizevizError(f"heatmap bin must be > 0 cm, got {bin_cm}")
+
+    height_cm: float
+    x_edges: np.ndarray
+    y_edges: np.ndarray
+    transmission: np.ndarray
+    rays: np.ndarray
+    total: float
+
+
+def transmission_map(result: LightResult, height: float, bin_cm: float = 5.0) -> TransmissionMap:
+    """Binned transmission at ``height`` over where the rays cross that plane."""
+    if not bin_cm > 0:
+        raise MaizevizError(f"the heatmap bin must be > 0 cm, got {bin_cm}", quantity="heatmap_bin")
     xy = result.crossings(height)
     reached = result.first_z < height
     x0, y0, x1, y1 = result.rect
@@ -30,48 +55,87 @@ def transmission_map(result, height: float, bin_cm: float = 5.0):
     lit, _, _ = np.histogram2d(xy[reached, 0], xy[reached, 1], [xe, ye])
     with np.errstate(invalid="ignore", divide="ignore"):
         t = np.where(counts > 0, lit / counts, np.nan)
-    return xe, ye, t, counts
+    k = int(np.argmin(np.abs(result.heights_cm - height)))
+    total = float(result.transmission[k]) if result.heights_cm[k] == height else \
+        float(np.count_nonzero(reached) / len(reached))
+    return TransmissionMap(float(height), xe, ye, t, counts.astype(np.int64), total)
 
 
-def write_heatmaps(folder: str | Path, result, bin_cm: float = 5.0) -> list[Path]:
-    """One ``transmission_h<h>cm.png`` and ``.csv`` per height in ``folder``; returns paths."""
+def heatmap_figure(tmap: TransmissionMap, result: LightResult, width_in: float = 8.0,
+                   dpi: int = 110) -> Figure:
+    """A figure of one map: colour bar, axes in cm, sun angles, level and rays in the title."""
     from matplotlib.figure import Figure
 
+    xe, ye = tmap.x_edges, tmap.y_edges
+    aspect = (ye[-1] - ye[0]) / (xe[-1] - xe[0])
+    fig = Figure(figsize=(width_in, width_in * aspect * 0.8 + 0.2 * width_in), dpi=dpi)
+    ax = fig.add_subplot()
+    im = ax.pcolormesh(xe, ye, tmap.transmission.T, vmin=0, vmax=1, cmap="viridis",
+                       shading="flat")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (cm, across rows)")
+    ax.set_ylabel("y (cm, along rows)")
+    bin_cm = (xe[-1] - xe[0]) / max(len(xe) - 1, 1)
+    ax.set_title(f"direct-light transmission at {tmap.height_cm:g} cm: {tmap.total:.3f}\n"
+                 f"sun zenith {result.sun.zenith_deg:.1f} deg, azimuth "
+                 f"{result.sun.azimuth_deg:.1f} deg; level {result.level}; "
+                 f"{result.rays:,} rays, {bin_cm:.3g} cm bins", fontsize=9)
+    fig.colorbar(im, ax=ax, label="transmission (fraction of rays reaching this height)",
+                 shrink=0.8)
+    fig.tight_layout()
+    return fig
+
+
+def write_map_csv(path: str | Path, tmap: TransmissionMap) -> None:
+    """One line per bin: x_cm, y_cm (bin centre), height_cm, transmission (empty if no ray),
+    rays (atomically)."""
+    xc = 0.5 * (tmap.x_edges[1:] + tmap.x_edges[:-1])
+    yc = 0.5 * (tmap.y_edges[1:] + tmap.y_edges[:-1])
+    with atomic_open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["x_cm", "y_cm", "height_cm", "transmission", "rays"])
+        t = tmap.transmission
+        for i, x in enumerate(xc):
+            for j, y in enumerate(yc):
+                w.writerow([f"{x:.2f}", f"{y:.2f}", f"{tmap.height_cm:g}",
+                            "" if np.isnan(t[i, j]) else f"{t[i, j]:.4f}", int(tmap.rays[i, j])])
+
+
+def save_figure(fig: Figure, path: str | Path) -> None:
+    """Save a figure as PNG (or the format of the extension), atomically."""
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=Path(path).suffix.lstrip(".") or "png")
+
+
+def _tag(text: str) -> str:
+    return "".join(c if c.isalnum() else "_" for c in text).strip("_")
+
+
+def heatmap_stems(result: LightResult) -> list[str]:
+    """Distinct file stems, one per height: ``transmission_<level>_h<height>cm``."""
+    level = _tag(result.level) or "level"
+    stems: list[str] = []
+    for h in result.heights_cm:
+        stem = f"transmission_{level}_h{h:g}cm".replace(".", "p")
+        while stem in stems:                         # heights equal to %g precision
+            stem += "_"
+        stems.append(stem)
+    return stems
+
+
+def write_heatmaps(folder: str | Path, result: LightResult, bin_cm: float = 5.0) -> list[Path]:
+    """One PNG and one CSV per height in ``folder`` (created if needed); returns the paths
+    written, PNG and CSV alternating."""
     folder = Path(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
         raise MaizevizError(f"{folder}: cannot create the folder ({exc.strerror})") from None
     written = []
-    tag = "".join(c if c.isalnum() else "_" for c in result.level).strip("_") or "level"
-    for h, total in zip(result.heights_cm, result.transmission):
-        xe, ye, t, counts = transmission_map(result, h, bin_cm)
-        stem = folder / f"transmission_{tag}_h{h:g}cm"
-        fig = Figure(figsize=(8, 8 * (ye[-1] - ye[0]) / (xe[-1] - xe[0]) * 0.8 + 1.6), dpi=110)
-        ax = fig.add_subplot()
-        im = ax.pcolormesh(xe, ye, t.T, vmin=0, vmax=1, cmap="viridis", shading="flat")
-        ax.set_aspect("equal")
-        ax.set_xlabel("x (cm, across rows)")
-        ax.set_ylabel("y (cm, along rows)")
-        ax.set_title(f"direct-light transmission at {h:g} cm: {total:.3f}\n"
-                     f"sun zenith {result.sun.zenith_deg:.1f} deg, azimuth "
-                     f"{result.sun.azimuth_deg:.1f} deg; level {result.level}; "
-                     f"{result.rays:,} rays, {bin_cm:g} cm bins", fontsize=9)
-        fig.colorbar(im, ax=ax, label="transmission (fraction of rays reaching this height)",
-                     shrink=0.8)
-        fig.tight_layout()
-        try:
-            fig.savefig(stem.with_suffix(".png"))
-            with open(stem.with_suffix(".csv"), "w", newline="") as fh:
-                w = csv.writer(fh)
-                w.writerow(["x_cm", "y_cm", "height_cm", "transmission", "rays"])
-                xc, yc = 0.5 * (xe[1:] + xe[:-1]), 0.5 * (ye[1:] + ye[:-1])
-                for i, x in enumerate(xc):
-                    for j, y in enumerate(yc):
-                        w.writerow([f"{x:.2f}", f"{y:.2f}", f"{h:g}",
-                                    "" if np.isnan(t[i, j]) else f"{t[i, j]:.4f}",
-                                    int(counts[i, j])])
-        except OSError as exc:
-            raise MaizevizError(f"{stem}: cannot write ({exc.strerror})") from None
-        written += [stem.with_suffix(".png"), stem.with_suffix(".csv")]
+    for h, stem in zip(result.heights_cm, heatmap_stems(result)):
+        tmap = transmission_map(result, float(h), bin_cm)
+        png, csv_path = folder / f"{stem}.png", folder / f"{stem}.csv"
+        save_figure(heatmap_figure(tmap, result), png)
+        write_map_csv(csv_path, tmap)
+        written += [png, csv_path]
     return written

@@ -3,7 +3,7 @@
 Every mesh level of maizeviz (dense reference, standard, simplified) is a grid of vertices
 over the leaf's (u, v) parameter lines, so one triangulation serves all of them. Each quad
 (i, j) - (i+1, j) - (i+1, j+1) - (i, j+1) gives two triangles wound so that their normal is
-dS/du x dS/dv: the upper face under the column convention of SCIENCE.md. Zero-area triangles
+dS/du x dS/dv: the upper face under the column convention of docs/method.md. Zero-area triangles
 (at a collapsed tip) are dropped.
 """
 
@@ -99,3 +99,22 @@ def mesh_grid(vertices: np.ndarray, u: np.ndarray, v: np.ndarray, level: str = "
     faces = grid_faces(a, b)
     bad = degenerate_faces(vertices)
     return LeafMesh(vertices, u, v, faces[~bad] if bad.any() else faces, level, plant, leaf)
+
+
+def merge_meshes(meshes: list[LeafMesh]) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+    """Concatenate leaf meshes for export.
+
+    Returns
+    -------
+    points : (V, 3) float64 cm, faces : (F, 3) int64,
+    cell data : {"plant": (F,) int32, "leaf": (F,) int32}
+    """
+    from maizeviz.errors import MaizevizError
+
+    if not meshes:
+        raise MaizevizError("nothing to export: no leaf mesh")
+    offsets = np.cumsum([0] + [len(m.points) for m in meshes[:-1]])
+    faces = np.concatenate([m.faces.astype(np.int64) + o for m, o in zip(meshes, offsets)])
+    plant = np.concatenate([np.full(len(m.faces), m.plant, np.int32) for m in meshes])
+    leaf = np.concatenate([np.full(len(m.faces), m.leaf, np.int32) for m in meshes])
+    return np.concatenate([m.points for m in meshes]), faces, {"plant": plant, "leaf": leaf}

@@ -9,12 +9,14 @@ import pytest
 from maizeviz.canopy.layout import (LayoutError, layout_from_dict, load_layout, parse_shape,
                                     save_layout, tiled_layout, union_area)
 from maizeviz.canopy.measures import ground_cover, measure_canopy
-from maizeviz.canopy.scene import build_canopy, plant_bases
+from maizeviz.canopy.layout import plant_bases
+from maizeviz.canopy.scene import build_canopy
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.grid import LeafGrid
-from maizeviz.leaf.reconstruct import Level, fit_leaves, measure, mesh_leaf
-from maizeviz.synth import PlantShape, block_grids, plant_grids
+from maizeviz.leaf.fit import fit_leaves
+from maizeviz.mesh.levels import Level, measure, mesh_leaf
+from maizeviz.leaf.synth import PlantShape, block_grids, plant_grids
 
 PHENO = str(Path(__file__).resolve().parents[2] / "resources/phenotrack3d/1649057232.json.gz")
 

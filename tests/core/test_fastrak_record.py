@@ -22,7 +22,7 @@ from maizeviz.digitizer.session import Session, SessionError
 from maizeviz.digitizer.simulator import FastrakSimulator
 from maizeviz.io.points import read_points, write_points
 from maizeviz.leaf.grid import LeafGrid, build_grids
-from maizeviz.synth import LeafShape, leaf_points
+from maizeviz.leaf.synth import LeafShape, leaf_points
 
 
 class Recorder:

@@ -13,8 +13,11 @@ from maizeviz.canopy.scene import Canopy
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
 from maizeviz.light.sun import Sun, sun_at
-from maizeviz.light.transmission import (LightRequest, beer_lambert, leaf_light, ray_grid,
-                                         trace_light)
+from maizeviz.light.beer_lambert import beer_lambert
+from maizeviz.light.leaf_light import leaf_light
+from maizeviz.light.rays import ray_grid
+from maizeviz.light.request import LightRequest
+from maizeviz.light.transmission import trace_light
 
 BLOCK = str(Path(__file__).resolve().parents[2] / "resources/block3x3.csv")
 
@@ -156,10 +159,10 @@ def test_periodic_rays_wrap_in_every_direction(azimuth):
 
 def test_beer_lambert_from_mesh():
     c = canopy_of([(0, 0, 50, 100), (50, 50, 50, 20)])
-    t, g, lai = beer_lambert(c, Sun(0, 0), [0, 50, 150])
-    assert g == pytest.approx(1.0)
-    assert lai == pytest.approx([0.5, 0.25, 0.0])
-    assert t == pytest.approx(np.exp(-lai))
+    bl = beer_lambert(c, Sun(0, 0), [0, 50, 150])
+    assert bl.G == pytest.approx(1.0)
+    assert bl.lai_above == pytest.approx([0.5, 0.25, 0.0])
+    assert bl.transmission == pytest.approx(np.exp(-bl.lai_above))
 
 
 def test_sun_from_pvlib_beijing():
@@ -189,7 +192,7 @@ def test_bad_suns(make, match):
 @pytest.mark.parametrize("req, match", [
     (dict(rect=(200, 200, 300, 300)), "not inside the plot"),
     (dict(rect=(50, 50, 40, 60)), "x1 > x0"),
-    (dict(density=0), "--density must be > 0"),
+    (dict(density=0), "density must be > 0"),
     (dict(density=1e7), "rays.*limit"),
     (dict(heights_cm=(-5,)), "heights must be >= 0"),
     (dict(heights_cm=()), "at least one height"),
@@ -275,7 +278,7 @@ def test_cli_light_levels_and_explicit_sun(capsys):
     ([], "where is the sun"),
     (["--sun-zenith", "30", "--sun-azimuth", "0", "--date", "2005-08-01"], "not both"),
     (["--sun-zenith", "30", "--sun-azimuth", "0", "--density", "0"], "density"),
-    (["--sun-zenith", "30", "--sun-azimuth", "0", "--rect", "1,2,3"], "--rect needs 4"),
+    (["--sun-zenith", "30", "--sun-azimuth", "0", "--rect", "1,2,3"], "needs 4 numbers, got '1,2,3' (--rect)"),
     (["--sun-zenith", "30", "--sun-azimuth", "0", "--rect", "900,0,1000,50"], "not inside"),
     (["--sun-zenith", "30", "--sun-azimuth", "0", "--heights", "0,abc"], "--heights"),
     (["--date", "2005-08-01", "--time", "23:30", "--lat", "39.9", "--lon", "116.4", "--tz",

@@ -4,12 +4,14 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
+from maizeviz.errors import MaizevizError
 from maizeviz.leaf.grid import LeafGrid
-from maizeviz.leaf.reconstruct import (Level, fit_leaves, measure, mesh_leaf, mesh_leaves,
-                                       parse_level, parse_levels)
+from maizeviz.leaf.fit import fit_leaves
+from maizeviz.mesh.levels import (Level, measure, mesh_leaf, mesh_leaves, parse_level,
+                                  parse_levels)
 from maizeviz.mesh import measures
 from maizeviz.mesh.simplify import count_triangles, select_lines
-from maizeviz.synth import LeafShape, example_leaf, leaf_points
+from maizeviz.leaf.synth import LeafShape, example_leaf, leaf_points
 
 
 def leaf_of(points, tip=False, plant=1, leaf=1):
@@ -150,5 +152,5 @@ def test_parse_levels(text, level):
 
 @pytest.mark.parametrize("bad", ["K-1", "fine", "0", ""])
 def test_parse_bad_levels(bad):
-    with pytest.raises(ValueError):
+    with pytest.raises(MaizevizError, match="mesh level|triangle budget"):
         parse_level(bad)

@@ -13,11 +13,13 @@ os.environ["XDG_CONFIG_HOME"] = tempfile.mkdtemp(prefix="maizeviz-settings-")
 @pytest.fixture
 def window(qtbot):
     """A main window on the bundled example; closed (viewport included) after the test."""
-    from app.main_window import EXAMPLE, MainWindow
+    from maizeviz.resources import example_points
+    from maizeviz_app.main_window import MainWindow
 
     made = []
 
-    def make(points=EXAMPLE, tile=3):
+    def make(points=None, tile=3):
+        points = points or example_points()
         w = MainWindow(points, tile)
         w.show()
         qtbot.waitExposed(w)

@@ -1,6 +1,6 @@
 """Embree (through embreex) ray queries on triangle soups.
 
-Facts measured on these machines (SCIENCE.md section 5): a scene must be committed (one small
+Facts measured on these machines (docs/method.md, direct light): a scene must be committed (one small
 query) before threads share it; ``robust=False`` is about 25% faster; coherent, spatially
 sorted rays are about twice as fast as shuffled ones; ``run`` releases the GIL.
 """

@@ -1,0 +1,110 @@
+"""The ``maizeviz`` command: headless subcommands; with none, the desktop app.
+
+Exit codes: 0 all done; 1 nothing could be done (bad file, every leaf refused, bad request);
+2 bad command-line usage; 3 done, but some leaves were skipped (listed on stderr).
+
+The desktop app is not imported from here: it registers itself under the entry-point group
+``maizeviz.gui`` (see pyproject.toml), so the core never depends on Qt, and a headless install
+(without the ``gui`` extra) still runs every subcommand.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import traceback
+from collections.abc import Callable, Sequence
+from importlib.metadata import entry_points
+
+from maizeviz import __version__
+from maizeviz.cli import canopy, leaf, light, phenomenal, record, simulate, synth
+from maizeviz.cli.common import (EXIT_FAIL, EXIT_OK, EXIT_PARTIAL, EXIT_USAGE, error_line,
+                                 say)
+from maizeviz.errors import MaizevizError
+
+__all__ = ["main", "build_parser", "EXIT_OK", "EXIT_FAIL", "EXIT_USAGE", "EXIT_PARTIAL"]
+
+#: The subcommands, in the order ``--help`` lists them.
+COMMANDS = (leaf, canopy, light, record, simulate, synth, phenomenal)
+#: Entry-point group under which the desktop app registers its ``run(argv) -> int``.
+GUI_GROUP = "maizeviz.gui"
+GUI_HINT = 'the desktop app is not installed: pip install "maizeviz[gui]"'
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="maizeviz",
+        description="Digitized maize plants: leaf surfaces, mesh complexity, canopies, light. "
+                    "Without a subcommand, opens the desktop app.")
+    parser.add_argument("--version", action="version", version=f"maizeviz {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for command in COMMANDS:
+        command.add_parser(sub)
+    return parser
+
+
+def has_screen() -> bool:
+    """True where a window can open (an X server or Wayland, or macOS/Windows)."""
+    if sys.platform in ("darwin", "win32"):
+        return True
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def find_gui() -> tuple[Callable[[Sequence[str]], int] | None, str]:
+    """The desktop app's ``run`` from its entry point, or None and why not (one line)."""
+    found = entry_points(group=GUI_GROUP)
+    if not found:
+        return None, GUI_HINT
+    try:
+        return next(iter(found)).load(), ""
+    except ImportError as exc:                 # the gui extra is missing or broken
+        return None, f"{GUI_HINT} ({exc})"
+
+
+def _no_command(argv: list[str]) -> int:
+    """No subcommand: the desktop app where there is a screen, else the headless report."""
+    from maizeviz.resources import example_points
+
+    rest = [a for a in argv if a != "--debug"]
+    gui, why = find_gui()
+    if gui is None:
+        say(f"note: {why}")
+    elif has_screen():
+        return gui(rest)
+    else:
+        say("no screen (DISPLAY is not set): the headless report on the bundled example "
+            "follows; for the window run 'xvfb-run -a maizeviz --screenshot app.png' or use a "
+            "desktop")
+    if rest and not rest[0].startswith("-"):
+        say(f"note: opening {rest[0]} needs the desktop app; the report below is on the bundled "
+            "example")
+    return main(["canopy", str(example_points()), "--tile", "3x3", "--levels"])
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    tokens = list(sys.argv[1:] if argv is None else argv)
+    names = set(parser._subparsers._group_actions[0].choices)  # type: ignore[union-attr]
+    first = next((t for t in tokens if t != "--debug"), None)
+    if first not in names and first not in ("-h", "--help", "--version"):
+        return _no_command(tokens)                 # the app, with its own options
+    args = parser.parse_args(tokens)
+    debug = args.debug or bool(os.environ.get("MAIZEVIZ_DEBUG"))
+    try:
+        return int(args.run(args))
+    except MaizevizError as exc:
+        say(error_line(exc))
+        return EXIT_FAIL
+    except KeyboardInterrupt:
+        say("interrupted")
+        return 130
+    except BrokenPipeError:
+        return EXIT_OK
+    except Exception as exc:  # a bug: say so in one line unless asked for the traceback
+        if debug:
+            traceback.print_exc()
+        else:
+            say(f"internal error: {type(exc).__name__}: {exc} (run with --debug and report it)")
+        return EXIT_FAIL

@@ -1,0 +1,178 @@
+"""What the subcommands share: options, the terminal progress bar, tables, messages, exit codes."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from maizeviz.canopy.layout import CanopyLayout, layout_for, parse_shape
+from maizeviz.errors import LeafError, MaizevizError
+from maizeviz.io.atomic import atomic_open
+from maizeviz.leaf.fit import Leaf, read_leaves
+from maizeviz.mesh.levels import Level, parse_level, parse_levels
+
+EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_PARTIAL = 0, 1, 2, 3
+
+#: The flag (or flags) through which each quantity of :data:`maizeviz.errors.QUANTITIES`
+#: reaches the core: errors about a quantity name it.
+FLAGS = {
+    "density": "--density", "heights": "--heights", "rect": "--rect", "threads": "--threads",
+    "heatmap_bin": "--heatmap-bin", "cover_resolution": "--cover-resolution",
+    "row_spacing": "--row-spacing", "plant_spacing": "--plant-spacing", "tile": "--tile",
+    "block": "--block", "level": "--levels", "interp": "--interp", "triangles": "--triangles",
+    "degree": "--degree", "params": "--params", "sun": "--sun-zenith/--sun-azimuth",
+    "date": "--date", "time": "--time", "place": "--lat/--lon", "tz": "--tz", "cols": "--cols",
+    "plants": "--plants", "sections": "--sections", "at": "--at", "periodic": "--periodic",
+}
+
+
+def say(msg: str) -> None:
+    """A line on stderr (notes, warnings, errors: stdout carries the results)."""
+    print(msg, file=sys.stderr)
+
+
+def error_line(exc: MaizevizError) -> str:
+    """``error: <message> (<flag>)``: the core's words plus the flag that carried the value."""
+    flag = FLAGS.get(exc.quantity or "")
+    return f"error: {exc}" + (f" ({flag})" if flag else "")
+
+
+def fmt_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
+    """A plain-text table, right-aligned columns."""
+    cells = [list(headers)] + [[str(c) for c in r] for r in rows]
+    widths = [max(len(r[i]) for r in cells) for i in range(len(headers))]
+    lines = ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in cells]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+class Progress:
+    """A progress callback for the core: a bar on stderr when it is a terminal, else silent."""
+
+    def __init__(self, label: str):
+        self.label = label
+        self.tty = sys.stderr.isatty()
+        self.last = -1
+
+    def __call__(self, done: int, total: int) -> bool | None:
+        if not self.tty or total <= 0:
+            return None
+        pct = int(100 * done / total)
+        if pct != self.last:
+            self.last = pct
+            bar = "#" * (pct // 4)
+            sys.stderr.write(f"\r{self.label} [{bar:<25}] {pct:3d}%")
+            if done >= total:
+                sys.stderr.write("\n")
+            sys.stderr.flush()
+        return None
+
+
+# ------------------------------------------------------------------------------ options
+def add_level_options(p: argparse.ArgumentParser, default_levels: str) -> None:
+    lv = p.add_mutually_exclusive_group()
+    lv.add_argument("--interp", type=int, metavar="K",
+                    help="K points interpolated between data points (0 = standard mesh; "
+                         "default 4, the paper's reference mesh)")
+    lv.add_argument("--triangles", type=int, metavar="N",
+                    help="at most N triangles per leaf (inverse multi-line segment splitting)")
+    lv.add_argument("--levels", nargs="?", const=default_levels, metavar="LIST",
+                    help=f"compare levels (default {default_levels})")
+    p.add_argument("--no-preserve-area", dest="preserve_area", action="store_false",
+                   help="below the standard mesh, do not widen cross-sections to keep the "
+                        "smooth surface's area")
+
+
+def levels_from(args: argparse.Namespace, default_k: int = 4) -> list[Level]:
+    """The levels asked for by --levels, --triangles or --interp (default K = 4)."""
+    if args.levels is not None:
+        return parse_levels(args.levels)
+    if args.triangles is not None:
+        return [Level(triangles=args.triangles)]
+    return [Level(interp=default_k if args.interp is None else args.interp)]
+
+
+def add_canopy_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("points", help="points CSV of the digitized plants (field coordinates, cm)")
+    p.add_argument("--tile", default="1x1", metavar="AxB",
+                   help="repeat the digitized block A times across rows (x) and B times along "
+                        "them (y); the paper uses 3x3 (default 1x1)")
+    p.add_argument("--block", metavar="RxP",
+                   help="rows x plants per row of the digitized block (default: inferred from "
+                        "the stalk positions)")
+    p.add_argument("--row-spacing", type=float, default=60.0, metavar="CM",
+                   help="distance between rows along x, cm (default 60)")
+    p.add_argument("--plant-spacing", type=float, default=30.0, metavar="CM",
+                   help="distance between plants in a row along y, cm (default 30)")
+    p.add_argument("--layout", metavar="JSON", help="a layout file instead of tiling")
+    p.add_argument("--strict", action="store_true",
+                   help="stop at the first bad leaf instead of skipping it")
+
+
+def load_leaves(path: str, strict: bool = False, degree: int = 3,
+                method: str = "chord") -> tuple[list[Leaf], list[LeafError]]:
+    """Read, grid and fit a points file, saying skipped lines and repairs on stderr."""
+    found = read_leaves(path, strict, degree, method)
+    for problem in found.problems:
+        say(f"warning: {problem}")
+    for note in found.notes:
+        say(f"note: {note}")
+    return found.leaves, found.skipped
+
+
+def canopy_setup(args: argparse.Namespace) -> tuple[list[Leaf], list[LeafError], CanopyLayout]:
+    """Leaves and layout from the canopy options; warnings on stderr."""
+    tile = parse_shape(args.tile, "tile")
+    block = parse_shape(args.block, "block") if args.block else None
+    leaves, skipped = load_leaves(args.points, args.strict)
+    if not leaves:
+        for e in skipped:
+            say(f"skipped: {e}")
+        raise MaizevizError("no leaf could be reconstructed; the canopy is empty")
+    layout = layout_for(leaves, tile, args.row_spacing, args.plant_spacing, block, args.layout)
+    for w in layout.warnings:
+        say(f"note: {w}")
+    return leaves, skipped, layout
+
+
+def floats(text: str, what: str, quantity: str, count: int | None = None) -> list[float]:
+    """Numbers separated by commas (``"0,50,100"``)."""
+    try:
+        vals = [float(v) for v in str(text).split(",") if v.strip()]
+    except ValueError:
+        raise MaizevizError(f"{what} must be numbers separated by commas, got '{text}'",
+                            quantity=quantity) from None
+    if count is not None and len(vals) != count:
+        raise MaizevizError(f"{what} needs {count} numbers, got '{text}'", quantity=quantity)
+    return vals
+
+
+def write_rows(path: str | Path, rows: list[dict]) -> None:
+    """Rows of dicts as a CSV file with a header (atomically)."""
+    fields = list(rows[0].keys()) if rows else []
+    with atomic_open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields)
+        w.writeheader()
+        w.writerows(rows)
+
+
+def suffixed(path: str | Path, label: str) -> Path:
+    """``light.csv`` + ``"K=4"`` -> ``light_K_4.csv`` (one file per level)."""
+    p = Path(path)
+    tag = "".join(c if c.isalnum() else "_" for c in label).strip("_")
+    return p.with_name(f"{p.stem}_{tag}{p.suffix}")
+
+
+def leaves_summary(done: int, skipped: list[LeafError]) -> int:
+    """Say the skipped leaves; the exit code (0 all done, 3 some skipped, 1 none done)."""
+    for e in skipped:
+        say(f"skipped: {e}")
+    if skipped:
+        say(f"{done} leaves done, {len(skipped)} skipped")
+    if done == 0:
+        say("error: no leaf could be processed")
+        return EXIT_FAIL
+    return EXIT_PARTIAL if skipped else EXIT_OK

@@ -1,0 +1,91 @@
+"""``maizeviz leaf``: fit NURBS surfaces through digitized leaves and mesh them (Table 1)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from maizeviz.cli.common import (add_level_options, fmt_table, leaves_summary, levels_from,
+                                 load_leaves, say)
+from maizeviz.errors import MaizevizError
+from maizeviz.io.atomic import refuse_overwriting_inputs
+from maizeviz.io.meshfile import check_mesh_path, write_mesh
+from maizeviz.mesh.levels import DEFAULT_LEVELS, measure, mesh_leaves
+from maizeviz.mesh.tessellate import merge_meshes
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "leaf", help="fit NURBS surfaces through digitized leaves and mesh them",
+        description="Fit a NURBS surface through every leaf of a points file and mesh it at "
+                    "the chosen complexity. Areas in cm2, lengths in cm.")
+    p.add_argument("points", help="points CSV (plant,leaf,row,col,x,y,z in cm)")
+    add_level_options(p, DEFAULT_LEVELS)
+    p.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    p.add_argument("--export", metavar="PATH",
+                   help="write the meshes: .ply .obj .vtk .vtu .vtp .stl (plant/leaf ids kept "
+                        "as cell data where the format allows)")
+    p.add_argument("--degree", type=int, default=3, help="NURBS degree in u and v (default 3)")
+    p.add_argument("--params", choices=("chord", "centripetal"), default="chord",
+                   help="data parameters (default chord length)")
+    p.add_argument("--strict", action="store_true",
+                   help="stop at the first bad leaf instead of skipping it")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    levels = levels_from(args)
+    if args.export:
+        if len(levels) > 1:
+            raise MaizevizError("--export writes one level: use it with --interp or --triangles")
+        check_mesh_path(args.export)
+        refuse_overwriting_inputs([("the mesh export", args.export)], [args.points])
+    leaves, skipped = load_leaves(args.points, args.strict, args.degree, args.params)
+    per_level = []
+    for level in levels:
+        meshes = mesh_leaves(leaves, level, args.preserve_area)
+        per_level.append((level, meshes, [measure(lf, m) for lf, m in zip(leaves, meshes)]))
+
+    if args.export and leaves:
+        path = write_mesh(args.export, *merge_meshes(per_level[0][1]))
+        say(f"wrote {sum(m.n_triangles for m in per_level[0][1])} triangles of "
+            f"{len(leaves)} leaves to {path}")
+
+    skipped_json = [{"plant": e.plant, "leaf": e.leaf, "error": e.detail} for e in skipped]
+    if args.json:
+        out: dict
+        if args.levels is not None:
+            out = {"levels": [str(lv) for lv in levels], "leaves": [
+                {"plant": lf.grid.plant, "leaf": lf.grid.leaf, "rows": lf.grid.shape[0],
+                 "cols": lf.grid.shape[1], "notes": list(lf.grid.notes),
+                 "levels": [ms[i].as_dict() for _, _, ms in per_level]}
+                for i, lf in enumerate(leaves)]}
+        else:
+            out = {"level": str(levels[0]),
+                   "leaves": [dict(ms.as_dict(), notes=list(lf.grid.notes))
+                              for lf, ms in zip(leaves, per_level[0][2])]}
+        out["skipped"] = skipped_json
+        print(json.dumps(out, indent=1))
+    elif args.levels is not None:
+        for i, lf in enumerate(leaves):
+            print(f"plant {lf.grid.plant}, leaf {lf.grid.leaf} ({lf.grid.shape[0]} x "
+                  f"{lf.grid.shape[1]} points)")
+            print(fmt_table(
+                ["level", "triangles", "area cm2", "area err %", "projected cm2",
+                 "max dev cm"],
+                [[ms[i].level, ms[i].triangles, f"{ms[i].area_cm2:.1f}",
+                  f"{ms[i].area_error_pct:+.1f}", f"{ms[i].projected_area_cm2:.1f}",
+                  f"{ms[i].max_deviation_cm:.2f}"] for _, _, ms in per_level]))
+            print()
+    else:
+        ms = per_level[0][2]
+        print(f"level: {levels[0]}")
+        print(fmt_table(
+            ["plant", "leaf", "rows x cols", "triangles", "area cm2", "projected cm2",
+             "max dev cm"],
+            [[m.plant, m.leaf, f"{m.rows} x {m.cols}", m.triangles, f"{m.area_cm2:.1f}",
+              f"{m.projected_area_cm2:.1f}", f"{m.max_deviation_cm:.2f}"] for m in ms]))
+        if ms:
+            print(f"total: {len(ms)} leaves, {sum(m.triangles for m in ms)} triangles, "
+                  f"{sum(m.area_cm2 for m in ms):.1f} cm2 of leaf")
+    return leaves_summary(len(leaves), skipped)

@@ -1,0 +1,82 @@
+"""``maizeviz record``: digitize with a Polhemus FASTRAK, stylus presses becoming points."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import threading
+
+from maizeviz.cli.common import EXIT_OK, say
+from maizeviz.digitizer.port import FastrakPort
+from maizeviz.digitizer.recorder import Recorder
+from maizeviz.digitizer.session import Session
+from maizeviz.errors import MaizevizError
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "record", help="digitize with a Polhemus FASTRAK: stylus presses become points",
+        description="Record stylus presses from a FASTRAK as points of plants, leaves and "
+                    "cross-sections. Every point is on disk (fsync) before it is reported. "
+                    "Controls, one per line on standard input: n next leaf, p next plant, "
+                    "r end the row early (tip), u undo the last point, q finish.")
+    p.add_argument("--port", required=True, help="serial port, e.g. /dev/ttyUSB0")
+    p.add_argument("--out", required=True, help="points CSV to append to")
+    p.add_argument("--cols", type=int, default=5,
+                   help="points per cross-section, margin to margin (default 5)")
+    p.add_argument("--resume", action="store_true", help="continue --out where it stopped")
+    p.add_argument("--baud", type=int, default=115200, help="baud rate (default 115200)")
+    p.add_argument("--reference-station", type=int, choices=(2, 3, 4), metavar="N",
+                   help="a receiver fixed to the stalk: points are re-expressed in its frame")
+    p.add_argument("--answer-timeout", type=float, default=1.0, metavar="S",
+                   help="seconds to wait for each reply of the unit (default 1)")
+    p.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    session = Session(args.out, args.cols, args.resume, args.reference_station)
+    if args.resume:
+        q0 = session.pos
+        say(f"resuming {args.out}: {session.count.points} points on disk; next point is plant "
+            f"{q0.plant} leaf {q0.leaf} row {q0.row} col {q0.col}")
+    port = FastrakPort(args.port, args.baud, args.answer_timeout)
+    stations = (1,) if args.reference_station is None else (1, args.reference_station)
+    try:
+        config = port.configure(stations)
+    except MaizevizError:
+        session.close()
+        port.close()
+        raise
+    for w in config.warnings:
+        say(f"warning: {w}")
+    recorder = Recorder(session, port)
+    recorder.start()
+
+    def read_stdin() -> None:
+        try:
+            for line in sys.stdin:
+                recorder.control(line)
+        except (OSError, ValueError):
+            pass
+
+    if sys.stdin is not None and not sys.stdin.closed:
+        threading.Thread(target=read_stdin, daemon=True, name="controls").start()
+    old = signal.signal(signal.SIGTERM, lambda signum, _frame: recorder.signal(signum))
+    print(f"ready on {args.port}: press the stylus; controls n, p, r, u, q + Enter", flush=True)
+    code = EXIT_OK
+    try:
+        while not recorder.finished:
+            for update in recorder.poll(timeout=0.5):
+                if update.kind in ("lost", "failed"):
+                    say(f"error: {update.message}")
+                elif update.kind in ("recorded", "refused", "control", "said"):
+                    print(update.message, flush=True)
+                code = update.code or code
+    except KeyboardInterrupt:
+        code = 130
+    finally:
+        signal.signal(signal.SIGTERM, old)
+        recorder.close()
+        print(session.summary(), flush=True)
+    return code

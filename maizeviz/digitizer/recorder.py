@@ -1,0 +1,132 @@
+"""A digitizing session as one loop: the port's reader thread and the technician's controls
+feed one queue; :meth:`Recorder.poll` turns what is queued into journal lines and updates.
+
+The command line (``maizeviz record``) polls with a timeout; the app polls from a GUI timer.
+Nothing is handled after the session finished (``q``) or the port vanished, so a control and a
+record arriving in the same poll can never act on a closed session.
+"""
+
+from __future__ import annotations
+
+import queue
+from dataclasses import dataclass
+from typing import Literal
+
+from maizeviz.digitizer.port import FastrakPort, PortLost
+from maizeviz.digitizer.protocol import Garbled
+from maizeviz.digitizer.session import Session
+from maizeviz.errors import MaizevizError
+
+#: What an update is about: a point recorded, a press refused, a garbled record, a control
+#: applied, a message from elsewhere (the demo), the session finished (q), the port lost, a
+#: write that failed, a signal (SIGTERM) received.
+UpdateKind = Literal["recorded", "refused", "garbled", "control", "said", "finished", "lost",
+                     "failed", "signal"]
+#: Kinds after which the recorder handles nothing more.
+FINAL_KINDS = ("finished", "lost", "failed", "signal")
+
+
+@dataclass(frozen=True)
+class Update:
+    """One thing that happened, with the line to show the technician (may be empty)."""
+
+    kind: UpdateKind
+    message: str = ""
+    code: int = 0
+
+
+class Recorder:
+    """A session journal fed by a configured port.
+
+    Parameters
+    ----------
+    session : the journal (opened, resumed if asked)
+    port : a configured :class:`FastrakPort`; its reader starts with :meth:`start`
+    """
+
+    def __init__(self, session: Session, port: FastrakPort | None):
+        self.session = session
+        self.port = port
+        self.events: queue.Queue = queue.Queue()
+        self.final: Update | None = None
+
+    @property
+    def finished(self) -> bool:
+        return self.final is not None
+
+    def start(self) -> None:
+        """Start the port's reader thread, its events going to this recorder's queue."""
+        if self.port is not None:
+            self.port.start_reader(self.events.put)
+
+    # thread-safe producers -------------------------------------------------------------
+    def control(self, key: str) -> None:
+        """Queue a technician's control (n, p, r, u, q), from any thread."""
+        self.events.put(("control", key))
+
+    def say(self, message: str) -> None:
+        """Queue a message to pass on (a demo's instructions), from any thread."""
+        self.events.put(("say", message))
+
+    def signal(self, signum: int) -> None:
+        """Queue the end of the session by a signal (SIGTERM), from a signal handler."""
+        self.events.put(("signal", signum))
+
+    # the loop --------------------------------------------------------------------------
+    def poll(self, timeout: float = 0.0, limit: int = 2000) -> list[Update]:
+        """Handle up to ``limit`` queued events, waiting up to ``timeout`` s for the first.
+
+        Returns the updates in order; the last is final (``finished``, ``lost``, ``failed``,
+        ``signal``) when the session ended, and later calls return nothing.
+        """
+        out: list[Update] = []
+        for k in range(limit):
+            if self.final is not None:
+                break
+            try:
+                ev = self.events.get(timeout=timeout) if k == 0 and timeout > 0 else \
+                    self.events.get_nowait()
+            except queue.Empty:
+                break
+            update = self._handle(ev)
+            if update is None:
+                continue
+            out.append(update)
+            if update.kind in FINAL_KINDS:
+                self.final = update
+        return out
+
+    def _handle(self, ev: object) -> Update | None:
+        try:
+            return self._apply(ev)
+        except MaizevizError as exc:                # the journal cannot be written (disk full)
+            return Update("failed", str(exc), 1)
+
+    def _apply(self, ev: object) -> Update | None:
+        if isinstance(ev, tuple):
+            kind, value = ev
+            if kind == "signal":
+                return Update("signal", f"stopped by signal {value}", 128 + int(value))
+            if kind == "say":
+                return Update("said", str(value))
+            key = str(value)
+            if not key.strip():
+                return None
+            msg = self.session.control(key)
+            if msg == "quit":
+                return Update("finished", "finished")
+            return Update("control", msg)
+        if isinstance(ev, PortLost):
+            return Update("lost", f"{ev.message}; every point reported recorded is on disk", 1)
+        msg = self.session.on_event(ev)
+        if isinstance(ev, Garbled):
+            return Update("garbled", "")
+        if not msg:
+            return None
+        return Update("recorded" if msg.startswith("recorded") else "refused", msg)
+
+    def close(self) -> None:
+        """Stop the reader, close the port and the journal (idempotent)."""
+        if self.port is not None:
+            self.port.close()
+        self.session.close()

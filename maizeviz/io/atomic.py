@@ -1,0 +1,150 @@
+"""Atomic output files: a kill or a full disk leaves the old file or the new one, never a part.
+
+Every file maizeviz writes goes to a temporary file in the same folder, is flushed to disk
+(fsync) and renamed over the target (``os.replace`` is atomic within a file system); the folder
+is fsynced so the rename itself survives a power cut. A failure removes the temporary file and
+raises :class:`~maizeviz.errors.MaizevizError` naming the path.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+from typing import IO, Any
+
+from maizeviz.errors import MaizevizError
+
+
+def _umask_mode() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
+def _fsync_folder(folder: Path) -> None:
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:                              # some file systems cannot open folders
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def cannot_write(path: str | Path, exc: OSError) -> MaizevizError:
+    """The one-line error for an output that could not be written."""
+    return MaizevizError(f"{path}: cannot write ({exc.strerror or exc}); nothing was written "
+                         "there")
+
+
+def check_output(path: str | Path) -> Path:
+    """Refuse, before any work, an output whose folder is missing or that is a folder."""
+    path = Path(path)
+    if path.is_dir():
+        raise MaizevizError(f"{path} is a folder; give a file name")
+    folder = path.parent
+    if not folder.is_dir():
+        raise MaizevizError(f"{path}: the folder {folder} does not exist")
+    return path
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | Path) -> Iterator[Path]:
+    """A temporary path beside ``path`` (same suffix, for writers that pick a format by it);
+    renamed over ``path`` when the block ends without an exception.
+
+    Raises
+    ------
+    MaizevizError
+        The folder is missing or the file cannot be written (the target is left untouched).
+    """
+    path = check_output(path)
+    folder = path.parent
+    try:
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}",
+                                        dir=folder)
+    except OSError as exc:
+        raise cannot_write(path, exc) from None
+    os.close(fd)
+    tmp = Path(tmp_name)
+    try:
+        os.chmod(tmp, _umask_mode())
+        yield tmp
+        with open(tmp, "rb+") as fh:
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise cannot_write(path, exc) from None
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    _fsync_folder(folder)
+
+
+@contextlib.contextmanager
+def atomic_open(path: str | Path, mode: str = "w", **kwargs: Any) -> Iterator[IO[Any]]:
+    """``open(path, mode)`` for writing, atomically (see the module docstring).
+
+    ``mode`` is ``"w"`` or ``"wb"``; ``kwargs`` go to :func:`open` (``newline``,
+    ``encoding``). Text defaults to UTF-8.
+    """
+    if mode not in ("w", "wb"):
+        raise ValueError(f"atomic_open writes whole files: mode 'w' or 'wb', not '{mode}'")
+    if mode == "w":
+        kwargs.setdefault("encoding", "utf-8")
+    with atomic_path(path) as tmp:
+        try:
+            with open(tmp, mode, **kwargs) as fh:
+                yield fh
+        except OSError as exc:
+            raise cannot_write(path, exc) from None
+
+
+def write_text(path: str | Path, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` atomically."""
+    with atomic_open(path, "w") as fh:
+        fh.write(text)
+
+
+def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str | Path | None]],
+                              inputs: Iterable[str | Path | None]) -> None:
+    """Refuse an output that is one of the inputs (a points file, a layout...).
+
+    Parameters
+    ----------
+    outputs : (what, path) pairs, e.g. ``("the leaf light table", "b.csv")``; None paths skipped
+    inputs : paths read by the same run; None skipped
+
+    Raises
+    ------
+    MaizevizError
+        Naming the output and the input it would overwrite.
+    """
+    ins = []
+    for p in inputs:
+        if p is None:
+            continue
+        try:
+            ins.append((Path(p), Path(p).resolve()))
+        except OSError:
+            continue
+    for what, out in outputs:
+        if out is None:
+            continue
+        target = Path(out)
+        for src, resolved in ins:
+            same = False
+            try:
+                same = target.exists() and os.path.samefile(target, src)
+            except OSError:
+                same = False
+            if same or target.resolve() == resolved:
+                raise MaizevizError(f"{out}: {what} would overwrite the input file {src}; "
+                                    "choose another name")

@@ -1,0 +1,111 @@
+"""The paper's hit classes: a sun ray's first leaf hit receives direct light, its second hit
+second-class light, the rest none.
+
+The rays form a :class:`SunRays` bundle: a regular grid over the sample rectangle on the
+ground, each ray started on a plane above the canopy and followed down toward the ground
+against the sun direction.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+
+from maizeviz.light.rays import Rect, Tracer, grid_shape, ray_grid
+
+#: Distance (cm) past a first hit where the second-hit ray starts (Embree starts at t = 0).
+SECOND_HIT_EPS = 0.01
+
+
+@dataclass(frozen=True)
+class SunRays:
+    """Parallel rays toward the ground rectangle.
+
+    Attributes
+    ----------
+    rect : (x0, y0, x1, y1) cm, the sample rectangle on the ground
+    density : rays per cm2 of it
+    sun : (3,) unit vector toward the sun, field coordinates
+    top : height (cm) of the plane the rays start from, above every triangle
+    """
+
+    rect: Rect
+    density: float
+    sun: np.ndarray
+    top: float
+
+    @cached_property
+    def shape(self) -> tuple[int, int]:
+        return grid_shape(self.rect, self.density)
+
+    @property
+    def n(self) -> int:
+        return self.shape[0] * self.shape[1]
+
+    @property
+    def ray_area_cm2(self) -> float:
+        """Horizontal footprint of one ray on the ground (cm2)."""
+        x0, y0, x1, y1 = self.rect
+        return (x1 - x0) * (y1 - y0) / self.n
+
+    @property
+    def reach(self) -> float:
+        """Distance (cm) along a ray from the top plane to the ground."""
+        return self.top / float(self.sun[2])
+
+    @cached_property
+    def _top_axes(self) -> tuple[np.ndarray, np.ndarray]:
+        nx, ny = self.shape
+        x0, y0, x1, y1 = self.rect
+        dx, dy = (x1 - x0) / nx, (y1 - y0) / ny
+        xs = (x0 + (np.arange(nx) + 0.5) * dx + self.sun[0] * self.reach).astype(np.float32)
+        ys = (y0 + (np.arange(ny) + 0.5) * dy + self.sun[1] * self.reach).astype(np.float32)
+        return xs, ys
+
+    def origins(self, a: int, b: int) -> np.ndarray:
+        """Start points (b - a, 3) float32 cm on the top plane of rays a..b (grid order)."""
+        xs, ys = self._top_axes
+        ny = self.shape[1]
+        k = np.arange(a, b)
+        i, j = np.divmod(k, ny)
+        org = np.empty((b - a, 3), dtype=np.float32)
+        org[:, 0] = xs[i]
+        org[:, 1] = ys[j]
+        org[:, 2] = self.top
+        return org
+
+
+def first_hits(tracer: Tracer, rays: SunRays, a: int, b: int,
+               ids: bool) -> tuple[np.ndarray | None, np.ndarray]:
+    """First hits of rays a..b: triangle ids (b - a,) int32, -1 where none (None unless
+    ``ids``), and the height (cm) of each hit (b - a,) float32, -inf where none."""
+    prim, dist = tracer.trace(rays.origins(a, b), np.full(b - a, rays.reach, np.float32), ids=ids)
+    z = (rays.top - dist * rays.sun[2]).astype(np.float32)
+    return prim, z
+
+
+def second_hits(tracer: Tracer, rays: SunRays, a: int, b: int, first_prim: np.ndarray,
+                first_z: np.ndarray) -> np.ndarray:
+    """Triangle ids of the second hits of rays a..b, given their first hits (ids (b - a,) and
+    heights (b - a,) cm): only the rays that have one."""
+    sel = np.flatnonzero(first_prim >= 0)
+    zf = first_z[sel].astype(np.float64)
+    s = rays.sun
+    dist_first = (rays.top - zf) / s[2]
+    left = rays.reach - dist_first - SECOND_HIT_EPS
+    org = np.empty((len(sel), 3))
+    org[:, :2] = ray_grid(rays.rect, rays.density, a, b)[0][sel] + left[:, None] * s[:2]
+    org[:, 2] = zf - SECOND_HIT_EPS * s[2]
+    prim, _ = tracer.trace(org, np.maximum(left, 0.0))
+    assert prim is not None
+    return prim[prim >= 0]
+
+
+def hit_counts(first_prim: np.ndarray, second: list[np.ndarray],
+               n_faces: int) -> tuple[np.ndarray, np.ndarray]:
+    """Rays whose first / second hit is each triangle: two (F,) int64 arrays."""
+    first = np.bincount(first_prim[first_prim >= 0], minlength=n_faces).astype(np.int64)
+    seconds = np.concatenate(second) if second else np.empty(0, np.int32)
+    return first, np.bincount(seconds, minlength=n_faces).astype(np.int64)
