@@ -156,7 +156,7 @@ def _localize(day: _dt.date, clock: str, tz, what: str):
     naive = pd.Timestamp(_dt.datetime.combine(day, t))
     try:
         return naive.tz_localize(tz, ambiguous="raise", nonexistent="raise")
-    except Exception:  # pytz/zoneinfo raise several types for skipped and repeated clock times
+    except ValueError:  # pandas' NonExistentTimeError / AmbiguousTimeError
         raise MaizevizError(f"the {what} time {text} on {day} does not exist or occurs twice "
                             f"in {tz} (a daylight-saving change); pick another time") from None
 
@@ -233,7 +233,7 @@ class SunTrack:
 
 def _step_edges(total_s: float, step_s: float) -> np.ndarray:
     """Offsets (s) of the step edges from the period start; the last step may be shorter."""
-    full = int(math.floor(total_s / step_s + 1e-9))
+    full = math.floor(total_s / step_s + 1e-9)
     edges = np.arange(full + 1, dtype=np.float64) * step_s
     if total_s - edges[-1] > 1e-6:
         edges = np.append(edges, total_s)
@@ -448,7 +448,7 @@ class Period:
                               "steps": np.ones(self.n_steps, dtype=np.int64)}, index=days)
         return frame.groupby(level="date").sum()
 
-    def with_par_factor(self, par_umol_per_j: float) -> "Period":
+    def with_par_factor(self, par_umol_per_j: float) -> Period:
         """The same period with another PAR conversion factor (umol per J of shortwave)."""
         return replace(self, par_umol_per_j=_check_par_factor(par_umol_per_j))
 
@@ -457,7 +457,7 @@ class Period:
         from maizeviz.light.sun import Sun
 
         return [Sun(float(z), float(a), t.isoformat())
-                for z, a, t in zip(self.zenith_deg, self.azimuth_deg, self.times)]
+                for z, a, t in zip(self.zenith_deg, self.azimuth_deg, self.times, strict=True)]
 
 
 # --------------------------------------------------------------------------- clear sky
@@ -561,7 +561,7 @@ class Weather:
     @property
     def columns(self) -> tuple:
         """Irradiance columns the file gave."""
-        return ("ghi",) + tuple(c for c in WEATHER_OPTIONAL if getattr(self, c) is not None)
+        return ("ghi", *(c for c in WEATHER_OPTIONAL if getattr(self, c) is not None))
 
 
 def _read_text(path: Path, max_bytes: int) -> str:
@@ -647,7 +647,8 @@ def _parse_times(texts: list, lines: list, path: Path, tz):
         except (ValueError, TypeError, OverflowError):
             for k in idx:
                 parse_one(k)
-            raise WeatherFileError(f"{path}, column time: cannot read the times as ISO 8601")
+            raise WeatherFileError(f"{path}, column time: cannot read the times as ISO "
+                                   f"8601") from None
 
     utc = np.empty(len(texts), dtype="datetime64[ns]")
     with_zone = np.flatnonzero(zoned)
@@ -658,11 +659,11 @@ def _parse_times(texts: list, lines: list, path: Path, tz):
         local = parse_all(naive)
         try:
             aware = local.tz_localize(tz, ambiguous="raise", nonexistent="raise")
-        except Exception:  # several exception types for skipped and repeated clock times
-            for k, t in zip(naive, local):
+        except ValueError:  # pandas' NonExistentTimeError / AmbiguousTimeError
+            for k, t in zip(naive, local, strict=True):
                 try:
                     t.tz_localize(tz, ambiguous="raise", nonexistent="raise")
-                except Exception:
+                except ValueError:
                     raise WeatherFileError(
                         f"{path}, line {lines[k]}, column time: '{texts[k]}' does not exist or "
                         f"occurs twice in {tz} (a daylight-saving change); write it with an "
@@ -782,7 +783,7 @@ def read_weather(path, tz: str | None = None, label: str = "center",
     texts = [row[columns["time"]] for row in data]
     times = _parse_times(texts, lines, path, zone)
     values = {c: _parse_values([row[columns[c]] for row in data], lines, texts, c, path)
-              for c in ("ghi",) + WEATHER_OPTIONAL if c in columns}
+              for c in ("ghi", *WEATHER_OPTIONAL) if c in columns}
     utc_ns = times.tz_convert("UTC").tz_localize(None).to_numpy("datetime64[ns]").astype(np.int64)
     steps = _check_order(utc_ns, lines, texts, path)
     edges = _intervals(utc_ns / 1e9, steps, key)

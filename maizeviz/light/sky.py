@@ -347,13 +347,13 @@ def equal_area_bands(n: int) -> tuple[np.ndarray, np.ndarray]:
         ideal = n * (np.cos(theta[:-1]) - np.cos(theta[1:]))   # cells each band would hold
         counts, carry = [], 0.0
         for x in ideal:
-            m = int(round(x + carry))
+            m = round(x + carry)
             carry += x - m
             counts.append(m)
         if min(counts) >= 1 or bands == 1:
             break
         bands -= 1
-    counts = np.array([1] + counts, dtype=np.int64)
+    counts = np.array([1, *counts], dtype=np.int64)
     counts[-1] += n - counts.sum()                 # absorbs rounding of the carry, if any
     c_edges = 1.0 - np.concatenate([[0], np.cumsum(counts)]) / n
     c_edges[-1] = 0.0

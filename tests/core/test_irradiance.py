@@ -223,7 +223,7 @@ def clear_day_rows(step_min=30):
 def weather_text(mids, cs, columns=("ghi", "dni", "dhi"), fmt=None):
     fmt = fmt or (lambda t: t.isoformat())
     lines = ["time," + ",".join(columns)]
-    for t, (_, row) in zip(mids, cs.iterrows()):
+    for t, (_, row) in zip(mids, cs.iterrows(), strict=True):
         lines.append(fmt(t) + "," + ",".join(f"{row[c]:.6f}" for c in columns))
     return "\n".join(lines) + "\n"
 
@@ -326,7 +326,7 @@ T = ["2005-08-01T10:00+08:00", "2005-08-01T11:00+08:00", "2005-08-01T12:00+08:00
 
 
 def rows(*values):
-    return "".join(f"{t},{v}\n" for t, v in zip(T, values))
+    return "".join(f"{t},{v}\n" for t, v in zip(T, values, strict=False))
 
 
 @pytest.mark.parametrize("text, expect", [

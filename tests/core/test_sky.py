@@ -155,8 +155,10 @@ def icosahedral_turtle():
     dodecahedron whose triangle centres den Dulk's turtle uses.
     """
     a = math.atan(0.5)
-    ring = lambda az, z: [math.cos(a) * math.sin(math.radians(az)),      # noqa: E731
-                          math.cos(a) * math.cos(math.radians(az)), z]
+
+    def ring(az, z):
+        return [math.cos(a) * math.sin(math.radians(az)), math.cos(a) * math.cos(math.radians(az)), z]
+
     v = np.array([[0, 0, 1.0], [0, 0, -1.0]] + [ring(72 * k, math.sin(a)) for k in range(5)]
                  + [ring(36 + 72 * k, -math.sin(a)) for k in range(5)])
     d = np.linalg.norm(v[:, None] - v[None], axis=2)
@@ -166,7 +168,7 @@ def icosahedral_turtle():
     assert len(faces) == 20
     centre = {f: unit(v[list(f)].sum(0)) for f in faces}
     points = list(v) + list(centre.values())
-    for i, j in zip(*np.nonzero(np.triu(near))):
+    for i, j in zip(*np.nonzero(np.triu(near)), strict=True):
         f1, f2 = [f for f in faces if i in f and j in f]
         points += [unit(v[k] + centre[f1] + centre[f2]) for k in (i, j)]
     return np.array(points)
