@@ -214,6 +214,10 @@ class Sky:
     directions: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self):
+        object.__setattr__(self, "kind", _check_kind(self.kind))
+        if self.split not in SKY_SPLITS[1:]:
+            raise MaizevizError(f"unknown sky split '{self.split}' (known: "
+                                f"{', '.join(SKY_SPLITS[1:])})")
         n = len(self.weights)
         for name in ("zenith_deg", "azimuth_deg", "solid_angle_sr", "weights"):
             arr = _frozen(getattr(self, name))

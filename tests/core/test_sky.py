@@ -260,6 +260,33 @@ def test_tregenza_has_its_145_patches():
     assert 0.0 in set(sky.azimuth_deg[el == 6.0])          # patch 1 points due north
 
 
+@pytest.mark.parametrize("kind", KINDS)
+def test_tregenza_patch_integrals_match_a_lattice(kind):
+    # Fibonacci lattice points given to the patch whose altitude band and azimuth sector hold
+    # them (Tregenza's definition), independently of the closed-form band integrals
+    sky = make_sky(kind, 145)
+    m = 400_000
+    i = np.arange(m)
+    mu = (i + 0.5) / m
+    az = np.degrees(i * np.pi * (3 - math.sqrt(5))) % 360
+    alt = np.degrees(np.arcsin(mu))
+    band = np.minimum((alt // 12).astype(int), 7)
+    per_band = np.array([30, 30, 24, 24, 18, 12, 6, 1])
+    sector = np.round(az / (360 / per_band[band])).astype(int) % per_band[band]
+    centre_alt = np.where(band == 7, 90.0, band * 12 + 6.0)
+    centre_az = np.where(band == 7, 0.0, sector * 360 / per_band[band])
+    key = np.round(centre_alt, 6) * 1000 + np.round(centre_az, 6)
+    sky_key = np.round(90 - sky.zenith_deg, 6) * 1000 + np.round(sky.azimuth_deg, 6)
+    order = np.argsort(sky_key)
+    owner = order[np.searchsorted(sky_key[order], key)]
+    assert np.array_equal(sky_key[owner], key)
+    lum = (1 + 2 * mu) / 3 if kind == "soc" else np.ones_like(mu)
+    share = np.bincount(owner, weights=lum * mu, minlength=145)
+    solid = np.bincount(owner, minlength=145) * 2 * np.pi / m
+    assert solid == pytest.approx(sky.solid_angle_sr, abs=1e-4)       # measured 3.1e-5
+    assert share / share.sum() == pytest.approx(sky.weights, abs=3e-5)  # measured 9.5e-6
+
+
 def test_equal_split_cells_have_equal_solid_angles():
     for n in (1, 2, 3, 7, 46, 145, 1000):
         sky = make_sky("uoc", n, "equal")
@@ -331,6 +358,10 @@ def test_a_sky_is_immutable_and_validated():
         sky.kind = "uoc"
     with pytest.raises(MaizevizError, match="sum to 1"):
         Sky("soc", "equal", [0.0, 45.0], [0.0, 0.0], [np.pi, np.pi], [0.5, 0.6])
+    with pytest.raises(MaizevizError, match="unknown sky kind 'cie'"):
+        Sky("cie", "equal", [0.0], [0.0], [2 * np.pi], [1.0])
+    with pytest.raises(MaizevizError, match="unknown sky split 'auto'"):
+        Sky("soc", "auto", [0.0], [0.0], [2 * np.pi], [1.0])
     with pytest.raises(MaizevizError, match="above the horizon"):
         Sky("soc", "equal", [0.0, 90.0], [0.0, 0.0], [np.pi, np.pi], [0.5, 0.5])
     assert "weights sum to 1.000000000000000" in sky.table()
