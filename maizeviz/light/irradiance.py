@@ -674,27 +674,41 @@ def _parse_times(texts: list, lines: list, path: Path, tz):
     return pd.DatetimeIndex(utc).tz_localize("UTC").tz_convert(zone)
 
 
+def _value_problem(text: str) -> str | None:
+    """What is wrong with one irradiance cell, or None."""
+    if text == "":
+        return "missing value"
+    try:
+        value = float(text)
+    except ValueError:
+        return f"'{text}' is not a number"
+    if math.isnan(value):
+        return f"missing value ('{text}')"
+    if not math.isfinite(value):
+        return f"'{text}' is not a finite number"
+    if value < 0:
+        return f"negative irradiance {value:g} W/m2"
+    if value > MAX_IRRADIANCE_W_M2:
+        return f"{value:g} W/m2 is more than {MAX_IRRADIANCE_W_M2:g} W/m2; is the unit W/m2?"
+    return None
+
+
 def _parse_values(texts: list, lines: list, times: list, column: str, path: Path) -> np.ndarray:
-    out = np.empty(len(texts))
-    for k, text in enumerate(texts):
-        where = f"{path}, line {lines[k]} ({times[k]}), column {column}"
-        if text == "":
-            raise WeatherFileError(f"{where}: missing value")
-        try:
-            value = float(text)
-        except ValueError:
-            raise WeatherFileError(f"{where}: '{text}' is not a number") from None
-        if math.isnan(value):
-            raise WeatherFileError(f"{where}: missing value ('{text}')")
-        if not math.isfinite(value):
-            raise WeatherFileError(f"{where}: '{text}' is not a finite number")
-        if value < 0:
-            raise WeatherFileError(f"{where}: negative irradiance {value:g} W/m2")
-        if value > MAX_IRRADIANCE_W_M2:
-            raise WeatherFileError(f"{where}: {value:g} W/m2 is more than "
-                                   f"{MAX_IRRADIANCE_W_M2:g} W/m2; is the unit W/m2?")
-        out[k] = value
-    return out
+    """Irradiance cells -> (n,) float64 W/m2; refuses the first bad cell in file order."""
+    try:
+        values = np.array(texts, dtype=np.float64)
+        ok = np.isfinite(values) & (values >= 0) & (values <= MAX_IRRADIANCE_W_M2)
+        bad = np.flatnonzero(~ok)
+    except ValueError:                              # an empty or non-numeric cell somewhere
+        values, bad = None, range(len(texts))
+    for k in bad:
+        problem = _value_problem(texts[k])
+        if problem:
+            raise WeatherFileError(f"{path}, line {lines[k]} ({times[k]}), column {column}: "
+                                   f"{problem}")
+    if values is None:                              # forms float() reads and numpy does not
+        values = np.array([float(t) for t in texts])
+    return values
 
 
 def _check_order(utc_ns: np.ndarray, lines: list, texts: list, path: Path) -> np.ndarray:
