@@ -73,4 +73,11 @@ QUANTITIES = {
     "cols": "points per cross-section",
     "plants": "rows x plants per row",
     "sections": "cross-sections of a long leaf",
+    "sky": "sky radiance distribution and split",
+    "sky_directions": "number of sky directions",
+    "step": "time step of a period, min",
+    "period": "start and end clock times of a period",
+    "par_factor": "PAR photons per joule of shortwave, umol/J",
+    "linke_turbidity": "Linke turbidity of the clear sky",
+    "altitude": "site altitude, m",
 }

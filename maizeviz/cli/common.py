@@ -26,6 +26,9 @@ FLAGS = {
     "degree": "--degree", "params": "--params", "sun": "--sun-zenith/--sun-azimuth",
     "date": "--date", "time": "--time", "place": "--lat/--lon", "tz": "--tz", "cols": "--cols",
     "plants": "--plants", "sections": "--sections", "at": "--at", "periodic": "--periodic",
+    "sky": "--sky", "sky_directions": "--sky-directions", "step": "--step",
+    "period": "--from/--to", "par_factor": "--par-factor", "linke_turbidity": "--linke-turbidity",
+    "altitude": "--altitude",
 }
 
 

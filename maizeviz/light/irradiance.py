@@ -112,11 +112,11 @@ def _check_place(lat, lon) -> tuple[float, float]:
     try:
         lat, lon = float(lat), float(lon)
     except (TypeError, ValueError):
-        raise MaizevizError(f"latitude and longitude must be numbers, got {lat!r}, {lon!r}") \
-            from None
+        raise MaizevizError(f"latitude and longitude must be numbers, got {lat!r}, {lon!r}",
+                            quantity="place") from None
     if not (-90 <= lat <= 90) or not (-180 <= lon <= 360):
         raise MaizevizError(f"latitude must be in [-90, 90] and longitude in [-180, 360], "
-                            f"got {lat}, {lon}")
+                            f"got {lat}, {lon}", quantity="place")
     return lat, lon
 
 
@@ -124,7 +124,7 @@ def _check_altitude(altitude) -> float:
     if not isinstance(altitude, (int, float, np.floating, np.integer)) \
             or not math.isfinite(altitude) or not (-500 <= altitude <= 9000):
         raise MaizevizError(f"site altitude must be a number of metres in [-500, 9000], "
-                            f"got {altitude!r}")
+                            f"got {altitude!r}", quantity="altitude")
     return float(altitude)
 
 
@@ -132,7 +132,7 @@ def _check_par_factor(par_umol_per_j) -> float:
     if not isinstance(par_umol_per_j, (int, float, np.floating, np.integer)) \
             or not math.isfinite(par_umol_per_j) or not (0 < par_umol_per_j <= 10):
         raise MaizevizError(f"PAR conversion factor must be in (0, 10] umol per J of "
-                            f"shortwave, got {par_umol_per_j!r}")
+                            f"shortwave, got {par_umol_per_j!r}", quantity="par_factor")
     return float(par_umol_per_j)
 
 
@@ -143,7 +143,7 @@ def _time_zone(tz: str):
         return zoneinfo.ZoneInfo(str(tz))
     except (zoneinfo.ZoneInfoNotFoundError, ValueError, TypeError):
         raise MaizevizError(f"unknown time zone '{tz}' (give an IANA name such as "
-                            f"Asia/Shanghai, or UTC)") from None
+                            f"Asia/Shanghai, or UTC)", quantity="tz") from None
 
 
 def _localize(day: _dt.date, clock: str, tz, what: str):
@@ -156,14 +156,15 @@ def _localize(day: _dt.date, clock: str, tz, what: str):
     try:
         t = _dt.time.fromisoformat(text)
     except ValueError:
-        raise MaizevizError(f"the {what} time must be HH:MM (local clock), got '{clock}'") \
-            from None
+        raise MaizevizError(f"the {what} time must be HH:MM (local clock), got '{clock}'",
+                            quantity="period") from None
     naive = pd.Timestamp(_dt.datetime.combine(day, t))
     try:
         return naive.tz_localize(tz, ambiguous="raise", nonexistent="raise")
     except ValueError:  # pandas' NonExistentTimeError / AmbiguousTimeError
         raise MaizevizError(f"the {what} time {text} on {day} does not exist or occurs twice "
-                            f"in {tz} (a daylight-saving change); pick another time") from None
+                            f"in {tz} (a daylight-saving change); pick another time",
+                            quantity="period") from None
 
 
 def _solar_position(times, lat, lon, altitude):
@@ -279,25 +280,26 @@ def sun_track(date, lat: float, lon: float, tz: str, step_min: float = 30.0,
     try:
         day = date if isinstance(date, _dt.date) else _dt.date.fromisoformat(str(date))
     except ValueError:
-        raise MaizevizError(f"the date must be YYYY-MM-DD, got '{date}'") from None
+        raise MaizevizError(f"the date must be YYYY-MM-DD, got '{date}'",
+                            quantity="date") from None
     zone = _time_zone(tz)
     if isinstance(step_min, bool) or not isinstance(step_min, (int, float, np.integer,
                                                               np.floating)) \
             or not math.isfinite(step_min) or step_min <= 0:
-        raise MaizevizError(f"the time step must be > 0 min, got {step_min!r}")
+        raise MaizevizError(f"the time step must be > 0 min, got {step_min!r}", quantity="step")
     t0 = _localize(day, start or "00:00", zone, "start")
     t1 = _localize(day, end or "24:00", zone, "end")
     total = (t1 - t0).total_seconds()
     if total <= 0:
         raise MaizevizError(f"the period must end after it starts, got {start or '00:00'} to "
-                            f"{end or '24:00'}")
+                            f"{end or '24:00'}", quantity="period")
     step_s = float(step_min) * 60.0
     if step_s > total + 1e-6:
         raise MaizevizError(f"the time step ({_fmt_duration(step_s)}) is longer than the "
-                            f"period ({_fmt_duration(total)})")
+                            f"period ({_fmt_duration(total)})", quantity="step")
     if total / step_s > MAX_STEPS:
         raise MaizevizError(f"a time step of {step_min:g} min gives {total / step_s:.0f} steps, "
-                            f"more than {MAX_STEPS}")
+                            f"more than {MAX_STEPS}", quantity="step")
     edges = _step_edges(total, step_s)
     mids = (edges[:-1] + edges[1:]) / 2.0
     times = t0 + pd.to_timedelta(np.round(mids * 1e6).astype(np.int64), unit="us")
@@ -490,7 +492,7 @@ def clear_sky(track: SunTrack, linke_turbidity: float = DEFAULT_LINKE_TURBIDITY,
             linke_turbidity, (int, float, np.integer, np.floating)) \
             or not math.isfinite(linke_turbidity) or not (1 <= linke_turbidity <= 10):
         raise MaizevizError(f"Linke turbidity must be a number in [1, 10], got "
-                            f"{linke_turbidity!r}")
+                            f"{linke_turbidity!r}", quantity="linke_turbidity")
     par = _check_par_factor(par_umol_per_j)
     params = {"model": "ineichen", "linke_turbidity": float(linke_turbidity),
               "altitude_m": track.altitude_m, "airmass_model": "kastenyoung1989",

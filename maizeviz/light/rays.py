@@ -2,9 +2,16 @@
 
 Rays lie on a regular grid of ``density`` rays per cm2 (cell centres, x slow and y fast so
 neighbouring rays stay together: Embree is about twice as fast on coherent rays). The
-:class:`Tracer` follows rays through an Embree scene; with a periodic field a ray that leaves
-the plot sideways re-enters through the opposite side (the plot repeats forever, as Helios,
-Caribu and LESS do), segment by segment, until it has gone its full length.
+:class:`Tracer` follows rays through an Embree scene, asking either for the first hit
+(:meth:`Tracer.trace`) or only whether anything is hit (:meth:`Tracer.occluded`, Embree's
+cheaper occlusion query); with a periodic field a ray that leaves the plot sideways re-enters
+through the opposite side (the plot repeats forever, as Helios, Caribu and LESS do), segment by
+segment, until it has gone its full length.
+
+Sensor planes (:func:`sensor_offsets`): the sample rectangle raised to each height h carries the
+same grid, slid by less than half a cell so that the sun path from a sample point at one height
+passes through a sample point of every height above it. In a periodic field whose period is the
+rectangle the sampled transmission then never increases downward, as in the continuum.
 """
 
 from __future__ import annotations
@@ -46,6 +53,31 @@ def ray_grid(rect: Rect, density: float, start: int = 0,
     pts[:, 0] = x0 + (i + 0.5) * ((x1 - x0) / nx)
     pts[:, 1] = y0 + (j + 0.5) * ((y1 - y0) / ny)
     return pts, (x1 - x0) * (y1 - y0) / (nx * ny)
+
+
+def sensor_offsets(heights_cm: np.ndarray, toward_sun: np.ndarray, rect: Rect,
+                   density: float) -> np.ndarray:
+    """Offsets (H, 2) cm of the sample grid at each height from the ground grid's cell centres.
+
+    The sun path from a ground cell centre crosses height h at ``h * s_xy / s_z`` from it; the
+    grid at h is slid by that distance modulo the cell (to within +- half a cell), so that it
+    stays inside the rectangle and every path through a sample point at one height meets a
+    sample point of every other height (modulo the rectangle, in a periodic field). A vertical
+    sun gives zero offsets.
+
+    Parameters
+    ----------
+    heights_cm : (H,) float64, cm
+    toward_sun : (3,) unit vector toward the sun (z > 0)
+    rect : (x0, y0, x1, y1) cm; density : rays per cm2
+    """
+    x0, y0, x1, y1 = rect
+    nx, ny = grid_shape(rect, density)
+    cell = np.array([(x1 - x0) / nx, (y1 - y0) / ny])
+    h = np.asarray(heights_cm, dtype=np.float64)
+    shift = h[:, None] * (np.asarray(toward_sun[:2], dtype=np.float64) / float(toward_sun[2]))
+    t = shift / cell
+    return (t - np.round(t)) * cell
 
 
 class Tracer:
@@ -107,6 +139,31 @@ class Tracer:
             return prim, t, prim >= 0
         t = self.scene.distance(org, dirs, length)
         return None, t, t < np.asarray(length, np.float32)
+
+    def occluded(self, org: np.ndarray, length: np.ndarray) -> np.ndarray:
+        """Whether anything lies on the rays from ``org`` (N, 3) cm within ``length`` (N,) cm:
+        (N,) bool. Embree's occlusion query (any hit, not the nearest), wrapped like
+        :meth:`trace` in a periodic field."""
+        n = len(org)
+        if not self.periodic:
+            return self.scene.occluded(org, self.dirs[:n], length)
+        blocked = np.zeros(n, dtype=bool)
+        todo = np.arange(n)
+        org = self._wrap(np.asarray(org, dtype=np.float64).copy())
+        remaining = np.asarray(length, dtype=np.float64).copy()
+        for _ in range(10_000):
+            if not len(todo):
+                break
+            seg = np.minimum(self._exit(org), remaining)
+            hit = self.scene.occluded(org, self.dirs[: len(org)], seg)
+            blocked[todo[hit]] = True
+            go = ~hit & (remaining - seg > 1e-6)
+            todo, org = todo[go], org[go] + seg[go, None] * self.down
+            remaining = remaining[go] - seg[go]
+            org = self._cross(org)
+        if len(todo):  # pragma: no cover - a ray advances by at least one plot crossing a step
+            raise MaizevizError(f"periodic tracing left {len(todo)} rays unfinished")
+        return blocked
 
     def trace(self, org: np.ndarray, length: np.ndarray,
               ids: bool = True) -> tuple[np.ndarray | None, np.ndarray]:

@@ -1,21 +1,33 @@
-"""Direct sunlight through a canopy: transmission by height (the paper's Table 3).
+"""Direct sunlight through a canopy: transmission on sensor planes by height (the paper's Table 3).
 
-Parallel rays on a regular grid of ``density`` rays per cm2 cover the horizontal sample
-rectangle on the ground (:class:`~maizeviz.light.hits.SunRays`). Each ray is followed from above
-the canopy down toward the ground against the sun direction. Transmission at height h is the
-fraction of these rays that are still unobstructed when they pass height h. The same rays serve
-every height, so T = 1 above the canopy and T never increases going down; for a periodic canopy
-whose period is the sample rectangle this equals the sunfleck fraction of the rectangle at
-height h. The rays' first and second hits give the paper's hit classes
-(:mod:`maizeviz.light.hits`).
+Transmission at height h is measured on the sample rectangle raised to h: the same x, y
+rectangle, as a row of light sensors held at that height. The rectangle at h carries a regular
+grid of ``density`` sensors per cm2 (:func:`~maizeviz.light.rays.sensor_offsets`), and Embree is
+asked whether the path from each sensor toward the sun is blocked (an occlusion query, cheaper
+than a nearest-hit query); T(h) is the fraction of sensors whose path is clear.
 
-With ``periodic`` a ray that leaves the plot sideways re-enters on the opposite side. Without
-it, a warning says when the sun is low enough for rays reaching the rectangle to have crossed
-the plot edge, where nothing stops them.
+The paper's hit classes come from parallel rays landing on the ground rectangle
+(:class:`~maizeviz.light.hits.SunRays`): each is followed from above the canopy down toward the
+ground against the sun direction; its first leaf hit receives direct light, its second hit
+second-class light (:mod:`maizeviz.light.hits`). The ground's sensors are these rays' landing
+points, so T(0) comes from them without another query.
+
+With ``periodic`` every ray and every sensor path that leaves the plot sideways re-enters on the
+opposite side. Without it, a warning says when the sun is low enough for paths reaching the
+rectangle to have crossed the plot edge, where nothing stops them.
+
+Why not the rays' own crossings of height h (version 0.1): they lie on the ground rectangle
+shifted toward the sun by h tan(zenith), which is the same place only in a periodic canopy whose
+period is the rectangle; a single leaf at 100 cm under a 45 deg sun shades the whole rectangle at
+50 cm while the shifted crossings report half of it lit, and for a low sun the shifted rectangle
+can leave the plot. On sensor planes T need not decrease downward (a shadow can move out of the
+rectangle below a height); in a periodic field whose period is the rectangle it does, as in the
+continuum, because the grids of all heights are aligned along the sun path.
 """
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -27,13 +39,14 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.hits import SunRays, first_hits, hit_counts, second_hits
-from maizeviz.light.rays import Rect, Tracer, ray_grid
-from maizeviz.light.request import LightRequest, check_request
+from maizeviz.light.rays import Rect, Tracer, ray_grid, sensor_offsets
+from maizeviz.light.request import LightRequest, canopy_top, check_request
 from maizeviz.light.sun import Sun
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, report
 
-#: Rays traced per chunk: bounds memory and sets the progress step.
+#: Rays traced per chunk: bounds memory and sets the progress step (a multiple of 8, so that
+#: the sensors' bits of a chunk pack into whole bytes).
 CHUNK = 1 << 18
 
 T = TypeVar("T")
@@ -46,15 +59,21 @@ class LightResult:
     Attributes
     ----------
     sun : Sun
-    heights_cm : (H,) float64; transmission : (H,) float64 in [0, 1]
-    rays : int; rect : (x0, y0, x1, y1) cm; ray_area_cm2 : horizontal footprint of a ray
-    first_z : (N,) float32, height (cm) of each ray's first hit, -inf where none
+    heights_cm : (H,) float64; transmission : (H,) float64 in [0, 1], on the sensor planes
+    rays : int, rays (and sensors per plane); rect : (x0, y0, x1, y1) cm;
+    ray_area_cm2 : horizontal footprint of a ray (and of a sensor)
+    first_z : (N,) float32, height (cm) of each ground ray's first hit, -inf where none
     first_hits, second_hits : (F,) int64, rays whose first / second hit is each triangle
         (None unless the request asked for hit classes)
     seconds : "build" and "trace" (and "second" for second hits), s
     warnings : what the user should know about this result
     level : mesh level label; density : rays per cm2 asked for
     direction : (3,) unit vector toward the sun in field coordinates
+    sensor_lit : (H, ceil(N / 8)) uint8, the sensors of each plane whose path to the sun is
+        clear, bits packed in ray grid order (:meth:`lit`); None for results made elsewhere
+    sensor_offset_cm : (H, 2) float64 cm, where each plane's grid sits relative to the ground
+        grid's cell centres (:meth:`sensor_xy`)
+    periodic : rays and sensor paths wrapped across the plot
     """
 
     sun: Sun
@@ -71,6 +90,9 @@ class LightResult:
     warnings: tuple[str, ...] = ()
     level: str = ""
     density: float = 0.0
+    sensor_lit: np.ndarray | None = None
+    sensor_offset_cm: np.ndarray | None = None
+    periodic: bool = False
 
     @property
     def rect_area_cm2(self) -> float:
@@ -96,8 +118,33 @@ class LightResult:
         return ray_grid(self.rect, self.density)[0]
 
     def crossings(self, height: float) -> np.ndarray:
-        """Where each ray crosses the plane at ``height`` (N, 2) cm (ray grid order)."""
+        """Where each ground ray crosses the plane at ``height`` (N, 2) cm (ray grid order): the
+        rectangle shifted toward the sun, where version 0.1 measured transmission."""
         return self.ground_xy + self.direction[:2] * (height / self.direction[2])
+
+    def height_index(self, height: float) -> int:
+        """Index of ``height`` (cm) among the traced heights; MaizevizError if not traced."""
+        from maizeviz.errors import MaizevizError
+
+        k = np.flatnonzero(np.isclose(self.heights_cm, height, rtol=0, atol=1e-9))
+        if not len(k):
+            raise MaizevizError(f"height {height:g} cm was not traced (traced: "
+                                f"{', '.join(f'{h:g}' for h in self.heights_cm)} cm)",
+                                quantity="heights")
+        return int(k[0])
+
+    def sensor_xy(self, k: int) -> np.ndarray:
+        """Sensor positions (N, 2) cm of the plane of height index ``k``, in ray grid order."""
+        off = np.zeros(2) if self.sensor_offset_cm is None else self.sensor_offset_cm[k]
+        return self.ground_xy + off
+
+    def lit(self, k: int) -> np.ndarray:
+        """(N,) bool: the sensors of the plane of height index ``k`` that see the sun."""
+        if self.sensor_lit is None:
+            from maizeviz.errors import MaizevizError
+
+            raise MaizevizError("this result carries no sensor planes")
+        return np.unpackbits(self.sensor_lit[k], count=self.rays).astype(bool)
 
 
 def light_scene(canopy: Canopy, with_stalks: bool = False) -> RayScene:
@@ -109,11 +156,21 @@ def light_scene(canopy: Canopy, with_stalks: bool = False) -> RayScene:
     return RayScene(verts, faces)
 
 
-def _in_chunks(fn: Callable[[int, int], T], n: int, threads: int,
+def _chunks(n: int) -> list[tuple[int, int]]:
+    size = max(8, CHUNK - CHUNK % 8)
+    return [(a, min(a + size, n)) for a in range(0, n, size)]
+
+
+def _in_chunks(fn: Callable[[int, int], T], chunks: list[tuple[int, int]], threads: int,
                progress: Callable[[], None]) -> list[T]:
-    """``fn(a, b)`` over chunks of :data:`CHUNK` rays on ``threads`` threads, in order;
-    ``progress()`` after each chunk (it may raise InterruptedError to stop)."""
-    chunks = [(a, min(a + CHUNK, n)) for a in range(0, n, CHUNK)]
+    """``fn(a, b)`` over ``chunks`` of rays on ``threads`` threads, in order; ``progress()``
+    after each chunk (it may raise InterruptedError to stop)."""
+    if threads <= 1 or len(chunks) <= 1:
+        out = []
+        for a, b in chunks:
+            out.append(fn(a, b))
+            progress()
+        return out
     out = []
     with ThreadPoolExecutor(max_workers=threads) as pool:
         futures = [pool.submit(fn, a, b) for a, b in chunks]
@@ -126,6 +183,150 @@ def _in_chunks(fn: Callable[[int, int], T], n: int, threads: int,
                 f.cancel()
             raise
     return out
+
+
+@dataclass(frozen=True)
+class Sampler:
+    """What every direction traced through one canopy shares: the scene, the sample rectangle
+    and its grid, the sensor heights, the periodic field.
+
+    Attributes
+    ----------
+    scene : RayScene of the canopy (leaves first, then stalks if any)
+    rect : (x0, y0, x1, y1) cm; density : rays per cm2 asked for
+    heights_cm : (H,) float64 cm; periodic : bool
+    bounds : (x0, y0, x1, y1) cm, the plot
+    top : cm, height of the plane the ground rays start from (1 cm above every triangle)
+    n_leaf_triangles : F_leaf, the canopy's leaf triangles (scene triangles after them are stalks)
+    """
+
+    scene: RayScene
+    rect: Rect
+    density: float
+    heights_cm: np.ndarray
+    periodic: bool
+    bounds: Rect
+    top: float
+    n_leaf_triangles: int
+
+    @cached_property
+    def n(self) -> int:
+        return SunRays(self.rect, self.density, np.array([0.0, 0.0, 1.0]), self.top).n
+
+    @cached_property
+    def ray_area_cm2(self) -> float:
+        x0, y0, x1, y1 = self.rect
+        return (x1 - x0) * (y1 - y0) / self.n
+
+
+def sampler(canopy: Canopy, scene: RayScene, rect: Rect, density: float,
+            heights_cm: tuple[float, ...] | np.ndarray, periodic: bool,
+            with_stalks: bool = False) -> Sampler:
+    """A :class:`Sampler` for a checked request (see :func:`check_sampling`)."""
+    return Sampler(scene, rect, density, np.asarray(heights_cm, dtype=np.float64), periodic,
+                   canopy.layout.bounds, canopy_top(canopy, with_stalks) + 1.0,
+                   canopy.n_triangles)
+
+
+@dataclass(frozen=True)
+class DirectionTrace:
+    """One direction traced by :func:`trace_direction`.
+
+    Attributes
+    ----------
+    toward : (3,) unit vector toward the light (sun or sky element)
+    transmission : (H,) float64, fraction of each plane's sensors that see the light
+    first_z : (N,) float32 cm, height of each ground ray's first hit, -inf where none
+    first_prim : (N,) int32, each ground ray's first triangle, -1 where none (None unless ids)
+    second_prim : list of int32 arrays, the second triangles hit (None unless second hits)
+    sensor_lit : (H, ceil(N / 8)) uint8, packed bits of :attr:`transmission`'s sensors
+    sensor_offset_cm : (H, 2) float64 cm
+    seconds : "trace" (and "second"), s
+    """
+
+    toward: np.ndarray
+    transmission: np.ndarray
+    first_z: np.ndarray
+    first_prim: np.ndarray | None
+    second_prim: list[np.ndarray] | None
+    sensor_lit: np.ndarray
+    sensor_offset_cm: np.ndarray
+    seconds: dict[str, float]
+
+
+def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second: bool = False,
+                    threads: int = 1, tick: Callable[[], None] | None = None,
+                    stop: threading.Event | None = None) -> DirectionTrace:
+    """Trace one parallel beam through the canopy: ground rays and every sensor plane.
+
+    Parameters
+    ----------
+    smp : Sampler
+    toward : (3,) unit vector toward the light, z > 0 (field coordinates)
+    ids : keep each ground ray's first triangle; second : also trace second hits (needs ids)
+    threads : threads over chunks of rays
+    tick : called after each chunk (it may raise InterruptedError to stop)
+    stop : when set, the next chunk raises InterruptedError (cancellation from another thread)
+    """
+    t0 = time.perf_counter()
+    s = np.asarray(toward, dtype=np.float64)
+    rays = SunRays(smp.rect, smp.density, s, smp.top)
+    n = rays.n
+    chunks = _chunks(n)
+    heights = smp.heights_cm
+    h32 = heights.astype(np.float32)
+    offsets = sensor_offsets(heights, s, smp.rect, smp.density)
+    size = min(n, chunks[0][1])
+    down = Tracer(smp.scene, -s, smp.bounds, smp.periodic, size)
+    up = Tracer(smp.scene, s, smp.bounds, smp.periodic, size)
+    first_z = np.empty(n, dtype=np.float32)
+    first_prim = np.empty(n, dtype=np.int32) if ids or second else None
+    packed = np.zeros((len(heights), (n + 7) // 8), dtype=np.uint8)
+    leaf_top = smp.top - 1.0
+
+    def chunk(a: int, b: int) -> np.ndarray:
+        if stop is not None and stop.is_set():
+            raise InterruptedError("light computation cancelled")
+        prim, z = first_hits(down, rays, a, b, ids=first_prim is not None)
+        first_z[a:b] = z
+        if first_prim is not None and prim is not None:
+            first_prim[a:b] = prim
+        ground = None
+        counts = np.empty(len(heights), dtype=np.int64)
+        for k, h in enumerate(heights):
+            if h > leaf_top:
+                lit = np.ones(b - a, dtype=bool)
+            elif h == 0.0:
+                lit = z < h32[k]                 # the ground's sensors are the rays' landings
+            else:
+                if ground is None:
+                    ground = ray_grid(smp.rect, smp.density, a, b)[0]
+                org = np.empty((b - a, 3))
+                org[:, :2] = ground + offsets[k]
+                org[:, 2] = h
+                lit = ~up.occluded(org, np.full(b - a, (smp.top - h) / s[2]))
+            counts[k] = np.count_nonzero(lit)
+            packed[k, a // 8:(b + 7) // 8] = np.packbits(lit)
+        return counts
+
+    transmission = np.sum(_in_chunks(chunk, chunks, threads, tick or (lambda: None)),
+                          axis=0) / n
+    seconds = {"trace": time.perf_counter() - t0}
+    seconds_prims = None
+    if second and first_prim is not None:
+        t2 = time.perf_counter()
+        fp = first_prim
+
+        def chunk2(a: int, b: int) -> np.ndarray:
+            if stop is not None and stop.is_set():
+                raise InterruptedError("light computation cancelled")
+            return second_hits(down, rays, a, b, fp[a:b], first_z[a:b])
+
+        seconds_prims = _in_chunks(chunk2, chunks, threads, tick or (lambda: None))
+        seconds["second"] = time.perf_counter() - t2
+    return DirectionTrace(s, transmission.astype(np.float64), first_z,
+                          first_prim if ids or second else None, seconds_prims, packed, offsets,
+                          seconds)
 
 
 def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | None = None,
@@ -145,19 +346,10 @@ def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | 
         scene = light_scene(canopy, with_stalks)
     build_s = time.perf_counter() - t0
 
-    t1 = time.perf_counter()
     s = req.sun.direction(canopy.layout.north_deg)
-    top = float(canopy.vertices[:, 2].max()) + 1.0
-    if with_stalks and len(canopy.stalk_vertices):
-        top = max(top, float(canopy.stalk_vertices[:, 2].max()) + 1.0)
-    rays = SunRays(rect, req.density, s, top)
-    n = rays.n
-    heights = np.asarray(req.heights_cm, dtype=np.float64)
-    h32 = heights.astype(np.float32)
-    tracer = Tracer(scene, -s, canopy.layout.bounds, req.periodic, min(n, CHUNK))
-    first_z = np.empty(n, dtype=np.float32)
-    first_prim = np.empty(n, dtype=np.int32) if req.classes else None
-    total = -(-n // CHUNK) * (2 if req.classes else 1)
+    smp = sampler(canopy, scene, rect, req.density, req.heights_cm, req.periodic, with_stalks)
+    n = smp.n
+    total = len(_chunks(n)) * (2 if req.classes else 1)
     done = 0
 
     def tick() -> None:
@@ -165,24 +357,13 @@ def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | 
         done += 1
         report(progress, done, total, "light computation")
 
-    def first(a: int, b: int) -> np.ndarray:
-        prim, z = first_hits(tracer, rays, a, b, ids=req.classes)
-        first_z[a:b] = z
-        if first_prim is not None and prim is not None:
-            first_prim[a:b] = prim
-        # rays whose first hit lies below h have reached h unobstructed
-        return np.array([np.count_nonzero(z < h) for h in h32])
-
-    transmission = np.sum(_in_chunks(first, n, req.threads, tick), axis=0) / n
-    seconds = {"build": build_s, "trace": time.perf_counter() - t1}
+    tr = trace_direction(smp, s, ids=req.classes, second=req.classes, threads=req.threads,
+                         tick=tick)
+    seconds = {"build": build_s, **tr.seconds}
     counts: tuple[np.ndarray, np.ndarray] | tuple[None, None] = (None, None)
-    if first_prim is not None:
-        t2 = time.perf_counter()
-        fp = first_prim
-        seconds_prims = _in_chunks(lambda a, b: second_hits(tracer, rays, a, b, fp[a:b],
-                                                            first_z[a:b]), n, req.threads, tick)
-        counts = hit_counts(fp, seconds_prims, scene.n_triangles)
-        seconds["second"] = time.perf_counter() - t2
-    return LightResult(req.sun, heights, transmission, n, rect, rays.ray_area_cm2, first_z,
-                       counts[0], counts[1], s, seconds, tuple(warnings), canopy.level,
-                       req.density)
+    if tr.first_prim is not None and tr.second_prim is not None:
+        counts = hit_counts(tr.first_prim, tr.second_prim, scene.n_triangles)
+    return LightResult(req.sun, smp.heights_cm, tr.transmission, n, rect, smp.ray_area_cm2,
+                       tr.first_z, counts[0], counts[1], s, seconds, tuple(warnings),
+                       canopy.level, req.density, tr.sensor_lit, tr.sensor_offset_cm,
+                       req.periodic)
