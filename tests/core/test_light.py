@@ -14,6 +14,7 @@ from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
 from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.beer_lambert import beer_lambert
+from maizeviz.light.heatmap import transmission_map
 from maizeviz.light.leaf_light import leaf_light
 from maizeviz.light.rays import ray_grid
 from maizeviz.light.request import LightRequest
@@ -113,21 +114,77 @@ def test_random_horizontal_leaves_transmit_exp_minus_lai(lai):
     assert r.transmission[1] == pytest.approx(math.exp(-lai * 95 / 190), abs=0.03)
 
 
-@settings(max_examples=15, deadline=None)
-@given(st.floats(0, 70), st.floats(0, 360), st.integers(0, 2**31), st.booleans())
-def test_transmission_monotone_and_bounded(zenith, azimuth, seed, periodic):
+def test_single_leaf_sensor_planes_are_exact_at_every_height():
+    """The issue's case: a leaf at 100 cm over x 50..150, a 45 deg sun from the east, the
+    rectangle x 0..100 under the leaf's west half. At height h the shadow covers x h-50..h+50,
+    so T(h) = 1 - overlap / 100: 0.5 on the ground, 0 at 50 cm, 1 above the leaf. Rays landing
+    on the ground rectangle (version 0.1) say 0.5 at every height below the leaf."""
+    v = np.array([[50, -20, 100], [150, -20, 100], [150, 120, 100], [50, 120, 100]], float)
+    c = Canopy.from_triangles(v, np.array([[0, 1, 2], [0, 2, 3]]), plot(-200, -50, 300, 150),
+                              np.array([1, 1]))
+    heights = tuple(float(h) for h in range(0, 100, 5)) + (100.5, 130.0)
+    for density in (1.0, 4.0):
+        r = trace_light(c, LightRequest(Sun(45, 90), heights, density, rect=(0, 20, 100, 80)))
+        expect = [1 - (min(h + 50, 100) - max(h - 50, 0)) / 100 if h < 100 else 1.0
+                  for h in heights]
+        assert r.transmission == pytest.approx(expect, abs=1e-12), density
+        k50 = heights.index(50.0)
+        assert r.transmission[k50] == 0.0
+        assert np.mean(r.first_z < 50) == pytest.approx(0.5, abs=1e-12)   # the old sampling
+        # the map at 50 cm is the rectangle's own x, y: all of it dark
+        m = transmission_map(r, 50.0, 10.0)
+        assert m.x_edges[0] == 0 and m.x_edges[-1] == 100 and np.all(m.transmission == 0)
+        g = transmission_map(r, 0.0, 10.0)
+        assert np.all(g.transmission[:5] == 0) and np.all(g.transmission[5:] == 1)   # x < 50 dark
+
+
+def _random_squares(seed, n=60):
     rng = np.random.default_rng(seed)
-    n = 60
-    specs = [(x, y, s, h) for x, y, s, h in zip(rng.uniform(0, 90, n), rng.uniform(0, 90, n),
-                                                  rng.uniform(2, 15, n), rng.uniform(5, 150, n))]
-    c = canopy_of(specs)
-    heights = tuple(np.linspace(0, 200, 9))
-    r = trace_light(c, LightRequest(Sun(zenith, azimuth), heights, density=1,
-                                    rect=(20, 20, 80, 80), periodic=periodic, classes=False))
+    return canopy_of([(x, y, s, h) for x, y, s, h in zip(
+        rng.uniform(0, 90, n), rng.uniform(0, 90, n), rng.uniform(2, 15, n),
+        rng.uniform(5, 150, n))])
+
+
+@settings(max_examples=12, deadline=None)
+@given(st.integers(0, 2**31), st.floats(0, 30), st.floats(0, 30), st.floats(31, 100),
+       st.floats(31, 100), st.booleans(), st.sampled_from([0.7, 1.0, 2.3]))
+def test_vertical_sun_transmission_never_increases_downward(seed, x0, y0, x1, y1, periodic,
+                                                            density):
+    """Under a vertical sun each sensor's path contains the path of the sensor above it: on any
+    rectangle T is monotone exactly, and 1 above the canopy."""
+    heights = tuple(np.sort(np.random.default_rng(seed).uniform(0, 200, 10)))
+    r = trace_light(_random_squares(seed), LightRequest(Sun(0, 0), heights, density,
+                                                        (x0, y0, x1, y1), periodic,
+                                                        classes=False))
     t = r.transmission
     assert np.all((0 <= t) & (t <= 1))
     assert np.all(np.diff(t) >= 0), "transmission increased going down"
-    assert t[-1] == 1.0
+    assert np.all(t[np.asarray(heights) > 150 + 15] == 1.0)
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.floats(0, 70), st.floats(0, 360), st.integers(0, 2**31),
+       st.sampled_from([0.7, 1.0, 2.3]))
+def test_periodic_field_transmission_never_increases_downward(zenith, azimuth, seed, density):
+    """In a periodic field sampled over its whole period every height's grid lies on the sun
+    paths of the others (sensor_offsets), so T is monotone as in the continuum, at any sun."""
+    heights = tuple(np.sort(np.random.default_rng(seed).uniform(0, 200, 10)))
+    r = trace_light(_random_squares(seed), LightRequest(Sun(zenith, azimuth), heights, density,
+                                                        (0, 0, 100, 100), True, classes=False))
+    t = r.transmission
+    assert np.all((0 <= t) & (t <= 1))
+    assert np.all(np.diff(t) >= 0), "transmission increased going down"
+    assert np.all(t[np.asarray(heights) > 150 + 15] == 1.0)
+
+
+def test_sensor_planes_outside_a_periodic_period_can_rise_downward():
+    """Not a bug: below a leaf whose shadow leaves the rectangle lower down, the lower plane is
+    brighter (the single-leaf case); only periodic full-period sampling is monotone."""
+    v = np.array([[50, -20, 100], [150, -20, 100], [150, 120, 100], [50, 120, 100]], float)
+    c = Canopy.from_triangles(v, np.array([[0, 1, 2], [0, 2, 3]]), plot(-200, -50, 300, 150),
+                              np.array([1, 1]))
+    r = trace_light(c, LightRequest(Sun(45, 90), (0, 50), 1, rect=(0, 20, 100, 80)))
+    assert r.transmission[0] > r.transmission[1]
 
 
 def test_periodic_field_stops_rays_that_leave_the_plot():
