@@ -46,16 +46,27 @@ def tile_representatives(layout: CanopyLayout, rect: Rect | None, periodic: bool
     kx, ky = (px1 - px0) / w, (py1 - py0) / h
     if min(kx, ky) < 1.5 or abs(kx - round(kx)) > 1e-6 or abs(ky - round(ky)) > 1e-6:
         return identity
-    scale = 1e4                                     # positions compared to 1e-4 of a tile
-    keys: dict[tuple, list[int]] = {}
-    for i, pl in enumerate(layout.placements):
-        fx = int(round((pl.x - x0) / w * scale)) % int(scale)
-        fy = int(round((pl.y - y0) / h * scale)) % int(scale)
-        keys.setdefault((pl.plant, round(float(pl.azimuth_deg) % 360.0, 6), fx, fy),
-                        []).append(i)
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    # stalk positions folded into one tile; copies lie within 0.01 cm of each other there
+    xy = np.array([[pl.x - x0, pl.y - y0] for pl in layout.placements]) % [w, h]
+    xy = np.minimum(xy, np.nextafter([w, h], 0))    # keep inside [0, box) for the tree
+    pairs = cKDTree(xy, boxsize=[w, h]).query_pairs(0.01, output_type="ndarray")
+    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
     copies = int(round(kx)) * int(round(ky))
-    if any(len(v) != copies for v in keys.values()):
-        return identity
+    keys: dict[int, list[int]] = {}
+    for i, lab in enumerate(label):
+        keys.setdefault(int(lab), []).append(i)
+    for members in keys.values():
+        first = layout.placements[members[0]]
+        if len(members) != copies or any(
+                layout.placements[i].plant != first.plant
+                or abs((layout.placements[i].azimuth_deg - first.azimuth_deg + 180) % 360 - 180)
+                > 1e-6 for i in members):
+            return identity
     rep = identity.copy()
     for members in keys.values():
         inside = [i for i in members if x0 <= layout.placements[i].x < x1

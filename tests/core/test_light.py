@@ -345,3 +345,25 @@ def test_cli_light_bad_input(capsys, argv, says):
     assert main(["light", BLOCK, *argv]) == EXIT_FAIL
     err = capsys.readouterr().err
     assert says in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_occlusion_queries_agree_with_nearest_hits(periodic):
+    """The tracer's occlusion mode (sensor planes) and its nearest-hit mode (ground rays) see
+    the same triangles along the same paths, wrapped or not."""
+    from maizeviz.light.rays import Tracer
+    from maizeviz.light.transmission import light_scene
+
+    c = _random_squares(7, n=120)
+    scene = light_scene(c)
+    rng = np.random.default_rng(7)
+    for zenith, azimuth in ((0, 0), (40, 75), (75, 200), (85, 310)):
+        s = Sun(zenith, azimuth).direction()
+        org = np.column_stack([rng.uniform(0, 100, 3000), rng.uniform(0, 100, 3000),
+                               rng.uniform(0, 160, 3000)])
+        length = rng.uniform(0, 600, 3000)
+        up = Tracer(scene, s, c.layout.bounds, periodic, 3000)
+        blocked = up.occluded(org.copy(), length)
+        _, dist = up.trace(org.copy(), length, ids=True)
+        assert np.mean(blocked == np.isfinite(dist)) > 0.999
+        assert blocked.any() and not blocked.all()
