@@ -58,10 +58,13 @@ def binned(xy: np.ndarray, lit: np.ndarray, xe: np.ndarray,
     Parameters
     ----------
     xy : (N, 2) cm, sensor positions; lit : (N,) bool or float weights
-    xe, ye : bin edges, cm; sensors on the last edge fall in the last bin
+    xe, ye : evenly spaced bin edges (:func:`bin_edges`), cm; sensors on the last edge fall in
+        the last bin
     """
-    i = np.clip(np.searchsorted(xe, xy[:, 0], side="right") - 1, 0, len(xe) - 2)
-    j = np.clip(np.searchsorted(ye, xy[:, 1], side="right") - 1, 0, len(ye) - 2)
+    i = np.clip(((xy[:, 0] - xe[0]) * ((len(xe) - 1) / (xe[-1] - xe[0]))).astype(np.int64),
+                0, len(xe) - 2)
+    j = np.clip(((xy[:, 1] - ye[0]) * ((len(ye) - 1) / (ye[-1] - ye[0]))).astype(np.int64),
+                0, len(ye) - 2)
     flat = i * (len(ye) - 1) + j
     size = (len(xe) - 1) * (len(ye) - 1)
     counts = np.bincount(flat, minlength=size).astype(np.float64)

@@ -367,3 +367,24 @@ def test_occlusion_queries_agree_with_nearest_hits(periodic):
         _, dist = up.trace(org.copy(), length, ids=True)
         assert np.mean(blocked == np.isfinite(dist)) > 0.999
         assert blocked.any() and not blocked.all()
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_sensor_planes_by_occlusion_and_by_the_ray_family_agree(monkeypatch, periodic):
+    """A sensor's path to the sun is asked either as an occlusion query or as the first hit of
+    the ray of the same family through it; both give the same planes."""
+    import maizeviz.light.transmission as tr
+
+    c = _random_squares(9, n=150)
+    heights = (0.0, 20.0, 55.5, 100.0, 140.0, 400.0)
+    for zenith, azimuth in ((0, 0), (25, 160), (55, 300), (78, 45)):
+        req = LightRequest(Sun(zenith, azimuth), heights, 2.0, (10, 5, 90, 95), periodic)
+        results = []
+        for cost in (1e-9, 1e9):                    # never / always the ray family
+            monkeypatch.setattr(tr, "OCCLUSION_COST", cost)
+            results.append(trace_light(c, req))
+        occ, fam = results
+        assert np.abs(occ.transmission - fam.transmission).max() <= 2 / occ.rays
+        for k in range(len(heights)):
+            assert np.mean(occ.lit(k) != fam.lit(k)) <= 2 / occ.rays
+        assert np.array_equal(occ.first_hits, fam.first_hits)
