@@ -223,13 +223,12 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
                 cells.append(c)
                 if key == (0, 0):
                     centre.append(c)
-    cells = np.array(cells)
     overlap = _overlaps(np.array(centre))
     if overlap:
         warnings.append(f"digitized plants {overlap} stand closer than the spacing: their "
                         "cells overlap")
-    return CanopyLayout(tuple(placements), cells, float(row_spacing), float(plant_spacing),
-                        north_deg, np.array(centre), tuple(warnings),
+    return CanopyLayout(tuple(placements), np.array(cells), float(row_spacing),
+                        float(plant_spacing), north_deg, np.array(centre), tuple(warnings),
                         a * b * union_area(np.array(centre)))
 
 

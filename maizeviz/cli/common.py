@@ -11,8 +11,9 @@ from pathlib import Path
 from maizeviz.canopy.layout import CanopyLayout, layout_for, parse_shape
 from maizeviz.errors import LeafError, MaizevizError
 from maizeviz.io.atomic import atomic_open
+from maizeviz.io.meshfile import check_mesh_path
 from maizeviz.leaf.fit import Leaf, read_leaves
-from maizeviz.mesh.levels import Level, parse_level, parse_levels
+from maizeviz.mesh.levels import Level, parse_levels
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_PARTIAL = 0, 1, 2, 3
 
@@ -84,6 +85,15 @@ def add_level_options(p: argparse.ArgumentParser, default_levels: str) -> None:
     p.add_argument("--no-preserve-area", dest="preserve_area", action="store_false",
                    help="below the standard mesh, do not widen cross-sections to keep the "
                         "smooth surface's area")
+
+
+def check_export(path: str | None, levels: list[Level]) -> None:
+    """Refuse, before any work, a mesh export of several levels or to an unusable path."""
+    if path is None:
+        return
+    if len(levels) > 1:
+        raise MaizevizError("--export writes one level: use it with --interp or --triangles")
+    check_mesh_path(path)
 
 
 def levels_from(args: argparse.Namespace, default_k: int = 4) -> list[Level]:

@@ -8,9 +8,19 @@ import os
 import time
 
 from maizeviz.canopy.scene import build_canopy
-from maizeviz.cli.common import (Progress, add_canopy_options, add_level_options, canopy_setup,
-                                 floats, fmt_table, leaves_summary, levels_from, say, suffixed,
-                                 write_rows)
+from maizeviz.cli.common import (
+    Progress,
+    add_canopy_options,
+    add_level_options,
+    canopy_setup,
+    floats,
+    fmt_table,
+    leaves_summary,
+    levels_from,
+    say,
+    suffixed,
+    write_rows,
+)
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import refuse_overwriting_inputs
 from maizeviz.light.beer_lambert import beer_lambert, clumping
@@ -21,10 +31,13 @@ from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import trace_light
 from maizeviz.mesh.levels import CANOPY_LEVELS
 
+#: The subcommand.
+NAME = "light"
+
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "light", help="direct sunlight through the canopy with Embree (Table 3)",
+        NAME, help="direct sunlight through the canopy with Embree (Table 3)",
         description="Trace parallel sun rays through a canopy: transmission at several heights "
                     "inside a sample rectangle, sunlit and second-class area per leaf, per mesh "
                     "level with timings.")

@@ -48,9 +48,9 @@ import datetime as _dt
 import io
 import math
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from collections.abc import Mapping
 from types import MappingProxyType
 from typing import TYPE_CHECKING
 
