@@ -51,7 +51,7 @@ class Placement:
     x: float
     y: float
     azimuth_deg: float = 0.0
-    tile: tuple = (0, 0)
+    tile: tuple[int, int] = (0, 0)
 
 
 @dataclass(frozen=True)
@@ -71,13 +71,13 @@ class CanopyLayout:
     warnings : tuple[str, ...]
     """
 
-    placements: tuple
+    placements: tuple[Placement, ...]
     cells: np.ndarray
     row_spacing: float
     plant_spacing: float
     north_deg: float = 0.0
     centre_cells: np.ndarray = field(default_factory=lambda: np.empty((0, 4)))
-    warnings: tuple = ()
+    warnings: tuple[str, ...] = ()
     ground_area: float | None = None
 
     @property

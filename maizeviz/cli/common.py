@@ -27,6 +27,7 @@ FLAGS = {
     "degree": "--degree", "params": "--params", "sun": "--sun-zenith/--sun-azimuth",
     "date": "--date", "time": "--time", "place": "--lat/--lon", "tz": "--tz", "cols": "--cols",
     "plants": "--plants", "sections": "--sections", "at": "--at", "periodic": "--periodic",
+    "baud": "--baud",
 }
 
 

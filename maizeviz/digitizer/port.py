@@ -42,8 +42,8 @@ class DeviceConfig:
 
     centimetres: bool
     binary: bool
-    items: dict
-    warnings: tuple = ()
+    items: dict[int, tuple[int, ...]]
+    warnings: tuple[str, ...] = ()
 
 
 class FastrakPort:
@@ -117,7 +117,7 @@ class FastrakPort:
             f"no answer from a FASTRAK on {self.port_name} at {self.baud} baud after "
             f"{self.retries} status requests: check that the unit is on (a unit just "
             "re-initialised stays silent about 10 s), the cable, and that the baud rate matches "
-            "its rear DIP switches (--baud)")
+            "its rear DIP switches", quantity="baud")
 
     def configure(self, stations=(1,)) -> DeviceConfig:
         """The start-up sequence; returns what the device ended up reporting."""
@@ -132,7 +132,7 @@ class FastrakPort:
             self._send(fp.station_enable(station, station in self.stations))
         self._send(fp.CENTIMETRES)
         self._send(fp.ASCII)
-        items = {}
+        items: dict[int, tuple[int, ...]] = {}
         for station in self.stations:
             items[station] = fp.STYLUS_ITEMS if station == 1 else fp.DEFAULT_ITEMS
             self._send(fp.output_list(station, items[station]))
@@ -153,7 +153,8 @@ class FastrakPort:
         """A record with its position in centimetres, whatever the unit was set to."""
         if self.config is None or self.config.centimetres or rec.position is None:
             return rec
-        return replace(rec, position=tuple(v * CM_PER_INCH for v in rec.position))
+        x, y, z = rec.position
+        return replace(rec, position=(x * CM_PER_INCH, y * CM_PER_INCH, z * CM_PER_INCH))
 
     # ------------------------------------------------------------------------- reader
     def start_reader(self, callback=None) -> "queue.Queue | None":

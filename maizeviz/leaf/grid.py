@@ -50,8 +50,8 @@ class LeafGrid:
     leaf: int
     points: np.ndarray
     tip_collapsed: bool = False
-    rows: tuple = ()
-    notes: tuple = ()
+    rows: tuple[int, ...] = ()
+    notes: tuple[str, ...] = ()
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -39,7 +39,7 @@ class LeafShape:
 
     length: float = 90.0
     width: float = 9.0
-    base: tuple = (0.0, 0.0, 100.0)
+    base: tuple[float, float, float] = (0.0, 0.0, 100.0)
     azimuth_deg: float = 0.0
     insertion_deg: float = 35.0
     curvature_deg: float = 70.0
