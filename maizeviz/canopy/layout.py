@@ -201,6 +201,10 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
     a, b = tile
     if a < 1 or b < 1:
         raise LayoutError(f"tile must be at least 1x1, got {a}x{b}", quantity="tile")
+    if a * b * len(bases) > MAX_PLANTS:
+        raise LayoutError(f"tiling {a}x{b} places {a * b * len(bases):,} plants; a canopy holds "
+                          f"at most {MAX_PLANTS:,} (a hectare at 60 x 30 cm is about 55,000)",
+                          quantity="tile")
     warnings = []
     inferred, lattice = block_lattice(bases, row_spacing, plant_spacing)
     if block is None:

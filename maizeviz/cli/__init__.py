@@ -15,7 +15,6 @@ import os
 import sys
 import traceback
 from collections.abc import Callable, Sequence
-from importlib.metadata import entry_points
 
 from maizeviz import __version__
 from maizeviz.cli import canopy, leaf, light, phenomenal, record, simulate, synth
@@ -53,6 +52,8 @@ def has_screen() -> bool:
 
 def find_gui() -> tuple[Callable[[Sequence[str]], int] | None, str]:
     """The desktop app's ``run`` from its entry point, or None and why not (one line)."""
+    from importlib.metadata import entry_points
+
     found = entry_points(group=GUI_GROUP)
     if not found:
         return None, GUI_HINT

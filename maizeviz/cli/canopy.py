@@ -15,12 +15,14 @@ from maizeviz.cli.common import (
     add_canopy_options,
     add_level_options,
     canopy_setup,
+    check_canopy_costs,
     check_export,
     fmt_table,
     leaves_summary,
     levels_from,
     say,
 )
+from maizeviz.cost import light_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import refuse_overwriting_inputs
 from maizeviz.mesh.levels import CANOPY_LEVELS
@@ -56,6 +58,8 @@ def run(args: argparse.Namespace) -> int:
     refuse_overwriting_inputs([("the mesh export", args.export),
                                ("the saved layout", args.save_layout)], [args.points, args.layout])
     leaves, skipped, layout = canopy_setup(args)
+    cover = light_cost(layout.bounds, 1 / args.cover_resolution**2, 1)
+    check_canopy_costs(leaves, layout, levels, args.force, [cover])
     if args.save_layout:
         save_layout(args.save_layout, layout)
     runs = []

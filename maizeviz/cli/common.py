@@ -5,10 +5,12 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
+from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 
-from maizeviz.canopy.layout import CanopyLayout, layout_for, parse_shape
+from maizeviz.canopy.layout import MAX_PLANTS, CanopyLayout, layout_for, parse_shape
+from maizeviz.cost import Cost, canopy_cost, check
 from maizeviz.errors import LeafError, MaizevizError
 from maizeviz.io.atomic import atomic_open
 from maizeviz.io.meshfile import check_mesh_path
@@ -121,6 +123,17 @@ def add_canopy_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--layout", metavar="JSON", help="a layout file instead of tiling")
     p.add_argument("--strict", action="store_true",
                    help="stop at the first bad leaf instead of skipping it")
+    p.add_argument("--force", action="store_true",
+                   help="run work estimated to take longer than 15 min (what would not fit in "
+                        "memory is refused anyway)")
+
+
+def check_canopy_costs(leaves: list[Leaf], layout: CanopyLayout, levels: list[Level],
+                       force: bool, per_level: Sequence[Cost] = ()) -> None:
+    """Refuse, before building anything, canopies (plus ``per_level`` work on each) that would
+    not fit in memory, or take too long unless ``force``."""
+    placed = dict(Counter(p.plant for p in layout.placements))
+    check([[canopy_cost(leaves, placed, level), *per_level] for level in levels], force)
 
 
 def load_leaves(path: str, strict: bool = False, degree: int = 3,
@@ -137,6 +150,10 @@ def load_leaves(path: str, strict: bool = False, degree: int = 3,
 def canopy_setup(args: argparse.Namespace) -> tuple[list[Leaf], list[LeafError], CanopyLayout]:
     """Leaves and layout from the canopy options; warnings on stderr."""
     tile = parse_shape(args.tile, "tile")
+    if tile[0] * tile[1] > MAX_PLANTS:                # refused before reading anything
+        raise MaizevizError(f"tiling {tile[0]}x{tile[1]} makes {tile[0] * tile[1]:,} copies of "
+                            f"the block; a canopy holds at most {MAX_PLANTS:,} plants",
+                            quantity="tile")
     block = parse_shape(args.block, "block") if args.block else None
     leaves, skipped = load_leaves(args.points, args.strict)
     if not leaves:

@@ -13,6 +13,7 @@ from maizeviz.cli.common import (
     add_canopy_options,
     add_level_options,
     canopy_setup,
+    check_canopy_costs,
     floats,
     fmt_table,
     leaves_summary,
@@ -21,6 +22,7 @@ from maizeviz.cli.common import (
     suffixed,
     write_rows,
 )
+from maizeviz.cost import heatmap_cost, light_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import refuse_overwriting_inputs
 from maizeviz.light.beer_lambert import beer_lambert, clumping
@@ -110,6 +112,11 @@ def run(args: argparse.Namespace) -> int:
     say(f"sun: zenith {sun.zenith_deg:.2f} deg, azimuth {sun.azimuth_deg:.2f} deg"
         + (f" ({sun.when})" if sun.when else ""))
     leaves, skipped, layout = canopy_setup(args)
+    sampled = rect or layout.centre_bounds
+    work = [light_cost(sampled, args.density, len(heights))]            # type: ignore[arg-type]
+    if args.heatmaps:
+        work.append(heatmap_cost(sampled, args.heatmap_bin, len(heights)))  # type: ignore[arg-type]
+    check_canopy_costs(leaves, layout, levels, args.force, work)
     want_classes = bool(args.leaf_light or args.plant_light)
     records: list[dict] = []
     for level in levels:

@@ -14,7 +14,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import BSpline
 
 from maizeviz.errors import LeafError
 
@@ -207,6 +206,8 @@ class NurbsSurfaces:
         p = a[:, :3] / a[:, 3:]
         if not derivative:
             return p, None, None
+        from scipy.interpolate import BSpline  # ~1 s to import: only for normals
+
         su = BSpline(self.knots_u[0], hom, self.degree_u).derivative()(u)              # (K, nv, 4)
         sv = BSpline(self.knots_v[0], hom.transpose(1, 0, 2), self.degree_v).derivative()(v)
         au = np.einsum("kjc,kj->kc", su, bv)
