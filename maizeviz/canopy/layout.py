@@ -19,11 +19,14 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import write_text
+from maizeviz.io.inputs import read_input
 from maizeviz.leaf.fit import Leaf
 
 LAYOUT_SCHEMA = 1
 #: Plants a layout may hold (a hectare at 60 x 30 cm is about 55,000).
 MAX_PLANTS = 100_000
+#: Largest layout file read (bytes): 100,000 plants take about 8 MB.
+MAX_LAYOUT_BYTES = 20_000_000
 
 
 class LayoutError(MaizevizError):
@@ -288,14 +291,11 @@ def load_layout(path: str | Path, plants: set[int] | None = None) -> CanopyLayou
         Naming the field that is wrong.
     """
     path = Path(path)
+    raw = read_input(path, "layout file", MAX_LAYOUT_BYTES, LayoutError)
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise LayoutError(f"{path}: no such layout file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise LayoutError(f"{path}: cannot be read ({exc})") from None
-    if len(text) > 20_000_000:
-        raise LayoutError(f"{path}: {len(text)} bytes is too large for a layout file")
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise LayoutError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
     try:
         data = json.loads(text)
     except (json.JSONDecodeError, RecursionError) as exc:
