@@ -18,17 +18,40 @@ from typing import Any
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy, build_canopy
-from maizeviz.cli.common import (Progress, add_canopy_options, add_level_options, canopy_setup,
-                                 floats, fmt_table, leaves_summary, levels_from, say, suffixed,
-                                 write_rows)
+from maizeviz.cli.common import (
+    Progress,
+    add_canopy_options,
+    add_level_options,
+    canopy_setup,
+    check_canopy_costs,
+    floats,
+    fmt_table,
+    leaves_summary,
+    levels_from,
+    say,
+    suffixed,
+    write_rows,
+)
+from maizeviz.cost import heatmap_cost, light_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import atomic_open, refuse_overwriting_inputs
 from maizeviz.light.beer_lambert import beer_lambert, beer_lambert_sky, clumping
 from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
-from maizeviz.light.heatmap import (TransmissionMap, heatmap_figure, save_figure, write_heatmaps,
-                                    write_map_csv)
-from maizeviz.light.irradiance import (DEFAULT_LINKE_TURBIDITY, DEFAULT_PAR_UMOL_PER_J, Period,
-                                       clear_sky_period, read_weather, weather_period)
+from maizeviz.light.heatmap import (
+    TransmissionMap,
+    heatmap_figure,
+    save_figure,
+    write_heatmaps,
+    write_map_csv,
+)
+from maizeviz.light.irradiance import (
+    DEFAULT_LINKE_TURBIDITY,
+    DEFAULT_PAR_UMOL_PER_J,
+    Period,
+    clear_sky_period,
+    read_weather,
+    weather_period,
+)
 from maizeviz.light.leaf_light import leaf_light, leaf_sums, merge_rows, plant_light
 from maizeviz.light.request import LightRequest, Sampling
 from maizeviz.light.sky import SKY_KINDS, Sky, make_sky
@@ -36,10 +59,13 @@ from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import LightResult, light_scene, trace_light
 from maizeviz.mesh.levels import CANOPY_LEVELS
 
+#: The subcommand.
+NAME = "light"
+
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "light", help="sunlight and skylight through the canopy with Embree (Table 3)",
+        NAME, help="sunlight and skylight through the canopy with Embree (Table 3)",
         description="Trace parallel rays through a canopy for a sun, a diffuse sky or a whole "
                     "day: transmission on sensor planes at several heights over a sample "
                     "rectangle, light intercepted per leaf and per plant, per mesh level with "
@@ -226,6 +252,14 @@ def run(args: argparse.Namespace) -> int:
         say(f"period: {period.start.isoformat()} to {period.end.isoformat()}, "
             f"{period.n_steps} steps with the sun up; {period.source}")
     leaves, skipped, layout = canopy_setup(args)
+    sampled = rect or layout.centre_bounds
+    directions = (sun is not None) + (sky.n if sky is not None else 0) + \
+        (period.n_steps if period is not None else 0)
+    work = [light_cost(sampled, args.density, len(heights), max(directions, 1))]  # type: ignore[arg-type]
+    if args.heatmaps:
+        maps = (sun is not None) + (sky is not None) + (period is not None)
+        work.append(heatmap_cost(sampled, args.heatmap_bin, len(heights) * maps))  # type: ignore[arg-type]
+    check_canopy_costs(leaves, layout, levels, args.force, work)
     want_rows = bool(args.leaf_light or args.plant_light)
     records: list[dict[str, Any]] = []
     said: set[str] = set()

@@ -10,10 +10,13 @@ from maizeviz.io.phenomenal import load_phenomenal
 from maizeviz.io.points import write_points
 from maizeviz.leaf.phenomenal import move_plant, phenomenal_grids
 
+#: The subcommand.
+NAME = "import-phenomenal"
+
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "import-phenomenal", help="turn a Phenomenal/PhenoTrack3D plant into leaf point grids",
+        NAME, help="turn a Phenomenal/PhenoTrack3D plant into leaf point grids",
         description="Import a plant segmented by the Phenomenal pipeline (JSON, optionally "
                     "gzip-compressed, mm) as a points file (cm): each leaf's midrib and "
                     "surface voxels become cross-sections of 5 points.")

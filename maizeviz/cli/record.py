@@ -13,10 +13,13 @@ from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import Session
 from maizeviz.errors import MaizevizError
 
+#: The subcommand.
+NAME = "record"
+
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "record", help="digitize with a Polhemus FASTRAK: stylus presses become points",
+        NAME, help="digitize with a Polhemus FASTRAK: stylus presses become points",
         description="Record stylus presses from a FASTRAK as points of plants, leaves and "
                     "cross-sections. Every point is on disk (fsync) before it is reported. "
                     "Controls, one per line on standard input: n next leaf, p next plant, "

@@ -9,10 +9,13 @@ from maizeviz.cli.common import EXIT_OK
 from maizeviz.digitizer.replay import replay_points
 from maizeviz.digitizer.simulator import FastrakSimulator
 
+#: The subcommand.
+NAME = "fastrak-sim"
+
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "fastrak-sim", help="a pretend FASTRAK on a pseudo-terminal (prints its path)",
+        NAME, help="a pretend FASTRAK on a pseudo-terminal (prints its path)",
         description="Open a pseudo-terminal that behaves like a FASTRAK and, with --replay, "
                     "press the stylus at every point of a points file once a recorder has "
                     "configured it.")

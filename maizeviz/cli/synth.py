@@ -10,10 +10,13 @@ from maizeviz.errors import MaizevizError
 from maizeviz.io.points import write_points
 from maizeviz.leaf.synth import block_grids
 
+#: The subcommand.
+NAME = "synth"
+
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "synth", help="write a realistic digitized block of synthetic maize plants",
+        NAME, help="write a realistic digitized block of synthetic maize plants",
         description="Write a points file of a block of parametric maize plants at silking "
                     "(about 245 cm, 16 leaves, 0.94 m2 of leaf each), digitized the way a "
                     "technician would, with 0.08 cm digitizer noise.")

@@ -1,9 +1,9 @@
-"""Parametric maize leaves and plants that look digitized (SCIENCE.md section 8).
+"""Parametric maize leaves and plants that look digitized (docs/method.md, "A synthetic maize plant").
 
 Used to make realistic test grids, benchmarks and the bundled example. A leaf is a midrib
 curve with a two-part curvature law, the Prevot width profile, a V-shaped cross-section, margin
 waves in opposite phase growing toward the tip, and FASTRAK noise (0.08 cm RMS). Grids follow
-the column convention of SCIENCE.md: col 0 is the right margin seen from above with the tip
+the column convention of docs/method.md: col 0 is the right margin seen from above with the tip
 ahead, so dS/du x dS/dv points out of the upper face; the tip row collapses to one point.
 """
 
@@ -39,7 +39,7 @@ class LeafShape:
 
     length: float = 90.0
     width: float = 9.0
-    base: tuple = (0.0, 0.0, 100.0)
+    base: tuple[float, float, float] = (0.0, 0.0, 100.0)
     azimuth_deg: float = 0.0
     insertion_deg: float = 35.0
     curvature_deg: float = 70.0

@@ -43,13 +43,18 @@ from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.light.heatmap import TransmissionMap, bin_edges, binned
 from maizeviz.light.irradiance import Period
-from maizeviz.light.request import (LightRequest, Rect, Sampling, canopy_top, check_sampling,
-                                    edge_reach)
+from maizeviz.light.request import (
+    LightRequest,
+    Rect,
+    Sampling,
+    canopy_top,
+    check_sampling,
+    edge_reach,
+)
 from maizeviz.light.sky import Sky
 from maizeviz.light.transmission import Sampler, light_scene, sampler, trace_direction
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, report
-
 
 # --------------------------------------------------------------------------- one beam
 

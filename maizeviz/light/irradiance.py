@@ -48,15 +48,16 @@ import datetime as _dt
 import io
 import math
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from collections.abc import Mapping
 from types import MappingProxyType
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from maizeviz.errors import MaizevizError
+from maizeviz.io.inputs import read_input
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -572,23 +573,9 @@ class Weather:
 
 
 def _read_text(path: Path, max_bytes: int) -> str:
-    try:
-        size = path.stat().st_size
-    except FileNotFoundError:
-        raise WeatherFileError(f"{path}: no such weather file") from None
-    except OSError as exc:
-        raise WeatherFileError(f"{path}: cannot be read ({exc.strerror})") from None
-    if path.is_dir():
-        raise WeatherFileError(f"{path}: is a folder, not a weather file")
-    if size > max_bytes:
-        raise WeatherFileError(f"{path}: the weather file is {size / 2 ** 20:.1f} MiB, more "
-                               f"than the {max_bytes / 2 ** 20:g} MiB limit; split it")
-    if size == 0:
+    raw = read_input(path, "weather file", max_bytes, WeatherFileError)
+    if not raw:
         raise WeatherFileError(f"{path}: the weather file is empty")
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise WeatherFileError(f"{path}: cannot be read ({exc.strerror})") from None
     if b"\x00" in raw[:4096]:
         raise WeatherFileError(f"{path}: not a CSV text file (binary content)")
     try:

@@ -38,8 +38,7 @@ from typing import TypeVar
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.light.hits import (SunRays, first_hits, hit_counts, lattice_first_hits,
-                                 second_hits)
+from maizeviz.light.hits import SunRays, first_hits, hit_counts, lattice_first_hits, second_hits
 from maizeviz.light.rays import Rect, Tracer, ray_grid, sensor_offsets
 from maizeviz.light.request import LightRequest, canopy_top, check_request
 from maizeviz.light.sun import Sun

@@ -4,7 +4,6 @@ every bad input said in one line."""
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -109,7 +108,7 @@ def test_a_period_is_cancelled_from_its_progress_callback(canopy, scene):
         calls = []
         with pytest.raises(InterruptedError):
             trace_period(canopy, period, sampling(threads), make_sky("soc", 6), scene=scene,
-                         progress=lambda d, t: calls.append((d, t)) or d < 4)
+                         progress=lambda d, t, calls=calls: calls.append((d, t)) or d < 4)
         assert calls[-1] == (4, 6 + period.n_steps)
 
 

@@ -155,7 +155,7 @@ def test_threads_agree_and_progress_counts_directions_and_cancels():
         calls = []
         with pytest.raises(InterruptedError):
             trace_sky(c, sky, Sampling(**smp, threads=threads),
-                      progress=lambda d, t: calls.append(d) or d < 3)
+                      progress=lambda d, t, calls=calls: calls.append(d) or d < 3)
         assert calls[-1] == 3
 
 
