@@ -69,7 +69,7 @@ def main() -> None:
         r = trace_light(canopy, req)                           # builds its own scene
         single.append(time.perf_counter() - t0)
         t0 = time.perf_counter()
-        scene = light_scene(canopy)
+        scene = light_scene(canopy, periodic=True)
         builds.append(time.perf_counter() - t0)
         t0 = time.perf_counter()
         trace_light(canopy, req, scene=scene)

@@ -269,7 +269,7 @@ def run(args: argparse.Namespace) -> int:
                               Progress(f"building {level}"))
         canopy_s = time.perf_counter() - t0
         t1 = time.perf_counter()
-        scene = light_scene(canopy, args.with_stalks)
+        scene = light_scene(canopy, args.with_stalks, args.periodic)
         scene_s = time.perf_counter() - t1
         sampling = Sampling(heights, args.density, rect, args.periodic, args.threads)  # type: ignore[arg-type]
         rec: dict[str, Any] = {"level": level.label, "triangles": canopy.n_triangles,

@@ -52,7 +52,7 @@ from maizeviz.light.request import (
     edge_reach,
 )
 from maizeviz.light.sky import Sky
-from maizeviz.light.transmission import Sampler, light_scene, sampler, trace_direction
+from maizeviz.light.transmission import Sampler, sampler, scene_for, trace_direction
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, report
 
@@ -87,7 +87,7 @@ def _beam(smp: Sampler, toward: np.ndarray, edges: tuple[np.ndarray, np.ndarray]
     assert tr.first_prim is not None
     prim = tr.first_prim
     leaf = np.count_nonzero((prim >= 0) & (prim < smp.n_leaf_triangles)) / smp.n
-    ids, hits = _sparse_counts(prim, smp.scene.n_triangles)
+    ids, hits = _sparse_counts(prim, smp.n_triangles)
     xe, ye = edges
     bins = np.empty((len(smp.heights_cm), len(xe) - 1, len(ye) - 1))
     for k in range(len(smp.heights_cm)):
@@ -346,8 +346,8 @@ def _prepare(canopy: Canopy, sampling: Sampling | LightRequest, with_stalks: boo
     counts, _ = binned(xy, np.ones(len(xy)), xe, ye)
     bins = _Bins((xe, ye), counts.astype(np.int64))
     t0 = time.perf_counter()
-    if scene is None:
-        scene = light_scene(canopy, with_stalks)
+    scene, said = scene_for(canopy, sampling.periodic, scene, with_stalks)
+    warnings += said
     build_s = time.perf_counter() - t0
     smp = sampler(canopy, scene, rect, sampling.density, sampling.heights_cm, sampling.periodic,
                   with_stalks)
@@ -375,7 +375,7 @@ def _sky_light(sky: Sky, smp: Sampler, beams: list[_Beam], bins: _Bins, level: s
     w = np.asarray(sky.weights, dtype=np.float64)
     per_dir = np.array([b.transmission for b in beams]).reshape(sky.n, len(smp.heights_cm))
     per_int = np.array([b.leaf_fraction for b in beams])
-    share = np.zeros(smp.scene.n_triangles)
+    share = np.zeros(smp.n_triangles)
     maps = np.zeros((len(smp.heights_cm), len(edges[0]) - 1, len(edges[1]) - 1))
     for wi, b in zip(w, beams):
         np.add.at(share, b.ids, wi * b.hits / smp.n)
@@ -399,8 +399,8 @@ def trace_sky(canopy: Canopy, sky: Sky, sampling: Sampling | LightRequest,
         a :class:`LightRequest` whose sun is ignored)
     progress : ``progress(done, total)`` after each direction; returning ``False`` cancels
         with InterruptedError
-    scene : the canopy's scene from :func:`light_scene` (same ``with_stalks``); built here when
-        not given
+    scene : the canopy's scene from :func:`~maizeviz.light.transmission.light_scene` (same
+        ``with_stalks`` and ``periodic``); built here when not given
     bin_cm : bin edge of the maps, cm
 
     Raises
@@ -438,7 +438,7 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
         turtle of 46 directions
     progress : ``progress(done, total)`` after each direction (sky directions first, then the
         time steps); returning ``False`` cancels with InterruptedError
-    scene : the canopy's scene (same ``with_stalks``); built here when not given
+    scene : the canopy's scene (same ``with_stalks`` and ``periodic``); built here when not given
     bin_cm : bin edge of the maps, cm
 
     Returns
@@ -453,7 +453,7 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
     warnings += list(period.notes)
     n_h = len(smp.heights_cm)
     shape = (n_h, len(edges[0]) - 1, len(edges[1]) - 1)
-    zeros = np.zeros(smp.scene.n_triangles)
+    zeros = np.zeros(smp.n_triangles)
     if period.n_steps == 0:
         return PeriodLight(period, None, smp.heights_cm, np.zeros((0, n_h)), np.zeros(0),
                            zeros, zeros.copy(), smp.rect, smp.n, np.full(shape, np.nan), edges,
@@ -489,7 +489,7 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
     direct_mol = np.asarray(period.step_direct_par_mol_m2, dtype=np.float64)
     diffuse_mol = math.fsum(period.step_diffuse_par_mol_m2)
     area_m2 = (smp.rect[2] - smp.rect[0]) * (smp.rect[3] - smp.rect[1]) * 1e-4
-    tri_direct = np.zeros(smp.scene.n_triangles)
+    tri_direct = np.zeros(smp.n_triangles)
     for dose, b in zip(direct_mol, steps):
         np.add.at(tri_direct, b.ids, dose * area_m2 * b.hits / smp.n)
     tri_diffuse = sky_light.triangle_share * diffuse_mol * area_m2

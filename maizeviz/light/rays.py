@@ -99,6 +99,8 @@ class Tracer:
         self.down = np.asarray(direction, dtype=np.float64)
         self.bounds = bounds
         self.periodic = periodic
+        # overhang copies of a periodic scene are reported as the triangles they copy
+        self.source = getattr(scene, "source", None)
         # one writable float32 direction buffer, sliced per chunk (embreex needs writable input)
         self.dirs = np.tile(self.down.astype(np.float32), (max(size, 1), 1))
 
@@ -172,6 +174,14 @@ class Tracer:
         Returns triangle ids (N,) int32, -1 where none (None unless ``ids``), and hit distances
         (N,) float64 cm (inf where none).
         """
+        prim, dist = self._trace(org, length, ids)
+        if prim is not None and self.source is not None:
+            hit = prim >= 0
+            prim[hit] = self.source[prim[hit]]
+        return prim, dist
+
+    def _trace(self, org: np.ndarray, length: np.ndarray,
+               ids: bool) -> tuple[np.ndarray | None, np.ndarray]:
         n = len(org)
         prim = np.full(n, -1, dtype=np.int32) if ids else None
         dist = np.full(n, np.inf)

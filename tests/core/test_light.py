@@ -389,3 +389,27 @@ def test_sensor_planes_by_occlusion_and_by_the_ray_family_agree(monkeypatch, per
         for k in range(len(heights)):
             assert np.mean(occ.lit(k) != fam.lit(k)) <= 2 / occ.rays
         assert np.array_equal(occ.first_hits, fam.first_hits)
+
+
+def test_a_leaf_overhanging_a_periodic_plot_shades_the_opposite_edge():
+    """A leaf hanging 20 cm over the east edge of a periodic 100 cm plot stands, in the
+    infinite field, 20 cm inside its west edge too: its light is counted on the leaf itself."""
+    from maizeviz.light.transmission import light_scene
+
+    c = canopy_of([(90, 40, 30, 50)])                       # x 90..120 over the edge at 100
+    req = LightRequest(Sun(0, 0), (0, 60), 4, (0, 0, 100, 100), periodic=True)
+    r = trace_light(c, req)
+    assert r.transmission[0] == pytest.approx(1 - 900 / 10000, abs=1e-12)
+    m = transmission_map(r, 0.0, 10.0)
+    assert np.all(m.transmission[[0, 1, 9], 4:7] == 0)      # x 0..20 and 90..100 shaded
+    assert len(r.first_hits) == c.n_triangles
+    rows = leaf_light(c, r)
+    assert rows[0]["sunlit_area_cm2"] == pytest.approx(900, rel=1e-9)
+    # an open field has no such copy; a scene built for one is said to miss the overhang
+    assert trace_light(c, LightRequest(Sun(0, 0), (0,), 4, (0, 0, 100, 100))).transmission[0] \
+        == pytest.approx(1 - 300 / 10000, abs=1e-12)
+    plain = trace_light(c, req, scene=light_scene(c))
+    assert any("overhanging" in w for w in plain.warnings)
+    with pytest.raises(MaizevizError, match="cannot trace an open field"):
+        trace_light(c, LightRequest(Sun(0, 0), (0,), 4, (0, 0, 100, 100)),
+                    scene=light_scene(c, periodic=True))

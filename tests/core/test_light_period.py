@@ -29,7 +29,7 @@ def canopy():
 
 @pytest.fixture(scope="module")
 def scene(canopy):
-    return light_scene(canopy)
+    return light_scene(canopy, periodic=True)
 
 
 def sampling(threads=2):
