@@ -455,7 +455,8 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
             n += _write_maps(folder, "diffuse", label,
                              [sky.transmission_map(float(h)) for h in sky.heights_cm],
                              "diffuse transmission",
-                             f"{sky.sky.description}; level {label}; {sky.rays:,} sensors per "
+                             f"{SKY_KINDS[sky.sky.kind].split(',')[0]}, {sky.sky.split} split of "
+                             f"{sky.sky.n} directions; level {label}; {sky.rays:,} sensors per "
                              "direction")
         if pl is not None and pl.n_steps:
             p = pl.period

@@ -107,9 +107,11 @@ def heatmap_figure(tmap: TransmissionMap, result: LightResult | None = None,
         title = (f"sun zenith {result.sun.zenith_deg:.1f} deg, azimuth "
                  f"{result.sun.azimuth_deg:.1f} deg; level {result.level}; "
                  f"{result.rays:,} sensors, {bin_cm:.3g} cm bins")
+    import textwrap
+
     ax.set_title(f"{what} at {tmap.height_cm:g} cm: {tmap.total:.3f}"
-                 + (f"\n{title}" if title else ""), fontsize=9)
-    fig.colorbar(im, ax=ax, label="transmission (fraction of sensors lit at this height)",
+                 + ("\n" + "\n".join(textwrap.wrap(title, 95)) if title else ""), fontsize=9)
+    fig.colorbar(im, ax=ax, label="transmission (fraction of the light reaching this height)",
                  shrink=0.8)
     fig.tight_layout()
     return fig
