@@ -16,6 +16,7 @@ from maizeviz.cli.common import (
     add_level_options,
     canopy_setup,
     check_canopy_costs,
+    check_outputs,
     check_export,
     fmt_table,
     leaves_summary,
@@ -55,6 +56,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.cover_resolution > 0:
         raise MaizevizError(f"the ground-cover pixel must be > 0 cm, got {args.cover_resolution}",
                             quantity="cover_resolution")
+    check_outputs(args.save_layout)
     refuse_overwriting_inputs([("the mesh export", args.export),
                                ("the saved layout", args.save_layout)], [args.points, args.layout])
     leaves, skipped, layout = canopy_setup(args)

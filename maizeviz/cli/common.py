@@ -12,7 +12,7 @@ from pathlib import Path
 from maizeviz.canopy.layout import MAX_PLANTS, CanopyLayout, layout_for, parse_shape
 from maizeviz.cost import Cost, canopy_cost, check
 from maizeviz.errors import LeafError, MaizevizError
-from maizeviz.io.atomic import atomic_open
+from maizeviz.io.atomic import atomic_open, check_output
 from maizeviz.io.meshfile import check_mesh_path
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.mesh.levels import Level, parse_levels
@@ -29,7 +29,8 @@ FLAGS = {
     "degree": "--degree", "params": "--params", "sun": "--sun-zenith/--sun-azimuth",
     "date": "--date", "time": "--time", "place": "--lat/--lon", "tz": "--tz", "cols": "--cols",
     "plants": "--plants", "sections": "--sections", "at": "--at", "periodic": "--periodic",
-    "baud": "--baud",
+    "baud": "--baud", "points_across": "--points-across", "seed": "--seed", "plant": "--plant",
+    "pace": "--pace", "noise": "--noise", "answer_timeout": "--answer-timeout",
 }
 
 
@@ -88,6 +89,13 @@ def add_level_options(p: argparse.ArgumentParser, default_levels: str) -> None:
     p.add_argument("--no-preserve-area", dest="preserve_area", action="store_false",
                    help="below the standard mesh, do not widen cross-sections to keep the "
                         "smooth surface's area")
+
+
+def check_outputs(*paths: str | None) -> None:
+    """Refuse, before any work, output files whose folder is missing or that are folders."""
+    for path in paths:
+        if path is not None:
+            check_output(path)
 
 
 def check_export(path: str | None, levels: list[Level]) -> None:
