@@ -38,7 +38,7 @@ from maizeviz.digitizer.geometry import to_reference_frame
 from maizeviz.digitizer.protocol import TRUST_ERRORS, Garbled, Record
 from maizeviz.errors import MaizevizError, PointsFileError
 from maizeviz.io.points import (DISCARDED, JOURNAL_COLUMNS, LineParser, file_kind, file_lines,
-                                open_regular, text_of)
+                                open_regular, refuse_binary, text_of)
 
 COLUMNS = JOURNAL_COLUMNS
 CONTROLS = {"n": "next_leaf", "p": "next_plant", "r": "end_row", "u": "undo", "q": "quit"}
@@ -176,6 +176,10 @@ class JournalReplay(LineParser):
         self.history: list[tuple] = []
         self.pos = Position()
         self.controls = 0
+
+    def _discard(self, lineno: int) -> None:
+        """A torn line marked when an earlier session resumed: skipped without a word."""
+        self.pending = None
 
     def commit(self, outcome) -> None:
         kind, payload, _ = outcome
@@ -375,6 +379,7 @@ class Session:
         try:
             fh, _ = open_regular(p, SessionError, "recording")
             with fh:
+                refuse_binary(fh, str(p))
                 for lineno, (text, terminated) in enumerate(file_lines(fh, str(p)), 1):
                     replay.feed(lineno, text, terminated)
                     if replay.header is not None and not replay.journal:

@@ -179,6 +179,13 @@ def _looks_binary(head: bytes) -> bool:
     return controls > len(head) // 10
 
 
+def refuse_binary(fh, source: str) -> None:
+    """Raise :class:`PointsFileError` when the first bytes of a binary file (opened by
+    :func:`open_regular`) are not text; reads nothing away."""
+    if _looks_binary(fh.peek(_BINARY_SNIFF)[:_BINARY_SNIFF]):
+        raise PointsFileError(f"{source}: not a CSV text file (binary content)")
+
+
 def _decode(raw: bytes) -> str:
     try:
         return raw.decode("utf-8")
@@ -539,12 +546,7 @@ def read_points(path: str | Path, max_points: int = MAX_POINTS,
     fh, _ = open_regular(path)
     with fh:
         try:
-            head = fh.peek(_BINARY_SNIFF)[:_BINARY_SNIFF]
-        except OSError as exc:
-            raise PointsFileError(f"{path}: cannot be read ({exc.strerror or exc})") from None
-        if _looks_binary(head):
-            raise PointsFileError(f"{path}: not a CSV text file (binary content)")
-        try:
+            refuse_binary(fh, str(path))
             return _parse_stream(file_lines(fh, str(path)), str(path),
                                  max_points, max_lines)
         except OSError as exc:
