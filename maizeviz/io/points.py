@@ -127,7 +127,7 @@ def _parse_id(text: str, what: str, limit: int, low: int) -> int:
     """A whole number within ``low..limit``; :class:`_BadValue` names ``what`` and the range."""
     value = _parse_int(text)
     if not low <= value <= limit:
-        raise _BadValue(f"{what} {text.strip()[:30]} is beyond the range {low}..{limit:,}")
+        raise _BadValue(f"{what} {text.strip()[:30]} is beyond the range {low:,}..{limit:,}")
     return value
 
 
