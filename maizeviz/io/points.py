@@ -32,6 +32,7 @@ import io
 import math
 import os
 import stat
+import warnings
 from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -68,6 +69,10 @@ MAX_MESSAGES = 1000
 #: Leaves with unreadable lines before the file is taken for something else.
 MAX_BAD_LEAVES = 100_000
 _BINARY_SNIFF = 4096
+#: Bytes read at a time; blocks of plain numeric lines are parsed by numpy in one go.
+BLOCK_BYTES = 1 << 20
+#: What a block of plain numeric lines may hold, besides its delimiter.
+_NUMERIC = b"0123456789+-.eE \r\n"
 
 _KIND = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
@@ -193,27 +198,44 @@ def _decode(raw: bytes) -> str:
         return raw.decode("latin-1")              # decodes every byte
 
 
+def file_blocks(fh, max_line: int = MAX_LINE_BYTES, size: int | None = None):
+    """Blocks of whole lines of a binary file, about ``size`` bytes each.
+
+    A block ends with a line end, or with the file, or with a line longer than ``max_line``
+    (whose first ``max_line + 1`` bytes the block holds: the line checks refuse it).
+    """
+    size = size or BLOCK_BYTES
+    while True:
+        block = fh.read(size)
+        if not block:
+            return
+        if not block.endswith(b"\n"):
+            block += fh.readline(max_line + 1)
+        yield block
+
+
+def raw_line_text(raw: bytes, lineno: int, source: str, max_line: int = MAX_LINE_BYTES) -> str:
+    """The text of one physical line (its line end kept), refusing over-long or binary lines."""
+    body = len(raw) - 1 if raw.endswith(b"\n") else len(raw)
+    if body > max_line:
+        raise PointsFileError(
+            f"{source}: line {lineno} is longer than {max_line:,} bytes; not a readable "
+            "CSV file of points (a points line is under 100 bytes)")
+    if b"\x00" in raw:
+        raise PointsFileError(f"{source}: line {lineno}: binary content (a NUL byte); not "
+                              "a CSV text file")
+    if lineno == 1 and raw.startswith(b"\xef\xbb\xbf"):
+        raw = raw[3:]
+    return _decode(raw)
+
+
 def file_lines(fh, source: str, max_line: int = MAX_LINE_BYTES):
     """(text, terminated) for each physical line of a binary file, bounded in length."""
-    first = True
     lineno = 0
-    while True:
-        raw = fh.readline(max_line + 1)
-        if not raw:
-            return
-        lineno += 1
-        terminated = raw.endswith(b"\n")
-        if len(raw) > max_line and not (terminated and len(raw) <= max_line + 1):
-            raise PointsFileError(
-                f"{source}: line {lineno} is longer than {max_line:,} bytes; not a readable "
-                "CSV file of points (a points line is under 100 bytes)")
-        if b"\x00" in raw:
-            raise PointsFileError(f"{source}: line {lineno}: binary content (a NUL byte); not "
-                                  "a CSV text file")
-        if first:
-            raw = raw[3:] if raw.startswith(b"\xef\xbb\xbf") else raw
-            first = False
-        yield _decode(raw), terminated
+    for block in file_blocks(fh, max_line):
+        for raw in io.BytesIO(block):
+            lineno += 1
+            yield raw_line_text(raw, lineno, source, max_line), raw.endswith(b"\n")
 
 
 def _text_lines(text: str, source: str, max_line: int):
@@ -469,6 +491,69 @@ class LineParser:
         elif kind == "undo":
             self.undone.append((outcome[1], len(self.lines)))
 
+    # ------------------------------------------------------------------ blocks
+    def feed_block(self, block: bytes, lineno: int) -> int:
+        """Feed a block of whole lines that follows line ``lineno``; returns the last line
+        number. Plain numeric lines go through :meth:`_fast`, the rest line by line."""
+        pos = 0
+        while pos < len(block):
+            if self._fast_ok():
+                rest = block[pos:] if pos else block
+                done = self._fast(rest, lineno)
+                if done:
+                    return lineno + done
+                for raw in io.BytesIO(rest):
+                    lineno += 1
+                    self.feed(lineno, raw_line_text(raw, lineno, self.source), raw.endswith(b"\n"))
+                return lineno
+            end = block.find(b"\n", pos)
+            end = len(block) if end < 0 else end + 1
+            lineno += 1
+            raw = block[pos:end]
+            self.feed(lineno, raw_line_text(raw, lineno, self.source), raw.endswith(b"\n"))
+            pos = end
+        return lineno
+
+    def _fast_ok(self) -> bool:
+        return (self.header is not None and self.status_col is None and not self.extra_index
+                and len(self.header) == len(REQUIRED) and not self.carry)
+
+    def _fast(self, block: bytes, lineno: int) -> int:
+        """Parse a block of plain numeric lines with numpy; returns the lines taken (0: the
+        block is not plain, read it line by line)."""
+        delim = self.delimiter.encode()
+        if block.translate(None, _NUMERIC + delim) or block.count(b"\r") != block.count(b"\r\n"):
+            return 0                                   # quotes, words, nan, blanks in lines...
+        ends = np.flatnonzero(np.frombuffer(block, np.uint8) == 10)
+        n = len(ends) + (0 if block.endswith(b"\n") else 1)
+        lengths = np.diff(np.concatenate([[-1], ends, [len(block) - 1]]))[:n]
+        if not n or lengths.max() > MAX_LINE_BYTES + 1 or lineno + n > self.max_lines:
+            return 0                                   # the line-by-line checks say why
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                values = np.loadtxt(io.BytesIO(block), delimiter=self.delimiter, comments=None,
+                                    dtype=np.float64, ndmin=2, encoding="latin-1")
+        except (ValueError, Warning):
+            return 0
+        if values.shape != (n, len(REQUIRED)) or not np.isfinite(values).all():
+            return 0
+        ids = values[:, self.index[:4]]
+        xyz = values[:, self.index[4:]]
+        limit = np.array([MAX_ID, MAX_ID, MAX_INDEX, MAX_INDEX], dtype=np.float64)
+        low = np.array([-MAX_ID, -MAX_ID, 0, 0], dtype=np.float64)
+        if not (np.all(ids == np.floor(ids)) and np.all(ids <= limit) and np.all(ids >= low)):
+            return 0
+        if len(self.lines) + n > self.max_points:
+            return 0
+        self.ids.frombytes(ids.astype(np.int64).tobytes())
+        self.xyz.frombytes(np.ascontiguousarray(xyz).tobytes())
+        self.lines.frombytes(np.arange(lineno + 1, lineno + n + 1, dtype=np.int64).tobytes())
+        self.data_lines += n
+        if not block.endswith(b"\n"):
+            self.torn = (lineno + n, "")
+        return n
+
     # ------------------------------------------------------------------ result
     def finish(self) -> PointsTable:
         if self.carry:                               # an unclosed quote at the end of the file
@@ -535,6 +620,10 @@ def read_points(path: str | Path, max_points: int = MAX_POINTS,
                 max_lines: int = MAX_LINES) -> PointsTable:
     """Read a points CSV file, streaming (memory follows the points kept).
 
+    Blocks of plain numeric lines (no status or extra column, no quote, no blank line, every
+    value a number and every id in range) are parsed by numpy in one go; any other block goes
+    line by line, so every message is the one the line-by-line reading gives.
+
     Raises
     ------
     PointsFileError
@@ -543,12 +632,16 @@ def read_points(path: str | Path, max_points: int = MAX_POINTS,
         more than ``max_points`` points or ``max_lines`` lines, or not one line could be read.
     """
     path = Path(path)
+    source = str(path)
     fh, _ = open_regular(path)
     with fh:
         try:
-            refuse_binary(fh, str(path))
-            return _parse_stream(file_lines(fh, str(path)), str(path),
-                                 max_points, max_lines)
+            refuse_binary(fh, source)
+            parser = LineParser(source, max_points, max_lines)
+            lineno = 0
+            for block in file_blocks(fh):
+                lineno = parser.feed_block(block, lineno)
+            return parser.finish()
         except OSError as exc:
             raise PointsFileError(f"{path}: cannot be read ({exc.strerror or exc})") from None
 
