@@ -38,7 +38,7 @@ from maizeviz.digitizer.geometry import to_reference_frame
 from maizeviz.digitizer.protocol import TRUST_ERRORS, Garbled, Record
 from maizeviz.errors import MaizevizError, PointsFileError
 from maizeviz.io.points import (DISCARDED, JOURNAL_COLUMNS, LineParser, file_kind, file_lines,
-                                open_regular, refuse_binary, text_of)
+                                open_regular, refuse_binary, shown, text_of)
 
 COLUMNS = JOURNAL_COLUMNS
 CONTROLS = {"n": "next_leaf", "p": "next_plant", "r": "end_row", "u": "undo", "q": "quit"}
@@ -223,7 +223,7 @@ def _describe_fragment(text: str) -> str:
     """The point a torn line was about, in words, from the fields that survived."""
     fields = text.rstrip("\r\n").split(",")
     if len(fields) > 7 and fields[7] and not "recorded".startswith(fields[7]):
-        return f"a '{fields[7][:20]}' line"
+        return f"a '{shown(fields[7], 20)}' line"
     try:
         plant, leaf, row, col = (int(f) for f in fields[:4])
     except ValueError:

@@ -132,7 +132,7 @@ def _parse_id(text: str, what: str, limit: int, low: int) -> int:
     """A whole number within ``low..limit``; :class:`_BadValue` names ``what`` and the range."""
     value = _parse_int(text)
     if not low <= value <= limit:
-        raise _BadValue(f"{what} {text.strip()[:30]} is beyond the range {low:,}..{limit:,}")
+        raise _BadValue(f"{what} {shown(text)} is beyond the range {low:,}..{limit:,}")
     return value
 
 
@@ -290,10 +290,10 @@ class LineParser:
         header = [f.strip().lower() for f in fields]
         missing = [c for c in REQUIRED if c not in header]
         if missing:
-            shown = ",".join(header)[:80]
+            found = shown(",".join(header), 80)
             raise PointsFileError(
                 f"{self.source}: line {lineno}: missing column(s) {', '.join(missing)}; "
-                f"a points file needs the header plant,leaf,row,col,x,y,z (found '{shown}')")
+                f"a points file needs the header plant,leaf,row,col,x,y,z (found '{found}')")
         self.header = header
         self.header_line = lineno
         self.index = [header.index(name) for name in REQUIRED]
@@ -321,7 +321,9 @@ class LineParser:
             raise PointsFileError(
                 f"{self.source}: more than {self.max_lines:,} lines; reading more would take "
                 "many minutes (split the file by plant)")
-        if self.carry or (text.count('"') % 2 and terminated):
+        # a quoted field may run over line ends, except in a recording: the recorder never
+        # writes one, and a torn line's open quote must not swallow the lines after it
+        if self.carry or (text.count('"') % 2 and terminated and not self.journal):
             if not self.carry:
                 self.carry_start = lineno
             self.carry += text
@@ -404,7 +406,7 @@ class LineParser:
             if self.journal and status != RECORDED:
                 if status in CONTROL_STATUSES:
                     return self._control(lineno, fields, status)
-                return ("problem", f"line {lineno}: unknown status '{status[:20]}'; skipped",
+                return ("problem", f"line {lineno}: unknown status '{shown(status, 20)}'; skipped",
                         lineno)
             if status not in ("", RECORDED, "ok"):
                 return self._control(lineno, fields, status)   # controls carry no point
@@ -429,19 +431,19 @@ class LineParser:
             return ("problem", f"line {lineno}: {exc}; line skipped", lineno)
         except (ValueError, OverflowError):
             return ("problem", f"line {lineno}: plant/leaf id is not an integer "
-                    f"('{p.strip()[:30]}', '{lf.strip()[:30]}'); line skipped", lineno)
+                    f"('{shown(p)}', '{shown(lf)}'); line skipped", lineno)
         try:
             row = _parse_int(r)
             col = _parse_int(c)
         except (ValueError, OverflowError):
             return ("bad", ((plant, leaf), f"line {lineno}: row/col is not a whole number "
-                    f"('{r.strip()[:30]}', '{c.strip()[:30]}')"), lineno)
+                    f"('{shown(r)}', '{shown(c)}')"), lineno)
         if row < 0 or col < 0:
-            return ("bad", ((plant, leaf), f"line {lineno}: row {r.strip()[:30]}, col "
-                    f"{c.strip()[:30]}: negative index"), lineno)
+            return ("bad", ((plant, leaf), f"line {lineno}: row {shown(r)}, col "
+                    f"{shown(c)}: negative index"), lineno)
         if row > MAX_INDEX or col > MAX_INDEX:
-            return ("bad", ((plant, leaf), f"line {lineno}: row {r.strip()[:30]}, col "
-                    f"{c.strip()[:30]}: beyond {MAX_INDEX:,}, the largest cross-section "
+            return ("bad", ((plant, leaf), f"line {lineno}: row {shown(r)}, col "
+                    f"{shown(c)}: beyond {MAX_INDEX:,}, the largest cross-section "
                     "index"), lineno)
         coords = []
         for axis, value in zip("xyz", (x, y, z)):
@@ -449,7 +451,7 @@ class LineParser:
                 coords.append(float(value))
             except ValueError:
                 return ("bad", ((plant, leaf), f"row {row}, col {col} (line {lineno}): {axis} is "
-                        f"not a number ('{value.strip()[:30]}')"), lineno)
+                        f"not a number ('{shown(value)}')"), lineno)
         extras = [fields[i].strip() for i in self.extra_index.values()]
         return ("point", (plant, leaf, row, col, coords, extras), lineno)
 
@@ -589,10 +591,19 @@ class LineParser:
                            bad_leaves=self.bad_leaves, source=self.source)
 
 
+def shown(text: str, limit: int = 30) -> str:
+    """Text from a file as it may appear in a one-line message: stripped, shortened, and
+    with line ends and other control characters written as escapes."""
+    text = text.strip()
+    cut = text[:limit]
+    if not cut.isprintable():
+        cut = "".join(c if c.isprintable() else repr(c)[1:-1] for c in cut)
+    return cut + ("..." if len(text) > limit else "")
+
+
 def text_of(fields: list[str], limit: int = 40) -> str:
     """A line's fields joined back, shortened for a message."""
-    text = ",".join(fields)
-    return text if len(text) <= limit else text[:limit] + "..."
+    return shown(",".join(fields), limit)
 
 
 def _undo_mask(ids: np.ndarray, undone: list) -> np.ndarray:
