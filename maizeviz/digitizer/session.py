@@ -46,8 +46,9 @@ CONTROLS = {"n": "next_leaf", "p": "next_plant", "r": "end_row", "u": "undo", "q
 MIN_FREE_BYTES = 1 << 20
 #: The header line the recorder writes (csv's CR LF line end).
 HEADER = (",".join(COLUMNS) + "\r\n").encode("ascii")
-#: Most lines a recording may hold to be resumed: a day of digitizing is some 20,000.
-MAX_JOURNAL_LINES = 5_000_000
+#: Most lines a recording may hold to be resumed: a day of digitizing is some 20,000 (each
+#: point replayed takes about 300 bytes of memory).
+MAX_JOURNAL_LINES = 1_000_000
 
 
 class SessionError(MaizevizError):
@@ -167,7 +168,7 @@ class JournalReplay(LineParser):
     ----------
     history : list of (Position, (x, y, z) cm), points recorded and not undone, in order
     pos : Position, where the next point goes
-    notes : lines that were skipped, with the reason (the points reader says the same)
+    problems : lines that were skipped, with the reason (the points reader says the same)
     """
 
     def __init__(self, source: str, cols: int):
@@ -194,7 +195,7 @@ class JournalReplay(LineParser):
                 self.pos = Position(last.plant, last.leaf, last.row, last.col)
         elif kind == "control":
             self.controls += 1
-            status, key = payload
+            _, key = payload
             if key is not None:
                 self.pos = Position(*key)
         elif kind == "bad":

@@ -241,10 +241,13 @@ def file_lines(fh, source: str, max_line: int = MAX_LINE_BYTES):
 def _text_lines(text: str, source: str, max_line: int):
     """(text, terminated) for each line of a string, split at LF only as the file reader does."""
     for lineno, line in enumerate(io.StringIO(text), start=1):
-        if len(line) > max_line + 1:
+        if len(line) - line.endswith("\n") > max_line:
             raise PointsFileError(
                 f"{source}: line {lineno} is longer than {max_line:,} characters; not a "
                 "readable CSV file of points (a points line is under 100 bytes)")
+        if "\x00" in line:
+            raise PointsFileError(f"{source}: line {lineno}: binary content (a NUL byte); not "
+                                  "a CSV text file")
         yield line, line.endswith("\n")
 
 
@@ -660,7 +663,7 @@ def read_points(path: str | Path, max_points: int = MAX_POINTS,
 def parse_points(text: str, source: str = "<memory>", max_points: int = MAX_POINTS,
                  max_lines: int = MAX_LINES) -> PointsTable:
     """Parse the text of a points CSV file; see :func:`read_points`."""
-    text = text[1:] if text.startswith("\ufeff") else text
+    text = text.removeprefix("\ufeff")
     if "\x00" in text[:_BINARY_SNIFF]:
         raise PointsFileError(f"{source}: not a CSV text file (binary content)")
     return _parse_stream(_text_lines(text, source, MAX_LINE_BYTES), source, max_points,

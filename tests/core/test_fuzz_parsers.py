@@ -87,7 +87,7 @@ def check_table(table):
     for msgs in table.bad_leaves.values():
         for m in msgs:
             assert len(m.splitlines()) == 1, m
-    grids, errors = build_grids(table)                # what every reader of a table does next
+    _, errors = build_grids(table)                    # what every reader of a table does next
     for e in errors:
         one_line(e)
 

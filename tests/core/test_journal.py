@@ -21,7 +21,7 @@ import pytest
 from maizeviz.digitizer import session as session_mod
 from maizeviz.digitizer.protocol import Record
 from maizeviz.digitizer.replay import presses_of
-from maizeviz.digitizer.session import (HEADER, JournalInUse, Session, SessionError, lock_path)
+from maizeviz.digitizer.session import HEADER, JournalInUse, Session, SessionError, lock_path
 from maizeviz.digitizer.simulator import FastrakSimulator
 from maizeviz.io.points import parse_points, read_points
 from maizeviz.leaf.grid import build_grids
