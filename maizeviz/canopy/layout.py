@@ -174,6 +174,25 @@ def _clusters(values: np.ndarray, spacing: float) -> np.ndarray:
     return out
 
 
+def check_tile(tile, plants: int = 1) -> tuple[int, int]:
+    """The tile count (A, B) as whole numbers, refused when A x B copies of a block of
+    ``plants`` plants exceed :data:`MAX_PLANTS`; cheap, so callers can check it before
+    reading any points (with ``plants=1``) and again once the block is known."""
+    try:
+        parts = tuple(tile)
+    except TypeError:
+        parts = ()
+    if len(parts) != 2:
+        raise LayoutError(f"the tile count must be two numbers (across rows, along rows), "
+                          f"got {_shown(tile)}")
+    a, b = (_check_count(v, "the tile count", MAX_PLANTS) for v in parts)
+    if a * b * plants > MAX_PLANTS:
+        block = f"a block of {plants} plants" if plants > 1 else "one plant"
+        raise LayoutError(f"{a} x {b} tiles of {block} make {a * b * plants:,} plants; a "
+                          f"canopy holds at most {MAX_PLANTS:,}")
+    return a, b
+
+
 def block_lattice(bases: dict[int, tuple[float, float]], row_spacing: float,
                   plant_spacing: float) -> tuple[tuple[int, int], dict[int, tuple[float, float]]]:
     """Rows x plants per row of a digitized block, and each plant's lattice position (cm).
@@ -222,13 +241,7 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
         if len(xy) != 2 or not all(math.isfinite(v) and abs(v) <= MAX_COORD_CM for v in xy):
             raise LayoutError(f"plant {pid}: its stalk base {tuple(xy)} cm is not within "
                               f"{MAX_COORD_CM:g} cm (1 km) of the origin")
-    if len(tile) != 2:
-        raise LayoutError(f"the tile count must be two numbers (across rows, along rows), "
-                          f"got {_shown(tile)}")
-    a, b = (_check_count(v, "the tile count", MAX_PLANTS) for v in tile)
-    if a * b * len(bases) > MAX_PLANTS:
-        raise LayoutError(f"{a} x {b} tiles of a block of {len(bases)} plants make "
-                          f"{a * b * len(bases):,} plants; a canopy holds at most {MAX_PLANTS:,}")
+    a, b = check_tile(tile, len(bases))
     if block is not None:
         if len(block) != 2:
             raise LayoutError(f"the block shape must be two numbers, got {_shown(block)}")

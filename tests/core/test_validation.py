@@ -207,3 +207,15 @@ def test_reading_streams_memory_follows_points_kept(tmp_path):
 
 def test_every_layout_and_points_error_is_a_maizeviz_error():
     assert issubclass(LayoutError, MaizevizError) and issubclass(PointsFileError, MaizevizError)
+
+
+def test_tile_count_checked_before_any_point_is_read():
+    from maizeviz.canopy.layout import check_tile
+    t0 = time.monotonic()
+    with pytest.raises(LayoutError, match="1000 x 1000 tiles of one plant make 1,000,000 plants"):
+        check_tile((1000, 1000))
+    assert time.monotonic() - t0 < 0.1
+    assert check_tile((3, 3), 9) == (3, 3)
+    for bad in ((3,), None, ("3", 3), (True, 3)):
+        with pytest.raises(LayoutError, match="tile count"):
+            check_tile(bad)
