@@ -138,11 +138,11 @@ def _cell(x, y, row_spacing, plant_spacing):
 def _check_spacing(row_spacing, plant_spacing):
     """Both spacings numbers of cm within :data:`MIN_LENGTH_CM` .. :data:`MAX_COORD_CM`."""
     for name, v in (("row spacing", row_spacing), ("plant spacing", plant_spacing)):
-        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) \
-                or not math.isfinite(float(v)) or v <= 0:
+        f = _finite(v)
+        if f is None or f <= 0:
             raise LayoutError(f"{name} must be a positive number of cm, got {_shown(v)}")
-        if not MIN_LENGTH_CM <= v <= MAX_COORD_CM:
-            raise LayoutError(f"{name} is {float(v):g} cm; it must be from {MIN_LENGTH_CM:g} to "
+        if not MIN_LENGTH_CM <= f <= MAX_COORD_CM:
+            raise LayoutError(f"{name} is {f:g} cm; it must be from {MIN_LENGTH_CM:g} to "
                               f"{MAX_COORD_CM:g} cm (1 km)")
 
 
@@ -238,7 +238,8 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
     if len(bases) > MAX_PLANTS:
         raise LayoutError(f"{len(bases):,} digitized plants; a canopy holds at most {MAX_PLANTS:,}")
     for pid, xy in bases.items():
-        if len(xy) != 2 or not all(math.isfinite(v) and abs(v) <= MAX_COORD_CM for v in xy):
+        if len(xy) != 2 or not all(_finite(v) is not None and abs(v) <= MAX_COORD_CM
+                                   for v in xy):
             raise LayoutError(f"plant {pid}: its stalk base {tuple(xy)} cm is not within "
                               f"{MAX_COORD_CM:g} cm (1 km) of the origin")
     a, b = check_tile(tile, len(bases))
@@ -309,17 +310,31 @@ def _shown(v, limit: int = 40) -> str:
     try:
         text = json.dumps(v)
     except (TypeError, ValueError, RecursionError):
-        text = "a number too long to show" if isinstance(v, int) else type(v).__name__
+        try:
+            text = str(v)                                  # numpy numbers, tuples
+        except ValueError:                                 # an integer of over 4300 digits
+            text = "a number too long to show"
     return text if len(text) <= limit else text[:limit] + "..."
+
+
+def _finite(v) -> float | None:
+    """``v`` as a finite float, or None for anything else (bools, text, NaN, 10**400)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+        return None
+    try:
+        f = float(v)
+    except OverflowError:
+        return None
+    return f if math.isfinite(f) else None
 
 
 def _angle(v, what: str) -> float:
     """An angle in degrees within +-:data:`MAX_ANGLE_DEG`."""
-    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)) or \
-            not math.isfinite(float(v)) or abs(v) > MAX_ANGLE_DEG:
+    f = _finite(v)
+    if f is None or abs(f) > MAX_ANGLE_DEG:
         raise LayoutError(f"{what} must be an angle from -{MAX_ANGLE_DEG:g} to "
                           f"{MAX_ANGLE_DEG:g} degrees, got {_shown(v)}")
-    return float(v)
+    return f
 
 
 def _number(obj, key, where, default=None, positive=False, low=None, high=None, unit=" cm"):

@@ -146,7 +146,7 @@ def flat(m=4, n=3):
     ("1e300,1,0,0,1,2,3", "line 14: plant id 1e300 is beyond the range "
                           "-1,000,000,000..1,000,000,000; line skipped"),
     ("1,-1e300,0,0,1,2,3", "line 14: leaf id -1e300 is beyond the range"),
-    ("1," + "9" * 400 + ",0,0,1,2,3", "leaf id 999999999999999999999999999999 is beyond"),
+    ("1," + "9" * 400 + ",0,0,1,2,3", "leaf id 999999999999999999999999999999... is beyond"),
     ("inf,1,0,0,1,2,3", "plant/leaf id is not an integer ('inf', '1')"),
 ])
 def test_absurd_ids_skip_the_line(line, says):
@@ -219,3 +219,11 @@ def test_tile_count_checked_before_any_point_is_read():
     for bad in ((3,), None, ("3", 3), (True, 3)):
         with pytest.raises(LayoutError, match="tile count"):
             check_tile(bad)
+
+
+@pytest.mark.parametrize("kw", [{"north_deg": 10**400}, {"row_spacing": 10**400},
+                                {"plant_spacing": np.float64("nan")}, {"tile": (np.int64(0), 1)}])
+def test_tiling_arguments_of_any_type(kw):
+    with pytest.raises(LayoutError) as exc:
+        tiled_layout(bases(), **{"tile": (1, 1), **kw})
+    assert len(str(exc.value).splitlines()) == 1 and len(str(exc.value)) < 300
