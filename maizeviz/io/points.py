@@ -7,8 +7,8 @@ A ``status`` column (written by ``maizeviz record``) is honoured: ``undone`` lin
 latest recording of that point, control lines (``next_leaf``, ``next_plant``, ``end_row``)
 carry no point, and a ``discarded`` line takes back the line just above it: a line the
 recorder was cut off while writing (a crash, a full disk), terminated when the recording was
-resumed. A last line without its line end is such a cut-off line too; it is skipped with a
-note, never read as a point. In a recording (the header is exactly :data:`JOURNAL_COLUMNS`)
+resumed. In a recording (the header is exactly :data:`JOURNAL_COLUMNS`) a last line without
+its line end is such a cut-off line too, skipped with a note and never read as a point, and
 every line must have all its fields: two lines run together, or a line cut short, are
 skipped with a note.
 
@@ -352,7 +352,7 @@ class LineParser:
         if self.status_col is None:
             self.commit(self._outcome(lineno, fields))
             return
-        if not terminated:
+        if not terminated and self.journal:
             if self.journal and not any(f.strip() for f in fields[:len(REQUIRED)]):
                 self._discard(lineno)                # a repair cut short after its line end
                 return

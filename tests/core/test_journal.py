@@ -472,3 +472,10 @@ def test_reader_refuses_special_files_at_once(tmp_path):
             assert time.monotonic() - t0 < 30
     finally:
         sock.close()
+
+
+def test_hand_made_status_file_keeps_its_last_line_without_line_end():
+    """Only a recording (its exact header) has torn lines; a file made by hand with a status
+    column and no final line end keeps its last point, as before."""
+    t = parse_points("plant,leaf,row,col,x,y,z,status\n1,1,0,0,1,2,3,\n1,1,0,1,2,2,3,ok")
+    assert len(t) == 2 and not t.problems
