@@ -6,8 +6,10 @@ message is one line, never anything else, within a deadline. Cases the fuzzers f
 pinned down as plain regression tests at the end of the file.
 """
 
+import atexit
 import json
 import os
+import shutil
 import string
 import tempfile
 from pathlib import Path
@@ -35,6 +37,7 @@ FUZZ = settings(max_examples=_LONG or 120, deadline=5000, derandomize=not _LONG,
 FEW = settings(FUZZ, max_examples=_LONG or 50)
 
 _DIR = tempfile.mkdtemp(prefix="maizeviz-fuzz-")
+atexit.register(shutil.rmtree, _DIR, True)
 
 
 def scratch(name: str) -> Path:
