@@ -17,6 +17,7 @@ from maizeviz.cli.common import (
     canopy_setup,
     check_canopy_costs,
     check_export,
+    check_outputs,
     fmt_table,
     leaves_summary,
     levels_from,
@@ -55,6 +56,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.cover_resolution > 0:
         raise MaizevizError(f"the ground-cover pixel must be > 0 cm, got {args.cover_resolution}",
                             quantity="cover_resolution")
+    check_outputs(args.save_layout)
     refuse_overwriting_inputs([("the mesh export", args.export),
                                ("the saved layout", args.save_layout)], [args.points, args.layout])
     leaves, skipped, layout = canopy_setup(args)

@@ -9,10 +9,10 @@ from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 
-from maizeviz.canopy.layout import MAX_PLANTS, CanopyLayout, layout_for, parse_shape
+from maizeviz.canopy.layout import CanopyLayout, check_tile, layout_for, parse_shape
 from maizeviz.cost import Cost, canopy_cost, check
 from maizeviz.errors import LeafError, MaizevizError
-from maizeviz.io.atomic import atomic_open
+from maizeviz.io.atomic import atomic_open, check_output
 from maizeviz.io.meshfile import check_mesh_path
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.mesh.levels import Level, parse_levels
@@ -31,7 +31,10 @@ FLAGS = {
     "plants": "--plants", "sections": "--sections", "at": "--at", "periodic": "--periodic",
     "sky": "--sky", "sky_directions": "--sky-directions", "step": "--step",
     "period": "--from/--to", "par_factor": "--par-factor", "linke_turbidity": "--linke-turbidity",
-    "altitude": "--altitude", "baud": "--baud",
+    "altitude": "--altitude",
+    "baud": "--baud", "points_across": "--points-across", "seed": "--seed", "plant": "--plant",
+    "pace": "--pace", "noise": "--noise", "answer_timeout": "--answer-timeout",
+    "resume": "--resume",
 }
 
 
@@ -90,6 +93,13 @@ def add_level_options(p: argparse.ArgumentParser, default_levels: str) -> None:
     p.add_argument("--no-preserve-area", dest="preserve_area", action="store_false",
                    help="below the standard mesh, do not widen cross-sections to keep the "
                         "smooth surface's area")
+
+
+def check_outputs(*paths: str | None) -> None:
+    """Refuse, before any work, output files whose folder is missing or that are folders."""
+    for path in paths:
+        if path is not None:
+            check_output(path)
 
 
 def check_export(path: str | None, levels: list[Level]) -> None:
@@ -151,11 +161,7 @@ def load_leaves(path: str, strict: bool = False, degree: int = 3,
 
 def canopy_setup(args: argparse.Namespace) -> tuple[list[Leaf], list[LeafError], CanopyLayout]:
     """Leaves and layout from the canopy options; warnings on stderr."""
-    tile = parse_shape(args.tile, "tile")
-    if tile[0] * tile[1] > MAX_PLANTS:                # refused before reading anything
-        raise MaizevizError(f"tiling {tile[0]}x{tile[1]} makes {tile[0] * tile[1]:,} copies of "
-                            f"the block; a canopy holds at most {MAX_PLANTS:,} plants",
-                            quantity="tile")
+    tile = check_tile(parse_shape(args.tile, "tile"))      # refused before reading anything
     block = parse_shape(args.block, "block") if args.block else None
     leaves, skipped = load_leaves(args.points, args.strict)
     if not leaves:

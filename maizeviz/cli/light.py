@@ -24,6 +24,7 @@ from maizeviz.cli.common import (
     add_level_options,
     canopy_setup,
     check_canopy_costs,
+    check_outputs,
     floats,
     fmt_table,
     leaves_summary,
@@ -235,6 +236,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.heatmap_bin > 0:
         raise MaizevizError(f"the heatmap bin must be > 0 cm, got {args.heatmap_bin}",
                             quantity="heatmap_bin")
+    check_outputs(args.leaf_light, args.plant_light, args.steps)
     refuse_overwriting_inputs([("the leaf light table", args.leaf_light),
                                ("the plant light table", args.plant_light),
                                ("the time-step table", args.steps)],

@@ -50,7 +50,7 @@ def blade_grid(polyline: np.ndarray, voxels: np.ndarray, insertion: np.ndarray |
     stations = np.linspace(0, length, m)
     si = np.clip(np.searchsorted(fine_s, stations), 0, len(fine_s) - 1)
 
-    from scipy.spatial import cKDTree                # ~0.5 s to import: only when importing
+    from scipy.spatial import cKDTree  # ~0.5 s to import: only when importing
 
     near = cKDTree(fine).query(vox)[1] if len(vox) else np.empty(0, int)
     vs = fine_s[near]

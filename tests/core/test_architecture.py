@@ -55,7 +55,7 @@ def test_core_type_checks():
 
 
 def test_no_reference_to_documents_outside_the_repository():
-    outside = re.compile(r"SCIENCE\.md|FASTRAK\.md|PAPER\.md|STYLE\.md|\.\./shared|shared/data")
+    outside = re.compile(r"SCIENCE\.md|FASTRAK\.md|PAPER\.md|STYLE\.md|\.\./shared|shared\/data")
     docs = re.compile(r"docs/[A-Za-z0-9_./-]+\.md")
     bad, missing = [], []
     for path in _tracked_files():
