@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from maizeviz.errors import LeafError
+from maizeviz.progress import ProgressCallback, report
 
 #: Points closer than this (cm) are the same press: the FASTRAK prints 0.01 cm steps.
 DUPLICATE_TOL_CM = 0.005
@@ -174,8 +175,22 @@ def grid_from_rows(plant: int, leaf: int, rows: dict[int, np.ndarray],
     return LeafGrid(plant, leaf, grid, tip_collapsed, tuple(kept_rows), tuple(notes))
 
 
-def build_grids(table, strict: bool = False) -> tuple[list[LeafGrid], list[LeafError]]:
+def build_grids(table, strict: bool = False, progress: ProgressCallback | None = None
+                ) -> tuple[list[LeafGrid], list[LeafError]]:
     """Gather a :class:`~maizeviz.io.points.PointsTable` into leaf grids.
+
+    Leaves that need nothing repaired (rows 0 .. m-1, every row with the same number n >= 2 of
+    points, or the last with one point, a collapsed tip; no point or row repeated, every
+    coordinate a number within :data:`MAX_ABS_COORD_CM`), the common case, are assembled with
+    a few numpy calls per grid shape; the others go through :func:`grid_from_rows`, which
+    repairs or refuses them. Both give the same grids, notes and errors.
+
+    Parameters
+    ----------
+    table : PointsTable (ids (N, 4) plant, leaf, row, col; xyz (N, 3) cm; line (N,))
+    strict : raise on the first refused leaf instead of listing it
+    progress : ``progress(done, total)`` in leaves; returning ``False`` stops with
+        :class:`InterruptedError`
 
     Returns
     -------
@@ -187,38 +202,143 @@ def build_grids(table, strict: bool = False) -> tuple[list[LeafGrid], list[LeafE
     LeafError
         With ``strict=True``, on the first refused leaf.
     """
+    ids, xyz, line = table.ids, table.xyz, table.line
+    if len(ids) and not _lexsorted(ids):
+        order = np.lexsort((ids[:, 3], ids[:, 2], ids[:, 1], ids[:, 0]))
+        ids, xyz, line = ids[order], xyz[order], line[order]
+    seg = _Segments(ids, xyz)
+    found = {key: k for k, key in enumerate(seg.keys)}
+    keys = sorted(set(found) | set(table.bad_leaves))
+    total = len(keys)
+    fast = _regular_grids(seg, xyz)
     grids, errors = [], []
-    keys = sorted(set(map(tuple, table.ids[:, :2].tolist())) | set(table.bad_leaves))
-    order = np.lexsort((table.ids[:, 3], table.ids[:, 2], table.ids[:, 1], table.ids[:, 0]))
-    ids, xyz, line = table.ids[order], table.xyz[order], table.line[order]
-    starts = {}
-    if len(ids):
-        change = np.flatnonzero(np.any(np.diff(ids[:, :2], axis=0) != 0, axis=1)) + 1
-        bounds = np.concatenate([[0], change, [len(ids)]])
-        for a, b in zip(bounds[:-1], bounds[1:]):
-            starts[(int(ids[a, 0]), int(ids[a, 1]))] = (a, b)
-    for key in keys:
+    for done, key in enumerate(keys, start=1):
         plant, leaf = key
+        k = found.get(key, -1)
         try:
             if key in table.bad_leaves:
                 raise LeafError(plant, leaf, "; ".join(table.bad_leaves[key]))
-            a, b = starts[key]
-            rc = ids[a:b, 2:]
-            dup = np.flatnonzero(np.all(np.diff(rc, axis=0) == 0, axis=1))
-            if len(dup):
-                k = a + dup[0]
-                raise LeafError(plant, leaf,
-                                f"row {ids[k, 2]}, col {ids[k, 3]} appears twice "
-                                f"(lines {line[k]} and {line[k + 1]})")
-            rows, cols = {}, {}
-            for r in np.unique(rc[:, 0]):
-                sel = slice(a + np.searchsorted(rc[:, 0], r, "left"),
-                            a + np.searchsorted(rc[:, 0], r, "right"))
-                rows[int(r)] = xyz[sel]
-                cols[int(r)] = ids[sel, 3]
-            grids.append(grid_from_rows(plant, leaf, rows, cols))
+            grid = fast.get(k)
+            if grid is None:
+                grid = _grid_of_leaf(plant, leaf, ids, xyz, line, seg.start[k], seg.start[k + 1])
+            grids.append(grid)
         except LeafError as exc:
             if strict:
                 raise
             errors.append(exc)
+        if done % 4096 == 0 or done == total:
+            report(progress, done, total, "gathering leaf grids")
     return grids, errors
+
+
+def _lexsorted(ids: np.ndarray, block: int = 1 << 20) -> bool:
+    """Whether rows of ``ids`` (N, c) int are in lexicographic order (ties allowed), checked
+    ``block`` rows at a time."""
+    for s in range(0, len(ids) - 1, block):
+        part = ids[s:s + block + 1]
+        less = np.zeros(len(part) - 1, dtype=bool)
+        same = np.ones(len(part) - 1, dtype=bool)
+        for c in range(ids.shape[1]):
+            d = part[1:, c] - part[:-1, c]
+            less |= same & (d < 0)
+            same &= d == 0
+        if less.any():
+            return False
+    return True
+
+
+class _Segments:
+    """Leaves and rows of points sorted by (plant, leaf, row, col).
+
+    Attributes
+    ----------
+    keys : list of (plant, leaf), one per leaf, sorted
+    start : (K + 1,) int: leaf k holds points start[k] .. start[k + 1] - 1
+    row_start : (R + 1,) int: the same for the rows of all leaves, in order
+    row_leaf : (R,) int: the leaf of each row
+    first_row : (K + 1,) int: leaf k holds rows first_row[k] .. first_row[k + 1] - 1
+    """
+
+    def __init__(self, ids: np.ndarray, xyz: np.ndarray):
+        n = len(ids)
+        leaf_change = (ids[1:, 0] != ids[:-1, 0]) | (ids[1:, 1] != ids[:-1, 1])
+        row_change = leaf_change | (ids[1:, 2] != ids[:-1, 2])
+        self.start = np.concatenate([[0], np.flatnonzero(leaf_change) + 1, [n]]) if n else \
+            np.zeros(1, dtype=np.int64)
+        self.keys = [(int(p), int(q)) for p, q in ids[self.start[:-1], :2]]
+        self.row_start = np.concatenate([[0], np.flatnonzero(row_change) + 1, [n]]) if n else \
+            np.zeros(1, dtype=np.int64)
+        self.row_leaf = np.searchsorted(self.start, self.row_start[:-1], side="right") - 1
+        self.first_row = np.searchsorted(self.row_leaf, np.arange(len(self.keys) + 1))
+        self.row_index = ids[self.row_start[:-1], 2]
+        #: (N - 1,) bool: point i + 1 starts a row; (N - 1,) bool: it repeats the (row, col)
+        self.row_change = row_change
+        self.same_col = ~row_change & (ids[1:, 3] == ids[:-1, 3])
+
+
+def _regular_grids(seg: _Segments, xyz: np.ndarray) -> dict[int, LeafGrid]:
+    """The grids of the leaves that need no repair, by leaf number, built per grid shape."""
+    nleaves = len(seg.keys)
+    if nleaves == 0:
+        return {}
+    row_len = np.diff(seg.row_start)
+    nrows = np.diff(seg.first_row)
+    # a point that rules its leaf out: not a number or absurd, the same place as the previous
+    # point of its row (a press recorded twice), or the same row and col as it
+    bad_point = ~np.isfinite(xyz).all(axis=1) | (np.abs(xyz) > MAX_ABS_COORD_CM).any(axis=1)
+    step = np.linalg.norm(np.diff(xyz, axis=0), axis=1)
+    repeat = (~seg.row_change & ~(step > DUPLICATE_TOL_CM)) | seg.same_col
+    bad_leaf = np.zeros(nleaves, dtype=bool)
+    leaf_of_point = np.repeat(np.arange(nleaves), np.diff(seg.start))
+    bad_leaf[leaf_of_point[bad_point]] = True
+    bad_leaf[leaf_of_point[1:][repeat]] = True
+    # rows numbered 0 .. m-1 in each leaf
+    rank = np.arange(len(seg.row_index)) - seg.first_row[seg.row_leaf]
+    bad_leaf[seg.row_leaf[seg.row_index != rank]] = True
+    # every row with n >= 2 points, the last one with n or 1
+    first = seg.first_row[:-1]
+    last = seg.first_row[1:] - 1
+    n = row_len[first]
+    tip = row_len[last] == 1
+    full_rows = nrows - tip
+    bad_leaf |= (nrows < 2) | (n < 2)
+    wrong = row_len != n[seg.row_leaf]
+    wrong[last[tip]] = False
+    bad_leaf[seg.row_leaf[wrong]] = True
+    out: dict[int, LeafGrid] = {}
+    ok = np.flatnonzero(~bad_leaf)
+    shapes = np.stack([nrows[ok], n[ok], tip[ok]], axis=1)
+    for m, cols, is_tip in np.unique(shapes, axis=0).tolist():
+        which = ok[np.all(shapes == (m, cols, is_tip), axis=1)]
+        full = m - is_tip
+        take = seg.start[which][:, None] + np.arange(full * cols)
+        grid = np.empty((len(which), m, cols, 3))
+        grid[:, :full] = xyz[take].reshape(len(which), full, cols, 3)
+        if is_tip:
+            grid[:, -1] = xyz[seg.start[which] + full * cols][:, None, :]
+        # a row with the same points as the one before is merged by grid_from_rows
+        same = np.all(np.linalg.norm(grid[:, :full - 1] - grid[:, 1:full], axis=-1)
+                      <= DUPLICATE_TOL_CM, axis=-1).any(axis=-1)
+        rows = tuple(range(m))
+        for k, g in zip(which[~same].tolist(), grid[~same]):
+            plant, leaf = seg.keys[k]
+            out[k] = LeafGrid(plant, leaf, g, bool(is_tip), rows, ())
+    return out
+
+
+def _grid_of_leaf(plant: int, leaf: int, ids: np.ndarray, xyz: np.ndarray, line: np.ndarray,
+                  a: int, b: int) -> LeafGrid:
+    """:func:`grid_from_rows` of the points ``a .. b - 1`` of sorted arrays (one leaf)."""
+    rc = ids[a:b, 2:]
+    dup = np.flatnonzero(np.all(np.diff(rc, axis=0) == 0, axis=1))
+    if len(dup):
+        k = a + dup[0]
+        raise LeafError(plant, leaf, f"row {ids[k, 2]}, col {ids[k, 3]} appears twice "
+                                     f"(lines {line[k]} and {line[k + 1]})")
+    rows, cols = {}, {}
+    for r in np.unique(rc[:, 0]):
+        sel = slice(a + np.searchsorted(rc[:, 0], r, "left"),
+                    a + np.searchsorted(rc[:, 0], r, "right"))
+        rows[int(r)] = xyz[sel]
+        cols[int(r)] = ids[sel, 3]
+    return grid_from_rows(plant, leaf, rows, cols)

@@ -48,8 +48,8 @@ def projected_area(mesh: LeafMesh, direction=(0.0, 0.0, 1.0)) -> float:
 def areas(meshes: list[LeafMesh], direction=(0.0, 0.0, 1.0)) -> tuple[np.ndarray, np.ndarray]:
     """Areas and projected areas (cm2) of many meshes with a few numpy calls.
 
-    Each value is the one :func:`area` and :func:`projected_area` give (to rounding in the
-    sums, 1e-15 relative).
+    Each value is the one :func:`area` and :func:`projected_area` give, to rounding in the
+    sums (1e-15 relative).
 
     Returns
     -------
@@ -57,21 +57,31 @@ def areas(meshes: list[LeafMesh], direction=(0.0, 0.0, 1.0)) -> tuple[np.ndarray
     """
     d = np.asarray(direction, dtype=np.float64)
     d = d / np.linalg.norm(d)
+    out_a, out_p = np.zeros(len(meshes)), np.zeros(len(meshes))
     if not meshes:
-        return np.zeros(0), np.zeros(0)
+        return out_a, out_p
     counts = np.array([m.n_triangles for m in meshes])
     sizes = np.array([m.points.shape[0] for m in meshes])
-    offsets = np.repeat(np.cumsum(sizes) - sizes, counts)
     faces = np.concatenate([m.faces for m in meshes]).astype(np.int64)
-    faces += offsets[:, None]
-    a, n = triangle_areas_normals(np.concatenate([m.points for m in meshes]), faces)
-    proj = a * np.abs(n @ d)
+    faces += np.repeat(np.cumsum(sizes) - sizes, counts)[:, None]
+    pts = np.concatenate([m.points for m in meshes]).T                   # (3, V)
+    e1 = np.take(pts, faces[:, 1], axis=1) - (v0 := np.take(pts, faces[:, 0], axis=1))
+    e2 = np.take(pts, faces[:, 2], axis=1) - v0
+    cross = _cross(e1, e2)
+    twice = np.sqrt(np.einsum("ij,ij->j", cross, cross))
+    # |A n . d| = |cross . d| / 2, as A = |cross| / 2 and n = cross / |cross|
+    proj = np.abs(d @ cross)
     starts = np.cumsum(counts) - counts
-    out_a, out_p = np.zeros(len(meshes)), np.zeros(len(meshes))
     some = counts > 0
-    out_a[some] = np.add.reduceat(a, starts[some])
-    out_p[some] = np.add.reduceat(proj, starts[some])
+    out_a[some] = 0.5 * np.add.reduceat(twice, starts[some])
+    out_p[some] = 0.5 * np.add.reduceat(proj, starts[some])
     return out_a, out_p
+
+
+def _cross(e1: np.ndarray, e2: np.ndarray) -> np.ndarray:
+    """Cross products of vectors given one row per coordinate: (3, ...) x (3, ...)."""
+    return np.stack([e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                     e1[0] * e2[1] - e1[1] * e2[0]])
 
 
 def grid_areas(vertices: np.ndarray, rel_tol: float = 1e-9) -> np.ndarray:
@@ -79,7 +89,7 @@ def grid_areas(vertices: np.ndarray, rel_tol: float = 1e-9) -> np.ndarray:
     :func:`~maizeviz.mesh.tessellate.mesh_grid` does: :func:`area` of ``mesh_grid(grid)`` for
     each, its zero-area triangles (a grid edge shorter than ``rel_tol`` times the longest, as
     :func:`~maizeviz.mesh.tessellate.degenerate_faces` finds them) left out."""
-    nl, a, b = vertices.shape[:3]
+    nl = vertices.shape[0]
     h = np.diff(vertices, axis=2)
     h = np.einsum("lijk,lijk->lij", h, h)                               # (L, a, b-1) squared
     w = np.diff(vertices, axis=1)
@@ -88,12 +98,18 @@ def grid_areas(vertices: np.ndarray, rel_tol: float = 1e-9) -> np.ndarray:
                          w.reshape(nl, -1).max(axis=1, initial=0.0))
     tol = (rel_tol**2 * np.maximum(longest, 1e-300))[:, None, None]
     h0, w0 = h <= tol, w <= tol
-    bad = np.empty((nl, a - 1, b - 1, 2), dtype=bool)
-    bad[..., 0] = h0[:, 1:] | w0[:, :, :-1]
-    bad[..., 1] = h0[:, :-1] | w0[:, :, 1:]
-    tri, _ = triangle_areas_normals(vertices.reshape(nl, a * b, 3), grid_faces(a, b))
-    tri[bad.reshape(nl, -1)] = 0.0
-    return tri.sum(axis=1)
+    # the two triangles of each quad: (p00, p10, p11) and (p00, p11, p01), as grid_faces
+    vt = np.moveaxis(vertices, -1, 0)                                    # (3, L, a, b)
+    p00 = vt[:, :, :-1, :-1]
+    diag = vt[:, :, 1:, 1:] - p00
+    total = np.zeros(nl)
+    for t, (edge, bad) in enumerate(((vt[:, :, 1:, :-1] - p00, h0[:, 1:] | w0[:, :, :-1]),
+                                     (vt[:, :, :-1, 1:] - p00, h0[:, :-1] | w0[:, :, 1:]))):
+        cross = _cross(edge, diag) if t == 0 else _cross(diag, edge)
+        twice = np.sqrt(np.einsum("i...,i...->...", cross, cross))       # (L, a-1, b-1)
+        twice[bad] = 0.0
+        total += twice.reshape(nl, -1).sum(axis=1)
+    return 0.5 * total
 
 
 # ------------------------------------------------------------------ point-to-triangle distance
