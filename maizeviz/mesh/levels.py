@@ -10,16 +10,20 @@ from __future__ import annotations
 import re
 from collections import defaultdict
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from maizeviz.errors import MaizevizError
-from maizeviz.leaf.fit import Leaf
-from maizeviz.leaf.nurbs import NurbsSurfaces, refine_parameters
-from maizeviz.mesh import measures
 from maizeviz.mesh.simplify import simplify
 from maizeviz.mesh.tessellate import LeafMesh, mesh_grid
 from maizeviz.progress import ProgressCallback, report
+
+if TYPE_CHECKING:
+    # Level and parse_level are light (the app's slider reads them before its window shows);
+    # the surfaces (scipy) and the measures (trimesh) are imported when a leaf is meshed.
+    from maizeviz.leaf.fit import Leaf
+    from maizeviz.leaf.nurbs import NurbsSurfaces
 
 #: Interpolation count of the paper's reference mesh (four points between data points).
 REFERENCE_K = 4
@@ -109,6 +113,8 @@ def reference_area_cm2(leaf: Leaf) -> float:
     """Area (cm2) of the leaf's reference mesh (K = 4); computed once per leaf, so a
     complexity slider does not pay for it at every rebuild."""
     if "reference_area_cm2" not in leaf.cache:
+        from maizeviz.mesh import measures
+
         pts, u, v = _sample(leaf.surface, REFERENCE_K)
         leaf.cache["reference_area_cm2"] = measures.area(mesh_grid(pts[0], u[0], v[0]))
     return float(leaf.cache["reference_area_cm2"])
@@ -124,6 +130,8 @@ def deviation_samples(leaf: Leaf) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def _sample(surfaces: NurbsSurfaces, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    from maizeviz.leaf.nurbs import refine_parameters
+
     u = refine_parameters(surfaces.params_u, k)
     v = refine_parameters(surfaces.params_v, k)
     return surfaces.evaluate_grid(u, v), u, v
@@ -177,6 +185,8 @@ def mesh_leaf(leaf: Leaf, level: Level, preserve_area: bool = True) -> LeafMesh:
 
 
 def _stack(surfaces: list[NurbsSurfaces]) -> NurbsSurfaces:
+    from maizeviz.leaf.nurbs import NurbsSurfaces
+
     if len(surfaces) == 1:
         return surfaces[0]
     s0 = surfaces[0]
@@ -217,6 +227,8 @@ def measure(leaf: Leaf, mesh: LeafMesh) -> LeafMeasures:
     The reference area is the paper's reference mesh (K = 4); the deviation is measured from
     the surface sampled at K = 8.
     """
+    from maizeviz.mesh import measures
+
     m, n = leaf.grid.shape
     return LeafMeasures(
         plant=leaf.grid.plant, leaf=leaf.grid.leaf, rows=m, cols=n, level=mesh.level,
