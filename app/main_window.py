@@ -34,6 +34,7 @@ from PySide6.QtWidgets import (QApplication, QDockWidget, QFileDialog, QHBoxLayo
 
 from maizeviz import __version__
 from maizeviz.errors import MaizevizError
+from maizeviz.mesh.levels import COMPLEXITY_STOPS as LEVELS  # noqa: F401 - the slider's stops
 from maizeviz.resources import example_points
 from maizeviz_app.messages import user_message
 from maizeviz_app.panels.canopy import CanopyPanel
@@ -52,7 +53,7 @@ PAPER = ("Xinyu Guo, Chunjiang Zhao, Boxiang Xiao, Shenglian Lu, Changfeng Li. <
          "University of Technology. (Chinese version: Xiao B., Guo X., Wang J., Zheng W., "
          "Wang D. <i>Scientia Agricultura Sinica</i> 40(4): 693-697, 2007.)")
 #: Modules the warm-up thread imports while the window is already on screen.
-WARM_MODULES = ("numpy", "superqt.utils", "pyvista", "pyvistaqt", "maizeviz_app.viewport",
+WARM_MODULES = ("numpy", "pyvista", "pyvistaqt", "maizeviz_app.viewport",
                 "maizeviz_app.jobs", "maizeviz.light.leaf_light", "maizeviz.light.heatmap",
                 "matplotlib.figure", "matplotlib.backends.backend_agg", "maizeviz_app.plots",
                 "maizeviz.canopy.export", "maizeviz_app.project")
@@ -102,6 +103,8 @@ class MainWindow(QMainWindow):
                                           # keeps the last one and its Embree scene)
         self._points_bytes = b""
         self._points_origin = ""          # where the points came from (a project's original)
+        self._layout_edited = False       # the layout is not the tiling of the settings
+        self._project_layout = False
         self._heatmaps_for: object = None
 
         placeholder = QLabel("starting the 3D view…", alignment=Qt.AlignCenter)
@@ -387,6 +390,7 @@ class MainWindow(QMainWindow):
         self.plots.set_transmission(None)
         self.canopy_panel.set_file(loaded.shown_name)
         self.project_path = project
+        self._layout_edited = project is not None and self._project_layout
         opened = project or loaded.path
         if loaded.path != str(example_points()) or project:
             self._settings.setValue("last_opened", opened)
@@ -406,6 +410,7 @@ class MainWindow(QMainWindow):
         if self.loaded is None:
             return
         self.loaded = replace(self.loaded, layout=layout)
+        self._layout_edited = True
         self._serial += 1
         if self.runs.runs:
             self.say("note: the layout changed; light results of the previous layout were "
@@ -682,6 +687,7 @@ class MainWindow(QMainWindow):
         from maizeviz_app import project
 
         loaded, data, origin = self.loaded, self._points_bytes, self._points_origin
+        layout = loaded.layout if self._layout_edited else None   # else: the tiling, exactly
         canopy = {"tile": self.canopy_panel.tile_n, "level": self.level,
                   "preserve_area": self.canopy_panel.preserve.isChecked()}
         light = self.light_panel.settings()
@@ -691,7 +697,7 @@ class MainWindow(QMainWindow):
         def work(job):
             from maizeviz.io.project import save_project
 
-            proj = project.make_project(origin, data, loaded.layout, canopy, light, runs)
+            proj = project.make_project(origin, data, layout, canopy, light, runs)
             save_project(path, proj)
             return path
 
@@ -746,6 +752,7 @@ class MainWindow(QMainWindow):
         self.canopy_panel.preserve.setChecked(preserve)
         self.canopy_panel.preserve.blockSignals(False)
         self.light_panel.apply_settings(light)
+        self._project_layout = opened.project.layout is not None
         self._on_loaded(loaded, opened.project.points_csv, opened.path,
                         opened.project.points_path)
         self._pending_runs = list(opened.runs)

@@ -132,6 +132,9 @@ class CoreProcess:
         proc.start()
         child.close()
         self._proc, self._conn, self._key = proc, parent, None
+        if self._closed:                       # closed while the child was starting
+            self._kill()
+            raise InterruptedError("closing")
 
     def _kill(self) -> None:
         proc, conn = self._proc, self._conn

@@ -1,5 +1,11 @@
 """Jobs the window hands to threads (and, through them, to the core processes).
 
+Jobs run on Qt's global thread pool as plain QRunnables started at once, and their results
+come back through the runner's own queued signal. (superqt's ``create_worker`` starts a worker
+from a 1 ms timer when an event loop runs, so a job asked for just before the window closed
+could start after it; and its queued ``returned`` is lost when the worker object is deleted
+first. Both made closing racy: issue 9's "Signal source has been deleted".)
+
 Each job has an id, a kind (``load``, ``build``, ``light``...), a cancel flag and a progress
 channel. A newer job of the same kind supersedes the running one (its result is dropped: the
 window only takes results from the latest job of each kind, as napari's async slicing drops
@@ -22,7 +28,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from PySide6.QtCore import QObject, QThreadPool, Signal
+from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
 
 from maizeviz_app.process import CoreProcess
 
@@ -56,7 +62,7 @@ class Job:
 
 
 class JobRunner(QObject):
-    """Runs jobs on superqt thread workers; see the module docstring.
+    """Runs jobs on the thread pool; see the module docstring.
 
     Signals (GUI thread): ``progressed(job id, kind, label, done, total)``, ``changed()`` when
     the set of running jobs changes.
@@ -65,15 +71,19 @@ class JobRunner(QObject):
     progressed = Signal(int, str, str, int, int)
     changed = Signal()
     _progress_signal = Signal(int, int, int)
+    _delivered = Signal(int, object, object)
 
     def __init__(self, parent=None):
         super().__init__(parent)
         self._ids = itertools.count(1)
         self._current: dict[str, Job] = {}
-        self._workers: set = set()
+        self._handlers: dict[int, tuple] = {}
+        self._tasks: dict[int, QRunnable] = {}
         self._closed = False
-        self._lock = threading.Lock()
         self._progress_signal.connect(self._on_progress)
+        # results come back through the runner's own signal (queued to the GUI thread), so a
+        # result that arrives after shutdown is seen, and dropped, here
+        self._delivered.connect(self._on_delivered)
         #: The core processes: Embree work off the GIL (see maizeviz_app.process).
         self.cover_process = CoreProcess("cover")
         self.light_process = CoreProcess("light")
@@ -95,61 +105,62 @@ class JobRunner(QObject):
             on_error: Callable[[BaseException], None] | None = None,
             supersede: bool = True) -> Job | None:
         """Run ``func(job, *args)`` on a worker thread; ``on_done(result)`` on the GUI thread
-        if it is still the latest ``kind`` job when it returns. A result of None means the job
-        stopped (cancelled) and calls nothing. Returns the job, or None after shutdown."""
+        if it is still the latest ``kind`` job when it returns (an InterruptedError from
+        ``func`` means it stopped: nothing is called). Returns the job, or None after
+        shutdown."""
         if self._closed:
             return None
-        from superqt.utils import create_worker
-
         old = self._current.get(kind)
         if old is not None and supersede:
             old.cancel.set()
         job = Job(next(self._ids), kind, label, self)
         self._current[kind] = job
+        self._handlers[job.id] = (kind, on_done, on_error)
+        delivered = self._delivered
 
-        def guarded(j: Job, *a: Any) -> Any:
+        def guarded() -> None:
             try:
-                return func(j, *a)
+                result, exc = func(job, *args), None
             except InterruptedError:                  # superseded, cancelled or closing
-                return None
-
-        worker = create_worker(guarded, job, *args, _start_thread=False, _ignore_errors=True)
-
-        def done(result: Any) -> None:
-            if self._closed or self._current.get(kind) is not job or job.cancelled:
-                return
-            if result is None:
-                return
+                result, exc = None, InterruptedError()
+            except Exception as e:  # noqa: BLE001 - handed to the GUI thread
+                result, exc = None, e
             try:
-                on_done(result)
-            except Exception as exc:  # noqa: BLE001 - a slot must not let an exception escape
-                describe_internal(exc)
-                if on_error is not None:
-                    on_error(exc)
+                delivered.emit(job.id, result, exc)
+            except RuntimeError:                      # the runner is gone
+                pass
 
-        def error(exc: BaseException) -> None:
-            if self._closed or self._current.get(kind) is not job or job.cancelled:
-                return
-            if on_error is not None:
-                try:
-                    on_error(exc)
-                except Exception as exc2:  # noqa: BLE001 - a slot must not raise
-                    describe_internal(exc2)
-
-        def finished() -> None:
-            self._workers.discard(worker)
-            if self._current.get(kind) is job:
-                del self._current[kind]
-            if not self._closed:
-                self.changed.emit()
-
-        worker.returned.connect(done)
-        worker.errored.connect(error)
-        worker.finished.connect(finished)
-        self._workers.add(worker)
-        worker.start()
+        task = _Task(guarded)
+        self._tasks[job.id] = task
+        QThreadPool.globalInstance().start(task)
         self.changed.emit()
         return job
+
+    def _on_delivered(self, job_id: int, result: Any, exc: BaseException | None) -> None:
+        self._tasks.pop(job_id, None)
+        kind, on_done, on_error = self._handlers.pop(job_id, (None, None, None))
+        job = self._current.get(kind) if kind is not None else None
+        if job is not None and job.id == job_id:
+            del self._current[kind]
+            if not self._closed:
+                self.changed.emit()
+        else:
+            job = None                                # superseded by a newer job
+        if self._closed or job is None or job.cancelled or isinstance(exc, InterruptedError):
+            return
+        try:
+            if exc is None:
+                if on_done is not None:
+                    on_done(result)
+            elif on_error is not None:
+                on_error(exc)
+        except Exception as exc2:  # noqa: BLE001 - a slot must not let an exception escape
+            describe_internal(exc2)
+            if exc is None and on_error is not None:
+                try:
+                    on_error(exc2)
+                except Exception as exc3:  # noqa: BLE001
+                    describe_internal(exc3)
 
     def cancel(self, kind: str | None = None) -> None:
         """Cancel the running job of ``kind`` (all jobs when None); returns at once."""
@@ -179,20 +190,28 @@ class JobRunner(QObject):
         """Stop everything: no more results or progress, cancel every job, kill the core
         processes, wait (up to ``timeout_s``) for the threads. True if all stopped."""
         self._closed = True
+        self._handlers.clear()
         for job in self._current.values():
             job.cancel.set()
         self.cover_process.close()
         self.light_process.close()
-        for worker in list(self._workers):
-            try:
-                worker.quit()
-            except RuntimeError:
-                pass
         ok = QThreadPool.globalInstance().waitForDone(int(timeout_s * 1000))
         if not ok:
             print("maizeviz: some work was still running when the window closed",
                   file=sys.stderr)
         return ok
+
+
+class _Task(QRunnable):
+    """A function on the thread pool (kept alive by the runner until its result is back)."""
+
+    def __init__(self, fn: Callable[[], None]):
+        super().__init__()
+        self.setAutoDelete(False)
+        self._fn = fn
+
+    def run(self) -> None:
+        self._fn()
 
 
 def describe_internal(exc: BaseException) -> None:

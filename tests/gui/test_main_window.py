@@ -13,14 +13,20 @@ def test_opens_example_and_slider_rebuilds(window, qtbot):
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT) as first:
         pass
     assert first.args == ["36 triangles"]
-    assert "canopy" in w.viewport.actors and "stalks" in w.viewport.actors
+    assert "canopy" in w.viewport.actors
+    assert np.any(w.viewport.canopy_mesh.cell_data["light"] == -2)      # stalks, same mesh
     n36 = w.canopy.n_triangles
     assert w.table.rowCount() == 1 and w.table.item(0, 0).text() == "36 triangles"
     lai = float(w.table.item(0, 5).text())
     assert 4.5 < lai < 5.8
+    shown = "at most 36 triangles" in w.level_label.text()
+    w.slider.setValue(LEVELS.index("4"))
+    qtbot.wait(300)                      # debounced: the build has started, not finished
+    assert shown and "at most 36 triangles" in w.level_label.text()
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT,
                           check_params_cb=lambda lv: lv == "4 triangles"):
-        w.slider.setValue(LEVELS.index("4"))
+        pass
+    # label, table and view changed together
     assert w.canopy.n_triangles < n36
     assert w.table.rowCount() == 2
     assert "at most 4 triangles" in w.level_label.text()
@@ -49,38 +55,67 @@ def test_fast_slider_moves_show_only_the_last_level(window, qtbot):
     assert shown == ["4 triangles", "8 triangles"]
 
 
-def test_compute_light(window, qtbot):
+def test_compute_light_colours_the_leaves(window, qtbot):
     w = window()
     qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait()
-    w.density.setValue(1.0)
+    panel = w.light_panel
+    panel.density.setValue(1.0)
     with qtbot.waitSignal(w.light_shown, timeout=TIMEOUT):
-        w.light_button.click()
-    t = [float(w.light_table.item(i, 1).text()) for i in range(w.light_table.rowCount())]
+        panel.compute_button.click()
+    t = [float(panel.table.item(i, 1).text()) for i in range(panel.table.rowCount())]
     assert len(t) == 6 and all(0 <= v <= 1 for v in t)
     assert np.all(np.diff(t) >= 0) and 0.02 < t[0] < 0.15
-    assert not w.heatmap.pixmap().isNull()
-    assert w.light_button.isEnabled()
+    assert panel.compute_button.isEnabled() and not panel.cancel_button.isEnabled()
+    # the leaves are coloured by the light they received, with a legend
+    assert w.viewport.colouring == "light"
+    assert w.viewport.actors["canopy"].mapper.GetArrayName() == "light"
+    light = w.viewport.canopy_mesh.cell_data["light"][:w.canopy.n_triangles]
+    assert set(np.unique(light)) == {0, 1, 2}
+    assert w.actions["colour_light"].isChecked()
+    # a heatmap per height and the transmission plot
+    assert w.plots.height.count() == 6 and w.plots.heatmap.image() is not None
+    assert w.plots.transmission.image() is not None
+    w.plots.height.setCurrentIndex(3)
+    assert w.plots.shown_height == 150.0
 
 
 def test_sun_from_place_and_bad_place(window, qtbot):
     w = window()
-    w.place.setText("2005-08-01 12:00 39.9 116.4 Asia/Shanghai")
-    w._sun_from_place()
-    assert w.zenith.value() == pytest.approx(22.34, abs=0.02)
-    w.place.setText("yesterday noon somewhere")
-    w._sun_from_place()
+    panel = w.light_panel
+    panel.place.setText("2005-08-01 12:00 39.9 116.4 Asia/Shanghai")
+    panel.zenith.setValue(10)
+    w.sun_from_place()
+    qtbot.waitUntil(lambda: abs(panel.zenith.value() - 22.34) < 0.02, timeout=TIMEOUT)
+    panel.place.setText("yesterday noon somewhere")
+    with qtbot.waitSignal(w.failed, timeout=TIMEOUT) as err:
+        w.sun_from_place()
+    assert "YYYY-MM-DD" in err.args[0]
     assert "error" in w.messages.toPlainText()
+    assert "d0342c" in panel.place.styleSheet()            # the field is marked
 
 
-def test_bad_points_file_says_so(window, qtbot, tmp_path):
+def test_bad_points_file_says_so_and_keeps_the_canopy(window, qtbot, tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("this,is,not\n1,2,3\n")
     w = window(bad)
     with qtbot.waitSignal(w.failed, timeout=TIMEOUT) as err:
         pass
-    assert "missing column" in err.args[0]
+    assert "missing column" in err.args[0] and "Choose a points CSV" in err.args[0]
+    assert "Error" not in err.args[0] and "maizeviz.errors" not in err.args[0]
     assert "error" in w.messages.toPlainText()
     assert w.canopy is None
+    # a good file, then a bad one: the good one stays, named in the label
+    from maizeviz.resources import example_points
+    with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
+        w.open_points(example_points())
+    canopy, label = w.canopy, w.canopy_panel.file_label.text()
+    assert label.endswith("block3x3.csv")
+    notnum = tmp_path / "notnum.csv"
+    notnum.write_text("plant,leaf,row,col,x,y,z\nA,1,0,0,x,y,z\n")
+    with qtbot.waitSignal(w.failed, timeout=TIMEOUT) as err:
+        w.open_points(notnum)
+    assert "could not convert" not in err.args[0]
+    assert w.canopy is canopy and w.canopy_panel.file_label.text() == label
 
 
 def test_digitizer_demo_records_through_the_simulator(window, qtbot, tmp_path):
