@@ -29,7 +29,7 @@ from pathlib import Path
 
 from PySide6.QtCore import QSettings, Qt, QTimer, Signal
 from PySide6.QtWidgets import (QApplication, QDockWidget, QFileDialog, QHBoxLayout, QLabel,
-                               QMainWindow, QMessageBox, QPlainTextEdit, QProgressBar,
+                               QMainWindow, QMessageBox, QPlainTextEdit,
                                QPushButton, QScrollArea, QStackedWidget, QWidget)
 
 from maizeviz import __version__
@@ -52,11 +52,14 @@ PAPER = ("Xinyu Guo, Chunjiang Zhao, Boxiang Xiao, Shenglian Lu, Changfeng Li. <
          "Research Center for Information Technology in Agriculture, Beijing; Dalian "
          "University of Technology. (Chinese version: Xiao B., Guo X., Wang J., Zheng W., "
          "Wang D. <i>Scientia Agricultura Sinica</i> 40(4): 693-697, 2007.)")
-#: Modules the warm-up thread imports while the window is already on screen.
-WARM_MODULES = ("numpy", "pyvista", "pyvistaqt", "maizeviz_app.viewport",
-                "maizeviz_app.jobs", "maizeviz.light.leaf_light", "maizeviz.light.heatmap",
-                "matplotlib.figure", "matplotlib.backends.backend_agg", "maizeviz_app.plots",
-                "maizeviz.canopy.export", "maizeviz_app.project")
+#: Modules the warm-up thread imports while the window is already on screen, in three stages:
+#: the core (then the points file opens), the 3D view (then the view is made), the rest.
+WARM_STAGES = (
+    ("core", ("maizeviz_app.jobs", "maizeviz.light.leaf_light")),
+    ("view", ("pyvista", "pyvistaqt", "maizeviz_app.viewport", "maizeviz_app.layout_panel",
+              "maizeviz_app.digitizer_panel")),
+    ("rest", ("matplotlib.figure", "matplotlib.backends.backend_agg", "maizeviz_app.plots",
+              "maizeviz.light.heatmap", "maizeviz.canopy.export", "maizeviz_app.project")))
 
 
 def _scrolled(widget: QWidget) -> QScrollArea:
@@ -78,9 +81,9 @@ class MainWindow(QMainWindow):
     canopy_shown = Signal(str)          # level label, when a new canopy is on screen
     light_shown = Signal()              # a light result is in the table, figures and view
     failed = Signal(str)                # an error the user was told about
-    ready = Signal()                    # the 3D view exists (heavy imports done)
+    ready = Signal()                    # the 3D view and every panel exist
     saved = Signal(str)                 # a project or export written (its path)
-    _warmed = Signal(object)            # from the warm-up thread: None or the import error
+    _warmed = Signal(str, object)       # from the warm-up thread: stage, None or the error
 
     def __init__(self, points: str | Path | None = None, tile: int = 3):
         super().__init__()
@@ -99,6 +102,7 @@ class MainWindow(QMainWindow):
         self.project_path: str | None = None
         self._serial = 0                  # changes whenever the points or layout change
         self._pending_runs: list = []     # light results of a project, waiting for a canopy
+        self._progress_shown = 0.0
         self._canopy_id = 0               # identifies the canopy shown (the light process
                                           # keeps the last one and its Embree scene)
         self._points_bytes = b""
@@ -121,6 +125,7 @@ class MainWindow(QMainWindow):
         self._default_state = None             # taken at the first show, docks sized
         self._state_restored = self._restore_window()
         self._to_open = str(points) if points is not None else self._last_opened()
+        self._view_ready = threading.Event()  # the build job waits for it before meshing
         self._warmed.connect(self._on_warmed)
         QTimer.singleShot(0, self._warm_up)
 
@@ -136,9 +141,6 @@ class MainWindow(QMainWindow):
         return dock
 
     def _build_panels(self, tile: int) -> None:
-        from maizeviz_app.digitizer_panel import DigitizerPanel
-        from maizeviz_app.layout_panel import LayoutPanel
-
         self.setCorner(Qt.BottomRightCorner, Qt.RightDockWidgetArea)
         self.setCorner(Qt.TopRightCorner, Qt.RightDockWidgetArea)
         self.setDockOptions(QMainWindow.AnimatedDocks | QMainWindow.AllowTabbedDocks)
@@ -152,20 +154,20 @@ class MainWindow(QMainWindow):
         self.light_panel.cancel_requested.connect(lambda: self.cancel_jobs("light"))
         self.light_panel.place_requested.connect(lambda _t: self.sun_from_place())
         self.light_panel.export_requested.connect(self.choose_export)
-        self.layout_panel = LayoutPanel()
-        self.layout_panel.applied.connect(self._on_layout)
-        self.layout_panel.problem.connect(self.say)
-        self.digitizer = DigitizerPanel(None)
-        self.digitizer.stopped.connect(self._on_digitizing_stopped)
+        # the layout editor and the digitizer import much of the core: they are made once the
+        # window is on screen (see _make_late_panels)
+        self.layout_panel = None
+        self.digitizer = None
         self.plots = LightPlots()
+        self.plots.heatmap_needed.connect(self._draw_heatmap)
         self.messages = QPlainTextEdit(readOnly=True)
         self.messages.setMaximumBlockCount(1000)
 
         right = Qt.RightDockWidgetArea
         canopy = self._dock("canopy", "Canopy", self.canopy_panel, right)
         light = self._dock("light", "Light", self.light_panel, right)
-        layout = self._dock("layout", "Layout", self.layout_panel, right)
-        digitizer = self._dock("digitizer", "Digitizer", self.digitizer, right)
+        layout = self._dock("layout", "Layout", QLabel("starting…"), right)
+        digitizer = self._dock("digitizer", "Digitizer", QLabel("starting…"), right)
         for d in (light, layout, digitizer):
             self.tabifyDockWidget(canopy, d)
         canopy.raise_()
@@ -177,21 +179,23 @@ class MainWindow(QMainWindow):
         results.raise_()
 
     def _build_status(self) -> None:
+        """What is running, how far, and Cancel: always in place (showing or hiding widgets
+        relayouts the window), updated as text (a QProgressBar repaints synchronously, and
+        every repaint recomposes the whole window with the 3D view: 50-100 ms on software
+        OpenGL)."""
         box = QWidget()
         lay = QHBoxLayout(box)
         lay.setContentsMargins(0, 0, 0, 0)
         self.job_label = QLabel("")
-        self.progress = QProgressBar()
-        self.progress.setMaximumWidth(200)
-        self.progress.setTextVisible(False)
+        self.job_label.setFixedWidth(300)
+        self.job_label.setAlignment(Qt.AlignRight | Qt.AlignVCenter)
         self.cancel_button = QPushButton("Cancel")
         self.cancel_button.setToolTip("stop the work under way (Esc)")
         self.cancel_button.clicked.connect(lambda: self.cancel_jobs())
-        for w in (self.job_label, self.progress, self.cancel_button):
-            lay.addWidget(w)
+        self.cancel_button.setEnabled(False)
+        lay.addWidget(self.job_label)
+        lay.addWidget(self.cancel_button)
         self.statusBar().addPermanentWidget(box)
-        self._status_box = box
-        box.setVisible(False)
 
     def _restore_window(self) -> None:
         geometry = self._settings.value("geometry")
@@ -248,47 +252,75 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ start-up
     def _warm_up(self) -> None:
-        """Import the heavy modules off the GUI thread, then make the 3D view."""
+        """Import the heavy modules off the GUI thread, stage by stage (see WARM_STAGES)."""
         if self._closing:
             return
-        self.say("starting: loading the 3D view and the core…", status_only=True)
+        self.say("starting: loading the core and the 3D view…", status_only=True)
+        warmed, view_ready = self._warmed, self._view_ready
 
         def work():
             import importlib
 
-            error = None
-            try:
-                for name in WARM_MODULES:
-                    importlib.import_module(name)
-            except Exception as exc:  # noqa: BLE001 - reported in the window
-                error = exc
-            try:
-                self._warmed.emit(error)
-            except RuntimeError:            # the window is gone
-                pass
+            for stage, names in WARM_STAGES:
+                error = None
+                try:
+                    for name in names:
+                        importlib.import_module(name)
+                except Exception as exc:  # noqa: BLE001 - reported in the window
+                    error = exc
+                try:
+                    warmed.emit(stage, error)
+                except RuntimeError:            # the window is gone
+                    return
+                if stage == "view":
+                    view_ready.set()
+                if error is not None:
+                    return
 
         threading.Thread(target=work, name="maizeviz-warm-up", daemon=True).start()
 
-    def _on_warmed(self, error) -> None:
+    def _on_warmed(self, stage: str, error) -> None:
         if self._closing:
             return
         if error is not None:
             describe_internal(error)
-            self.say(f"error: the 3D view cannot start ({error}); reinstall maizeviz with "
-                     "its gui extra: pip install \"maizeviz[gui]\"", error=True)
+            self.say(f"error: the app cannot start ({error}); reinstall maizeviz with its gui "
+                     "extra: pip install \"maizeviz[gui]\"", error=True)
             return
-        from maizeviz_app.viewport import Viewport
+        if stage == "core":
+            threading.Thread(target=self._start_processes, name="maizeviz-processes",
+                             daemon=True).start()
+            if self._to_open:
+                self.open_any(self._to_open)
+        elif stage == "view":
+            from maizeviz_app.viewport import Viewport
 
-        self.viewport = Viewport(self)
-        # the central widget stays (a new one would make the docks take its room)
-        self._centre.addWidget(self.viewport)
-        self._centre.setCurrentWidget(self.viewport)
+            self.viewport = Viewport(self)
+            # the central widget stays (a new one would make the docks take its room)
+            self._centre.addWidget(self.viewport)
+            self._centre.setCurrentWidget(self.viewport)
+            self._make_late_panels()
+            self.ready.emit()
+        else:
+            import gc
+
+            gc.freeze()       # start-up objects out of the collector's way: shorter pauses
+
+    def _make_late_panels(self) -> None:
+        from maizeviz_app.digitizer_panel import DigitizerPanel
+        from maizeviz_app.layout_panel import LayoutPanel
+
+        self.layout_panel = LayoutPanel()
+        self.layout_panel.applied.connect(self._on_layout)
+        self.layout_panel.problem.connect(self.say)
+        self.digitizer = DigitizerPanel(None)
+        # when a session stops the panel may call self.viewport.restore_canopy() (issue 9,
+        # item 5, is the digitizer's); the window does not take the plant away by itself
+        self.docks["layout"].setWidget(_scrolled(self.layout_panel))
+        self.docks["digitizer"].setWidget(_scrolled(self.digitizer))
         self.digitizer.viewport = self.viewport
-        threading.Thread(target=self._start_processes, name="maizeviz-processes",
-                         daemon=True).start()
-        self.ready.emit()
-        if self._to_open:
-            self.open_any(self._to_open)
+        if self.loaded is not None:
+            self.layout_panel.show_layout(self.loaded.layout, self.loaded.plants)
 
     def _start_processes(self) -> None:
         for proc in (self.runner.cover_process, self.runner.light_process):
@@ -403,7 +435,8 @@ class MainWindow(QMainWindow):
             self.say(f"skipped: {e}")
         self.say(f"{len(loaded.leaves)} leaves of {len(loaded.plants)} plants; "
                  f"{len(loaded.layout.placements)} plants in the canopy")
-        self.layout_panel.show_layout(loaded.layout, loaded.plants)
+        if self.layout_panel is not None:
+            self.layout_panel.show_layout(loaded.layout, loaded.plants)
         self.rebuild()
 
     def _on_layout(self, layout) -> None:
@@ -455,10 +488,10 @@ class MainWindow(QMainWindow):
         serial = self._serial
         key = object()
         runner = self.runner
+        view_ready = self._view_ready
 
         def work(job):
             from maizeviz.canopy.measures import TABLE2_COLUMNS, table2_row
-            from maizeviz_app.viewport import canopy_polydata
 
             canopy, build_s, label = jobs.build(loaded, level, preserve, job.report)
             job.check()
@@ -466,6 +499,10 @@ class MainWindow(QMainWindow):
             m = runner.cover_process.call("measure", key, canopy,
                                           (jobs.APP_COVER_RESOLUTION_CM,), job)
             measure_s = time.perf_counter() - t0
+            while not view_ready.wait(0.05):        # pyvista still loading at start-up
+                job.check()
+            from maizeviz_app.viewport import canopy_polydata
+
             mesh = canopy_polydata(canopy)
             row = table2_row(m, build_s, label)
             return jobs.Built(level, label, canopy, m, build_s, measure_s,
@@ -525,6 +562,7 @@ class MainWindow(QMainWindow):
         prior = self.runs.curves() if self.runs.settings == settings_key else []
         key = self._canopy_id
         runner = self.runner
+        shown_height = max(self.plots.height.currentIndex(), 0)
 
         def work(job):
             from maizeviz.light.leaf_light import triangle_light
@@ -533,7 +571,7 @@ class MainWindow(QMainWindow):
             result = runner.light_process.call("light", key, canopy, (request,), job)
             job.check()
             classes = triangle_light(canopy, result)
-            maps = plots.heatmap_images(result, check=job.check)
+            maps = plots.heatmap_images(result, first=shown_height, check=job.check)
             curves = [c for c in prior if c.label != label]
             curves.append(plots.Curve(label, tuple(map(float, result.heights_cm)),
                                       tuple(map(float, result.transmission))))
@@ -566,9 +604,9 @@ class MainWindow(QMainWindow):
             info += f"; leaves take {share:.1%} of the direct light"
         info += "".join(f"\n⚠ {w}" for w in r.warnings)
         self.light_panel.show_runs(self.runs, info)
+        self._heatmaps_for = run
         self.plots.set_heatmaps(maps)
         self.plots.set_transmission(plot)
-        self._heatmaps_for = run
         for w in r.warnings:
             self.say(f"warning: {w}")
         if self.viewport is not None and self.built is not None and \
@@ -580,6 +618,24 @@ class MainWindow(QMainWindow):
                  + ", ".join(f"{t:.3f}" for t in r.transmission) + " at "
                  + ", ".join(f"{h:g}" for h in r.heights_cm) + " cm", status_only=True)
         self.light_shown.emit()
+
+    def _draw_heatmap(self, index: int) -> None:
+        """The heatmap of another height of the result shown, drawn in a worker."""
+        run = self._heatmaps_for
+        if run is None:
+            return
+        from maizeviz_app import plots
+
+        result = run.result
+        height = float(result.heights_cm[index])
+
+        def done(rgba):
+            if self._heatmaps_for is run:
+                self.plots.set_heatmap(index, rgba)
+
+        self.runner.run("heatmap", f"drawing the heatmap at {height:g} cm",
+                        lambda job: plots.heatmap_image(result, height), on_done=done,
+                        on_error=lambda e: self._fail(e, "light"))
 
     def sun_from_place(self) -> None:
         """Sun angles from the date, time and place typed (pvlib, in a worker)."""
@@ -630,10 +686,6 @@ class MainWindow(QMainWindow):
             if act is not None:
                 act.setChecked(self.viewport.colouring == name)
 
-    def _on_digitizing_stopped(self, _why: str) -> None:
-        if self.viewport is not None and self.canopy is not None:
-            self.viewport.restore_canopy()
-
     # ------------------------------------------------------------------ jobs
     def cancel_jobs(self, kind: str | None = None) -> None:
         """Stop the light computation and rebuilds under way (Esc)."""
@@ -648,19 +700,23 @@ class MainWindow(QMainWindow):
         self.say("cancelled: " + ", ".join(j.label for j in running))
 
     def _on_progress(self, _job_id: int, _kind: str, label: str, done: int, total: int) -> None:
-        self.job_label.setText(label)
-        self.progress.setMaximum(max(total, 1))
-        self.progress.setValue(min(done, max(total, 1)))
+        # each repaint recomposes the window (see _build_status): twice a second at most
+        now = time.perf_counter()
+        if now - self._progress_shown < 0.5:
+            return
+        self._progress_shown = now
+        self.job_label.setText(f"{label}… {100 * done // max(total, 1)}%")
 
     def _on_jobs_changed(self) -> None:
         if self._closing:
             return
         running = [j for j in self.runner.running() if j.kind in ("load", "build", "light",
                                                                    "open", "save", "export")]
-        self._status_box.setVisible(bool(running))
-        if running:
-            self.job_label.setText(", ".join(j.label for j in running))
-            self.progress.setMaximum(0)              # busy until a job reports progress
+        text = ", ".join(j.label for j in running) + ("…" if running else "")
+        if self.job_label.text() != text:
+            self.job_label.setText(text)
+        if self.cancel_button.isEnabled() != bool(running):
+            self.cancel_button.setEnabled(bool(running))
         if not any(j.kind == "light" for j in running):
             self.light_panel.set_running(False)
 
@@ -782,6 +838,7 @@ class MainWindow(QMainWindow):
             return
         curves = self.runs.curves()
         result = last.result
+        self._heatmaps_for = last
 
         def work(job):
             maps = plots.heatmap_images(result, check=job.check)
@@ -929,7 +986,8 @@ class MainWindow(QMainWindow):
         window's geometry and docks, close the 3D view explicitly."""
         self._closing = True
         try:
-            self.digitizer.stop("window closed")
+            if self.digitizer is not None:
+                self.digitizer.stop("window closed")
         except Exception as exc:  # noqa: BLE001 - closing must go on
             print(f"maizeviz: the digitizer did not stop cleanly: {exc}", file=sys.stderr)
         self.runner.shutdown(10.0)

@@ -47,7 +47,7 @@ def transmission_figure(curves: Sequence[Curve], title: str = "", width_in: floa
                 ha="center", va="center", transform=ax.transAxes, fontsize=9, color="0.4")
     ax.set_title(title or "transmission by height, per mesh level (the paper's Table 3)",
                  fontsize=9)
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.12, right=0.97, bottom=0.14, top=0.9)   # tight_layout: 2 draws
     return fig
 
 
@@ -60,16 +60,26 @@ def rgba(fig) -> np.ndarray:
     return np.asarray(canvas.buffer_rgba()).copy()
 
 
-def heatmap_images(result, bin_cm: float = 5.0, width_in: float = 8.0,
-                   dpi: int = 64, check=None) -> list[tuple[float, np.ndarray]]:
-    """The core's heatmap of every height of a light result, drawn: [(height, RGBA)].
-    ``check()`` is called between heights (it may raise InterruptedError)."""
+def heatmap_image(result, height: float, bin_cm: float = 5.0, width_in: float = 8.0,
+                  dpi: int = 64) -> np.ndarray:
+    """The core's heatmap of one height of a light result, drawn (RGBA)."""
     from maizeviz.light.heatmap import heatmap_figure, transmission_map
 
-    out = []
-    for h in result.heights_cm:
+    tmap = transmission_map(result, float(height), bin_cm)
+    return rgba(heatmap_figure(tmap, result, width_in=width_in, dpi=dpi))
+
+
+def heatmap_images(result, first: int = 0, all_heights: bool = False,
+                   check=None) -> list[tuple[float, np.ndarray | None]]:
+    """[(height, RGBA or None)] for every height of a light result: the ``first`` one drawn
+    (each figure takes 0.3-1 s), the others too with ``all_heights``, else drawn when asked
+    for. ``check()`` is called between figures (it may raise InterruptedError)."""
+    heights = [float(h) for h in result.heights_cm]
+    first = first if 0 <= first < len(heights) else 0
+    out: list[tuple[float, np.ndarray | None]] = []
+    for k, h in enumerate(heights):
         if check is not None:
             check()
-        tmap = transmission_map(result, float(h), bin_cm)
-        out.append((float(h), rgba(heatmap_figure(tmap, result, width_in=width_in, dpi=dpi))))
+        drawn = k == first or all_heights
+        out.append((h, heatmap_image(result, h) if drawn else None))
     return out

@@ -22,7 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 import pyvista as pv
-from PySide6.QtCore import Signal
+from PySide6.QtCore import QPointF, QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QFont, QImage, QLinearGradient, QPainter, QPen
+from PySide6.QtWidgets import QWidget
 from pyvistaqt import QtInteractor
 
 from maizeviz_app.options import CAMERAS, COLOURINGS, LIGHT_CLASSES, NOT_TRACED, STALK
@@ -80,11 +82,15 @@ class Viewport(QtInteractor):
         self.render_count = 0
         self.ren_win.AddObserver("EndEvent", self._on_frame)
         self.set_background("white", top="lightskyblue")
-        self.add_axes(line_width=2, labels_off=False)
+        # no orientation triad, no VTK scalar bar, no 3D text: each is a render pass or text
+        # layout at every frame (60-80 ms each on llvmpipe); the ground carries the axes and
+        # cm labels in its texture and the legend is a Qt widget drawn once per colouring
+        self.key = Legend(self)
+        self.key.move(10, 10)
+        self.key.hide()
         self.canopy_mesh: pv.PolyData | None = None
         self.colouring = "leaf"
         self._canopy_actor = None
-        self._scalar_bar = None
         self._ground_bounds = None
         self._framed = False
         self._digitizing_frame = None
@@ -169,22 +175,26 @@ class Viewport(QtInteractor):
         what = self.colouring
         cells = self.canopy_mesh.cell_data
         if what == "light":
+            shown = {k: v for k, v in LIGHT_CLASSES.items() if k != NOT_TRACED}
             lut = _categorical(LIGHT_CLASSES)
             lo, hi = min(LIGHT_CLASSES), max(LIGHT_CLASSES)
-            title = "light (paper's hit classes)"
+            self.key.set_categories("light received (the paper's classes)",
+                                       [shown[k] for k in sorted(shown, reverse=True)])
         elif what == "plant":
             ids = np.unique(cells["plant"])
-            lut = _categorical({int(p): (f"plant {p}", _PLANT_COLOURS[k % len(_PLANT_COLOURS)])
-                                for k, p in enumerate(ids)})
+            cats = {int(p): (f"plant {p}", _PLANT_COLOURS[k % len(_PLANT_COLOURS)])
+                    for k, p in enumerate(ids)}
+            lut = _categorical(cats)
             lo, hi = float(ids.min()), float(ids.max())
-            title = "digitized plant"
+            self.key.set_categories("digitized plant", list(cats.values()))
         else:
             hi = float(max(cells["leaf"].max(), 1))
             lut = pv.LookupTable(cmap="summer", n_values=max(int(hi), 2))
             lut.SetBelowRangeColor(*pv.Color(LIGHT_CLASSES[STALK][1]).float_rgb, 1.0)
             lut.UseBelowRangeColorOn()
             lo = 1.0
-            title = "leaf rank"
+            self.key.set_gradient("leaf rank (from the base)", np.asarray(lut.values),
+                                     int(lo), int(hi), LIGHT_CLASSES[STALK])
         lut.SetTableRange(lo, hi)
         mapper.SetLookupTable(lut)
         mapper.SetScalarModeToUseCellFieldData()
@@ -192,86 +202,25 @@ class Viewport(QtInteractor):
         mapper.SetScalarRange(lo, hi)
         mapper.SetUseLookupTableScalarRange(True)
         mapper.ScalarVisibilityOn()
-        self._set_scalar_bar(lut, title, categorical=what != "leaf")
-
-    def _set_scalar_bar(self, lut, title: str, categorical: bool) -> None:
-        from vtkmodules.vtkRenderingAnnotation import vtkScalarBarActor
-
-        bar = self._scalar_bar
-        if bar is None:
-            bar = vtkScalarBarActor()
-            bar.SetOrientationToVertical()
-            bar.SetPosition(0.015, 0.3)
-            bar.SetWidth(0.09)
-            bar.SetHeight(0.62)
-            bar.SetMaximumWidthInPixels(140)
-            bar.SetBarRatio(0.22)
-            bar.SetUnconstrainedFontSize(True)
-            for prop in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty(),
-                         bar.GetAnnotationTextProperty()):
-                prop.SetColor(0.1, 0.1, 0.1)
-                prop.SetFontSize(11)
-                prop.ShadowOff()
-                prop.ItalicOff()
-                prop.BoldOff()
-            self.renderer.AddViewProp(bar)
-            self._scalar_bar = bar
-        bar.SetLookupTable(lut)
-        bar.SetTitle(title)
-        # annotations (categories) sit opposite the tick labels: both on the right
-        if categorical:
-            bar.SetTextPositionToPrecedeScalarBar()
-        else:
-            bar.SetTextPositionToSucceedScalarBar()
-        bar.SetDrawAnnotations(categorical)
-        bar.SetNumberOfLabels(0 if categorical else 5)
-        bar.SetLabelFormat("%.0f")
-        bar.SetVisibility(True)
+        self.key.show()
 
     # ------------------------------------------------------------------ ground
     def _set_ground(self, layout) -> None:
+        """The ground: the field with its plant cells as a grid, and the x and y axes with
+        cm labels in a margin around it, all one textured rectangle (one cheap draw)."""
         bounds = tuple(round(v, 6) for v in layout.bounds) + (layout.row_spacing,
                                                               layout.plant_spacing)
         if bounds == self._ground_bounds:
             return
         self._ground_bounds = bounds
         x0, y0, x1, y1, rs, ps = bounds
-        ground = pv.Plane(center=((x0 + x1) / 2, (y0 + y1) / 2, -0.05), i_size=x1 - x0,
-                          j_size=y1 - y0)
-        self.add_mesh(ground, name="ground", color="#d8c9a3", render=False, pickable=False)
-        xs = _ticks(x0, x1, rs)
-        ys = _ticks(y0, y1, ps)
-        segs = [((x, y0, 0.0), (x, y1, 0.0)) for x in xs] + \
-               [((x0, y, 0.0), (x1, y, 0.0)) for y in ys]
-        pts = np.array(segs, np.float32).reshape(-1, 3)
-        lines = np.column_stack([np.full(len(segs), 2), np.arange(0, 2 * len(segs), 2),
-                                 np.arange(1, 2 * len(segs), 2)]).ravel()
-        self.add_mesh(pv.PolyData(pts, lines=lines), name="grid", color="#8a7a55",
-                      line_width=1, render=False, pickable=False)
-        self._set_labels(x0, y0, x1, y1, xs, ys)
-
-    def _set_labels(self, x0, y0, x1, y1, xs, ys) -> None:
-        from vtkmodules.vtkRenderingCore import vtkBillboardTextActor3D
-
-        for name in [n for n in self.actors if str(n).startswith("label")]:
-            self.remove_actor(name, render=False)
-        step_x = max(1, int(np.ceil(len(xs) / 8)))
-        step_y = max(1, int(np.ceil(len(ys) / 8)))
-        off = 0.04 * max(x1 - x0, y1 - y0)
-        items = [(f"{x:.0f}", (x, y0 - off, 0.0)) for x in xs[::step_x]]
-        items += [(f"{y:.0f}", (x0 - off, y, 0.0)) for y in ys[::step_y]]
-        items += [("x cm (across rows)", ((x0 + x1) / 2, y0 - 2.6 * off, 0.0)),
-                  ("y cm (along rows)", (x0 - 2.6 * off, (y0 + y1) / 2, 0.0))]
-        for k, (text, pos) in enumerate(items):
-            actor = vtkBillboardTextActor3D()
-            actor.SetInput(text)
-            actor.SetPosition(*pos)
-            prop = actor.GetTextProperty()
-            prop.SetFontSize(12)
-            prop.SetColor(0.15, 0.15, 0.15)
-            prop.SetJustificationToCentered()
-            prop.SetVerticalJustificationToCentered()
-            self.add_actor(actor, name=f"label{k}", render=False, pickable=False)
+        margin = max(25.0, 0.09 * max(x1 - x0, y1 - y0))
+        gx0, gy0, gx1, gy1 = x0 - margin, y0 - margin, x1 + margin, y1 + margin
+        ground = pv.Plane(center=((gx0 + gx1) / 2, (gy0 + gy1) / 2, -0.05),
+                          i_size=gx1 - gx0, j_size=gy1 - gy0)
+        image = ground_image((x0, y0, x1, y1), margin, _ticks(x0, x1, rs), _ticks(y0, y1, ps))
+        self.add_mesh(ground, name="ground", texture=pv.Texture(image), render=False,
+                      pickable=False, lighting=False)
 
     # ------------------------------------------------------------------ camera
     def camera_preset(self, name: str) -> None:
@@ -301,12 +250,9 @@ class Viewport(QtInteractor):
         for actor in (self._canopy_actor,):
             if actor is not None:
                 actor.SetVisibility(False)
-        if self._scalar_bar is not None:
-            self._scalar_bar.SetVisibility(False)
-        for name in ("ground", "grid") + tuple(n for n in self.actors
-                                               if str(n).startswith("label")):
-            if name in self.actors:
-                self.actors[name].SetVisibility(False)
+        self.key.hide()
+        if "ground" in self.actors:
+            self.actors["ground"].SetVisibility(False)
         self._digitizing_frame = None
         self.render()
 
@@ -315,12 +261,10 @@ class Viewport(QtInteractor):
         self._clear_digitizing()
         if self._canopy_actor is not None:
             self._canopy_actor.SetVisibility(True)
-        if self._scalar_bar is not None:
-            self._scalar_bar.SetVisibility(True)
-        for name in ("ground", "grid") + tuple(n for n in self.actors
-                                               if str(n).startswith("label")):
-            if name in self.actors:
-                self.actors[name].SetVisibility(True)
+        if "ground" in self.actors:
+            self.actors["ground"].SetVisibility(True)
+        if self._canopy_actor is not None:
+            self.key.show()
         if self._canopy_actor is not None:
             self.camera_preset("perspective")
         self.render()
@@ -371,3 +315,123 @@ def _ticks(lo: float, hi: float, step: float) -> np.ndarray:
     if hi - xs[-1] > 1e-6 * step:
         xs = np.append(xs, hi)
     return xs
+
+
+def ground_image(field: tuple[float, float, float, float], margin: float, xs: np.ndarray,
+                 ys: np.ndarray, max_px: int = 2048) -> np.ndarray:
+    """The ground texture (h, w, 4) uint8, row 0 at the largest y (as pyvista maps an image
+    on a plane): the field (tan) with grid
+    lines at ``xs`` / ``ys`` (cm), and a ``margin`` (cm) carrying the tick labels in cm and
+    the axis names. GUI thread (QPainter)."""
+    x0, y0, x1, y1 = field
+    width_cm, height_cm = x1 - x0 + 2 * margin, y1 - y0 + 2 * margin
+    scale = min(4.0, max_px / max(width_cm, height_cm))
+    w, h = int(round(width_cm * scale)), int(round(height_cm * scale))
+    img = QImage(w, h, QImage.Format_RGBA8888)
+    img.fill(QColor("#ece3cc"))
+
+    def px(x, y):
+        return QPointF((x - x0 + margin) * scale, (y1 + margin - y) * scale)
+
+    p = QPainter(img)
+    p.setRenderHint(QPainter.Antialiasing)
+    p.fillRect(QRectF(px(x0, y1), px(x1, y0)), QColor("#cdb98f"))
+    p.setPen(QPen(QColor("#8a7a55"), max(1.0, 0.35 * scale)))
+    for x in xs:
+        p.drawLine(px(x, y0), px(x, y1))
+    for y in ys:
+        p.drawLine(px(x0, y), px(x1, y))
+    font = QFont("DejaVu Sans")
+    font.setPixelSize(max(8, int(margin * scale * 0.3)))
+    p.setFont(font)
+    p.setPen(QColor("#333333"))
+    step_x = max(1, int(np.ceil(len(xs) / 10)))
+    step_y = max(1, int(np.ceil(len(ys) / 10)))
+    box = margin * scale * 0.45
+    for x in xs[::step_x]:
+        c = px(x, y0 - margin * 0.27)
+        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), Qt.AlignCenter,
+                   f"{x:.0f}")
+    for y in ys[::step_y]:
+        c = px(x0 - margin * 0.27, y)
+        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), Qt.AlignCenter,
+                   f"{y:.0f}")
+    c = px((x0 + x1) / 2, y0 - margin * 0.72)
+    p.drawText(QRectF(c.x() - 20 * box, c.y() - box / 2, 40 * box, box), Qt.AlignCenter,
+               "x (cm, across the rows)")
+    c = px(x0 - margin * 0.72, (y0 + y1) / 2)
+    p.translate(c)
+    p.rotate(-90)
+    p.drawText(QRectF(-20 * box, -box / 2, 40 * box, box), Qt.AlignCenter,
+               "y (cm, along the rows)")
+    p.end()
+    arr = np.frombuffer(img.constBits(), np.uint8).reshape(h, img.bytesPerLine())[:, :4 * w]
+    return arr.reshape(h, w, 4).copy()
+
+
+class Legend(QWidget):
+    """The colour key over the 3D view: categories (swatches) or a gradient. A Qt widget, so
+    it costs nothing at each frame."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.setAttribute(Qt.WA_TransparentForMouseEvents)
+        self._title = ""
+        self._items: list[tuple[str, str]] = []
+        self._gradient: tuple | None = None
+
+    def set_categories(self, title: str, items: list[tuple[str, str]]) -> None:
+        self._title, self._items, self._gradient = title, list(items), None
+        self._fit()
+
+    def set_gradient(self, title: str, colours: np.ndarray, lo: int, hi: int,
+                     below: tuple[str, str] | None = None) -> None:
+        self._title, self._gradient = title, (np.asarray(colours), lo, hi)
+        self._items = [below] if below else []
+        self._fit()
+
+    def text(self) -> str:
+        """What the legend says (title and labels)."""
+        parts = [self._title] + [label for label, _ in self._items]
+        if self._gradient is not None:
+            parts += [str(self._gradient[1]), str(self._gradient[2])]
+        return " | ".join(parts)
+
+    def _fit(self) -> None:
+        fm = self.fontMetrics()
+        line = fm.height() + 4
+        rows = len(self._items) + (2 if self._gradient is not None else 0)
+        width = max([fm.horizontalAdvance(self._title)] +
+                    [fm.horizontalAdvance(t) + 26 for t, _ in self._items] + [120]) + 16
+        self.resize(width, 10 + line * (rows + 1))
+        self.update()
+
+    def paintEvent(self, _event) -> None:  # noqa: N802 - Qt's name
+        p = QPainter(self)
+        p.setRenderHint(QPainter.Antialiasing)
+        p.setPen(Qt.NoPen)
+        p.setBrush(QColor(255, 255, 255, 215))
+        p.drawRoundedRect(QRectF(self.rect()), 6, 6)
+        fm = self.fontMetrics()
+        line = fm.height() + 4
+        p.setPen(QColor("#222222"))
+        y = 6
+        p.drawText(QRectF(8, y, self.width() - 16, line), Qt.AlignLeft | Qt.AlignVCenter,
+                   self._title)
+        y += line
+        if self._gradient is not None:
+            colours, lo, hi = self._gradient
+            grad = QLinearGradient(8, 0, self.width() - 8, 0)
+            for k, c in enumerate(colours):
+                grad.setColorAt(k / max(len(colours) - 1, 1), QColor(*[int(v) for v in c[:3]]))
+            p.fillRect(QRectF(8, y + 2, self.width() - 16, line - 4), grad)
+            y += line
+            p.drawText(QRectF(8, y, self.width() - 16, line), Qt.AlignLeft, str(lo))
+            p.drawText(QRectF(8, y, self.width() - 16, line), Qt.AlignRight, str(hi))
+            y += line
+        for label, colour in self._items:
+            p.fillRect(QRectF(8, y + 3, 16, line - 6), QColor(colour))
+            p.drawText(QRectF(30, y, self.width() - 38, line), Qt.AlignLeft | Qt.AlignVCenter,
+                       label)
+            y += line
+        p.end()

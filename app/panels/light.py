@@ -338,7 +338,10 @@ class ImageView(QLabel):
 
 
 class LightPlots(QWidget):
-    """The heatmap of one height (chosen in ``height``) beside transmission vs height."""
+    """The heatmap of one height (chosen in ``height``) beside transmission vs height.
+    ``heatmap_needed(index)`` asks for a height's figure not drawn yet."""
+
+    heatmap_needed = Signal(int)
 
     def __init__(self, parent=None):
         super().__init__(parent)
@@ -358,9 +361,9 @@ class LightPlots(QWidget):
         lay.addLayout(left, 1)
         self.transmission = ImageView("transmission by height appears here")
         lay.addWidget(self.transmission, 1)
-        self._maps: list[tuple[float, np.ndarray]] = []
+        self._maps: list[tuple[float, np.ndarray | None]] = []
 
-    def set_heatmaps(self, maps: Sequence[tuple[float, np.ndarray]]) -> None:
+    def set_heatmaps(self, maps: Sequence[tuple[float, np.ndarray | None]]) -> None:
         keep = self.height.currentIndex()
         self._maps = list(maps)
         self.height.blockSignals(True)
@@ -371,9 +374,20 @@ class LightPlots(QWidget):
             self.height.setCurrentIndex(keep if 0 <= keep < len(self._maps) else 0)
         self._show_height(self.height.currentIndex())
 
+    def set_heatmap(self, index: int, rgba: np.ndarray) -> None:
+        """A height's figure, drawn after it was asked for."""
+        if 0 <= index < len(self._maps):
+            self._maps[index] = (self._maps[index][0], rgba)
+            if index == self.height.currentIndex():
+                self.heatmap.set_rgba(rgba)
+
     def _show_height(self, index: int) -> None:
         if 0 <= index < len(self._maps):
-            self.heatmap.set_rgba(self._maps[index][1])
+            rgba = self._maps[index][1]
+            self.heatmap.set_rgba(rgba)
+            if rgba is None:
+                self.heatmap.setText("drawing…")
+                self.heatmap_needed.emit(index)
         else:
             self.heatmap.set_rgba(None)
 

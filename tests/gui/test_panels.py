@@ -119,7 +119,8 @@ def test_figures_are_the_core_heatmap_and_a_level_comparison(small_canopy):
 
     result = trace_light(small_canopy, LightRequest(Sun(22.3, 167.0), (0.0, 100.0), 0.5,
                                                     classes=True))
-    maps = heatmap_images(result)
+    maps = heatmap_images(result, all_heights=True)
+    assert heatmap_images(result, first=1)[0][1] is None      # drawn when asked for
     assert [h for h, _ in maps] == [0.0, 100.0]
     assert all(img.ndim == 3 and img.shape[2] == 4 and img.shape[1] > 300 for _, img in maps)
     fig = transmission_figure([Curve("K=4", (0.0, 100.0), (0.1, 0.5)),

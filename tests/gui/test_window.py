@@ -32,17 +32,21 @@ def test_close_right_after_start(window, qtbot, capfd):
     assert "RuntimeError" not in err and "Traceback" not in err, err
 
 
-def test_a_result_queued_at_close_starts_nothing(window, qtbot):
-    """The file has loaded and its result waits in the event queue when the window closes:
-    it must not start a build on the closed window."""
-    w = window()
-    assert w.runner.current("load") is not None
+def test_a_result_queued_at_close_starts_nothing(window, qtbot, small_points):
+    """A file has loaded and its result waits in the event queue when the window closes:
+    it must not start a build on the closed window (nor change what the window shows)."""
+    from maizeviz.resources import example_points
+
+    w = shown(qtbot, window(small_points, tile=1))
+    loaded, label = w.loaded, w.canopy_panel.file_label.text()
+    w.open_points(example_points())
     QThreadPool.globalInstance().waitForDone(TIMEOUT)     # loaded; result not yet delivered
     builds = []
     w.canopy_shown.connect(builds.append)
     w.close()
     qtbot.wait(1000)
-    assert w.loaded is None and w.runner.current("build") is None and not builds
+    assert w.loaded is loaded and w.canopy_panel.file_label.text() == label
+    assert w.runner.current("build") is None and not builds
     assert QThreadPool.globalInstance().waitForDone(10_000)
 
 
