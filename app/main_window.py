@@ -234,7 +234,7 @@ class MainWindow(QMainWindow):
 
     def _apply_default_sizes(self) -> None:
         w, h = self.width(), self.height()
-        self.resizeDocks([self.docks["canopy"]], [max(360, min(460, int(w * 0.32)))],
+        self.resizeDocks([self.docks["canopy"]], [max(380, min(480, int(w * 0.33)))],
                          Qt.Horizontal)
         self.resizeDocks([self.docks["results"]], [max(200, min(380, int(h * 0.36)))],
                          Qt.Vertical)
@@ -420,7 +420,8 @@ class MainWindow(QMainWindow):
         self.light_panel.show_runs(self.runs)
         self.plots.set_heatmaps([])
         self.plots.set_transmission(None)
-        self.canopy_panel.set_file(loaded.shown_name)
+        self.canopy_panel.set_file(Path(loaded.shown_name).name if project is None
+                                   else loaded.shown_name, loaded.path)
         self.project_path = project
         self._layout_edited = project is not None and self._project_layout
         opened = project or loaded.path

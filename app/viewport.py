@@ -81,7 +81,7 @@ class Viewport(QtInteractor):
         self.setMinimumSize(320, 200)
         self.render_count = 0
         self.ren_win.AddObserver("EndEvent", self._on_frame)
-        self.set_background("white", top="lightskyblue")
+        self.set_background("#e4edf5")          # a gradient costs a full-screen pass per frame
         # no orientation triad, no VTK scalar bar, no 3D text: each is a render pass or text
         # layout at every frame (60-80 ms each on llvmpipe); the ground carries the axes and
         # cm labels in its texture and the legend is a Qt widget drawn once per colouring
@@ -342,12 +342,12 @@ def ground_image(field: tuple[float, float, float, float], margin: float, xs: np
     for y in ys:
         p.drawLine(px(x0, y), px(x1, y))
     font = QFont("DejaVu Sans")
-    font.setPixelSize(max(8, int(margin * scale * 0.3)))
+    font.setPixelSize(max(8, int(margin * scale * 0.42)))
     p.setFont(font)
     p.setPen(QColor("#333333"))
     step_x = max(1, int(np.ceil(len(xs) / 10)))
     step_y = max(1, int(np.ceil(len(ys) / 10)))
-    box = margin * scale * 0.45
+    box = margin * scale * 0.6
     for x in xs[::step_x]:
         c = px(x, y0 - margin * 0.27)
         p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), Qt.AlignCenter,

@@ -121,9 +121,9 @@ class CanopyPanel(QWidget):
         self.tile.setCurrentText(f"{n}x{n}")
         self.tile.blockSignals(False)
 
-    def set_file(self, name: str) -> None:
+    def set_file(self, name: str, tooltip: str = "") -> None:
         self.file_label.setText(name)
-        self.file_label.setToolTip(name)
+        self.file_label.setToolTip(tooltip or name)
 
     def _on_slider(self, _value: int) -> None:
         self.asked_label.setText(f"asked: {describe(self.level)}")
@@ -142,7 +142,9 @@ class CanopyPanel(QWidget):
         """A new canopy is on screen: its level label and its Table 2 row, together."""
         self.level_label.setText(f"showing: {describe(level)}")
         self.asked_label.setText("")
-        headers = [h for _, h in columns]
+        # units on a second line: the table fits a 400 px panel without scrolling sideways
+        headers = [h.rsplit(" ", 1)[0] + "\n" + h.rsplit(" ", 1)[1] if " " in h else h
+                   for _, h in columns]
         if headers != self.columns:
             self.columns = headers
             self.table.setColumnCount(len(headers))
