@@ -14,16 +14,26 @@ import time
 from pathlib import Path
 
 import numpy as np
+from maizeviz.resources import example_points
 from PySide6.QtCore import QSettings, QTimer, Signal
-from PySide6.QtWidgets import (QCheckBox, QFileDialog, QFormLayout, QHBoxLayout, QLabel,
-                               QLineEdit, QListWidget, QPushButton, QSpinBox, QVBoxLayout,
-                               QWidget)
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QFileDialog,
+    QFormLayout,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QListWidget,
+    QPushButton,
+    QSpinBox,
+    QVBoxLayout,
+    QWidget,
+)
 
 from maizeviz.digitizer.port import FastrakPort
 from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import Session
 from maizeviz.errors import MaizevizError
-from maizeviz.resources import example_points
 
 
 class DigitizerPanel(QWidget):
@@ -221,10 +231,10 @@ class DigitizerPanel(QWidget):
         if self.viewport is None or self.session is None or not self.session.history:
             return
         from maizeviz.errors import LeafError
-        from maizeviz.leaf.grid import grid_from_rows
         from maizeviz.leaf.fit import Leaf
-        from maizeviz.mesh.levels import Level, mesh_leaf
+        from maizeviz.leaf.grid import grid_from_rows
         from maizeviz.leaf.nurbs import fit_surface
+        from maizeviz.mesh.levels import Level, mesh_leaf
 
         plant = self.session.history[-1][0].plant
         mine = [(p, xyz) for p, xyz in self.session.history if p.plant == plant]

@@ -9,15 +9,27 @@ from __future__ import annotations
 
 import json
 
+from PySide6.QtCore import Signal
+from PySide6.QtWidgets import (
+    QFileDialog,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
+
+from maizeviz.canopy.layout import (
+    LayoutError,
+    Placement,
+    layout_from_dict,
+    layout_to_dict,
+    load_layout,
+)
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import write_text
-
-from PySide6.QtCore import Signal
-from PySide6.QtWidgets import (QFileDialog, QHBoxLayout, QLabel, QPushButton, QTableWidget,
-                               QTableWidgetItem, QVBoxLayout, QWidget)
-
-from maizeviz.canopy.layout import (LayoutError, Placement, layout_from_dict, layout_to_dict,
-                                    load_layout)
 
 COLUMNS = ("x cm", "y cm", "plant", "azimuth °")
 

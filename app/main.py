@@ -12,9 +12,17 @@ at the app on a machine without a screen (under ``xvfb-run``).
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import os
 import sys
 from collections.abc import Sequence
+
+#: What the app needs beyond the core (the ``gui`` extra); checked when the entry point loads,
+#: without importing them (pyvista and VTK take seconds to import).
+GUI_PACKAGES = ("PySide6", "pyvista", "pyvistaqt")
+_missing = [name for name in GUI_PACKAGES if importlib.util.find_spec(name) is None]
+if _missing:
+    raise ImportError(f"{', '.join(_missing)} not installed")
 
 
 def gl_format() -> None:

@@ -1,33 +1,76 @@
-"""``maizeviz light``: direct sunlight through the canopy with Embree (Table 3)."""
+"""``maizeviz light``: sunlight and skylight through the canopy with Embree (Table 3 and beyond).
+
+Three things can be asked, alone or together: a single sun (angles, or a place and a clock
+time), a diffuse sky (``--sky``), and a day or a period (``--day``, ``--from/--to``,
+``--weather``), whose diffuse part uses the sky traced once for the whole period.
+"""
 
 from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import time
+from pathlib import Path
+from typing import Any
 
-from maizeviz.canopy.scene import build_canopy
-from maizeviz.cli.common import (Progress, add_canopy_options, add_level_options, canopy_setup,
-                                 floats, fmt_table, leaves_summary, levels_from, say, suffixed,
-                                 write_rows)
+import numpy as np
+
+from maizeviz.canopy.scene import Canopy, build_canopy
+from maizeviz.cli.common import (
+    Progress,
+    add_canopy_options,
+    add_level_options,
+    canopy_setup,
+    check_canopy_costs,
+    check_outputs,
+    floats,
+    fmt_table,
+    leaves_summary,
+    levels_from,
+    say,
+    suffixed,
+    write_rows,
+)
+from maizeviz.cost import heatmap_cost, light_cost
 from maizeviz.errors import MaizevizError
-from maizeviz.io.atomic import refuse_overwriting_inputs
-from maizeviz.light.beer_lambert import beer_lambert, clumping
-from maizeviz.light.heatmap import write_heatmaps
-from maizeviz.light.leaf_light import leaf_light, plant_light
-from maizeviz.light.request import LightRequest
+from maizeviz.io.atomic import atomic_open, refuse_overwriting_inputs
+from maizeviz.light.beer_lambert import beer_lambert, beer_lambert_sky, clumping
+from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
+from maizeviz.light.heatmap import (
+    TransmissionMap,
+    heatmap_figure,
+    save_figure,
+    write_heatmaps,
+    write_map_csv,
+)
+from maizeviz.light.irradiance import (
+    DEFAULT_LINKE_TURBIDITY,
+    DEFAULT_PAR_UMOL_PER_J,
+    Period,
+    clear_sky_period,
+    read_weather,
+    weather_period,
+)
+from maizeviz.light.leaf_light import leaf_light, leaf_sums, merge_rows, plant_light
+from maizeviz.light.request import LightRequest, Sampling
+from maizeviz.light.sky import SKY_KINDS, Sky, make_sky
 from maizeviz.light.sun import Sun, sun_at
-from maizeviz.light.transmission import trace_light
+from maizeviz.light.transmission import LightResult, light_scene, trace_light
 from maizeviz.mesh.levels import CANOPY_LEVELS
+
+#: The subcommand.
+NAME = "light"
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "light", help="direct sunlight through the canopy with Embree (Table 3)",
-        description="Trace parallel sun rays through a canopy: transmission at several heights "
-                    "inside a sample rectangle, sunlit and second-class area per leaf, per mesh "
-                    "level with timings.")
+        NAME, help="sunlight and skylight through the canopy with Embree (Table 3)",
+        description="Trace parallel rays through a canopy for a sun, a diffuse sky or a whole "
+                    "day: transmission on sensor planes at several heights over a sample "
+                    "rectangle, light intercepted per leaf and per plant, per mesh level with "
+                    "timings.")
     add_canopy_options(p)
     add_level_options(p, CANOPY_LEVELS)
     sun = p.add_argument_group("sun (explicit angles, or place + date + time through pvlib)")
@@ -41,12 +84,39 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     sun.add_argument("--lon", type=float, help="longitude, degrees east")
     sun.add_argument("--tz", default=None,
                      help="time zone, e.g. Asia/Shanghai (default UTC, or the offset of --time)")
+    sky = p.add_argument_group("diffuse sky")
+    sky.add_argument("--sky", choices=sorted(SKY_KINDS),
+                     help="soc: standard overcast (radiance (1 + 2 cos zenith)/3), uoc: uniform "
+                          "overcast; a period uses soc unless told")
+    sky.add_argument("--sky-directions", type=int, default=None, metavar="N",
+                     help="directions of the sky: 6, 16, 46 (den Dulk's turtle), 145 (Tregenza) "
+                          "or any N >= 1 (equal solid angles); default 46")
+    per = p.add_argument_group("a day or a period (sun every --step, sky once)")
+    per.add_argument("--day", action="store_true", help="the whole of --date, 00:00 to 24:00")
+    per.add_argument("--from", dest="from_", metavar="HH:MM",
+                     help="start of the period on --date (local clock time)")
+    per.add_argument("--to", metavar="HH:MM", help="end of the period on --date")
+    per.add_argument("--step", type=float, default=None, metavar="MIN",
+                     help="time step, minutes (default 30)")
+    per.add_argument("--weather", metavar="CSV",
+                     help="irradiance from a weather file (time with zone, ghi W/m2, optional "
+                          "dni, dhi) instead of the clear sky; the file sets the period")
+    per.add_argument("--linke-turbidity", type=float, default=None, metavar="T",
+                     help=f"Linke turbidity of the clear sky (default {DEFAULT_LINKE_TURBIDITY:g})")
+    per.add_argument("--altitude", type=float, default=0.0, metavar="M",
+                     help="site altitude, m (clear sky and sun positions; default 0)")
+    per.add_argument("--par-factor", type=float, default=None, metavar="UMOL_PER_J",
+                     help=f"umol of PAR per J of shortwave (default 0.48 x 4.57 = "
+                          f"{DEFAULT_PAR_UMOL_PER_J:.4g})")
+    per.add_argument("--steps", metavar="CSV", help="write one line per time step")
+    per.add_argument("--plots", metavar="DIR",
+                     help="write PNGs of the period: PAR through the day, transmission profile")
     p.add_argument("--heights", default="0,50,100,150,200,225", metavar="CM,...",
-                   help="heights of the sample planes, cm (default 0,50,100,150,200,225)")
+                   help="heights of the sensor planes, cm (default 0,50,100,150,200,225)")
     p.add_argument("--density", type=float, default=4.0,
-                   help="rays per cm2 of the sample rectangle (default 4)")
+                   help="rays (and sensors) per cm2 of the sample rectangle (default 4)")
     p.add_argument("--rect", metavar="X0,Y0,X1,Y1",
-                   help="sample rectangle on the ground, cm (default: the central tile)")
+                   help="sample rectangle, cm (default: the central tile)")
     p.add_argument("--periodic", action="store_true",
                    help="rays leaving the plot sideways re-enter on the other side (infinite field)")
     p.add_argument("--threads", type=int, default=os.cpu_count() or 1,
@@ -55,19 +125,64 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--check", action="store_true",
                    help="print Beer-Lambert exp(-G L(h)/cos theta) from the mesh beside each value")
     p.add_argument("--json", action="store_true", help="print JSON instead of tables")
+    p.add_argument("--verbose", action="store_true",
+                   help="print the sky's directions and weights on stderr")
     p.add_argument("--heatmaps", metavar="DIR", help="write a transmission map PNG + CSV per height")
     p.add_argument("--heatmap-bin", type=float, default=5.0, metavar="CM",
                    help="heatmap bin size, cm (default 5)")
     p.add_argument("--leaf-light", metavar="CSV",
-                   help="write sunlit and second-class area of every lit leaf")
+                   help="write the light intercepted by every lit leaf")
     p.add_argument("--plant-light", metavar="CSV", help="the same summed per plant")
     p.set_defaults(run=run)
 
 
-def sun_from(args: argparse.Namespace) -> Sun:
-    """The sun of the command line: explicit angles, or a place and time through pvlib."""
+# ------------------------------------------------------------------------------ what is asked
+def _period_asked(args: argparse.Namespace) -> bool:
+    return bool(args.day or args.from_ or args.to or args.weather)
+
+
+def _check_options(args: argparse.Namespace) -> None:
+    """Refuse options that contradict each other, one line each."""
+    explicit = args.sun_zenith is not None or args.sun_azimuth is not None
+    if _period_asked(args):
+        what = "--weather" if args.weather else ("--day" if args.day else "--from/--to")
+        if explicit:
+            raise MaizevizError(f"{what} follows the sun through the period: give no "
+                                "--sun-zenith/--sun-azimuth")
+        if args.time or args.solar_noon:
+            raise MaizevizError(f"{what} follows the sun through the period: give no --time or "
+                                "--solar-noon")
+        if args.day and (args.from_ or args.to):
+            raise MaizevizError("give either --day or --from/--to, not both")
+        if args.weather:
+            if args.day or args.from_ or args.to or args.step is not None:
+                raise MaizevizError("the weather file sets the period and its steps: give no "
+                                    "--day, --from, --to or --step with --weather")
+            if args.linke_turbidity is not None:
+                raise MaizevizError("--linke-turbidity is for the clear sky, not for --weather")
+            if args.lat is None or args.lon is None:
+                raise MaizevizError("a weather file needs the place: give --lat and --lon")
+        else:
+            if args.date is None or args.lat is None or args.lon is None:
+                raise MaizevizError(f"{what} needs --date, --lat and --lon (and --tz)")
+        return
+    for flag, value in (("--step", args.step), ("--linke-turbidity", args.linke_turbidity),
+                        ("--par-factor", args.par_factor), ("--steps", args.steps),
+                        ("--plots", args.plots)):
+        if value is not None:
+            raise MaizevizError(f"{flag} is for a period: add --day (or --from/--to, or "
+                                "--weather) with --date, --lat and --lon")
+    if args.sky_directions is not None and args.sky is None:
+        raise MaizevizError("--sky-directions needs --sky (soc or uoc) or a period")
+
+
+def sun_from(args: argparse.Namespace) -> Sun | None:
+    """The single sun of the command line: explicit angles, or a place and time through pvlib;
+    None when only a sky or a period is asked for."""
     explicit = args.sun_zenith is not None or args.sun_azimuth is not None
     place = any(v is not None for v in (args.date, args.time, args.lat, args.lon)) or args.solar_noon
+    if _period_asked(args):
+        return None
     if explicit and place:
         raise MaizevizError("give either --sun-zenith/--sun-azimuth or a place and time, not both")
     if explicit:
@@ -75,15 +190,45 @@ def sun_from(args: argparse.Namespace) -> Sun:
             raise MaizevizError("give both --sun-zenith and --sun-azimuth")
         return Sun(args.sun_zenith, args.sun_azimuth)
     if not place:
+        if args.sky is not None:
+            return None
         raise MaizevizError("where is the sun? give --sun-zenith and --sun-azimuth, or --date, "
-                            "--time (or --solar-noon), --lat, --lon and --tz")
+                            "--time (or --solar-noon), --lat, --lon and --tz; or --sky soc for "
+                            "an overcast sky, or --day for a whole day")
     if args.date is None or args.lat is None or args.lon is None:
         raise MaizevizError("a sun from a place needs --date, --lat and --lon (and --time or "
                             "--solar-noon, --tz)")
+    if not args.time and not args.solar_noon:
+        raise MaizevizError("give --time HH:MM or --solar-noon for one sun, or --day (or "
+                            "--from/--to) for a period")
     return sun_at(args.date, args.time, args.lat, args.lon, args.tz, args.solar_noon)
 
 
+def period_from(args: argparse.Namespace) -> Period | None:
+    """The period of the command line (clear sky or weather file), or None."""
+    if not _period_asked(args):
+        return None
+    par = DEFAULT_PAR_UMOL_PER_J if args.par_factor is None else args.par_factor
+    if args.weather:
+        weather = read_weather(args.weather, tz=args.tz)
+        return weather_period(weather, args.lat, args.lon, args.altitude, par)
+    linke = DEFAULT_LINKE_TURBIDITY if args.linke_turbidity is None else args.linke_turbidity
+    return clear_sky_period(args.date, args.lat, args.lon, args.tz or "UTC",
+                            30.0 if args.step is None else args.step, args.from_, args.to,
+                            args.altitude, linke, par)
+
+
+def sky_from(args: argparse.Namespace, period: Period | None) -> Sky | None:
+    """The diffuse sky: --sky, or the standard overcast sky for a period."""
+    if args.sky is None and period is None:
+        return None
+    n = 46 if args.sky_directions is None else args.sky_directions
+    return make_sky(args.sky or "soc", n)
+
+
+# ------------------------------------------------------------------------------ run
 def run(args: argparse.Namespace) -> int:
+    _check_options(args)
     levels = levels_from(args)
     sun = sun_from(args)
     heights = tuple(floats(args.heights, "heights", "heights"))
@@ -91,69 +236,330 @@ def run(args: argparse.Namespace) -> int:
     if not args.heatmap_bin > 0:
         raise MaizevizError(f"the heatmap bin must be > 0 cm, got {args.heatmap_bin}",
                             quantity="heatmap_bin")
+    check_outputs(args.leaf_light, args.plant_light, args.steps)
     refuse_overwriting_inputs([("the leaf light table", args.leaf_light),
-                               ("the plant light table", args.plant_light)],
-                              [args.points, args.layout])
-    say(f"sun: zenith {sun.zenith_deg:.2f} deg, azimuth {sun.azimuth_deg:.2f} deg"
-        + (f" ({sun.when})" if sun.when else ""))
+                               ("the plant light table", args.plant_light),
+                               ("the time-step table", args.steps)],
+                              [args.points, args.layout, args.weather])
+    period = period_from(args)
+    sky = sky_from(args, period)
+    if sun is not None:
+        say(f"sun: zenith {sun.zenith_deg:.2f} deg, azimuth {sun.azimuth_deg:.2f} deg"
+            + (f" ({sun.when})" if sun.when else ""))
+    if sky is not None:
+        say(f"sky: {sky.description}")
+        if args.verbose:
+            say(sky.table())
+    if period is not None:
+        say(f"period: {period.start.isoformat()} to {period.end.isoformat()}, "
+            f"{period.n_steps} steps with the sun up; {period.source}")
     leaves, skipped, layout = canopy_setup(args)
-    want_classes = bool(args.leaf_light or args.plant_light)
-    records: list[dict] = []
+    sampled = rect or layout.centre_bounds
+    directions = (sun is not None) + (sky.n if sky is not None else 0) + \
+        (period.n_steps if period is not None else 0)
+    work = [light_cost(sampled, args.density, len(heights), max(directions, 1))]  # type: ignore[arg-type]
+    if args.heatmaps:
+        maps = (sun is not None) + (sky is not None) + (period is not None)
+        work.append(heatmap_cost(sampled, args.heatmap_bin, len(heights) * maps))  # type: ignore[arg-type]
+    check_canopy_costs(leaves, layout, levels, args.force, work)
+    want_rows = bool(args.leaf_light or args.plant_light)
+    records: list[dict[str, Any]] = []
+    said: set[str] = set()
     for level in levels:
         t0 = time.perf_counter()
         canopy = build_canopy(leaves, layout, level, args.preserve_area,
                               Progress(f"building {level}"))
         canopy_s = time.perf_counter() - t0
-        req = LightRequest(sun, heights, args.density, rect, args.periodic, args.threads,  # type: ignore[arg-type]
-                           classes=want_classes or len(levels) == 1)
-        res = trace_light(canopy, req, Progress(f"tracing {level}"), args.with_stalks)
-        for w in res.warnings:
-            if not records or w not in records[-1]["warnings"]:
-                say(f"warning: {w}")
-        rec = {"level": level.label, "triangles": canopy.n_triangles,
-               "sun": {"zenith_deg": sun.zenith_deg, "azimuth_deg": sun.azimuth_deg,
-                       "when": sun.when or None},
-               "heights_cm": list(map(float, res.heights_cm)),
-               "transmission": list(map(float, res.transmission)), "rays": res.rays,
-               "density_per_cm2": res.density_per_cm2,
-               "rect_cm": list(res.rect), "periodic": args.periodic, "threads": args.threads,
-               "seconds": dict(canopy=canopy_s, scene=res.seconds["build"],
-                               trace=res.seconds["trace"],
-                               second_hits=res.seconds.get("second", 0.0)),
-               "warnings": list(res.warnings)}
-        if args.check:
-            bl = beer_lambert(canopy, sun, heights)
-            rec["beer_lambert"] = {"G": bl.G, "lai_above": list(map(float, bl.lai_above)),
-                                   "transmission": list(map(float, bl.transmission))}
-        if res.sunlit_intercepted_fraction is not None:
-            rec["sunlit_intercepted_fraction"] = res.sunlit_intercepted_fraction
-        if args.heatmaps:
-            paths = write_heatmaps(args.heatmaps, res, args.heatmap_bin)
-            say(f"wrote {len(paths) // 2} transmission maps (PNG + CSV) to {args.heatmaps}")
-        if want_classes:
-            rows = leaf_light(canopy, res)
-            for r in rows:
-                r["level"] = level.label
-            if args.leaf_light:
-                write_rows(args.leaf_light if len(levels) == 1 else
-                           suffixed(args.leaf_light, level.label), rows)
-            if args.plant_light:
-                write_rows(args.plant_light if len(levels) == 1 else
-                           suffixed(args.plant_light, level.label), plant_light(rows))
+        t1 = time.perf_counter()
+        scene = light_scene(canopy, args.with_stalks, args.periodic)
+        scene_s = time.perf_counter() - t1
+        sampling = Sampling(heights, args.density, rect, args.periodic, args.threads)  # type: ignore[arg-type]
+        rec: dict[str, Any] = {"level": level.label, "triangles": canopy.n_triangles,
+                               "heights_cm": [float(h) for h in heights],
+                               "periodic": args.periodic, "threads": args.threads,
+                               "seconds": {"canopy": canopy_s, "scene": scene_s}}
+        warnings: list[str] = []
+        tables: list[list[dict]] = []
+        res = sky_res = per_res = None
+        if sun is not None:
+            req = LightRequest(sun, heights, args.density, rect, args.periodic,  # type: ignore[arg-type]
+                               args.threads, classes=want_rows or len(levels) == 1)
+            res = trace_light(canopy, req, Progress(f"tracing {level}"), args.with_stalks,
+                              scene=scene)
+            warnings += res.warnings
+            rec.update(_sun_record(res, sun, canopy, args, heights))
+            rec["seconds"].update(trace=res.seconds["trace"],
+                                  second_hits=res.seconds.get("second", 0.0))
+            if want_rows:
+                tables.append(leaf_light(canopy, res))
+        if period is not None:
+            per_res = trace_period(canopy, period, sampling, sky,
+                                   Progress(f"tracing the period, {level}"), args.with_stalks,
+                                   scene=scene, bin_cm=args.heatmap_bin)
+            sky_res = per_res.sky
+            warnings += per_res.warnings
+            rec["seconds"]["period"] = per_res.seconds["trace"]
+        elif sky is not None:
+            sky_res = trace_sky(canopy, sky, sampling, Progress(f"tracing the sky, {level}"),
+                                args.with_stalks, scene=scene, bin_cm=args.heatmap_bin)
+            warnings += sky_res.warnings
+            rec["seconds"]["sky"] = sky_res.seconds["trace"]
+        if sky_res is not None:
+            rec["diffuse"] = _sky_record(sky_res, canopy, args, heights)
+            if want_rows:
+                tables.append(leaf_sums(canopy, {
+                    "diffuse_intercepted_cm2": sky_res.triangle_intercepted_cm2},
+                    sky_res.rect, sky_res.periodic))
+        elif sky is not None and period is not None:
+            rec["diffuse"] = None                   # the sun never rose: no sky traced
+        if per_res is not None:
+            rec["period"] = _period_record(per_res, args)
+            if want_rows:
+                tables.append(_period_rows(canopy, per_res))
+        for w in warnings:
+            if w not in said:
+                said.add(w)
+                say(f"{'note' if w in (period.notes if period else ()) else 'warning'}: {w}")
+        rec["warnings"] = list(dict.fromkeys(warnings))
+        if sun is None:
+            rays = per_res.rays if per_res else sky_res.rays if sky_res else 0
+            x0, y0, x1, y1 = per_res.rect if per_res else sky_res.rect if sky_res else (0, 0, 1, 1)
+            rec.update(sun=None, transmission=None, rays=rays, rect_cm=[x0, y0, x1, y1],
+                       density_per_cm2=rays / ((x1 - x0) * (y1 - y0)))
+        _write_outputs(args, canopy, level.label, len(levels), res, sky_res, per_res, tables)
         records.append(rec)
 
     if args.json:
-        print(json.dumps(records[0] if len(records) == 1 else {"levels": records}, indent=1))
+        print(json.dumps(_jsonable(records[0] if len(records) == 1 else {"levels": records}),
+                         indent=1))
     else:
         _print_tables(records, sun, heights, args)
     return leaves_summary(len(leaves), skipped)
 
 
-def _print_tables(records: list[dict], sun: Sun, heights: tuple[float, ...],
+# ------------------------------------------------------------------------------ records
+def _sun_record(res: LightResult, sun: Sun, canopy: Canopy, args: argparse.Namespace,
+                heights: tuple[float, ...]) -> dict[str, Any]:
+    rec: dict[str, Any] = {
+        "sun": {"zenith_deg": sun.zenith_deg, "azimuth_deg": sun.azimuth_deg,
+                "when": sun.when or None},
+        "transmission": [float(t) for t in res.transmission], "rays": res.rays,
+        "density_per_cm2": res.density_per_cm2, "rect_cm": list(res.rect)}
+    if args.check:
+        bl = beer_lambert(canopy, sun, heights)
+        rec["beer_lambert"] = {"G": bl.G, "lai_above": [float(v) for v in bl.lai_above],
+                               "transmission": [float(v) for v in bl.transmission]}
+    if res.sunlit_intercepted_fraction is not None:
+        rec["sunlit_intercepted_fraction"] = res.sunlit_intercepted_fraction
+    return rec
+
+
+def _sky_record(sky: SkyLight, canopy: Canopy, args: argparse.Namespace,
+                heights: tuple[float, ...]) -> dict[str, Any]:
+    x0, y0, x1, y1 = sky.rect
+    rec: dict[str, Any] = {
+        "sky": sky.sky.kind, "split": sky.sky.split, "directions": sky.sky.n,
+        "description": sky.sky.description, "heights_cm": [float(h) for h in sky.heights_cm],
+        "transmission": [float(t) for t in sky.transmission],
+        "intercepted_fraction": sky.intercepted_fraction, "rays_per_direction": sky.rays,
+        "density_per_cm2": sky.rays / ((x1 - x0) * (y1 - y0)), "rect_cm": list(sky.rect),
+        "weights": [float(w) for w in sky.sky.weights],
+        "zenith_deg": [float(z) for z in sky.sky.zenith_deg],
+        "azimuth_deg": [float(a) for a in sky.sky.azimuth_deg]}
+    if args.check:
+        bl = beer_lambert_sky(canopy, sky.sky, heights)
+        rec["beer_lambert"] = {"G": bl.G, "lai_above": [float(v) for v in bl.lai_above],
+                               "transmission": [float(v) for v in bl.transmission]}
+    return rec
+
+
+def _period_record(pl: PeriodLight, args: argparse.Namespace) -> dict[str, Any]:
+    p = pl.period
+    rec: dict[str, Any] = {
+        "start": p.start.isoformat(), "end": p.end.isoformat(), "steps": p.n_steps,
+        "step_min": None if args.weather else (30.0 if args.step is None else args.step),
+        "par_umol_per_j": p.par_umol_per_j,
+        "shortwave_mj_m2": p.shortwave_mj_m2,
+        "par_incident_mol_m2": pl.par_incident_mol_m2,
+        "par_direct_mol_m2": pl.par_direct_mol_m2,
+        "par_diffuse_mol_m2": pl.par_diffuse_mol_m2,
+        "par_intercepted_mol_m2": pl.par_intercepted_mol_m2,
+        "fraction_intercepted": pl.fraction_intercepted,
+        "transmission_by_height": {
+            "heights_cm": [float(h) for h in pl.heights_cm],
+            "par_mol_m2": [float(v) for v in pl.par_transmitted_mol_m2],
+            "fraction": [None if not math.isfinite(v) else float(v)
+                         for v in pl.transmission_by_height]},
+        "source": p.source, "notes": list(p.notes)}
+    if args.weather:
+        rec["weather_file"] = str(args.weather)
+        rec["weather"] = dict(p.parameters)
+    else:
+        rec["clear_sky_model"] = dict(p.parameters)
+    return rec
+
+
+def _period_rows(canopy: Canopy, pl: PeriodLight) -> list[dict]:
+    rows = leaf_sums(canopy, {"par_intercepted_mol": pl.triangle_mol,
+                              "direct_par_intercepted_mol": pl.triangle_direct_mol,
+                              "diffuse_par_intercepted_mol": pl.triangle_diffuse_mol},
+                     pl.rect, pl.periodic)
+    for r in rows:
+        r["par_mol_per_m2_leaf"] = float(r["par_intercepted_mol"]) / \
+            (float(r["leaf_area_cm2"]) * 1e-4)
+    return rows
+
+
+def _jsonable(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, (np.floating, float)):
+        return float(obj) if math.isfinite(obj) else None
+    if isinstance(obj, np.integer):
+        return int(obj)
+    return obj
+
+
+# ------------------------------------------------------------------------------ files
+def _folder(path: str) -> Path:
+    folder = Path(path)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise MaizevizError(f"{folder}: cannot create the folder ({exc.strerror})") from None
+    return folder
+
+
+def _tag(text: str) -> str:
+    return "".join(c if c.isalnum() else "_" for c in text).strip("_") or "level"
+
+
+def _write_maps(folder: Path, prefix: str, label: str, maps: list[TransmissionMap],
+                what: str, title: str) -> int:
+    for tmap in maps:
+        stem = f"{prefix}_{_tag(label)}_h{tmap.height_cm:g}cm".replace(".", "p")
+        save_figure(heatmap_figure(tmap, title=title, what=what), folder / f"{stem}.png")
+        write_map_csv(folder / f"{stem}.csv", tmap)
+    return len(maps)
+
+
+def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_levels: int,
+                   res: LightResult | None, sky: SkyLight | None, pl: PeriodLight | None,
+                   tables: list[list[dict]]) -> None:
+    if args.heatmaps:
+        folder = _folder(args.heatmaps)
+        n = 0
+        if res is not None:
+            n += len(write_heatmaps(folder, res, args.heatmap_bin)) // 2
+        if sky is not None:
+            n += _write_maps(folder, "diffuse", label,
+                             [sky.transmission_map(float(h)) for h in sky.heights_cm],
+                             "diffuse transmission",
+                             f"{SKY_KINDS[sky.sky.kind].split(',')[0]}, {sky.sky.split} split of "
+                             f"{sky.sky.n} directions; level {label}; {sky.rays:,} sensors per "
+                             "direction")
+        if pl is not None and pl.n_steps:
+            p = pl.period
+            n += _write_maps(folder, "period", label,
+                             [pl.transmission_map(float(h)) for h in pl.heights_cm],
+                             "fraction of the period's PAR",
+                             f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M}, "
+                             f"{p.n_steps} steps; level {label}")
+        say(f"wrote {n} transmission maps (PNG + CSV) to {folder}")
+    if pl is not None and args.steps:
+        path = args.steps if n_levels == 1 else suffixed(args.steps, label)
+        _write_steps(path, pl)
+    if pl is not None and args.plots:
+        from maizeviz.light.plots import day_figure
+
+        folder = _folder(args.plots)
+        p = pl.period
+        title = (f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M} ({p.start.tz}); "
+                 f"{p.source}; level {label}")
+        path = folder / f"day_{_tag(label)}.png"
+        save_figure(day_figure(pl, title), path)
+        say(f"wrote {path}")
+    if tables:
+        rows = merge_rows(*tables)
+        for r in rows:
+            r["level"] = label
+        if args.leaf_light:
+            write_rows(args.leaf_light if n_levels == 1 else suffixed(args.leaf_light, label), rows)
+        if args.plant_light:
+            write_rows(args.plant_light if n_levels == 1 else suffixed(args.plant_light, label),
+                       plant_light(rows))
+
+
+def _write_steps(path: str | Path, pl: PeriodLight) -> None:
+    """One line per time step (sun up), atomically."""
+    import csv
+
+    p = pl.period
+    hs = [f"{h:g}".replace(".", "p") for h in pl.heights_cm]
+    head = (["time", "step_s", "zenith_deg", "azimuth_deg", "ghi_w_m2", "direct_horizontal_w_m2",
+             "diffuse_w_m2", "par_direct_mol_m2", "par_diffuse_mol_m2", "par_intercepted_mol_m2",
+             "fraction_intercepted"] + [f"direct_transmission_h{h}cm" for h in hs]
+            + [f"par_transmitted_mol_m2_h{h}cm" for h in hs])
+    with atomic_open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(head)
+        for j in range(pl.n_steps):
+            w.writerow([p.times[j].isoformat(), f"{p.step_s[j]:g}", f"{p.zenith_deg[j]:.3f}",
+                        f"{p.azimuth_deg[j]:.3f}", f"{p.ghi[j]:.2f}",
+                        f"{p.direct_horizontal[j]:.2f}", f"{p.dhi[j]:.2f}",
+                        f"{pl.step_direct_mol_m2[j]:.6f}", f"{pl.step_diffuse_mol_m2[j]:.6f}",
+                        f"{pl.step_intercepted_mol_m2[j]:.6f}",
+                        f"{pl.step_fraction_intercepted[j]:.5f}"]
+                       + [f"{t:.5f}" for t in pl.step_transmission[j]]
+                       + [f"{t:.6f}" for t in pl.step_transmitted_mol_m2[j]])
+
+
+# ------------------------------------------------------------------------------ tables
+def _print_tables(records: list[dict], sun: Sun | None, heights: tuple[float, ...],
                   args: argparse.Namespace) -> None:
     r0 = records[0]
+    if sun is not None:
+        _print_sun(records, sun, heights, args)
+    if r0.get("diffuse"):
+        _print_sky(records, heights, args)
+    if "period" in r0:
+        for r in records:
+            _print_period(r, len(records) > 1)
+    print()
+    t_ref = _cost(r0)
+    cols = ["level", "triangles", "canopy s", "scene s"]
+    cols += ["trace s"] if sun is not None else []
+    cols += ["sky s"] if "sky" in r0["seconds"] else []
+    cols += ["period s"] if "period" in r0["seconds"] else []
+    cols += ["scene+trace vs first"]
+    rows = []
+    for r in records:
+        sec = r["seconds"]
+        row = [r["level"], r["triangles"], f"{sec['canopy']:.2f}", f"{sec['scene']:.2f}"]
+        if sun is not None:
+            row.append(f"{sec['trace']:.3f}")
+        if "sky" in sec:
+            row.append(f"{sec['sky']:.2f}")
+        if "period" in sec:
+            row.append(f"{sec['period']:.2f}")
+        row.append(f"{_cost(r) / t_ref:.0%}" if t_ref > 0 else "")
+        rows.append(row)
+    print(fmt_table(cols, rows))
+
+
+def _cost(r: dict) -> float:
+    sec = r["seconds"]
+    return (sec["scene"] + sec.get("trace", 0.0) + sec.get("sky", 0.0)
+            + sec.get("period", 0.0))
+
+
+def _print_sun(records: list[dict], sun: Sun, heights: tuple[float, ...],
+               args: argparse.Namespace) -> None:
+    r0 = records[0]
     rc = ", ".join(f"{v:.1f}" for v in r0["rect_cm"])
-    print(f"direct light: {r0['rays']:,} rays over x0,y0,x1,y1 = {rc} cm "
+    print(f"direct light: {r0['rays']:,} sensors per plane over x0,y0,x1,y1 = {rc} cm "
           f"({r0['density_per_cm2']:.2f} per cm2), sun zenith {sun.zenith_deg:.2f} deg, "
           f"azimuth {sun.azimuth_deg:.2f} deg{', periodic field' if args.periodic else ''}")
     head = ["height cm"] + [r["level"] for r in records]
@@ -163,20 +569,68 @@ def _print_tables(records: list[dict], sun: Sun, heights: tuple[float, ...],
     for i, h in enumerate(heights):
         row = [f"{h:g}"] + [f"{r['transmission'][i]:.3f}" for r in records]
         if args.check:
-            row.append(f"{records[0]['beer_lambert']['transmission'][i]:.3f}")
+            row.append(f"{r0['beer_lambert']['transmission'][i]:.3f}")
         rows.append(row)
     print(fmt_table(head, rows))
     if args.check:
-        bl = records[0]["beer_lambert"]
-        omega = clumping(records[0]["transmission"][0], bl["transmission"][0])
-        print(f"Beer-Lambert with G = {bl['G']:.3f} and L(h) from the {records[0]['level']} "
+        bl = r0["beer_lambert"]
+        omega = clumping(r0["transmission"][0], bl["transmission"][0])
+        print(f"Beer-Lambert with G = {bl['G']:.3f} and L(h) from the {r0['level']} "
               f"mesh; effective clumping at {heights[0]:g} cm: ln T / ln T_BL = {omega:.2f} "
               "(1: random foliage; below 1: clumped, T above Beer-Lambert, as in most row "
               "crops (0.7-1); above 1: more regular than random)")
     print()
-    t_ref = records[0]["seconds"]["scene"] + records[0]["seconds"]["trace"]
-    print(fmt_table(
-        ["level", "triangles", "canopy s", "scene s", "trace s", "scene+trace vs first"],
-        [[r["level"], r["triangles"], f"{r['seconds']['canopy']:.2f}",
-          f"{r['seconds']['scene']:.2f}", f"{r['seconds']['trace']:.3f}",
-          f"{(r['seconds']['scene'] + r['seconds']['trace']) / t_ref:.0%}"] for r in records]))
+
+
+def _print_sky(records: list[dict], heights: tuple[float, ...],
+               args: argparse.Namespace) -> None:
+    d0 = records[0]["diffuse"]
+    rc = ", ".join(f"{v:.1f}" for v in d0["rect_cm"])
+    print(f"diffuse light: {d0['description']}; {d0['rays_per_direction']:,} sensors per plane "
+          f"and direction over x0,y0,x1,y1 = {rc} cm"
+          f"{', periodic field' if args.periodic else ''}")
+    head = ["height cm"] + [f"{r['level']} diffuse T" for r in records]
+    if args.check:
+        head += ["Beer-Lambert"]
+    rows = []
+    for i, h in enumerate(heights):
+        row = [f"{h:g}"] + [f"{r['diffuse']['transmission'][i]:.3f}" for r in records]
+        if args.check:
+            row.append(f"{d0['beer_lambert']['transmission'][i]:.3f}")
+        rows.append(row)
+    print(fmt_table(head, rows))
+    print("leaves intercept " + ", ".join(
+        f"{r['diffuse']['intercepted_fraction']:.3f}" + (f" ({r['level']})" if len(records) > 1
+                                                         else "")
+        for r in records) + " of the diffuse light (first hits; scattering not followed)")
+    if args.check:
+        bl = d0["beer_lambert"]
+        print(f"Beer-Lambert under the same sky: sum of w_i exp(-G_i L(h)/cos theta_i), G_i "
+              f"from the {records[0]['level']} mesh (weighted mean {bl['G']:.3f})")
+    print()
+
+
+def _print_period(r: dict, label: bool) -> None:
+    p = r["period"]
+    print(f"period{' (' + r['level'] + ')' if label else ''}: {p['start']} to {p['end']}, "
+          f"{p['steps']} time steps with the sun up")
+    print(f"irradiance: {p['source']}")
+    print(f"PAR = {p['par_umol_per_j']:.4g} umol per J of shortwave; shortwave "
+          f"{p['shortwave_mj_m2']:.2f} MJ/m2")
+    frac = p["fraction_intercepted"]
+    if not p["steps"]:
+        print("no sunlight in this period: incident, intercepted and transmitted PAR are 0")
+        return
+    inc = p["par_incident_mol_m2"]
+    print(f"PAR incident {inc:.2f} mol/m2 of ground (direct {p['par_direct_mol_m2']:.2f}, "
+          f"diffuse {p['par_diffuse_mol_m2']:.2f}, {p['par_diffuse_mol_m2'] / inc:.0%} "
+          f"diffuse); intercepted by the leaves {p['par_intercepted_mol_m2']:.2f} mol/m2 "
+          f"({frac:.1%})")
+    tb = p["transmission_by_height"]
+    diffuse = r.get("diffuse") or {}
+    print(fmt_table(["height cm", "PAR mol/m2", "fraction", "diffuse T"],
+                    [[f"{h:g}", f"{v:.2f}", f"{f:.3f}" if f is not None else "",
+                      f"{diffuse['transmission'][i]:.3f}" if diffuse else ""]
+                     for i, (h, v, f) in enumerate(zip(tb["heights_cm"], tb["par_mol_m2"],
+                                                       tb["fraction"]))]))
+    print()

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
+from maizeviz.light.sky import Sky
 from maizeviz.light.sun import Sun
 from maizeviz.mesh.tessellate import triangle_areas_normals
 
@@ -49,3 +50,20 @@ def clumping(traced: float, beer_lambert_t: float) -> float:
     if 0 < traced < 1 and 0 < beer_lambert_t < 1:
         return math.log(traced) / math.log(beer_lambert_t)
     return float("nan")
+
+
+def beer_lambert_sky(canopy: Canopy, sky: Sky,
+                     heights_cm: np.ndarray | tuple[float, ...]) -> BeerLambert:
+    """Beer-Lambert diffuse transmission under a sky: sum_i w_i exp(-G_i L(h) / cos(theta_i)),
+    with G_i and L(h) from the mesh as in :func:`beer_lambert`.
+
+    Returns
+    -------
+    BeerLambert with transmission (H,), G the weight-averaged G_i, lai_above (H,) m2/m2
+    """
+    area, normals = triangle_areas_normals(canopy.vertices, canopy.faces)
+    dirs = sky.field_directions(canopy.layout.north_deg)
+    g = (area[:, None] * np.abs(normals @ dirs.T)).sum(axis=0) / area.sum()      # (n,)
+    lai = beer_lambert(canopy, Sun(0.0, 0.0), heights_cm).lai_above
+    t = np.exp(-np.outer(lai, g / dirs[:, 2])) @ sky.weights
+    return BeerLambert(t, float(g @ sky.weights), lai)

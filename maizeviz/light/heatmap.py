@@ -1,5 +1,6 @@
-"""Transmission maps: binned transmission over a sample plane, as a matplotlib figure, PNG and
-CSV (matplotlib's Agg canvas: no GUI toolkit; the app shows the same figure)."""
+"""Transmission maps: binned transmission over a sensor plane (the sample rectangle raised to a
+height, in its own x, y), as a matplotlib figure, PNG and CSV (matplotlib's Agg canvas: no GUI
+toolkit; the app shows the same figure)."""
 
 from __future__ import annotations
 
@@ -26,8 +27,8 @@ class TransmissionMap:
     ----------
     height_cm : the plane's height
     x_edges : (a + 1,) cm; y_edges : (b + 1,) cm
-    transmission : (a, b), NaN in bins no ray crossed
-    rays : (a, b) int, rays per bin
+    transmission : (a, b), NaN in bins without a sensor
+    rays : (a, b) int, sensors per bin
     total : transmission of the whole plane
     """
 
@@ -39,31 +40,57 @@ class TransmissionMap:
     total: float
 
 
-def transmission_map(result: LightResult, height: float, bin_cm: float = 5.0) -> TransmissionMap:
-    """Binned transmission at ``height`` over where the rays cross that plane."""
+def bin_edges(rect: tuple[float, float, float, float],
+              bin_cm: float) -> tuple[np.ndarray, np.ndarray]:
+    """Bin edges (a + 1,), (b + 1,) cm over the rectangle, bins as close to ``bin_cm`` as fit."""
     if not bin_cm > 0:
         raise MaizevizError(f"the heatmap bin must be > 0 cm, got {bin_cm}", quantity="heatmap_bin")
-    xy = result.crossings(height)
-    reached = result.first_z < height
-    x0, y0, x1, y1 = result.rect
-    sx, sy = xy[:, 0].min() - x0, xy[:, 1].min() - y0          # the rectangle, shifted
+    x0, y0, x1, y1 = rect
     nx = max(1, int(round((x1 - x0) / bin_cm)))
     ny = max(1, int(round((y1 - y0) / bin_cm)))
-    xe = np.linspace(x0, x1, nx + 1) + sx
-    ye = np.linspace(y0, y1, ny + 1) + sy
-    counts, _, _ = np.histogram2d(xy[:, 0], xy[:, 1], [xe, ye])
-    lit, _, _ = np.histogram2d(xy[reached, 0], xy[reached, 1], [xe, ye])
+    return np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1)
+
+
+def binned(xy: np.ndarray, lit: np.ndarray, xe: np.ndarray,
+           ye: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Sensors per bin and lit sensors per bin: two (a, b) float64 arrays.
+
+    Parameters
+    ----------
+    xy : (N, 2) cm, sensor positions; lit : (N,) bool or float weights
+    xe, ye : evenly spaced bin edges (:func:`bin_edges`), cm; sensors on the last edge fall in
+        the last bin
+    """
+    i = np.clip(((xy[:, 0] - xe[0]) * ((len(xe) - 1) / (xe[-1] - xe[0]))).astype(np.int64),
+                0, len(xe) - 2)
+    j = np.clip(((xy[:, 1] - ye[0]) * ((len(ye) - 1) / (ye[-1] - ye[0]))).astype(np.int64),
+                0, len(ye) - 2)
+    flat = i * (len(ye) - 1) + j
+    size = (len(xe) - 1) * (len(ye) - 1)
+    counts = np.bincount(flat, minlength=size).astype(np.float64)
+    lit_counts = np.bincount(flat, weights=np.asarray(lit, dtype=np.float64), minlength=size)
+    shape = (len(xe) - 1, len(ye) - 1)
+    return counts.reshape(shape), lit_counts.reshape(shape)
+
+
+def transmission_map(result: LightResult, height: float, bin_cm: float = 5.0) -> TransmissionMap:
+    """Binned transmission on the sensor plane at ``height`` (one of the traced heights), in the
+    rectangle's own x, y."""
+    xe, ye = bin_edges(result.rect, bin_cm)
+    k = result.height_index(height)
+    counts, lit = binned(result.sensor_xy(k), result.lit(k), xe, ye)
     with np.errstate(invalid="ignore", divide="ignore"):
         t = np.where(counts > 0, lit / counts, np.nan)
-    k = int(np.argmin(np.abs(result.heights_cm - height)))
-    total = float(result.transmission[k]) if result.heights_cm[k] == height else \
-        float(np.count_nonzero(reached) / len(reached))
-    return TransmissionMap(float(height), xe, ye, t, counts.astype(np.int64), total)
+    return TransmissionMap(float(result.heights_cm[k]), xe, ye, t, counts.astype(np.int64),
+                           float(result.transmission[k]))
 
 
-def heatmap_figure(tmap: TransmissionMap, result: LightResult, width_in: float = 8.0,
-                   dpi: int = 110) -> Figure:
-    """A figure of one map: colour bar, axes in cm, sun angles, level and rays in the title."""
+def heatmap_figure(tmap: TransmissionMap, result: LightResult | None = None,
+                   width_in: float = 8.0, dpi: int = 110, title: str | None = None,
+                   what: str = "direct-light transmission") -> Figure:
+    """A figure of one map: colour bar, axes in cm; the title names the sun angles, level and
+    rays of ``result``, or is ``title`` (the first line always names ``what``, the height and
+    the plane's total)."""
     from matplotlib.figure import Figure
 
     xe, ye = tmap.x_edges, tmap.y_edges
@@ -76,11 +103,15 @@ def heatmap_figure(tmap: TransmissionMap, result: LightResult, width_in: float =
     ax.set_xlabel("x (cm, across rows)")
     ax.set_ylabel("y (cm, along rows)")
     bin_cm = (xe[-1] - xe[0]) / max(len(xe) - 1, 1)
-    ax.set_title(f"direct-light transmission at {tmap.height_cm:g} cm: {tmap.total:.3f}\n"
-                 f"sun zenith {result.sun.zenith_deg:.1f} deg, azimuth "
+    if title is None and result is not None:
+        title = (f"sun zenith {result.sun.zenith_deg:.1f} deg, azimuth "
                  f"{result.sun.azimuth_deg:.1f} deg; level {result.level}; "
-                 f"{result.rays:,} rays, {bin_cm:.3g} cm bins", fontsize=9)
-    fig.colorbar(im, ax=ax, label="transmission (fraction of rays reaching this height)",
+                 f"{result.rays:,} sensors, {bin_cm:.3g} cm bins")
+    import textwrap
+
+    ax.set_title(f"{what} at {tmap.height_cm:g} cm: {tmap.total:.3f}"
+                 + ("\n" + "\n".join(textwrap.wrap(title, 95)) if title else ""), fontsize=9)
+    fig.colorbar(im, ax=ax, label="transmission (fraction of the light reaching this height)",
                  shrink=0.8)
     fig.tight_layout()
     return fig

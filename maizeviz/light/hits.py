@@ -86,6 +86,21 @@ def first_hits(tracer: Tracer, rays: SunRays, a: int, b: int,
     return prim, z
 
 
+def lattice_first_hits(tracer: Tracer, rays: SunRays, i: np.ndarray, j: np.ndarray,
+                       ids: bool) -> tuple[np.ndarray | None, np.ndarray]:
+    """First hits of the rays of the same family landing on lattice cells (i, j) of the ground
+    grid extended beyond the rectangle (i across x, j along y; any integers): ids (k,) int32
+    (None unless ``ids``) and heights (k,) float32 cm, -inf where none."""
+    nx, ny = rays.shape
+    x0, y0, x1, y1 = rays.rect
+    org = np.empty((len(i), 3))
+    org[:, 0] = x0 + (i + 0.5) * ((x1 - x0) / nx) + rays.sun[0] * rays.reach
+    org[:, 1] = y0 + (j + 0.5) * ((y1 - y0) / ny) + rays.sun[1] * rays.reach
+    org[:, 2] = rays.top
+    prim, dist = tracer.trace(org, np.full(len(i), rays.reach, np.float32), ids=ids)
+    return prim, (rays.top - dist * rays.sun[2]).astype(np.float32)
+
+
 def second_hits(tracer: Tracer, rays: SunRays, a: int, b: int, first_prim: np.ndarray,
                 first_z: np.ndarray) -> np.ndarray:
     """Triangle ids of the second hits of rays a..b, given their first hits (ids (b - a,) and

@@ -48,13 +48,19 @@ import datetime as _dt
 import io
 import math
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from maizeviz.errors import MaizevizError
+from maizeviz.io.inputs import read_input
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: Share of shortwave (global) radiation in the PAR band (400-700 nm).
 PAR_FRACTION = 0.48
@@ -107,11 +113,11 @@ def _check_place(lat, lon) -> tuple[float, float]:
     try:
         lat, lon = float(lat), float(lon)
     except (TypeError, ValueError):
-        raise MaizevizError(f"latitude and longitude must be numbers, got {lat!r}, {lon!r}") \
-            from None
+        raise MaizevizError(f"latitude and longitude must be numbers, got {lat!r}, {lon!r}",
+                            quantity="place") from None
     if not (-90 <= lat <= 90) or not (-180 <= lon <= 360):
         raise MaizevizError(f"latitude must be in [-90, 90] and longitude in [-180, 360], "
-                            f"got {lat}, {lon}")
+                            f"got {lat}, {lon}", quantity="place")
     return lat, lon
 
 
@@ -119,7 +125,7 @@ def _check_altitude(altitude) -> float:
     if not isinstance(altitude, (int, float, np.floating, np.integer)) \
             or not math.isfinite(altitude) or not (-500 <= altitude <= 9000):
         raise MaizevizError(f"site altitude must be a number of metres in [-500, 9000], "
-                            f"got {altitude!r}")
+                            f"got {altitude!r}", quantity="altitude")
     return float(altitude)
 
 
@@ -127,7 +133,7 @@ def _check_par_factor(par_umol_per_j) -> float:
     if not isinstance(par_umol_per_j, (int, float, np.floating, np.integer)) \
             or not math.isfinite(par_umol_per_j) or not (0 < par_umol_per_j <= 10):
         raise MaizevizError(f"PAR conversion factor must be in (0, 10] umol per J of "
-                            f"shortwave, got {par_umol_per_j!r}")
+                            f"shortwave, got {par_umol_per_j!r}", quantity="par_factor")
     return float(par_umol_per_j)
 
 
@@ -138,7 +144,7 @@ def _time_zone(tz: str):
         return zoneinfo.ZoneInfo(str(tz))
     except (zoneinfo.ZoneInfoNotFoundError, ValueError, TypeError):
         raise MaizevizError(f"unknown time zone '{tz}' (give an IANA name such as "
-                            f"Asia/Shanghai, or UTC)") from None
+                            f"Asia/Shanghai, or UTC)", quantity="tz") from None
 
 
 def _localize(day: _dt.date, clock: str, tz, what: str):
@@ -151,14 +157,15 @@ def _localize(day: _dt.date, clock: str, tz, what: str):
     try:
         t = _dt.time.fromisoformat(text)
     except ValueError:
-        raise MaizevizError(f"the {what} time must be HH:MM (local clock), got '{clock}'") \
-            from None
+        raise MaizevizError(f"the {what} time must be HH:MM (local clock), got '{clock}'",
+                            quantity="period") from None
     naive = pd.Timestamp(_dt.datetime.combine(day, t))
     try:
         return naive.tz_localize(tz, ambiguous="raise", nonexistent="raise")
     except ValueError:  # pandas' NonExistentTimeError / AmbiguousTimeError
         raise MaizevizError(f"the {what} time {text} on {day} does not exist or occurs twice "
-                            f"in {tz} (a daylight-saving change); pick another time") from None
+                            f"in {tz} (a daylight-saving change); pick another time",
+                            quantity="period") from None
 
 
 def _solar_position(times, lat, lon, altitude):
@@ -198,18 +205,18 @@ class SunTrack:
     notes : tuple of str: things said once about the period (polar night...)
     """
 
-    times: object
+    times: pd.DatetimeIndex
     step_s: np.ndarray
     zenith_deg: np.ndarray
     true_zenith_deg: np.ndarray
     azimuth_deg: np.ndarray
-    start: object
-    end: object
+    start: pd.Timestamp
+    end: pd.Timestamp
     latitude: float
     longitude: float
     altitude_m: float
     tz: str
-    notes: tuple = ()
+    notes: tuple[str, ...] = ()
 
     def __post_init__(self):
         for name in ("step_s", "zenith_deg", "true_zenith_deg", "azimuth_deg"):
@@ -274,25 +281,26 @@ def sun_track(date, lat: float, lon: float, tz: str, step_min: float = 30.0,
     try:
         day = date if isinstance(date, _dt.date) else _dt.date.fromisoformat(str(date))
     except ValueError:
-        raise MaizevizError(f"the date must be YYYY-MM-DD, got '{date}'") from None
+        raise MaizevizError(f"the date must be YYYY-MM-DD, got '{date}'",
+                            quantity="date") from None
     zone = _time_zone(tz)
     if isinstance(step_min, bool) or not isinstance(step_min, (int, float, np.integer,
                                                               np.floating)) \
             or not math.isfinite(step_min) or step_min <= 0:
-        raise MaizevizError(f"the time step must be > 0 min, got {step_min!r}")
+        raise MaizevizError(f"the time step must be > 0 min, got {step_min!r}", quantity="step")
     t0 = _localize(day, start or "00:00", zone, "start")
     t1 = _localize(day, end or "24:00", zone, "end")
     total = (t1 - t0).total_seconds()
     if total <= 0:
         raise MaizevizError(f"the period must end after it starts, got {start or '00:00'} to "
-                            f"{end or '24:00'}")
+                            f"{end or '24:00'}", quantity="period")
     step_s = float(step_min) * 60.0
     if step_s > total + 1e-6:
         raise MaizevizError(f"the time step ({_fmt_duration(step_s)}) is longer than the "
-                            f"period ({_fmt_duration(total)})")
+                            f"period ({_fmt_duration(total)})", quantity="step")
     if total / step_s > MAX_STEPS:
         raise MaizevizError(f"a time step of {step_min:g} min gives {total / step_s:.0f} steps, "
-                            f"more than {MAX_STEPS}")
+                            f"more than {MAX_STEPS}", quantity="step")
     edges = _step_edges(total, step_s)
     mids = (edges[:-1] + edges[1:]) / 2.0
     times = t0 + pd.to_timedelta(np.round(mids * 1e6).astype(np.int64), unit="us")
@@ -330,7 +338,7 @@ class Period:
     rounded sum (math.fsum) of its steps.
     """
 
-    times: object
+    times: pd.DatetimeIndex
     step_s: np.ndarray
     zenith_deg: np.ndarray
     azimuth_deg: np.ndarray
@@ -338,12 +346,12 @@ class Period:
     dni: np.ndarray
     dhi: np.ndarray
     direct_horizontal: np.ndarray
-    start: object
-    end: object
+    start: pd.Timestamp
+    end: pd.Timestamp
     source: str
-    parameters: object = field(default_factory=dict)
+    parameters: Mapping[str, object] = field(default_factory=dict)
     par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J
-    notes: tuple = ()
+    notes: tuple[str, ...] = ()
 
     def __post_init__(self):
         n = len(self.times)
@@ -485,7 +493,7 @@ def clear_sky(track: SunTrack, linke_turbidity: float = DEFAULT_LINKE_TURBIDITY,
             linke_turbidity, (int, float, np.integer, np.floating)) \
             or not math.isfinite(linke_turbidity) or not (1 <= linke_turbidity <= 10):
         raise MaizevizError(f"Linke turbidity must be a number in [1, 10], got "
-                            f"{linke_turbidity!r}")
+                            f"{linke_turbidity!r}", quantity="linke_turbidity")
     par = _check_par_factor(par_umol_per_j)
     params = {"model": "ineichen", "linke_turbidity": float(linke_turbidity),
               "altitude_m": track.altitude_m, "airmass_model": "kastenyoung1989",
@@ -543,15 +551,15 @@ class Weather:
     """
 
     path: str
-    times: object
+    times: pd.DatetimeIndex
     step_s: np.ndarray
     ghi: np.ndarray
     dni: np.ndarray | None
     dhi: np.ndarray | None
     line: np.ndarray
     label: str
-    start: object
-    end: object
+    start: pd.Timestamp
+    end: pd.Timestamp
 
     def __post_init__(self):
         for name in ("step_s", "ghi", "dni", "dhi"):
@@ -559,29 +567,15 @@ class Weather:
                 object.__setattr__(self, name, _frozen(getattr(self, name)))
 
     @property
-    def columns(self) -> tuple:
+    def columns(self) -> tuple[str, ...]:
         """Irradiance columns the file gave."""
         return ("ghi", *(c for c in WEATHER_OPTIONAL if getattr(self, c) is not None))
 
 
 def _read_text(path: Path, max_bytes: int) -> str:
-    try:
-        size = path.stat().st_size
-    except FileNotFoundError:
-        raise WeatherFileError(f"{path}: no such weather file") from None
-    except OSError as exc:
-        raise WeatherFileError(f"{path}: cannot be read ({exc.strerror})") from None
-    if path.is_dir():
-        raise WeatherFileError(f"{path}: is a folder, not a weather file")
-    if size > max_bytes:
-        raise WeatherFileError(f"{path}: the weather file is {size / 2 ** 20:.1f} MiB, more "
-                               f"than the {max_bytes / 2 ** 20:g} MiB limit; split it")
-    if size == 0:
+    raw = read_input(path, "weather file", max_bytes, WeatherFileError)
+    if not raw:
         raise WeatherFileError(f"{path}: the weather file is empty")
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise WeatherFileError(f"{path}: cannot be read ({exc.strerror})") from None
     if b"\x00" in raw[:4096]:
         raise WeatherFileError(f"{path}: not a CSV text file (binary content)")
     try:
@@ -660,7 +654,7 @@ def _parse_times(texts: list, lines: list, path: Path, tz):
         try:
             aware = local.tz_localize(tz, ambiguous="raise", nonexistent="raise")
         except ValueError:  # pandas' NonExistentTimeError / AmbiguousTimeError
-            for k, t in zip(naive, local, strict=True):
+            for k, t in zip(naive.tolist(), local, strict=True):
                 try:
                     t.tz_localize(tz, ambiguous="raise", nonexistent="raise")
                 except ValueError:
@@ -700,7 +694,7 @@ def _parse_values(texts: list, lines: list, times: list, column: str, path: Path
         ok = np.isfinite(values) & (values >= 0) & (values <= MAX_IRRADIANCE_W_M2)
         bad = np.flatnonzero(~ok)
     except ValueError:                              # an empty or non-numeric cell somewhere
-        values, bad = None, range(len(texts))
+        values, bad = None, np.arange(len(texts))
     for k in bad:
         problem = _value_problem(texts[k])
         if problem:
@@ -781,7 +775,7 @@ def read_weather(path, tz: str | None = None, label: str = "center",
     first = next(rows, None)
     if first is None:
         raise WeatherFileError(f"{path}: the weather file is empty (no header, no rows)")
-    columns = _header(*first, path)
+    columns = _header(first[0], first[1], path)
     lines, data = [], []
     for line, fields in rows:
         if len(fields) != len(columns):

@@ -2,9 +2,16 @@
 
 Rays lie on a regular grid of ``density`` rays per cm2 (cell centres, x slow and y fast so
 neighbouring rays stay together: Embree is about twice as fast on coherent rays). The
-:class:`Tracer` follows rays through an Embree scene; with a periodic field a ray that leaves
-the plot sideways re-enters through the opposite side (the plot repeats forever, as Helios,
-Caribu and LESS do), segment by segment, until it has gone its full length.
+:class:`Tracer` follows rays through an Embree scene, asking either for the first hit
+(:meth:`Tracer.trace`) or only whether anything is hit (:meth:`Tracer.occluded`, Embree's
+cheaper occlusion query); with a periodic field a ray that leaves the plot sideways re-enters
+through the opposite side (the plot repeats forever, as Helios, Caribu and LESS do), segment by
+segment, until it has gone its full length.
+
+Sensor planes (:func:`sensor_offsets`): the sample rectangle raised to each height h carries the
+same grid, slid by less than half a cell so that the sun path from a sample point at one height
+passes through a sample point of every height above it. In a periodic field whose period is the
+rectangle the sampled transmission then never increases downward, as in the continuum.
 """
 
 from __future__ import annotations
@@ -48,6 +55,31 @@ def ray_grid(rect: Rect, density: float, start: int = 0,
     return pts, (x1 - x0) * (y1 - y0) / (nx * ny)
 
 
+def sensor_offsets(heights_cm: np.ndarray, toward_sun: np.ndarray, rect: Rect,
+                   density: float) -> np.ndarray:
+    """Offsets (H, 2) cm of the sample grid at each height from the ground grid's cell centres.
+
+    The sun path from a ground cell centre crosses height h at ``h * s_xy / s_z`` from it; the
+    grid at h is slid by that distance modulo the cell (to within +- half a cell), so that it
+    stays inside the rectangle and every path through a sample point at one height meets a
+    sample point of every other height (modulo the rectangle, in a periodic field). A vertical
+    sun gives zero offsets.
+
+    Parameters
+    ----------
+    heights_cm : (H,) float64, cm
+    toward_sun : (3,) unit vector toward the sun (z > 0)
+    rect : (x0, y0, x1, y1) cm; density : rays per cm2
+    """
+    x0, y0, x1, y1 = rect
+    nx, ny = grid_shape(rect, density)
+    cell = np.array([(x1 - x0) / nx, (y1 - y0) / ny])
+    h = np.asarray(heights_cm, dtype=np.float64)
+    shift = h[:, None] * (np.asarray(toward_sun[:2], dtype=np.float64) / float(toward_sun[2]))
+    t = shift / cell
+    return (t - np.round(t)) * cell
+
+
 class Tracer:
     """Follows rays along one direction through a scene, wrapping them across the plot when
     periodic.
@@ -67,6 +99,8 @@ class Tracer:
         self.down = np.asarray(direction, dtype=np.float64)
         self.bounds = bounds
         self.periodic = periodic
+        # overhang copies of a periodic scene are reported as the triangles they copy
+        self.source = getattr(scene, "source", None)
         # one writable float32 direction buffer, sliced per chunk (embreex needs writable input)
         self.dirs = np.tile(self.down.astype(np.float32), (max(size, 1), 1))
 
@@ -108,6 +142,31 @@ class Tracer:
         t = self.scene.distance(org, dirs, length)
         return None, t, t < np.asarray(length, np.float32)
 
+    def occluded(self, org: np.ndarray, length: np.ndarray) -> np.ndarray:
+        """Whether anything lies on the rays from ``org`` (N, 3) cm within ``length`` (N,) cm:
+        (N,) bool. Embree's occlusion query (any hit, not the nearest), wrapped like
+        :meth:`trace` in a periodic field."""
+        n = len(org)
+        if not self.periodic:
+            return self.scene.occluded(org, self.dirs[:n], length)
+        blocked = np.zeros(n, dtype=bool)
+        todo = np.arange(n)
+        org = self._wrap(np.asarray(org, dtype=np.float64).copy())
+        remaining = np.asarray(length, dtype=np.float64).copy()
+        for _ in range(10_000):
+            if not len(todo):
+                break
+            seg = np.minimum(self._exit(org), remaining)
+            hit = self.scene.occluded(org, self.dirs[: len(org)], seg)
+            blocked[todo[hit]] = True
+            go = ~hit & (remaining - seg > 1e-6)
+            todo, org = todo[go], org[go] + seg[go, None] * self.down
+            remaining = remaining[go] - seg[go]
+            org = self._cross(org)
+        if len(todo):  # pragma: no cover - a ray advances by at least one plot crossing a step
+            raise MaizevizError(f"periodic tracing left {len(todo)} rays unfinished")
+        return blocked
+
     def trace(self, org: np.ndarray, length: np.ndarray,
               ids: bool = True) -> tuple[np.ndarray | None, np.ndarray]:
         """First hit of rays from ``org`` (N, 3) cm within ``length`` (N,) cm.
@@ -115,6 +174,14 @@ class Tracer:
         Returns triangle ids (N,) int32, -1 where none (None unless ``ids``), and hit distances
         (N,) float64 cm (inf where none).
         """
+        prim, dist = self._trace(org, length, ids)
+        if prim is not None and self.source is not None:
+            hit = prim >= 0
+            prim[hit] = self.source[prim[hit]]
+        return prim, dist
+
+    def _trace(self, org: np.ndarray, length: np.ndarray,
+               ids: bool) -> tuple[np.ndarray | None, np.ndarray]:
         n = len(org)
         prim = np.full(n, -1, dtype=np.int32) if ids else None
         dist = np.full(n, np.inf)

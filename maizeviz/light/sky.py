@@ -106,7 +106,8 @@ _GL_LEVELS = 1  # each fan triangle of a cell is split in 4**levels before the q
 def _check_kind(kind: str) -> str:
     key = str(kind).strip().lower()
     if key not in SKY_KINDS:
-        raise MaizevizError(f"unknown sky kind '{kind}' (known: {', '.join(SKY_KINDS)})")
+        raise MaizevizError(f"unknown sky kind '{kind}' (known: {', '.join(SKY_KINDS)})",
+                            quantity="sky")
     return key
 
 
@@ -358,11 +359,11 @@ def equal_area_bands(n: int) -> tuple[np.ndarray, np.ndarray]:
         if min(counts) >= 1 or bands == 1:
             break
         bands -= 1
-    counts = np.array([1, *counts], dtype=np.int64)
-    counts[-1] += n - counts.sum()                 # absorbs rounding of the carry, if any
-    c_edges = 1.0 - np.concatenate([[0], np.cumsum(counts)]) / n
+    per_band = np.array([1, *counts], dtype=np.int64)
+    per_band[-1] += n - per_band.sum()             # absorbs rounding of the carry, if any
+    c_edges = 1.0 - np.concatenate([[0], np.cumsum(per_band)]) / n
     c_edges[-1] = 0.0
-    return c_edges, counts
+    return c_edges, per_band
 
 
 def _equal_sky(kind: str, n: int) -> Sky:
@@ -403,7 +404,7 @@ def turtle_directions(n: int = 46) -> tuple[np.ndarray, np.ndarray]:
     """
     if n not in TURTLE_SIZES:
         raise MaizevizError(f"the turtle sky has {', '.join(map(str, TURTLE_SIZES[:-1]))} or "
-                            f"{TURTLE_SIZES[-1]} directions, got {n}")
+                            f"{TURTLE_SIZES[-1]} directions, got {n}", quantity="sky_directions")
     el = np.concatenate([np.full(len(az), e) for e, az in _TURTLE_BANDS])
     az = np.concatenate([np.array(a) for _, a in _TURTLE_BANDS])
     return 90.0 - el[:n], az[:n]
@@ -507,15 +508,15 @@ def _turtle_sky(kind: str, n: int) -> Sky:
     zen, azi = turtle_directions(n)
     dirs = _unit_vectors(zen, azi)
     cells = _voronoi_cells(dirs)
-    owner, ta, tb, tc = [], [], [], []
+    owners, tas, tbs, tcs = [], [], [], []
     for i, verts in enumerate(cells):
         k = len(verts)
-        owner.append(np.full(k, i))
-        ta.append(np.repeat(dirs[i][None, :], k, axis=0))
-        tb.append(verts)
-        tc.append(np.roll(verts, -1, axis=0))
-    owner = np.concatenate(owner)
-    ta, tb, tc = np.concatenate(ta), np.concatenate(tb), np.concatenate(tc)
+        owners.append(np.full(k, i))
+        tas.append(np.repeat(dirs[i][None, :], k, axis=0))
+        tbs.append(verts)
+        tcs.append(np.roll(verts, -1, axis=0))
+    owner = np.concatenate(owners)
+    ta, tb, tc = np.concatenate(tas), np.concatenate(tbs), np.concatenate(tcs)
     solid = np.bincount(owner, weights=triangle_solid_angle(ta, tb, tc), minlength=n)
     nodes, dom = spherical_triangle_quadrature(ta, tb, tc)
     cz = np.clip(nodes[..., 2], 0.0, 1.0)
@@ -529,16 +530,19 @@ def _turtle_sky(kind: str, n: int) -> Sky:
 
 def _check_count(directions) -> int:
     if isinstance(directions, bool) or not isinstance(directions, (int, np.integer, float)):
-        raise MaizevizError(f"sky directions must be a whole number, got {directions!r}")
+        raise MaizevizError(f"sky directions must be a whole number, got {directions!r}",
+                            quantity="sky_directions")
     if isinstance(directions, float) and (not math.isfinite(directions)
                                           or directions != int(directions)):
-        raise MaizevizError(f"sky directions must be a whole number, got {directions}")
+        raise MaizevizError(f"sky directions must be a whole number, got {directions}",
+                            quantity="sky_directions")
     n = int(directions)
     if n < 1:
-        raise MaizevizError(f"sky directions must be at least 1, got {n}")
+        raise MaizevizError(f"sky directions must be at least 1, got {n}",
+                            quantity="sky_directions")
     if n > MAX_SKY_DIRECTIONS:
         raise MaizevizError(f"sky directions must be at most {MAX_SKY_DIRECTIONS}, got {n} "
-                            f"(each direction is one full tracing pass)")
+                            f"(each direction is one full tracing pass)", quantity="sky_directions")
     return n
 
 
@@ -561,11 +565,13 @@ def make_sky(kind: str = "soc", directions: int = 46, split: str = "auto") -> Sk
     n = _check_count(directions)
     key = str(split).strip().lower()
     if key not in SKY_SPLITS:
-        raise MaizevizError(f"unknown sky split '{split}' (known: {', '.join(SKY_SPLITS)})")
+        raise MaizevizError(f"unknown sky split '{split}' (known: {', '.join(SKY_SPLITS)})",
+                            quantity="sky")
     if key == "auto":
         key = "turtle" if n in TURTLE_SIZES else ("tregenza" if n == TREGENZA_SIZE else "equal")
     if key == "tregenza" and n != TREGENZA_SIZE:
-        raise MaizevizError(f"the Tregenza sky has {TREGENZA_SIZE} directions, got {n}")
+        raise MaizevizError(f"the Tregenza sky has {TREGENZA_SIZE} directions, got {n}",
+                            quantity="sky_directions")
     if key == "turtle" and n not in TURTLE_SIZES:
         turtle_directions(n)                        # raises with the sizes on offer
     return _cached_sky(kind, n, key)

@@ -1,21 +1,33 @@
-"""Direct sunlight through a canopy: transmission by height (the paper's Table 3).
+"""Direct sunlight through a canopy: transmission on sensor planes by height (the paper's Table 3).
 
-Parallel rays on a regular grid of ``density`` rays per cm2 cover the horizontal sample
-rectangle on the ground (:class:`~maizeviz.light.hits.SunRays`). Each ray is followed from above
-the canopy down toward the ground against the sun direction. Transmission at height h is the
-fraction of these rays that are still unobstructed when they pass height h. The same rays serve
-every height, so T = 1 above the canopy and T never increases going down; for a periodic canopy
-whose period is the sample rectangle this equals the sunfleck fraction of the rectangle at
-height h. The rays' first and second hits give the paper's hit classes
-(:mod:`maizeviz.light.hits`).
+Transmission at height h is measured on the sample rectangle raised to h: the same x, y
+rectangle, as a row of light sensors held at that height. The rectangle at h carries a regular
+grid of ``density`` sensors per cm2 (:func:`~maizeviz.light.rays.sensor_offsets`), and Embree is
+asked whether the path from each sensor toward the sun is blocked (an occlusion query, cheaper
+than a nearest-hit query); T(h) is the fraction of sensors whose path is clear.
 
-With ``periodic`` a ray that leaves the plot sideways re-enters on the opposite side. Without
-it, a warning says when the sun is low enough for rays reaching the rectangle to have crossed
-the plot edge, where nothing stops them.
+The paper's hit classes come from parallel rays landing on the ground rectangle
+(:class:`~maizeviz.light.hits.SunRays`): each is followed from above the canopy down toward the
+ground against the sun direction; its first leaf hit receives direct light, its second hit
+second-class light (:mod:`maizeviz.light.hits`). The ground's sensors are these rays' landing
+points, so T(0) comes from them without another query.
+
+With ``periodic`` every ray and every sensor path that leaves the plot sideways re-enters on the
+opposite side. Without it, a warning says when the sun is low enough for paths reaching the
+rectangle to have crossed the plot edge, where nothing stops them.
+
+Why not the rays' own crossings of height h (version 0.1): they lie on the ground rectangle
+shifted toward the sun by h tan(zenith), which is the same place only in a periodic canopy whose
+period is the rectangle; a single leaf at 100 cm under a 45 deg sun shades the whole rectangle at
+50 cm while the shifted crossings report half of it lit, and for a low sun the shifted rectangle
+can leave the plot. On sensor planes T need not decrease downward (a shadow can move out of the
+rectangle below a height); in a periodic field whose period is the rectangle it does, as in the
+continuum, because the grids of all heights are aligned along the sun path.
 """
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
@@ -26,14 +38,15 @@ from typing import TypeVar
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.light.hits import SunRays, first_hits, hit_counts, second_hits
-from maizeviz.light.rays import Rect, Tracer, ray_grid
-from maizeviz.light.request import LightRequest, check_request
+from maizeviz.light.hits import SunRays, first_hits, hit_counts, lattice_first_hits, second_hits
+from maizeviz.light.rays import Rect, Tracer, ray_grid, sensor_offsets
+from maizeviz.light.request import LightRequest, canopy_top, check_request
 from maizeviz.light.sun import Sun
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, report
 
-#: Rays traced per chunk: bounds memory and sets the progress step.
+#: Rays traced per chunk: bounds memory and sets the progress step (a multiple of 8, so that
+#: the sensors' bits of a chunk pack into whole bytes).
 CHUNK = 1 << 18
 
 T = TypeVar("T")
@@ -46,15 +59,21 @@ class LightResult:
     Attributes
     ----------
     sun : Sun
-    heights_cm : (H,) float64; transmission : (H,) float64 in [0, 1]
-    rays : int; rect : (x0, y0, x1, y1) cm; ray_area_cm2 : horizontal footprint of a ray
-    first_z : (N,) float32, height (cm) of each ray's first hit, -inf where none
+    heights_cm : (H,) float64; transmission : (H,) float64 in [0, 1], on the sensor planes
+    rays : int, rays (and sensors per plane); rect : (x0, y0, x1, y1) cm;
+    ray_area_cm2 : horizontal footprint of a ray (and of a sensor)
+    first_z : (N,) float32, height (cm) of each ground ray's first hit, -inf where none
     first_hits, second_hits : (F,) int64, rays whose first / second hit is each triangle
         (None unless the request asked for hit classes)
     seconds : "build" and "trace" (and "second" for second hits), s
     warnings : what the user should know about this result
     level : mesh level label; density : rays per cm2 asked for
     direction : (3,) unit vector toward the sun in field coordinates
+    sensor_lit : (H, ceil(N / 8)) uint8, the sensors of each plane whose path to the sun is
+        clear, bits packed in ray grid order (:meth:`lit`); None for results made elsewhere
+    sensor_offset_cm : (H, 2) float64 cm, where each plane's grid sits relative to the ground
+        grid's cell centres (:meth:`sensor_xy`)
+    periodic : rays and sensor paths wrapped across the plot
     """
 
     sun: Sun
@@ -71,6 +90,9 @@ class LightResult:
     warnings: tuple[str, ...] = ()
     level: str = ""
     density: float = 0.0
+    sensor_lit: np.ndarray | None = None
+    sensor_offset_cm: np.ndarray | None = None
+    periodic: bool = False
 
     @property
     def rect_area_cm2(self) -> float:
@@ -96,24 +118,146 @@ class LightResult:
         return ray_grid(self.rect, self.density)[0]
 
     def crossings(self, height: float) -> np.ndarray:
-        """Where each ray crosses the plane at ``height`` (N, 2) cm (ray grid order)."""
+        """Where each ground ray crosses the plane at ``height`` (N, 2) cm (ray grid order): the
+        rectangle shifted toward the sun, where version 0.1 measured transmission."""
         return self.ground_xy + self.direction[:2] * (height / self.direction[2])
 
+    def height_index(self, height: float) -> int:
+        """Index of ``height`` (cm) among the traced heights; MaizevizError if not traced."""
+        from maizeviz.errors import MaizevizError
 
-def light_scene(canopy: Canopy, with_stalks: bool = False) -> RayScene:
-    """The Embree scene of a canopy's leaves (and stalks): build it once, trace many suns."""
+        k = np.flatnonzero(np.isclose(self.heights_cm, height, rtol=0, atol=1e-9))
+        if not len(k):
+            raise MaizevizError(f"height {height:g} cm was not traced (traced: "
+                                f"{', '.join(f'{h:g}' for h in self.heights_cm)} cm)",
+                                quantity="heights")
+        return int(k[0])
+
+    def sensor_xy(self, k: int) -> np.ndarray:
+        """Sensor positions (N, 2) cm of the plane of height index ``k``, in ray grid order."""
+        off = np.zeros(2) if self.sensor_offset_cm is None else self.sensor_offset_cm[k]
+        return self.ground_xy + off
+
+    def lit(self, k: int) -> np.ndarray:
+        """(N,) bool: the sensors of the plane of height index ``k`` that see the sun."""
+        if self.sensor_lit is None:
+            from maizeviz.errors import MaizevizError
+
+            raise MaizevizError("this result carries no sensor planes")
+        return np.unpackbits(self.sensor_lit[k], count=self.rays).astype(bool)
+
+
+class CanopyScene(RayScene):
+    """A canopy's Embree scene: leaf triangles, then stalk triangles, then (for a periodic
+    field) copies of the triangles that overhang the plot, moved to the opposite side.
+
+    In a periodic field a ray that leaves the plot re-enters on the opposite side, so a leaf
+    part hanging over the edge (3.7 % of the leaf area of the bundled block tiled 3 x 3) must
+    also stand just inside the opposite edge, where the next tile's plants would put it.
+
+    Attributes
+    ----------
+    n_original : int, leaf + stalk triangles (the ids hits are reported in)
+    source : (F_scene,) int64, the original triangle of each scene triangle (None: identity)
+    wrapped : (x0, y0, x1, y1) cm, the plot whose overhangs were copied, or None
+    """
+
+    def __init__(self, vertices: np.ndarray, faces: np.ndarray, n_original: int | None = None,
+                 source: np.ndarray | None = None, wrapped: Rect | None = None):
+        super().__init__(vertices, faces)
+        self.n_original = len(faces) if n_original is None else n_original
+        self.source = source
+        self.wrapped = wrapped
+
+
+def _overhang_copies(verts: np.ndarray, faces: np.ndarray,
+                     bounds: Rect) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Copies of the triangles that reach over the plot edges, moved by the plot's width and
+    height into it: vertices (3k, 3), faces (k, 3) numbered from 0, source ids (k,)."""
+    x0, y0, x1, y1 = bounds
+    w, h = x1 - x0, y1 - y0
+    tri = verts[faces]
+    lo, hi = tri.min(axis=1), tri.max(axis=1)
+    out_v, out_src = [], []
+    for dx in (-w, 0.0, w):
+        for dy in (-h, 0.0, h):
+            if dx == 0.0 and dy == 0.0:
+                continue
+            keep = np.flatnonzero((hi[:, 0] + dx > x0) & (lo[:, 0] + dx < x1) &
+                                  (hi[:, 1] + dy > y0) & (lo[:, 1] + dy < y1))
+            if len(keep):
+                out_v.append((tri[keep] + np.array([dx, dy, 0.0])).reshape(-1, 3))
+                out_src.append(keep)
+    if not out_v:
+        return np.empty((0, 3)), np.empty((0, 3), np.int64), np.empty(0, np.int64)
+    v = np.vstack(out_v)
+    return v, np.arange(len(v)).reshape(-1, 3), np.concatenate(out_src).astype(np.int64)
+
+
+def light_scene(canopy: Canopy, with_stalks: bool = False,
+                periodic: bool = False) -> CanopyScene:
+    """The Embree scene of a canopy's leaves (and stalks): build it once, trace many suns.
+
+    Parameters
+    ----------
+    with_stalks : stalks intercept light too
+    periodic : for a periodic field (``--periodic``): leaf parts overhanging the plot edges are
+        copied to the opposite side; such a scene traces periodic requests only
+    """
     verts, faces = canopy.vertices, canopy.faces
     if with_stalks:
         verts = np.vstack([verts, canopy.stalk_vertices])
         faces = np.vstack([faces, canopy.stalk_faces + len(canopy.vertices)])
-    return RayScene(verts, faces)
+    n = len(faces)
+    if not periodic:
+        return CanopyScene(verts, faces)
+    bounds = canopy.layout.bounds
+    cv, cf, src = _overhang_copies(verts, faces, bounds)
+    return CanopyScene(np.vstack([verts, cv]), np.vstack([faces, cf + len(verts)]), n,
+                       np.concatenate([np.arange(n, dtype=np.int64), src]), bounds)
 
 
-def _in_chunks(fn: Callable[[int, int], T], n: int, threads: int,
+def scene_for(canopy: Canopy, periodic: bool, scene: RayScene | None,
+              with_stalks: bool) -> tuple[RayScene, list[str]]:
+    """The scene to trace a request with, and what to say about it: ``scene`` when it suits
+    the request (built here when None).
+
+    Raises
+    ------
+    MaizevizError
+        A scene with copied overhangs (periodic) given for an open field.
+    """
+    from maizeviz.errors import MaizevizError
+
+    if scene is None:
+        return light_scene(canopy, with_stalks, periodic), []
+    wrapped = getattr(scene, "wrapped", None)
+    if wrapped is not None and not periodic:
+        raise MaizevizError("this scene holds copies of the leaves overhanging the plot edges "
+                            "(built for a periodic field): it cannot trace an open field",
+                            quantity="periodic")
+    if periodic and wrapped is None:
+        return scene, ["the scene was built without the leaves overhanging the plot edges: the "
+                       "periodic field misses them (build it with light_scene(canopy, "
+                       "periodic=True))"]
+    return scene, []
+
+
+def _chunks(n: int) -> list[tuple[int, int]]:
+    size = max(8, CHUNK - CHUNK % 8)
+    return [(a, min(a + size, n)) for a in range(0, n, size)]
+
+
+def _in_chunks(fn: Callable[[int, int], T], chunks: list[tuple[int, int]], threads: int,
                progress: Callable[[], None]) -> list[T]:
-    """``fn(a, b)`` over chunks of :data:`CHUNK` rays on ``threads`` threads, in order;
-    ``progress()`` after each chunk (it may raise InterruptedError to stop)."""
-    chunks = [(a, min(a + CHUNK, n)) for a in range(0, n, CHUNK)]
+    """``fn(a, b)`` over ``chunks`` of rays on ``threads`` threads, in order; ``progress()``
+    after each chunk (it may raise InterruptedError to stop)."""
+    if threads <= 1 or len(chunks) <= 1:
+        out = []
+        for a, b in chunks:
+            out.append(fn(a, b))
+            progress()
+        return out
     out = []
     with ThreadPoolExecutor(max_workers=threads) as pool:
         futures = [pool.submit(fn, a, b) for a, b in chunks]
@@ -128,6 +272,265 @@ def _in_chunks(fn: Callable[[int, int], T], n: int, threads: int,
     return out
 
 
+@dataclass(frozen=True)
+class Sampler:
+    """What every direction traced through one canopy shares: the scene, the sample rectangle
+    and its grid, the sensor heights, the periodic field.
+
+    Attributes
+    ----------
+    scene : RayScene of the canopy (leaves first, then stalks if any)
+    rect : (x0, y0, x1, y1) cm; density : rays per cm2 asked for
+    heights_cm : (H,) float64 cm; periodic : bool
+    bounds : (x0, y0, x1, y1) cm, the plot
+    top : cm, height of the plane the ground rays start from (1 cm above every triangle)
+    n_leaf_triangles : F_leaf, the canopy's leaf triangles (triangle ids after them are stalks)
+    """
+
+    scene: RayScene
+    rect: Rect
+    density: float
+    heights_cm: np.ndarray
+    periodic: bool
+    bounds: Rect
+    top: float
+    n_leaf_triangles: int
+
+    @cached_property
+    def n(self) -> int:
+        return SunRays(self.rect, self.density, np.array([0.0, 0.0, 1.0]), self.top).n
+
+    @property
+    def n_triangles(self) -> int:
+        """Leaf and stalk triangles: hits are reported in these ids (overhang copies of a
+        periodic scene are reported as their originals)."""
+        return int(getattr(self.scene, "n_original", self.scene.n_triangles))
+
+    @cached_property
+    def ray_area_cm2(self) -> float:
+        x0, y0, x1, y1 = self.rect
+        return (x1 - x0) * (y1 - y0) / self.n
+
+
+def sampler(canopy: Canopy, scene: RayScene, rect: Rect, density: float,
+            heights_cm: tuple[float, ...] | np.ndarray, periodic: bool,
+            with_stalks: bool = False) -> Sampler:
+    """A :class:`Sampler` for a checked request (see :func:`check_sampling`)."""
+    return Sampler(scene, rect, density, np.asarray(heights_cm, dtype=np.float64), periodic,
+                   canopy.layout.bounds, canopy_top(canopy, with_stalks) + 1.0,
+                   canopy.n_triangles)
+
+
+@dataclass(frozen=True)
+class DirectionTrace:
+    """One direction traced by :func:`trace_direction`.
+
+    Attributes
+    ----------
+    toward : (3,) unit vector toward the light (sun or sky element)
+    transmission : (H,) float64, fraction of each plane's sensors that see the light
+    first_z : (N,) float32 cm, height of each ground ray's first hit, -inf where none
+    first_prim : (N,) int32, each ground ray's first triangle, -1 where none (None unless ids)
+    second_prim : list of int32 arrays, the second triangles hit (None unless second hits)
+    sensor_lit : (H, ceil(N / 8)) uint8, packed bits of :attr:`transmission`'s sensors
+    sensor_offset_cm : (H, 2) float64 cm
+    seconds : "trace" (and "second"), s
+    """
+
+    toward: np.ndarray
+    transmission: np.ndarray
+    first_z: np.ndarray
+    first_prim: np.ndarray | None
+    second_prim: list[np.ndarray] | None
+    sensor_lit: np.ndarray
+    sensor_offset_cm: np.ndarray
+    seconds: dict[str, float]
+
+
+#: Cost of an occlusion query from a sensor plane up to the top, relative to a ground ray's
+#: nearest-hit query from the top down (measured on the bundled canopy: 0.6 to 0.9).
+OCCLUSION_COST = 0.7
+
+
+@dataclass(frozen=True)
+class _Family:
+    """The rays of one direction through every sensor of every plane below the canopy top.
+
+    With the grids aligned (:func:`sensor_offsets`), the sensor (a, b) of plane k lies on the ray
+    landing on ground lattice cell (a - r_k[0], b - r_k[1]); its path to the light is the part of
+    that ray above h_k, so it is lit exactly when the ray's first hit lies below h_k. Tracing
+    the union of these shifted grids once answers every plane.
+    """
+
+    lo: tuple[int, int]                 # lattice index of the box's first cell
+    index: np.ndarray                   # (bw, bh) int32: ray of each box cell, -1 outside
+    cells: np.ndarray                   # (k,) int64: flat box cells of the rays, x slow
+    shifts: np.ndarray                  # (H, 2) int64: r_k
+    size: tuple[int, int]               # nx, ny
+
+
+def _family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family | None:
+    """The ray family through the planes ``planes`` and the ground, or None when per-plane
+    occlusion queries cost less (low suns: the shifted grids hardly overlap)."""
+    from maizeviz.light.rays import grid_shape
+
+    nx, ny = grid_shape(smp.rect, smp.density)
+    x0, y0, x1, y1 = smp.rect
+    cell = np.array([(x1 - x0) / nx, (y1 - y0) / ny])
+    t = smp.heights_cm[:, None] * (s[:2] / s[2]) / cell
+    shifts = np.round(t).astype(np.int64)
+    shifts[[k for k in range(len(shifts)) if k not in planes]] = 0
+    used = np.array([0, *planes])
+    r = np.vstack([np.zeros((1, 2), np.int64), shifts[planes]])
+    lo = (-r).min(axis=0)
+    hi = (np.array([nx, ny]) - r).max(axis=0)
+    bw, bh = (hi - lo).tolist()
+    n = nx * ny
+    budget = n * (1 + OCCLUSION_COST * len(planes))
+    if bw * bh > 8 * n and bw * bh > budget:
+        return None                                 # too spread out to be worth a box
+    mask = np.zeros((bw, bh), dtype=bool)
+    for k in used:
+        ox, oy = -shifts[k] - lo
+        mask[ox:ox + nx, oy:oy + ny] = True
+    cells = np.flatnonzero(mask)
+    if len(cells) > budget:
+        return None
+    index = np.full((bw, bh), -1, dtype=np.int32)
+    index.flat[cells] = np.arange(len(cells), dtype=np.int32)
+    return _Family((int(lo[0]), int(lo[1])), index, cells, shifts, (nx, ny))
+
+
+def _plane_rays(fam: _Family, k: int) -> np.ndarray:
+    """(N,) int64: the family ray through each sensor of plane k, in sensor grid order."""
+    nx, ny = fam.size
+    ox, oy = -fam.shifts[k] - np.array(fam.lo)
+    return fam.index[ox:ox + nx, oy:oy + ny].ravel()
+
+
+def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second: bool = False,
+                    threads: int = 1, tick: Callable[[], None] | None = None,
+                    stop: threading.Event | None = None,
+                    chunks_out: list[int] | None = None) -> DirectionTrace:
+    """Trace one parallel beam through the canopy: ground rays and every sensor plane.
+
+    Each sensor's path to the light is asked of Embree as an occlusion query, or, where fewer
+    rays do it (suns high enough for the shifted grids to overlap), answered by the first hit
+    of the ray of the same family through it (:class:`_Family`): the same segment, the same
+    periodic wrap, the same answer.
+
+    Parameters
+    ----------
+    smp : Sampler
+    toward : (3,) unit vector toward the light, z > 0 (field coordinates)
+    ids : keep each ground ray's first triangle; second : also trace second hits (needs ids)
+    threads : threads over chunks of rays
+    tick : called after each chunk (it may raise InterruptedError to stop)
+    stop : when set, the next chunk raises InterruptedError (cancellation from another thread)
+    chunks_out : if given, receives the number of chunks this call will tick, before the first
+    """
+    t0 = time.perf_counter()
+    s = np.asarray(toward, dtype=np.float64)
+    rays = SunRays(smp.rect, smp.density, s, smp.top)
+    n = rays.n
+    heights = smp.heights_cm
+    h32 = heights.astype(np.float32)
+    leaf_top = smp.top - 1.0
+    planes = [k for k, h in enumerate(heights) if 0.0 < h <= leaf_top]
+    fam = _family(smp, s, planes) if planes else None
+    offsets = sensor_offsets(heights, s, smp.rect, smp.density)
+    chunks = _chunks(n if fam is None else len(fam.cells))
+    ground_chunks = _chunks(n)
+    if chunks_out is not None:
+        chunks_out.append(len(chunks) + (len(ground_chunks) if second else 0))
+    size = chunks[0][1]
+    down = Tracer(smp.scene, -s, smp.bounds, smp.periodic, max(size, ground_chunks[0][1]))
+    first_z = np.empty(n, dtype=np.float32)
+    keep_ids = ids or second
+    first_prim = np.empty(n, dtype=np.int32) if keep_ids else None
+    packed = np.zeros((len(heights), (n + 7) // 8), dtype=np.uint8)
+    tick = tick or (lambda: None)
+
+    def check() -> None:
+        if stop is not None and stop.is_set():
+            raise InterruptedError("light computation cancelled")
+
+    if fam is None:
+        up = Tracer(smp.scene, s, smp.bounds, smp.periodic, size)
+
+        def chunk(a: int, b: int) -> np.ndarray:
+            check()
+            prim, z = first_hits(down, rays, a, b, ids=keep_ids)
+            first_z[a:b] = z
+            if first_prim is not None and prim is not None:
+                first_prim[a:b] = prim
+            ground = None
+            counts = np.empty(len(heights), dtype=np.int64)
+            for k, h in enumerate(heights):
+                if h > leaf_top:
+                    lit = np.ones(b - a, dtype=bool)
+                elif h == 0.0:
+                    lit = z < h32[k]             # the ground's sensors are the rays' landings
+                else:
+                    if ground is None:
+                        ground = ray_grid(smp.rect, smp.density, a, b)[0]
+                    org = np.empty((b - a, 3))
+                    org[:, :2] = ground + offsets[k]
+                    org[:, 2] = h
+                    lit = ~up.occluded(org, np.full(b - a, (smp.top - h) / s[2]))
+                counts[k] = np.count_nonzero(lit)
+                packed[k, a // 8:(b + 7) // 8] = np.packbits(lit)
+            return counts
+
+        transmission = np.sum(_in_chunks(chunk, chunks, threads, tick), axis=0) / n
+    else:
+        family = fam
+        fz = np.empty(len(family.cells), dtype=np.float32)
+        fp = np.empty(len(family.cells), dtype=np.int32) if keep_ids else None
+        bh = family.index.shape[1]
+
+        def fchunk(a: int, b: int) -> None:
+            check()
+            i, j = np.divmod(family.cells[a:b], bh)
+            prim, z = lattice_first_hits(down, rays, i + family.lo[0], j + family.lo[1],
+                                         ids=keep_ids)
+            fz[a:b] = z
+            if fp is not None and prim is not None:
+                fp[a:b] = prim
+
+        _in_chunks(fchunk, chunks, threads, tick)
+        g = family.index[-family.lo[0]:-family.lo[0] + family.size[0],
+                         -family.lo[1]:-family.lo[1] + family.size[1]].ravel()
+        first_z[:] = fz[g]
+        if first_prim is not None and fp is not None:
+            first_prim[:] = fp[g]
+        transmission = np.empty(len(heights))
+        for k, h in enumerate(heights):
+            if h > leaf_top:
+                lit = np.ones(n, dtype=bool)
+            elif k in planes:
+                lit = fz[_plane_rays(family, k)] < h32[k]
+            else:
+                lit = first_z < h32[k]
+            transmission[k] = np.count_nonzero(lit) / n
+            packed[k] = np.packbits(lit)
+    seconds = {"trace": time.perf_counter() - t0}
+    seconds_prims = None
+    if second and first_prim is not None:
+        t2 = time.perf_counter()
+        fprim = first_prim
+
+        def chunk2(a: int, b: int) -> np.ndarray:
+            check()
+            return second_hits(down, rays, a, b, fprim[a:b], first_z[a:b])
+
+        seconds_prims = _in_chunks(chunk2, ground_chunks, threads, tick)
+        seconds["second"] = time.perf_counter() - t2
+    return DirectionTrace(s, transmission.astype(np.float64), first_z,
+                          first_prim if keep_ids else None, seconds_prims, packed, offsets,
+                          seconds)
+
+
 def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | None = None,
                 with_stalks: bool = False, scene: RayScene | None = None) -> LightResult:
     """Trace the sun through ``canopy``; see the module docstring.
@@ -136,53 +539,33 @@ def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | 
     ----------
     progress : called after each chunk of rays; returning ``False`` cancels with
         :class:`InterruptedError`
-    scene : the canopy's scene from :func:`light_scene` (same ``with_stalks``), to trace several
-        suns on one scene; built here when not given
+    scene : the canopy's scene from :func:`light_scene` (same ``with_stalks`` and ``periodic``),
+        to trace several suns on one scene; built here when not given
     """
     rect, warnings = check_request(canopy, req)
     t0 = time.perf_counter()
-    if scene is None:
-        scene = light_scene(canopy, with_stalks)
+    scene, said = scene_for(canopy, req.periodic, scene, with_stalks)
+    warnings += said
     build_s = time.perf_counter() - t0
 
-    t1 = time.perf_counter()
     s = req.sun.direction(canopy.layout.north_deg)
-    top = float(canopy.vertices[:, 2].max()) + 1.0
-    if with_stalks and len(canopy.stalk_vertices):
-        top = max(top, float(canopy.stalk_vertices[:, 2].max()) + 1.0)
-    rays = SunRays(rect, req.density, s, top)
-    n = rays.n
-    heights = np.asarray(req.heights_cm, dtype=np.float64)
-    h32 = heights.astype(np.float32)
-    tracer = Tracer(scene, -s, canopy.layout.bounds, req.periodic, min(n, CHUNK))
-    first_z = np.empty(n, dtype=np.float32)
-    first_prim = np.empty(n, dtype=np.int32) if req.classes else None
-    total = -(-n // CHUNK) * (2 if req.classes else 1)
+    smp = sampler(canopy, scene, rect, req.density, req.heights_cm, req.periodic, with_stalks)
+    n = smp.n
+    total: list[int] = []
     done = 0
 
     def tick() -> None:
         nonlocal done
         done += 1
-        report(progress, done, total, "light computation")
+        report(progress, done, total[0], "light computation")
 
-    def first(a: int, b: int) -> np.ndarray:
-        prim, z = first_hits(tracer, rays, a, b, ids=req.classes)
-        first_z[a:b] = z
-        if first_prim is not None and prim is not None:
-            first_prim[a:b] = prim
-        # rays whose first hit lies below h have reached h unobstructed
-        return np.array([np.count_nonzero(z < h) for h in h32])
-
-    transmission = np.sum(_in_chunks(first, n, req.threads, tick), axis=0) / n
-    seconds = {"build": build_s, "trace": time.perf_counter() - t1}
+    tr = trace_direction(smp, s, ids=req.classes, second=req.classes, threads=req.threads,
+                         tick=tick, chunks_out=total)
+    seconds = {"build": build_s, **tr.seconds}
     counts: tuple[np.ndarray, np.ndarray] | tuple[None, None] = (None, None)
-    if first_prim is not None:
-        t2 = time.perf_counter()
-        fp = first_prim
-        seconds_prims = _in_chunks(lambda a, b: second_hits(tracer, rays, a, b, fp[a:b],
-                                                            first_z[a:b]), n, req.threads, tick)
-        counts = hit_counts(fp, seconds_prims, scene.n_triangles)
-        seconds["second"] = time.perf_counter() - t2
-    return LightResult(req.sun, heights, transmission, n, rect, rays.ray_area_cm2, first_z,
-                       counts[0], counts[1], s, seconds, tuple(warnings), canopy.level,
-                       req.density)
+    if tr.first_prim is not None and tr.second_prim is not None:
+        counts = hit_counts(tr.first_prim, tr.second_prim, smp.n_triangles)
+    return LightResult(req.sun, smp.heights_cm, tr.transmission, n, rect, smp.ray_area_cm2,
+                       tr.first_z, counts[0], counts[1], s, seconds, tuple(warnings),
+                       canopy.level, req.density, tr.sensor_lit, tr.sensor_offset_cm,
+                       req.periodic)

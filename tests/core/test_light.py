@@ -1,22 +1,24 @@
 """Direct light through real Embree: analytic scenes, Beer-Lambert, bad requests, the CLI."""
 
 import json
-from pathlib import Path
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from maizeviz.canopy.layout import layout_from_dict
 from maizeviz.canopy.scene import Canopy
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
-from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.beer_lambert import beer_lambert
+from maizeviz.light.heatmap import transmission_map
 from maizeviz.light.leaf_light import leaf_light
 from maizeviz.light.rays import ray_grid
 from maizeviz.light.request import LightRequest
+from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import trace_light
 
 BLOCK = str(Path(__file__).resolve().parents[2] / "resources/block3x3.csv")
@@ -113,21 +115,77 @@ def test_random_horizontal_leaves_transmit_exp_minus_lai(lai):
     assert r.transmission[1] == pytest.approx(math.exp(-lai * 95 / 190), abs=0.03)
 
 
-@settings(max_examples=15, deadline=None)
-@given(st.floats(0, 70), st.floats(0, 360), st.integers(0, 2**31), st.booleans())
-def test_transmission_monotone_and_bounded(zenith, azimuth, seed, periodic):
+def test_single_leaf_sensor_planes_are_exact_at_every_height():
+    """The issue's case: a leaf at 100 cm over x 50..150, a 45 deg sun from the east, the
+    rectangle x 0..100 under the leaf's west half. At height h the shadow covers x h-50..h+50,
+    so T(h) = 1 - overlap / 100: 0.5 on the ground, 0 at 50 cm, 1 above the leaf. Rays landing
+    on the ground rectangle (version 0.1) say 0.5 at every height below the leaf."""
+    v = np.array([[50, -20, 100], [150, -20, 100], [150, 120, 100], [50, 120, 100]], float)
+    c = Canopy.from_triangles(v, np.array([[0, 1, 2], [0, 2, 3]]), plot(-200, -50, 300, 150),
+                              np.array([1, 1]))
+    heights = tuple(float(h) for h in range(0, 100, 5)) + (100.5, 130.0)
+    for density in (1.0, 4.0):
+        r = trace_light(c, LightRequest(Sun(45, 90), heights, density, rect=(0, 20, 100, 80)))
+        expect = [1 - (min(h + 50, 100) - max(h - 50, 0)) / 100 if h < 100 else 1.0
+                  for h in heights]
+        assert r.transmission == pytest.approx(expect, abs=1e-12), density
+        k50 = heights.index(50.0)
+        assert r.transmission[k50] == 0.0
+        assert np.mean(r.first_z < 50) == pytest.approx(0.5, abs=1e-12)   # the old sampling
+        # the map at 50 cm is the rectangle's own x, y: all of it dark
+        m = transmission_map(r, 50.0, 10.0)
+        assert m.x_edges[0] == 0 and m.x_edges[-1] == 100 and np.all(m.transmission == 0)
+        g = transmission_map(r, 0.0, 10.0)
+        assert np.all(g.transmission[:5] == 0) and np.all(g.transmission[5:] == 1)   # x < 50 dark
+
+
+def _random_squares(seed, n=60):
     rng = np.random.default_rng(seed)
-    n = 60
-    specs = [(x, y, s, h) for x, y, s, h in zip(rng.uniform(0, 90, n), rng.uniform(0, 90, n),
-                                                  rng.uniform(2, 15, n), rng.uniform(5, 150, n))]
-    c = canopy_of(specs)
-    heights = tuple(np.linspace(0, 200, 9))
-    r = trace_light(c, LightRequest(Sun(zenith, azimuth), heights, density=1,
-                                    rect=(20, 20, 80, 80), periodic=periodic, classes=False))
+    return canopy_of([(x, y, s, h) for x, y, s, h in zip(
+        rng.uniform(0, 90, n), rng.uniform(0, 90, n), rng.uniform(2, 15, n),
+        rng.uniform(5, 150, n))])
+
+
+@settings(max_examples=12, deadline=None)
+@given(st.integers(0, 2**31), st.floats(0, 30), st.floats(0, 30), st.floats(31, 100),
+       st.floats(31, 100), st.booleans(), st.sampled_from([0.7, 1.0, 2.3]))
+def test_vertical_sun_transmission_never_increases_downward(seed, x0, y0, x1, y1, periodic,
+                                                            density):
+    """Under a vertical sun each sensor's path contains the path of the sensor above it: on any
+    rectangle T is monotone exactly, and 1 above the canopy."""
+    heights = tuple(np.sort(np.random.default_rng(seed).uniform(0, 200, 10)))
+    r = trace_light(_random_squares(seed), LightRequest(Sun(0, 0), heights, density,
+                                                        (x0, y0, x1, y1), periodic,
+                                                        classes=False))
     t = r.transmission
     assert np.all((0 <= t) & (t <= 1))
     assert np.all(np.diff(t) >= 0), "transmission increased going down"
-    assert t[-1] == 1.0
+    assert np.all(t[np.asarray(heights) > 150 + 15] == 1.0)
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.floats(0, 70), st.floats(0, 360), st.integers(0, 2**31),
+       st.sampled_from([0.7, 1.0, 2.3]))
+def test_periodic_field_transmission_never_increases_downward(zenith, azimuth, seed, density):
+    """In a periodic field sampled over its whole period every height's grid lies on the sun
+    paths of the others (sensor_offsets), so T is monotone as in the continuum, at any sun."""
+    heights = tuple(np.sort(np.random.default_rng(seed).uniform(0, 200, 10)))
+    r = trace_light(_random_squares(seed), LightRequest(Sun(zenith, azimuth), heights, density,
+                                                        (0, 0, 100, 100), True, classes=False))
+    t = r.transmission
+    assert np.all((0 <= t) & (t <= 1))
+    assert np.all(np.diff(t) >= 0), "transmission increased going down"
+    assert np.all(t[np.asarray(heights) > 150 + 15] == 1.0)
+
+
+def test_sensor_planes_outside_a_periodic_period_can_rise_downward():
+    """Not a bug: below a leaf whose shadow leaves the rectangle lower down, the lower plane is
+    brighter (the single-leaf case); only periodic full-period sampling is monotone."""
+    v = np.array([[50, -20, 100], [150, -20, 100], [150, 120, 100], [50, 120, 100]], float)
+    c = Canopy.from_triangles(v, np.array([[0, 1, 2], [0, 2, 3]]), plot(-200, -50, 300, 150),
+                              np.array([1, 1]))
+    r = trace_light(c, LightRequest(Sun(45, 90), (0, 50), 1, rect=(0, 20, 100, 80)))
+    assert r.transmission[0] > r.transmission[1]
 
 
 def test_periodic_field_stops_rays_that_leave_the_plot():
@@ -288,3 +346,70 @@ def test_cli_light_bad_input(capsys, argv, says):
     assert main(["light", BLOCK, *argv]) == EXIT_FAIL
     err = capsys.readouterr().err
     assert says in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_occlusion_queries_agree_with_nearest_hits(periodic):
+    """The tracer's occlusion mode (sensor planes) and its nearest-hit mode (ground rays) see
+    the same triangles along the same paths, wrapped or not."""
+    from maizeviz.light.rays import Tracer
+    from maizeviz.light.transmission import light_scene
+
+    c = _random_squares(7, n=120)
+    scene = light_scene(c)
+    rng = np.random.default_rng(7)
+    for zenith, azimuth in ((0, 0), (40, 75), (75, 200), (85, 310)):
+        s = Sun(zenith, azimuth).direction()
+        org = np.column_stack([rng.uniform(0, 100, 3000), rng.uniform(0, 100, 3000),
+                               rng.uniform(0, 160, 3000)])
+        length = rng.uniform(0, 600, 3000)
+        up = Tracer(scene, s, c.layout.bounds, periodic, 3000)
+        blocked = up.occluded(org.copy(), length)
+        _, dist = up.trace(org.copy(), length, ids=True)
+        assert np.mean(blocked == np.isfinite(dist)) > 0.999
+        assert blocked.any() and not blocked.all()
+
+
+@pytest.mark.parametrize("periodic", [False, True])
+def test_sensor_planes_by_occlusion_and_by_the_ray_family_agree(monkeypatch, periodic):
+    """A sensor's path to the sun is asked either as an occlusion query or as the first hit of
+    the ray of the same family through it; both give the same planes."""
+    import maizeviz.light.transmission as tr
+
+    c = _random_squares(9, n=150)
+    heights = (0.0, 20.0, 55.5, 100.0, 140.0, 400.0)
+    for zenith, azimuth in ((0, 0), (25, 160), (55, 300), (78, 45)):
+        req = LightRequest(Sun(zenith, azimuth), heights, 2.0, (10, 5, 90, 95), periodic)
+        results = []
+        for cost in (1e-9, 1e9):                    # never / always the ray family
+            monkeypatch.setattr(tr, "OCCLUSION_COST", cost)
+            results.append(trace_light(c, req))
+        occ, fam = results
+        assert np.abs(occ.transmission - fam.transmission).max() <= 2 / occ.rays
+        for k in range(len(heights)):
+            assert np.mean(occ.lit(k) != fam.lit(k)) <= 2 / occ.rays
+        assert np.array_equal(occ.first_hits, fam.first_hits)
+
+
+def test_a_leaf_overhanging_a_periodic_plot_shades_the_opposite_edge():
+    """A leaf hanging 20 cm over the east edge of a periodic 100 cm plot stands, in the
+    infinite field, 20 cm inside its west edge too: its light is counted on the leaf itself."""
+    from maizeviz.light.transmission import light_scene
+
+    c = canopy_of([(90, 40, 30, 50)])                       # x 90..120 over the edge at 100
+    req = LightRequest(Sun(0, 0), (0, 60), 4, (0, 0, 100, 100), periodic=True)
+    r = trace_light(c, req)
+    assert r.transmission[0] == pytest.approx(1 - 900 / 10000, abs=1e-12)
+    m = transmission_map(r, 0.0, 10.0)
+    assert np.all(m.transmission[[0, 1, 9], 4:7] == 0)      # x 0..20 and 90..100 shaded
+    assert len(r.first_hits) == c.n_triangles
+    rows = leaf_light(c, r)
+    assert rows[0]["sunlit_area_cm2"] == pytest.approx(900, rel=1e-9)
+    # an open field has no such copy; a scene built for one is said to miss the overhang
+    assert trace_light(c, LightRequest(Sun(0, 0), (0,), 4, (0, 0, 100, 100))).transmission[0] \
+        == pytest.approx(1 - 300 / 10000, abs=1e-12)
+    plain = trace_light(c, req, scene=light_scene(c))
+    assert any("overhanging" in w for w in plain.warnings)
+    with pytest.raises(MaizevizError, match="cannot trace an open field"):
+        trace_light(c, LightRequest(Sun(0, 0), (0,), 4, (0, 0, 100, 100)),
+                    scene=light_scene(c, periodic=True))

@@ -1,0 +1,505 @@
+"""Diffuse light from the sky and light over a day or a period, on one Embree scene.
+
+Every direction, a sky element or the sun at a time step, is traced exactly like the sun of
+:func:`~maizeviz.light.transmission.trace_light`: parallel rays landing on the ground rectangle
+(first hits: light intercepted per triangle) and sensor planes at each height (transmission),
+with the same periodic wrap. The scene is built once and shared by every direction; directions
+run in parallel on ``threads`` threads (Embree releases the GIL), and ``progress(done, total)``
+is called after each direction, in order (returning ``False`` cancels with InterruptedError).
+
+Diffuse light (:func:`trace_sky`): a :class:`~maizeviz.light.sky.Sky` of n directions with
+weights w_i (each direction's share of the horizontal diffuse irradiance, summing to 1) gives
+
+    T_diffuse(h) = sum_i w_i T_i(h),   share of triangle t = sum_i w_i hits_i(t) / N,
+
+where N is the number of rays per direction: the share is the fraction of the rectangle's
+horizontal diffuse light that the triangle intercepts (first hits; light scattered by leaves is
+not followed).
+
+A period (:func:`trace_period`, a :class:`~maizeviz.light.irradiance.Period`): step j carries a
+direct PAR dose D_j and a diffuse dose S_j (mol/m2 of ground, midpoint rule); the sun is traced
+at each step, the sky once for the whole period. Per step,
+
+    transmitted_j(h) = D_j T_sun_j(h) + S_j T_diffuse(h)
+    intercepted_j    = D_j f_sun_j + S_j f_diffuse        (f: leaves' share of the beam)
+
+and the period's totals are the exactly rounded sums (math.fsum) of its steps. Intercepted PAR
+per triangle in mol is its share times the dose times the rectangle's area.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+from collections.abc import Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from maizeviz.canopy.scene import Canopy
+from maizeviz.errors import MaizevizError
+from maizeviz.light.heatmap import TransmissionMap, bin_edges, binned
+from maizeviz.light.irradiance import Period
+from maizeviz.light.request import (
+    LightRequest,
+    Rect,
+    Sampling,
+    canopy_top,
+    check_sampling,
+    edge_reach,
+)
+from maizeviz.light.sky import Sky
+from maizeviz.light.transmission import Sampler, sampler, scene_for, trace_direction
+from maizeviz.mesh.raytrace import RayScene
+from maizeviz.progress import ProgressCallback, report
+
+# --------------------------------------------------------------------------- one beam
+
+
+@dataclass(frozen=True)
+class _Beam:
+    """What is kept of one traced direction (the rays themselves are dropped)."""
+
+    transmission: np.ndarray          # (H,)
+    leaf_fraction: float              # leaves' first hits / N
+    ids: np.ndarray                   # (k,) int64, triangles with first hits
+    hits: np.ndarray                  # (k,) int64, their first-hit counts
+    lit_bins: np.ndarray              # (H, a, b) float64, lit fraction per bin (NaN: no sensor)
+    seconds: float
+
+
+def _sparse_counts(prim: np.ndarray, n_triangles: int) -> tuple[np.ndarray, np.ndarray]:
+    hit = prim[prim >= 0]
+    if n_triangles <= 8 * len(prim):
+        dense = np.bincount(hit, minlength=n_triangles)
+        ids = np.flatnonzero(dense)
+        return ids.astype(np.int64), dense[ids].astype(np.int64)
+    ids, counts = np.unique(hit, return_counts=True)
+    return ids.astype(np.int64), counts.astype(np.int64)
+
+
+def _beam(smp: Sampler, toward: np.ndarray, edges: tuple[np.ndarray, np.ndarray],
+          ground_xy: np.ndarray, stop: threading.Event) -> _Beam:
+    tr = trace_direction(smp, toward, ids=True, stop=stop)
+    assert tr.first_prim is not None
+    prim = tr.first_prim
+    leaf = np.count_nonzero((prim >= 0) & (prim < smp.n_leaf_triangles)) / smp.n
+    ids, hits = _sparse_counts(prim, smp.n_triangles)
+    xe, ye = edges
+    bins = np.empty((len(smp.heights_cm), len(xe) - 1, len(ye) - 1))
+    for k in range(len(smp.heights_cm)):
+        lit = np.unpackbits(tr.sensor_lit[k], count=smp.n).astype(bool)
+        counts, lit_counts = binned(ground_xy + tr.sensor_offset_cm[k], lit, xe, ye)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            bins[k] = np.where(counts > 0, lit_counts / counts, np.nan)
+    return _Beam(tr.transmission, float(leaf), ids, hits, bins, tr.seconds["trace"])
+
+
+def _beams(smp: Sampler, towards: Sequence[np.ndarray], threads: int,
+           progress: ProgressCallback | None, edges: tuple[np.ndarray, np.ndarray],
+           what: str) -> Iterator[_Beam]:
+    """Trace ``towards`` (each (3,), toward the light) on ``threads`` threads; yields the beams
+    in order, calling ``progress(done, total)`` after each."""
+    from maizeviz.light.rays import ray_grid
+
+    ground_xy = ray_grid(smp.rect, smp.density)[0]
+    stop = threading.Event()
+    total = len(towards)
+    if threads <= 1:
+        for i, s in enumerate(towards):
+            yield _beam(smp, s, edges, ground_xy, stop)
+            report(progress, i + 1, total, what)
+        return
+    with ThreadPoolExecutor(max_workers=threads) as pool:
+        futures = [pool.submit(_beam, smp, s, edges, ground_xy, stop) for s in towards]
+        try:
+            for i, f in enumerate(futures):
+                yield f.result()
+                report(progress, i + 1, total, what)
+        except BaseException:
+            stop.set()
+            for f in futures:
+                f.cancel()
+            raise
+
+
+# --------------------------------------------------------------------------- results
+
+
+@dataclass(frozen=True, eq=False)
+class SkyLight:
+    """Diffuse light under a sky, from :func:`trace_sky`.
+
+    Attributes
+    ----------
+    sky : Sky
+    heights_cm : (H,) float64 cm
+    transmission : (H,) float64 in [0, 1]: sum_i w_i T_i(h), the fraction of the horizontal
+        diffuse irradiance reaching each sensor plane
+    per_direction : (n, H) float64: T_i(h) of each sky direction
+    intercepted_fraction : float: share of the rectangle's diffuse light whose first hit is a
+        leaf
+    per_direction_intercepted : (n,) float64: the same per direction (leaves' share of its beam)
+    triangle_share : (F,) float64: share of the rectangle's diffuse light each scene triangle
+        intercepts (leaf triangles first, then stalks)
+    rect : (x0, y0, x1, y1) cm; rays : rays per direction; density : rays per cm2 asked for
+    maps : (H, a, b) float64: diffuse transmission per bin (NaN: no sensor); map_edges : x and
+        y bin edges, cm; map_rays : (a, b) int64, sensors per bin (ground grid)
+    level : mesh level; warnings : tuple of str; seconds : "build", "trace" (wall clock), s
+    periodic : rays and sensor paths wrapped across the plot
+    """
+
+    sky: Sky
+    heights_cm: np.ndarray
+    transmission: np.ndarray
+    per_direction: np.ndarray
+    intercepted_fraction: float
+    per_direction_intercepted: np.ndarray
+    triangle_share: np.ndarray
+    rect: Rect
+    rays: int
+    density: float
+    maps: np.ndarray
+    map_edges: tuple[np.ndarray, np.ndarray]
+    map_rays: np.ndarray
+    level: str = ""
+    warnings: tuple[str, ...] = ()
+    seconds: dict[str, float] = field(default_factory=dict)
+    periodic: bool = False
+
+    @property
+    def rect_area_cm2(self) -> float:
+        x0, y0, x1, y1 = self.rect
+        return (x1 - x0) * (y1 - y0)
+
+    @property
+    def triangle_intercepted_cm2(self) -> np.ndarray:
+        """(F,) float64 cm2: each triangle's share times the rectangle's area (the horizontal
+        area whose diffuse light it takes)."""
+        return self.triangle_share * self.rect_area_cm2
+
+    def transmission_map(self, height: float) -> TransmissionMap:
+        """Diffuse transmission binned over the sensor plane at ``height`` (a traced height)."""
+        return _map(self.heights_cm, self.maps, self.map_edges, self.transmission, height,
+                    self.map_rays)
+
+
+@dataclass(frozen=True, eq=False)
+class PeriodLight:
+    """Light over a period, from :func:`trace_period`. PAR doses are mol/m2 of ground.
+
+    Attributes
+    ----------
+    period : Period (times, sun, irradiance, PAR factor)
+    sky : SkyLight used for the diffuse part (None when the sun never rises)
+    heights_cm : (H,) float64 cm
+    step_transmission : (n, H) float64: direct-sun transmission at each step
+    step_intercepted_fraction : (n,) float64: leaves' share of the direct beam at each step
+    triangle_direct_mol, triangle_diffuse_mol : (F,) float64 mol: PAR intercepted by each scene
+        triangle over the period (leaf triangles first, then stalks)
+    rect : (x0, y0, x1, y1) cm; rays : rays per direction
+    maps : (H, a, b) float64: fraction of the period's PAR reaching each bin; map_edges : x and
+        y bin edges, cm; map_rays : (a, b) int64, sensors per bin (ground grid)
+    level, warnings, seconds ("build", "trace", s); periodic : as :class:`SkyLight`
+    """
+
+    period: Period
+    sky: SkyLight | None
+    heights_cm: np.ndarray
+    step_transmission: np.ndarray
+    step_intercepted_fraction: np.ndarray
+    triangle_direct_mol: np.ndarray
+    triangle_diffuse_mol: np.ndarray
+    rect: Rect
+    rays: int
+    maps: np.ndarray
+    map_edges: tuple[np.ndarray, np.ndarray]
+    map_rays: np.ndarray
+    level: str = ""
+    warnings: tuple[str, ...] = ()
+    seconds: dict[str, float] = field(default_factory=dict)
+    periodic: bool = False
+
+    @property
+    def n_steps(self) -> int:
+        return self.period.n_steps
+
+    @property
+    def rect_area_m2(self) -> float:
+        x0, y0, x1, y1 = self.rect
+        return (x1 - x0) * (y1 - y0) * 1e-4
+
+    # ---- per step, mol/m2 of ground
+    @cached_property
+    def step_direct_mol_m2(self) -> np.ndarray:
+        """(n,) direct PAR incident at each step."""
+        return np.asarray(self.period.step_direct_par_mol_m2, dtype=np.float64)
+
+    @cached_property
+    def step_diffuse_mol_m2(self) -> np.ndarray:
+        """(n,) diffuse PAR incident at each step."""
+        return np.asarray(self.period.step_diffuse_par_mol_m2, dtype=np.float64)
+
+    @cached_property
+    def step_incident_mol_m2(self) -> np.ndarray:
+        """(n,) PAR incident at each step (direct + diffuse)."""
+        return self.step_direct_mol_m2 + self.step_diffuse_mol_m2
+
+    @cached_property
+    def step_intercepted_mol_m2(self) -> np.ndarray:
+        """(n,) PAR intercepted by the leaves at each step."""
+        fd = self.sky.intercepted_fraction if self.sky is not None else 0.0
+        return (self.step_direct_mol_m2 * self.step_intercepted_fraction
+                + self.step_diffuse_mol_m2 * fd)
+
+    @cached_property
+    def step_transmitted_mol_m2(self) -> np.ndarray:
+        """(n, H) PAR reaching each sensor plane at each step."""
+        td = self.sky.transmission if self.sky is not None else np.zeros(len(self.heights_cm))
+        return (self.step_direct_mol_m2[:, None] * self.step_transmission
+                + self.step_diffuse_mol_m2[:, None] * td[None, :])
+
+    @cached_property
+    def step_fraction_intercepted(self) -> np.ndarray:
+        """(n,) share of each step's incident PAR intercepted by the leaves (NaN without light)."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.step_incident_mol_m2 > 0,
+                            self.step_intercepted_mol_m2 / self.step_incident_mol_m2, np.nan)
+
+    # ---- the period: sums of the steps
+    @property
+    def par_incident_mol_m2(self) -> float:
+        return math.fsum(self.step_incident_mol_m2)
+
+    @property
+    def par_direct_mol_m2(self) -> float:
+        return math.fsum(self.step_direct_mol_m2)
+
+    @property
+    def par_diffuse_mol_m2(self) -> float:
+        return math.fsum(self.step_diffuse_mol_m2)
+
+    @property
+    def par_intercepted_mol_m2(self) -> float:
+        return math.fsum(self.step_intercepted_mol_m2)
+
+    @property
+    def par_transmitted_mol_m2(self) -> np.ndarray:
+        """(H,) PAR reaching each sensor plane over the period."""
+        return np.array([math.fsum(c) for c in self.step_transmitted_mol_m2.T]) \
+            if self.n_steps else np.zeros(len(self.heights_cm))
+
+    @property
+    def fraction_intercepted(self) -> float | None:
+        """Intercepted / incident PAR over the period; None when no light came."""
+        inc = self.par_incident_mol_m2
+        return self.par_intercepted_mol_m2 / inc if inc > 0 else None
+
+    @property
+    def transmission_by_height(self) -> np.ndarray:
+        """(H,) transmitted / incident PAR over the period (NaN when no light came)."""
+        inc = self.par_incident_mol_m2
+        return self.par_transmitted_mol_m2 / inc if inc > 0 else \
+            np.full(len(self.heights_cm), np.nan)
+
+    @property
+    def triangle_mol(self) -> np.ndarray:
+        """(F,) float64 mol: PAR intercepted by each scene triangle over the period."""
+        return self.triangle_direct_mol + self.triangle_diffuse_mol
+
+    def transmission_map(self, height: float) -> TransmissionMap:
+        """Fraction of the period's PAR reaching each bin of the sensor plane at ``height``."""
+        return _map(self.heights_cm, self.maps, self.map_edges, self.transmission_by_height,
+                    height, self.map_rays)
+
+
+def _map(heights: np.ndarray, maps: np.ndarray, edges: tuple[np.ndarray, np.ndarray],
+         totals: np.ndarray, height: float, rays: np.ndarray) -> TransmissionMap:
+    k = np.flatnonzero(np.isclose(heights, height, rtol=0, atol=1e-9))
+    if not len(k):
+        raise MaizevizError(f"height {height:g} cm was not traced (traced: "
+                            f"{', '.join(f'{h:g}' for h in heights)} cm)", quantity="heights")
+    i = int(k[0])
+    xe, ye = edges
+    return TransmissionMap(float(heights[i]), xe, ye, maps[i], rays, float(totals[i]))
+
+
+# --------------------------------------------------------------------------- entry points
+
+
+@dataclass(frozen=True)
+class _Bins:
+    edges: tuple[np.ndarray, np.ndarray]
+    rays: np.ndarray                  # (a, b) int64, ground-grid sensors per bin
+
+
+def _prepare(canopy: Canopy, sampling: Sampling | LightRequest, with_stalks: bool,
+             scene: RayScene | None, bin_cm: float) -> tuple[Sampler, list[str], float, _Bins]:
+    from maizeviz.light.rays import ray_grid
+
+    rect, warnings = check_sampling(canopy, sampling)
+    xe, ye = bin_edges(rect, bin_cm)
+    xy = ray_grid(rect, sampling.density)[0]
+    counts, _ = binned(xy, np.ones(len(xy)), xe, ye)
+    bins = _Bins((xe, ye), counts.astype(np.int64))
+    t0 = time.perf_counter()
+    scene, said = scene_for(canopy, sampling.periodic, scene, with_stalks)
+    warnings += said
+    build_s = time.perf_counter() - t0
+    smp = sampler(canopy, scene, rect, sampling.density, sampling.heights_cm, sampling.periodic,
+                  with_stalks)
+    return smp, warnings, build_s, bins
+
+
+def _edge_warning(canopy: Canopy, smp: Sampler, zenith: np.ndarray, towards: np.ndarray,
+                  what: str) -> str | None:
+    """One warning for all directions whose paths cross the plot edge (non-periodic field)."""
+    if smp.periodic or not len(zenith):
+        return None
+    top = canopy_top(canopy)
+    crossing = [z for z, s in zip(zenith, towards) if edge_reach(canopy, smp.rect, float(z), s,
+                                                                 top) is not None]
+    if not crossing:
+        return None
+    return (f"{len(crossing)} of {len(zenith)} {what} (zenith {min(crossing):.0f} deg and lower) "
+            "reach the sample rectangle across the plot edge, where nothing stops them; "
+            "transmission is overestimated (trace a periodic field)")
+
+
+def _sky_light(sky: Sky, smp: Sampler, beams: list[_Beam], bins: _Bins, level: str,
+               warnings: list[str], seconds: dict[str, float]) -> SkyLight:
+    edges = bins.edges
+    w = np.asarray(sky.weights, dtype=np.float64)
+    per_dir = np.array([b.transmission for b in beams]).reshape(sky.n, len(smp.heights_cm))
+    per_int = np.array([b.leaf_fraction for b in beams])
+    share = np.zeros(smp.n_triangles)
+    maps = np.zeros((len(smp.heights_cm), len(edges[0]) - 1, len(edges[1]) - 1))
+    for wi, b in zip(w, beams):
+        np.add.at(share, b.ids, wi * b.hits / smp.n)
+        maps += wi * b.lit_bins
+    trans = np.array([math.fsum(w * per_dir[:, k]) for k in range(per_dir.shape[1])])
+    return SkyLight(sky, smp.heights_cm, np.clip(trans, 0.0, 1.0), per_dir,
+                    math.fsum(w * per_int), per_int, share, smp.rect, smp.n, smp.density, maps,
+                    edges, bins.rays, level, tuple(warnings), seconds, smp.periodic)
+
+
+def trace_sky(canopy: Canopy, sky: Sky, sampling: Sampling | LightRequest,
+              progress: ProgressCallback | None = None, with_stalks: bool = False,
+              scene: RayScene | None = None, bin_cm: float = 5.0) -> SkyLight:
+    """Diffuse light: every direction of ``sky`` traced like the sun on one scene.
+
+    Parameters
+    ----------
+    canopy : Canopy
+    sky : Sky from :func:`maizeviz.light.sky.make_sky`
+    sampling : heights, density, rectangle, periodic field and threads (a :class:`Sampling`, or
+        a :class:`LightRequest` whose sun is ignored)
+    progress : ``progress(done, total)`` after each direction; returning ``False`` cancels
+        with InterruptedError
+    scene : the canopy's scene from :func:`~maizeviz.light.transmission.light_scene` (same
+        ``with_stalks`` and ``periodic``); built here when not given
+    bin_cm : bin edge of the maps, cm
+
+    Raises
+    ------
+    MaizevizError
+        A bad request (as :func:`maizeviz.light.request.check_sampling`), naming the quantity.
+    """
+    smp, warnings, build_s, bins = _prepare(canopy, sampling, with_stalks, scene, bin_cm)
+    towards = sky.field_directions(canopy.layout.north_deg)
+    w = _edge_warning(canopy, smp, sky.zenith_deg, towards, "sky directions")
+    if w:
+        warnings.append(w)
+    t0 = time.perf_counter()
+    beams = list(_beams(smp, list(towards), sampling.threads, progress, bins.edges,
+                        "sky tracing"))
+    seconds = {"build": build_s, "trace": time.perf_counter() - t0}
+    return _sky_light(sky, smp, beams, bins, canopy.level, warnings, seconds)
+
+
+def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightRequest,
+                 sky: Sky | SkyLight | None = None, progress: ProgressCallback | None = None,
+                 with_stalks: bool = False, scene: RayScene | None = None,
+                 bin_cm: float = 5.0) -> PeriodLight:
+    """Light over a period: the sun traced at every step, the sky once; see the module docstring.
+
+    Parameters
+    ----------
+    canopy : Canopy
+    period : Period from :func:`maizeviz.light.irradiance.clear_sky_period` or
+        :func:`~maizeviz.light.irradiance.weather_period`
+    sampling : heights, density, rectangle, periodic field and threads
+    sky : the Sky for the diffuse part (traced here, its directions and the sun steps sharing
+        the threads), or a SkyLight already traced on this canopy with the same sampling
+        (reused: a sweep over days traces its sky once); None for the standard overcast
+        turtle of 46 directions
+    progress : ``progress(done, total)`` after each direction (sky directions first, then the
+        time steps); returning ``False`` cancels with InterruptedError
+    scene : the canopy's scene (same ``with_stalks`` and ``periodic``); built here when not given
+    bin_cm : bin edge of the maps, cm
+
+    Returns
+    -------
+    PeriodLight; a period without sun (polar night) traces nothing and gives zeros (its
+    ``period.notes`` say so).
+    """
+    from maizeviz.light.sky import make_sky
+
+    smp, warnings, build_s, bins = _prepare(canopy, sampling, with_stalks, scene, bin_cm)
+    edges = bins.edges
+    warnings += list(period.notes)
+    n_h = len(smp.heights_cm)
+    shape = (n_h, len(edges[0]) - 1, len(edges[1]) - 1)
+    zeros = np.zeros(smp.n_triangles)
+    if period.n_steps == 0:
+        return PeriodLight(period, None, smp.heights_cm, np.zeros((0, n_h)), np.zeros(0),
+                           zeros, zeros.copy(), smp.rect, smp.n, np.full(shape, np.nan), edges,
+                           bins.rays, canopy.level, tuple(warnings), {"build": build_s, "trace": 0.0},
+                           smp.periodic)
+    sky_light = sky if isinstance(sky, SkyLight) else None
+    if sky_light is not None:
+        if not (np.array_equal(sky_light.heights_cm, smp.heights_cm)
+                and sky_light.rect == smp.rect and sky_light.rays == smp.n):
+            raise MaizevizError("the sky light was traced with other heights, rectangle or "
+                                "density than this period", quantity="sky")
+    sky_obj = sky_light.sky if sky_light is not None else \
+        (sky if isinstance(sky, Sky) else make_sky("soc", 46))
+    north = canopy.layout.north_deg
+    suns = period.suns()
+    sun_dirs = [s.direction(north) for s in suns]
+    sky_dirs = [] if sky_light is not None else list(sky_obj.field_directions(north))
+    for zen, dirs, what in ((np.array([s.zenith_deg for s in suns]), np.array(sun_dirs),
+                             "time steps' suns"),
+                            (sky_obj.zenith_deg, sky_obj.field_directions(north),
+                             "sky directions")):
+        w = _edge_warning(canopy, smp, zen, dirs, what)
+        if w and w not in warnings:
+            warnings.append(w)
+    t0 = time.perf_counter()
+    beams = list(_beams(smp, sky_dirs + sun_dirs, sampling.threads, progress, edges,
+                        "period tracing"))
+    trace_s = time.perf_counter() - t0
+    if sky_light is None:
+        sky_light = _sky_light(sky_obj, smp, beams[:len(sky_dirs)], bins, canopy.level, [],
+                               {"build": 0.0, "trace": trace_s})
+    steps = beams[len(sky_dirs):]
+    direct_mol = np.asarray(period.step_direct_par_mol_m2, dtype=np.float64)
+    diffuse_mol = math.fsum(period.step_diffuse_par_mol_m2)
+    area_m2 = (smp.rect[2] - smp.rect[0]) * (smp.rect[3] - smp.rect[1]) * 1e-4
+    tri_direct = np.zeros(smp.n_triangles)
+    for dose, b in zip(direct_mol, steps):
+        np.add.at(tri_direct, b.ids, dose * area_m2 * b.hits / smp.n)
+    tri_diffuse = sky_light.triangle_share * diffuse_mol * area_m2
+    incident = math.fsum(period.step_par_mol_m2)
+    maps = sky_light.maps * diffuse_mol
+    for dose, b in zip(direct_mol, steps):
+        maps = maps + dose * b.lit_bins
+    maps = maps / incident if incident > 0 else np.full(shape, np.nan)
+    return PeriodLight(period, sky_light, smp.heights_cm,
+                       np.array([b.transmission for b in steps]).reshape(len(steps), n_h),
+                       np.array([b.leaf_fraction for b in steps]), tri_direct, tri_diffuse,
+                       smp.rect, smp.n, maps, edges, bins.rays, canopy.level, tuple(warnings),
+                       {"build": build_s, "trace": trace_s}, smp.periodic)
