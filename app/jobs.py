@@ -92,13 +92,15 @@ def op_measure(state: dict, progress: ProgressCallback, cover_resolution: float)
 
 
 def op_light(state: dict, progress: ProgressCallback, request: LightRequest) -> LightResult:
-    """Trace the sun through the child's canopy; the scene is kept for the next sun."""
+    """Trace the sun through the child's canopy; the scene (a periodic field's holds copies of
+    the leaves overhanging the plot edges) is kept for the next sun."""
     build_s = 0.0
-    if "scene" not in state:
+    key = ("scene", bool(request.periodic))
+    if key not in state:
         t0 = time.perf_counter()
-        state["scene"] = light_scene(state["canopy"])
+        state[key] = light_scene(state["canopy"], False, bool(request.periodic))
         build_s = time.perf_counter() - t0
-    result = trace_light(state["canopy"], request, progress, False, state["scene"])
+    result = trace_light(state["canopy"], request, progress, False, state[key])
     result.seconds["build"] = build_s              # the scene kept from an earlier sun: 0
     return result
 

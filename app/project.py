@@ -37,8 +37,13 @@ def light_record(label: str, result) -> Record:
             "ray_area_cm2": float(result.ray_area_cm2), "density": float(result.density),
             "direction": [float(v) for v in result.direction],
             "seconds": {k: float(v) for k, v in result.seconds.items()},
-            "warnings": [str(w) for w in result.warnings]}
+            "warnings": [str(w) for w in result.warnings],
+            "periodic": bool(getattr(result, "periodic", False))}
     arrays = {"first_z": np.asarray(result.first_z, np.float32)}
+    for name, dtype in (("sensor_lit", np.uint8), ("sensor_offset_cm", np.float64)):
+        a = getattr(result, name, None)
+        if a is not None:
+            arrays[name] = np.asarray(a, dtype)
     for name in ("first_hits", "second_hits"):
         a = getattr(result, name)
         if a is not None:
@@ -71,6 +76,15 @@ def light_from_record(rec: Record, where: str) -> tuple[str, Any]:
         if a is not None and (a.ndim != 1 or a.dtype.kind not in "iu"):
             raise ProjectError(f"{where}: '{name}' of a light result is not a list of counts")
         hits[name] = None if a is None else a.astype(np.int64)
+    planes = {}
+    lit, offset = rec.arrays.get("sensor_lit"), rec.arrays.get("sensor_offset_cm")
+    if lit is not None:
+        if lit.dtype != np.uint8 or lit.shape != (len(heights), -(-rays // 8)) or \
+                offset is None or offset.shape != (len(heights), 2):
+            raise ProjectError(f"{where}: a light result's sensor planes do not match its "
+                               "heights and rays; the project is damaged")
+        planes = {"sensor_lit": lit, "sensor_offset_cm": offset.astype(np.float64),
+                  "periodic": bool(get(m, "periodic", bool, False, where))}
     try:
         result = LightResult(
             sun=Sun(float(get(sun, "zenith_deg", (int, float), where=where)),
@@ -84,7 +98,7 @@ def light_from_record(rec: Record, where: str) -> tuple[str, Any]:
                      if isinstance(v, (int, float))},
             warnings=tuple(str(w) for w in get(m, "warnings", list, [], where)),
             level=str(get(m, "level", str, "", where)),
-            density=float(get(m, "density", (int, float), where=where)), **hits)
+            density=float(get(m, "density", (int, float), where=where)), **hits, **planes)
     except (ValueError, MaizevizError) as exc:     # e.g. a sun below the horizon
         raise ProjectError(f"{where}: a stored light result cannot be used ({exc})") from None
     return str(get(m, "label", str, result.level, where)), result
