@@ -77,7 +77,12 @@ class Viewport(QtInteractor):
     rendered = Signal(int)
 
     def __init__(self, parent=None):
-        super().__init__(parent, auto_update=False, multi_samples=0)
+        super().__init__(parent, auto_update=False, multi_samples=0, lighting="none")
+        # two lights (pyvista's light kit has five; each is shading work for every pixel of
+        # every frame on software OpenGL): one at the camera, one from high above
+        self.add_light(pv.Light(light_type="headlight", intensity=0.75))
+        self.add_light(pv.Light(position=(0.3, -0.4, 1.0), focal_point=(0, 0, 0),
+                                light_type="scene light", intensity=0.45))
         self.setMinimumSize(320, 200)
         self.render_count = 0
         self.ren_win.AddObserver("EndEvent", self._on_frame)
@@ -236,7 +241,8 @@ class Viewport(QtInteractor):
         elif name == "across":
             self.view_yz(render=False)
         else:
-            self.view_isometric(render=False)
+            # from the south-west, above: the ground's labels read the right way up
+            self.view_vector((-0.75, -1.3, 0.95), viewup=(0, 0, 1), render=False)
         cam.SetParallelProjection(False)
         self.reset_camera(render=False)
         if name == "perspective":
