@@ -351,8 +351,8 @@ def ground_image(field: tuple[float, float, float, float], margin: float, xs: np
     font.setPixelSize(max(8, int(margin * scale * 0.42)))
     p.setFont(font)
     p.setPen(QColor("#333333"))
-    step_x = max(1, int(np.ceil(len(xs) / 10)))
-    step_y = max(1, int(np.ceil(len(ys) / 10)))
+    step_x = max(1, int(np.ceil(len(xs) / 7)))
+    step_y = max(1, int(np.ceil(len(ys) / 5)))
     box = margin * scale * 0.6
     for x in xs[::step_x]:
         c = px(x, y0 - margin * 0.27)
