@@ -162,7 +162,7 @@ class MainWindow(QMainWindow):
         self.addDockWidget(Qt.RightDockWidgetArea, dock)
 
     def _build_digitizer(self) -> None:
-        from maizeviz_app.digitizer_panel import DigitizerPanel
+        from maizeviz_app.panels.digitizer import DigitizerPanel
 
         self.digitizer = DigitizerPanel(self.viewport)
         dock = QDockWidget("Digitizer", self)
@@ -171,7 +171,7 @@ class MainWindow(QMainWindow):
         self.addDockWidget(Qt.LeftDockWidgetArea, dock)
 
     def _build_layout_editor(self) -> None:
-        from maizeviz_app.layout_panel import LayoutPanel
+        from maizeviz_app.panels.layout import LayoutPanel
 
         self.layout_panel = LayoutPanel()
         self.layout_panel.applied.connect(self._on_layout)
