@@ -165,10 +165,16 @@ class MainWindow(QMainWindow):
         from maizeviz_app.panels.digitizer import DigitizerPanel
 
         self.digitizer = DigitizerPanel(self.viewport)
+        self.digitizer.alert.connect(lambda text: self.statusBar().showMessage(text, 15_000))
+        self.digitizer.stopped.connect(self._digitizing_stopped)
         dock = QDockWidget("Digitizer", self)
         dock.setObjectName("digitizer")
         dock.setWidget(self.digitizer)
         self.addDockWidget(Qt.LeftDockWidgetArea, dock)
+
+    def _digitizing_stopped(self, _why: str) -> None:
+        if self.canopy is not None:                 # the canopy comes back after a session
+            self.viewport.show_canopy(self.canopy)
 
     def _build_layout_editor(self) -> None:
         from maizeviz_app.panels.layout import LayoutPanel
