@@ -89,21 +89,21 @@ class Viewport(QtInteractor):
                               render: bool = True) -> None:
         """Points (N, 3) cm small and semi-transparent, so the surfaces show through; the last
         press (3,) as a bigger opaque dot."""
-        points = np.asarray(points, np.float32).reshape(-1, 3)
-        if len(points):
-            self.add_mesh(pv.PolyData(points), name="digitized", color="crimson", opacity=0.45,
-                          render_points_as_spheres=True, point_size=5, reset_camera=False,
-                          render=False)
-        else:
-            self.remove_actor("digitized", render=False)
-        if last is not None:
-            self.add_mesh(pv.PolyData(np.asarray(last, np.float32).reshape(1, 3)),
-                          name="digitized-last", color="red", render_points_as_spheres=True,
-                          point_size=11, reset_camera=False, render=False)
-        else:
-            self.remove_actor("digitized-last", render=False)
+        self._points_actor("digitized", points, color="crimson", opacity=0.45, point_size=5)
+        self._points_actor("digitized-last", last, color="red", opacity=1.0, point_size=11)
         if render:
             self.render()
+
+    def _points_actor(self, name: str, points, **style) -> None:
+        points = np.asarray(points if points is not None else [], np.float32).reshape(-1, 3)
+        actor = self.actors.get(name)
+        if not len(points):
+            self.remove_actor(name, render=False)
+        elif actor is not None:                 # a press adds a point: update in place
+            actor.mapper.dataset.shallow_copy(pv.PolyData(points))
+        else:
+            self.add_mesh(pv.PolyData(points), name=name, render_points_as_spheres=True,
+                          reset_camera=False, render=False, **style)
 
     def frame_bounds(self, bounds, render: bool = True) -> None:
         """Point the camera at x0, x1, y0, y1, z0, z1 (cm), keeping its direction."""
