@@ -69,14 +69,18 @@ class StatusBand(QFrame):
         self.set_state("idle")
 
     def set_state(self, state: str, message: str | None = None, where: str | None = None):
+        if state != self.state or not self.styleSheet():
+            self._paint(state)
         self.state = state
-        bg, fg = BAND[state]
-        self.setStyleSheet(f"QFrame#band {{ background: {bg}; border-radius: 6px; }} "
-                           f"QFrame#band QLabel {{ color: {fg}; }}")
         if message is not None:
             self.message.setText(message)
         if where is not None:
             self.where.setText(where)
+
+    def _paint(self, state: str) -> None:
+        bg, fg = BAND[state]
+        self.setStyleSheet(f"QFrame#band {{ background: {bg}; border-radius: 6px; }} "
+                           f"QFrame#band QLabel {{ color: {fg}; }}")
 
 
 class _ControlKeys(QObject):
@@ -189,6 +193,7 @@ class DigitizerPanel(QWidget):
         self.counts.setWordWrap(True)
         lay.addWidget(self.counts)
         self.log = QListWidget()
+        self.log.setUniformItemSizes(True)          # scrolling 400 lines stays instant
         self.log.setMinimumHeight(90)
         lay.addWidget(self.log, 1)
 

@@ -83,50 +83,6 @@ def test_bad_points_file_says_so(window, qtbot, tmp_path):
     assert w.canopy is None
 
 
-def test_digitizer_demo_records_through_the_simulator(window, qtbot, tmp_path):
-    """Demo mode: a simulated FASTRAK on a real pty, the panel's reader, the session on disk."""
-    from maizeviz.io.points import read_points, write_points
-    from maizeviz.leaf.grid import LeafGrid
-    from maizeviz.leaf.synth import LeafShape, leaf_points
-
-    rng = np.random.default_rng(1)
-    src = tmp_path / "two_leaves.csv"
-    write_points(src, [LeafGrid(1, k + 1, leaf_points(LeafShape(length=40, base=(0, 0, 30 * k)),
-                                                      4, 3, rng=rng), True) for k in range(2)])
-    w = window()
-    panel = w.digitizer
-    panel.demo_file, panel.demo_pace = src, 0.34
-    panel.cols.setValue(3)
-    out = tmp_path / "session.csv"
-    panel.out_edit.setText(str(out))
-    recorded, stopped = [], []
-    panel.recorded.connect(recorded.append)
-    panel.stopped.connect(stopped.append)
-    panel.demo_button.click()
-    # the demo presses every point, then types q itself: the session finishes on its own
-    qtbot.waitUntil(lambda: bool(stopped), timeout=TIMEOUT)
-    assert stopped == ["finished"] and recorded[-1] == 20
-    assert "digitized" in w.viewport.actors
-    pts = read_points(out)
-    assert len(pts) == 20 and set(map(tuple, pts.ids[:, :2].tolist())) == {(1, 1), (1, 2)}
-    assert "20 points, 2 leaves" in panel.counts.text()
-
-
-def test_digitizer_refuses_unwritable_output_and_silent_port(window, qtbot, tmp_path):
-    w = window()
-    panel = w.digitizer
-    panel.out_edit.setText(str(tmp_path / "missing" / "x.csv"))
-    panel.connect_button.click()
-    assert "no such folder" in panel.log.item(panel.log.count() - 1).text()
-    assert panel.connect_button.isEnabled()
-    panel.out_edit.setText(str(tmp_path / "ok.csv"))
-    panel.port_edit.setText("/dev/does-not-exist")
-    panel.connect_button.click()
-    texts = [panel.log.item(i).text() for i in range(panel.log.count())]
-    assert any("cannot open /dev/does-not-exist" in t for t in texts)
-    assert panel.connect_button.isEnabled() and panel.session is None
-
-
 def test_layout_editor_turns_a_plant_and_saves(window, qtbot, tmp_path):
     from maizeviz.canopy.layout import load_layout
 
