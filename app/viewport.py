@@ -75,7 +75,7 @@ class Viewport(QtInteractor):
                             render: bool = True) -> None:
         """Add or replace one leaf surface (vertices (n, 3) cm, faces (F, 3) int)."""
         self.add_mesh(_polydata(vertices, faces), name=name, color="yellowgreen",
-                      show_edges=True, edge_color="darkgreen", reset_camera=False, render=False)
+                      smooth_shading=True, reset_camera=False, render=False)
         if render:
             self.render()
 
