@@ -194,6 +194,8 @@ class DigitizerPanel(QWidget):
         lay.addWidget(self.counts)
         self.log = QListWidget()
         self.log.setUniformItemSizes(True)          # scrolling 400 lines stays instant
+        self.log.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
+        self.log.setTextElideMode(Qt.ElideMiddle)   # the band shows the whole last line
         self.log.setMinimumHeight(90)
         lay.addWidget(self.log, 1)
 
@@ -410,9 +412,10 @@ class DigitizerPanel(QWidget):
             for update in updates:
                 self._show_update(update)
                 changed = changed or update.kind in ("recorded", "control")
+            if updates:
+                self._show_counts()
             if changed and self.session is not None:
                 self.band.where.setText(self._where())
-                self._show_counts()
                 self.plant.update(self.session.history, self.session.pos)
                 self.recorded.emit(self.session.count.points)
         except Exception as exc:  # noqa: BLE001 - see the docstring

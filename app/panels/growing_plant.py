@@ -151,6 +151,6 @@ class GrowingPlant(QObject):
                 return
         size = np.maximum(hi - lo, 20.0)                # at least 20 cm around a first point
         centre = (lo + hi) / 2
-        lo, hi = centre - 0.65 * size, centre + 0.65 * size
+        lo, hi = centre - 0.55 * size, centre + 0.55 * size
         self._framed = np.column_stack([lo, hi]).ravel()
         self.viewport.frame_bounds(self._framed, render=False)
