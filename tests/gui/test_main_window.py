@@ -81,32 +81,3 @@ def test_bad_points_file_says_so(window, qtbot, tmp_path):
     assert "missing column" in err.args[0]
     assert "error" in w.messages.toPlainText()
     assert w.canopy is None
-
-
-def test_layout_editor_turns_a_plant_and_saves(window, qtbot, tmp_path):
-    from maizeviz.canopy.layout import load_layout
-
-    w = window(tile=1)
-    qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait()
-    panel = w.layout_panel
-    assert panel.table.rowCount() == 9
-    first = int(panel.table.item(0, 2).text())
-    before = w.canopy.vertices[w.canopy.faces[w.canopy.face_plant == first]].copy()
-    panel.table.item(0, 3).setText("90")
-    with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
-        panel.apply_button.click()
-    after = w.canopy.vertices[w.canopy.faces[w.canopy.face_plant == first]]
-    assert not np.allclose(before, after)                       # that plant turned
-    assert [p.azimuth_deg for p in w.loaded.layout.placements if p.plant == first] == [90]
-    assert w.loaded.layout.ground_area_cm2 == pytest.approx(180 * 90)
-    path = tmp_path / "lay.json"
-    panel.save(path)
-    back = load_layout(path, panel.plants)
-    assert len(back.placements) == 9
-    assert [p.azimuth_deg for p in back.placements if p.plant == first] == [90]
-    panel.table.item(1, 2).setText("77")                         # a plant that does not exist
-    panel.apply_button.click()
-    assert "plant 77 is not in the points file" in w.messages.toPlainText()
-    panel.table.item(1, 2).setText("x")
-    panel.apply_button.click()
-    assert "row 2, plant: 'x' is not a number" in w.messages.toPlainText()
