@@ -8,9 +8,17 @@ quits: the way to look at the app on a machine without a screen (under ``xvfb-ru
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import os
 import sys
 from collections.abc import Sequence
+
+#: What the app needs beyond the core (the ``gui`` extra); checked when the entry point loads,
+#: without importing them (pyvista and VTK take seconds to import).
+GUI_PACKAGES = ("PySide6", "pyvista", "pyvistaqt", "superqt")
+_missing = [name for name in GUI_PACKAGES if importlib.util.find_spec(name) is None]
+if _missing:
+    raise ImportError(f"{', '.join(_missing)} not installed")
 
 
 def run(argv: Sequence[str] | None = None) -> int:
@@ -20,11 +28,10 @@ def run(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--screenshot", metavar="PNG", help="save the window and quit")
     args = ap.parse_args(argv)
     os.environ.setdefault("QT_API", "pyside6")
-    from PySide6.QtCore import QTimer
-    from PySide6.QtWidgets import QApplication
-
     from maizeviz.resources import example_points
     from maizeviz_app.main_window import MainWindow
+    from PySide6.QtCore import QTimer
+    from PySide6.QtWidgets import QApplication
 
     app = QApplication.instance() or QApplication([sys.argv[0]])
     app.setApplicationName("maizeviz")

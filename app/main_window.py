@@ -12,12 +12,32 @@ import itertools
 import traceback
 from pathlib import Path
 
+from maizeviz.resources import example_points
+from maizeviz_app import workers
+from maizeviz_app.viewport import Viewport
 from PySide6.QtCore import QSettings, Qt, QTimer, Signal
 from PySide6.QtGui import QPixmap
-from PySide6.QtWidgets import (QCheckBox, QComboBox, QDockWidget, QDoubleSpinBox, QFileDialog,
-                               QFormLayout, QGroupBox, QHBoxLayout, QLabel, QLineEdit,
-                               QMainWindow, QPlainTextEdit, QProgressBar, QPushButton, QSlider,
-                               QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QDockWidget,
+    QDoubleSpinBox,
+    QFileDialog,
+    QFormLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QMainWindow,
+    QPlainTextEdit,
+    QProgressBar,
+    QPushButton,
+    QSlider,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
 from superqt.utils import create_worker
 
 from maizeviz.canopy.measures import TABLE2_COLUMNS, table2_row
@@ -26,9 +46,6 @@ from maizeviz.light.request import LightRequest
 from maizeviz.light.sun import Sun, sun_at
 from maizeviz.mesh.levels import COMPLEXITY_STOPS as LEVELS
 from maizeviz.mesh.levels import parse_level
-from maizeviz.resources import example_points
-from maizeviz_app import workers
-from maizeviz_app.viewport import Viewport
 
 
 def _label(level: str) -> str:

@@ -20,12 +20,11 @@ from pathlib import Path
 
 import numpy as np
 
-from maizeviz.canopy.layout import tiled_layout
-from maizeviz.canopy.layout import plant_bases
+from maizeviz.canopy.layout import plant_bases, tiled_layout
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.io.points import read_points
-from maizeviz.leaf.grid import build_grids
 from maizeviz.leaf.fit import fit_leaves
+from maizeviz.leaf.grid import build_grids
 from maizeviz.mesh.levels import parse_level
 
 ROOT = Path(__file__).resolve().parents[1]

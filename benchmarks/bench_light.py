@@ -22,18 +22,17 @@ from pathlib import Path
 
 import numpy as np
 
-from maizeviz.canopy.layout import tiled_layout
-from maizeviz.canopy.layout import plant_bases
+from maizeviz.canopy.layout import plant_bases, tiled_layout
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.io.points import read_points
-from maizeviz.leaf.grid import build_grids
 from maizeviz.leaf.fit import fit_leaves
-from maizeviz.mesh.levels import parse_level
-from maizeviz.mesh.raytrace import RayScene
-from maizeviz.light.sun import Sun
+from maizeviz.leaf.grid import build_grids
 from maizeviz.light.rays import ray_grid
 from maizeviz.light.request import LightRequest
+from maizeviz.light.sun import Sun
 from maizeviz.light.transmission import trace_light
+from maizeviz.mesh.levels import parse_level
+from maizeviz.mesh.raytrace import RayScene
 
 ROOT = Path(__file__).resolve().parents[1]
 

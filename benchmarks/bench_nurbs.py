@@ -17,12 +17,12 @@ import time
 import numpy as np
 from geomdl import fitting
 
+from maizeviz.leaf.fit import fit_leaves
 from maizeviz.leaf.grid import LeafGrid
 from maizeviz.leaf.nurbs import fit_surface, refine_parameters
-from maizeviz.leaf.fit import fit_leaves
+from maizeviz.leaf.synth import LeafShape, leaf_points
 from maizeviz.mesh.levels import Level, mesh_leaves
 from maizeviz.mesh.tessellate import mesh_grid
-from maizeviz.leaf.synth import LeafShape, leaf_points
 
 
 def best_of(fn, repeat, number=1):

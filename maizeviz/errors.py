@@ -48,6 +48,20 @@ class LeafError(MaizevizError):
         super().__init__(f"plant {plant}, leaf {leaf}: {message}")
 
 
+def check_range(value: float, name: str, low: float, high: float, quantity: str | None = None,
+                whole: bool = False, unit: str = "") -> None:
+    """Refuse a value outside [low, high] (or not finite, or not whole when ``whole``), naming
+    it: ``"cross-sections must be a whole number between 2 and 200, got 0"``."""
+    kind = "a whole number" if whole else "a number"
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and \
+        value == value and low <= value <= high and (not whole or float(value).is_integer())
+    if not ok:
+        units = f" {unit}" if unit else ""
+        lo, hi = (f"{int(v):,}" if whole else f"{v:g}" for v in (low, high))
+        raise MaizevizError(f"{name} must be {kind} between {lo} and {hi}{units}, got {value}",
+                            quantity=quantity)
+
+
 #: Inputs an error may be about, with what they mean; the CLI maps each to its flag.
 QUANTITIES = {
     "density": "rays per cm2 of the sample rectangle",
@@ -73,4 +87,13 @@ QUANTITIES = {
     "cols": "points per cross-section",
     "plants": "rows x plants per row",
     "sections": "cross-sections of a long leaf",
+    "points_across": "points per cross-section of a synthetic leaf",
+    "seed": "random seed",
+    "plant": "plant id",
+    "pace": "seconds between simulated presses",
+    "noise": "simulated digitizer noise, cm",
+    "answer_timeout": "seconds to wait for the digitizer's replies",
+    "baud": "serial baud rate",
+    "at": "stalk position x, y, cm",
+    "params": "data parameterisation",
 }

@@ -19,11 +19,14 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import write_text
+from maizeviz.io.inputs import read_input
 from maizeviz.leaf.fit import Leaf
 
 LAYOUT_SCHEMA = 1
 #: Plants a layout may hold (a hectare at 60 x 30 cm is about 55,000).
 MAX_PLANTS = 100_000
+#: Largest layout file read (bytes): 100,000 plants take about 8 MB.
+MAX_LAYOUT_BYTES = 20_000_000
 
 
 class LayoutError(MaizevizError):
@@ -51,7 +54,7 @@ class Placement:
     x: float
     y: float
     azimuth_deg: float = 0.0
-    tile: tuple = (0, 0)
+    tile: tuple[int, int] = (0, 0)
 
 
 @dataclass(frozen=True)
@@ -71,13 +74,13 @@ class CanopyLayout:
     warnings : tuple[str, ...]
     """
 
-    placements: tuple
+    placements: tuple[Placement, ...]
     cells: np.ndarray
     row_spacing: float
     plant_spacing: float
     north_deg: float = 0.0
     centre_cells: np.ndarray = field(default_factory=lambda: np.empty((0, 4)))
-    warnings: tuple = ()
+    warnings: tuple[str, ...] = ()
     ground_area: float | None = None
 
     @property
@@ -201,6 +204,10 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
     a, b = tile
     if a < 1 or b < 1:
         raise LayoutError(f"tile must be at least 1x1, got {a}x{b}", quantity="tile")
+    if a * b * len(bases) > MAX_PLANTS:
+        raise LayoutError(f"tiling {a}x{b} places {a * b * len(bases):,} plants; a canopy holds "
+                          f"at most {MAX_PLANTS:,} (a hectare at 60 x 30 cm is about 55,000)",
+                          quantity="tile")
     warnings = []
     inferred, lattice = block_lattice(bases, row_spacing, plant_spacing)
     if block is None:
@@ -223,13 +230,12 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
                 cells.append(c)
                 if key == (0, 0):
                     centre.append(c)
-    cells = np.array(cells)
     overlap = _overlaps(np.array(centre))
     if overlap:
         warnings.append(f"digitized plants {overlap} stand closer than the spacing: their "
                         "cells overlap")
-    return CanopyLayout(tuple(placements), cells, float(row_spacing), float(plant_spacing),
-                        north_deg, np.array(centre), tuple(warnings),
+    return CanopyLayout(tuple(placements), np.array(cells), float(row_spacing),
+                        float(plant_spacing), north_deg, np.array(centre), tuple(warnings),
                         a * b * union_area(np.array(centre)))
 
 
@@ -285,14 +291,11 @@ def load_layout(path: str | Path, plants: set[int] | None = None) -> CanopyLayou
         Naming the field that is wrong.
     """
     path = Path(path)
+    raw = read_input(path, "layout file", MAX_LAYOUT_BYTES, LayoutError)
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise LayoutError(f"{path}: no such layout file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise LayoutError(f"{path}: cannot be read ({exc})") from None
-    if len(text) > 20_000_000:
-        raise LayoutError(f"{path}: {len(text)} bytes is too large for a layout file")
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise LayoutError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
     try:
         data = json.loads(text)
     except (json.JSONDecodeError, RecursionError) as exc:

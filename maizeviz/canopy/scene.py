@@ -145,7 +145,7 @@ def build_canopy(leaves: list[Leaf], layout: CanopyLayout, level: Level,
         leaf_ids = np.concatenate([np.full(len(m.faces), m.leaf, np.int32) for m in ms])
         local[p] = (verts, faces, leaf_ids, len(ms))
 
-    vparts, fparts, inst, plant_ids, leaf_ids, nleaves = [], [], [], [], [], []
+    vparts, fparts, inst, plant_ids, leaf_parts, nleaves = [], [], [], [], [], []
     svparts, sfparts = [], []
     v_off = s_off = 0
     for i, pl in enumerate(layout.placements):
@@ -156,7 +156,7 @@ def build_canopy(leaves: list[Leaf], layout: CanopyLayout, level: Level,
         v_off += len(verts)
         inst.append(np.full(len(faces), i, np.int32))
         plant_ids.append(np.full(len(faces), pl.plant, np.int32))
-        leaf_ids.append(lids)
+        leaf_parts.append(lids)
         nleaves.append(nl)
         sv, sf = stalk_mesh(tops[pl.plant])
         svparts.append(sv + [pl.x, pl.y, 0.0])
@@ -165,6 +165,6 @@ def build_canopy(leaves: list[Leaf], layout: CanopyLayout, level: Level,
         if i % 9 == 8 or i == n_place - 1:
             report(progress, len(source) + i + 1, total, "canopy build")
     return Canopy(np.concatenate(vparts), np.concatenate(fparts), np.concatenate(inst),
-                  np.concatenate(plant_ids), np.concatenate(leaf_ids), layout, level.label,
+                  np.concatenate(plant_ids), np.concatenate(leaf_parts), layout, level.label,
                   np.concatenate(svparts), np.concatenate(sfparts),
                   np.array(nleaves, dtype=np.int32))

@@ -15,12 +15,10 @@ import os
 import sys
 import traceback
 from collections.abc import Callable, Sequence
-from importlib.metadata import entry_points
 
 from maizeviz import __version__
 from maizeviz.cli import canopy, leaf, light, phenomenal, record, simulate, synth
-from maizeviz.cli.common import (EXIT_FAIL, EXIT_OK, EXIT_PARTIAL, EXIT_USAGE, error_line,
-                                 say)
+from maizeviz.cli.common import EXIT_FAIL, EXIT_OK, EXIT_PARTIAL, EXIT_USAGE, error_line, say
 from maizeviz.errors import MaizevizError
 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_FAIL", "EXIT_USAGE", "EXIT_PARTIAL"]
@@ -54,6 +52,8 @@ def has_screen() -> bool:
 
 def find_gui() -> tuple[Callable[[Sequence[str]], int] | None, str]:
     """The desktop app's ``run`` from its entry point, or None and why not (one line)."""
+    from importlib.metadata import entry_points
+
     found = entry_points(group=GUI_GROUP)
     if not found:
         return None, GUI_HINT
@@ -72,7 +72,10 @@ def _no_command(argv: list[str]) -> int:
     if gui is None:
         say(f"note: {why}")
     elif has_screen():
-        return gui(rest)
+        try:
+            return gui(rest)
+        except ImportError as exc:              # Qt present but unusable (a missing libxcb...)
+            say(f"note: the desktop app cannot start ({exc}); the headless report follows")
     else:
         say("no screen (DISPLAY is not set): the headless report on the bundled example "
             "follows; for the window run 'xvfb-run -a maizeviz --screenshot app.png' or use a "
@@ -86,7 +89,7 @@ def _no_command(argv: list[str]) -> int:
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     tokens = list(sys.argv[1:] if argv is None else argv)
-    names = set(parser._subparsers._group_actions[0].choices)  # type: ignore[union-attr]
+    names = {command.NAME for command in COMMANDS}
     first = next((t for t in tokens if t != "--debug"), None)
     if first not in names and first not in ("-h", "--help", "--version"):
         return _no_command(tokens)                 # the app, with its own options

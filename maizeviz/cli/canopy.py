@@ -10,17 +10,31 @@ from maizeviz.canopy.export import export_canopy
 from maizeviz.canopy.layout import save_layout
 from maizeviz.canopy.measures import TABLE2_COLUMNS, measure_canopy, table2_row
 from maizeviz.canopy.scene import build_canopy
-from maizeviz.cli.common import (Progress, add_canopy_options, add_level_options, canopy_setup,
-                                 fmt_table, leaves_summary, levels_from, say)
+from maizeviz.cli.common import (
+    Progress,
+    add_canopy_options,
+    add_level_options,
+    canopy_setup,
+    check_canopy_costs,
+    check_outputs,
+    check_export,
+    fmt_table,
+    leaves_summary,
+    levels_from,
+    say,
+)
+from maizeviz.cost import light_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import refuse_overwriting_inputs
-from maizeviz.io.meshfile import check_mesh_path
 from maizeviz.mesh.levels import CANOPY_LEVELS
+
+#: The subcommand.
+NAME = "canopy"
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "canopy", help="lay out digitized plants as a canopy and measure it (Table 2)",
+        NAME, help="lay out digitized plants as a canopy and measure it (Table 2)",
         description="Build a canopy from digitized plants, tiled or from a layout file, and "
                     "report leaf area, projected area, ground cover and LAI.")
     add_canopy_options(p)
@@ -38,16 +52,16 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     levels = levels_from(args)
-    if args.export:
-        if len(levels) > 1:
-            raise MaizevizError("--export writes one level: use it with --interp or --triangles")
-        check_mesh_path(args.export)
+    check_export(args.export, levels)
     if not args.cover_resolution > 0:
         raise MaizevizError(f"the ground-cover pixel must be > 0 cm, got {args.cover_resolution}",
                             quantity="cover_resolution")
+    check_outputs(args.save_layout)
     refuse_overwriting_inputs([("the mesh export", args.export),
                                ("the saved layout", args.save_layout)], [args.points, args.layout])
     leaves, skipped, layout = canopy_setup(args)
+    cover = light_cost(layout.bounds, 1 / args.cover_resolution**2, 1)
+    check_canopy_costs(leaves, layout, levels, args.force, [cover])
     if args.save_layout:
         save_layout(args.save_layout, layout)
     runs = []

@@ -5,14 +5,17 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
+from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 
-from maizeviz.canopy.layout import CanopyLayout, layout_for, parse_shape
+from maizeviz.canopy.layout import MAX_PLANTS, CanopyLayout, layout_for, parse_shape
+from maizeviz.cost import Cost, canopy_cost, check
 from maizeviz.errors import LeafError, MaizevizError
-from maizeviz.io.atomic import atomic_open
+from maizeviz.io.atomic import atomic_open, check_output
+from maizeviz.io.meshfile import check_mesh_path
 from maizeviz.leaf.fit import Leaf, read_leaves
-from maizeviz.mesh.levels import Level, parse_level, parse_levels
+from maizeviz.mesh.levels import Level, parse_levels
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_PARTIAL = 0, 1, 2, 3
 
@@ -26,6 +29,8 @@ FLAGS = {
     "degree": "--degree", "params": "--params", "sun": "--sun-zenith/--sun-azimuth",
     "date": "--date", "time": "--time", "place": "--lat/--lon", "tz": "--tz", "cols": "--cols",
     "plants": "--plants", "sections": "--sections", "at": "--at", "periodic": "--periodic",
+    "baud": "--baud", "points_across": "--points-across", "seed": "--seed", "plant": "--plant",
+    "pace": "--pace", "noise": "--noise", "answer_timeout": "--answer-timeout",
 }
 
 
@@ -86,6 +91,22 @@ def add_level_options(p: argparse.ArgumentParser, default_levels: str) -> None:
                         "smooth surface's area")
 
 
+def check_outputs(*paths: str | None) -> None:
+    """Refuse, before any work, output files whose folder is missing or that are folders."""
+    for path in paths:
+        if path is not None:
+            check_output(path)
+
+
+def check_export(path: str | None, levels: list[Level]) -> None:
+    """Refuse, before any work, a mesh export of several levels or to an unusable path."""
+    if path is None:
+        return
+    if len(levels) > 1:
+        raise MaizevizError("--export writes one level: use it with --interp or --triangles")
+    check_mesh_path(path)
+
+
 def levels_from(args: argparse.Namespace, default_k: int = 4) -> list[Level]:
     """The levels asked for by --levels, --triangles or --interp (default K = 4)."""
     if args.levels is not None:
@@ -110,6 +131,17 @@ def add_canopy_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--layout", metavar="JSON", help="a layout file instead of tiling")
     p.add_argument("--strict", action="store_true",
                    help="stop at the first bad leaf instead of skipping it")
+    p.add_argument("--force", action="store_true",
+                   help="run work estimated to take longer than 15 min (what would not fit in "
+                        "memory is refused anyway)")
+
+
+def check_canopy_costs(leaves: list[Leaf], layout: CanopyLayout, levels: list[Level],
+                       force: bool, per_level: Sequence[Cost] = ()) -> None:
+    """Refuse, before building anything, canopies (plus ``per_level`` work on each) that would
+    not fit in memory, or take too long unless ``force``."""
+    placed = dict(Counter(p.plant for p in layout.placements))
+    check([[canopy_cost(leaves, placed, level), *per_level] for level in levels], force)
 
 
 def load_leaves(path: str, strict: bool = False, degree: int = 3,
@@ -126,6 +158,10 @@ def load_leaves(path: str, strict: bool = False, degree: int = 3,
 def canopy_setup(args: argparse.Namespace) -> tuple[list[Leaf], list[LeafError], CanopyLayout]:
     """Leaves and layout from the canopy options; warnings on stderr."""
     tile = parse_shape(args.tile, "tile")
+    if tile[0] * tile[1] > MAX_PLANTS:                # refused before reading anything
+        raise MaizevizError(f"tiling {tile[0]}x{tile[1]} makes {tile[0] * tile[1]:,} copies of "
+                            f"the block; a canopy holds at most {MAX_PLANTS:,} plants",
+                            quantity="tile")
     block = parse_shape(args.block, "block") if args.block else None
     leaves, skipped = load_leaves(args.points, args.strict)
     if not leaves:

@@ -5,18 +5,27 @@ from __future__ import annotations
 import argparse
 import json
 
-from maizeviz.cli.common import (add_level_options, fmt_table, leaves_summary, levels_from,
-                                 load_leaves, say)
-from maizeviz.errors import MaizevizError
+from maizeviz.cli.common import (
+    add_level_options,
+    check_export,
+    fmt_table,
+    leaves_summary,
+    levels_from,
+    load_leaves,
+    say,
+)
 from maizeviz.io.atomic import refuse_overwriting_inputs
-from maizeviz.io.meshfile import check_mesh_path, write_mesh
+from maizeviz.io.meshfile import write_mesh
 from maizeviz.mesh.levels import DEFAULT_LEVELS, measure, mesh_leaves
 from maizeviz.mesh.tessellate import merge_meshes
+
+#: The subcommand.
+NAME = "leaf"
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "leaf", help="fit NURBS surfaces through digitized leaves and mesh them",
+        NAME, help="fit NURBS surfaces through digitized leaves and mesh them",
         description="Fit a NURBS surface through every leaf of a points file and mesh it at "
                     "the chosen complexity. Areas in cm2, lengths in cm.")
     p.add_argument("points", help="points CSV (plant,leaf,row,col,x,y,z in cm)")
@@ -35,11 +44,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     levels = levels_from(args)
-    if args.export:
-        if len(levels) > 1:
-            raise MaizevizError("--export writes one level: use it with --interp or --triangles")
-        check_mesh_path(args.export)
-        refuse_overwriting_inputs([("the mesh export", args.export)], [args.points])
+    check_export(args.export, levels)
+    refuse_overwriting_inputs([("the mesh export", args.export)], [args.points])
     leaves, skipped = load_leaves(args.points, args.strict, args.degree, args.params)
     per_level = []
     for level in levels:

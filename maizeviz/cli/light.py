@@ -8,9 +8,22 @@ import os
 import time
 
 from maizeviz.canopy.scene import build_canopy
-from maizeviz.cli.common import (Progress, add_canopy_options, add_level_options, canopy_setup,
-                                 floats, fmt_table, leaves_summary, levels_from, say, suffixed,
-                                 write_rows)
+from maizeviz.cli.common import (
+    Progress,
+    add_canopy_options,
+    add_level_options,
+    canopy_setup,
+    check_canopy_costs,
+    check_outputs,
+    floats,
+    fmt_table,
+    leaves_summary,
+    levels_from,
+    say,
+    suffixed,
+    write_rows,
+)
+from maizeviz.cost import heatmap_cost, light_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import refuse_overwriting_inputs
 from maizeviz.light.beer_lambert import beer_lambert, clumping
@@ -21,10 +34,13 @@ from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import trace_light
 from maizeviz.mesh.levels import CANOPY_LEVELS
 
+#: The subcommand.
+NAME = "light"
+
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "light", help="direct sunlight through the canopy with Embree (Table 3)",
+        NAME, help="direct sunlight through the canopy with Embree (Table 3)",
         description="Trace parallel sun rays through a canopy: transmission at several heights "
                     "inside a sample rectangle, sunlit and second-class area per leaf, per mesh "
                     "level with timings.")
@@ -91,12 +107,18 @@ def run(args: argparse.Namespace) -> int:
     if not args.heatmap_bin > 0:
         raise MaizevizError(f"the heatmap bin must be > 0 cm, got {args.heatmap_bin}",
                             quantity="heatmap_bin")
+    check_outputs(args.leaf_light, args.plant_light)
     refuse_overwriting_inputs([("the leaf light table", args.leaf_light),
                                ("the plant light table", args.plant_light)],
                               [args.points, args.layout])
     say(f"sun: zenith {sun.zenith_deg:.2f} deg, azimuth {sun.azimuth_deg:.2f} deg"
         + (f" ({sun.when})" if sun.when else ""))
     leaves, skipped, layout = canopy_setup(args)
+    sampled = rect or layout.centre_bounds
+    work = [light_cost(sampled, args.density, len(heights))]            # type: ignore[arg-type]
+    if args.heatmaps:
+        work.append(heatmap_cost(sampled, args.heatmap_bin, len(heights)))  # type: ignore[arg-type]
+    check_canopy_costs(leaves, layout, levels, args.force, work)
     want_classes = bool(args.leaf_light or args.plant_light)
     records: list[dict] = []
     for level in levels:

@@ -5,15 +5,19 @@ from __future__ import annotations
 import argparse
 
 from maizeviz.cli.common import EXIT_OK, floats, say
-from maizeviz.io.atomic import refuse_overwriting_inputs
+from maizeviz.errors import check_range
+from maizeviz.io.atomic import check_output, refuse_overwriting_inputs
 from maizeviz.io.phenomenal import load_phenomenal
 from maizeviz.io.points import write_points
 from maizeviz.leaf.phenomenal import move_plant, phenomenal_grids
 
+#: The subcommand.
+NAME = "import-phenomenal"
+
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "import-phenomenal", help="turn a Phenomenal/PhenoTrack3D plant into leaf point grids",
+        NAME, help="turn a Phenomenal/PhenoTrack3D plant into leaf point grids",
         description="Import a plant segmented by the Phenomenal pipeline (JSON, optionally "
                     "gzip-compressed, mm) as a points file (cm): each leaf's midrib and "
                     "surface voxels become cross-sections of 5 points.")
@@ -25,6 +29,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_range(args.plant, "the plant id", 0, 2**31 - 1, "plant", whole=True)
+    check_output(args.out)
     refuse_overwriting_inputs([("the points file", args.out)], [args.file])
     grids, warnings = phenomenal_grids(load_phenomenal(args.file), args.plant)
     for w in warnings:

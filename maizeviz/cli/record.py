@@ -11,12 +11,15 @@ from maizeviz.cli.common import EXIT_OK, say
 from maizeviz.digitizer.port import FastrakPort
 from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import Session
-from maizeviz.errors import MaizevizError
+from maizeviz.errors import MaizevizError, check_range
+
+#: The subcommand.
+NAME = "record"
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "record", help="digitize with a Polhemus FASTRAK: stylus presses become points",
+        NAME, help="digitize with a Polhemus FASTRAK: stylus presses become points",
         description="Record stylus presses from a FASTRAK as points of plants, leaves and "
                     "cross-sections. Every point is on disk (fsync) before it is reported. "
                     "Controls, one per line on standard input: n next leaf, p next plant, "
@@ -35,6 +38,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_range(args.answer_timeout, "the answer timeout", 0.01, 600, "answer_timeout", unit="s")
+    check_range(args.baud, "the baud rate", 300, 4_000_000, "baud", whole=True)
     session = Session(args.out, args.cols, args.resume, args.reference_station)
     if args.resume:
         q0 = session.pos

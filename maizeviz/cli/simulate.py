@@ -8,11 +8,15 @@ import time
 from maizeviz.cli.common import EXIT_OK
 from maizeviz.digitizer.replay import replay_points
 from maizeviz.digitizer.simulator import FastrakSimulator
+from maizeviz.errors import check_range
+
+#: The subcommand.
+NAME = "fastrak-sim"
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "fastrak-sim", help="a pretend FASTRAK on a pseudo-terminal (prints its path)",
+        NAME, help="a pretend FASTRAK on a pseudo-terminal (prints its path)",
         description="Open a pseudo-terminal that behaves like a FASTRAK and, with --replay, "
                     "press the stylus at every point of a points file once a recorder has "
                     "configured it.")
@@ -30,6 +34,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_range(args.pace, "the pace", 0, 3600, "pace", unit="s")
+    check_range(args.noise, "the position noise", 0, 100, "noise", unit="cm")
+    check_range(args.seed, "the random seed", 0, 2**32 - 1, "seed", whole=True)
     stations = (1, 2) if args.reference else (1,)
     with FastrakSimulator(stations, args.noise, args.seed) as sim:
         print(f"FASTRAK simulator on {sim.path}", flush=True)

@@ -6,14 +6,17 @@ import argparse
 
 from maizeviz.canopy.layout import parse_shape
 from maizeviz.cli.common import EXIT_OK, say
-from maizeviz.errors import MaizevizError
+from maizeviz.io.atomic import check_output
 from maizeviz.io.points import write_points
 from maizeviz.leaf.synth import block_grids
+
+#: The subcommand.
+NAME = "synth"
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "synth", help="write a realistic digitized block of synthetic maize plants",
+        NAME, help="write a realistic digitized block of synthetic maize plants",
         description="Write a points file of a block of parametric maize plants at silking "
                     "(about 245 cm, 16 leaves, 0.94 m2 of leaf each), digitized the way a "
                     "technician would, with 0.08 cm digitizer noise.")
@@ -32,10 +35,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     rows, per_row = parse_shape(args.plants, "plants")
-    if not (args.row_spacing > 0 and args.plant_spacing > 0):
-        raise MaizevizError("spacings must be positive numbers of cm")
-    if args.sections < 2 or args.points_across < 2:
-        raise MaizevizError("--sections and --points-across must be at least 2")
+    check_output(args.out)
     grids = block_grids(rows, per_row, args.row_spacing, args.plant_spacing, args.seed,
                         grid_rows=args.sections, grid_cols=args.points_across)
     write_points(args.out, grids)

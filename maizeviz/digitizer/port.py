@@ -42,8 +42,8 @@ class DeviceConfig:
 
     centimetres: bool
     binary: bool
-    items: dict
-    warnings: tuple = ()
+    items: dict[int, tuple[int, ...]]
+    warnings: tuple[str, ...] = ()
 
 
 class FastrakPort:
@@ -77,10 +77,18 @@ class FastrakPort:
         except (serial.SerialException, OSError, ValueError) as exc:
             raise DeviceError(f"cannot open {self.port_name}: {exc}") from None
 
+    @property
+    def _port(self) -> serial.Serial:
+        """The open serial port (:class:`DeviceError` when it is not open)."""
+        if self.serial is None:
+            raise DeviceError(f"{self.port_name} is not open")
+        return self.serial
+
     def _send(self, data: bytes) -> None:
+        port = self._port
         try:
-            self.serial.write(data)
-            self.serial.flush()
+            port.write(data)
+            port.flush()
         except (serial.SerialException, OSError) as exc:
             raise DeviceError(f"{self.port_name}: write failed ({exc})") from None
 
@@ -90,7 +98,7 @@ class FastrakPort:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             try:
-                chunk = self.serial.read(256)
+                chunk = self._port.read(256)
             except (serial.SerialException, OSError) as exc:
                 raise DeviceError(f"{self.port_name}: read failed ({exc})") from None
             for ev in parser.feed(chunk):
@@ -100,7 +108,7 @@ class FastrakPort:
 
     def status(self) -> fp.Status:
         """Ask for a status record, retrying; :class:`DeviceError` when nothing answers."""
-        for attempt in range(self.retries):
+        for _ in range(self.retries):
             self._send(fp.STATUS)
             ev = self._read_reply(fp.Status, self.answer_timeout)
             if isinstance(ev, fp.Status):
@@ -109,7 +117,7 @@ class FastrakPort:
             f"no answer from a FASTRAK on {self.port_name} at {self.baud} baud after "
             f"{self.retries} status requests: check that the unit is on (a unit just "
             "re-initialised stays silent about 10 s), the cable, and that the baud rate matches "
-            "its rear DIP switches (--baud)")
+            "its rear DIP switches", quantity="baud")
 
     def configure(self, stations=(1,)) -> DeviceConfig:
         """The start-up sequence; returns what the device ended up reporting."""
@@ -118,16 +126,16 @@ class FastrakPort:
         self.stations = tuple(stations)
         self._send(fp.STOP_CONTINUOUS)
         time.sleep(0.05)
-        self.serial.reset_input_buffer()
+        self._port.reset_input_buffer()
         self.status()
-        for st in range(1, 5):
-            self._send(fp.station_enable(st, st in self.stations))
+        for station in range(1, 5):
+            self._send(fp.station_enable(station, station in self.stations))
         self._send(fp.CENTIMETRES)
         self._send(fp.ASCII)
-        items = {}
-        for st in self.stations:
-            items[st] = fp.STYLUS_ITEMS if st == 1 else fp.DEFAULT_ITEMS
-            self._send(fp.output_list(st, items[st]))
+        items: dict[int, tuple[int, ...]] = {}
+        for station in self.stations:
+            items[station] = fp.STYLUS_ITEMS if station == 1 else fp.DEFAULT_ITEMS
+            self._send(fp.output_list(station, items[station]))
         self._send(fp.stylus_mode(1, True))
         time.sleep(0.05)
         st = self.status()
@@ -138,14 +146,15 @@ class FastrakPort:
             warnings.append("the unit keeps answering in binary; records are read as binary")
         self.config = DeviceConfig(st.centimetres, st.binary, items, tuple(warnings))
         self.parser = fp.RecordParser(items, binary=st.binary)
-        self.serial.reset_input_buffer()
+        self._port.reset_input_buffer()
         return self.config
 
     def to_cm(self, rec: fp.Record) -> fp.Record:
         """A record with its position in centimetres, whatever the unit was set to."""
         if self.config is None or self.config.centimetres or rec.position is None:
             return rec
-        return replace(rec, position=tuple(v * CM_PER_INCH for v in rec.position))
+        x, y, z = rec.position
+        return replace(rec, position=(x * CM_PER_INCH, y * CM_PER_INCH, z * CM_PER_INCH))
 
     # ------------------------------------------------------------------------- reader
     def start_reader(self, callback=None) -> "queue.Queue | None":
@@ -156,7 +165,7 @@ class FastrakPort:
         """
         if self.parser is None:
             raise DeviceError("configure the device before reading")
-        q = None
+        q: queue.Queue | None = None
         if callback is None:
             q = queue.Queue()
             callback = q.put
@@ -167,7 +176,8 @@ class FastrakPort:
         return q
 
     def _read_loop(self, callback):
-        ser = self.serial
+        ser, parser = self._port, self.parser
+        assert parser is not None                  # start_reader checked it
         while not self._stop.is_set():
             try:
                 data = ser.read(max(1, min(ser.in_waiting, 65536)))
@@ -177,7 +187,7 @@ class FastrakPort:
                 return
             if not data:
                 continue
-            for ev in self.parser.feed(data):
+            for ev in parser.feed(data):
                 callback(self.to_cm(ev) if isinstance(ev, fp.Record) else ev)
 
     def stop(self) -> None:

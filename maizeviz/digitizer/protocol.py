@@ -76,8 +76,8 @@ class Record:
 
     station: int
     error: str
-    position: tuple | None
-    angles: tuple | None
+    position: tuple[float, float, float] | None
+    angles: tuple[float, float, float] | None
     stylus: int | None
     values: dict = field(default_factory=dict)
 

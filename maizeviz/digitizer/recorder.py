@@ -123,14 +123,14 @@ class Recorder:
             return Update("control", msg)
         if isinstance(ev, PortLost):
             return Update("lost", f"{ev.message}; every point reported recorded is on disk", 1)
-        msg = self.session.on_event(ev)
+        said = self.session.on_event(ev)
         if isinstance(ev, Garbled):
             return Update("garbled", f"garbled record skipped ({ev.reason}); "
                                      f"{self.session.count.garbled} so far: check the cable if "
                                      "this repeats")
-        if not msg:
+        if not said:
             return None
-        return Update("recorded" if msg.startswith("recorded") else "refused", msg)
+        return Update("recorded" if said.startswith("recorded") else "refused", said)
 
     def close(self) -> None:
         """Stop the reader, close the port and the journal (idempotent)."""

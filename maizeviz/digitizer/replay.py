@@ -43,7 +43,7 @@ def replay_points(sim, path, pace: float = 1.0, faults: bool = False, sway: bool
         wait_for_recorder(sim)
     say(f"replaying {len(ids)} points from {path}")
     made = 0
-    last_leaf = tuple(ids[0, :2]) if len(ids) else None
+    last_leaf = (int(ids[0, 0]), int(ids[0, 1])) if len(ids) else (-1, -1)
     last_leaf_start = int(np.flatnonzero(np.any(ids[:, :2] != ids[-1, :2], axis=1)).max() + 1) \
         if len(ids) and np.any(ids[:, :2] != ids[-1, :2]) else len(ids)
     for k, (key, p) in enumerate(zip(ids, xyz)):

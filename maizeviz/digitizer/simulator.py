@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from maizeviz.digitizer.protocol import DEFAULT_ITEMS, ITEMS
 from maizeviz.digitizer.geometry import euler_matrix
+from maizeviz.digitizer.protocol import DEFAULT_ITEMS, ITEMS
 
 CM_PER_INCH = 2.54
 PRESS_GAP_S = 0.333

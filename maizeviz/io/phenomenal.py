@@ -8,6 +8,7 @@ grids is :mod:`maizeviz.leaf.phenomenal`'s job.
 from __future__ import annotations
 
 import gzip
+import io
 import json
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from maizeviz.errors import MaizevizError
+from maizeviz.io.inputs import read_input
 
 LEAF_LABELS = ("mature_leaf", "growing_leaf")
 
@@ -38,15 +40,11 @@ MAX_JSON_BYTES = 512 * 2**20
 
 def _read_bounded(path: Path) -> bytes:
     """The file's bytes, gunzipped if compressed, never more than :data:`MAX_JSON_BYTES`."""
-    if not path.exists():
-        raise MaizevizError(f"{path}: no such file")
-    if not path.is_file():
-        raise MaizevizError(f"{path}: not a regular file")
-    with open(path, "rb") as raw:
-        gz = raw.read(2) == b"\x1f\x8b"
-        raw.seek(0)
-        fh = gzip.GzipFile(fileobj=raw) if gz else raw
-        data = fh.read(MAX_JSON_BYTES + 1)
+    data = read_input(path, "Phenomenal plant", MAX_JSON_BYTES)
+    gz = data[:2] == b"\x1f\x8b"
+    if gz:
+        with gzip.GzipFile(fileobj=io.BytesIO(data)) as fh:
+            data = fh.read(MAX_JSON_BYTES + 1)
     if len(data) > MAX_JSON_BYTES:
         raise MaizevizError(f"{path}: more than {MAX_JSON_BYTES // 2**20} MiB"
                             f"{' once decompressed' if gz else ''}; a Phenomenal plant is "

@@ -1,6 +1,6 @@
 """Gather digitized points into one rows x cols grid per leaf, repairing what is safe.
 
-Convention (SCIENCE.md section 1): ``row`` i runs along the midrib from the collar (0) to the
+Convention (docs/method.md, section 1): ``row`` i runs along the midrib from the collar (0) to the
 tip, ``col`` j across the blade from one margin (0) over the midrib to the other margin.
 
 Repairs, each reported in :attr:`LeafGrid.notes`:
@@ -50,8 +50,8 @@ class LeafGrid:
     leaf: int
     points: np.ndarray
     tip_collapsed: bool = False
-    rows: tuple = ()
-    notes: tuple = ()
+    rows: tuple[int, ...] = ()
+    notes: tuple[str, ...] = ()
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -14,7 +14,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import BSpline
 
 from maizeviz.errors import LeafError
 
@@ -207,6 +206,8 @@ class NurbsSurfaces:
         p = a[:, :3] / a[:, 3:]
         if not derivative:
             return p, None, None
+        from scipy.interpolate import BSpline  # ~1 s to import: only for normals
+
         su = BSpline(self.knots_u[0], hom, self.degree_u).derivative()(u)              # (K, nv, 4)
         sv = BSpline(self.knots_v[0], hom.transpose(1, 0, 2), self.degree_v).derivative()(v)
         au = np.einsum("kjc,kj->kc", su, bv)
@@ -222,7 +223,7 @@ class NurbsSurfaces:
     def normals(self, u, v) -> np.ndarray:
         """Unit normals dS/du x dS/dv of the first surface at pairs (K,), (K,) -> (K, 3).
 
-        With the column convention of SCIENCE.md (col 0 = right margin seen from above, tip
+        With the column convention of docs/method.md section 1 (col 0 = right margin seen from above, tip
         ahead) they point out of the upper (adaxial) face. Where the surface is degenerate
         (a collapsed tip) the normal is taken just inside the leaf.
         """
@@ -266,7 +267,7 @@ def fit_surfaces(points: np.ndarray, degree_u: int = 3, degree_v: int = 3,
     nb, m, n = points.shape[:3]
     keys = list(keys) if keys is not None else [(-1, -1)] * nb
     if m < 2 or n < 2:
-        raise LeafError(*keys[0], f"grid {m}x{n}: needs at least 2 rows and 2 cols")
+        raise LeafError(keys[0][0], keys[0][1], f"grid {m}x{n}: needs at least 2 rows and 2 cols")
     pu = max(1, min(degree_u, m - 1))
     pv = max(1, min(degree_v, n - 1))
     u, v = data_parameters(points, method)
@@ -276,8 +277,9 @@ def fit_surfaces(points: np.ndarray, degree_u: int = 3, degree_v: int = 3,
         if bad.any():
             leaf = int(np.argmax(bad))
             k = int(np.nanargmin(np.where(np.isnan(step[leaf]), -1, step[leaf])))
-            raise LeafError(*keys[leaf], f"{name}s {k} and {k + 1} coincide; cannot interpolate "
-                                         f"(merge or remove the repeated {name})")
+            raise LeafError(keys[leaf][0], keys[leaf][1],
+                            f"{name}s {k} and {k + 1} coincide; cannot interpolate "
+                            f"(merge or remove the repeated {name})")
     ku = averaged_knots(u, pu)
     kv = averaged_knots(v, pv)
     nu = basis_matrix(u, ku, pu)                                     # (L, m, m)

@@ -13,7 +13,6 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from maizeviz.errors import MaizevizError
 from maizeviz.io.phenomenal import LEAF_LABELS
@@ -50,6 +49,8 @@ def blade_grid(polyline: np.ndarray, voxels: np.ndarray, insertion: np.ndarray |
     up = np.cross(right, tangent)
     stations = np.linspace(0, length, m)
     si = np.clip(np.searchsorted(fine_s, stations), 0, len(fine_s) - 1)
+
+    from scipy.spatial import cKDTree  # ~0.5 s to import: only when importing
 
     near = cKDTree(fine).query(vox)[1] if len(vox) else np.empty(0, int)
     vs = fine_s[near]

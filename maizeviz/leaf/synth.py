@@ -1,9 +1,9 @@
-"""Parametric maize leaves and plants that look digitized (SCIENCE.md section 8).
+"""Parametric maize leaves and plants that look digitized (docs/method.md, "A synthetic maize plant").
 
 Used to make realistic test grids, benchmarks and the bundled example. A leaf is a midrib
 curve with a two-part curvature law, the Prevot width profile, a V-shaped cross-section, margin
 waves in opposite phase growing toward the tip, and FASTRAK noise (0.08 cm RMS). Grids follow
-the column convention of SCIENCE.md: col 0 is the right margin seen from above with the tip
+the column convention of docs/method.md: col 0 is the right margin seen from above with the tip
 ahead, so dS/du x dS/dv points out of the upper face; the tip row collapses to one point.
 """
 
@@ -13,9 +13,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from maizeviz.errors import check_range
 from maizeviz.leaf.grid import LeafGrid
 
 DIGITIZER_NOISE_CM = 0.08
+
+#: Plants a synthetic block may hold (a 100 x 100 block is already 1.5 million points).
+MAX_SYNTH_PLANTS = 10_000
 
 
 def prevot_width(s: np.ndarray, a: float = -2.3) -> np.ndarray:
@@ -39,7 +43,7 @@ class LeafShape:
 
     length: float = 90.0
     width: float = 9.0
-    base: tuple = (0.0, 0.0, 100.0)
+    base: tuple[float, float, float] = (0.0, 0.0, 100.0)
     azimuth_deg: float = 0.0
     insertion_deg: float = 35.0
     curvature_deg: float = 70.0
@@ -183,6 +187,13 @@ def block_grids(rows: int = 3, plants_per_row: int = 3, row_spacing: float = 60.
     leaf plane turned at random (field maize shows no strong preference at 60 x 30 cm), plant
     ids 1.. row by row as a technician walks them.
     """
+    check_range(rows * plants_per_row, "a synthetic block's plants", 1, MAX_SYNTH_PLANTS,
+                "plants", whole=True)
+    check_range(row_spacing, "the row spacing", 1, 1e4, "row_spacing", unit="cm")
+    check_range(plant_spacing, "the plant spacing", 1, 1e4, "plant_spacing", unit="cm")
+    check_range(seed, "the random seed", 0, 2**32 - 1, "seed", whole=True)
+    check_range(grid_rows, "cross-sections of a long leaf", 2, 200, "sections", whole=True)
+    check_range(grid_cols, "points per cross-section", 2, 51, "points_across", whole=True)
     rng = np.random.default_rng(seed)
     out = []
     pid = 1

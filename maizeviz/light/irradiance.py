@@ -48,13 +48,19 @@ import datetime as _dt
 import io
 import math
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import MappingProxyType
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from maizeviz.errors import MaizevizError
+from maizeviz.io.inputs import read_input
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 #: Share of shortwave (global) radiation in the PAR band (400-700 nm).
 PAR_FRACTION = 0.48
@@ -198,18 +204,18 @@ class SunTrack:
     notes : tuple of str: things said once about the period (polar night...)
     """
 
-    times: object
+    times: pd.DatetimeIndex
     step_s: np.ndarray
     zenith_deg: np.ndarray
     true_zenith_deg: np.ndarray
     azimuth_deg: np.ndarray
-    start: object
-    end: object
+    start: pd.Timestamp
+    end: pd.Timestamp
     latitude: float
     longitude: float
     altitude_m: float
     tz: str
-    notes: tuple = ()
+    notes: tuple[str, ...] = ()
 
     def __post_init__(self):
         for name in ("step_s", "zenith_deg", "true_zenith_deg", "azimuth_deg"):
@@ -330,7 +336,7 @@ class Period:
     rounded sum (math.fsum) of its steps.
     """
 
-    times: object
+    times: pd.DatetimeIndex
     step_s: np.ndarray
     zenith_deg: np.ndarray
     azimuth_deg: np.ndarray
@@ -338,12 +344,12 @@ class Period:
     dni: np.ndarray
     dhi: np.ndarray
     direct_horizontal: np.ndarray
-    start: object
-    end: object
+    start: pd.Timestamp
+    end: pd.Timestamp
     source: str
-    parameters: object = field(default_factory=dict)
+    parameters: Mapping[str, object] = field(default_factory=dict)
     par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J
-    notes: tuple = ()
+    notes: tuple[str, ...] = ()
 
     def __post_init__(self):
         n = len(self.times)
@@ -543,15 +549,15 @@ class Weather:
     """
 
     path: str
-    times: object
+    times: pd.DatetimeIndex
     step_s: np.ndarray
     ghi: np.ndarray
     dni: np.ndarray | None
     dhi: np.ndarray | None
     line: np.ndarray
     label: str
-    start: object
-    end: object
+    start: pd.Timestamp
+    end: pd.Timestamp
 
     def __post_init__(self):
         for name in ("step_s", "ghi", "dni", "dhi"):
@@ -559,29 +565,15 @@ class Weather:
                 object.__setattr__(self, name, _frozen(getattr(self, name)))
 
     @property
-    def columns(self) -> tuple:
+    def columns(self) -> tuple[str, ...]:
         """Irradiance columns the file gave."""
         return ("ghi", *(c for c in WEATHER_OPTIONAL if getattr(self, c) is not None))
 
 
 def _read_text(path: Path, max_bytes: int) -> str:
-    try:
-        size = path.stat().st_size
-    except FileNotFoundError:
-        raise WeatherFileError(f"{path}: no such weather file") from None
-    except OSError as exc:
-        raise WeatherFileError(f"{path}: cannot be read ({exc.strerror})") from None
-    if path.is_dir():
-        raise WeatherFileError(f"{path}: is a folder, not a weather file")
-    if size > max_bytes:
-        raise WeatherFileError(f"{path}: the weather file is {size / 2 ** 20:.1f} MiB, more "
-                               f"than the {max_bytes / 2 ** 20:g} MiB limit; split it")
-    if size == 0:
+    raw = read_input(path, "weather file", max_bytes, WeatherFileError)
+    if not raw:
         raise WeatherFileError(f"{path}: the weather file is empty")
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise WeatherFileError(f"{path}: cannot be read ({exc.strerror})") from None
     if b"\x00" in raw[:4096]:
         raise WeatherFileError(f"{path}: not a CSV text file (binary content)")
     try:
@@ -660,7 +652,7 @@ def _parse_times(texts: list, lines: list, path: Path, tz):
         try:
             aware = local.tz_localize(tz, ambiguous="raise", nonexistent="raise")
         except ValueError:  # pandas' NonExistentTimeError / AmbiguousTimeError
-            for k, t in zip(naive, local, strict=True):
+            for k, t in zip(naive.tolist(), local, strict=True):
                 try:
                     t.tz_localize(tz, ambiguous="raise", nonexistent="raise")
                 except ValueError:
@@ -700,7 +692,7 @@ def _parse_values(texts: list, lines: list, times: list, column: str, path: Path
         ok = np.isfinite(values) & (values >= 0) & (values <= MAX_IRRADIANCE_W_M2)
         bad = np.flatnonzero(~ok)
     except ValueError:                              # an empty or non-numeric cell somewhere
-        values, bad = None, range(len(texts))
+        values, bad = None, np.arange(len(texts))
     for k in bad:
         problem = _value_problem(texts[k])
         if problem:
@@ -781,7 +773,7 @@ def read_weather(path, tz: str | None = None, label: str = "center",
     first = next(rows, None)
     if first is None:
         raise WeatherFileError(f"{path}: the weather file is empty (no header, no rows)")
-    columns = _header(*first, path)
+    columns = _header(first[0], first[1], path)
     lines, data = [], []
     for line, fields in rows:
         if len(fields) != len(columns):

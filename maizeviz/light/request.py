@@ -6,12 +6,14 @@ import math
 from dataclasses import dataclass
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.errors import MaizevizError
+from maizeviz.errors import MaizevizError, check_range
 from maizeviz.light.rays import ray_count
 from maizeviz.light.sun import Sun
 
 #: More rays than this are refused (minutes of tracing and GiB of results).
 MAX_RAYS = 400_000_000
+#: More tracing threads than this are refused (Embree gains nothing past the cores).
+MAX_THREADS = 1024
 #: Bytes kept per ray for the results (first/second hit ids and heights).
 BYTES_PER_RAY = 16
 
@@ -61,8 +63,7 @@ def check_request(canopy: Canopy, req: LightRequest) -> tuple[Rect, list[str]]:
     if not (math.isfinite(req.density) and req.density > 0):
         raise MaizevizError(f"the ray density must be > 0 rays per cm2, got {req.density}",
                             quantity="density")
-    if req.threads < 1:
-        raise MaizevizError(f"tracing threads must be >= 1, got {req.threads}", quantity="threads")
+    check_range(req.threads, "tracing threads", 1, MAX_THREADS, "threads", whole=True)
     px0, py0, px1, py1 = canopy.layout.bounds
     rect: Rect = tuple(float(v) for v in (req.rect or canopy.layout.centre_bounds))  # type: ignore[assignment]
     x0, y0, x1, y1 = rect

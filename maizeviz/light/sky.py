@@ -358,11 +358,11 @@ def equal_area_bands(n: int) -> tuple[np.ndarray, np.ndarray]:
         if min(counts) >= 1 or bands == 1:
             break
         bands -= 1
-    counts = np.array([1, *counts], dtype=np.int64)
-    counts[-1] += n - counts.sum()                 # absorbs rounding of the carry, if any
-    c_edges = 1.0 - np.concatenate([[0], np.cumsum(counts)]) / n
+    per_band = np.array([1, *counts], dtype=np.int64)
+    per_band[-1] += n - per_band.sum()             # absorbs rounding of the carry, if any
+    c_edges = 1.0 - np.concatenate([[0], np.cumsum(per_band)]) / n
     c_edges[-1] = 0.0
-    return c_edges, counts
+    return c_edges, per_band
 
 
 def _equal_sky(kind: str, n: int) -> Sky:
@@ -507,15 +507,15 @@ def _turtle_sky(kind: str, n: int) -> Sky:
     zen, azi = turtle_directions(n)
     dirs = _unit_vectors(zen, azi)
     cells = _voronoi_cells(dirs)
-    owner, ta, tb, tc = [], [], [], []
+    owners, tas, tbs, tcs = [], [], [], []
     for i, verts in enumerate(cells):
         k = len(verts)
-        owner.append(np.full(k, i))
-        ta.append(np.repeat(dirs[i][None, :], k, axis=0))
-        tb.append(verts)
-        tc.append(np.roll(verts, -1, axis=0))
-    owner = np.concatenate(owner)
-    ta, tb, tc = np.concatenate(ta), np.concatenate(tb), np.concatenate(tc)
+        owners.append(np.full(k, i))
+        tas.append(np.repeat(dirs[i][None, :], k, axis=0))
+        tbs.append(verts)
+        tcs.append(np.roll(verts, -1, axis=0))
+    owner = np.concatenate(owners)
+    ta, tb, tc = np.concatenate(tas), np.concatenate(tbs), np.concatenate(tcs)
     solid = np.bincount(owner, weights=triangle_solid_angle(ta, tb, tc), minlength=n)
     nodes, dom = spherical_triangle_quadrature(ta, tb, tc)
     cz = np.clip(nodes[..., 2], 0.0, 1.0)

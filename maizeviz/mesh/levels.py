@@ -158,11 +158,13 @@ def mesh_leaves(leaves: list[Leaf], level: Level, preserve_area: bool = True,
                 out[i] = mesh_grid(pts[k], u[k], v[k], level.label, g.plant, g.leaf)
             tick(len(idx))
             continue
+        budget = level.triangles
+        assert budget is not None                    # a level is K or a budget
         for k, i in enumerate(idx):
             g = leaves[i].grid
             target = reference_area_cm2(leaves[i]) if preserve_area else None
             try:
-                out[i] = simplify(g.points, surf.params_u[k], surf.params_v[k], level.triangles,
+                out[i] = simplify(g.points, surf.params_u[k], surf.params_v[k], budget,
                                   g.tip_collapsed, target, g.plant, g.leaf)
             except ValueError as exc:                    # a budget below the coarsest mesh
                 raise MaizevizError(f"{level}: plant {g.plant}, leaf {g.leaf}: {exc}",

@@ -100,7 +100,7 @@ def select_lines(grid: np.ndarray, budget: int, tip_collapsed: bool) -> Selectio
     if budget < least:
         raise ValueError(f"a budget of {budget} triangles is below the coarsest mesh of this leaf "
                          f"({least}: collar to tip, margin to margin)")
-    best = None
+    best: tuple[float, np.ndarray, np.ndarray] | None = None
     seeds = [False]
     if n >= 3 and count_triangles(2, 3, tip_collapsed) <= budget:
         seeds.append(True)
@@ -113,6 +113,7 @@ def select_lines(grid: np.ndarray, budget: int, tip_collapsed: bool) -> Selectio
         residual = _greedy(grid, rows, cols, budget, tip_collapsed)
         if best is None or residual <= best[0] + 1e-9:
             best = (residual, rows, cols)
+    assert best is not None                          # seeds always holds False
     return Selection(np.flatnonzero(best[1]), np.flatnonzero(best[2]))
 
 

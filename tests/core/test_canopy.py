@@ -6,17 +6,24 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from maizeviz.canopy.layout import (LayoutError, layout_from_dict, load_layout, parse_shape,
-                                    save_layout, tiled_layout, union_area)
+from maizeviz.canopy.layout import (
+    LayoutError,
+    layout_from_dict,
+    load_layout,
+    parse_shape,
+    plant_bases,
+    save_layout,
+    tiled_layout,
+    union_area,
+)
 from maizeviz.canopy.measures import ground_cover, measure_canopy
-from maizeviz.canopy.layout import plant_bases
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
-from maizeviz.leaf.grid import LeafGrid
 from maizeviz.leaf.fit import fit_leaves
-from maizeviz.mesh.levels import Level, measure, mesh_leaf
+from maizeviz.leaf.grid import LeafGrid
 from maizeviz.leaf.synth import PlantShape, block_grids, plant_grids
+from maizeviz.mesh.levels import Level, measure, mesh_leaf
 
 PHENO = str(Path(__file__).resolve().parents[2] / "resources/phenotrack3d/1649057232.json.gz")
 
@@ -202,7 +209,7 @@ def test_layout_naming_missing_plant_is_refused():
 
 
 def test_synthetic_plant_matches_the_paper():
-    """Default synthetic plant: ~245 cm, ~16 leaves, ~0.94 m2 of leaf (SCIENCE.md section 8)."""
+    """Default synthetic plant: ~245 cm, ~16 leaves, ~0.94 m2 of leaf (docs/method.md, synthetic plant)."""
     areas, heights, counts = [], [], []
     for seed in range(4):
         grids = block_grids(1, 1, seed=seed)

@@ -4,7 +4,8 @@ import struct
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from maizeviz.digitizer import protocol as fp
 from maizeviz.digitizer.geometry import euler_matrix, to_reference_frame

@@ -9,9 +9,16 @@ import pvlib
 import pytest
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.irradiance import (DEFAULT_PAR_UMOL_PER_J, MAX_IRRADIANCE_W_M2,
-                                       WeatherFileError, clear_sky, clear_sky_period,
-                                       read_weather, sun_track, weather_period)
+from maizeviz.light.irradiance import (
+    DEFAULT_PAR_UMOL_PER_J,
+    MAX_IRRADIANCE_W_M2,
+    WeatherFileError,
+    clear_sky,
+    clear_sky_period,
+    read_weather,
+    sun_track,
+    weather_period,
+)
 from maizeviz.light.sun import sun_at
 
 BEIJING = dict(lat=39.9, lon=116.4, tz="Asia/Shanghai")

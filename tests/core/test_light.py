@@ -1,22 +1,23 @@
 """Direct light through real Embree: analytic scenes, Beer-Lambert, bad requests, the CLI."""
 
 import json
-from pathlib import Path
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from maizeviz.canopy.layout import layout_from_dict
 from maizeviz.canopy.scene import Canopy
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
-from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.beer_lambert import beer_lambert
 from maizeviz.light.leaf_light import leaf_light
 from maizeviz.light.rays import ray_grid
 from maizeviz.light.request import LightRequest
+from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import trace_light
 
 BLOCK = str(Path(__file__).resolve().parents[2] / "resources/block3x3.csv")

@@ -2,16 +2,16 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from maizeviz.errors import MaizevizError
-from maizeviz.leaf.grid import LeafGrid
 from maizeviz.leaf.fit import fit_leaves
-from maizeviz.mesh.levels import (Level, measure, mesh_leaf, mesh_leaves, parse_level,
-                                  parse_levels)
-from maizeviz.mesh import measures
-from maizeviz.mesh.simplify import count_triangles, select_lines
+from maizeviz.leaf.grid import LeafGrid
 from maizeviz.leaf.synth import LeafShape, example_leaf, leaf_points
+from maizeviz.mesh import measures
+from maizeviz.mesh.levels import Level, measure, mesh_leaf, mesh_leaves, parse_level, parse_levels
+from maizeviz.mesh.simplify import count_triangles, select_lines
 
 
 def leaf_of(points, tip=False, plant=1, leaf=1):

@@ -3,12 +3,19 @@
 import numpy as np
 import pytest
 from geomdl import fitting
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.interpolate import BSpline
 
 from maizeviz.errors import LeafError
-from maizeviz.leaf.nurbs import (averaged_knots, basis_matrix, data_parameters, fit_surface,
-                                 fit_surfaces, refine_parameters)
+from maizeviz.leaf.nurbs import (
+    averaged_knots,
+    basis_matrix,
+    data_parameters,
+    fit_surface,
+    fit_surfaces,
+    refine_parameters,
+)
 
 
 def random_grid(rng, m, n):

@@ -5,13 +5,20 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.spatial import cKDTree
 from scipy.special import expn
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.sky import (MAX_SKY_DIRECTIONS, Sky, analytic_diffuse_transmission,
-                                equal_area_bands, make_sky, turtle_directions)
+from maizeviz.light.sky import (
+    MAX_SKY_DIRECTIONS,
+    Sky,
+    analytic_diffuse_transmission,
+    equal_area_bands,
+    make_sky,
+    turtle_directions,
+)
 from maizeviz.light.sun import Sun
 
 KINDS = ("soc", "uoc")

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-
 from maizeviz_app.main_window import LEVELS
 
 TIMEOUT = 120_000

@@ -1,0 +1,173 @@
+"""What a computation will cost, estimated before any work, so that a typing slip (a 1000x1000
+tiling, a density of 24,000 rays per cm2) is refused in a second instead of eating the
+machine's memory for minutes.
+
+The command line, the app and sweeps call the same functions: :func:`canopy_cost`,
+:func:`light_cost` and :func:`heatmap_cost` give :class:`Cost` estimates; :func:`check` refuses
+what would not fit in the memory available (always) or what would take longer than
+:data:`SLOW_SECONDS` (unless forced: the app asks, the command line takes ``--force``). The
+constants were measured on the bundled example (docs/limits.md says how).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+
+from maizeviz.errors import MaizevizError
+from maizeviz.leaf.fit import Leaf
+from maizeviz.light.rays import Rect, ray_count
+from maizeviz.mesh.levels import Level
+
+#: Peak bytes per canopy triangle: the canopy arrays, its Embree scene, the ground-cover scene
+#: and the transients of building them (measured: 345 B at K = 4 on the bundled example).
+BYTES_PER_TRIANGLE = 400
+#: Bytes per traced ray: origins, hits, heights, ground positions (measured: 48-55 B).
+BYTES_PER_RAY = 64
+#: Bytes per heatmap cell: histograms, the drawn mesh and the CSV line.
+BYTES_PER_HEATMAP_CELL = 600
+#: Rough speeds on one core of these machines, for the time estimate.
+TRIANGLES_PER_S = 2_000_000              # meshing, placing and Embree building
+RAYS_PER_S = 3_000_000                   # tracing, all heights
+#: Work longer than this (estimated seconds) needs a confirmation.
+SLOW_SECONDS = 900.0
+#: Share of the available memory one computation may plan to use.
+MEMORY_SHARE = 0.8
+
+
+@dataclass(frozen=True)
+class Cost:
+    """An estimate of one piece of work.
+
+    Attributes
+    ----------
+    what : what is estimated, in words ("the canopy at K=4")
+    quantity : the input that drives it (see :data:`maizeviz.errors.QUANTITIES`)
+    count : how many items; unit : what they are ("triangles", "rays", "heatmap cells")
+    bytes : peak memory, bytes
+    seconds : rough run time on one core, s
+    """
+
+    what: str
+    quantity: str
+    count: int
+    unit: str
+    bytes: int
+    seconds: float
+
+    def describe(self) -> str:
+        return (f"{self.what}: {self.count:,} {self.unit}, about {_size(self.bytes)} of memory "
+                f"and {_duration(self.seconds)}")
+
+
+def _size(n: float) -> str:
+    for unit in ("bytes", "KiB", "MiB", "GiB", "TiB"):
+        if n < 1024 or unit == "TiB":
+            return f"{n:.0f} {unit}" if unit == "bytes" else f"{n:.1f} {unit}"
+        n /= 1024
+    return f"{n:.1f} TiB"                                      # pragma: no cover
+
+
+def _duration(s: float) -> str:
+    if s < 90:
+        return f"{max(s, 1):.0f} s"
+    if s < 5400:
+        return f"{s / 60:.0f} min"
+    return f"{s / 3600:.1f} h"
+
+
+def memory_available() -> int:
+    """Bytes of memory available to a new computation (MemAvailable on Linux)."""
+    try:
+        with open("/proc/meminfo") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (ValueError, OSError, AttributeError):              # pragma: no cover
+        return 8 * 2**30
+
+
+def leaf_triangles(rows: int, cols: int, tip_collapsed: bool, level: Level) -> int:
+    """Triangles of one leaf of an m x n point grid at ``level`` (an upper bound below the
+    standard mesh)."""
+    k = level.interp if level.interp is not None else 0
+    a, b = (rows - 1) * (k + 1), (cols - 1) * (k + 1)
+    full = 2 * a * b - (b if tip_collapsed else 0)          # the collapsed tip row's slivers
+    return full if level.triangles is None else min(level.triangles, full)
+
+
+def canopy_cost(leaves: Iterable[Leaf], placements: Mapping[int, int], level: Level) -> Cost:
+    """The canopy of ``leaves`` at ``level`` with ``placements[plant]`` copies of each
+    digitized plant standing in the field."""
+    per_plant: dict[int, int] = {}
+    for lf in leaves:
+        m, n = lf.grid.shape
+        per_plant[lf.plant] = per_plant.get(lf.plant, 0) + leaf_triangles(
+            m, n, lf.grid.tip_collapsed, level)
+    tris = sum(per_plant.get(p, 0) * count for p, count in placements.items())
+    plants = sum(placements.values())
+    return Cost(f"the canopy of {plants:,} plants at {level}", "tile", tris, "triangles",
+                tris * BYTES_PER_TRIANGLE, tris / TRIANGLES_PER_S)
+
+
+def light_cost(rect: Rect, density: float, heights: int, directions: int = 1,
+               triangles: int = 0) -> Cost:
+    """Tracing ``directions`` parallel beams (the sun, sky directions, time steps) of rays at
+    ``density`` per cm2 over ``rect`` (cm), measured at ``heights`` planes."""
+    if not (math.isfinite(density) and density > 0):
+        raise MaizevizError(f"the ray density must be > 0 rays per cm2, got {density}",
+                            quantity="density")
+    rays = ray_count(rect, density)                         # arithmetic only: no grid built
+    work = rays * directions * (1 + max(heights, 1) / 2)
+    what = "direct light" if directions == 1 else f"light from {directions:,} directions"
+    return Cost(f"{what} at {density:g} rays per cm2", "density", rays * directions,
+                "rays", rays * BYTES_PER_RAY + triangles * BYTES_PER_TRIANGLE // 4,
+                work / RAYS_PER_S)
+
+
+def heatmap_cost(rect: Rect, bin_cm: float, heights: int) -> Cost:
+    """Transmission maps of ``rect`` (cm) in ``bin_cm`` bins at ``heights`` planes."""
+    if not (math.isfinite(bin_cm) and bin_cm > 0):
+        raise MaizevizError(f"the heatmap bin must be > 0 cm, got {bin_cm}",
+                            quantity="heatmap_bin")
+    x0, y0, x1, y1 = rect
+    cells = math.ceil((x1 - x0) / bin_cm) * math.ceil((y1 - y0) / bin_cm)
+    return Cost(f"transmission maps in {bin_cm:g} cm bins", "heatmap_bin", cells * heights,
+                "heatmap cells", cells * BYTES_PER_HEATMAP_CELL, cells * heights * 2e-5)
+
+
+def check(stages: Iterable[Iterable[Cost]], force: bool = False,
+          available: int | None = None) -> None:
+    """Refuse work that would not fit in memory, or that is slow unless ``force``.
+
+    ``stages`` run one after the other (the levels of a comparison); the costs within a stage
+    are held in memory together (a canopy and the rays traced through it).
+
+    Raises
+    ------
+    MaizevizError
+        One line naming the estimate, the limit and the input that drives it (``quantity``);
+        for slow work the message says it can be forced.
+    """
+    stages = [list(s) for s in stages]
+    costs = [c for s in stages for c in s]
+    if not costs:
+        return
+    limit = int(MEMORY_SHARE * (available if available is not None else memory_available()))
+    for stage in stages:
+        if sum(c.bytes for c in stage) > limit:
+            worst = max(stage, key=lambda c: c.bytes)
+            raise MaizevizError(f"{worst.describe()}; that is more than the {_size(limit)} of "
+                                "memory this machine has available", quantity=worst.quantity)
+    seconds = sum(c.seconds for c in costs)
+    if seconds > SLOW_SECONDS and not force:
+        worst = max(costs, key=lambda c: c.seconds)
+        raise MaizevizError(f"{worst.describe()}: about {_duration(seconds)} in all, more than "
+                            f"{_duration(SLOW_SECONDS)}; force it to run anyway",
+                            quantity=worst.quantity)

@@ -1,0 +1,180 @@
+"""The house rules, checked: layers that only point down, a Qt-free core, types, a wheel that
+works from any folder, and no reference to a document the repository does not hold."""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import sys
+import sysconfig
+import zipfile
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+GUI_MODULES = ("PySide6", "pyvista", "pyvistaqt", "vtk", "vtkmodules", "qtpy", "superqt",
+               "maizeviz_app")
+
+
+def _tracked_files() -> list[Path]:
+    out = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True)
+    if out.returncode != 0:                       # not a git checkout: walk the tree
+        return [p for p in ROOT.rglob("*") if p.is_file() and ".venv" not in p.parts]
+    return [ROOT / line for line in out.stdout.splitlines() if (ROOT / line).is_file()]
+
+
+def test_every_core_module_imports_without_qt_or_pyvista():
+    code = ("import importlib, pkgutil, sys, maizeviz\n"
+            "mods = [m.name for m in pkgutil.walk_packages(maizeviz.__path__, 'maizeviz.')\n"
+            "        if not m.name.endswith('__main__')]\n"
+            "for m in mods: importlib.import_module(m)\n"
+            f"bad = sorted(m for m in sys.modules if m.split('.')[0] in {GUI_MODULES!r})\n"
+            "print(len(mods), ','.join(bad)); sys.exit(1 if bad or len(mods) < 40 else 0)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=ROOT, timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def test_layers_only_point_down():
+    """import-linter contracts of pyproject.toml: digitizer -> leaf -> mesh -> canopy -> light
+    -> cli, and no Qt, pyvista or app import from the core."""
+    lint = Path(sys.executable).with_name("lint-imports")
+    proc = subprocess.run([str(lint), "--no-cache"], capture_output=True, text=True, cwd=ROOT,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-2000:]
+    assert "0 broken" in proc.stdout
+
+
+def test_core_type_checks():
+    from mypy import api
+
+    out, err, status = api.run(["--config-file", str(ROOT / "pyproject.toml")])
+    assert status == 0, out[-5000:] + err[-2000:]
+
+
+def test_no_reference_to_documents_outside_the_repository():
+    outside = re.compile(r"SCIENCE\.md|FASTRAK\.md|PAPER\.md|STYLE\.md|\.\./shared|shared\/data")
+    docs = re.compile(r"docs/[A-Za-z0-9_./-]+\.md")
+    bad, missing = [], []
+    for path in _tracked_files():
+        if path.suffix not in (".py", ".md", ".toml", ".sh", ".txt", ".cfg", ".yml", ".yaml") \
+                and path.name != "run":
+            continue
+        text = path.read_text(errors="replace")
+        rel = path.relative_to(ROOT)
+        for m in outside.finditer(text):
+            bad.append(f"{rel}: {m.group(0)}")
+        for m in docs.finditer(text):
+            if not (ROOT / m.group(0)).is_file():
+                missing.append(f"{rel}: {m.group(0)}")
+    assert not bad, "references to documents outside the repository: " + "; ".join(bad)
+    assert not missing, "references to docs pages that do not exist: " + "; ".join(missing)
+
+
+def test_every_package_folder_is_installed():
+    """Each folder with an __init__.py is listed in pyproject's packages (else a wheel lacks it)."""
+    import tomllib
+
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+    listed = set(config["packages"])
+    dirs = {"maizeviz": "maizeviz", "maizeviz_app": "app", "maizeviz.resources": "resources"}
+    found = set()
+    for name, folder in dirs.items():
+        for init in (ROOT / folder).rglob("__init__.py"):
+            parts = init.parent.relative_to(ROOT / folder).parts
+            found.add(".".join((name, *parts)))
+    assert found == listed, f"not listed: {found - listed}; listed but absent: {listed - found}"
+
+
+@pytest.fixture(scope="module")
+def wheel_env(tmp_path_factory):
+    """The wheel built from this checkout, unpacked into a fresh virtual environment whose
+    dependencies come from the test environment (no network), as ``pip install .`` gives."""
+    tmp = tmp_path_factory.mktemp("wheel")
+    build = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps",
+                            "--no-build-isolation", "-q", "-w", str(tmp / "dist"), str(ROOT)],
+                           capture_output=True, text=True, timeout=600)
+    if build.returncode != 0:
+        pytest.fail(f"the wheel does not build: {build.stderr[-2000:]}")
+    wheel = next((tmp / "dist").glob("maizeviz-*.whl"))
+    venv = tmp / "venv"
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(venv)], check=True)
+    py = venv / "bin" / "python"
+    site = subprocess.run([str(py), "-c", "import sysconfig; print(sysconfig.get_paths()['purelib'])"],
+                          capture_output=True, text=True, check=True).stdout.strip()
+    with zipfile.ZipFile(wheel) as zf:
+        zf.extractall(site)
+    # the dependencies (numpy, embreex, PySide6...) from this environment, but not its
+    # editable maizeviz: a .pth adds the folder to sys.path without running its .pth files
+    Path(site, "deps.pth").write_text(sysconfig.get_paths()["purelib"] + "\n")
+    empty = tmp / "empty"
+    empty.mkdir()
+    (empty / "app").mkdir()                       # a folder of the user's named like ours
+    (empty / "app" / "main.py").write_text("raise SystemExit('the wrong app ran')\n")
+    return wheel, py, empty
+
+
+def _run(py, cwd, *args, env=None, timeout=600):
+    env = {**os.environ, **(env or {})}
+    env.pop("PYTHONPATH", None)
+    return subprocess.run([str(py), *args], cwd=cwd, capture_output=True, text=True,
+                          timeout=timeout, env=env)
+
+
+def test_wheel_holds_the_app_and_the_data_under_our_names(wheel_env):
+    wheel, _, _ = wheel_env
+    names = zipfile.ZipFile(wheel).namelist()
+    tops = {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")}
+    assert tops == {"maizeviz", "maizeviz_app"}
+    for needed in ("maizeviz/resources/block3x3.csv", "maizeviz/py.typed",
+                   "maizeviz/resources/phenotrack3d/1649057232.json.gz",
+                   "maizeviz_app/main_window.py"):
+        assert needed in names
+    meta = next(n for n in names if n.endswith("entry_points.txt"))
+    text = zipfile.ZipFile(wheel).read(meta).decode()
+    assert "maizeviz = maizeviz.cli:main" in text and "maizeviz_app.main:run" in text
+
+
+def test_installed_wheel_runs_from_an_empty_folder(wheel_env):
+    _, py, empty = wheel_env
+    proc = _run(py, empty, "-m", "maizeviz", "--help")
+    assert proc.returncode == 0 and "canopy" in proc.stdout, proc.stderr
+    code = ("from maizeviz.resources import example_points; import maizeviz, maizeviz_app; "
+            "print(example_points(), maizeviz.__file__, maizeviz_app.__file__)")
+    where = _run(py, empty, "-c", code)
+    assert where.returncode == 0, where.stderr
+    example = where.stdout.split()[0]
+    assert str(ROOT) not in where.stdout, "the wheel's files must not come from the checkout"
+    proc = _run(py, empty, "-m", "maizeviz", "canopy", example, "--tile", "1x1", "--triangles",
+                "4", "--json")
+    assert proc.returncode == 0, proc.stderr
+    assert '"plants": 9' in proc.stdout
+
+
+def test_without_the_gui_extra_the_app_is_one_line_away(wheel_env):
+    """Without PySide6, ``maizeviz`` says in one line how to get the app, then the headless
+    report runs."""
+    _, py, empty = wheel_env
+    code = ("import sys; sys.modules['PySide6'] = None\n"
+            "from maizeviz.cli import find_gui\n"
+            "gui, why = find_gui(); print(gui, why)")
+    proc = _run(py, empty, "-c", code)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.startswith("None ") and 'pip install "maizeviz[gui]"' in proc.stdout
+    assert proc.stdout.strip().count("\n") == 0
+
+
+def test_readme_python_example_runs(tmp_path):
+    """The README's library example, run as written from an empty folder."""
+    readme = (ROOT / "README.md").read_text()
+    code = re.search(r"```python\n(.*?)```", readme, re.S)
+    assert code, "the README has a Python example"
+    proc = subprocess.run([sys.executable, "-c", code.group(1)], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    lai, transmission = proc.stdout.splitlines()[:2]
+    assert 4.5 < float(lai) < 5.5
+    values = [float(v) for v in transmission.strip("[]").split()]
+    assert len(values) == 6 and all(a <= b for a, b in zip(values, values[1:]))
