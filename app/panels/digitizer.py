@@ -18,20 +18,35 @@ import threading
 import time
 from pathlib import Path
 
+from maizeviz.resources import example_points
+from maizeviz_app.panels.growing_plant import GrowingPlant
 from PySide6.QtCore import QEvent, QObject, QSettings, Qt, QThreadPool, QTimer, Signal
 from PySide6.QtGui import QKeySequence, QShortcut
-from PySide6.QtWidgets import (QApplication, QCheckBox, QFileDialog, QFormLayout, QFrame,
-                               QGridLayout, QGroupBox, QHBoxLayout, QLabel, QLineEdit,
-                               QListWidget, QPushButton, QScrollArea, QSizePolicy, QSpinBox,
-                               QVBoxLayout, QWidget)
+from PySide6.QtWidgets import (
+    QApplication,
+    QCheckBox,
+    QFileDialog,
+    QFormLayout,
+    QFrame,
+    QGridLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QListWidget,
+    QPushButton,
+    QScrollArea,
+    QSizePolicy,
+    QSpinBox,
+    QVBoxLayout,
+    QWidget,
+)
 from superqt.utils import create_worker
 
 from maizeviz.digitizer.port import FastrakPort
 from maizeviz.digitizer.recorder import Recorder, Update
 from maizeviz.digitizer.session import Session
 from maizeviz.errors import MaizevizError
-from maizeviz.resources import example_points
-from maizeviz_app.panels.growing_plant import GrowingPlant
 
 #: The technician's controls: key, button text.
 CONTROLS = (("n", "Next leaf"), ("p", "Next plant"), ("r", "End row"), ("u", "Undo"))

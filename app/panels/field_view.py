@@ -13,14 +13,21 @@ from __future__ import annotations
 
 import math
 
+from maizeviz_app.panels.layout_model import fmt
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QBrush, QColor, QFont, QPainter, QPen, QTransform
-from PySide6.QtWidgets import (QGraphicsEllipseItem, QGraphicsItem, QGraphicsLineItem,
-                               QGraphicsRectItem, QGraphicsScene, QGraphicsSimpleTextItem,
-                               QGraphicsView, QStyle)
+from PySide6.QtWidgets import (
+    QGraphicsEllipseItem,
+    QGraphicsItem,
+    QGraphicsLineItem,
+    QGraphicsRectItem,
+    QGraphicsScene,
+    QGraphicsSimpleTextItem,
+    QGraphicsView,
+    QStyle,
+)
 
 from maizeviz.canopy.layout import rows_of
-from maizeviz_app.panels.layout_model import fmt
 
 WHEEL_STEP_DEG = 5.0
 PLANT = QColor("#2e7d32")

@@ -15,19 +15,42 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from maizeviz_app.panels.field_view import FieldView
+from maizeviz_app.panels.layout_model import (
+    EditedLayout,
+    EditPlacement,
+    PlacementTable,
+    ReplaceLayout,
+    fmt,
+)
 from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtGui import QKeySequence, QUndoStack
-from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QComboBox, QFileDialog,
-                               QHBoxLayout, QHeaderView, QLabel, QMessageBox, QPushButton,
-                               QSplitter, QStyle, QTableView, QToolButton, QVBoxLayout,
-                               QWidget)
+from PySide6.QtWidgets import (
+    QAbstractItemView,
+    QCheckBox,
+    QComboBox,
+    QFileDialog,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QMessageBox,
+    QPushButton,
+    QSplitter,
+    QStyle,
+    QTableView,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
 
-from maizeviz.canopy.layout import (LayoutError, block_lattice, load_layout, save_layout,
-                                    tiled_layout)
+from maizeviz.canopy.layout import (
+    LayoutError,
+    block_lattice,
+    load_layout,
+    save_layout,
+    tiled_layout,
+)
 from maizeviz.errors import MaizevizError
-from maizeviz_app.panels.field_view import FieldView
-from maizeviz_app.panels.layout_model import (EditedLayout, EditPlacement, PlacementTable,
-                                              ReplaceLayout, fmt)
 
 #: Tiling presets: tiles of the digitized block along each side.
 TILINGS = (1, 3, 5, 7, 9)
