@@ -281,8 +281,8 @@ def test_demo_records_through_the_simulator(qtbot, make_panel, viewport, tmp_pat
     assert f"{n_points} points, 2 leaves" in panel.counts.text()
 
 
-def test_canopy_returns_in_the_window_after_a_session(window, qtbot, tmp_path):
-    w = window(tile=1)
+def test_canopy_returns_in_the_window_after_a_session(window, two_plants, qtbot, tmp_path):
+    w = window(two_plants, tile=1)
     qtbot.waitSignal(w.canopy_shown, timeout=120_000).wait()
     alerts = []
     w.statusBar().messageChanged.connect(alerts.append)
