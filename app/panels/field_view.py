@@ -24,7 +24,6 @@ from PySide6.QtWidgets import (
     QGraphicsScene,
     QGraphicsSimpleTextItem,
     QGraphicsView,
-    QStyle,
 )
 
 from maizeviz.canopy.layout import rows_of
@@ -72,7 +71,10 @@ class PlantItem(QGraphicsEllipseItem):
     def __init__(self, view: "FieldView", index: int, placement, radius: float, reach: float):
         super().__init__(-radius, -radius, 2 * radius, 2 * radius)
         self.view, self.index = view, index
-        self.setFlags(QGraphicsItem.ItemIsMovable | QGraphicsItem.ItemIsSelectable)
+        # movable but not selectable: the picked plant is shown by its colour (FieldView.select).
+        # No Python paint() or itemChange() here: PySide6 leaks a reference to None on every
+        # such call, and a few thousand plants drain it until the interpreter aborts at exit.
+        self.setFlags(QGraphicsItem.ItemIsMovable)
         self.setBrush(QBrush(PLANT))
         self.setPen(_pen("#1b5e20"))
         self.setCursor(Qt.OpenHandCursor)
@@ -102,19 +104,9 @@ class PlantItem(QGraphicsEllipseItem):
         # the view flips y (north up), so Qt's rotation shows counter-clockwise, as azimuths go
         self.arrow.setRotation(deg)
 
-    def itemChange(self, change, value):  # noqa: N802
-        if change == QGraphicsItem.ItemSelectedHasChanged:
-            self.setBrush(QBrush(PICKED if value else PLANT))
-        return super().itemChange(change, value)
-
-    def paint(self, painter, option, widget=None) -> None:
-        option.state &= ~QStyle.State_Selected            # our own highlight, not a dashed box
-        super().paint(painter, option, widget)
-
     def mousePressEvent(self, event) -> None:  # noqa: N802
-        self.scene().clearSelection()
-        self.setSelected(True)
         self._pressed_at = self.pos()
+        self.view.select(self.index)
         self.view.picked.emit(self.index)
         super().mousePressEvent(event)
 
@@ -144,6 +136,7 @@ class FieldView(QGraphicsView):
         self._labels: list[QGraphicsSimpleTextItem] = []
         self._spacing = 30.0
         self._zoomed = False
+        self._picked = -1
 
     # ------------------------------------------------------------------------ content
     def show_layout(self, layout, placements) -> None:
@@ -151,6 +144,7 @@ class FieldView(QGraphicsView):
         scene = self.scene()
         scene.clear()
         self.items_ = []
+        self._picked = -1
         if layout is None:
             return
         rs, ps = layout.row_spacing, layout.plant_spacing
@@ -198,10 +192,14 @@ class FieldView(QGraphicsView):
             self.items_[index].set_placement(placement)
 
     def select(self, index: int) -> None:
-        self.scene().clearSelection()
-        if 0 <= index < len(self.items_):
-            self.items_[index].setSelected(True)
-            self.ensureVisible(self.items_[index], 20, 20)
+        """Show placement ``index`` as the picked one (-1: none)."""
+        if 0 <= self._picked < len(self.items_):
+            self.items_[self._picked].setBrush(QBrush(PLANT))
+        self._picked = index if 0 <= index < len(self.items_) else -1
+        if self._picked >= 0:
+            item = self.items_[self._picked]
+            item.setBrush(QBrush(PICKED))
+            self.ensureVisible(item, 20, 20)
 
     # --------------------------------------------------------------------------- view
     def fit(self) -> None:
