@@ -12,6 +12,7 @@ a double click on empty ground fits the field.
 from __future__ import annotations
 
 import math
+from functools import lru_cache
 
 from maizeviz_app.panels.layout_model import fmt
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
@@ -33,6 +34,7 @@ PLANT = QColor("#2e7d32")
 PICKED = QColor("#ff8f00")
 
 
+@lru_cache(maxsize=32)
 def _pen(color, width: float = 1.0, style=Qt.SolidLine) -> QPen:
     pen = QPen(QColor(color), width, style)
     pen.setCosmetic(True)                       # pixels, whatever the zoom

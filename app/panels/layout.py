@@ -129,6 +129,7 @@ class LayoutPanel(QWidget):
         self.table.setSelectionMode(QAbstractItemView.SingleSelection)
         self.table.horizontalHeader().setSectionResizeMode(QHeaderView.Stretch)
         self.table.verticalHeader().setDefaultSectionSize(22)
+        self.table.verticalHeader().setSectionResizeMode(QHeaderView.Fixed)   # 700 rows stay fast
         self.table.selectionModel().currentRowChanged.connect(
             lambda cur, _prev: self.view.select(cur.row()))
         self.splitter.addWidget(self.view)
