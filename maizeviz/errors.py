@@ -96,4 +96,5 @@ QUANTITIES = {
     "baud": "serial baud rate",
     "at": "stalk position x, y, cm",
     "params": "data parameterisation",
+    "resume": "continue an existing recording",
 }

@@ -25,7 +25,21 @@ from maizeviz.leaf.fit import Leaf
 LAYOUT_SCHEMA = 1
 #: Plants a layout may hold (a hectare at 60 x 30 cm is about 55,000).
 MAX_PLANTS = 100_000
-#: Largest layout file read (bytes): 100,000 plants take about 8 MB.
+#: Shortest spacing and field side (cm): below a centimetre plants would stand inside each
+#: other and a leaf area index divides by almost nothing.
+MIN_LENGTH_CM = 1.0
+#: Farthest coordinate and longest spacing or field side (cm, 1 km): a field plot is far
+#: smaller; larger numbers are typing mistakes that would place plants nowhere near the others.
+MAX_COORD_CM = 100_000.0
+#: Largest random displacement of a plant about its place (cm): farther, it has another place.
+MAX_JITTER_CM = 100.0
+#: Largest angle (degrees, either sign) for north and plant azimuths: one full turn.
+MAX_ANGLE_DEG = 360.0
+#: Seeds of the jitter's random generator: whole numbers 0 .. 2^32 - 1.
+MAX_SEED = 2**32 - 1
+#: Largest plant id (absolute value), as in points files.
+MAX_PLANT_ID = 1_000_000_000
+#: Largest layout file read (bytes).
 MAX_LAYOUT_BYTES = 20_000_000
 
 
@@ -125,10 +139,23 @@ def _cell(x, y, row_spacing, plant_spacing):
 
 
 def _check_spacing(row_spacing, plant_spacing):
-    for name, v in (("row_spacing", row_spacing), ("plant_spacing", plant_spacing)):
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-            raise LayoutError(f"{name.replace('_', ' ')} must be a positive number of cm, got {v}",
-                              quantity=name)
+    """Both spacings numbers of cm within :data:`MIN_LENGTH_CM` .. :data:`MAX_COORD_CM`."""
+    for name, v in (("row spacing", row_spacing), ("plant spacing", plant_spacing)):
+        f = _finite(v)
+        if f is None or f <= 0:
+            raise LayoutError(f"{name} must be a positive number of cm, got {_shown(v)}",
+                              quantity=name.replace(" ", "_"))
+        if not MIN_LENGTH_CM <= f <= MAX_COORD_CM:
+            raise LayoutError(f"{name} is {f:g} cm; it must be from {MIN_LENGTH_CM:g} to "
+                              f"{MAX_COORD_CM:g} cm (1 km)", quantity=name.replace(" ", "_"))
+
+
+def _check_count(v, what: str, limit: int, quantity: str | None = None) -> int:
+    """A whole number 1 .. limit (numpy integers too)."""
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 1 <= v <= limit:
+        raise LayoutError(f"{what} must be a whole number from 1 to {limit:,}, got {_shown(v)}",
+                          quantity=quantity)
+    return int(v)
 
 
 def parse_shape(text: str, quantity: str = "tile") -> tuple[int, int]:
@@ -163,6 +190,25 @@ def _clusters(values: np.ndarray, spacing: float) -> np.ndarray:
     out = np.empty(len(values), dtype=int)
     out[order] = breaks
     return out
+
+
+def check_tile(tile, plants: int = 1) -> tuple[int, int]:
+    """The tile count (A, B) as whole numbers, refused when A x B copies of a block of
+    ``plants`` plants exceed :data:`MAX_PLANTS`; cheap, so callers can check it before
+    reading any points (with ``plants=1``) and again once the block is known."""
+    try:
+        parts = tuple(tile)
+    except TypeError:
+        parts = ()
+    if len(parts) != 2:
+        raise LayoutError(f"the tile count must be two numbers (across rows, along rows), "
+                          f"got {_shown(tile)}", quantity="tile")
+    a, b = (_check_count(v, "the tile count", MAX_PLANTS, "tile") for v in parts)
+    if a * b * plants > MAX_PLANTS:
+        block = f"a block of {plants} plants" if plants > 1 else "one plant"
+        raise LayoutError(f"{a} x {b} tiles of {block} make {a * b * plants:,} plants; a "
+                          f"canopy holds at most {MAX_PLANTS:,}", quantity="tile")
+    return a, b
 
 
 def block_lattice(bases: dict[int, tuple[float, float]], row_spacing: float,
@@ -201,13 +247,20 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
     _check_spacing(row_spacing, plant_spacing)
     if not bases:
         raise LayoutError("no plant to lay out")
-    a, b = tile
-    if a < 1 or b < 1:
-        raise LayoutError(f"tile must be at least 1x1, got {a}x{b}", quantity="tile")
-    if a * b * len(bases) > MAX_PLANTS:
-        raise LayoutError(f"tiling {a}x{b} places {a * b * len(bases):,} plants; a canopy holds "
-                          f"at most {MAX_PLANTS:,} (a hectare at 60 x 30 cm is about 55,000)",
-                          quantity="tile")
+    if len(bases) > MAX_PLANTS:
+        raise LayoutError(f"{len(bases):,} digitized plants; a canopy holds at most {MAX_PLANTS:,}")
+    for pid, xy in bases.items():
+        if len(xy) != 2 or not all(_finite(v) is not None and abs(v) <= MAX_COORD_CM
+                                   for v in xy):
+            raise LayoutError(f"plant {pid}: its stalk base {tuple(xy)} cm is not within "
+                              f"{MAX_COORD_CM:g} cm (1 km) of the origin")
+    a, b = check_tile(tile, len(bases))
+    if block is not None:
+        if len(block) != 2:
+            raise LayoutError(f"the block shape must be two numbers, got {_shown(block)}")
+        block = (_check_count(block[0], "the block shape", MAX_PLANTS, "block"),
+                 _check_count(block[1], "the block shape", MAX_PLANTS, "block"))
+    north_deg = _angle(north_deg, "north")
     warnings = []
     inferred, lattice = block_lattice(bases, row_spacing, plant_spacing)
     if block is None:
@@ -215,8 +268,8 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
         warnings.append(f"block inferred from stalk positions: {block[0]} rows x {block[1]} "
                         f"plants per row ({len(bases)} plants)")
     elif block[0] * block[1] != len(bases):
-        warnings.append(f"the block {block[0]}x{block[1]} has {block[0] * block[1]} places but "
-                        f"the file has {len(bases)} plants")
+        warnings.append(f"the block shape {block[0]}x{block[1]} has {block[0] * block[1]} places "
+                        f"but the file has {len(bases)} plants")
     step_x, step_y = block[0] * row_spacing, block[1] * plant_spacing
     placements, cells, centre = [], [], []
     for ti in range(a):
@@ -264,21 +317,65 @@ def _overlaps(cells: np.ndarray) -> str:
 
 
 # ------------------------------------------------------------------------- layout files
-def _number(obj, key, where, default=None, positive=False):
+def _shown(v, limit: int = 40) -> str:
+    """A value as JSON for a message, shortened; never fails."""
+    try:
+        text = json.dumps(v)
+    except (TypeError, ValueError, RecursionError):
+        try:
+            text = str(v)                                  # numpy numbers, tuples
+        except ValueError:                                 # an integer of over 4300 digits
+            text = "a number too long to show"
+    return text if len(text) <= limit else text[:limit] + "..."
+
+
+def _finite(v) -> float | None:
+    """``v`` as a finite float, or None for anything else (bools, text, NaN, 10**400)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+        return None
+    try:
+        f = float(v)
+    except OverflowError:
+        return None
+    return f if math.isfinite(f) else None
+
+
+def _angle(v, what: str) -> float:
+    """An angle in degrees within +-:data:`MAX_ANGLE_DEG`."""
+    f = _finite(v)
+    if f is None or abs(f) > MAX_ANGLE_DEG:
+        raise LayoutError(f"{what} must be an angle from -{MAX_ANGLE_DEG:g} to "
+                          f"{MAX_ANGLE_DEG:g} degrees, got {_shown(v)}")
+    return f
+
+
+def _number(obj, key, where, default=None, positive=False, low=None, high=None, unit=" cm"):
+    """``obj[key]`` as a finite float within ``low`` .. ``high``; a LayoutError names
+    ``where`` and ``key`` (the field) otherwise; ``default`` when absent (None: required)."""
     if key not in obj:
         if default is None:
             raise LayoutError(f"{where}: '{key}' is missing")
         return default
     v = obj[key]
-    if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-        raise LayoutError(f"{where}: '{key}' must be a number, got {json.dumps(v)[:40]}")
-    if positive and v <= 0:
-        raise LayoutError(f"{where}: '{key}' must be positive, got {v}")
-    return float(v)
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise LayoutError(f"{where}: '{key}' must be a number, got {_shown(v)}")
+    try:
+        f = float(v)
+    except OverflowError:                                   # an integer of 309 digits or more
+        f = math.inf
+    if not math.isfinite(f):
+        raise LayoutError(f"{where}: '{key}' must be a number, got {_shown(v)}")
+    if positive and f <= 0:
+        raise LayoutError(f"{where}: '{key}' must be positive, got {f:g}")
+    if (low is not None and f < low) or (high is not None and f > high):
+        raise LayoutError(f"{where}: '{key}' is {f:g}{unit}; it must be from {low:g} to "
+                          f"{high:g}{unit}")
+    return f
 
 
 def load_layout(path: str | Path, plants: set[int] | None = None) -> CanopyLayout:
-    """Read a layout file (schema in the README).
+    """Read a layout file (schema in the README): a regular file of at most
+    :data:`MAX_LAYOUT_BYTES` bytes of UTF-8 JSON.
 
     Parameters
     ----------
@@ -293,33 +390,50 @@ def load_layout(path: str | Path, plants: set[int] | None = None) -> CanopyLayou
     path = Path(path)
     raw = read_input(path, "layout file", MAX_LAYOUT_BYTES, LayoutError)
     try:
-        text = raw.decode("utf-8")
+        text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise LayoutError(f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+        raise LayoutError(f"{path}: cannot be read (not UTF-8 text: byte {exc.start})") from None
     try:
         data = json.loads(text)
-    except (json.JSONDecodeError, RecursionError) as exc:
+    except json.JSONDecodeError as exc:
         raise LayoutError(f"{path}: not valid JSON ({exc})") from None
+    except RecursionError:
+        raise LayoutError(f"{path}: not valid JSON (nested too deeply)") from None
+    except ValueError:                                   # an integer of over 4300 digits
+        raise LayoutError(f"{path}: not valid JSON (a number too long to read)") from None
     return layout_from_dict(data, plants, str(path))
 
 
 def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout") -> CanopyLayout:
-    """Validate a layout document (already parsed JSON); see :func:`load_layout`."""
+    """Validate a layout document (already parsed JSON); see :func:`load_layout`.
+
+    Every value is checked by type and range (spacings and field sides
+    :data:`MIN_LENGTH_CM` .. :data:`MAX_COORD_CM`, coordinates within :data:`MAX_COORD_CM`,
+    jitter up to :data:`MAX_JITTER_CM`, angles within :data:`MAX_ANGLE_DEG`, the seed
+    0 .. :data:`MAX_SEED`); a :class:`LayoutError` names the field, e.g.
+    ``rows[1].plants[0]: 'jitter_cm'``.
+    """
     if not isinstance(data, dict):
         raise LayoutError(f"{source}: a layout is a JSON object")
     version = data.get("maizeviz_layout")
-    if version != LAYOUT_SCHEMA:
-        raise LayoutError(f"{source}: 'maizeviz_layout' is {json.dumps(version)}; this version of "
+    if isinstance(version, bool) or version != LAYOUT_SCHEMA:
+        raise LayoutError(f"{source}: 'maizeviz_layout' is {_shown(version)}; this version of "
                           f"maizeviz reads schema {LAYOUT_SCHEMA}")
-    rs = _number(data, "row_spacing", source, positive=True)
-    ps = _number(data, "plant_spacing", source, positive=True)
-    north = _number(data, "north_deg", source, default=0.0)
+    length = {"low": MIN_LENGTH_CM, "high": MAX_COORD_CM}
+    coord = {"low": -MAX_COORD_CM, "high": MAX_COORD_CM}
+    rs = _number(data, "row_spacing", source, positive=True, **length)
+    ps = _number(data, "plant_spacing", source, positive=True, **length)
+    north = _number(data, "north_deg", source, default=0.0, low=-MAX_ANGLE_DEG,
+                    high=MAX_ANGLE_DEG, unit=" degrees")
     fld = data.get("field")
     if not isinstance(fld, dict):
         raise LayoutError(f"{source}: 'field' must be an object {{x0, y0, x1, y1}} in cm")
-    x0, y0, x1, y1 = (_number(fld, k, f"{source}: field") for k in ("x0", "y0", "x1", "y1"))
+    x0, y0, x1, y1 = (_number(fld, k, f"{source}: field", **coord) for k in ("x0", "y0", "x1", "y1"))
     if x1 <= x0 or y1 <= y0:
         raise LayoutError(f"{source}: field must have x1 > x0 and y1 > y0")
+    if x1 - x0 < MIN_LENGTH_CM or y1 - y0 < MIN_LENGTH_CM:
+        raise LayoutError(f"{source}: field is {x1 - x0:g} x {y1 - y0:g} cm; each side must be "
+                          f"at least {MIN_LENGTH_CM:g} cm")
     rows = data.get("rows")
     if not isinstance(rows, list) or not rows:
         raise LayoutError(f"{source}: 'rows' must be a non-empty list")
@@ -327,14 +441,14 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
                 isinstance(r.get("plants"), list) else 0 for r in rows)
     if count > MAX_PLANTS:
         raise LayoutError(f"{source}: {count} plants; a layout holds at most {MAX_PLANTS}")
-    seed = int(_number(data, "seed", source, default=0.0))
+    seed = _seed(data, source)
     rng = np.random.default_rng(seed)
     placements, cells, warnings, outside = [], [], [], []
     for i, row in enumerate(rows):
         where = f"{source}: rows[{i}]"
         if not isinstance(row, dict):
             raise LayoutError(f"{where} must be an object {{x, plants}}")
-        x = _number(row, "x", where)
+        x = _number(row, "x", where, **coord)
         plist = row.get("plants")
         if not isinstance(plist, list):
             raise LayoutError(f"{where}: 'plants' must be a list")
@@ -342,17 +456,15 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
             w = f"{where}.plants[{j}]"
             if not isinstance(pos, dict):
                 raise LayoutError(f"{w} must be an object {{y, plant}}")
-            y = _number(pos, "y", w)
-            pid = pos.get("plant")
-            if isinstance(pid, bool) or not isinstance(pid, int):
-                raise LayoutError(f"{w}: 'plant' must be an integer plant id")
-            if plants is not None and pid not in plants:
-                raise LayoutError(f"{w}: plant {pid} is not in the points file "
-                                  f"(it has {', '.join(map(str, sorted(plants)))})")
-            az = _number(pos, "azimuth_deg", w, default=0.0)
+            y = _number(pos, "y", w, **coord)
+            pid = _plant_id(pos, w, plants)
+            az = _number(pos, "azimuth_deg", w, default=0.0, low=-MAX_ANGLE_DEG,
+                         high=MAX_ANGLE_DEG, unit=" degrees")
             jitter = _number(pos, "jitter_cm", w, default=0.0)
-            if jitter < 0:
-                raise LayoutError(f"{w}: 'jitter_cm' must be >= 0")
+            if not 0 <= jitter <= MAX_JITTER_CM:
+                raise LayoutError(f"{w}: 'jitter_cm' is {jitter:g} cm; it must be from 0 to "
+                                  f"{MAX_JITTER_CM:g} cm (farther, the plant has another place: "
+                                  "give that position)")
             px, py = x, y
             if jitter > 0:
                 r, t = jitter * np.sqrt(rng.random()), 2 * np.pi * rng.random()
@@ -361,6 +473,9 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
                 outside.append(f"{w}: plant at ({px:.1f}, {py:.1f}) cm")
             placements.append(Placement(pid, px, py, az, (0, 0)))
             cells.append(_cell(x, y, rs, ps))
+    if not placements:
+        raise LayoutError(f"{source}: no plant stands in the layout: every row's 'plants' "
+                          "list is empty")
     if outside:
         more = f" and {len(outside) - 1} more" if len(outside) > 1 else ""
         warnings.append(f"{outside[0]} stands outside the field{more}")
@@ -369,6 +484,30 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
         warnings.append(f"{source}: some positions are closer than the spacing {overlap}")
     field_rect = np.array([[x0, y0, x1, y1]])
     return CanopyLayout(tuple(placements), field_rect, rs, ps, north, field_rect, tuple(warnings))
+
+
+def _seed(data: dict, source: str) -> int:
+    """The jitter seed: a whole number 0 .. :data:`MAX_SEED` (0 when absent)."""
+    v = data.get("seed", 0)
+    whole = isinstance(v, int) or (isinstance(v, float) and math.isfinite(v) and v.is_integer())
+    if isinstance(v, bool) or not whole or not 0 <= v <= MAX_SEED:
+        raise LayoutError(f"{source}: 'seed' must be a whole number from 0 to {MAX_SEED}, "
+                          f"got {_shown(v)}")
+    return int(v)
+
+
+def _plant_id(pos: dict, where: str, plants: set[int] | None) -> int:
+    """The digitized plant a position names, checked against the plants available."""
+    pid = pos.get("plant")
+    if isinstance(pid, bool) or not isinstance(pid, int) or abs(pid) > MAX_PLANT_ID:
+        raise LayoutError(f"{where}: 'plant' must be an integer plant id (at most "
+                          f"{MAX_PLANT_ID:,}), got {_shown(pid)}")
+    if plants is not None and pid not in plants:
+        have = sorted(plants)
+        shown = ", ".join(map(str, have[:10])) + (f" and {len(have) - 10} more"
+                                                  if len(have) > 10 else "")
+        raise LayoutError(f"{where}: plant {pid} is not in the points file (it has {shown})")
+    return pid
 
 
 def rows_of(placements: list[Placement] | tuple[Placement, ...]) -> list[dict]:

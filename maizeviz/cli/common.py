@@ -9,7 +9,7 @@ from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 
-from maizeviz.canopy.layout import MAX_PLANTS, CanopyLayout, layout_for, parse_shape
+from maizeviz.canopy.layout import CanopyLayout, check_tile, layout_for, parse_shape
 from maizeviz.cost import Cost, canopy_cost, check
 from maizeviz.errors import LeafError, MaizevizError
 from maizeviz.io.atomic import atomic_open, check_output
@@ -31,6 +31,7 @@ FLAGS = {
     "plants": "--plants", "sections": "--sections", "at": "--at", "periodic": "--periodic",
     "baud": "--baud", "points_across": "--points-across", "seed": "--seed", "plant": "--plant",
     "pace": "--pace", "noise": "--noise", "answer_timeout": "--answer-timeout",
+    "resume": "--resume",
 }
 
 
@@ -157,11 +158,7 @@ def load_leaves(path: str, strict: bool = False, degree: int = 3,
 
 def canopy_setup(args: argparse.Namespace) -> tuple[list[Leaf], list[LeafError], CanopyLayout]:
     """Leaves and layout from the canopy options; warnings on stderr."""
-    tile = parse_shape(args.tile, "tile")
-    if tile[0] * tile[1] > MAX_PLANTS:                # refused before reading anything
-        raise MaizevizError(f"tiling {tile[0]}x{tile[1]} makes {tile[0] * tile[1]:,} copies of "
-                            f"the block; a canopy holds at most {MAX_PLANTS:,} plants",
-                            quantity="tile")
+    tile = check_tile(parse_shape(args.tile, "tile"))      # refused before reading anything
     block = parse_shape(args.block, "block") if args.block else None
     leaves, skipped = load_leaves(args.points, args.strict)
     if not leaves:

@@ -41,6 +41,8 @@ def run(args: argparse.Namespace) -> int:
     check_range(args.answer_timeout, "the answer timeout", 0.01, 600, "answer_timeout", unit="s")
     check_range(args.baud, "the baud rate", 300, 4_000_000, "baud", whole=True)
     session = Session(args.out, args.cols, args.resume, args.reference_station)
+    for message in session.messages:
+        say(f"note: {message}")
     if args.resume:
         q0 = session.pos
         say(f"resuming {args.out}: {session.count.points} points on disk; next point is plant "

@@ -11,47 +11,74 @@ from __future__ import annotations
 import os
 import stat
 from pathlib import Path
+from typing import BinaryIO
 
 from maizeviz.errors import MaizevizError
 
-_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a named pipe"),
-          (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
-          (stat.S_ISSOCK, "a socket"))
+_KINDS = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character device"),
+          (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
 
 
-def _kind(mode: int) -> str:
-    return next((name for test, name in _KINDS if test(mode)), "not a regular file")
+def file_kind(mode: int) -> str | None:
+    """What a file that is neither regular nor a folder is, in words (else None)."""
+    return next((name for test, name in _KINDS if test(mode)), None)
 
 
-def read_input(path: str | Path, what: str, max_bytes: int,
-               error: type[MaizevizError] = MaizevizError) -> bytes:
-    """The bytes of the input file ``path`` (``what`` names it in messages: "points file").
+def open_input(path: str | Path, what: str, error: type[MaizevizError] = MaizevizError,
+               buffering: int = 1 << 20) -> tuple[BinaryIO, int]:
+    """Open the input file ``path`` for reading in binary (``what`` names it in messages:
+    "points file"); returns (file, size in bytes).
 
     Raises
     ------
     error
-        Missing, not a regular file (saying what it is), unreadable, or larger than
-        ``max_bytes`` (the message states the limit).
+        Missing, a folder, not a regular file (saying what it is), or unreadable.
     """
     path = Path(path)
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
     except FileNotFoundError:
         raise error(f"{path}: no such {what}") from None
     except IsADirectoryError:
         raise error(f"{path}: is a folder, not a {what}") from None
-    except OSError as exc:
-        raise error(f"{path}: cannot be read ({exc.strerror or exc})") from None
-    mode = os.fstat(fd).st_mode
-    if not stat.S_ISREG(mode):
+    except (OSError, ValueError) as exc:
+        try:                                       # a socket cannot even be opened
+            kind = file_kind(os.stat(path).st_mode)
+        except (OSError, ValueError):
+            kind = None
+        if kind:
+            raise error(f"{path}: is {kind}, not a regular file; a {what} must be a regular "
+                        "file") from None
+        raise error(f"{path}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode):
         os.close(fd)
-        raise error(f"{path}: is {_kind(mode)}, not a {what}")
+        if stat.S_ISDIR(st.st_mode):
+            raise error(f"{path}: is a folder, not a {what}")
+        raise error(f"{path}: is {file_kind(st.st_mode) or 'not a file'}, not a regular file; "
+                    f"a {what} must be a regular file")
     os.set_blocking(fd, True)
-    with os.fdopen(fd, "rb") as fh:
+    return os.fdopen(fd, "rb", buffering=buffering), st.st_size
+
+
+def _size(n: int) -> str:
+    if n % 2**20 == 0:
+        return f"{n // 2**20} MiB"
+    return f"{n / 1e6:g} MB" if n >= 10**6 else f"{n:,} bytes"
+
+
+def read_input(path: str | Path, what: str, max_bytes: int,
+               error: type[MaizevizError] = MaizevizError) -> bytes:
+    """The bytes of the input file ``path``, refused beyond ``max_bytes`` (the message states
+    the limit); see :func:`open_input`."""
+    fh, size = open_input(path, what, error)
+    with fh:
+        if size > max_bytes:
+            raise error(f"{path}: more than the {_size(max_bytes)} limit for a {what}")
         try:
             data = fh.read(max_bytes + 1)
         except OSError as exc:
             raise error(f"{path}: cannot be read ({exc.strerror or exc})") from None
     if len(data) > max_bytes:
-        raise error(f"{path}: more than the {max_bytes / 2**20:g} MiB limit for a {what}")
+        raise error(f"{path}: more than the {_size(max_bytes)} limit for a {what}")
     return data

@@ -1,12 +1,28 @@
 """Read and write the digitized points format.
 
 CSV with a header; required columns ``plant,leaf,row,col,x,y,z`` (any order, any case), other
-columns are kept as text in :attr:`PointsTable.extra`. A ``status`` column (written by
-``maizeviz record``) is honoured: ``undone`` lines take back the latest recording of that
-point, and control lines (``next_leaf``, ``next_plant``, ``end_row``) carry no point. ``x, y, z`` are centimetres, z up.
+columns are kept as text in :attr:`PointsTable.extra`. ``x, y, z`` are centimetres, z up.
+
+A ``status`` column (written by ``maizeviz record``) is honoured: ``undone`` lines take back the
+latest recording of that point, control lines (``next_leaf``, ``next_plant``, ``end_row``)
+carry no point, and a ``discarded`` line takes back the line just above it: a line the
+recorder was cut off while writing (a crash, a full disk), terminated when the recording was
+resumed. In a recording (the header is exactly :data:`JOURNAL_COLUMNS`) a last line without
+its line end is such a cut-off line too, skipped with a note and never read as a point, and
+every line must have all its fields: two lines run together, or a line cut short, are
+skipped with a note.
+
 A row whose ids cannot be read is reported and skipped; a row whose coordinates cannot be read
 marks its leaf as bad (the leaf is refused later with the line number), so one bad press never
 takes the other leaves down with it.
+
+Reading streams: the file is read line by line into compact arrays (64 bytes for each point
+kept), so memory follows the points kept, not the size of the file. Limits (each message says
+which was reached and why it is there; pass a larger value to lift it):
+
+- :data:`MAX_LINE_BYTES` bytes in a line (a points line is under 100 bytes);
+- :data:`MAX_POINTS` points and :data:`MAX_LINES` lines in a file;
+- ids within :data:`MAX_ID` and row / col within :data:`MAX_INDEX`.
 """
 
 from __future__ import annotations
@@ -14,6 +30,8 @@ from __future__ import annotations
 import csv
 import io
 import math
+import warnings
+from array import array
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -21,9 +39,41 @@ import numpy as np
 
 from maizeviz.errors import PointsFileError
 from maizeviz.io.atomic import atomic_open
+from maizeviz.io.inputs import open_input
 
 REQUIRED = ("plant", "leaf", "row", "col", "x", "y", "z")
 ID_COLUMNS = ("plant", "leaf", "row", "col")
+#: The header ``maizeviz record`` writes; a file with exactly this header is a recording.
+JOURNAL_COLUMNS = ("plant", "leaf", "row", "col", "x", "y", "z", "status", "time", "station",
+                   "error")
+#: Status of a point line, of an undo, of the controls, and of the mark that takes back a
+#: cut-off line.
+RECORDED, UNDONE, DISCARDED = "recorded", "undone", "discarded"
+CONTROL_STATUSES = ("next_leaf", "next_plant", "end_row")
+
+#: Longest line read (bytes). A points line is under 100 bytes; 10,000 leaves room for long
+#: extra columns and stops a file without line ends (binary data, one huge field) early.
+MAX_LINE_BYTES = 10_000
+#: Most points read from one file: 20 million is about 18,000 digitized plants of 1,100 points
+#: (a 200 MB file holds about 5 million); they take 1.3 GB while reading.
+MAX_POINTS = 20_000_000
+#: Most lines read from one file (blank, skipped and control lines count): 50 million lines
+#: take a few minutes to read.
+MAX_LINES = 50_000_000
+#: Largest plant or leaf id (absolute value); larger ones are typing mistakes.
+MAX_ID = 1_000_000_000
+#: Largest row or col index: a leaf has at most a few hundred cross-sections.
+MAX_INDEX = 10_000
+#: Problem lines and bad-leaf messages kept for the report; the rest are counted.
+MAX_MESSAGES = 1000
+#: Leaves with unreadable lines before the file is taken for something else.
+MAX_BAD_LEAVES = 100_000
+_BINARY_SNIFF = 4096
+#: Bytes read at a time; blocks of plain numeric lines are parsed by numpy in one go.
+BLOCK_BYTES = 1 << 20
+#: What a block of plain numeric lines may hold, besides its delimiter.
+_NUMERIC = b"0123456789+-.eE \r\n"
+
 
 
 @dataclass(frozen=True)
@@ -60,156 +110,532 @@ class PointsTable:
         return len(self.line)
 
 
+class _BadValue(ValueError):
+    """A field that is a number but out of range; ``str`` says why."""
+
+
 def _parse_int(text: str) -> int:
-    value = float(text)  # accepts "3", "3.0", " 3 "
+    """A whole number written as ``3``, ``3.0`` or `` 3 ``; ValueError otherwise."""
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    value = float(text)
     if not math.isfinite(value) or value != int(value):
         raise ValueError
     return int(value)
 
 
-def read_points(path: str | Path) -> PointsTable:
-    """Read a points CSV file.
+def _parse_id(text: str, what: str, limit: int, low: int) -> int:
+    """A whole number within ``low..limit``; :class:`_BadValue` names ``what`` and the range."""
+    value = _parse_int(text)
+    if not low <= value <= limit:
+        raise _BadValue(f"{what} {shown(text)} is beyond the range {low:,}..{limit:,}")
+    return value
+
+
+# ----------------------------------------------------------------------------- opening
+def open_regular(path: Path, error=PointsFileError, what: str = "points file"):
+    """Open ``path`` for reading in binary, refusing anything but a regular file (see
+    :func:`maizeviz.io.inputs.open_input`). Returns ``(binary file, size in bytes)``."""
+    return open_input(path, what, error)
+
+
+def _looks_binary(head: bytes) -> bool:
+    """NUL bytes, or many control characters, in the first bytes of a file."""
+    if b"\x00" in head:
+        return True
+    controls = sum(head.count(bytes([c])) for c in range(32) if c not in (9, 10, 12, 13))
+    return controls > len(head) // 10
+
+
+def refuse_binary(fh, source: str) -> None:
+    """Raise :class:`PointsFileError` when the first bytes of a binary file (opened by
+    :func:`open_regular`) are not text; reads nothing away."""
+    if _looks_binary(fh.peek(_BINARY_SNIFF)[:_BINARY_SNIFF]):
+        raise PointsFileError(f"{source}: not a CSV text file (binary content)")
+
+
+def _decode(raw: bytes) -> str:
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError:
+        return raw.decode("latin-1")              # decodes every byte
+
+
+def file_blocks(fh, max_line: int = MAX_LINE_BYTES, size: int | None = None):
+    """Blocks of whole lines of a binary file, about ``size`` bytes each.
+
+    A block ends with a line end, or with the file, or with a line longer than ``max_line``
+    (whose first ``max_line + 1`` bytes the block holds: the line checks refuse it).
+    """
+    size = size or BLOCK_BYTES
+    while True:
+        block = fh.read(size)
+        if not block:
+            return
+        if not block.endswith(b"\n"):
+            block += fh.readline(max_line + 1)
+        yield block
+
+
+def raw_line_text(raw: bytes, lineno: int, source: str, max_line: int = MAX_LINE_BYTES) -> str:
+    """The text of one physical line (its line end kept), refusing over-long or binary lines."""
+    body = len(raw) - 1 if raw.endswith(b"\n") else len(raw)
+    if body > max_line:
+        raise PointsFileError(
+            f"{source}: line {lineno} is longer than {max_line:,} bytes; not a readable "
+            "CSV file of points (a points line is under 100 bytes)")
+    if b"\x00" in raw:
+        raise PointsFileError(f"{source}: line {lineno}: binary content (a NUL byte); not "
+                              "a CSV text file")
+    if lineno == 1 and raw.startswith(b"\xef\xbb\xbf"):
+        raw = raw[3:]
+    return _decode(raw)
+
+
+def file_lines(fh, source: str, max_line: int = MAX_LINE_BYTES):
+    """(text, terminated) for each physical line of a binary file, bounded in length."""
+    lineno = 0
+    for block in file_blocks(fh, max_line):
+        for raw in io.BytesIO(block):
+            lineno += 1
+            yield raw_line_text(raw, lineno, source, max_line), raw.endswith(b"\n")
+
+
+def _text_lines(text: str, source: str, max_line: int):
+    """(text, terminated) for each line of a string, split at LF only as the file reader does."""
+    for lineno, line in enumerate(io.StringIO(text), start=1):
+        if len(line) - line.endswith("\n") > max_line:
+            raise PointsFileError(
+                f"{source}: line {lineno} is longer than {max_line:,} characters; not a "
+                "readable CSV file of points (a points line is under 100 bytes)")
+        if "\x00" in line:
+            raise PointsFileError(f"{source}: line {lineno}: binary content (a NUL byte); not "
+                                  "a CSV text file")
+        yield line, line.endswith("\n")
+
+
+# ----------------------------------------------------------------------------- parsing
+class LineParser:
+    """Turns physical lines into compact arrays; one instance reads one file.
+
+    :meth:`feed` classifies each line into an outcome, ``(kind, payload, line number)`` with
+    kind ``point``, ``problem``, ``bad`` (a leaf with an unreadable line), ``undo`` or
+    ``control``, and :meth:`commit` applies it. Lines of files with a ``status`` column are
+    committed one line late, so that a ``discarded`` mark can take back the line just above it
+    (the recorder's resume subclasses this to replay a recording with the same rules).
+    """
+
+    def __init__(self, source: str, max_points: int, max_lines: int):
+        self.source = source
+        self.max_points = max_points
+        self.max_lines = max_lines
+        self.header: list[str] | None = None
+        self.header_line = 0
+        self.delimiter = ","
+        self.ids = array("q")
+        self.xyz = array("d")
+        self.lines = array("q")
+        self.extra: dict[str, list] = {}
+        self.problems: list[str] = []
+        self.dropped = 0                          # problem lines not kept in ``problems``
+        self.bad_leaves: dict = {}
+        self.undone: list = []                    # (ids, points before it)
+        self.pending: tuple | None = None         # (kind, payload, lineno) not yet committed
+        self.data_lines = 0
+        self.carry = ""                           # a quoted field running over line ends
+        self.carry_start = 0
+        self.torn: tuple[int, str] | None = None  # (line number, text) of a cut-off last line
+        self.journal = False
+
+    # ------------------------------------------------------------------ header
+    def _set_header(self, lineno: int, text: str) -> None:
+        first = text.strip()
+        if "," not in first:
+            self.delimiter = ";" if ";" in first else ("\t" if "\t" in first else ",")
+        fields = self._split(text)
+        header = [f.strip().lower() for f in fields]
+        missing = [c for c in REQUIRED if c not in header]
+        if missing:
+            found = shown(",".join(header), 80)
+            raise PointsFileError(
+                f"{self.source}: line {lineno}: missing column(s) {', '.join(missing)}; "
+                f"a points file needs the header plant,leaf,row,col,x,y,z (found '{found}')")
+        self.header = header
+        self.header_line = lineno
+        self.index = [header.index(name) for name in REQUIRED]
+        self.extra_index = {h: header.index(h) for h in header if h and h not in REQUIRED}
+        self.extra = {h: [] for h in self.extra_index}
+        self.status_col = header.index("status") if "status" in header else None
+        self.journal = tuple(header) == JOURNAL_COLUMNS
+
+    def _split(self, text: str) -> list[str]:
+        text = text.rstrip("\r\n")
+        if '"' not in text:
+            if "\r" in text:
+                raise PointsFileError(f"{self.source}: not a readable CSV file (a carriage "
+                                      "return inside a line: old Mac line ends?)")
+            return text.split(self.delimiter)
+        try:
+            return next(csv.reader(io.StringIO(text, newline=""), delimiter=self.delimiter),
+                        [])
+        except csv.Error as exc:
+            raise PointsFileError(f"{self.source}: not a readable CSV file ({exc})") from None
+
+    # ------------------------------------------------------------------ lines
+    def feed(self, lineno: int, text: str, terminated: bool) -> None:
+        if lineno > self.max_lines:
+            raise PointsFileError(
+                f"{self.source}: more than {self.max_lines:,} lines; reading more would take "
+                "many minutes (split the file by plant)")
+        # a quoted field may run over line ends, except in a recording: the recorder never
+        # writes one, and a torn line's open quote must not swallow the lines after it
+        if self.carry or (text.count('"') % 2 and terminated and not self.journal):
+            if not self.carry:
+                self.carry_start = lineno
+            self.carry += text
+            if len(self.carry) > MAX_LINE_BYTES:
+                raise PointsFileError(
+                    f"{self.source}: line {self.carry_start}: a quoted field runs over more "
+                    f"than {MAX_LINE_BYTES:,} bytes; not a readable CSV file of points")
+            if self.carry.count('"') % 2 and terminated:
+                return                              # the quoted field goes on
+            text, lineno, self.carry = self.carry, self.carry_start, ""
+        if not terminated:
+            self.torn = (lineno, text)
+        if self.header is None:
+            if text.strip() and any(f.strip() for f in self._split(text)):
+                self._set_header(lineno, text)
+            return
+        if not text.strip():
+            return
+        fields = self._split(text)
+        if not any(f.strip() for f in fields):
+            return
+        self.data_lines += 1
+        if self.status_col is None:
+            self.commit(self._outcome(lineno, fields))
+            return
+        if not terminated and self.journal:
+            if self.journal and not any(f.strip() for f in fields[:len(REQUIRED)]):
+                self._discard(lineno)                # a repair cut short after its line end
+                return
+            self._settle(("torn", f"line {lineno}: cut short (no line end): the recorder "
+                          "was stopped while writing it, so it was never recorded; skipped",
+                          lineno))
+            return
+        outcome = self._outcome(lineno, fields)
+        if outcome[0] == "discard":
+            self._discard(lineno)
+        elif outcome[0] == "unfinished":
+            self._note(outcome[1])                  # a repair mark cut short: wait for the next
+        else:
+            self._settle(outcome)
+
+    def _settle(self, outcome) -> None:
+        """Commit the line before, then hold this one until the next line is seen."""
+        if self.pending is not None:
+            self.commit(self.pending)
+        self.pending = outcome
+
+    def _discard(self, lineno: int) -> None:
+        if self.pending is None:
+            return
+        _, _, was = self.pending
+        self.pending = None
+        self._note(f"line {was}: cut short by a crash or a full disk and marked not recorded "
+                   f"when the recording was resumed (line {lineno}); skipped")
+
+    def _outcome(self, lineno: int, fields: list[str]):
+        """What one data line means: ("point", ...), ("problem", text), ("bad", ...), ..."""
+        header = self.header
+        assert header is not None                     # data lines come after the header
+        if self.journal and not any(f.strip() for f in fields[:len(REQUIRED)]):
+            col = self.status_col
+            status = fields[col].strip().lower() if col is not None and \
+                len(fields) == len(header) else ""
+            if status == DISCARDED:
+                return ("discard", None, lineno)
+            return ("unfinished", f"line {lineno}: an unfinished mark ('{text_of(fields)}'); "
+                    "skipped", lineno)
+        if len(fields) != len(header) and self.journal:
+            return ("problem", f"line {lineno}: {len(fields)} fields where a recording line has "
+                    f"{len(header)} (a line cut short, or two lines run together); skipped",
+                    lineno)
+        if len(fields) < len(header):
+            fields = fields + [""] * (len(header) - len(fields))
+        if self.status_col is not None:
+            status = fields[self.status_col].strip().lower()
+            if status == DISCARDED:
+                return ("discard", None, lineno)
+            if status == UNDONE:
+                _, key = self._control(lineno, fields, status)[1]
+                if key is None:
+                    return ("problem", f"line {lineno}: unreadable undo line; skipped", lineno)
+                return ("undo", key, lineno)
+            if self.journal and status != RECORDED:
+                if status in CONTROL_STATUSES:
+                    return self._control(lineno, fields, status)
+                return ("problem", f"line {lineno}: unknown status '{shown(status, 20)}'; skipped",
+                        lineno)
+            if status not in ("", RECORDED, "ok"):
+                return self._control(lineno, fields, status)   # controls carry no point
+        return self._point(lineno, fields)
+
+    def _control(self, lineno: int, fields: list[str], status: str):
+        """A control line: the position it leads to (None when unreadable)."""
+        try:
+            key = tuple(_parse_id(fields[self.index[k]], ID_COLUMNS[k],
+                                  MAX_ID if k < 2 else MAX_INDEX, -MAX_ID if k < 2 else 0)
+                        for k in range(4))
+        except (ValueError, OverflowError):
+            key = None
+        return ("control", (status, key), lineno)
+
+    def _point(self, lineno: int, fields: list[str]):
+        p, lf, r, c, x, y, z = (fields[i] for i in self.index)
+        try:
+            plant = _parse_id(p, "plant id", MAX_ID, -MAX_ID)
+            leaf = _parse_id(lf, "leaf id", MAX_ID, -MAX_ID)
+        except _BadValue as exc:
+            return ("problem", f"line {lineno}: {exc}; line skipped", lineno)
+        except (ValueError, OverflowError):
+            return ("problem", f"line {lineno}: plant/leaf id is not an integer "
+                    f"('{shown(p)}', '{shown(lf)}'); line skipped", lineno)
+        try:
+            row = _parse_int(r)
+            col = _parse_int(c)
+        except (ValueError, OverflowError):
+            return ("bad", ((plant, leaf), f"line {lineno}: row/col is not a whole number "
+                    f"('{shown(r)}', '{shown(c)}')"), lineno)
+        if row < 0 or col < 0:
+            return ("bad", ((plant, leaf), f"line {lineno}: row {shown(r)}, col "
+                    f"{shown(c)}: negative index"), lineno)
+        if row > MAX_INDEX or col > MAX_INDEX:
+            return ("bad", ((plant, leaf), f"line {lineno}: row {shown(r)}, col "
+                    f"{shown(c)}: beyond {MAX_INDEX:,}, the largest cross-section "
+                    "index"), lineno)
+        coords = []
+        for axis, value in zip("xyz", (x, y, z)):
+            try:
+                coords.append(float(value))
+            except ValueError:
+                return ("bad", ((plant, leaf), f"row {row}, col {col} (line {lineno}): {axis} is "
+                        f"not a number ('{shown(value)}')"), lineno)
+        extras = [fields[i].strip() for i in self.extra_index.values()]
+        return ("point", (plant, leaf, row, col, coords, extras), lineno)
+
+    def _note(self, text: str) -> None:
+        if len(self.problems) < MAX_MESSAGES:
+            self.problems.append(text)
+        else:
+            self.dropped += 1
+
+    def commit(self, outcome) -> None:
+        kind = outcome[0]
+        if kind == "point":
+            plant, leaf, row, col, coords, extras = outcome[1]
+            if len(self.lines) >= self.max_points:
+                raise PointsFileError(
+                    f"{self.source}: line {outcome[2]}: more than {self.max_points:,} points; "
+                    "that many would take over "
+                    f"{self.max_points * 64 / 1e9:.1f} GB of memory (split the file by plant)")
+            self.ids.extend((plant, leaf, row, col))
+            self.xyz.extend(coords)
+            self.lines.append(outcome[2])
+            for h, v in zip(self.extra, extras):
+                self.extra[h].append(v)
+        elif kind in ("problem", "torn"):
+            self._note(outcome[1])
+        elif kind == "bad":
+            key, message = outcome[1]
+            msgs = self.bad_leaves.get(key)
+            if msgs is None:
+                if len(self.bad_leaves) >= MAX_BAD_LEAVES:
+                    raise PointsFileError(
+                        f"{self.source}: more than {MAX_BAD_LEAVES:,} leaves with unreadable "
+                        "lines; this does not look like a points file")
+                msgs = self.bad_leaves[key] = []
+            if len(msgs) < 5:
+                msgs.append(message)
+            elif len(msgs) == 5:
+                msgs.append("more lines like these")
+        elif kind == "undo":
+            self.undone.append((outcome[1], len(self.lines)))
+
+    # ------------------------------------------------------------------ blocks
+    def feed_block(self, block: bytes, lineno: int) -> int:
+        """Feed a block of whole lines that follows line ``lineno``; returns the last line
+        number. Plain numeric lines go through :meth:`_fast`, the rest line by line."""
+        pos = 0
+        while pos < len(block):
+            if self._fast_ok():
+                rest = block[pos:] if pos else block
+                done = self._fast(rest, lineno)
+                if done:
+                    return lineno + done
+                for raw in io.BytesIO(rest):
+                    lineno += 1
+                    self.feed(lineno, raw_line_text(raw, lineno, self.source), raw.endswith(b"\n"))
+                return lineno
+            end = block.find(b"\n", pos)
+            end = len(block) if end < 0 else end + 1
+            lineno += 1
+            raw = block[pos:end]
+            self.feed(lineno, raw_line_text(raw, lineno, self.source), raw.endswith(b"\n"))
+            pos = end
+        return lineno
+
+    def _fast_ok(self) -> bool:
+        return (self.header is not None and self.status_col is None and not self.extra_index
+                and len(self.header) == len(REQUIRED) and not self.carry)
+
+    def _fast(self, block: bytes, lineno: int) -> int:
+        """Parse a block of plain numeric lines with numpy; returns the lines taken (0: the
+        block is not plain, read it line by line)."""
+        delim = self.delimiter.encode()
+        if block.translate(None, _NUMERIC + delim) or block.count(b"\r") != block.count(b"\r\n"):
+            return 0                                   # quotes, words, nan, blanks in lines...
+        ends = np.flatnonzero(np.frombuffer(block, np.uint8) == 10)
+        n = len(ends) + (0 if block.endswith(b"\n") else 1)
+        lengths = np.diff(np.concatenate([[-1], ends, [len(block) - 1]]))[:n]
+        if not n or lengths.max() > MAX_LINE_BYTES + 1 or lineno + n > self.max_lines:
+            return 0                                   # the line-by-line checks say why
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                values = np.loadtxt(io.BytesIO(block), delimiter=self.delimiter, comments=None,
+                                    dtype=np.float64, ndmin=2, encoding="latin-1")
+        except (ValueError, Warning):
+            return 0
+        if values.shape != (n, len(REQUIRED)) or not np.isfinite(values).all():
+            return 0
+        ids = values[:, self.index[:4]]
+        xyz = values[:, self.index[4:]]
+        limit = np.array([MAX_ID, MAX_ID, MAX_INDEX, MAX_INDEX], dtype=np.float64)
+        low = np.array([-MAX_ID, -MAX_ID, 0, 0], dtype=np.float64)
+        if not (np.all(ids == np.floor(ids)) and np.all(ids <= limit) and np.all(ids >= low)):
+            return 0
+        if len(self.lines) + n > self.max_points:
+            return 0
+        self.ids.frombytes(ids.astype(np.int64).tobytes())
+        self.xyz.frombytes(np.ascontiguousarray(xyz).tobytes())
+        self.lines.frombytes(np.arange(lineno + 1, lineno + n + 1, dtype=np.int64).tobytes())
+        self.data_lines += n
+        if not block.endswith(b"\n"):
+            self.torn = (lineno + n, "")
+        return n
+
+    # ------------------------------------------------------------------ result
+    def finish(self) -> PointsTable:
+        if self.carry:                               # an unclosed quote at the end of the file
+            text, self.carry = self.carry, ""
+            self.feed(self.carry_start, text, False)
+        if self.pending is not None:
+            self.commit(self.pending)
+            self.pending = None
+        if self.header is None:
+            raise PointsFileError(f"{self.source}: the file is empty")
+        if self.dropped:
+            self.problems.append(f"... and {self.dropped:,} more lines skipped")
+        n = len(self.lines)
+        ids = np.frombuffer(self.ids, dtype=np.int64).reshape(-1, 4) if n else \
+            np.empty((0, 4), np.int64)
+        xyz = np.frombuffer(self.xyz, dtype=np.float64).reshape(-1, 3) if n else \
+            np.empty((0, 3), np.float64)
+        lines = np.frombuffer(self.lines, dtype=np.int64) if n else np.empty(0, np.int64)
+        extra = self.extra
+        if self.undone:
+            keep = _undo_mask(ids, self.undone)
+            ids, xyz, lines = ids[keep], xyz[keep], lines[keep]
+            extra = {h: [v for v, k in zip(vals, keep) if k] for h, vals in extra.items()}
+        if not len(lines) and not self.bad_leaves:
+            if self.problems:
+                raise PointsFileError(f"{self.source}: no readable point; first problem: "
+                                      f"{self.problems[0]}")
+            if self.data_lines:
+                raise PointsFileError(f"{self.source}: no point: every line is a control or "
+                                      "an undone point")
+            raise PointsFileError(f"{self.source}: header only, no points")
+        return PointsTable(ids=ids, xyz=xyz, line=lines, extra=extra, problems=self.problems,
+                           bad_leaves=self.bad_leaves, source=self.source)
+
+
+def shown(text: str, limit: int = 30) -> str:
+    """Text from a file as it may appear in a one-line message: stripped, shortened, and
+    with line ends and other control characters written as escapes."""
+    text = text.strip()
+    cut = text[:limit]
+    if not cut.isprintable():
+        cut = "".join(c if c.isprintable() else repr(c)[1:-1] for c in cut)
+    return cut + ("..." if len(text) > limit else "")
+
+
+def text_of(fields: list[str], limit: int = 40) -> str:
+    """A line's fields joined back, shortened for a message."""
+    return shown(",".join(fields), limit)
+
+
+def _undo_mask(ids: np.ndarray, undone: list) -> np.ndarray:
+    """Points kept after each undo took back the latest recording of its point before it.
+
+    ids : (N, 4) int64; undone : [((plant, leaf, row, col), points before the undo)].
+    Returns (N,) bool.
+    """
+    keep = np.ones(len(ids), dtype=bool)
+    for key, before in undone:
+        hit = np.flatnonzero(keep[:before] & np.all(ids[:before] == key, axis=1))
+        if len(hit):
+            keep[hit[-1]] = False
+    return keep
+
+
+def _parse_stream(lines, source: str, max_points: int, max_lines: int) -> PointsTable:
+    parser = LineParser(source, max_points, max_lines)
+    for lineno, (text, terminated) in enumerate(lines, start=1):
+        parser.feed(lineno, text, terminated)
+    return parser.finish()
+
+
+def read_points(path: str | Path, max_points: int = MAX_POINTS,
+                max_lines: int = MAX_LINES) -> PointsTable:
+    """Read a points CSV file, streaming (memory follows the points kept).
+
+    Blocks of plain numeric lines (no status or extra column, no quote, no blank line, every
+    value a number and every id in range) are parsed by numpy in one go; any other block goes
+    line by line, so every message is the one the line-by-line reading gives.
 
     Raises
     ------
     PointsFileError
-        The file is missing, empty, binary, has no header or lacks a required column, or
-        not one line could be read.
+        The file is missing, not a regular file (a FIFO, a device, a socket), empty, binary,
+        has no header or lacks a required column, has a line over :data:`MAX_LINE_BYTES`,
+        more than ``max_points`` points or ``max_lines`` lines, or not one line could be read.
     """
     path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except FileNotFoundError:
-        raise PointsFileError(f"{path}: no such file") from None
-    except IsADirectoryError:
-        raise PointsFileError(f"{path}: is a folder, not a points file") from None
-    except OSError as exc:
-        raise PointsFileError(f"{path}: cannot be read ({exc.strerror})") from None
-    if b"\x00" in raw[:4096]:
-        raise PointsFileError(f"{path}: not a CSV text file (binary content)")
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
+    source = str(path)
+    fh, _ = open_regular(path)
+    with fh:
         try:
-            text = raw.decode("latin-1")
-        except UnicodeDecodeError:  # pragma: no cover - latin-1 decodes every byte
-            raise PointsFileError(f"{path}: not a text file") from None
-    return parse_points(text, source=str(path))
+            refuse_binary(fh, source)
+            parser = LineParser(source, max_points, max_lines)
+            lineno = 0
+            for block in file_blocks(fh):
+                lineno = parser.feed_block(block, lineno)
+            return parser.finish()
+        except OSError as exc:
+            raise PointsFileError(f"{path}: cannot be read ({exc.strerror or exc})") from None
 
 
-def parse_points(text: str, source: str = "<memory>") -> PointsTable:
+def parse_points(text: str, source: str = "<memory>", max_points: int = MAX_POINTS,
+                 max_lines: int = MAX_LINES) -> PointsTable:
     """Parse the text of a points CSV file; see :func:`read_points`."""
-    try:
-        return _parse(text, source)
-    except csv.Error as exc:                       # a field over csv's size limit, a NUL...
-        raise PointsFileError(f"{source}: not a readable CSV file ({exc})") from None
-
-
-def _parse(text: str, source: str) -> PointsTable:
-    text = text.lstrip("\ufeff")
-    if not text.strip():
-        raise PointsFileError(f"{source}: the file is empty")
-    first = text.lstrip().splitlines()[0]
-    delimiter = ","
-    if "," not in first:
-        delimiter = ";" if ";" in first else ("\t" if "\t" in first else ",")
-    reader = csv.reader(io.StringIO(text), delimiter=delimiter)
-    header = None
-    header_line = 0
-    for header_line, fields in enumerate(reader, start=1):
-        if any(f.strip() for f in fields):
-            header = [f.strip().lower() for f in fields]
-            break
-    missing = [c for c in REQUIRED if c not in (header or [])]
-    if missing:
-        shown = ",".join(header or [])[:80]
-        raise PointsFileError(
-            f"{source}: line {header_line}: missing column(s) {', '.join(missing)}; "
-            f"a points file needs the header plant,leaf,row,col,x,y,z (found '{shown}')")
-    index = {name: header.index(name) for name in REQUIRED}
-    extra_names = [h for h in header if h and h not in REQUIRED]
-    extra_index = {h: header.index(h) for h in extra_names}
-
-    ids, xyz, lines, problems = [], [], [], []
-    extra = {h: [] for h in extra_names}
-    bad_leaves: dict = {}
-    status_col = header.index("status") if "status" in header else None
-    undone = []                                   # (ids, line) taken back by the technician
-    for lineno, fields in enumerate(reader, start=header_line + 1):
-        if not any(f.strip() for f in fields):
-            continue
-        if len(fields) < len(header):
-            fields = fields + [""] * (len(header) - len(fields))
-        if status_col is not None:
-            status = fields[status_col].strip().lower()
-            if status == "undone":
-                try:
-                    undone.append((tuple(_parse_int(fields[index[c]]) for c in ID_COLUMNS),
-                                   len(ids)))
-                except ValueError:
-                    problems.append(f"line {lineno}: unreadable undo line; skipped")
-                continue
-            if status not in ("", "recorded", "ok"):
-                continue                          # session controls carry no point
-        try:
-            plant = _parse_int(fields[index["plant"]])
-            leaf = _parse_int(fields[index["leaf"]])
-        except ValueError:
-            problems.append(
-                f"line {lineno}: plant/leaf id is not an integer "
-                f"('{fields[index['plant']].strip()}', '{fields[index['leaf']].strip()}'); line skipped")
-            continue
-        try:
-            row = _parse_int(fields[index["row"]])
-            col = _parse_int(fields[index["col"]])
-        except ValueError:
-            bad_leaves.setdefault((plant, leaf), []).append(
-                f"line {lineno}: row/col is not a whole number "
-                f"('{fields[index['row']].strip()}', '{fields[index['col']].strip()}')")
-            continue
-        if row < 0 or col < 0:
-            bad_leaves.setdefault((plant, leaf), []).append(
-                f"line {lineno}: row {row}, col {col}: negative index")
-            continue
-        coords = []
-        for axis in "xyz":
-            value = fields[index[axis]].strip()
-            try:
-                coords.append(float(value))
-            except ValueError:
-                bad_leaves.setdefault((plant, leaf), []).append(
-                    f"row {row}, col {col} (line {lineno}): {axis} is not a number ('{value}')")
-                break
-        else:
-            ids.append((plant, leaf, row, col))
-            xyz.append(coords)
-            lines.append(lineno)
-            for h, i in extra_index.items():
-                extra[h].append(fields[i].strip())
-    if undone:                                    # drop each undone point (its latest recording)
-        keep = np.ones(len(ids), dtype=bool)
-        for key, before in undone:
-            for k in range(before - 1, -1, -1):
-                if keep[k] and ids[k] == key:
-                    keep[k] = False
-                    break
-        ids = [v for v, k in zip(ids, keep) if k]
-        xyz = [v for v, k in zip(xyz, keep) if k]
-        lines = [v for v, k in zip(lines, keep) if k]
-        extra = {h: [v for v, k in zip(vals, keep) if k] for h, vals in extra.items()}
-    if not ids and not bad_leaves:
-        if problems:
-            raise PointsFileError(f"{source}: no readable point; first problem: {problems[0]}")
-        raise PointsFileError(f"{source}: header only, no points")
-    return PointsTable(
-        ids=np.asarray(ids, dtype=np.int64).reshape(-1, 4),
-        xyz=np.asarray(xyz, dtype=np.float64).reshape(-1, 3),
-        line=np.asarray(lines, dtype=np.int64),
-        extra=extra,
-        problems=problems,
-        bad_leaves=bad_leaves,
-        source=source,
-    )
+    text = text.removeprefix("\ufeff")
+    if "\x00" in text[:_BINARY_SNIFF]:
+        raise PointsFileError(f"{source}: not a CSV text file (binary content)")
+    return _parse_stream(_text_lines(text, source, MAX_LINE_BYTES), source, max_points,
+                         max_lines)
 
 
 def write_points(path: str | Path, grids, decimals: int = 3) -> None:

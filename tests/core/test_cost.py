@@ -1,7 +1,7 @@
 """Cost estimates before any work: exact triangle counts, refusals that name the input."""
 
-import numpy as np
 import pytest
+from maizeviz.resources import example_points
 
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
@@ -10,7 +10,6 @@ from maizeviz.cost import Cost, canopy_cost, check, heatmap_cost, leaf_triangles
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.mesh.levels import Level, mesh_leaves
-from maizeviz.resources import example_points
 
 
 @pytest.fixture(scope="module")
@@ -75,7 +74,7 @@ def test_absurd_tiling_is_refused_before_the_file_is_read(capsys, tmp_path):
     missing = tmp_path / "never_read.csv"
     assert main(["canopy", str(missing), "--tile", "1000x1000"]) == EXIT_FAIL
     err = capsys.readouterr().err
-    assert "1,000,000 copies" in err and "(--tile)" in err and "no such file" not in err
+    assert "1,000,000 plants" in err and "(--tile)" in err and "no such file" not in err
 
 
 @pytest.mark.parametrize("argv, says, flag", [

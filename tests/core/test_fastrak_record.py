@@ -270,7 +270,8 @@ def test_existing_file_needs_resume(sim, tmp_path):
     out.write_text("plant,leaf,row,col,x,y,z\n1,1,0,0,1,2,3\n")
     proc = subprocess.run([sys.executable, "-m", "maizeviz", "record", "--port", sim.path,
                            "--out", str(out)], capture_output=True, text=True, timeout=20)
-    assert proc.returncode == 1 and "--resume" in proc.stderr
+    assert proc.returncode == 1 and "not a maizeviz recording" in proc.stderr
+    assert "record into another file" in proc.stderr
     assert out.read_text().count("\n") == 2
 
 

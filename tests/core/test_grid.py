@@ -55,7 +55,7 @@ def test_binary_and_missing_files(tmp_path):
     p.write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00\x00")
     with pytest.raises(PointsFileError, match="binary"):
         read_points(p)
-    with pytest.raises(PointsFileError, match="no such file"):
+    with pytest.raises(PointsFileError, match="no such points file"):
         read_points(tmp_path / "nope.csv")
     with pytest.raises(PointsFileError, match="folder"):
         read_points(tmp_path)

@@ -14,12 +14,12 @@ def test_regular_file_read_within_its_limit(tmp_path):
     p = tmp_path / "a.json"
     p.write_bytes(b"x" * 100)
     assert read_input(p, "layout file", 100) == b"x" * 100
-    with pytest.raises(MaizevizError, match="more than the .* MiB limit for a layout file"):
+    with pytest.raises(MaizevizError, match="more than the 99 bytes limit for a layout file"):
         read_input(p, "layout file", 99)
 
 
 @pytest.mark.parametrize("make, says", [
-    (lambda p: os.mkfifo(p), "is a named pipe, not a layout file"),
+    (lambda p: os.mkfifo(p), "is a FIFO (named pipe), not a regular file"),
     (lambda p: p.mkdir(), "is a folder, not a layout file"),
     (lambda p: None, "no such layout file"),
 ])
@@ -60,4 +60,4 @@ def test_cli_refuses_a_pipe_in_one_line(capsys, tmp_path, argv):
             else str(tmp_path / "o.csv") if a == "OUT" else a for a in argv]
     assert main(args) == EXIT_FAIL
     err = [ln for ln in capsys.readouterr().err.splitlines() if ln.startswith("error")]
-    assert len(err) == 1 and "named pipe" in err[0]
+    assert len(err) == 1 and "FIFO (named pipe)" in err[0]

@@ -397,7 +397,7 @@ def test_missing_binary_and_oversized_weather_files_are_refused(tmp_path, write_
     big = write_csv("time,ghi\n" + rows(1, 2, 3, 4) * 20)
     with pytest.raises(WeatherFileError) as err:
         read_weather(big, max_bytes=1024)
-    assert "more than the 0.000976562 MiB limit" in one_line(err)
+    assert "more than the 1,024 bytes limit for a weather file" in one_line(err)
     with pytest.raises(WeatherFileError, match="is a folder"):
         read_weather(tmp_path)
 
