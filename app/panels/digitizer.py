@@ -138,7 +138,7 @@ class DigitizerPanel(QWidget):
         self.demo_file = example_points()
         self.demo_pace = 0.5
         self._replay: threading.Thread | None = None
-        self._connecting: FastrakPort | None = None
+        self._connecting: tuple[FastrakPort, Session] | None = None
         self._connect_pool = QThreadPool(self)
         self._connect_pool.setMaxThreadCount(1)
         self._workers: set = set()
@@ -327,7 +327,7 @@ class DigitizerPanel(QWidget):
             port_name = self.sim.path
             self._say(f"demo: simulated FASTRAK on {port_name}")
         port = FastrakPort(port_name, self.baud.value(), answer_timeout=1.0)
-        self._connecting = port
+        self._connecting = (port, session)
         self.band.set_state("busy", f"connecting to {port_name} at {self.baud.value()} baud…",
                             "connecting")
         self._lock(False, connecting=True)
@@ -341,8 +341,9 @@ class DigitizerPanel(QWidget):
         self._connect_pool.start(worker)
 
     def _connected(self, port: FastrakPort, session: Session, cfg, demo: bool) -> None:
-        if self._connecting is not port:                 # stopped while connecting
-            return
+        if self._connecting is None or self._connecting[0] is not port:
+            port.close()                                # stopped while connecting: stop() has
+            return                                      # closed the session already
         self._connecting = None
         for w in cfg.warnings:
             self._say(f"warning: {w}")
@@ -355,7 +356,7 @@ class DigitizerPanel(QWidget):
             self._start_replay(session.reference_station is not None)
 
     def _not_connected(self, port: FastrakPort, session: Session, exc: Exception) -> None:
-        if self._connecting is not port:
+        if self._connecting is None or self._connecting[0] is not port:
             return
         self._connecting = None
         port.close()
@@ -468,8 +469,9 @@ class DigitizerPanel(QWidget):
         """End the session (or the connection attempt); the journal is already on disk."""
         self.timer.stop()
         connecting, self._connecting = self._connecting, None
-        if connecting is not None:
-            connecting.close()
+        if connecting is not None:                      # the unit had not answered yet
+            connecting[0].close()
+            connecting[1].close()                       # its journal lock goes at once
         recorder, self.recorder = self.recorder, None
         if recorder is not None and recorder.port is not None:
             recorder.port.close()

@@ -294,3 +294,23 @@ def test_canopy_returns_in_the_window_after_a_session(window, two_plants, qtbot,
     assert any("refused" in a for a in alerts)            # the status bar says it too
     w.digitizer.stop()
     assert "canopy" in w.viewport.actors
+
+
+def test_stop_while_connecting_lets_go_of_the_file(qtbot, make_panel, tmp_path):
+    """A unit that does not answer: the window stays live, Stop ends the attempt at once and
+    the journal (and its lock) is free for the next try."""
+    from maizeviz.digitizer.simulator import FastrakSimulator
+
+    with FastrakSimulator(silent=True) as silent:
+        panel = make_panel()
+        out = tmp_path / "s.csv"
+        panel.port_edit.setText(silent.path)
+        panel.out_edit.setText(str(out))
+        panel.connect_button.click()
+        assert panel.band.state == "busy" and panel.stop_button.isEnabled()
+        assert panel.out_edit.isReadOnly()
+        qtbot.wait(200)                                   # the GUI thread is not blocked
+        with qtbot.waitSignal(panel.stopped, timeout=TIMEOUT) as stopped:
+            panel.stop_button.click()
+        assert stopped.args == ["stopped"] and panel.connect_button.isEnabled()
+    Session(out, 3, resume=True).close()                  # nobody holds the file any more
