@@ -179,16 +179,22 @@ class MainWindow(QMainWindow):
         self.addDockWidget(Qt.RightDockWidgetArea, dock)
 
     def _build_digitizer(self) -> None:
-        from maizeviz_app.digitizer_panel import DigitizerPanel
+        from maizeviz_app.panels.digitizer import DigitizerPanel
 
         self.digitizer = DigitizerPanel(self.viewport)
+        self.digitizer.alert.connect(lambda text: self.statusBar().showMessage(text, 15_000))
+        self.digitizer.stopped.connect(self._digitizing_stopped)
         dock = QDockWidget("Digitizer", self)
         dock.setObjectName("digitizer")
         dock.setWidget(self.digitizer)
         self.addDockWidget(Qt.LeftDockWidgetArea, dock)
 
+    def _digitizing_stopped(self, _why: str) -> None:
+        if self.canopy is not None:                 # the canopy comes back after a session
+            self.viewport.show_canopy(self.canopy)
+
     def _build_layout_editor(self) -> None:
-        from maizeviz_app.layout_panel import LayoutPanel
+        from maizeviz_app.panels.layout import LayoutPanel
 
         self.layout_panel = LayoutPanel()
         self.layout_panel.applied.connect(self._on_layout)

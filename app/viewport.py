@@ -66,3 +66,52 @@ class Viewport(QtInteractor):
             self.reset_camera()
             self._framed = True
         self.render()
+
+    # ----------------------------------------------------- the plant being digitized
+    # Used by the digitizer panel: one actor per leaf surface (named "leafsurf...", so a new
+    # canopy clears them), the points as one small semi-transparent actor, the last press as
+    # one opaque dot. Each call renders once unless told not to.
+    def show_digitized_leaf(self, name: str, vertices: np.ndarray, faces: np.ndarray,
+                            render: bool = True) -> None:
+        """Add or replace one leaf surface (vertices (n, 3) cm, faces (F, 3) int)."""
+        self.add_mesh(_polydata(vertices, faces), name=name, color="yellowgreen",
+                      smooth_shading=True, reset_camera=False, render=False)
+        if render:
+            self.render()
+
+    def remove_digitized(self, names, render: bool = True) -> None:
+        for name in names:
+            self.remove_actor(name, render=False)
+        if render:
+            self.render()
+
+    def show_digitized_points(self, points: np.ndarray, last: np.ndarray | None = None,
+                              render: bool = True) -> None:
+        """Points (N, 3) cm small and semi-transparent, so the surfaces show through; the last
+        press (3,) as a bigger opaque dot."""
+        self._points_actor("digitized", points, color="crimson", opacity=0.45, point_size=5)
+        self._points_actor("digitized-last", last, color="red", opacity=1.0, point_size=11)
+        if render:
+            self.render()
+
+    def _points_actor(self, name: str, points, **style) -> None:
+        points = np.asarray(points if points is not None else [], np.float32).reshape(-1, 3)
+        actor = self.actors.get(name)
+        if not len(points):
+            self.remove_actor(name, render=False)
+        elif actor is not None:                 # a press adds a point: update in place
+            actor.mapper.dataset.shallow_copy(pv.PolyData(points))
+        else:
+            self.add_mesh(pv.PolyData(points), name=name, render_points_as_spheres=True,
+                          reset_camera=False, render=False, **style)
+
+    def frame_bounds(self, bounds, render: bool = True) -> None:
+        """Point the camera at x0, x1, y0, y1, z0, z1 (cm), keeping its direction."""
+        self.reset_camera(render=False, bounds=tuple(float(b) for b in bounds))
+        if render:
+            self.render()
+
+    def clear_digitized(self, render: bool = True) -> None:
+        """Remove every actor of the plant being digitized."""
+        names = [n for n in self.actors if str(n).startswith(("leafsurf", "digitized"))]
+        self.remove_digitized(names, render)
