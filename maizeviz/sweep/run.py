@@ -193,8 +193,8 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
         try:
             with _sigint_ignored():
                 cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                       dashboard_address=":8787" if _has_dashboard() else None,
-                                       silence_logs=logging.ERROR)
+                                       dashboard_address=":0",   # a free port, no clash
+                                       silence_logs=logging.CRITICAL)
             client = Client(cluster)
         except Exception as exc:                                # noqa: BLE001 - one line
             if cluster is not None:
@@ -214,10 +214,11 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
 
 # ------------------------------------------------------------------------------ progress
 class _Progress:
-    """A tqdm bar (done/total, rate, ETA) on a terminal; otherwise a line every 10 s."""
+    """A tqdm bar (done/total, rate, ETA) on a terminal, else a line every 10 s (``bar``
+    None); always the bar (True); nothing (False)."""
 
     def __init__(self, total: int, initial: int, bar: bool | None, say):
-        self.say = say
+        self.say = say if bar is not False else (lambda _msg: None)
         self.total = total
         self.done = initial
         self.t0 = time.monotonic()
@@ -253,6 +254,44 @@ class _Progress:
 
 
 # ------------------------------------------------------------------------------- the run
+class _CtrlC:
+    """Ctrl-C raises KeyboardInterrupt as usual, except while a result is being recorded:
+    then it is held until the part file and the counts agree, so that what the run says it
+    kept is exactly what is on disk."""
+
+    def __init__(self):
+        self.depth = 0
+        self.pending = False
+        self.old = None
+
+    def _handler(self, signum, frame):
+        if self.depth:
+            self.pending = True
+        else:
+            raise KeyboardInterrupt
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self.old = signal.signal(signal.SIGINT, self._handler)
+        return self
+
+    def __exit__(self, *exc):
+        if self.old is not None:
+            signal.signal(signal.SIGINT, self.old)
+        return False
+
+    @contextmanager
+    def held(self):
+        self.depth += 1
+        try:
+            yield
+        finally:
+            self.depth -= 1
+            if self.pending and not self.depth:
+                self.pending = False
+                raise KeyboardInterrupt
+
+
 def _failure(exc: BaseException | None) -> str:
     name = type(exc).__name__ if exc is not None else "cancelled"
     if name == "KilledWorker":
@@ -303,8 +342,9 @@ def run_sweep(spec, out, *, workers: int | None = None, scheduler: str | None = 
     ctx = dask_client(workers, scheduler, connect_timeout) if own else _given(client)
     run = None
     bar = None
+    ctrl_c = _CtrlC()
     try:
-        with ctx as (cl, kind):
+        with ctrl_c, ctx as (cl, kind):
             outcome.cluster = describe_cluster(cl, kind)
             if outcome.cluster["dashboard"]:
                 say(f"Dask dashboard: {outcome.cluster['dashboard']}")
@@ -313,7 +353,7 @@ def run_sweep(spec, out, *, workers: int | None = None, scheduler: str | None = 
             chunks = plan_tasks(todo, n_workers)
             outcome.tasks = len(chunks)
             bar = _Progress(len(spec.scenarios), len(done), progress, say)
-            _drive(cl, chunks, store, outcome, bar, on_result)
+            _drive(cl, chunks, store, outcome, bar, on_result, ctrl_c)
     except KeyboardInterrupt:
         outcome.interrupted = True
     finally:
@@ -338,7 +378,7 @@ def _given(client):
     yield client, "given client"
 
 
-def _drive(client, chunks, store, outcome, bar, on_result) -> None:
+def _drive(client, chunks, store, outcome, bar, on_result, ctrl_c) -> None:
     """Submit the chunks and record their results as they complete."""
     from distributed import as_completed
 
@@ -353,26 +393,26 @@ def _drive(client, chunks, store, outcome, bar, on_result) -> None:
     try:
         for fut in as_completed(list(futures)):
             chunk = futures.pop(fut)
-            bad = 0
             if fut.status == "finished":
                 res = fut.result()
                 for s, r in zip(chunk, res["results"]):
-                    store.add(s, r, res["worker"])
-                    bad += r["status"] != "ok"
-                outcome.errors += bad
-                outcome.computed += len(chunk)
+                    with ctrl_c.held():
+                        store.add(s, r, res["worker"])
+                        outcome.computed += 1
+                        outcome.errors += r["status"] != "ok"
             else:
                 msg = _failure(fut.exception() if fut.status == "error" else None)
                 for s in chunk:
-                    store.add(s, {"status": "failed", "error": msg})
-                bad = len(chunk)
-                outcome.failed += bad
+                    with ctrl_c.held():
+                        store.add(s, {"status": "failed", "error": msg})
+                        outcome.failed += 1
             del fut
             bar.update(len(chunk), outcome.errors + outcome.failed)
             if on_result is not None:
                 on_result(outcome)
             if time.monotonic() - last_flush > FLUSH_EVERY_S:
-                store.flush()
+                with ctrl_c.held():
+                    store.flush()
                 last_flush = time.monotonic()
     except BaseException:
         client.cancel(list(futures))

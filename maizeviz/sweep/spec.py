@@ -24,7 +24,9 @@ Defaults are those of ``maizeviz canopy`` and ``maizeviz light``::
     periodic = true                # rays leaving the plot re-enter it (default false)
     rect = [0, 0, 180, 90]         # sample rectangle x0, y0, x1, y1 in cm (default: centre tile)
 
-    exclude = [{level = "K4", density = 16}]  # partial scenarios to drop
+    [[exclude]]                    # partial scenarios to drop (or, before [canopy]:
+    level = "K4"                   # exclude = [{level = "K4", density = 16}])
+    density = 16
 
 Each scenario has a stable key: a hash of everything that determines its numbers (the points
 and layout files by content, not by name; every parameter; maizeviz's major.minor version), so
@@ -223,6 +225,9 @@ class _Checker:
 
     def known(self, table: dict, known: tuple, where: str):
         for k in table:
+            if k == "exclude" and where in ("canopy", "light"):
+                raise SweepSpecError(f"{self.source}: '{where}.exclude': exclude belongs at the "
+                                     "top of the file, before [canopy], or in [[exclude]] tables")
             if k not in known:
                 name = f"{where}.{k}" if where else k
                 raise SweepSpecError(f"{self.source}: unknown key '{name}' (known"
