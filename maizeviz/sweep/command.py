@@ -103,9 +103,10 @@ def _run(spec, args) -> int:
                   connect_timeout=args.connect_timeout, resume=args.resume, force=args.force,
                   progress=args.progress)
     out = Path(args.out)
-    rows = read_results(out)
+    rows = read_results(out) if (out / "results.parquet").exists() else []
     summary = summarize(rows, args.tolerance)
-    write_summary(out / "summary.csv", summary)
+    if rows:
+        write_summary(out / "summary.csv", summary)
     if not outcome.interrupted:
         print(format_summary(summary))
     ok = sum(1 for r in rows if r["status"] == "ok") // max(1, len(spec.scenarios[0].heights_cm))
@@ -169,12 +170,9 @@ def _dry_run(spec, args) -> int:
             fitted.add(g[0].points.sha256)
             cpu += compute.SECONDS_PER_LEAF_FIT * est["leaves"]
         triangles += est["triangles"]
-        cpu += (compute.SECONDS_PER_TRIANGLE * est["triangles"]
-                + compute.SECONDS_PER_COVER_RAY * est["cover_rays"])
-        for s in g:
-            n = compute.rays_of(est["rect"], s.density)
-            rays += n
-            cpu += compute.SECONDS_PER_RAY * n
+        n = [compute.rays_of(est["rect"], s.density) for s in g]
+        rays += sum(n)
+        cpu += compute.estimate_seconds(est, n)
     todo = len(spec.scenarios) - len(done)
     print()
     print(f"{len(spec.scenarios)} scenarios ({spec.excluded} excluded"
@@ -182,9 +180,9 @@ def _dry_run(spec, args) -> int:
           f"canopies (points x arrangement x level: one canopy, measure and Embree scene each)")
     print(f"{triangles:,} triangles to build, {rays:,} rays to trace")
     print(f"estimate: about {cpu:,.0f} CPU seconds, {cpu / workers:,.0f} s on {workers} "
-          f"workers (model: {compute.SECONDS_PER_TRIANGLE * 1e6:g} us per triangle, "
-          f"{compute.SECONDS_PER_RAY * 1e6:g} us per ray, measured on a 2-core machine; "
-          "yours may differ)" + ("" if todo == len(spec.scenarios) else
+          f"workers (model: {compute.SECONDS_PER_SCENE_TRIANGLE * 1e6:g} us per triangle "
+          f"and scene, {compute.SECONDS_PER_RAY * 1e6:g} us per ray, measured on a 2-core "
+          "machine; yours may differ)" + ("" if todo == len(spec.scenarios) else
                                   f"; {todo} scenarios left to compute"))
     for p in problems:
         _say(f"warning: {p}")

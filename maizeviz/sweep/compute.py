@@ -27,7 +27,6 @@ import threading
 import time
 from collections import OrderedDict
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from maizeviz.canopy.layout import load_layout, parse_shape, tiled_layout
 from maizeviz.canopy.measures import measure_canopy
@@ -37,6 +36,7 @@ from maizeviz.leaf.reconstruct import mesh_leaves, parse_level, read_leaves
 from maizeviz.light.raytrace import RayScene
 from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import LightRequest, ray_count, trace_light
+from maizeviz.sweep.errors import WorkerInputError
 
 
 def _accepts(fn, name: str) -> bool:
@@ -145,8 +145,9 @@ def _leaves(path: str, sha256: str):
     t0 = time.perf_counter()
     try:
         now = file_sha256(path)
-    except OSError:
-        now = sha256                  # read_leaves below says what is wrong with the path
+    except OSError as exc:            # the driver read it: this machine cannot
+        raise WorkerInputError(f"{path}: cannot be read here ({exc.strerror or exc}); every "
+                               "worker needs the points files at the same path") from None
     if now != sha256:
         raise MaizevizError(f"{path}: the file changed since the sweep started (its content "
                             "hash differs); run the sweep again")
@@ -174,6 +175,15 @@ class _GroupState:
 def _layout(s, leaves):
     a = s.arrangement
     if a.layout_path:
+        try:
+            now = file_sha256(a.layout_path)
+        except OSError as exc:
+            raise WorkerInputError(f"{a.layout_path}: cannot be read here "
+                                   f"({exc.strerror or exc}); every worker needs the layout "
+                                   "files at the same path") from None
+        if now != a.layout_sha256:
+            raise MaizevizError(f"{a.layout_path}: the file changed since the sweep started "
+                                "(its content hash differs); run the sweep again")
         return load_layout(a.layout_path, {lf.grid.plant for lf in leaves})
     return tiled_layout(plant_bases(leaves), tuple(a.tile), a.row_spacing, a.plant_spacing,
                         tuple(a.block) if a.block else None)
@@ -227,7 +237,8 @@ def _one_line(exc: BaseException) -> str:
 
 
 def _error(s, exc: BaseException) -> dict:
-    return {"key": s.key, "status": "error", "error": _one_line(exc)}
+    status = "failed" if isinstance(exc, WorkerInputError) else "error"
+    return {"key": s.key, "status": status, "error": _one_line(exc)}
 
 
 def _light(state: _GroupState, s) -> dict:
@@ -257,7 +268,8 @@ def _light(state: _GroupState, s) -> dict:
 def compute_scenarios(scenarios) -> list[dict]:
     """Results of scenarios that share one group, in the order given.
 
-    Returns one dict per scenario: ``key``, ``status`` ("ok" or "error"), ``error`` (one line
+    Returns one dict per scenario: ``key``, ``status`` ("ok"; "error": bad input; "failed":
+    an input file this process cannot read, worth retrying elsewhere), ``error`` (one line
     or None) and, when ok, the canopy measures (``triangles``, ``leaf_area_m2``, ``lai``, ...,
     areas in m2), ``rays``, ``heights_cm`` (H,) and ``transmission`` (H,) in [0, 1],
     ``warnings`` (list of str) and ``seconds`` per stage (fit, layout, build, scene, measure,
@@ -285,12 +297,23 @@ def compute_scenarios(scenarios) -> list[dict]:
 
 
 # ------------------------------------------------------------------------------- estimates
-#: Cost model of the dry-run estimate, measured on the 2-core machine this was written on
-#: (embreex scene construction dominates a group; periodic tracing about 1.3 M rays/s).
-SECONDS_PER_TRIANGLE = 3.5e-6
-SECONDS_PER_COVER_RAY = 0.4e-6
-SECONDS_PER_RAY = 0.8e-6
+#: Cost model of the dry-run estimate, measured on the 2-core machine this was written on:
+#: placing and measuring triangles; building an Embree scene (embreex's mesh construction
+#: dominates a large canopy); vertical ground-cover rays and (periodic) sun rays; fitting one
+#: digitized leaf.
+SECONDS_PER_TRIANGLE = 0.5e-6
+SECONDS_PER_SCENE_TRIANGLE = 2.2e-6
+SECONDS_PER_COVER_RAY = 1.0e-6
+SECONDS_PER_RAY = 1.0e-6
 SECONDS_PER_LEAF_FIT = 2.5e-3
+
+
+def estimate_seconds(est: dict, rays: list[int]) -> float:
+    """Model CPU seconds of one group (``estimate_group``) tracing ``rays`` per scenario,
+    fitting excluded. Without scene reuse every sun and the measure build their own scene."""
+    scenes = 1 if (MEASURE_TAKES_SCENE and TRACE_TAKES_SCENE) else 1 + len(rays)
+    return (est["triangles"] * (SECONDS_PER_TRIANGLE + scenes * SECONDS_PER_SCENE_TRIANGLE)
+            + est["cover_rays"] * SECONDS_PER_COVER_RAY + sum(rays) * SECONDS_PER_RAY)
 
 
 def estimate_group(s) -> dict:
@@ -306,7 +329,7 @@ def estimate_group(s) -> dict:
         used = sorted({p.plant for p in layout.placements})
         src = [lf for lf in found.leaves if lf.grid.plant in used]
         meshes = mesh_leaves(src, parse_level(s.level), s.preserve_area)
-    except (MaizevizError, ValueError) as exc:
+    except (MaizevizError, ValueError) as exc:       # WorkerInputError included
         return {"error": _one_line(exc)}
     per_plant: dict[int, int] = {}
     for lf, mesh in zip(src, meshes):

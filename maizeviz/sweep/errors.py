@@ -15,3 +15,8 @@ class SweepStoreError(MaizevizError):
 
 class SchedulerError(MaizevizError):
     """The Dask scheduler cannot be reached or the local cluster cannot start."""
+
+
+class WorkerInputError(MaizevizError):
+    """A worker cannot read an input file the sweep file named: an environment problem (a
+    cluster without the shared folder), recorded as "failed" so that a rerun retries it."""

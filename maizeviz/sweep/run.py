@@ -228,10 +228,15 @@ class _Progress:
         if bar is None:
             bar = sys.stderr.isatty()
         if bar:
+            import shutil
+
             from tqdm import tqdm
 
+            size = shutil.get_terminal_size((0, 0))
+            sized = size.columns > 0 and size.lines > 0     # a pty may have no size: tqdm
             self.bar = tqdm(total=total, initial=initial, unit="scenario", file=sys.stderr,
-                            dynamic_ncols=True, smoothing=0.1, desc="sweep")
+                            dynamic_ncols=sized, ncols=None if sized else 100,   # would hide
+                            nrows=None if sized else 50, smoothing=0.1, desc="sweep")
 
     def update(self, n: int, bad: int) -> None:
         self.done += n
@@ -348,10 +353,13 @@ def run_sweep(spec, out, *, workers: int | None = None, scheduler: str | None = 
             outcome.cluster = describe_cluster(cl, kind)
             if outcome.cluster["dashboard"]:
                 say(f"Dask dashboard: {outcome.cluster['dashboard']}")
-            run = store.start_run(outcome.cluster)
+            if not outcome.cluster["workers"]:
+                say("warning: the scheduler has no workers yet; the tasks wait for some")
             n_workers = max(1, outcome.cluster["workers"])
             chunks = plan_tasks(todo, n_workers)
             outcome.tasks = len(chunks)
+            run = store.start_run(dict(outcome.cluster, tasks=len(chunks),
+                                       **compute.describe_core()))
             bar = _Progress(len(spec.scenarios), len(done), progress, say)
             _drive(cl, chunks, store, outcome, bar, on_result, ctrl_c)
     except KeyboardInterrupt:
@@ -360,8 +368,8 @@ def run_sweep(spec, out, *, workers: int | None = None, scheduler: str | None = 
         if bar is not None:
             bar.close()
         outcome.seconds = time.perf_counter() - t0
-        store.flush()
         if run is not None:
+            store.flush()
             run.update(finished=now_iso(), computed=outcome.computed, errors=outcome.errors,
                        failed=outcome.failed, interrupted=outcome.interrupted,
                        seconds=outcome.seconds)
@@ -398,8 +406,11 @@ def _drive(client, chunks, store, outcome, bar, on_result, ctrl_c) -> None:
                 for s, r in zip(chunk, res["results"]):
                     with ctrl_c.held():
                         store.add(s, r, res["worker"])
-                        outcome.computed += 1
-                        outcome.errors += r["status"] != "ok"
+                        if r["status"] == "failed":        # retried by the next run
+                            outcome.failed += 1
+                        else:
+                            outcome.computed += 1
+                            outcome.errors += r["status"] == "error"
             else:
                 msg = _failure(fut.exception() if fut.status == "error" else None)
                 for s in chunk:

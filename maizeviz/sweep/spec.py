@@ -43,7 +43,8 @@ import json
 import math
 import os
 from dataclasses import dataclass
-from datetime import date, datetime, time as dtime
+from datetime import date, datetime
+from datetime import time as dtime
 from pathlib import Path
 
 try:

@@ -171,13 +171,11 @@ class ResultStore:
                 f"{old.get('scenarios', '?')} scenarios, fingerprint "
                 f"{old.get('fingerprint', '?')}; this one {self.spec.fingerprint}): use "
                 "another --out, or --force to reuse the folder")
-        try:
-            self.parts.mkdir(parents=True, exist_ok=True)
-            probe = f / f".write-probe.{os.getpid()}"
-            probe.write_bytes(b"")
-            probe.unlink()
-        except OSError as exc:
-            raise SweepStoreError(f"{f}: cannot be written ({exc.strerror or exc})") from None
+        existing = f
+        while not existing.exists() and existing.parent != existing:
+            existing = existing.parent                 # created only when a run starts
+        if not os.access(existing, os.W_OK | os.X_OK):
+            raise SweepStoreError(f"{f}: cannot be written (no permission in {existing})")
         if resume:
             self._load_parts()
         info = {"maizeviz_sweep": SCHEMA, "spec_file": self.spec.source,
@@ -189,6 +187,8 @@ class ResultStore:
         return info
 
     def _load_parts(self) -> None:
+        if not self.parts.is_dir():
+            return
         for s in self.spec.scenarios:
             p = self.parts / f"{s.key}.json"
             try:
@@ -229,7 +229,13 @@ class ResultStore:
         write_parquet(self.folder / "results.parquet", rows)
 
     def start_run(self, cluster: dict) -> dict:
-        """Note a run in sweep.json (written at once, so a crash still leaves the spec)."""
+        """Create the folder and note a run in sweep.json (written at once, so a crash still
+        leaves the spec)."""
+        try:
+            self.parts.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise SweepStoreError(f"{self.folder}: cannot be written "
+                                  f"({exc.strerror or exc})") from None
         run = {"started": now_iso(), "finished": None, "cluster": cluster,
                "already_done": len(self.done_keys()), "computed": 0, "errors": 0,
                "failed": 0, "interrupted": False}

@@ -135,6 +135,27 @@ def test_a_scenario_with_bad_input_is_recorded_and_the_sweep_goes_on(blocks, cli
     assert {r["status"] for r in rows if r["points"] == "b0.csv"} == {"ok"}
 
 
+def test_a_file_the_workers_cannot_read_fails_and_is_retried_by_the_rerun(blocks, client,
+                                                                          tmp_path):
+    (tmp_path / "b0.csv").write_bytes((blocks / "b0.csv").read_bytes())
+    # content no worker has fitted yet (workers cache leaves by content, not by path)
+    assert cli_main(["synth", "--plants", "1x2", "--seed", "7", "--out",
+                     str(tmp_path / "b1.csv")]) == 0
+    spec = load_spec(spec_file(tmp_path))
+    hidden = tmp_path / "b1.csv.away"
+    (tmp_path / "b1.csv").rename(hidden)               # gone after the spec was read
+    first = run_sweep(spec, tmp_path / "r", client=client, progress=False)
+    assert first.failed == 6 and first.computed == 6 and not first.complete
+    rows = read_results(tmp_path / "r")
+    failed = [r for r in rows if r["status"] == "failed"]
+    assert len(failed) == 6 * len(HEIGHTS)
+    assert "cannot be read here" in failed[0]["error"] and "same path" in failed[0]["error"]
+    hidden.rename(tmp_path / "b1.csv")
+    second = run_sweep(spec, tmp_path / "r", client=client, progress=False)
+    assert second.already_done == 6 and second.computed == 6 and second.complete
+    assert {r["status"] for r in check_complete(tmp_path / "r", spec)} == {"ok"}
+
+
 # ------------------------------------------------------------------------------ faults
 def test_a_killed_worker_costs_only_its_task(blocks, client, tmp_path):
     spec = load_spec(spec_file(blocks, SPEC.replace("density = [0.5]", "density = [6]")))
