@@ -161,7 +161,8 @@ def main():
         print(json.dumps(out, indent=1))
     else:
         print(f"{out['scenarios']} scenarios in {out['groups']} groups, "
-              f"{out['rays_per_scenario']:,} rays each: serial {best['serial']:.2f} s, 1 worker {best[1]:.2f} s "
+              f"{out['rays_per_scenario']:,} rays each: serial {best['serial']:.2f} s, "
+              f"1 worker {best[1]:.2f} s "
               f"({out['one_worker_over_serial']:.2f}x serial, {out['overhead_per_task_s']:+.3f} s "
               f"per task), 2 workers {best[2]:.2f} s (speedup {out['speedup']:.2f}); "
               f"results identical: {same}")
