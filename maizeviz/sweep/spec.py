@@ -284,7 +284,7 @@ class _Checker:
                              f"got {json.dumps(v, default=str)}")
         try:
             return compute.level_label(v)
-        except ValueError as exc:
+        except (MaizevizError, ValueError) as exc:         # the core has raised both
             self.fail(where, str(exc))
 
     def text(self, v, where):
