@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from maizeviz.sweep import compute
-from maizeviz.sweep.run import plan_tasks, run_sweep
+from maizeviz.sweep.run import LOCAL_CONFIG, plan_tasks, run_sweep
 from maizeviz.sweep.spec import load_spec
 from maizeviz.sweep.store import read_results
 
@@ -101,6 +101,7 @@ def main():
                     help="rays per cm2 (default 32: tracing about half the work)")
     ap.add_argument("--repeat", type=int, default=1, help="best of N (default 1)")
     args = ap.parse_args()
+    import dask
     from distributed import Client, LocalCluster
 
     logging.getLogger("distributed").setLevel(logging.ERROR)
@@ -108,8 +109,9 @@ def main():
     spec = load_spec(write_spec(tmp, str(Path(args.points).resolve()), args.tile, args.density))
     clusters = {}
     for n in (1, 2):
-        cl = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                          dashboard_address=":0", silence_logs=logging.CRITICAL)
+        with dask.config.set(LOCAL_CONFIG):                 # as maizeviz sweep starts it
+            cl = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                              dashboard_address=":0", silence_logs=logging.CRITICAL)
         client = Client(cl)
         client.run(__import__, "maizeviz.sweep.compute")
         clusters[n] = (cl, client)

@@ -157,7 +157,7 @@ def _dry_run(spec, args) -> int:
     groups = spec.groups()
     workers = args.workers or os.cpu_count() or 1
     cpu = 0.0
-    triangles = rays = 0
+    triangles = rays = peak = 0
     problems = []
     fitted = set()
     for g in groups:
@@ -170,6 +170,7 @@ def _dry_run(spec, args) -> int:
             fitted.add(g[0].points.sha256)
             cpu += compute.SECONDS_PER_LEAF_FIT * est["leaves"]
         triangles += est["triangles"]
+        peak = max(peak, est["bytes"])
         n = [compute.rays_of(est["rect"], s.density) for s in g]
         rays += sum(n)
         cpu += compute.estimate_seconds(est, n)
@@ -178,12 +179,13 @@ def _dry_run(spec, args) -> int:
     print(f"{len(spec.scenarios)} scenarios ({spec.excluded} excluded"
           + (f", {len(done)} already in {args.out}" if done else "") + f") in {len(groups)} "
           f"canopies (points x arrangement x level: one canopy, measure and Embree scene each)")
-    print(f"{triangles:,} triangles to build, {rays:,} rays to trace")
+    print(f"{triangles:,} triangles to build, {rays:,} rays to trace; the largest canopy needs "
+          f"about {peak / 2**30:.1f} GiB on its worker")
     print(f"estimate: about {cpu:,.0f} CPU seconds, {cpu / workers:,.0f} s on {workers} "
           f"workers (model: {compute.SECONDS_PER_SCENE_TRIANGLE * 1e6:g} us per triangle "
           f"and scene, {compute.SECONDS_PER_RAY * 1e6:g} us per ray, measured on a 2-core "
-          "machine; yours may differ)" + ("" if todo == len(spec.scenarios) else
-                                  f"; {todo} scenarios left to compute"))
+          "machine; yours may differ)"
+          + ("" if todo == len(spec.scenarios) else f"; {todo} scenarios left to compute"))
     for p in problems:
         _say(f"warning: {p}")
     return EXIT_OK

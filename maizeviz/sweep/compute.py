@@ -6,17 +6,19 @@ layout file, mesh level and area rule. Its work is done once and reused by all i
 - leaves are read and fitted once per points file per process (cached by the file's sha256, so
   a Dask worker fits each file once however many tasks it runs);
 - the canopy is built and measured once per group;
-- one Embree scene serves the ground-cover measure and every sun of the group, when the core
-  accepts a prebuilt scene (``scene=`` on ``measure_canopy`` and ``trace_light``); with an older
-  core each of them builds its own and the numbers are the same, only slower.
+- one Embree scene (``light_scene``) serves every sun of the group; the ground-cover measure
+  uses it too when ``measure_canopy`` accepts ``scene=`` (until then it builds its own: the
+  numbers are the same, only slower).
 
-Every import of the core is in this file, so that moving core modules is a one-file change. The
+Every import of the computing core (leaf, mesh, canopy, light) is in this file, so that moving
+core modules is a one-file change (the rest of the sweep uses only ``maizeviz.errors`` and
+``maizeviz.io.atomic``). The
 numbers equal ``maizeviz canopy --json`` and ``maizeviz light --json`` for the same inputs: the
 same functions with the same arguments, except that tracing runs on one thread (a Dask worker
 is one process per core) and without the hit classes, neither of which changes transmission.
 
-Scenarios are duck-typed (see :class:`maizeviz.sweep.spec.Scenario`); this module does not
-import the rest of the sweep, so workers need nothing but maizeviz itself.
+Scenarios are duck-typed (see :class:`maizeviz.sweep.spec.Scenario`); of the sweep this
+module imports only its errors.
 """
 
 from __future__ import annotations
@@ -27,15 +29,19 @@ import threading
 import time
 from collections import OrderedDict
 from dataclasses import dataclass, field
+from typing import Any
 
-from maizeviz.canopy.layout import load_layout, parse_shape, tiled_layout
+from maizeviz.canopy.layout import layout_for, parse_shape
 from maizeviz.canopy.measures import measure_canopy
-from maizeviz.canopy.scene import build_canopy, plant_bases
+from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.errors import MaizevizError
-from maizeviz.leaf.reconstruct import mesh_leaves, parse_level, read_leaves
-from maizeviz.light.raytrace import RayScene
+from maizeviz.leaf.fit import read_leaves
+from maizeviz.light.rays import ray_count
+from maizeviz.light.request import LightRequest
 from maizeviz.light.sun import Sun, sun_at
-from maizeviz.light.transmission import LightRequest, ray_count, trace_light
+from maizeviz.light.transmission import light_scene, trace_light
+from maizeviz.mesh.levels import mesh_leaves, parse_level
+from maizeviz.mesh.raytrace import RayScene
 from maizeviz.sweep.errors import WorkerInputError
 
 
@@ -46,9 +52,8 @@ def _accepts(fn, name: str) -> bool:
         return False
 
 
-#: The core takes a prebuilt Embree scene (see the module docstring).
+#: ``measure_canopy`` takes the prebuilt Embree scene (``trace_light`` does).
 MEASURE_TAKES_SCENE = _accepts(measure_canopy, "scene")
-TRACE_TAKES_SCENE = _accepts(trace_light, "scene")
 
 #: Points files whose fitted leaves a process keeps (a block of 9 plants is a few MB).
 LEAVES_CACHE_SIZE = 8
@@ -60,19 +65,21 @@ CANOPY_CACHE_SIZE = 2
 # ------------------------------------------------------------------------- values of a spec
 def level_label(text) -> str:
     """Canonical name of a mesh level: ``"K4"`` -> ``"K=4"``, ``"std"`` -> ``"standard"``,
-    ``36`` -> ``"36 triangles"``. Raises ValueError naming the text."""
+    ``36`` -> ``"36 triangles"``. Raises MaizevizError naming the text."""
     return parse_level(str(text)).label
 
 
 def level_order(label: str) -> tuple[int, int]:
     """Sort key, finest first: interpolated levels by K descending, then budgets descending."""
     lv = parse_level(label.replace(" triangles", ""))
-    return (0, -lv.interp) if lv.interp is not None else (1, -lv.triangles)
+    if lv.interp is not None:
+        return (0, -lv.interp)
+    return (1, -(lv.triangles or 0))
 
 
-def parse_tile(text, what: str) -> tuple[int, int]:
-    """``"3x3"`` -> (3, 3); MaizevizError naming ``what`` otherwise."""
-    return parse_shape(str(text), what)
+def parse_tile(text, quantity: str = "tile") -> tuple[int, int]:
+    """``"3x3"`` -> (3, 3); MaizevizError otherwise."""
+    return parse_shape(str(text), quantity)
 
 
 def resolve_sun(table: dict) -> tuple[float, float, str]:
@@ -164,15 +171,16 @@ def _leaves(path: str, sha256: str):
 class _GroupState:
     """A built canopy with its measures and scene; ``seconds`` not yet charged to a row."""
 
-    canopy: object
-    measures: dict
-    scene: object
+    canopy: Canopy
+    measures: dict[str, Any]
+    scene: RayScene
     leaves_skipped: int
-    warnings: list
-    seconds: dict = field(default_factory=dict)
+    warnings: list[str]
+    seconds: dict[str, float] = field(default_factory=dict)
 
 
 def _layout(s, leaves):
+    """The CLI's ``layout_for``: the layout file, or the digitized block tiled."""
     a = s.arrangement
     if a.layout_path:
         try:
@@ -184,9 +192,9 @@ def _layout(s, leaves):
         if now != a.layout_sha256:
             raise MaizevizError(f"{a.layout_path}: the file changed since the sweep started "
                                 "(its content hash differs); run the sweep again")
-        return load_layout(a.layout_path, {lf.grid.plant for lf in leaves})
-    return tiled_layout(plant_bases(leaves), tuple(a.tile), a.row_spacing, a.plant_spacing,
-                        tuple(a.block) if a.block else None)
+        return layout_for(leaves, layout_file=a.layout_path)
+    return layout_for(leaves, tuple(a.tile), a.row_spacing, a.plant_spacing,
+                      tuple(a.block) if a.block else None)
 
 
 def _group_state(s) -> _GroupState:
@@ -199,17 +207,13 @@ def _group_state(s) -> _GroupState:
     t0 = time.perf_counter()
     layout = _layout(s, found.leaves)
     t1 = time.perf_counter()
-    try:
-        canopy = build_canopy(found.leaves, layout, parse_level(s.level), s.preserve_area)
-    except ValueError as exc:                                # as the CLI says it
-        raise MaizevizError(f"{s.level}: {exc}") from None
+    canopy = build_canopy(found.leaves, layout, parse_level(s.level), s.preserve_area)
     t2 = time.perf_counter()
-    scene = None
-    if MEASURE_TAKES_SCENE or TRACE_TAKES_SCENE:
-        scene = RayScene(canopy.vertices, canopy.faces)
+    scene = light_scene(canopy)
     t3 = time.perf_counter()
     if MEASURE_TAKES_SCENE:
-        m = measure_canopy(canopy, s.cover_resolution, False, scene=scene)
+        measure: Any = measure_canopy                     # the core to come (see above)
+        m = measure(canopy, s.cover_resolution, False, scene=scene)
     else:
         m = measure_canopy(canopy, s.cover_resolution, False)
     t4 = time.perf_counter()
@@ -247,12 +251,8 @@ def _light(state: _GroupState, s) -> dict:
                        classes=False)
     seconds = _charge(state)
     t0 = time.perf_counter()
-    if TRACE_TAKES_SCENE:
-        res = trace_light(state.canopy, req, scene=state.scene)
-    else:
-        res = trace_light(state.canopy, req)
-    seconds["trace"] = time.perf_counter() - t0 - res.seconds["build"]
-    seconds["scene"] += res.seconds["build"]
+    res = trace_light(state.canopy, req, scene=state.scene)
+    seconds["trace"] = time.perf_counter() - t0
     m = state.measures
     return {"key": s.key, "status": "ok", "error": None, "triangles": m["triangles"],
             "plants": m["plants"], "leaves": m["leaves"],
@@ -298,30 +298,27 @@ def compute_scenarios(scenarios) -> list[dict]:
 
 # ------------------------------------------------------------------------------- estimates
 #: Cost model of the dry-run estimate, measured on the 2-core machine this was written on:
-#: placing and measuring triangles; building an Embree scene (embreex's mesh construction
-#: dominates a large canopy); vertical ground-cover rays and (periodic) sun rays; fitting one
-#: digitized leaf.
+#: meshing, placing and measuring triangles; building an Embree scene (embreex's mesh
+#: construction dominates a large canopy); vertical ground-cover rays and (periodic) sun rays;
+#: fitting one digitized leaf.
 SECONDS_PER_TRIANGLE = 0.5e-6
 SECONDS_PER_SCENE_TRIANGLE = 2.2e-6
 SECONDS_PER_COVER_RAY = 1.0e-6
 SECONDS_PER_RAY = 1.0e-6
 SECONDS_PER_LEAF_FIT = 2.5e-3
-
-
-def estimate_seconds(est: dict, rays: list[int]) -> float:
-    """Model CPU seconds of one group (``estimate_group``) tracing ``rays`` per scenario,
-    fitting excluded. Without scene reuse every sun and the measure build their own scene."""
-    scenes = 1 if (MEASURE_TAKES_SCENE and TRACE_TAKES_SCENE) else 1 + len(rays)
-    return (est["triangles"] * (SECONDS_PER_TRIANGLE + scenes * SECONDS_PER_SCENE_TRIANGLE)
-            + est["cover_rays"] * SECONDS_PER_COVER_RAY + sum(rays) * SECONDS_PER_RAY)
+#: Peak bytes per canopy triangle (the canopy arrays, its Embree scene and the transients of
+#: building them) and per traced ray.
+BYTES_PER_TRIANGLE = 400
+BYTES_PER_RAY = 64
 
 
 def estimate_group(s) -> dict:
-    """Triangles and ray counts of the group of ``s`` without building it.
+    """Triangles, rays and memory of the group of ``s`` without building it.
 
     Fits the leaves (cached), meshes each digitized leaf once at the level and counts the
     triangles over the placements. Returns ``triangles``, ``plants``, ``leaves``,
-    ``cover_rays`` and ``rect_area_cm2`` (the sample rectangle), or ``error``.
+    ``cover_rays``, ``rect`` (the sample rectangle, cm) and ``bytes`` (peak memory of the
+    canopy and its scene on a worker), or ``error``.
     """
     try:
         found, _ = _leaves(s.points.path, s.points.sha256)
@@ -329,16 +326,26 @@ def estimate_group(s) -> dict:
         used = sorted({p.plant for p in layout.placements})
         src = [lf for lf in found.leaves if lf.grid.plant in used]
         meshes = mesh_leaves(src, parse_level(s.level), s.preserve_area)
-    except (MaizevizError, ValueError) as exc:       # WorkerInputError included
+    except MaizevizError as exc:                      # WorkerInputError included
         return {"error": _one_line(exc)}
     per_plant: dict[int, int] = {}
     for lf, mesh in zip(src, meshes):
         per_plant[lf.grid.plant] = per_plant.get(lf.grid.plant, 0) + mesh.n_triangles
+    triangles = sum(per_plant[p.plant] for p in layout.placements)
     x0, y0, x1, y1 = s.rect_cm or layout.centre_bounds
-    return {"triangles": sum(per_plant[p.plant] for p in layout.placements),
-            "plants": len(layout.placements), "leaves": len(found.leaves),
+    return {"triangles": triangles, "plants": len(layout.placements),
+            "leaves": len(found.leaves),
             "cover_rays": int(layout.ground_area_cm2 / s.cover_resolution ** 2),
-            "rect": (x0, y0, x1, y1)}
+            "rect": (x0, y0, x1, y1), "bytes": triangles * BYTES_PER_TRIANGLE}
+
+
+def estimate_seconds(est: dict, rays: list[int]) -> float:
+    """Model CPU seconds of one group (``estimate_group``) tracing ``rays`` per scenario,
+    fitting excluded: one scene for the suns, and one more for the ground cover until
+    ``measure_canopy`` takes the scene."""
+    scenes = 1 if MEASURE_TAKES_SCENE else 2
+    return (est["triangles"] * (SECONDS_PER_TRIANGLE + scenes * SECONDS_PER_SCENE_TRIANGLE)
+            + est["cover_rays"] * SECONDS_PER_COVER_RAY + sum(rays) * SECONDS_PER_RAY)
 
 
 def rays_of(rect, density: float) -> int:
@@ -348,6 +355,5 @@ def rays_of(rect, density: float) -> int:
 
 def describe_core() -> dict:
     """What the core offers the sweep (recorded in sweep.json)."""
-    return {"scene_reuse": {"measure_canopy": MEASURE_TAKES_SCENE,
-                            "trace_light": TRACE_TAKES_SCENE}}
+    return {"scene_reuse": {"measure_canopy": MEASURE_TAKES_SCENE, "trace_light": True}}
 

@@ -47,6 +47,12 @@ RETRIES = 2
 FLUSH_EVERY_S = 30.0
 #: Seconds to wait for an external scheduler before giving up.
 CONNECT_TIMEOUT_S = 10.0
+#: Dask settings of the local cluster: our tasks are few and long, so the statistical
+#: profiler (a thread sampling every worker's stack every 10 ms) and work stealing (tasks are
+#: queued on the scheduler and handed out as workers free up) cost CPU for nothing.
+LOCAL_CONFIG = {"distributed.worker.profile.enabled": False,
+                "distributed.scheduler.work-stealing": False,
+                "distributed.admin.system-monitor.interval": "2s"}
 
 
 @dataclass
@@ -167,6 +173,7 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
         The scheduler does not answer within ``connect_timeout`` s, or a worker lacks maizeviz.
     """
     try:
+        import dask
         from distributed import Client, LocalCluster
     except ImportError as exc:
         raise SchedulerError(f"sweeps need dask.distributed ({exc}): pip install "
@@ -191,7 +198,7 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
         if n < 1:
             raise SchedulerError(f"--workers must be >= 1, got {n}")
         try:
-            with _sigint_ignored():
+            with _sigint_ignored(), dask.config.set(LOCAL_CONFIG):
                 cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                        dashboard_address=":0",   # a free port, no clash
                                        silence_logs=logging.CRITICAL)

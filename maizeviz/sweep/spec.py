@@ -42,14 +42,17 @@ import itertools
 import json
 import math
 import os
+import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import date, datetime
 from datetime import time as dtime
 from pathlib import Path
+from typing import Any, NoReturn
 
-try:
+if sys.version_info >= (3, 11):
     import tomllib
-except ModuleNotFoundError:  # pragma: no cover - Python 3.10
+else:  # pragma: no cover - Python 3.10: the tomli backport (the sweep extra installs it)
     import tomli as tomllib
 
 import maizeviz
@@ -111,12 +114,12 @@ class Arrangement:
 
     @property
     def label(self) -> str:
-        if self.layout:
-            return self.layout
+        if self.layout or self.tile is None:
+            return self.layout or "?"
         return f"{self.tile[0]}x{self.tile[1]} at {self.row_spacing:g} x {self.plant_spacing:g} cm"
 
     def canonical(self) -> dict:
-        if self.layout:
+        if self.layout or self.tile is None:
             return {"layout_sha256": self.layout_sha256}
         return {"tile": list(self.tile), "row_spacing": self.row_spacing,
                 "plant_spacing": self.plant_spacing,
@@ -221,7 +224,7 @@ class _Checker:
         self.source = source
         self.base = base
 
-    def fail(self, where: str, msg: str):
+    def fail(self, where: str, msg: str) -> NoReturn:
         raise SweepSpecError(f"{self.source}: {where}: {msg}")
 
     def known(self, table: dict, known: tuple, where: str):
@@ -244,7 +247,8 @@ class _Checker:
         values = raw if isinstance(raw, list) else [raw]
         if not values:
             self.fail(name, "is empty: give at least one value")
-        out, seen = [], {}
+        out: list[Any] = []
+        seen: dict[str, int] = {}
         for i, v in enumerate(values):
             item = f"{name}[{i}]" if isinstance(raw, list) else name
             c = convert(v, item)
@@ -274,7 +278,7 @@ class _Checker:
         if not isinstance(v, str):
             self.fail(where, f"must be a string such as \"3x3\", got {json.dumps(v, default=str)}")
         try:
-            return compute.parse_tile(v, where)
+            return compute.parse_tile(v, "block" if where.endswith("block") else "tile")
         except MaizevizError:
             self.fail(where, f"must look like 3x3 (whole numbers >= 1), got '{v}'")
 
@@ -415,7 +419,8 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
 
     # --- canopy axes
     paths = ck.axis(canopy, "points", "canopy", ck.files)
-    points, by_sha = [], {}
+    points: list[PointsFile] = []
+    by_sha: dict[str, str] = {}
     for i, group in enumerate(paths):
         for p in group:
             if any(q.path == p for q in points):
@@ -475,12 +480,13 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
         ck.fail("exclude", "must be a list of tables such as [{level = \"K4\", density = 16}]")
     matchers = [_matcher(ck, e, f"exclude[{i}]") for i, e in enumerate(excludes)]
 
-    axes = [points, arrangements, levels, preserve, densities, periodic, suns]
+    axes: list[list[Any]] = [points, arrangements, levels, preserve, densities, periodic, suns]
     total = math.prod(len(a) for a in axes)
     if total > HARD_MAX_SCENARIOS:
         raise SweepSpecError(f"{source}: the axes make {total:,} combinations, beyond the "
                              f"{HARD_MAX_SCENARIOS:,} one sweep file may hold: split the sweep")
-    scenarios, used, excluded = [], [False] * len(matchers), 0
+    scenarios: list[Scenario] = []
+    used, excluded = [False] * len(matchers), 0
     for pf, arr, lv, pa, dens, per, sun in itertools.product(*axes):
         values = {"points": pf, "arrangement": arr, "level": lv, "preserve_area": pa,
                   "density": dens, "periodic": per, "sun": sun}
@@ -507,50 +513,25 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
     return SweepSpec(source, document, tuple(scenarios), excluded, fingerprint)
 
 
-def _matcher(ck: _Checker, entry: dict, where: str):
+def _matcher(ck: _Checker, entry: dict, where: str) -> Callable[[dict[str, Any]], bool]:
     """A predicate over a scenario's axis values for one ``exclude`` entry."""
     ck.known(entry, AXES, where)
     if not entry:
         ck.fail(where, "is empty: name at least one axis value")
-    tests = []
+    wants: list[tuple[str, Any]] = []
     for key, v in entry.items():
         w = f"{where}.{key}"
+        want: Any
         if key in ("points", "layout"):
-            pat = ck.text(v, w)
-
-            def test(vals, pat=pat, key=key):
-                if key == "points":
-                    name = vals["points"].name
-                else:
-                    name = vals["arrangement"].layout
-                    if name is None:
-                        return False
-                return fnmatch.fnmatch(name, pat) or fnmatch.fnmatch(Path(name).name, pat)
+            want = ck.text(v, w)                           # a name or a glob
         elif key == "tile":
             want = ck.shape(v, w)
-
-            def test(vals, want=want):
-                return vals["arrangement"].tile == want
-        elif key in ("row_spacing", "plant_spacing"):
+        elif key in ("row_spacing", "plant_spacing", "density"):
             want = ck.number(v, w)
-
-            def test(vals, want=want, key=key):
-                return getattr(vals["arrangement"], key) == want
         elif key == "level":
             want = ck.level(v, w)
-
-            def test(vals, want=want):
-                return vals["level"] == want
         elif key in ("preserve_area", "periodic"):
             want = ck.boolean(v, w)
-
-            def test(vals, want=want, key=key):
-                return vals[key] == want
-        elif key == "density":
-            want = ck.number(v, w)
-
-            def test(vals, want=want):
-                return vals["density"] == want
         else:                                              # sun: every key given must agree
             if not isinstance(v, dict) or not v:
                 ck.fail(w, "must be a table of sun keys, such as {zenith = 30}")
@@ -558,9 +539,19 @@ def _matcher(ck: _Checker, entry: dict, where: str):
             want = {k: (x.isoformat() if isinstance(x, (date, datetime, dtime)) else
                         float(x) if isinstance(x, int) and not isinstance(x, bool) else x)
                     for k, x in v.items()}
+        wants.append((key, want))
+    return lambda vals: all(_matches(vals, key, want) for key, want in wants)
 
-            def test(vals, want=want):
-                given = dict(vals["sun"].given)
-                return all(given.get(k) == x for k, x in want.items())
-        tests.append(test)
-    return lambda vals: all(t(vals) for t in tests)
+
+def _matches(vals: dict[str, Any], key: str, want: Any) -> bool:
+    arr = vals["arrangement"]
+    if key in ("points", "layout"):
+        name = vals["points"].name if key == "points" else arr.layout
+        return name is not None and (fnmatch.fnmatch(name, want)
+                                     or fnmatch.fnmatch(Path(name).name, want))
+    if key in ("tile", "row_spacing", "plant_spacing"):
+        return bool(getattr(arr, key) == want)
+    if key == "sun":
+        given = dict(vals["sun"].given)
+        return all(given.get(k) == x for k, x in want.items())
+    return bool(vals[key] == want)

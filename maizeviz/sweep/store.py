@@ -25,8 +25,10 @@ import io
 import json
 import os
 from pathlib import Path
+from typing import Any
 
 import maizeviz
+from maizeviz.io.atomic import atomic_open, atomic_path
 from maizeviz.sweep.errors import SweepStoreError
 
 SCHEMA = 1
@@ -58,48 +60,17 @@ def now_iso() -> str:
     return dt.datetime.now(dt.timezone.utc).astimezone().isoformat(timespec="seconds")
 
 
-def _fsync_dir(folder: Path) -> None:
-    try:
-        fd = os.open(folder, os.O_RDONLY)
-    except OSError:  # pragma: no cover - platforms without directory fds
-        return
-    try:
-        os.fsync(fd)
-    except OSError:  # pragma: no cover
-        pass
-    finally:
-        os.close(fd)
-
-
-def write_atomic(path: Path, data: bytes | None = None, writer=None) -> None:
-    """Write ``data`` (or call ``writer(tmp_path)``) to a temporary name beside ``path``,
-    fsync, and rename it over ``path``: readers see the old file or the new one, never half."""
-    path = Path(path)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        if writer is None:
-            with open(tmp, "wb") as fh:
-                fh.write(data)
-                fh.flush()
-                os.fsync(fh.fileno())
-        else:
-            writer(tmp)
-            with open(tmp, "rb+") as fh:
-                os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            tmp.unlink()
-        except OSError:
-            pass
-        raise
-    _fsync_dir(path.parent)
+def write_atomic(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically (:mod:`maizeviz.io.atomic`): readers see the old
+    file or the new one, never half of it."""
+    with atomic_open(path, "wb") as fh:
+        fh.write(data)
 
 
 def scenario_rows(s, result: dict, worker: str | None, finished_at: str) -> list[dict]:
     """Result rows of a scenario, one per height, every column of :data:`COLUMNS`."""
     ok = result.get("status") == "ok"
-    base = {c: None for c in COLUMN_NAMES}
+    base: dict[str, Any] = {c: None for c in COLUMN_NAMES}
     base.update(s.axes())
     base.update(scenario=s.key, status=result["status"], error=result.get("error"),
                 worker=worker, maizeviz_version=maizeviz.__version__, finished_at=finished_at)
@@ -217,7 +188,7 @@ class ResultStore:
 
     def all_rows(self) -> list[dict]:
         """Rows of the spec's scenarios on record, in scenario order."""
-        out = []
+        out: list[dict] = []
         for s in self.spec.scenarios:
             out.extend(self.rows.get(s.key, ()))
         return out
@@ -265,7 +236,8 @@ def write_parquet(path: Path, rows: list[dict]) -> None:
     schema = pa.schema([(c, getattr(pa, "bool_" if t == "bool" else t)()) for c, t in COLUMNS])
     table = pa.Table.from_pylist([{c: r.get(c) for c in COLUMN_NAMES} for r in rows],
                                  schema=schema)
-    write_atomic(path, writer=lambda tmp: pq.write_table(table, tmp))
+    with atomic_path(path) as tmp:
+        pq.write_table(table, tmp)
 
 
 def read_results(folder) -> list[dict]:

@@ -71,7 +71,7 @@ def summarize(rows: list[dict], tolerance: float = DEFAULT_TOLERANCE) -> list[di
             # a level missing for some sun cannot be vouched for over all suns
             worst = {lv: d if counted[lv] == n_suns else float("inf")
                      for lv, d in overall.items()}
-            finest = max(tri_of, key=tri_of.get)
+            finest = max(tri_of, key=lambda lv: tri_of[lv])
             out.append(_row(canopy, f"all {n_suns} suns", tri_of.keys(), finest, tri_of[finest],
                             worst, tri_of, tolerance))
     return out
