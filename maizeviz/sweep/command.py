@@ -15,6 +15,8 @@ from pathlib import Path
 from maizeviz.errors import MaizevizError
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_PARTIAL, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
+#: The subcommand (``maizeviz.cli`` lists this module among its commands).
+NAME = "sweep"
 
 
 def _say(msg: str) -> None:
@@ -63,6 +65,10 @@ def add_sweep_parser(subparsers) -> argparse.ArgumentParser:
     _add_arguments(p)
     p.set_defaults(run=run_sweep)
     return p
+
+
+#: The interface of a ``maizeviz.cli`` command module.
+add_parser = add_sweep_parser
 
 
 def run_sweep(args) -> int:
