@@ -305,7 +305,9 @@ class _CtrlC:
 
 
 def _failure(exc: BaseException | None) -> str:
-    name = type(exc).__name__ if exc is not None else "cancelled"
+    if exc is None:
+        return "the task was cancelled (the scheduler restarted or lost it)"
+    name = type(exc).__name__
     if name == "KilledWorker":
         return ("the workers computing it died repeatedly (out of memory? see the worker "
                 "logs)")
