@@ -201,7 +201,8 @@ def test_rerun_after_an_interruption_computes_only_the_missing(blocks, client, t
     assert third.computed == 0 and third.already_done == 12
 
 
-def test_ctrl_c_on_the_command_stops_cleanly_and_the_rerun_finishes(blocks, tmp_path, capsys):
+def test_ctrl_c_on_the_command_stops_cleanly_and_the_rerun_finishes(blocks, client, tmp_path,
+                                                                    capsys):
     spec = spec_file(blocks, SPEC.replace("density = [0.5]", "density = [2]"), "slow.toml")
     out = tmp_path / "r"
     cmd = [sys.executable, "-m", "maizeviz.sweep", str(spec), "--out", str(out),
@@ -219,8 +220,9 @@ def test_ctrl_c_on_the_command_stops_cleanly_and_the_rerun_finishes(blocks, tmp_
     assert 1 <= done < 12 and f"interrupted: {done} of 12 scenarios are in" in err
     assert len(read_results(out)) == done * len(HEIGHTS)
 
-    from maizeviz.sweep.command import main
-    assert main([str(spec), "--out", str(out), "--workers", "1", "--no-progress"]) == 0
+    from maizeviz.sweep.command import main            # the rerun on a running scheduler
+    address = client.scheduler.address
+    assert main([str(spec), "--out", str(out), "--scheduler", address, "--no-progress"]) == 0
     cap = capsys.readouterr()
     assert f"{12 - done} computed now" in cap.err and f"{done} already there" in cap.err
     assert "cheapest level" in cap.out and (out / "summary.csv").exists()
