@@ -52,11 +52,17 @@ CONNECT_TIMEOUT_S = 10.0
 #: the scheduler and handed out as workers free up) cost CPU for nothing, and the event-loop
 #: health tick (20 ms) and memory monitor (100 ms) can be slower: measured here, an idle
 #: 2-worker cluster then takes 2 % of a core instead of 16 %, which a 2-core laptop feels.
+#: Dask also starts workers with MALLOC_TRIM_THRESHOLD_=65536, which pins glibc's mmap
+#: threshold: every numpy array above 128 KiB is then mapped afresh and page-faulted, and the
+#: same canopy and suns cost 20-40 % more CPU (system time) than in a plain process; the
+#: variable is left unset, at the price of workers giving freed memory back to the system
+#: less eagerly.
 LOCAL_CONFIG = {"distributed.worker.profile.enabled": False,
                 "distributed.scheduler.work-stealing": False,
                 "distributed.admin.system-monitor.interval": "2s",
                 "distributed.admin.tick.interval": "1s",
-                "distributed.worker.memory.monitor-interval": "1s"}
+                "distributed.worker.memory.monitor-interval": "1s",
+                "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
 
 
 @dataclass
