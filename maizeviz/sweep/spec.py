@@ -485,6 +485,9 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
     if total > HARD_MAX_SCENARIOS:
         raise SweepSpecError(f"{source}: the axes make {total:,} combinations, beyond the "
                              f"{HARD_MAX_SCENARIOS:,} one sweep file may hold: split the sweep")
+    if total > max_scenarios and not yes and not matchers:      # refused before listing
+        raise SweepSpecError(f"{source}: {total:,} scenarios is more than {max_scenarios:,}: "
+                             "confirm with --yes, or narrow the axes")
     scenarios: list[Scenario] = []
     used, excluded = [False] * len(matchers), 0
     for pf, arr, lv, pa, dens, per, sun in itertools.product(*axes):

@@ -270,7 +270,11 @@ def test_too_many_scenarios_need_yes(blocks, tmp_path):
     with pytest.raises(SweepSpecError, match=r"10,200 scenarios is more than 10,000: confirm "
                                              r"with --yes"):
         load_spec(path)
-    assert len(load_spec(path, yes=True).scenarios) == 2 * 50 * 2 * 17 * 3
+    small = spec_file(blocks, 'exclude = [{level = "8", sun = {zenith = 60}}]\n' + SPEC,
+                      "small.toml")                     # 10 scenarios after the exclusion
+    with pytest.raises(SweepSpecError, match=r"10 scenarios is more than 9: confirm"):
+        load_spec(small, max_scenarios=9)
+    assert len(load_spec(small, yes=True, max_scenarios=9).scenarios) == 10
 
 
 def test_keys_follow_content_not_names_and_exclude_drops(blocks, tmp_path):
