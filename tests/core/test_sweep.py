@@ -18,6 +18,7 @@ distributed = pytest.importorskip("distributed")
 pytest.importorskip("pyarrow")
 
 from maizeviz.cli import main as cli_main  # noqa: E402
+from maizeviz.sweep.command import main as sweep_main  # noqa: E402
 from maizeviz.sweep.errors import SchedulerError, SweepSpecError, SweepStoreError  # noqa: E402
 from maizeviz.sweep.run import dask_client, plan_tasks, run_sweep  # noqa: E402
 from maizeviz.sweep.spec import load_spec  # noqa: E402
@@ -220,9 +221,9 @@ def test_ctrl_c_on_the_command_stops_cleanly_and_the_rerun_finishes(blocks, clie
     assert 1 <= done < 12 and f"interrupted: {done} of 12 scenarios are in" in err
     assert len(read_results(out)) == done * len(HEIGHTS)
 
-    from maizeviz.sweep.command import main            # the rerun on a running scheduler
-    address = client.scheduler.address
-    assert main([str(spec), "--out", str(out), "--scheduler", address, "--no-progress"]) == 0
+    address = client.scheduler.address                # the rerun on a running scheduler
+    assert sweep_main([str(spec), "--out", str(out), "--scheduler", address,
+                       "--no-progress"]) == 0
     cap = capsys.readouterr()
     assert f"{12 - done} computed now" in cap.err and f"{done} already there" in cap.err
     assert "cheapest level" in cap.out and (out / "summary.csv").exists()
