@@ -141,8 +141,7 @@ def main():
     one_cpu = cpu[1]["driver"] + sum(cpu[1]["workers"])
     out = {"scenarios": len(spec.scenarios), "groups": len(spec.groups()),
            "tasks": tasks[2], "tile": args.tile, "density": args.density,
-           "rays_per_scenario": compute.rays_of(
-               compute.estimate_group(spec.scenarios[0])["rect"], args.density),
+           "rays_per_scenario": compute.group_costs(spec.groups()[0])[2].count,
            "seconds_1_worker": best[1], "seconds_2_workers": best[2],
            "speedup": best[1] / best[2], "speedup_vs_serial": best["serial"] / best[2],
            "overhead_per_task_s": (best[1] - best["serial"]) / tasks[1],

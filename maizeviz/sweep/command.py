@@ -91,6 +91,8 @@ def run_sweep(args) -> int:
         spec = load_spec(args.spec, yes=args.yes)
         if args.dry_run:
             return _dry_run(spec, args)
+        if not args.scheduler:                       # a cluster's workers have their own memory
+            check_memory(spec)
         return _run(spec, args)
     except MaizevizError as exc:
         _say(f"error: {exc}")
@@ -165,21 +167,16 @@ def _dry_run(spec, args) -> int:
     cpu = 0.0
     triangles = rays = peak = 0
     problems = []
-    fitted = set()
     for g in groups:
-        est = compute.estimate_group(g[0])
-        if "error" in est:
-            problems.append(f"{g[0].points.name}, {g[0].arrangement.label}, {g[0].level}: "
-                            f"{est['error']}")
+        try:
+            canopy, cover, *light = compute.group_costs(g)
+        except MaizevizError as exc:
+            problems.append(f"{g[0].points.name}, {g[0].arrangement.label}, {g[0].level}: {exc}")
             continue
-        if g[0].points.sha256 not in fitted:
-            fitted.add(g[0].points.sha256)
-            cpu += compute.SECONDS_PER_LEAF_FIT * est["leaves"]
-        triangles += est["triangles"]
-        peak = max(peak, est["bytes"])
-        n = [compute.rays_of(est["rect"], s.density) for s in g]
-        rays += sum(n)
-        cpu += compute.estimate_seconds(est, n)
+        triangles += canopy.count
+        rays += sum(c.count for c in light)
+        peak = max(peak, canopy.bytes + cover.bytes + max(c.bytes for c in light))
+        cpu += canopy.seconds + cover.seconds + sum(c.seconds for c in light)
     todo = len(spec.scenarios) - len(done)
     print()
     print(f"{len(spec.scenarios)} scenarios ({spec.excluded} excluded"
@@ -188,13 +185,29 @@ def _dry_run(spec, args) -> int:
     print(f"{triangles:,} triangles to build, {rays:,} rays to trace; the largest canopy needs "
           f"about {peak / 2**30:.1f} GiB on its worker")
     print(f"estimate: about {cpu:,.0f} CPU seconds, {cpu / workers:,.0f} s on {workers} "
-          f"workers (model: {compute.SECONDS_PER_SCENE_TRIANGLE * 1e6:g} us per triangle "
-          f"and scene, {compute.SECONDS_PER_RAY * 1e6:g} us per ray, measured on a 2-core "
-          "machine; yours may differ)"
+          "workers (maizeviz's cost model, the same as the canopy and light commands', "
+          "measured on a 2-core machine; yours may differ)"
           + ("" if todo == len(spec.scenarios) else f"; {todo} scenarios left to compute"))
     for p in problems:
         _say(f"warning: {p}")
     return EXIT_OK
+
+
+def check_memory(spec) -> None:
+    """Refuse a local sweep whose largest group would not fit in this machine's memory
+    (``maizeviz.cost``); a group that cannot be estimated (a bad file) is left to run and be
+    recorded as an error."""
+    from maizeviz.cost import check
+    from maizeviz.sweep import compute
+
+    stages = []
+    for g in spec.groups():
+        try:
+            canopy, cover, *light = compute.group_costs(g)
+        except MaizevizError:
+            continue
+        stages.append([canopy, cover, max(light, key=lambda c: c.bytes)])
+    check(stages, force=True)
 
 
 def main(argv=None) -> int:

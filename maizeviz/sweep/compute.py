@@ -6,9 +6,8 @@ layout file, mesh level and area rule. Its work is done once and reused by all i
 - leaves are read and fitted once per points file per process (cached by the file's sha256, so
   a Dask worker fits each file once however many tasks it runs);
 - the canopy is built and measured once per group;
-- one Embree scene (``light_scene``) serves every sun of the group; the ground-cover measure
-  uses it too when ``measure_canopy`` accepts ``scene=`` (until then it builds its own: the
-  numbers are the same, only slower).
+- one plain Embree scene (``light_scene``) serves the ground cover and every open-field sun of
+  the group, one periodic scene every periodic sun.
 
 Every import of the computing core (leaf, mesh, canopy, light) is in this file, so that moving
 core modules is a one-file change (the rest of the sweep uses only ``maizeviz.errors`` and
@@ -24,36 +23,24 @@ module imports only its errors.
 from __future__ import annotations
 
 import hashlib
-import inspect
 import threading
 import time
-from collections import OrderedDict
+from collections import Counter, OrderedDict
 from dataclasses import dataclass, field
 from typing import Any
 
 from maizeviz.canopy.layout import layout_for, parse_shape
 from maizeviz.canopy.measures import measure_canopy
 from maizeviz.canopy.scene import Canopy, build_canopy
+from maizeviz.cost import Cost, canopy_cost, light_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import read_leaves
-from maizeviz.light.rays import ray_count
 from maizeviz.light.request import LightRequest
 from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import light_scene, trace_light
-from maizeviz.mesh.levels import mesh_leaves, parse_level
+from maizeviz.mesh.levels import parse_level
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.sweep.errors import WorkerInputError
-
-
-def _accepts(fn, name: str) -> bool:
-    try:
-        return name in inspect.signature(fn).parameters
-    except (TypeError, ValueError):  # pragma: no cover - builtins without a signature
-        return False
-
-
-#: ``measure_canopy`` takes the prebuilt Embree scene (``trace_light`` does).
-MEASURE_TAKES_SCENE = _accepts(measure_canopy, "scene")
 
 #: Points files whose fitted leaves a process keeps (a block of 9 plants is a few MB).
 LEAVES_CACHE_SIZE = 8
@@ -173,10 +160,19 @@ class _GroupState:
 
     canopy: Canopy
     measures: dict[str, Any]
-    scene: RayScene
+    scenes: dict[bool, RayScene]
     leaves_skipped: int
     warnings: list[str]
     seconds: dict[str, float] = field(default_factory=dict)
+
+    def scene(self, periodic: bool) -> RayScene:
+        """The scene for plain or periodic requests (a periodic one wraps the leaves that
+        overhang the plot, as ``maizeviz light --periodic`` does), built once."""
+        if periodic not in self.scenes:
+            t0 = time.perf_counter()
+            self.scenes[periodic] = light_scene(self.canopy, periodic=periodic)
+            self.seconds["scene"] = self.seconds.get("scene", 0.0) + time.perf_counter() - t0
+        return self.scenes[periodic]
 
 
 def _layout(s, leaves):
@@ -201,7 +197,7 @@ def _group_state(s) -> _GroupState:
     """Leaves -> layout -> canopy -> measures (-> scene) for the group of scenario ``s``."""
     state = _CANOPIES.get(s.group_key)
     if state is not None:
-        return _GroupState(state.canopy, state.measures, state.scene, state.leaves_skipped,
+        return _GroupState(state.canopy, state.measures, state.scenes, state.leaves_skipped,
                            state.warnings)                   # nothing left to charge
     found, fit_s = _leaves(s.points.path, s.points.sha256)
     t0 = time.perf_counter()
@@ -209,18 +205,14 @@ def _group_state(s) -> _GroupState:
     t1 = time.perf_counter()
     canopy = build_canopy(found.leaves, layout, parse_level(s.level), s.preserve_area)
     t2 = time.perf_counter()
-    scene = light_scene(canopy)
+    scene = light_scene(canopy)                        # plain: the ground cover uses it too
     t3 = time.perf_counter()
-    if MEASURE_TAKES_SCENE:
-        measure: Any = measure_canopy                     # the core to come (see above)
-        m = measure(canopy, s.cover_resolution, False, scene=scene)
-    else:
-        m = measure_canopy(canopy, s.cover_resolution, False)
+    m = measure_canopy(canopy, s.cover_resolution, False, scene=scene)
     t4 = time.perf_counter()
     warnings = list(found.problems) + [f"skipped: {e}" for e in found.skipped]
     # the inferred block is a note the CLI prints for every tiling, not a warning
     warnings += [w for w in layout.warnings if not w.startswith("block inferred")]
-    state = _GroupState(canopy, m.as_dict(), scene, len(found.skipped), warnings,
+    state = _GroupState(canopy, m.as_dict(), {False: scene}, len(found.skipped), warnings,
                         {"fit": fit_s, "layout": t1 - t0, "build": t2 - t1, "scene": t3 - t2,
                          "measure": t4 - t3})
     _CANOPIES.put(s.group_key, state)
@@ -249,9 +241,10 @@ def _light(state: _GroupState, s) -> dict:
     sun = Sun(s.sun.zenith_deg, s.sun.azimuth_deg, s.sun.when or "")
     req = LightRequest(sun, tuple(s.heights_cm), s.density, s.rect_cm, s.periodic, threads=1,
                        classes=False)
+    scene = state.scene(s.periodic)
     seconds = _charge(state)
     t0 = time.perf_counter()
-    res = trace_light(state.canopy, req, scene=state.scene)
+    res = trace_light(state.canopy, req, scene=scene)
     seconds["trace"] = time.perf_counter() - t0
     m = state.measures
     return {"key": s.key, "status": "ok", "error": None, "triangles": m["triangles"],
@@ -297,63 +290,21 @@ def compute_scenarios(scenarios) -> list[dict]:
 
 
 # ------------------------------------------------------------------------------- estimates
-#: Cost model of the dry-run estimate, measured on the 2-core machine this was written on:
-#: meshing, placing and measuring triangles; building an Embree scene (embreex's mesh
-#: construction dominates a large canopy); vertical ground-cover rays and (periodic) sun rays;
-#: fitting one digitized leaf.
-SECONDS_PER_TRIANGLE = 0.5e-6
-SECONDS_PER_SCENE_TRIANGLE = 2.2e-6
-SECONDS_PER_COVER_RAY = 1.0e-6
-SECONDS_PER_RAY = 1.0e-6
-SECONDS_PER_LEAF_FIT = 2.5e-3
-#: Peak bytes per canopy triangle (the canopy arrays, its Embree scene and the transients of
-#: building them) and per traced ray.
-BYTES_PER_TRIANGLE = 400
-BYTES_PER_RAY = 64
-
-
-def estimate_group(s) -> dict:
-    """Triangles, rays and memory of the group of ``s`` without building it.
-
-    Fits the leaves (cached), meshes each digitized leaf once at the level and counts the
-    triangles over the placements. Returns ``triangles``, ``plants``, ``leaves``,
-    ``cover_rays``, ``rect`` (the sample rectangle, cm) and ``bytes`` (peak memory of the
-    canopy and its scene on a worker), or ``error``.
-    """
-    try:
-        found, _ = _leaves(s.points.path, s.points.sha256)
-        layout = _layout(s, found.leaves)
-        used = sorted({p.plant for p in layout.placements})
-        src = [lf for lf in found.leaves if lf.grid.plant in used]
-        meshes = mesh_leaves(src, parse_level(s.level), s.preserve_area)
-    except MaizevizError as exc:                      # WorkerInputError included
-        return {"error": _one_line(exc)}
-    per_plant: dict[int, int] = {}
-    for lf, mesh in zip(src, meshes):
-        per_plant[lf.grid.plant] = per_plant.get(lf.grid.plant, 0) + mesh.n_triangles
-    triangles = sum(per_plant[p.plant] for p in layout.placements)
-    x0, y0, x1, y1 = s.rect_cm or layout.centre_bounds
-    return {"triangles": triangles, "plants": len(layout.placements),
-            "leaves": len(found.leaves),
-            "cover_rays": int(layout.ground_area_cm2 / s.cover_resolution ** 2),
-            "rect": (x0, y0, x1, y1), "bytes": triangles * BYTES_PER_TRIANGLE}
-
-
-def estimate_seconds(est: dict, rays: list[int]) -> float:
-    """Model CPU seconds of one group (``estimate_group``) tracing ``rays`` per scenario,
-    fitting excluded: one scene for the suns, and one more for the ground cover until
-    ``measure_canopy`` takes the scene."""
-    scenes = 1 if MEASURE_TAKES_SCENE else 2
-    return (est["triangles"] * (SECONDS_PER_TRIANGLE + scenes * SECONDS_PER_SCENE_TRIANGLE)
-            + est["cover_rays"] * SECONDS_PER_COVER_RAY + sum(rays) * SECONDS_PER_RAY)
-
-
-def rays_of(rect, density: float) -> int:
-    """Rays traced over ``rect`` (x0, y0, x1, y1) cm at ``density`` per cm2."""
-    return int(ray_count(rect, density))
+def group_costs(scenarios) -> list[Cost]:
+    """What one group costs (``maizeviz.cost``, the same estimate as the command line's):
+    its canopy, its ground-cover rays and each scenario's tracing, without building anything
+    (the leaves are fitted, and cached, to know their grid shapes)."""
+    s = scenarios[0]
+    found, _ = _leaves(s.points.path, s.points.sha256)
+    layout = _layout(s, found.leaves)
+    placed = dict(Counter(p.plant for p in layout.placements))
+    rect = s.rect_cm or layout.centre_bounds
+    return [canopy_cost(found.leaves, placed, parse_level(s.level)),
+            light_cost(layout.bounds, 1 / s.cover_resolution**2, 1),
+            *(light_cost(rect, sc.density, len(sc.heights_cm)) for sc in scenarios)]
 
 
 def describe_core() -> dict:
     """What the core offers the sweep (recorded in sweep.json)."""
-    return {"scene_reuse": {"measure_canopy": MEASURE_TAKES_SCENE, "trace_light": True}}
+    return {"scene_reuse": {"measure_canopy": True, "trace_light": True}}
 
