@@ -56,8 +56,8 @@ PAPER = ("Xinyu Guo, Chunjiang Zhao, Boxiang Xiao, Shenglian Lu, Changfeng Li. <
 #: the core (then the points file opens), the 3D view (then the view is made), the rest.
 WARM_STAGES = (
     ("core", ("maizeviz_app.jobs", "maizeviz.light.leaf_light")),
-    ("view", ("pyvista", "pyvistaqt", "maizeviz_app.viewport", "maizeviz_app.layout_panel",
-              "maizeviz_app.digitizer_panel")),
+    ("view", ("pyvista", "pyvistaqt", "maizeviz_app.viewport", "maizeviz_app.panels.layout",
+              "maizeviz_app.panels.digitizer")),
     ("rest", ("matplotlib.figure", "matplotlib.backends.backend_agg", "maizeviz_app.plots",
               "maizeviz.light.heatmap", "maizeviz.canopy.export", "maizeviz_app.project")))
 
@@ -307,15 +307,15 @@ class MainWindow(QMainWindow):
             gc.freeze()       # start-up objects out of the collector's way: shorter pauses
 
     def _make_late_panels(self) -> None:
-        from maizeviz_app.digitizer_panel import DigitizerPanel
-        from maizeviz_app.layout_panel import LayoutPanel
+        from maizeviz_app.panels.digitizer import DigitizerPanel
+        from maizeviz_app.panels.layout import LayoutPanel
 
         self.layout_panel = LayoutPanel()
         self.layout_panel.applied.connect(self._on_layout)
         self.layout_panel.problem.connect(self.say)
         self.digitizer = DigitizerPanel(None)
-        # when a session stops the panel may call self.viewport.restore_canopy() (issue 9,
-        # item 5, is the digitizer's); the window does not take the plant away by itself
+        self.digitizer.alert.connect(lambda text: self.say(text, error=True, status_only=True))
+        self.digitizer.stopped.connect(self._digitizing_stopped)
         self.docks["layout"].setWidget(_scrolled(self.layout_panel))
         self.docks["digitizer"].setWidget(_scrolled(self.digitizer))
         self.digitizer.viewport = self.viewport
@@ -686,6 +686,10 @@ class MainWindow(QMainWindow):
             act = self.actions.get(f"colour_{name}")
             if act is not None:
                 act.setChecked(self.viewport.colouring == name)
+
+    def _digitizing_stopped(self, _why: str) -> None:
+        if self.viewport is not None and self.canopy is not None:
+            self.viewport.restore_canopy()          # the canopy comes back after a session
 
     # ------------------------------------------------------------------ jobs
     def cancel_jobs(self, kind: str | None = None) -> None:

@@ -276,34 +276,78 @@ class Viewport(QtInteractor):
         self.render()
 
     def _clear_digitizing(self) -> None:
-        for name in ("leafsurf", "digitized"):
-            if name in self.actors:
-                self.remove_actor(name, render=False)
+        self.clear_digitized(render=False)
+
+    # ----------------------------------------------------- the plant being digitized
+    # Used by the digitizer panel: one actor per leaf surface (named "leafsurf...", so a new
+    # canopy clears them), the points as one small semi-transparent actor, the last press as
+    # one opaque dot. Each call asks for one frame unless told not to.
+    def show_digitized_leaf(self, name: str, vertices: np.ndarray, faces: np.ndarray,
+                            render: bool = True) -> None:
+        """Add or replace one leaf surface (vertices (n, 3) cm, faces (F, 3) int)."""
+        poly = pv.PolyData.from_regular_faces(np.asarray(vertices, np.float32),
+                                              np.asarray(faces, np.int64))
+        self.add_mesh(poly, name=name, color="yellowgreen", smooth_shading=True,
+                      reset_camera=False, render=False)
+        if render:
+            self.render()
+
+    def remove_digitized(self, names, render: bool = True) -> None:
+        for name in names:
+            self.remove_actor(name, render=False)
+        if render:
+            self.render()
+
+    def show_digitized_points(self, points: np.ndarray, last: np.ndarray | None = None,
+                              render: bool = True) -> None:
+        """Points (N, 3) cm small and semi-transparent, so the surfaces show through; the last
+        press (3,) as a bigger opaque dot."""
+        self._points_actor("digitized", points, color="crimson", opacity=0.45, point_size=5)
+        self._points_actor("digitized-last", last, color="red", opacity=1.0, point_size=11)
+        if render:
+            self.render()
+
+    def _points_actor(self, name: str, points, **style) -> None:
+        points = np.asarray(points if points is not None else [], np.float32).reshape(-1, 3)
+        actor = self.actors.get(name)
+        if not len(points):
+            self.remove_actor(name, render=False)
+        elif actor is not None:                 # a press adds a point: update in place
+            actor.mapper.dataset.shallow_copy(pv.PolyData(points))
+        else:
+            self.add_mesh(pv.PolyData(points), name=name, render_points_as_spheres=True,
+                          reset_camera=False, render=False, **style)
+
+    def frame_bounds(self, bounds, render: bool = True) -> None:
+        """Point the camera at x0, x1, y0, y1, z0, z1 (cm), keeping its direction."""
+        self.reset_camera(render=False, bounds=tuple(float(b) for b in bounds))
+        if render:
+            self.render()
+
+    def clear_digitized(self, render: bool = True) -> None:
+        """Remove every actor of the plant being digitized."""
+        names = [n for n in self.actors if str(n).startswith(("leafsurf", "digitized"))]
+        self.remove_digitized(names, render)
 
     def show_leaf_surfaces(self, meshes, points) -> None:
-        """The plant being digitized: leaf meshes (``LeafMesh`` list) as one surface, and the
-        digitized points (N, 3) cm, small and semi-transparent over it. The camera reframes
-        when the points leave the framed region (a new plant)."""
+        """The plant being digitized in one call: leaf meshes (``LeafMesh`` list) as one
+        surface and the digitized points (N, 3) cm, small and semi-transparent over it; the
+        camera reframes when the points leave the framed region (a new plant)."""
+        self.clear_digitized(render=False)
         if meshes:
             verts = np.concatenate([m.points for m in meshes]).astype(np.float32)
             offs = np.cumsum([0] + [len(m.points) for m in meshes[:-1]])
             faces = np.concatenate([m.faces.astype(np.int64) + o for m, o in zip(meshes, offs)])
-            self.add_mesh(pv.PolyData.from_regular_faces(verts, faces), name="leafsurf",
-                          color="yellowgreen", show_edges=True, edge_color="darkgreen",
-                          render=False)
-        elif "leafsurf" in self.actors:
-            self.remove_actor("leafsurf", render=False)
+            self.show_digitized_leaf("leafsurf", verts, faces, render=False)
         pts = np.asarray(points, np.float32).reshape(-1, 3)
         if len(pts):
-            self.add_mesh(pv.PolyData(pts), name="digitized", color="red", opacity=0.55,
-                          render_points_as_spheres=True, point_size=5, render=False)
+            self.show_digitized_points(pts, None, render=False)
             lo, hi = pts.min(axis=0), pts.max(axis=0)
             frame = self._digitizing_frame
             if frame is None or np.any(lo < frame[0]) or np.any(hi > frame[1]):
                 pad = np.maximum(0.3 * (hi - lo), 10.0)
                 self._digitizing_frame = (lo - pad, hi + pad)
-                b = np.column_stack(self._digitizing_frame).ravel()
-                self.reset_camera(render=False, bounds=tuple(float(v) for v in b))
+                self.frame_bounds(np.column_stack(self._digitizing_frame).ravel(), render=False)
         self.render()
 
     def close(self) -> None:

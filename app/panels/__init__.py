@@ -1,1 +1,2 @@
-"""The main window's panels: widgets over their models, each testable on its own."""
+"""The window's panels, each a widget over its model: canopy (slider, Table 2), light
+(settings, results, figures), layout editor and digitizer."""

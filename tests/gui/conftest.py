@@ -112,3 +112,14 @@ def no_leftover_threads(qtbot):
     extra = [t for t in threading.enumerate() if t.ident not in before and t.is_alive()
              and not t.daemon]
     assert not extra, f"threads left running: {extra}"
+
+
+@pytest.fixture
+def two_plants(tmp_path):
+    """A points file of a digitized block of two plants in one row (fast to build)."""
+    from maizeviz.io.points import write_points
+    from maizeviz.leaf.synth import block_grids
+
+    path = tmp_path / "two_plants.csv"
+    write_points(path, block_grids(1, 2, seed=3))
+    return path
