@@ -97,6 +97,7 @@ class Viewport(QtInteractor):
         self.colouring = "leaf"
         self._canopy_actor = None
         self._ground_bounds = None
+        self._layout = None
         self._framed = False
         self._digitizing_frame = None
 
@@ -120,6 +121,7 @@ class Viewport(QtInteractor):
         frames the first canopy and then stays where the user put it."""
         poly = mesh if mesh is not None else canopy_polydata(canopy)
         self.canopy_mesh = poly
+        self._layout = canopy.layout
         self._clear_digitizing()
         if self._canopy_actor is None:
             self._canopy_actor = self.add_mesh(poly, name="canopy", render=False,
@@ -251,27 +253,21 @@ class Viewport(QtInteractor):
 
     # ------------------------------------------------------------------ digitizing
     def hide_canopy(self) -> None:
-        """Make room for a digitizing session (the canopy comes back with
-        :meth:`restore_canopy` or the next :meth:`show_canopy`)."""
-        for actor in (self._canopy_actor,):
-            if actor is not None:
-                actor.SetVisibility(False)
+        """Make room for a digitizing session: the canopy and the ground go (the canopy comes
+        back with :meth:`restore_canopy` or the next :meth:`show_canopy`)."""
+        for name in ("canopy", "ground"):
+            self.remove_actor(name, render=False)
+        self._canopy_actor = None
+        self._ground_bounds = None
         self.key.hide()
-        if "ground" in self.actors:
-            self.actors["ground"].SetVisibility(False)
         self._digitizing_frame = None
         self.render()
 
     def restore_canopy(self) -> None:
-        """The canopy back after a digitizing session (the leaf surfaces go)."""
+        """The canopy back after a digitizing session (the plant being digitized goes)."""
         self._clear_digitizing()
-        if self._canopy_actor is not None:
-            self._canopy_actor.SetVisibility(True)
-        if "ground" in self.actors:
-            self.actors["ground"].SetVisibility(True)
-        if self._canopy_actor is not None:
-            self.key.show()
-        if self._canopy_actor is not None:
+        if self.canopy_mesh is not None and self._layout is not None:
+            self.show_canopy(_Shown(self._layout), self.canopy_mesh)
             self.camera_preset("perspective")
         self.render()
 
@@ -356,6 +352,13 @@ class Viewport(QtInteractor):
         except AttributeError:
             pass
         super().close()
+
+
+class _Shown:
+    """What :meth:`Viewport.show_canopy` needs of a canopy whose mesh it already has."""
+
+    def __init__(self, layout):
+        self.layout = layout
 
 
 def _ticks(lo: float, hi: float, step: float) -> np.ndarray:

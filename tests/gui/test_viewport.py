@@ -80,12 +80,12 @@ def test_digitizing_hides_and_restores_the_canopy(qtbot, viewport, small_canopy)
 
     viewport.show_canopy(small_canopy)
     viewport.hide_canopy()
-    assert not viewport.actors["canopy"].GetVisibility()
+    assert "canopy" not in viewport.actors and "ground" not in viewport.actors
     leaves, _ = fit_leaves([LeafGrid(1, 1, example_leaf(seed=1), True)])
     meshes = mesh_leaves(leaves, Level(interp=1))
     viewport.show_leaf_surfaces(meshes, leaves[0].grid.points.reshape(-1, 3))
     assert "leafsurf" in viewport.actors and "digitized" in viewport.actors
     assert viewport.actors["digitized"].prop.opacity < 1           # points do not hide leaves
     viewport.restore_canopy()
-    assert viewport.actors["canopy"].GetVisibility()
+    assert viewport.actors["canopy"].GetVisibility() and "ground" in viewport.actors
     assert "leafsurf" not in viewport.actors and "digitized" not in viewport.actors
