@@ -199,13 +199,47 @@ def plant_light(rows: list[LightRow]) -> list[LightRow]:
     return list(per.values())
 
 
+#: :func:`triangle_light`'s value for a triangle no traced ray could reach.
+NOT_TRACED = -1
+
+
 def triangle_light(canopy: Canopy, result: LightResult) -> np.ndarray:
-    """Light class of every leaf triangle (F,) int8: 2 direct (some ray's first hit),
-    1 second class only, 0 none; for colouring the canopy and exporting it."""
+    """Light class of every leaf triangle (F,) int8, for colouring the canopy and exporting it:
+    2 direct (some ray's first hit), 1 second class only, 0 none, and :data:`NOT_TRACED` (-1)
+    where no traced ray could reach the triangle (it stands outside the sample rectangle seen
+    from the sun).
+
+    In a tile-periodic field (see :func:`tile_representatives`) every copy of a plant receives
+    what the copies receive together, so each copy gets the classes of its plant's triangles
+    summed over the copies: the whole field is classified, not only the sampled tile.
+    """
     if result.first_hits is None or result.second_hits is None:
         raise MaizevizError("hit classes were not traced")
     nf = canopy.n_triangles
-    out = np.zeros(nf, np.int8)
-    out[result.second_hits[:nf] > 0] = 1
-    out[result.first_hits[:nf] > 0] = 2
+    first, second = result.first_hits[:nf], result.second_hits[:nf]
+    rep = tile_representatives(canopy.layout, result.rect, result.periodic)
+    inst = canopy.face_instance.astype(np.int64)
+    if nf and (rep != np.arange(len(rep))).any() and np.all(np.diff(inst) >= 0):
+        # copies of a plant have the same triangles in the same order: fold hits by
+        # (representative placement, triangle index within the placement)
+        starts = np.searchsorted(inst, np.arange(len(rep)))
+        local = np.arange(nf) - starts[inst]
+        _, slot = np.unique(rep[inst] * (int(local.max()) + 1) + local, return_inverse=True)
+        first = np.bincount(slot, weights=first)[slot]
+        second = np.bincount(slot, weights=second)[slot]
+        traced = np.ones(nf, bool)
+    else:
+        centroid = canopy.vertices[canopy.faces].mean(axis=1)                       # (F, 3)
+        s = result.direction
+        ground = centroid[:, :2] - centroid[:, 2:3] / s[2] * s[:2]      # along the sun ray
+        if result.periodic:
+            px0, py0, px1, py1 = canopy.layout.bounds
+            ground = np.column_stack([px0 + np.mod(ground[:, 0] - px0, px1 - px0),
+                                      py0 + np.mod(ground[:, 1] - py0, py1 - py0)])
+        x0, y0, x1, y1 = result.rect
+        traced = ((ground[:, 0] >= x0) & (ground[:, 0] <= x1) &
+                  (ground[:, 1] >= y0) & (ground[:, 1] <= y1))
+    out = np.where(traced, 0, NOT_TRACED).astype(np.int8)
+    out[second > 0] = 1
+    out[first > 0] = 2
     return out
