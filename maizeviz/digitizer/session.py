@@ -60,6 +60,11 @@ HEADER = (",".join(COLUMNS) + "\r\n").encode("ascii")
 MAX_JOURNAL_LINES = 1_000_000
 
 
+def _count(n: int, word: str) -> str:
+    """``1 point``, ``2 points``."""
+    return f"{n} {word}{'' if n == 1 else 's'}"
+
+
 class SessionError(MaizevizError):
     """The session cannot record (output not writable, disk full, bad resume file)."""
 
@@ -579,8 +584,386 @@ class Session:
 
     def summary(self) -> str:
         c = self.count
-        return (f"{c.points} points, {len(c.leaves)} leaves, {len(c.plants)} plants recorded "
-                f"in {self.path}; {c.undone} undone, {c.refused} refused, {c.garbled} garbled")
+        leaves = f"{len(c.leaves)} {'leaf' if len(c.leaves) == 1 else 'leaves'}"
+        return (f"{_count(c.points, 'point')}, {leaves}, {_count(len(c.plants), 'plant')} "
+                f"recorded in {self.path}; {c.undone} undone, {c.refused} refused, "
+                f"{c.garbled} garbled")
+
+    def close(self) -> None:
+        """Commit the last line (the file has ended)."""
+        if self.pending is not None:
+            self.commit(self.pending)
+            self.pending = None
+        if self.dropped:
+            self.problems.append(f"... and {self.dropped:,} more lines skipped")
+
+
+def _after(p: Position, cols: int) -> Position:
+    """The position after a point at ``p``: the next col, or the next row after ``cols``."""
+    if p.col + 1 >= cols:
+        return Position(p.plant, p.leaf, p.row + 1, 0)
+    return Position(p.plant, p.leaf, p.row, p.col + 1)
+
+
+def _describe_fragment(text: str) -> str:
+    """The point a torn line was about, in words, from the fields that survived."""
+    fields = text.rstrip("\r\n").split(",")
+    if len(fields) > 7 and fields[7] and not "recorded".startswith(fields[7]):
+        return f"a '{shown(fields[7], 20)}' line"
+    try:
+        plant, leaf, row, col = (int(f) for f in fields[:4])
+    except ValueError:
+        return "the line (too little of it is left to say which point)"
+    return f"the point at plant {plant}, leaf {leaf}, row {row}, col {col}"
+
+
+# ------------------------------------------------------------------------- the session
+class Session:
+    """Turns stylus records into journal lines.
+
+    Parameters
+    ----------
+    path : output CSV
+    cols : points per cross-section; after ``cols`` presses the next row starts
+    resume : continue an existing recording where it stopped (else the file must not exist,
+        be empty, or hold no point yet, as after a start that failed)
+    reference_station : re-express stylus points in this receiver's frame (motion compensation)
+
+    Attributes
+    ----------
+    messages : list of str
+        What the technician should know about the file before the first press: a torn
+        last line found and marked not recorded, lines skipped in the replay.
+    """
+
+    def __init__(self, path, cols: int, resume: bool = False,
+                 reference_station: int | None = None, start: Position | None = None):
+        if isinstance(cols, bool) or not isinstance(cols, int) or not 1 <= cols <= 10_000:
+            raise SessionError(f"points per cross-section must be a whole number from 1 to "
+                               f"10000, got {cols}", quantity="cols")
+        self.path = Path(path)
+        self.cols = cols
+        self.reference_station = reference_station
+        self.pos = start or Position()
+        self.count = Counters()
+        self.history: list[tuple] = []          # (position, xyz) of recorded, not undone points
+        self._pending: Record | None = None     # a stylus record waiting for its reference
+        self.messages: list[str] = []
+        self.fd: int | None = None
+        self._lock: tuple | None = None
+        self._tail = ""                         # what follows the file's last line end
+        self._unmarked = False                  # a torn line is ended but not yet marked
+        self._torn_line: tuple | None = None    # (line number, text) found when opening
+        self._open(resume)
+
+    # ---------------------------------------------------------------------- journal
+    def _check_place(self) -> None:
+        """The file can be a recording: a regular file (or none yet) in a folder with room."""
+        p = self.path
+        folder = p.parent if str(p.parent) else Path(".")
+        if folder.exists() and not folder.is_dir():
+            raise SessionError(f"{folder} is a file, not a folder; cannot write {p.name} in it")
+        try:
+            st = os.stat(p)
+        except FileNotFoundError:
+            st = None
+        except OSError as exc:
+            raise SessionError(f"{p}: cannot write ({exc.strerror or exc}); nothing was "
+                               "recorded") from None
+        if st is not None and stat.S_ISDIR(st.st_mode):
+            raise SessionError(f"{p} is a folder; give a file name for the recording")
+        if st is not None and not stat.S_ISREG(st.st_mode):
+            raise SessionError(f"{p}: cannot write a recording there: it is "
+                               f"{file_kind(st.st_mode) or 'not a regular file'}, and a "
+                               "recording must be a regular file")
+        try:
+            free = shutil.disk_usage(folder).free
+        except OSError:
+            raise SessionError(f"{folder}: no such folder") from None
+        if free < MIN_FREE_BYTES:
+            raise SessionError(f"{folder}: only {free} bytes free; free some space first "
+                               f"(a recording needs {MIN_FREE_BYTES // 1024} KiB to start)")
+
+    def _open(self, resume: bool) -> None:
+        self._check_place()
+        if not resume:
+            self._examine(resume)        # "already holds points" even while another records it
+        self._lock = acquire_lock(self.path)
+        try:
+            state, replay = self._examine(resume)
+            if replay is not None:
+                self._adopt(replay, resume)
+            flags = os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_CLOEXEC", 0)
+            try:
+                if state == "rewrite":             # nothing in it but a header cut short
+                    flags |= os.O_TRUNC
+                self.fd = os.open(self.path, flags, 0o644)
+                if state in ("new", "rewrite"):
+                    self._append(HEADER)
+            except OSError as exc:
+                raise SessionError(f"{self.path}: cannot write ({exc.strerror or exc}); nothing "
+                                   "was recorded") from None
+            if self._tail or self._unmarked:
+                try:
+                    self._repair(announce=True)
+                except OSError as exc:
+                    raise SessionError(f"{self.path}: cannot end its torn last line "
+                                       f"({exc.strerror or exc}); nothing was recorded; free "
+                                       "some space and resume") from None
+        except BaseException:
+            self.close()
+            raise
+
+    def _examine(self, resume: bool) -> tuple[str, JournalReplay | None]:
+        """What the file holds: "new" (nothing), "rewrite" (only a header cut short), or
+        "append" (a recording, with its replay).
+
+        Raises
+        ------
+        SessionError
+            The file is not a recording, or (not resuming) it already holds points.
+        """
+        p = self.path
+        try:
+            size = os.stat(p).st_size
+        except FileNotFoundError:
+            return "new", None
+        if size <= len(HEADER) + 1:
+            with open_regular(p, SessionError, "recording")[0] as fh:
+                head = fh.read(len(HEADER) + 2)
+            core = head.strip(b" \t\r\n")
+            if not core:
+                return "rewrite", None
+            if HEADER.rstrip(b"\r\n").startswith(core):
+                return ("append" if head in (HEADER, HEADER[:-2] + b"\n") else "rewrite"), None
+        replay = self._replay(resume)
+        points = len(replay.history)
+        if not resume and points:
+            raise SessionError(f"{p} already holds points ({points} recorded); resume it to "
+                               "continue, or record into another file", quantity="resume")
+        return "append", replay
+
+    def _adopt(self, replay: JournalReplay, resume: bool) -> None:
+        """Take over the position and points of a replayed recording (when resuming) and
+        what it says about the file."""
+        if resume:
+            self.history = replay.history
+            self.pos = replay.pos
+            self.count.points = len(self.history)
+            for q, _ in self.history:
+                self.count.leaves.add((q.plant, q.leaf))
+                self.count.plants.add(q.plant)
+        self.messages.extend(replay.problems)
+        if replay.torn is not None:
+            self._tail = replay.torn[1]
+            self._torn_line = replay.torn
+
+    def _replay(self, resume: bool) -> JournalReplay:
+        """Read the whole recording with the points reader's rules; refuse anything else."""
+        p = self.path
+        replay = JournalReplay(str(p), self.cols)
+        try:
+            fh, _ = open_regular(p, SessionError, "recording")
+            with fh:
+                refuse_binary(fh, str(p))
+                for lineno, (text, terminated) in enumerate(file_lines(fh, str(p)), 1):
+                    replay.feed(lineno, text, terminated)
+                    if replay.header is not None and not replay.journal:
+                        break
+            if replay.carry:
+                raise PointsFileError(f"line {replay.carry_start}: a quote is never closed")
+            replay.close()
+        except PointsFileError as exc:
+            raise SessionError(self._not_a_recording(resume, str(exc).removeprefix(f"{p}: "))) from None
+        except OSError as exc:
+            raise SessionError(f"{p}: cannot be read ({exc.strerror or exc})") from None
+        if replay.header is None or not replay.journal:
+            found = ",".join(replay.header or [])[:80]
+            raise SessionError(self._not_a_recording(
+                resume, f"{p}: its header is '{found}', a recording's is '{','.join(COLUMNS)}'"))
+        return replay
+
+    def _not_a_recording(self, resume: bool, why: str) -> str:
+        if resume:
+            return (f"cannot resume {self.path}: not a maizeviz recording ({why}); "
+                    "record into another file")
+        return (f"{self.path} already holds data and is not a maizeviz recording ({why}); "
+                "resuming cannot continue it either: record into another file")
+
+    def _append(self, data: bytes) -> None:
+        """Write all of ``data`` (whole lines) at the end of the file and fsync it.
+
+        Raises OSError; what part of ``data`` reached the file before the error is kept in
+        ``_tail`` (the text after the last line end), repaired before the next write.
+        """
+        fd = self.fd
+        if fd is None:
+            raise OSError(errno.EBADF, "the recording is closed")
+        done = 0
+        try:
+            while done < len(data):
+                n = os.write(fd, data[done:])
+                if n <= 0:                                 # pragma: no cover - POSIX says > 0
+                    raise OSError(errno.EIO, "write made no progress")
+                done += n
+            os.fsync(fd)
+        except OSError:
+            written = data[:done]
+            cut = written.rfind(b"\n")
+            rest = written[cut + 1:].decode("utf-8", "replace")
+            self._tail = rest if cut >= 0 else self._tail + rest
+            raise
+        self._tail = ""
+
+    def _repair(self, announce: bool = False) -> None:
+        """End a torn last line and mark it not recorded: a line end, then a line whose status
+        ``discarded`` takes back the line above it (see :mod:`maizeviz.io.points`). Blanks
+        after the last line end only need the line end."""
+        torn = self._torn_line
+        mark = bool(self._tail.strip()) or self._unmarked
+        data = b"\r\n" if self._tail else b""
+        if mark:
+            buf = io.StringIO()
+            csv.writer(buf).writerow(["", "", "", "", "", "", "", DISCARDED,
+                                      f"{time.time():.3f}", "", ""])
+            data += buf.getvalue().encode("ascii")
+            self._unmarked = True
+        self._append(data)                        # OSError: the callers say what was lost
+        self._unmarked = False
+        self._torn_line = None
+        if announce and mark and torn is not None:
+            lineno, text = torn
+            shown = text_of(text.rstrip("\r\n").split(","), 60)
+            self.messages.append(
+                f"line {lineno} was cut short ('{shown}', no line end): "
+                f"{_describe_fragment(text)} was NOT recorded; that line is now marked "
+                f"discarded and every reader skips it; {self.count.points} points are kept")
+
+    def _write_line(self, values) -> None:
+        if self._tail or self._unmarked:
+            self._repair()
+        buf = io.StringIO()
+        csv.writer(buf).writerow(values)
+        self._append(buf.getvalue().encode("utf-8"))
+
+    def _advance_after_point(self, p: Position) -> None:
+        self.pos = _after(p, self.cols)
+
+    # ---------------------------------------------------------------------- events
+    def on_event(self, event) -> str | None:
+        """Handle one reader event; returns a line for the technician, or None."""
+        if isinstance(event, Garbled):
+            self.count.garbled += 1
+            return None
+        if not isinstance(event, Record):
+            return None
+        if self.reference_station is None:
+            if event.station != 1:
+                return None
+            return self._point(event, event.position)
+        if event.station == 1:
+            if self._pending is not None:
+                self.count.refused += 1
+                self._pending = event
+                return "refused: the previous press had no reference record"
+            self._pending = event
+            return None
+        if event.station == self.reference_station and self._pending is not None:
+            stylus, self._pending = self._pending, None
+            if not event.trustworthy:
+                self.count.refused += 1
+                return (f"refused: reference receiver error '{event.error}' "
+                        f"({TRUST_ERRORS[event.error]}); press again")
+            if event.position is None or event.angles is None:
+                self.count.refused += 1
+                return "refused: the reference record has no position or angles"
+            xyz = to_reference_frame(stylus.position, event.position, event.angles)
+            return self._point(stylus, tuple(xyz))
+        return None
+
+    def _point(self, rec: Record, xyz) -> str:
+        if not rec.trustworthy:
+            self.count.refused += 1
+            return (f"refused: error '{rec.error}' ({TRUST_ERRORS[rec.error]}); move the "
+                    "transmitter closer and press again")
+        if xyz is None or not np.all(np.isfinite(xyz)):
+            self.count.refused += 1
+            return "refused: the record has no usable position"
+        p = self.pos
+        try:
+            self._write_line([p.plant, p.leaf, p.row, p.col, *(f"{v:.3f}" for v in xyz),
+                              "recorded", f"{time.time():.3f}", rec.station, rec.error.strip()])
+        except OSError as exc:
+            raise SessionError(f"{self.path}: cannot write ({exc.strerror or exc}); the last "
+                               f"point was NOT recorded; {self.count.points} points are safe "
+                               "on disk") from None
+        self.history.append((p, tuple(xyz)))
+        self.count.points += 1
+        self.count.leaves.add((p.plant, p.leaf))
+        self.count.plants.add(p.plant)
+        self._advance_after_point(p)
+        return (f"recorded plant {p.plant} leaf {p.leaf} row {p.row} col {p.col}: "
+                f"{xyz[0]:.2f} {xyz[1]:.2f} {xyz[2]:.2f} cm")
+
+    def control(self, key: str) -> str:
+        """Apply a technician's control (n, p, r, u, q); returns what happened.
+
+        Raises
+        ------
+        SessionError
+            The control could not be written; the session is where it was before.
+        """
+        key = key.strip().lower()
+        if key not in CONTROLS:
+            return f"unknown control '{key[:20]}': n next leaf, p next plant, r end row, u undo, q quit"
+        action = CONTROLS[key]
+        p = self.pos
+        if action == "quit":
+            return "quit"
+        if action == "undo":
+            if not self.history:
+                return "nothing to undo"
+            last, xyz = self.history[-1]
+            self._write_control([last.plant, last.leaf, last.row, last.col,
+                                 *(f"{v:.3f}" for v in xyz), "undone", f"{time.time():.3f}",
+                                 "", ""], "the undo")
+            self.history.pop()
+            self.count.points -= 1
+            self.count.undone += 1
+            self.pos = Position(last.plant, last.leaf, last.row, last.col)
+            return (f"undone: plant {last.plant} leaf {last.leaf} row {last.row} col {last.col}; "
+                    "press again there")
+        if action == "end_row":
+            if p.col == 0:
+                return f"row {p.row} is empty; nothing to end"
+            q = Position(p.plant, p.leaf, p.row + 1, 0)
+        elif action == "next_leaf":
+            q = Position(p.plant, p.leaf + 1, 0, 0)
+        else:
+            q = Position(p.plant + 1, 1, 0, 0)
+        self._write_control([q.plant, q.leaf, q.row, q.col, "", "", "", action,
+                             f"{time.time():.3f}", "", ""], f"'{action.replace('_', ' ')}'")
+        self.pos = q
+        return f"{action.replace('_', ' ')}: next point is plant {q.plant} leaf {q.leaf} row {q.row}"
+
+    def _write_control(self, values, what: str) -> None:
+        try:
+            self._write_line(values)
+        except OSError as exc:
+            raise SessionError(f"{self.path}: cannot write ({exc.strerror or exc}); {what} was "
+                               f"NOT recorded; {self.count.points} points are safe on disk") from None
+
+    def summary(self) -> str:
+        c = self.count
+
+        def n(count: int, word: str) -> str:
+            return f"{count} {word}{'' if count == 1 else 's'}"
+
+        return (f"{n(c.points, 'point')}, {n(len(c.leaves), 'leaf')[:-1] if False else ''}"
+                .replace(", ", ", ") if False else
+                f"{n(c.points, 'point')}, {len(c.leaves)} {'leaf' if len(c.leaves) == 1 else 'leaves'}, "
+                f"{n(len(c.plants), 'plant')} recorded in {self.path}; {c.undone} undone, "
+                f"{c.refused} refused, {c.garbled} garbled")
 
     def close(self) -> None:
         """Close the file and let go of the lock; safe to call twice."""
