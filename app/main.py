@@ -1,8 +1,12 @@
 """Start the desktop app: ``maizeviz`` (through the ``maizeviz.gui`` entry point) or
 ``python -m maizeviz_app``.
 
-``--screenshot PNG`` builds the canopy, computes light once, saves a picture of the window and
-quits: the way to look at the app on a machine without a screen (under ``xvfb-run``).
+Only Qt and the light parts of maizeviz are imported before the window shows; the 3D view and
+the core follow in a warm-up thread (see :mod:`maizeviz_app.main_window`).
+
+``--screenshot PNG`` builds the canopy, computes light once, colours the leaves by light,
+saves a picture of the window (canopy, heatmap and transmission plot) and quits: the way to look
+at the app on a machine without a screen (under ``xvfb-run``).
 """
 
 from __future__ import annotations
@@ -15,48 +19,98 @@ from collections.abc import Sequence
 
 #: What the app needs beyond the core (the ``gui`` extra); checked when the entry point loads,
 #: without importing them (pyvista and VTK take seconds to import).
-GUI_PACKAGES = ("PySide6", "pyvista", "pyvistaqt", "superqt")
+GUI_PACKAGES = ("PySide6", "pyvista", "pyvistaqt")
 _missing = [name for name in GUI_PACKAGES if importlib.util.find_spec(name) is None]
 if _missing:
     raise ImportError(f"{', '.join(_missing)} not installed")
 
 
+def gl_format() -> None:
+    """The OpenGL format VTK needs, installed before any window exists (pyvistaqt sets the
+    same when the 3D view is made, but the main window shows earlier; a window made before
+    the default format is set cannot host the 3D view on some platforms)."""
+    from PySide6.QtGui import QSurfaceFormat
+
+    fmt = QSurfaceFormat()
+    fmt.setRenderableType(QSurfaceFormat.RenderableType.OpenGL)
+    fmt.setProfile(QSurfaceFormat.OpenGLContextProfile.CoreProfile)
+    fmt.setVersion(3, 2)
+    fmt.setSwapBehavior(QSurfaceFormat.SwapBehavior.DoubleBuffer)
+    for setter in ("setRedBufferSize", "setGreenBufferSize", "setBlueBufferSize",
+                   "setDepthBufferSize", "setAlphaBufferSize"):
+        getattr(fmt, setter)(8)
+    fmt.setStencilBufferSize(0)
+    fmt.setSamples(0)
+    QSurfaceFormat.setDefaultFormat(fmt)
+
+
 def run(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="maizeviz", description="The maizeviz desktop app.")
-    ap.add_argument("points", nargs="?", help="points CSV (default: the bundled 3x3 block)")
-    ap.add_argument("--tile", type=int, default=3, choices=(1, 3, 5))
+    ap.add_argument("points", nargs="?",
+                    help="points CSV or .maizeviz project (default: the last one opened, or "
+                         "the bundled 3x3 block)")
+    ap.add_argument("--tile", type=int, default=3, choices=(1, 3, 5),
+                    help="tiling of the digitized block (default 3: the paper's 81 plants)")
     ap.add_argument("--screenshot", metavar="PNG", help="save the window and quit")
+    ap.add_argument("--size", default="1366x768", metavar="WxH",
+                    help="window size for --screenshot (default 1366x768, a laptop screen)")
     args = ap.parse_args(argv)
     os.environ.setdefault("QT_API", "pyside6")
-    from maizeviz.resources import example_points
-    from maizeviz_app.main_window import MainWindow
     from PySide6.QtCore import QTimer
     from PySide6.QtWidgets import QApplication
 
+    gl_format()
     app = QApplication.instance() or QApplication([sys.argv[0]])
     app.setApplicationName("maizeviz")
-    window = MainWindow(args.points or example_points(), args.tile)
-    window.show()
+    app.setOrganizationName("maizeviz")
+    from maizeviz_app.main_window import MainWindow
+
+    points = args.points
+    if args.screenshot and points is None:
+        from maizeviz.resources import example_points
+
+        points = str(example_points())
+    window = MainWindow(points, args.tile)
     code = {"value": 0}
     if args.screenshot:
-        def shoot() -> None:
-            window.grab().save(args.screenshot)
-            print(f"saved {args.screenshot}")
-            window.close()
-            app.quit()
-
-        def fail(msg: str) -> None:
-            print(f"error: {msg}", file=sys.stderr)
-            code["value"] = 1
-            window.close()
-            app.quit()
-
-        window.canopy_shown.connect(lambda _: window.compute_light())
-        window.light_shown.connect(lambda: QTimer.singleShot(500, shoot))
-        window.failed.connect(fail)
-        QTimer.singleShot(180_000, lambda: fail("timed out"))
+        try:
+            w, h = (int(v) for v in args.size.lower().split("x"))
+        except ValueError:
+            ap.error(f"--size must look like 1366x768, got {args.size}")
+        window.resize(w, h)
+        _screenshot_flow(app, window, args.screenshot, code)
+    window.show()
     app.exec()
     return code["value"]
+
+
+def _screenshot_flow(app, window, path: str, code: dict) -> None:
+    """Canopy -> light -> a frame coloured by light -> grab -> quit."""
+    from PySide6.QtCore import QTimer
+
+    state = {"lit": False}
+
+    def shoot() -> None:
+        window.grab().save(path)
+        print(f"saved {path}")
+        window.close()
+        app.quit()
+
+    def fail(msg: str) -> None:
+        print(f"error: {msg}", file=sys.stderr)
+        code["value"] = 1
+        window.close()
+        app.quit()
+
+    def on_canopy(_label: str) -> None:
+        if not state["lit"]:
+            state["lit"] = True
+            window.compute_light()
+
+    window.canopy_shown.connect(on_canopy)
+    window.light_shown.connect(lambda: QTimer.singleShot(800, shoot))
+    window.failed.connect(fail)
+    QTimer.singleShot(300_000, lambda: fail("timed out"))
 
 
 if __name__ == "__main__":

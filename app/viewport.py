@@ -1,68 +1,490 @@
-"""The 3D view: the canopy's leaves, stalks and ground in a pyvistaqt interactor.
+"""The 3D view: the canopy as one mesh, the ground with a grid and cm labels, camera presets.
 
-Actors are replaced by name, so a rebuild never leaks the previous mesh. Touch it from the GUI
-thread only.
+Rendering happens only when something changed, once:
+
+- pyvistaqt's idle timer (5 renders a second by default) is off (``auto_update=False``).
+- :meth:`Viewport.render` only schedules a repaint (``QWidget.update``): pyvista calls it after
+  every change, Qt merges the requests, and the widget's paint renders the scene once. Calling
+  the render window directly would render twice (pyvistaqt then repaints to show the frame).
+- Multisampling is off: on software OpenGL (llvmpipe) 8x MSAA, pyvista's default, triples the
+  cost of a frame.
+
+The canopy is one actor over one merged mesh (leaves and stalks), with per-triangle cell data
+``plant`` (digitized plant id), ``instance`` (placement, from 1), ``leaf`` (rank; 0 for
+stalks) and ``light`` (2 direct, 1 second class, 0 none, -1 not traced; -2 for stalks).
+Colouring switches the mapper's array and lookup table; nothing is rebuilt. The mesh is made
+by :func:`canopy_polydata`, which worker threads call, so the GUI thread only swaps it in.
+
+Touch the widget from the GUI thread only.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pyvista as pv
+from PySide6.QtCore import QPointF, QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QFont, QImage, QLinearGradient, QPainter, QPen
+from PySide6.QtWidgets import QWidget
 from pyvistaqt import QtInteractor
 
+from maizeviz_app.options import CAMERAS, COLOURINGS, LIGHT_CLASSES, NOT_TRACED, STALK
 
-def _polydata(vertices: np.ndarray, faces: np.ndarray) -> pv.PolyData:
-    cells = np.empty((len(faces), 4), dtype=np.int64)
-    cells[:, 0] = 3
-    cells[:, 1:] = faces
-    return pv.PolyData(np.asarray(vertices, dtype=np.float32), cells.ravel())
+_PLANT_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+                  "#7f7f7f", "#bcbd22", "#17becf")
+
+
+def canopy_polydata(canopy) -> pv.PolyData:
+    """One mesh of a :class:`~maizeviz.canopy.scene.Canopy`'s leaves and stalks (float32
+    vertices, cm) with the cell data listed in the module docstring. Safe off the GUI thread."""
+    nv, nf = len(canopy.vertices), len(canopy.faces)
+    points = np.empty((nv + len(canopy.stalk_vertices), 3), np.float32)
+    points[:nv] = canopy.vertices
+    points[nv:] = canopy.stalk_vertices
+    faces = np.empty((nf + len(canopy.stalk_faces), 3), np.int64)
+    faces[:nf] = canopy.faces
+    faces[nf:] = canopy.stalk_faces + nv
+    poly = pv.PolyData.from_regular_faces(points, faces)
+    n_stalk = len(canopy.stalk_faces)
+    per_stalk = n_stalk // max(canopy.n_plants, 1)
+    stalk_inst = np.repeat(np.arange(canopy.n_plants, dtype=np.int32), per_stalk)
+    plant_of_inst = np.array([p.plant for p in canopy.layout.placements], np.int32)
+    poly.cell_data["plant"] = np.concatenate([canopy.face_plant, plant_of_inst[stalk_inst]])
+    poly.cell_data["instance"] = np.concatenate([canopy.face_instance, stalk_inst]) + 1
+    poly.cell_data["leaf"] = np.concatenate([canopy.face_leaf, np.zeros(n_stalk, np.int32)])
+    light = np.full(nf + n_stalk, NOT_TRACED, np.int8)
+    light[nf:] = STALK
+    poly.cell_data["light"] = light
+    poly.field_data["leaf_triangles"] = np.array([nf])
+    return poly
+
+
+def _categorical(values: dict[int, tuple[str, str]]):
+    """A lookup table of named categories: value -> (label, colour)."""
+    lut = pv.LookupTable()
+    lut.IndexedLookupOn()
+    lut.SetNumberOfTableValues(len(values))
+    for i, (value, (label, colour)) in enumerate(sorted(values.items())):
+        r, g, b = pv.Color(colour).float_rgb
+        lut.SetTableValue(i, r, g, b, 1.0)
+        lut.SetAnnotation(value, label)
+    return lut
 
 
 class Viewport(QtInteractor):
-    """A QtInteractor that knows how to show a :class:`~maizeviz.canopy.scene.Canopy`."""
+    """The canopy view (see the module docstring)."""
+
+    #: After each frame: the number of frames rendered so far.
+    rendered = Signal(int)
+
+    def __init__(self, parent=None):
+        super().__init__(parent, auto_update=False, multi_samples=0, lighting="none")
+        # two lights (pyvista's light kit has five; each is shading work for every pixel of
+        # every frame on software OpenGL): one at the camera, one from high above
+        self.add_light(pv.Light(light_type="headlight", intensity=0.75))
+        self.add_light(pv.Light(position=(0.3, -0.4, 1.0), focal_point=(0, 0, 0),
+                                light_type="scene light", intensity=0.45))
+        self.setMinimumSize(320, 200)
+        self.render_count = 0
+        self.ren_win.AddObserver("EndEvent", self._on_frame)
+        self.set_background("#e4edf5")          # a gradient costs a full-screen pass per frame
+        # no orientation triad, no VTK scalar bar, no 3D text: each is a render pass or text
+        # layout at every frame (60-80 ms each on llvmpipe); the ground carries the axes and
+        # cm labels in its texture and the legend is a Qt widget drawn once per colouring
+        self.key = Legend(self)
+        self.key.move(10, 10)
+        self.key.hide()
+        self.canopy_mesh: pv.PolyData | None = None
+        self.colouring = "leaf"
+        self._canopy_actor = None
+        self._ground_bounds = None
+        self._layout = None
+        self._framed = False
+        self._digitizing_frame = None
+
+    # ------------------------------------------------------------------ rendering
+    def render(self) -> None:
+        """Schedule one repaint (see the module docstring); never renders on the spot."""
+        if getattr(self, "_closed", False):
+            return
+        try:
+            self.update()
+        except RuntimeError:                      # the widget is being deleted
+            pass
+
+    def _on_frame(self, *_args) -> None:
+        self.render_count += 1
+        self.rendered.emit(self.render_count)
+
+    # ------------------------------------------------------------------ canopy
+    def show_canopy(self, canopy, mesh: pv.PolyData | None = None) -> None:
+        """Show a canopy (its mesh prepared by :func:`canopy_polydata` when given); the camera
+        frames the first canopy and then stays where the user put it."""
+        poly = mesh if mesh is not None else canopy_polydata(canopy)
+        self.canopy_mesh = poly
+        self._layout = canopy.layout
+        self._clear_digitizing()
+        if self._canopy_actor is None:
+            self._canopy_actor = self.add_mesh(poly, name="canopy", render=False,
+                                               show_scalar_bar=False, smooth_shading=False,
+                                               scalars="leaf")
+        else:
+            self._canopy_actor.mapper.SetInputData(poly)
+        self._canopy_actor.SetVisibility(True)
+        self._set_ground(canopy.layout)
+        if self.colouring == "light" and not self.has_light():
+            self.colouring = "leaf"
+        self._apply_colouring()
+        if not self._framed:
+            self.camera_preset("perspective")
+            self._framed = True
+        self.render()
+
+    def has_light(self) -> bool:
+        if self.canopy_mesh is None:
+            return False
+        return bool(np.any(self.canopy_mesh.cell_data["light"] >= 0))
+
+    def set_light(self, classes: np.ndarray | None) -> None:
+        """Light class of every leaf triangle (F,) (see ``maizeviz.light.leaf_light.
+        triangle_light``), or None to forget it; the view follows if coloured by light."""
+        if self.canopy_mesh is None:
+            return
+        light = self.canopy_mesh.cell_data["light"]
+        nf = int(self.canopy_mesh.field_data["leaf_triangles"][0])
+        if classes is None:
+            light[:nf] = NOT_TRACED
+        else:
+            if len(classes) != nf:
+                raise ValueError(f"{len(classes)} light classes for {nf} leaf triangles")
+            light[:nf] = classes
+        self.canopy_mesh.cell_data["light"] = light          # marks the array modified
+        if self.colouring == "light":
+            self._apply_colouring()
+            self.render()
+
+    def colour_by(self, what: str) -> bool:
+        """Colour the canopy by ``plant``, ``leaf`` or ``light``; False (and nothing changes)
+        for light when no light result belongs to this canopy."""
+        if what not in COLOURINGS:
+            raise ValueError(f"unknown colouring {what}")
+        if what == "light" and not self.has_light():
+            return False
+        if what != self.colouring:
+            self.colouring = what
+            self._apply_colouring()
+            self.render()
+        return True
+
+    def _apply_colouring(self) -> None:
+        if self._canopy_actor is None or self.canopy_mesh is None:
+            return
+        mapper = self._canopy_actor.mapper
+        what = self.colouring
+        cells = self.canopy_mesh.cell_data
+        if what == "light":
+            shown = {k: v for k, v in LIGHT_CLASSES.items() if k != NOT_TRACED}
+            lut = _categorical(LIGHT_CLASSES)
+            lo, hi = min(LIGHT_CLASSES), max(LIGHT_CLASSES)
+            self.key.set_categories("light received (the paper's classes)",
+                                       [shown[k] for k in sorted(shown, reverse=True)])
+        elif what == "plant":
+            ids = np.unique(cells["plant"])
+            cats = {int(p): (f"plant {p}", _PLANT_COLOURS[k % len(_PLANT_COLOURS)])
+                    for k, p in enumerate(ids)}
+            lut = _categorical(cats)
+            lo, hi = float(ids.min()), float(ids.max())
+            self.key.set_categories("digitized plant", list(cats.values()))
+        else:
+            hi = float(max(cells["leaf"].max(), 1))
+            lut = pv.LookupTable(cmap="summer", n_values=max(int(hi), 2))
+            lut.SetBelowRangeColor(*pv.Color(LIGHT_CLASSES[STALK][1]).float_rgb, 1.0)
+            lut.UseBelowRangeColorOn()
+            lo = 1.0
+            self.key.set_gradient("leaf rank (from the base)", np.asarray(lut.values),
+                                     int(lo), int(hi), LIGHT_CLASSES[STALK])
+        lut.SetTableRange(lo, hi)
+        mapper.SetLookupTable(lut)
+        mapper.SetScalarModeToUseCellFieldData()
+        mapper.SelectColorArray(what)
+        mapper.SetScalarRange(lo, hi)
+        mapper.SetUseLookupTableScalarRange(True)
+        mapper.ScalarVisibilityOn()
+        self.key.show()
+
+    # ------------------------------------------------------------------ ground
+    def _set_ground(self, layout) -> None:
+        """The ground: the field with its plant cells as a grid, and the x and y axes with
+        cm labels in a margin around it, all one textured rectangle (one cheap draw)."""
+        bounds = tuple(round(v, 6) for v in layout.bounds) + (layout.row_spacing,
+                                                              layout.plant_spacing)
+        if bounds == self._ground_bounds:
+            return
+        self._ground_bounds = bounds
+        x0, y0, x1, y1, rs, ps = bounds
+        margin = max(25.0, 0.09 * max(x1 - x0, y1 - y0))
+        gx0, gy0, gx1, gy1 = x0 - margin, y0 - margin, x1 + margin, y1 + margin
+        ground = pv.Plane(center=((gx0 + gx1) / 2, (gy0 + gy1) / 2, -0.05),
+                          i_size=gx1 - gx0, j_size=gy1 - gy0)
+        image = ground_image((x0, y0, x1, y1), margin, _ticks(x0, x1, rs), _ticks(y0, y1, ps))
+        self.add_mesh(ground, name="ground", texture=pv.Texture(image), render=False,
+                      pickable=False, lighting=False)
+
+    # ------------------------------------------------------------------ camera
+    def camera_preset(self, name: str) -> None:
+        """``top``, ``along`` (looking along the rows, +y), ``across`` (along +x) or
+        ``perspective``; frames the canopy."""
+        if name not in CAMERAS:
+            raise ValueError(f"unknown camera preset {name}")
+        cam = self.camera
+        if name == "top":
+            self.view_xy(render=False)
+        elif name == "along":
+            self.view_xz(render=False)
+        elif name == "across":
+            self.view_yz(render=False)
+        else:
+            # from the south-west, above: the ground's labels read the right way up
+            self.view_vector((-0.75, -1.3, 0.95), viewup=(0, 0, 1), render=False)
+        cam.SetParallelProjection(False)
+        self.reset_camera(render=False)
+        if name == "perspective":
+            cam.Zoom(1.25)
+        self.render()
+
+    # ------------------------------------------------------------------ digitizing
+    def hide_canopy(self) -> None:
+        """Make room for a digitizing session: the canopy and the ground go (the canopy comes
+        back with :meth:`restore_canopy` or the next :meth:`show_canopy`)."""
+        for name in ("canopy", "ground"):
+            self.remove_actor(name, render=False)
+        self._canopy_actor = None
+        self._ground_bounds = None
+        self.key.hide()
+        self._digitizing_frame = None
+        self.render()
+
+    def restore_canopy(self) -> None:
+        """The canopy back after a digitizing session (the plant being digitized goes)."""
+        self._clear_digitizing()
+        if self.canopy_mesh is not None and self._layout is not None:
+            self.show_canopy(_Shown(self._layout), self.canopy_mesh)
+            self.camera_preset("perspective")
+        self.render()
+
+    def _clear_digitizing(self) -> None:
+        self.clear_digitized(render=False)
+
+    # ----------------------------------------------------- the plant being digitized
+    # Used by the digitizer panel: one actor per leaf surface (named "leafsurf...", so a new
+    # canopy clears them), the points as one small semi-transparent actor, the last press as
+    # one opaque dot. Each call asks for one frame unless told not to.
+    def show_digitized_leaf(self, name: str, vertices: np.ndarray, faces: np.ndarray,
+                            render: bool = True) -> None:
+        """Add or replace one leaf surface (vertices (n, 3) cm, faces (F, 3) int)."""
+        poly = pv.PolyData.from_regular_faces(np.asarray(vertices, np.float32),
+                                              np.asarray(faces, np.int64))
+        self.add_mesh(poly, name=name, color="yellowgreen", smooth_shading=True,
+                      reset_camera=False, render=False)
+        if render:
+            self.render()
+
+    def remove_digitized(self, names, render: bool = True) -> None:
+        for name in names:
+            self.remove_actor(name, render=False)
+        if render:
+            self.render()
+
+    def show_digitized_points(self, points: np.ndarray, last: np.ndarray | None = None,
+                              render: bool = True) -> None:
+        """Points (N, 3) cm small and semi-transparent, so the surfaces show through; the last
+        press (3,) as a bigger opaque dot."""
+        self._points_actor("digitized", points, color="crimson", opacity=0.45, point_size=5)
+        self._points_actor("digitized-last", last, color="red", opacity=1.0, point_size=11)
+        if render:
+            self.render()
+
+    def _points_actor(self, name: str, points, **style) -> None:
+        points = np.asarray(points if points is not None else [], np.float32).reshape(-1, 3)
+        actor = self.actors.get(name)
+        if not len(points):
+            self.remove_actor(name, render=False)
+        elif actor is not None:                 # a press adds a point: update in place
+            actor.mapper.dataset.shallow_copy(pv.PolyData(points))
+        else:
+            self.add_mesh(pv.PolyData(points), name=name, render_points_as_spheres=True,
+                          reset_camera=False, render=False, **style)
+
+    def frame_bounds(self, bounds, render: bool = True) -> None:
+        """Point the camera at x0, x1, y0, y1, z0, z1 (cm), keeping its direction."""
+        self.reset_camera(render=False, bounds=tuple(float(b) for b in bounds))
+        if render:
+            self.render()
+
+    def clear_digitized(self, render: bool = True) -> None:
+        """Remove every actor of the plant being digitized."""
+        names = [n for n in self.actors if str(n).startswith(("leafsurf", "digitized"))]
+        self.remove_digitized(names, render)
+
+    def show_leaf_surfaces(self, meshes, points) -> None:
+        """The plant being digitized in one call: leaf meshes (``LeafMesh`` list) as one
+        surface and the digitized points (N, 3) cm, small and semi-transparent over it; the
+        camera reframes when the points leave the framed region (a new plant)."""
+        self.clear_digitized(render=False)
+        if meshes:
+            verts = np.concatenate([m.points for m in meshes]).astype(np.float32)
+            offs = np.cumsum([0] + [len(m.points) for m in meshes[:-1]])
+            faces = np.concatenate([m.faces.astype(np.int64) + o for m, o in zip(meshes, offs)])
+            self.show_digitized_leaf("leafsurf", verts, faces, render=False)
+        pts = np.asarray(points, np.float32).reshape(-1, 3)
+        if len(pts):
+            self.show_digitized_points(pts, None, render=False)
+            lo, hi = pts.min(axis=0), pts.max(axis=0)
+            frame = self._digitizing_frame
+            if frame is None or np.any(lo < frame[0]) or np.any(hi > frame[1]):
+                pad = np.maximum(0.3 * (hi - lo), 10.0)
+                self._digitizing_frame = (lo - pad, hi + pad)
+                self.frame_bounds(np.column_stack(self._digitizing_frame).ravel(), render=False)
+        self.render()
+
+    def close(self) -> None:
+        try:
+            self.ren_win.RemoveObservers("EndEvent")
+        except AttributeError:
+            pass
+        super().close()
+
+
+class _Shown:
+    """What :meth:`Viewport.show_canopy` needs of a canopy whose mesh it already has."""
+
+    def __init__(self, layout):
+        self.layout = layout
+
+
+def _ticks(lo: float, hi: float, step: float) -> np.ndarray:
+    """Grid positions from ``lo`` to ``hi`` every ``step`` (both ends included)."""
+    n = int(np.floor((hi - lo) / step + 1e-9))
+    xs = lo + step * np.arange(n + 1)
+    if hi - xs[-1] > 1e-6 * step:
+        xs = np.append(xs, hi)
+    return xs
+
+
+def ground_image(field: tuple[float, float, float, float], margin: float, xs: np.ndarray,
+                 ys: np.ndarray, max_px: int = 2048) -> np.ndarray:
+    """The ground texture (h, w, 4) uint8, row 0 at the largest y (as pyvista maps an image
+    on a plane): the field (tan) with grid
+    lines at ``xs`` / ``ys`` (cm), and a ``margin`` (cm) carrying the tick labels in cm and
+    the axis names. GUI thread (QPainter)."""
+    x0, y0, x1, y1 = field
+    width_cm, height_cm = x1 - x0 + 2 * margin, y1 - y0 + 2 * margin
+    scale = min(4.0, max_px / max(width_cm, height_cm))
+    w, h = int(round(width_cm * scale)), int(round(height_cm * scale))
+    img = QImage(w, h, QImage.Format_RGBA8888)
+    img.fill(QColor("#ece3cc"))
+
+    def px(x, y):
+        return QPointF((x - x0 + margin) * scale, (y1 + margin - y) * scale)
+
+    p = QPainter(img)
+    p.setRenderHint(QPainter.Antialiasing)
+    p.fillRect(QRectF(px(x0, y1), px(x1, y0)), QColor("#cdb98f"))
+    p.setPen(QPen(QColor("#8a7a55"), max(1.0, 0.35 * scale)))
+    for x in xs:
+        p.drawLine(px(x, y0), px(x, y1))
+    for y in ys:
+        p.drawLine(px(x0, y), px(x1, y))
+    font = QFont("DejaVu Sans")
+    font.setPixelSize(max(8, int(margin * scale * 0.42)))
+    p.setFont(font)
+    p.setPen(QColor("#333333"))
+    step_x = max(1, int(np.ceil(len(xs) / 7)))
+    step_y = max(1, int(np.ceil(len(ys) / 5)))
+    box = margin * scale * 0.6
+    for x in xs[::step_x]:
+        c = px(x, y0 - margin * 0.27)
+        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), Qt.AlignCenter,
+                   f"{x:.0f}")
+    for y in ys[::step_y]:
+        c = px(x0 - margin * 0.27, y)
+        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), Qt.AlignCenter,
+                   f"{y:.0f}")
+    c = px((x0 + x1) / 2, y0 - margin * 0.72)
+    p.drawText(QRectF(c.x() - 20 * box, c.y() - box / 2, 40 * box, box), Qt.AlignCenter,
+               "x (cm, across the rows)")
+    c = px(x0 - margin * 0.72, (y0 + y1) / 2)
+    p.translate(c)
+    p.rotate(-90)
+    p.drawText(QRectF(-20 * box, -box / 2, 40 * box, box), Qt.AlignCenter,
+               "y (cm, along the rows)")
+    p.end()
+    arr = np.frombuffer(img.constBits(), np.uint8).reshape(h, img.bytesPerLine())[:, :4 * w]
+    return arr.reshape(h, w, 4).copy()
+
+
+class Legend(QWidget):
+    """The colour key over the 3D view: categories (swatches) or a gradient. A Qt widget, so
+    it costs nothing at each frame."""
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        self.set_background("white", top="lightskyblue")
-        self.add_axes()
-        self._framed = False
+        self.setAttribute(Qt.WA_TransparentForMouseEvents)
+        self._title = ""
+        self._items: list[tuple[str, str]] = []
+        self._gradient: tuple | None = None
 
-    def hide_canopy(self) -> None:
-        """Make room for a digitizing session."""
-        for name in ("canopy", "stalks", "ground"):
-            self.remove_actor(name, render=False)
-        self._framed = False
+    def set_categories(self, title: str, items: list[tuple[str, str]]) -> None:
+        self._title, self._items, self._gradient = title, list(items), None
+        self._fit()
 
-    def show_leaf_surfaces(self, meshes, points) -> None:
-        """Digitized points (N, 3) and leaf meshes (LeafMesh list) of the plant being digitized."""
-        for name in [n for n in self.actors if str(n).startswith("leafsurf")]:
-            self.remove_actor(name, render=False)
-        for k, m in enumerate(meshes):
-            self.add_mesh(_polydata(m.points, m.faces), name=f"leafsurf{k}", color="yellowgreen",
-                          show_edges=True, edge_color="darkgreen")
-        self.add_mesh(pv.PolyData(np.asarray(points, np.float32)), name="digitized",
-                      color="red", render_points_as_spheres=True, point_size=9)
-        if not self._framed:
-            self.reset_camera()
-            self._framed = True
-        self.render()
+    def set_gradient(self, title: str, colours: np.ndarray, lo: int, hi: int,
+                     below: tuple[str, str] | None = None) -> None:
+        self._title, self._gradient = title, (np.asarray(colours), lo, hi)
+        self._items = [below] if below else []
+        self._fit()
 
-    def show_canopy(self, canopy) -> None:
-        for name in [n for n in self.actors if str(n).startswith("leafsurf")] + ["digitized"]:
-            self.remove_actor(name, render=False)
-        leaves = _polydata(canopy.vertices, canopy.faces)
-        leaves.cell_data["leaf rank"] = canopy.face_leaf
-        self.add_mesh(leaves, name="canopy", scalars="leaf rank", cmap="summer",
-                      show_scalar_bar=False, smooth_shading=False)
-        if len(canopy.stalk_faces):
-            self.add_mesh(_polydata(canopy.stalk_vertices, canopy.stalk_faces), name="stalks",
-                          color="peru")
-        x0, y0, x1, y1 = canopy.layout.bounds
-        ground = pv.Plane(center=((x0 + x1) / 2, (y0 + y1) / 2, 0), i_size=x1 - x0,
-                          j_size=y1 - y0)
-        self.add_mesh(ground, name="ground", color="tan", opacity=0.6)
-        if not self._framed:
-            self.view_isometric()
-            self.reset_camera()
-            self._framed = True
-        self.render()
+    def text(self) -> str:
+        """What the legend says (title and labels)."""
+        parts = [self._title] + [label for label, _ in self._items]
+        if self._gradient is not None:
+            parts += [str(self._gradient[1]), str(self._gradient[2])]
+        return " | ".join(parts)
+
+    def _fit(self) -> None:
+        fm = self.fontMetrics()
+        line = fm.height() + 4
+        rows = len(self._items) + (2 if self._gradient is not None else 0)
+        width = max([fm.horizontalAdvance(self._title)] +
+                    [fm.horizontalAdvance(t) + 26 for t, _ in self._items] + [120]) + 16
+        self.resize(width, 10 + line * (rows + 1))
+        self.update()
+
+    def paintEvent(self, _event) -> None:  # noqa: N802 - Qt's name
+        p = QPainter(self)
+        p.setRenderHint(QPainter.Antialiasing)
+        p.setPen(Qt.NoPen)
+        p.setBrush(QColor(255, 255, 255, 215))
+        p.drawRoundedRect(QRectF(self.rect()), 6, 6)
+        fm = self.fontMetrics()
+        line = fm.height() + 4
+        p.setPen(QColor("#222222"))
+        y = 6
+        p.drawText(QRectF(8, y, self.width() - 16, line), Qt.AlignLeft | Qt.AlignVCenter,
+                   self._title)
+        y += line
+        if self._gradient is not None:
+            colours, lo, hi = self._gradient
+            grad = QLinearGradient(8, 0, self.width() - 8, 0)
+            for k, c in enumerate(colours):
+                grad.setColorAt(k / max(len(colours) - 1, 1), QColor(*[int(v) for v in c[:3]]))
+            p.fillRect(QRectF(8, y + 2, self.width() - 16, line - 4), grad)
+            y += line
+            p.drawText(QRectF(8, y, self.width() - 16, line), Qt.AlignLeft, str(lo))
+            p.drawText(QRectF(8, y, self.width() - 16, line), Qt.AlignRight, str(hi))
+            y += line
+        for label, colour in self._items:
+            p.fillRect(QRectF(8, y + 3, 16, line - 6), QColor(colour))
+            p.drawText(QRectF(30, y, self.width() - 38, line), Qt.AlignLeft | Qt.AlignVCenter,
+                       label)
+            y += line
+        p.end()

@@ -8,6 +8,15 @@ can add its flag (``--density``) and the desktop app can point at its field.
 
 from __future__ import annotations
 
+#: Characters that would break a message over lines (``str.splitlines`` splits on each), or
+#: hide text, shown escaped instead: a message quoting a hostile file stays one line.
+_ESCAPES = {c: repr(chr(c))[1:-1] for c in (*range(0x20), 0x7F, 0x85, 0x2028, 0x2029)}
+
+
+def one_line(text: str) -> str:
+    """``text`` with line breaks and other control characters escaped (``\\n``, ``\\x0b``)."""
+    return str(text).translate(_ESCAPES)
+
 
 class MaizevizError(Exception):
     """Base of every error maizeviz raises on purpose (bad input, impossible request).
@@ -22,7 +31,7 @@ class MaizevizError(Exception):
     """
 
     def __init__(self, message: str = "", quantity: str | None = None):
-        super().__init__(message)
+        super().__init__(one_line(message))
         self.quantity = quantity
 
 

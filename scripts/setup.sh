@@ -31,5 +31,5 @@ if [ ! -x .venv/bin/python ]; then
   "$PY" -m venv .venv
 fi
 .venv/bin/python -m pip install -q --upgrade pip >/dev/null
-.venv/bin/python -m pip install -q -e ".[gui,test]"
+.venv/bin/python -m pip install -q -e ".[gui,sweep,test]"
 echo "setup: ready (.venv/bin/maizeviz)" >&2

@@ -91,8 +91,12 @@ def ground_cover(canopy: Canopy, resolution: float = COVER_RESOLUTION_CM,
 
 
 def measure_canopy(canopy: Canopy, cover_resolution: float = COVER_RESOLUTION_CM,
-                   with_stalks: bool = False) -> CanopyMeasures:
-    """Table 2 measures of a canopy; stalks count only ``with_stalks``."""
+                   with_stalks: bool = False, scene: RayScene | None = None) -> CanopyMeasures:
+    """Table 2 measures of a canopy; stalks count only ``with_stalks``.
+
+    ``scene`` is the canopy's plain Embree scene (the leaves, and the stalks when
+    ``with_stalks``; not a periodic one), to spare building it again for the ground cover.
+    """
     verts, faces = canopy.vertices, canopy.faces
     if with_stalks:
         faces = np.vstack([faces, canopy.stalk_faces + len(verts)])
@@ -103,7 +107,7 @@ def measure_canopy(canopy: Canopy, cover_resolution: float = COVER_RESOLUTION_CM
         level=canopy.level, plants=canopy.n_plants, leaves=canopy.n_leaves,
         triangles=canopy.n_triangles, leaf_area_m2=float(area.sum()) / 1e4,
         projected_area_m2=float((area * np.abs(normals[:, 2])).sum()) / 1e4,
-        ground_cover_m2=ground_cover(cover_src, cover_resolution) / 1e4,
+        ground_cover_m2=ground_cover(cover_src, cover_resolution, scene) / 1e4,
         ground_area_m2=canopy.layout.ground_area_cm2 / 1e4,
         cover_resolution_cm=cover_resolution)
 

@@ -20,11 +20,12 @@ from maizeviz import __version__
 from maizeviz.cli import canopy, leaf, light, phenomenal, record, simulate, synth
 from maizeviz.cli.common import EXIT_FAIL, EXIT_OK, EXIT_PARTIAL, EXIT_USAGE, error_line, say
 from maizeviz.errors import MaizevizError
+from maizeviz.sweep import command as sweep
 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_FAIL", "EXIT_USAGE", "EXIT_PARTIAL"]
 
 #: The subcommands, in the order ``--help`` lists them.
-COMMANDS = (leaf, canopy, light, record, simulate, synth, phenomenal)
+COMMANDS = (leaf, canopy, light, sweep, record, simulate, synth, phenomenal)
 #: Entry-point group under which the desktop app registers its ``run(argv) -> int``.
 GUI_GROUP = "maizeviz.gui"
 GUI_HINT = 'the desktop app is not installed: pip install "maizeviz[gui]"'

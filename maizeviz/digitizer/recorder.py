@@ -4,6 +4,9 @@ feed one queue; :meth:`Recorder.poll` turns what is queued into journal lines an
 The command line (``maizeviz record``) polls with a timeout; the app polls from a GUI timer.
 Nothing is handled after the session finished (``q``) or the port vanished, so a control and a
 record arriving in the same poll can never act on a closed session.
+
+:func:`plant_sections` reads a session's history back as the finished cross-sections of each
+leaf, which is what a live view of the plant needs to re-fit only the leaf that changed.
 """
 
 from __future__ import annotations
@@ -12,9 +15,11 @@ import queue
 from dataclasses import dataclass
 from typing import Literal
 
+import numpy as np
+
 from maizeviz.digitizer.port import FastrakPort, PortLost
 from maizeviz.digitizer.protocol import Garbled
-from maizeviz.digitizer.session import Session
+from maizeviz.digitizer.session import Position, Session
 from maizeviz.errors import MaizevizError
 
 #: What an update is about: a point recorded, a press refused, a garbled record, a control
@@ -120,7 +125,9 @@ class Recorder:
             return Update("lost", f"{ev.message}; every point reported recorded is on disk", 1)
         said = self.session.on_event(ev)
         if isinstance(ev, Garbled):
-            return Update("garbled", "")
+            return Update("garbled", f"garbled record skipped ({ev.reason}); "
+                                     f"{self.session.count.garbled} so far: check the cable if "
+                                     "this repeats")
         if not said:
             return None
         return Update("recorded" if said.startswith("recorded") else "refused", said)
@@ -130,3 +137,32 @@ class Recorder:
         if self.port is not None:
             self.port.close()
         self.session.close()
+
+
+def plant_sections(history: list[tuple], plant: int,
+                   current: Position | None = None) -> dict[int, dict[int, np.ndarray]]:
+    """The finished cross-sections of each leaf of ``plant``.
+
+    Parameters
+    ----------
+    history : [(Position, (x, y, z) cm)]
+        A session's recorded points that are not undone, in recording order
+        (:attr:`Session.history`).
+    current : Position, optional
+        Where the next point goes (:attr:`Session.pos`). The row it points into is still being
+        digitized and is left out; every other row counts as finished whatever its number of
+        points (a row ended with ``r``, a tip collapsed to one point).
+
+    Returns
+    -------
+    {leaf: {row: (k, 3) float64, cm}}, points of each row in column order; every leaf of the
+    plant with at least one point appears, possibly with no finished row.
+    """
+    rows: dict[int, dict[int, list]] = {}
+    for p, xyz in history:
+        if p.plant == plant:
+            rows.setdefault(p.leaf, {}).setdefault(p.row, []).append(xyz)
+    if current is not None and current.plant == plant and current.col > 0:
+        rows.get(current.leaf, {}).pop(current.row, None)
+    return {leaf: {r: np.asarray(v, dtype=np.float64).reshape(-1, 3) for r, v in sorted(rs.items())}
+            for leaf, rs in sorted(rows.items())}

@@ -88,35 +88,21 @@ def leaf_light(canopy: Canopy, result: LightResult) -> list[LightRow]:
     """
     if result.first_hits is None or result.second_hits is None:
         raise MaizevizError("hit classes were not traced")
-    area, normals = triangle_areas_normals(canopy.vertices, canopy.faces)
+    _, normals = triangle_areas_normals(canopy.vertices, canopy.faces)
     s = result.direction
-    cos_inc = np.abs(normals @ s)
-    beam = result.ray_area_cm2 * s[2]
+    # a ray on a grazing triangle stands for more than the triangle: capped per leaf below
+    lit = result.ray_area_cm2 * s[2] / np.maximum(np.abs(normals @ s), 1e-6)
     nf = canopy.n_triangles
-    rep = tile_representatives(canopy.layout, result.rect, result.periodic)
-    keys = rep[canopy.face_instance] * 10_000 + canopy.face_leaf
-    first = result.first_hits[:nf]
-    second = result.second_hits[:nf]
-    # a grazing triangle can collect a ray "worth" more than its area; cap by leaf below
-    lit1 = first * beam / np.maximum(cos_inc, 1e-6)
-    lit2 = second * beam / np.maximum(cos_inc, 1e-6)
-    touched = np.unique(keys[(first > 0) | (second > 0)])
-    order = np.argsort(keys, kind="stable")
-    sk = keys[order]
-    rows: list[LightRow] = []
-    for key in touched:
-        a, b = np.searchsorted(sk, key, "left"), np.searchsorted(sk, key, "right")
-        idx = order[a:b]
-        inst = int(key // 10_000)
-        leaf_area = float(area[idx].sum()) / len(np.unique(canopy.face_instance[idx]))
-        rows.append({"instance": inst + 1, "plant": int(canopy.face_plant[idx[0]]),
-                     "leaf": int(key % 10_000), "x_cm": canopy.layout.placements[inst].x,
-                     "y_cm": canopy.layout.placements[inst].y,
-                     "leaf_area_cm2": leaf_area,
-                     "sunlit_area_cm2": min(float(lit1[idx].sum()), leaf_area),
-                     "second_class_area_cm2": min(float(lit2[idx].sum()), leaf_area),
-                     "sunlit_intercepted_cm2": float(first[idx].sum() * result.ray_area_cm2),
-                     "second_class_intercepted_cm2": float(second[idx].sum() * result.ray_area_cm2)})
+    first = result.first_hits[:nf].astype(np.float64)
+    second = result.second_hits[:nf].astype(np.float64)
+    rows = leaf_sums(canopy, {"sunlit_area_cm2": first * lit,
+                              "second_class_area_cm2": second * lit,
+                              "sunlit_intercepted_cm2": first * result.ray_area_cm2,
+                              "second_class_intercepted_cm2": second * result.ray_area_cm2},
+                     result.rect, result.periodic)
+    for r in rows:
+        for k in ("sunlit_area_cm2", "second_class_area_cm2"):
+            r[k] = min(float(r[k]), float(r["leaf_area_cm2"]))
     return rows
 
 
@@ -199,13 +185,47 @@ def plant_light(rows: list[LightRow]) -> list[LightRow]:
     return list(per.values())
 
 
+#: :func:`triangle_light`'s value for a triangle no traced ray could reach.
+NOT_TRACED = -1
+
+
 def triangle_light(canopy: Canopy, result: LightResult) -> np.ndarray:
-    """Light class of every leaf triangle (F,) int8: 2 direct (some ray's first hit),
-    1 second class only, 0 none; for colouring the canopy and exporting it."""
+    """Light class of every leaf triangle (F,) int8, for colouring the canopy and exporting it:
+    2 direct (some ray's first hit), 1 second class only, 0 none, and :data:`NOT_TRACED` (-1)
+    where no traced ray could reach the triangle (it stands outside the sample rectangle seen
+    from the sun).
+
+    In a tile-periodic field (see :func:`tile_representatives`) every copy of a plant receives
+    what the copies receive together, so each copy gets the classes of its plant's triangles
+    summed over the copies: the whole field is classified, not only the sampled tile.
+    """
     if result.first_hits is None or result.second_hits is None:
         raise MaizevizError("hit classes were not traced")
     nf = canopy.n_triangles
-    out = np.zeros(nf, np.int8)
-    out[result.second_hits[:nf] > 0] = 1
-    out[result.first_hits[:nf] > 0] = 2
+    first, second = result.first_hits[:nf], result.second_hits[:nf]
+    rep = tile_representatives(canopy.layout, result.rect, result.periodic)
+    inst = canopy.face_instance.astype(np.int64)
+    if nf and (rep != np.arange(len(rep))).any() and np.all(np.diff(inst) >= 0):
+        # copies of a plant have the same triangles in the same order: fold hits by
+        # (representative placement, triangle index within the placement)
+        starts = np.searchsorted(inst, np.arange(len(rep)))
+        local = np.arange(nf) - starts[inst]
+        _, slot = np.unique(rep[inst] * (int(local.max()) + 1) + local, return_inverse=True)
+        first = np.bincount(slot, weights=first)[slot]
+        second = np.bincount(slot, weights=second)[slot]
+        traced = np.ones(nf, bool)
+    else:
+        centroid = canopy.vertices[canopy.faces].mean(axis=1)                       # (F, 3)
+        s = result.direction
+        ground = centroid[:, :2] - centroid[:, 2:3] / s[2] * s[:2]      # along the sun ray
+        if result.periodic:
+            px0, py0, px1, py1 = canopy.layout.bounds
+            ground = np.column_stack([px0 + np.mod(ground[:, 0] - px0, px1 - px0),
+                                      py0 + np.mod(ground[:, 1] - py0, py1 - py0)])
+        x0, y0, x1, y1 = result.rect
+        traced = ((ground[:, 0] >= x0) & (ground[:, 0] <= x1) &
+                  (ground[:, 1] >= y0) & (ground[:, 1] <= y1))
+    out = np.where(traced, 0, NOT_TRACED).astype(np.int8)
+    out[second > 0] = 1
+    out[first > 0] = 2
     return out

@@ -10,16 +10,21 @@ from __future__ import annotations
 import re
 from collections import defaultdict
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from maizeviz.errors import MaizevizError
-from maizeviz.leaf.fit import Leaf
-from maizeviz.leaf.nurbs import NurbsSurfaces, refine_parameters
 from maizeviz.mesh import measures
 from maizeviz.mesh.simplify import simplify
 from maizeviz.mesh.tessellate import LeafMesh, mesh_grid
 from maizeviz.progress import ProgressCallback, report
+
+if TYPE_CHECKING:
+    # Level and parse_level are light (the app's slider reads them before its window shows);
+    # the surfaces (scipy) are imported when a leaf is meshed (the measures are numpy only).
+    from maizeviz.leaf.fit import Leaf
+    from maizeviz.leaf.nurbs import NurbsSurfaces
 
 #: Interpolation count of the paper's reference mesh (four points between data points).
 REFERENCE_K = 4
@@ -165,6 +170,8 @@ def _chunks(idx: list[int], per_leaf: int) -> list[list[int]]:
 
 
 def _sample(surfaces: NurbsSurfaces, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    from maizeviz.leaf.nurbs import refine_parameters
+
     u = refine_parameters(surfaces.params_u, k)
     v = refine_parameters(surfaces.params_v, k)
     return surfaces.evaluate_grid(u, v), u, v
@@ -220,6 +227,8 @@ def mesh_leaf(leaf: Leaf, level: Level, preserve_area: bool = True) -> LeafMesh:
 
 
 def _stack(surfaces: list[NurbsSurfaces]) -> NurbsSurfaces:
+    from maizeviz.leaf.nurbs import NurbsSurfaces
+
     if len(surfaces) == 1:
         return surfaces[0]
     s0 = surfaces[0]

@@ -89,24 +89,37 @@ def grid_areas(vertices: np.ndarray, rel_tol: float = 1e-9) -> np.ndarray:
     :func:`~maizeviz.mesh.tessellate.mesh_grid` does: :func:`area` of ``mesh_grid(grid)`` for
     each, its zero-area triangles (a grid edge shorter than ``rel_tol`` times the longest, as
     :func:`~maizeviz.mesh.tessellate.degenerate_faces` finds them) left out."""
+    nl, a, b = vertices.shape[:3]
+    out = np.empty(nl)
+    step = max(1, CHUNK_PAIRS // (a * b))              # leaves whose arrays stay in cache
+    for s in range(0, nl, step):
+        out[s:s + step] = _grid_areas(vertices[s:s + step], rel_tol)
+    return out
+
+
+def _grid_areas(vertices: np.ndarray, rel_tol: float) -> np.ndarray:
     nl = vertices.shape[0]
-    h = np.diff(vertices, axis=2)
-    h = np.einsum("lijk,lijk->lij", h, h)                               # (L, a, b-1) squared
-    w = np.diff(vertices, axis=1)
-    w = np.einsum("lijk,lijk->lij", w, w)                               # (L, a-1, b)
+    vx, vy, vz = (np.ascontiguousarray(vertices[..., k]) for k in range(3))  # (L, a, b)
+    h = np.diff(vx, axis=2) ** 2 + np.diff(vy, axis=2) ** 2 + np.diff(vz, axis=2) ** 2
+    w = np.diff(vx, axis=1) ** 2 + np.diff(vy, axis=1) ** 2 + np.diff(vz, axis=1) ** 2
     longest = np.maximum(h.reshape(nl, -1).max(axis=1, initial=0.0),
                          w.reshape(nl, -1).max(axis=1, initial=0.0))
     tol = (rel_tol**2 * np.maximum(longest, 1e-300))[:, None, None]
-    h0, w0 = h <= tol, w <= tol
-    # the two triangles of each quad: (p00, p10, p11) and (p00, p11, p01), as grid_faces
-    vt = np.moveaxis(vertices, -1, 0)                                    # (3, L, a, b)
-    p00 = vt[:, :, :-1, :-1]
-    diag = vt[:, :, 1:, 1:] - p00
+    h0, w0 = h <= tol, w <= tol                    # (L, a, b-1), (L, a-1, b): zero-length edges
+    # the two triangles of each quad, (p00, p10, p11) and (p00, p11, p01) as grid_faces has
+    # them, share the diagonal p00-p11
+    dx, dy, dz = (c[:, 1:, 1:] - c[:, :-1, :-1] for c in (vx, vy, vz))
     total = np.zeros(nl)
-    for t, (edge, bad) in enumerate(((vt[:, :, 1:, :-1] - p00, h0[:, 1:] | w0[:, :, :-1]),
-                                     (vt[:, :, :-1, 1:] - p00, h0[:, :-1] | w0[:, :, 1:]))):
-        cross = _cross(edge, diag) if t == 0 else _cross(diag, edge)
-        twice = np.sqrt(np.einsum("i...,i...->...", cross, cross))       # (L, a-1, b-1)
+    for t in (0, 1):
+        if t == 0:
+            ex, ey, ez = (c[:, 1:, :-1] - c[:, :-1, :-1] for c in (vx, vy, vz))
+            bad = h0[:, 1:] | w0[:, :, :-1]
+            cx, cy, cz = ey * dz - ez * dy, ez * dx - ex * dz, ex * dy - ey * dx
+        else:
+            ex, ey, ez = (c[:, :-1, 1:] - c[:, :-1, :-1] for c in (vx, vy, vz))
+            bad = h0[:, :-1] | w0[:, :, 1:]
+            cx, cy, cz = dy * ez - dz * ey, dz * ex - dx * ez, dx * ey - dy * ex
+        twice = np.sqrt(cx * cx + cy * cy + cz * cz)                     # (L, a-1, b-1)
         twice[bad] = 0.0
         total += twice.reshape(nl, -1).sum(axis=1)
     return 0.5 * total

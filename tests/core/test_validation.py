@@ -7,13 +7,13 @@ import tracemalloc
 
 import numpy as np
 import pytest
-from maizeviz.leaf.synth import block_grids
 
 from maizeviz.canopy.layout import LayoutError, layout_from_dict, load_layout, tiled_layout
 from maizeviz.cli import EXIT_FAIL, main
 from maizeviz.errors import MaizevizError, PointsFileError
 from maizeviz.io.points import MAX_LINE_BYTES, parse_points, read_points
 from maizeviz.leaf.grid import build_grids
+from maizeviz.leaf.synth import block_grids
 from tests.conftest import grid_csv
 
 

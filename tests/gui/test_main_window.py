@@ -12,14 +12,20 @@ def test_opens_example_and_slider_rebuilds(window, qtbot):
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT) as first:
         pass
     assert first.args == ["36 triangles"]
-    assert "canopy" in w.viewport.actors and "stalks" in w.viewport.actors
+    assert "canopy" in w.viewport.actors
+    assert np.any(w.viewport.canopy_mesh.cell_data["light"] == -2)      # stalks, same mesh
     n36 = w.canopy.n_triangles
     assert w.table.rowCount() == 1 and w.table.item(0, 0).text() == "36 triangles"
     lai = float(w.table.item(0, 5).text())
     assert 4.5 < lai < 5.8
+    shown = "at most 36 triangles" in w.level_label.text()
+    w.slider.setValue(LEVELS.index("4"))
+    qtbot.wait(300)                      # debounced: the build has started, not finished
+    assert shown and "at most 36 triangles" in w.level_label.text()
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT,
                           check_params_cb=lambda lv: lv == "4 triangles"):
-        w.slider.setValue(LEVELS.index("4"))
+        pass
+    # label, table and view changed together
     assert w.canopy.n_triangles < n36
     assert w.table.rowCount() == 2
     assert "at most 4 triangles" in w.level_label.text()
@@ -48,108 +54,64 @@ def test_fast_slider_moves_show_only_the_last_level(window, qtbot):
     assert shown == ["4 triangles", "8 triangles"]
 
 
-def test_compute_light(window, qtbot):
+def test_compute_light_colours_the_leaves(window, qtbot):
     w = window()
     qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait()
-    w.density.setValue(1.0)
+    panel = w.light_panel
+    panel.density.setValue(1.0)
     with qtbot.waitSignal(w.light_shown, timeout=TIMEOUT):
-        w.light_button.click()
-    t = [float(w.light_table.item(i, 1).text()) for i in range(w.light_table.rowCount())]
+        panel.compute_button.click()
+    t = [float(panel.table.item(i, 1).text()) for i in range(panel.table.rowCount())]
     assert len(t) == 6 and all(0 <= v <= 1 for v in t)
     assert np.all(np.diff(t) >= 0) and 0.02 < t[0] < 0.15
-    assert not w.heatmap.pixmap().isNull()
-    assert w.light_button.isEnabled()
+    assert panel.compute_button.isEnabled() and not panel.cancel_button.isEnabled()
+    # the leaves are coloured by the light they received, with a legend
+    assert w.viewport.colouring == "light"
+    assert w.viewport.actors["canopy"].mapper.GetArrayName() == "light"
+    light = w.viewport.canopy_mesh.cell_data["light"][:w.canopy.n_triangles]
+    assert set(np.unique(light)) == {0, 1, 2}
+    assert w.actions["colour_light"].isChecked()
+    # a heatmap per height and the transmission plot
+    assert w.plots.height.count() == 6 and w.plots.heatmap.image() is not None
+    assert w.plots.transmission.image() is not None
+    w.plots.height.setCurrentIndex(3)
+    assert w.plots.shown_height == 150.0
 
 
 def test_sun_from_place_and_bad_place(window, qtbot):
     w = window()
-    w.place.setText("2005-08-01 12:00 39.9 116.4 Asia/Shanghai")
-    w._sun_from_place()
-    assert w.zenith.value() == pytest.approx(22.34, abs=0.02)
-    w.place.setText("yesterday noon somewhere")
-    w._sun_from_place()
+    panel = w.light_panel
+    panel.place.setText("2005-08-01 12:00 39.9 116.4 Asia/Shanghai")
+    panel.zenith.setValue(10)
+    w.sun_from_place()
+    qtbot.waitUntil(lambda: abs(panel.zenith.value() - 22.34) < 0.02, timeout=TIMEOUT)
+    panel.place.setText("yesterday noon somewhere")
+    with qtbot.waitSignal(w.failed, timeout=TIMEOUT) as err:
+        w.sun_from_place()
+    assert "YYYY-MM-DD" in err.args[0]
     assert "error" in w.messages.toPlainText()
+    assert "d0342c" in panel.place.styleSheet()            # the field is marked
 
 
-def test_bad_points_file_says_so(window, qtbot, tmp_path):
+def test_bad_points_file_says_so_and_keeps_the_canopy(window, qtbot, tmp_path):
     bad = tmp_path / "bad.csv"
     bad.write_text("this,is,not\n1,2,3\n")
     w = window(bad)
     with qtbot.waitSignal(w.failed, timeout=TIMEOUT) as err:
         pass
-    assert "missing column" in err.args[0]
+    assert "missing column" in err.args[0] and "Choose a points CSV" in err.args[0]
+    assert "Error" not in err.args[0] and "maizeviz.errors" not in err.args[0]
     assert "error" in w.messages.toPlainText()
     assert w.canopy is None
-
-
-def test_digitizer_demo_records_through_the_simulator(window, qtbot, tmp_path):
-    """Demo mode: a simulated FASTRAK on a real pty, the panel's reader, the session on disk."""
-    from maizeviz.io.points import read_points, write_points
-    from maizeviz.leaf.grid import LeafGrid
-    from maizeviz.leaf.synth import LeafShape, leaf_points
-
-    rng = np.random.default_rng(1)
-    src = tmp_path / "two_leaves.csv"
-    write_points(src, [LeafGrid(1, k + 1, leaf_points(LeafShape(length=40, base=(0, 0, 30 * k)),
-                                                      4, 3, rng=rng), True) for k in range(2)])
-    w = window()
-    panel = w.digitizer
-    panel.demo_file, panel.demo_pace = src, 0.34
-    panel.cols.setValue(3)
-    out = tmp_path / "session.csv"
-    panel.out_edit.setText(str(out))
-    recorded, stopped = [], []
-    panel.recorded.connect(recorded.append)
-    panel.stopped.connect(stopped.append)
-    panel.demo_button.click()
-    # the demo presses every point, then types q itself: the session finishes on its own
-    qtbot.waitUntil(lambda: bool(stopped), timeout=TIMEOUT)
-    assert stopped == ["finished"] and recorded[-1] == 20
-    assert "digitized" in w.viewport.actors
-    pts = read_points(out)
-    assert len(pts) == 20 and set(map(tuple, pts.ids[:, :2].tolist())) == {(1, 1), (1, 2)}
-    assert "20 points, 2 leaves" in panel.counts.text()
-
-
-def test_digitizer_refuses_unwritable_output_and_silent_port(window, qtbot, tmp_path):
-    w = window()
-    panel = w.digitizer
-    panel.out_edit.setText(str(tmp_path / "missing" / "x.csv"))
-    panel.connect_button.click()
-    assert "no such folder" in panel.log.item(panel.log.count() - 1).text()
-    assert panel.connect_button.isEnabled()
-    panel.out_edit.setText(str(tmp_path / "ok.csv"))
-    panel.port_edit.setText("/dev/does-not-exist")
-    panel.connect_button.click()
-    texts = [panel.log.item(i).text() for i in range(panel.log.count())]
-    assert any("cannot open /dev/does-not-exist" in t for t in texts)
-    assert panel.connect_button.isEnabled() and panel.session is None
-
-
-def test_layout_editor_turns_a_plant_and_saves(window, qtbot, tmp_path):
-    from maizeviz.canopy.layout import load_layout
-
-    w = window(tile=1)
-    qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait()
-    panel = w.layout_panel
-    assert panel.table.rowCount() == 9
-    first = int(panel.table.item(0, 2).text())
-    before = w.canopy.vertices[w.canopy.faces[w.canopy.face_plant == first]].copy()
-    panel.table.item(0, 3).setText("90")
+    # a good file, then a bad one: the good one stays, named in the label
+    from maizeviz.resources import example_points
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
-        panel.apply_button.click()
-    after = w.canopy.vertices[w.canopy.faces[w.canopy.face_plant == first]]
-    assert not np.allclose(before, after)                       # that plant turned
-    assert [p.azimuth_deg for p in w.loaded.layout.placements if p.plant == first] == [90]
-    assert w.loaded.layout.ground_area_cm2 == pytest.approx(180 * 90)
-    path = tmp_path / "lay.json"
-    panel.save(path)
-    back = load_layout(path, panel.plants)
-    assert len(back.placements) == 9
-    assert [p.azimuth_deg for p in back.placements if p.plant == first] == [90]
-    panel.table.item(1, 2).setText("77")                         # a plant that does not exist
-    panel.apply_button.click()
-    assert "plant 77 is not in the points file" in w.messages.toPlainText()
-    panel.table.item(1, 2).setText("x")
-    panel.apply_button.click()
-    assert "row 2, plant: 'x' is not a number" in w.messages.toPlainText()
+        w.open_points(example_points())
+    canopy, label = w.canopy, w.canopy_panel.file_label.text()
+    assert label.endswith("block3x3.csv")
+    notnum = tmp_path / "notnum.csv"
+    notnum.write_text("plant,leaf,row,col,x,y,z\nA,1,0,0,x,y,z\n")
+    with qtbot.waitSignal(w.failed, timeout=TIMEOUT) as err:
+        w.open_points(notnum)
+    assert "could not convert" not in err.args[0]
+    assert w.canopy is canopy and w.canopy_panel.file_label.text() == label

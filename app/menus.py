@@ -1,0 +1,108 @@
+"""The menu bar: every command of the window, with its shortcut shown in the menu."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PySide6.QtGui import QAction, QActionGroup, QKeySequence
+
+from maizeviz_app.options import CAMERAS, COLOURINGS
+
+RECENT_MAX = 8
+
+
+def _action(window, menu, text: str, slot, shortcut=None, tip: str = "") -> QAction:
+    act = QAction(text, window)
+    if shortcut is not None:
+        act.setShortcut(QKeySequence(shortcut))
+    if tip:
+        act.setStatusTip(tip)
+        act.setToolTip(tip)
+    act.triggered.connect(lambda _checked=False: slot())
+    menu.addAction(act)
+    return act
+
+
+def build_menus(w) -> dict[str, QAction]:
+    """Fill ``w.menuBar()``; returns the actions by name (tests and state updates use them)."""
+    bar = w.menuBar()
+    acts: dict[str, QAction] = {}
+    f = bar.addMenu("&File")
+    acts["open"] = _action(w, f, "&Open points…", w.choose_points, QKeySequence.Open,
+                           "open a digitized points CSV")
+    acts["open_project"] = _action(w, f, "Open &project…", w.choose_project, "Ctrl+Shift+O",
+                                   "open a maizeviz project")
+    w.recent_menu = f.addMenu("Open &recent")
+    w.recent_menu.aboutToShow.connect(lambda: fill_recent(w))
+    f.addSeparator()
+    acts["save"] = _action(w, f, "&Save project", w.save_project_here, QKeySequence.Save,
+                           "save points, layout, settings and light results in one file")
+    acts["save_as"] = _action(w, f, "Save project &as…", w.choose_project_target,
+                              QKeySequence.SaveAs)
+    f.addSeparator()
+    acts["export_mesh"] = _action(w, f, "&Export mesh…", lambda: w.choose_export("canopy"),
+                                  "Ctrl+E", "the canopy with plant, leaf and light ids per "
+                                            "triangle (PLY, VTK, OBJ, STL)")
+    results = f.addMenu("Export &results")
+    acts["export_table"] = _action(w, results, "Transmission table (CSV)…",
+                                   lambda: w.choose_export("table"), "Ctrl+Shift+T")
+    acts["export_measures"] = _action(w, results, "Canopy measures, Table 2 (CSV)…",
+                                      lambda: w.choose_export("measures"))
+    acts["export_heatmap"] = _action(w, results, "Heatmap shown (PNG)…",
+                                     lambda: w.choose_export("heatmap"), "Ctrl+Shift+H")
+    acts["export_plot"] = _action(w, results, "Transmission vs height (PNG)…",
+                                  lambda: w.choose_export("plot"), "Ctrl+Shift+G")
+    acts["export_canopy"] = _action(w, results, "Canopy coloured by light (PLY/VTK)…",
+                                    lambda: w.choose_export("canopy"))
+    f.addSeparator()
+    acts["quit"] = _action(w, f, "&Quit", w.close, QKeySequence.Quit)
+
+    v = bar.addMenu("&View")
+    cam = v.addMenu("&Camera")
+    for k, (name, text) in enumerate(CAMERAS.items(), start=1):
+        acts[f"camera_{name}"] = _action(w, cam, text, lambda n=name: w.camera(n),
+                                         f"Ctrl+{k}")
+    colour = v.addMenu("C&olour by")
+    group = QActionGroup(w)
+    for k, (name, text) in enumerate(COLOURINGS.items(), start=1):
+        act = _action(w, colour, text.capitalize(), lambda n=name: w.colour_by(n),
+                      f"Ctrl+Shift+{k}")
+        act.setCheckable(True)
+        act.setChecked(name == "leaf")
+        group.addAction(act)
+        acts[f"colour_{name}"] = act
+    v.addSeparator()
+    acts["finer"] = _action(w, v, "&Finer mesh", lambda: w.step_level(-1), "Ctrl+[")
+    acts["coarser"] = _action(w, v, "C&oarser mesh", lambda: w.step_level(1), "Ctrl+]")
+    v.addSeparator()
+    acts["reset_layout"] = _action(w, v, "&Reset window layout", w.reset_layout,
+                                   "Ctrl+Shift+R", "docks back where they started")
+    w.docks_menu = v.addMenu("&Panels")
+    for dock in w.docks.values():
+        w.docks_menu.addAction(dock.toggleViewAction())
+
+    r = bar.addMenu("&Light")
+    acts["compute"] = _action(w, r, "&Compute direct light", w.compute_light, "Ctrl+L")
+    acts["cancel"] = _action(w, r, "C&ancel", w.cancel_jobs, "Esc",
+                             "stop the light computation or rebuild under way")
+    acts["sun_place"] = _action(w, r, "&Sun from place", w.sun_from_place, "Ctrl+Shift+L")
+
+    h = bar.addMenu("&Help")
+    acts["about"] = _action(w, h, "&About maizeviz", w.about, QKeySequence.HelpContents)
+    return acts
+
+
+def fill_recent(w) -> None:
+    menu = w.recent_menu
+    menu.clear()
+    paths = w.recent_files()
+    if not paths:
+        act = menu.addAction("(none yet)")
+        act.setEnabled(False)
+        return
+    for k, path in enumerate(paths, start=1):
+        act = menu.addAction(f"&{k} {Path(path).name}  —  {Path(path).parent}")
+        act.setToolTip(path)
+        act.triggered.connect(lambda _c=False, p=path: w.open_any(p))
+    menu.addSeparator()
+    menu.addAction("Clear the list").triggered.connect(lambda _c=False: w.clear_recent())

@@ -1,0 +1,162 @@
+"""The canopy panel: the points file, the tiling, the mesh-complexity slider and Table 2.
+
+The slider says what is asked; the level label says what the 3D view shows. Both change
+together with the table when the window hands over a built canopy (:meth:`CanopyPanel.
+show_built`), so the label never names a level the view does not show yet.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QComboBox, QFormLayout, QGroupBox,
+                               QHBoxLayout, QHeaderView, QLabel, QPushButton, QSizePolicy,
+                               QSlider, QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
+
+from maizeviz.mesh.levels import COMPLEXITY_STOPS, parse_level
+
+#: Tilings of the digitized block offered (the paper's is 3 x 3).
+TILES = (1, 3, 5)
+
+
+def describe(level: str) -> str:
+    """A slider stop in words."""
+    return parse_level(level).description
+
+
+class CanopyPanel(QWidget):
+    """Signals: ``open_requested()``, ``tile_changed(n)``, ``level_requested(stop)`` (after
+    the slider rests 250 ms), ``preserve_changed(bool)``."""
+
+    open_requested = Signal()
+    tile_changed = Signal(int)
+    level_requested = Signal(str)
+    preserve_changed = Signal(bool)
+
+    def __init__(self, tile: int = 3, level: str = "36", parent=None):
+        super().__init__(parent)
+        lay = QVBoxLayout(self)
+        row = QHBoxLayout()
+        self.file_label = QLabel("no file")
+        self.file_label.setWordWrap(True)
+        self.file_label.setTextInteractionFlags(Qt.TextSelectableByMouse)
+        self.open_button = QPushButton("Open points…")
+        self.open_button.setToolTip("Open a digitized points CSV (Ctrl+O)")
+        self.open_button.clicked.connect(self.open_requested)
+        row.addWidget(self.file_label, 1)
+        row.addWidget(self.open_button)
+        lay.addLayout(row)
+        form = QFormLayout()
+        self.tile = QComboBox()
+        self.tile.addItems([f"{n}x{n}" for n in TILES])
+        self.tile.setCurrentText(f"{tile}x{tile}")
+        self.tile.setToolTip("how many times the digitized block is repeated across and along "
+                             "the rows (the paper: 3x3, 81 plants)")
+        self.tile.currentTextChanged.connect(lambda t: self.tile_changed.emit(int(t[0])))
+        form.addRow("tiling of the block", self.tile)
+        self.preserve = QCheckBox("keep leaf area below the standard mesh")
+        self.preserve.setToolTip("widen the kept cross-sections so a coarse leaf keeps the "
+                                 "reference mesh's area (off: the paper's plain splitting)")
+        self.preserve.setChecked(True)
+        self.preserve.toggled.connect(self.preserve_changed)
+        form.addRow(self.preserve)
+        lay.addLayout(form)
+
+        group = QGroupBox("mesh complexity")
+        g = QVBoxLayout(group)
+        self.slider = QSlider(Qt.Horizontal)
+        self.slider.setRange(0, len(COMPLEXITY_STOPS) - 1)
+        self.slider.setValue(COMPLEXITY_STOPS.index(level) if level in COMPLEXITY_STOPS
+                             else COMPLEXITY_STOPS.index("36"))
+        self.slider.setTickPosition(QSlider.TicksBelow)
+        self.slider.setPageStep(1)
+        self.slider.setToolTip("fine (K=4, the paper's reference mesh) to coarse (4 triangles "
+                               "per leaf); the canopy is rebuilt when the slider rests")
+        ends = QHBoxLayout()
+        ends.addWidget(QLabel("fine: K=4"))
+        ends.addStretch(1)
+        ends.addWidget(QLabel("coarse: 4 triangles"))
+        g.addWidget(self.slider)
+        g.addLayout(ends)
+        self.asked_label = QLabel("")
+        self.asked_label.setStyleSheet("color: #555;")
+        self.level_label = QLabel("no canopy yet")
+        self.level_label.setWordWrap(True)
+        self.level_label.setStyleSheet("font-weight: bold;")
+        g.addWidget(self.level_label)
+        g.addWidget(self.asked_label)
+        lay.addWidget(group)
+        lay.addWidget(QLabel("canopy measures per level (the paper's Table 2)"))
+        self.table = QTableWidget(0, 0)
+        self.table.verticalHeader().setVisible(False)
+        self.table.setEditTriggers(QAbstractItemView.NoEditTriggers)
+        self.table.setSelectionBehavior(QAbstractItemView.SelectRows)
+        self.table.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Expanding)
+        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeToContents)
+        lay.addWidget(self.table, 1)
+        self.rows: dict[str, list[str]] = {}
+        self.columns: list[str] = []
+        self._debounce = QTimer(self, singleShot=True, interval=250)
+        self._debounce.timeout.connect(lambda: self.level_requested.emit(self.level))
+        self.slider.valueChanged.connect(self._on_slider)
+
+    # ------------------------------------------------------------------ state
+    @property
+    def level(self) -> str:
+        """The slider's stop (``"K4"`` ... ``"4"``)."""
+        return COMPLEXITY_STOPS[self.slider.value()]
+
+    def set_level(self, level: str) -> None:
+        """Move the slider without asking for a rebuild."""
+        if level in COMPLEXITY_STOPS:
+            self.slider.blockSignals(True)
+            self.slider.setValue(COMPLEXITY_STOPS.index(level))
+            self.slider.blockSignals(False)
+
+    @property
+    def tile_n(self) -> int:
+        return int(self.tile.currentText()[0])
+
+    def set_tile(self, n: int) -> None:
+        self.tile.blockSignals(True)
+        self.tile.setCurrentText(f"{n}x{n}")
+        self.tile.blockSignals(False)
+
+    def set_file(self, name: str, tooltip: str = "") -> None:
+        self.file_label.setText(name)
+        self.file_label.setToolTip(tooltip or name)
+
+    def _on_slider(self, _value: int) -> None:
+        self.asked_label.setText(f"asked: {describe(self.level)}")
+        self._debounce.start()
+
+    def set_pending(self, text: str) -> None:
+        """What is being built (empty when the view shows what the slider asks)."""
+        self.asked_label.setText(text)
+
+    # ------------------------------------------------------------------ results
+    def clear_rows(self) -> None:
+        self.rows.clear()
+        self.table.setRowCount(0)
+
+    def show_built(self, level: str, columns: list[tuple[str, str]], row: dict[str, str]) -> None:
+        """A new canopy is on screen: its level label and its Table 2 row, together."""
+        self.level_label.setText(f"showing: {describe(level)}")
+        self.asked_label.setText("")
+        # units on a second line: the table fits a 400 px panel without scrolling sideways
+        headers = [h.rsplit(" ", 1)[0] + "\n" + h.rsplit(" ", 1)[1] if " " in h else h
+                   for _, h in columns]
+        if headers != self.columns:
+            self.columns = headers
+            self.table.setColumnCount(len(headers))
+            self.table.setHorizontalHeaderLabels(headers)
+        values = [row[k] for k, _ in columns]
+        self.rows[values[0]] = values
+        self.table.setRowCount(len(self.rows))
+        for r, vals in enumerate(self.rows.values()):
+            for c, v in enumerate(vals):
+                item = QTableWidgetItem(v)
+                item.setTextAlignment((Qt.AlignLeft if c == 0 else Qt.AlignRight)
+                                      | Qt.AlignVCenter)
+                self.table.setItem(r, c, item)
+        shown = list(self.rows).index(values[0])
+        self.table.selectRow(shown)

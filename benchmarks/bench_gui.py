@@ -1,0 +1,328 @@
+"""How the desktop app feels: GIL stalls, renders, slider latency, start-up, event-loop gaps.
+
+Run under a display (``xvfb-run -a -s "-screen 0 1366x768x24" python benchmarks/bench_gui.py
+--json``) on the bundled example (the 3 x 3 block tiled 3 x 3, 81 plants). Prints:
+
+- ``gil_max_block_ms``: longest gap of a pure-Python thread (sleeping 1 ms at a time) while the
+  app's own jobs rebuild the canopy at K = 4 (measures included) and trace light on it (hit
+  classes on, as the app asks); no Qt, no graphics. ``gil_idle_max_gap_ms`` is the same thread
+  with nothing running: on a shared machine the OS alone can delay a thread that long.
+- ``idle_renders_per_s``: frames the 3D view renders while nothing happens (target 0).
+- ``renders_per_canopy``: frames rendered for each new canopy (target 1), per level and worst.
+- ``slider_to_view_s``: {level: seconds from the slider move to the new canopy's frame}.
+- ``first_window_s``: from launching the app (a new Python process) to its window on screen;
+  ``first_canopy_s``: to the first canopy's frame.
+- ``event_loop_max_gap_ms``: {level: longest gap of a 10 ms timer on the GUI thread from the
+  slider move to the new frame}; ``light_event_loop_max_gap_ms`` during a light run at 36
+  triangles. Targets: under 200 ms at 36 triangles and below on software OpenGL.
+- ``anchor_s``: a fixed numpy workload timed in the same run (these machines are shared and
+  noisy; compare runs through it).
+
+    python benchmarks/bench_gui.py [--json] [--levels K4,K2,K1,standard,36,16,8,4]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+STOPS = "K4,K2,K1,standard,36,16,8,4"
+TIMEOUT_S = 600
+
+
+def anchor() -> float:
+    a = np.random.default_rng(0).random((400, 400))
+    t0 = time.perf_counter()
+    for _ in range(20):
+        a = a @ a
+        a /= np.abs(a).max()
+    return time.perf_counter() - t0
+
+
+class GilProbe:
+    """A pure-Python thread that sleeps 1 ms at a time and records the longest gap."""
+
+    def __init__(self) -> None:
+        self.worst = 0.0
+        self._stop = False
+        self._thread = threading.Thread(target=self._run, daemon=True)
+
+    def _run(self) -> None:
+        last = time.perf_counter()
+        while not self._stop:
+            time.sleep(0.001)
+            now = time.perf_counter()
+            self.worst = max(self.worst, now - last)
+            last = now
+
+    def __enter__(self) -> "GilProbe":
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._stop = True
+        self._thread.join()
+
+
+class Ticket:
+    def __init__(self) -> None:
+        self.cancel = threading.Event()
+
+    def report(self, done: int, total: int) -> bool:
+        return True
+
+
+def gil_part() -> dict:
+    """The app's build and light jobs at K = 4, no Qt: the longest stall of a Python thread."""
+    sys.setswitchinterval(0.005)
+    from maizeviz.light.leaf_light import triangle_light
+    from maizeviz.light.request import LightRequest
+    from maizeviz.light.sun import Sun
+    from maizeviz.resources import example_points
+    from maizeviz_app import jobs
+    from maizeviz_app.process import CoreProcess
+
+    cover, light = CoreProcess("cover"), CoreProcess("light")
+    cover.start()
+    light.start()
+    with GilProbe() as idle:
+        time.sleep(3.0)
+    loaded = jobs.load_points(str(example_points()), (3, 3))
+    import gc
+
+    gc.freeze()                       # as the app does once started (shorter GC pauses)
+    pauses: list[float] = []
+    started: dict[str, float] = {}
+
+    def gc_timer(phase: str, info: dict) -> None:
+        if phase == "start":
+            started["t"] = time.perf_counter()
+        elif "t" in started:
+            pauses.append(time.perf_counter() - started["t"])
+
+    gc.callbacks.append(gc_timer)
+    out = {"gil_idle_max_gap_ms": idle.worst * 1000}
+    with GilProbe() as probe:
+        t0 = time.perf_counter()
+        canopy, build_s, label = jobs.build(loaded, "K4", True)
+        cover.call("measure", 1, canopy, (jobs.APP_COVER_RESOLUTION_CM,), Ticket())
+        t1 = time.perf_counter()
+        req = LightRequest(Sun(22.34, 166.95), (0, 50, 100, 150, 200, 225), 2.0, None, True,
+                           2, classes=True)
+        result = light.call("light", 1, canopy, (req,), Ticket())
+        triangle_light(canopy, result)
+        t2 = time.perf_counter()
+    gc.callbacks.remove(gc_timer)
+    cover.close()
+    light.close()
+    out.update({"gil_max_block_ms": probe.worst * 1000,
+                "gc_max_pause_ms": max(pauses, default=0.0) * 1000, "k4_rebuild_and_measure_s": t1 - t0,
+                "k4_light_s": t2 - t1, "k4_triangles": canopy.n_triangles})
+    return out
+
+
+# ---------------------------------------------------------------------------- GUI parts
+def _app():
+    os.environ.setdefault("QT_API", "pyside6")
+    from PySide6.QtWidgets import QApplication
+
+    from maizeviz_app.main import gl_format
+
+    gl_format()
+    return QApplication.instance() or QApplication([sys.argv[0]])
+
+
+def startup_child() -> None:
+    """Launched as a new process: print when the window is exposed and when the first canopy
+    is on screen (the parent times from the launch)."""
+    os.environ["XDG_CONFIG_HOME"] = os.environ.get("BENCH_CONFIG", "/tmp/maizeviz-bench-cfg")
+    app = _app()
+    from PySide6.QtCore import QTimer
+
+    from maizeviz.resources import example_points
+    from maizeviz_app.main_window import MainWindow
+
+    window = MainWindow(str(example_points()), 3)
+    window.resize(1366, 740)
+    window.show()
+    said = {"window": False}
+
+    def poll() -> None:
+        handle = window.windowHandle()
+        if not said["window"] and handle is not None and handle.isExposed():
+            said["window"] = True
+            print("window", flush=True)
+
+    timer = QTimer(interval=5)
+    timer.timeout.connect(poll)
+    timer.start()
+
+    def canopy(_label: str) -> None:
+        window.viewport.rendered.connect(lambda _n: (print("canopy", flush=True),
+                                                     window.close(), app.quit()))
+
+    window.canopy_shown.connect(canopy)
+    QTimer.singleShot(TIMEOUT_S * 1000, app.quit)
+    app.exec()
+
+
+def startup_part() -> dict:
+    env = dict(os.environ, BENCH_CONFIG=f"/tmp/maizeviz-bench-{os.getpid()}")
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([sys.executable, __file__, "--child", "startup"],
+                            stdout=subprocess.PIPE, text=True, env=env)
+    times = {}
+    assert proc.stdout is not None
+    for line in proc.stdout:
+        times[line.strip()] = time.perf_counter() - t0
+    proc.wait(TIMEOUT_S)
+    return {"first_window_s": times.get("window"), "first_canopy_s": times.get("canopy")}
+
+
+class GapTimer:
+    """A 10 ms QTimer on the GUI thread: the longest gap between its ticks."""
+
+    def __init__(self) -> None:
+        from PySide6.QtCore import QTimer
+
+        self.worst = 0.0
+        self._last = time.perf_counter()
+        self.timer = QTimer(interval=10)
+        self.timer.timeout.connect(self._tick)
+
+    def _tick(self) -> None:
+        now = time.perf_counter()
+        self.worst = max(self.worst, now - self._last)
+        self._last = now
+
+    def start(self) -> None:
+        self.worst = 0.0
+        self._last = time.perf_counter()
+        self.timer.start()
+
+    def stop(self) -> float:
+        self._tick()
+        self.timer.stop()
+        return self.worst * 1000
+
+
+def gui_child(levels: list[str]) -> None:
+    """In a display: idle renders, renders per canopy, slider latency and gaps per level."""
+    os.environ["XDG_CONFIG_HOME"] = os.environ.get("BENCH_CONFIG", "/tmp/maizeviz-bench-cfg")
+    app = _app()
+    from PySide6.QtCore import QCoreApplication
+
+    from maizeviz.mesh.levels import COMPLEXITY_STOPS
+    from maizeviz.resources import example_points
+    from maizeviz_app.main_window import MainWindow
+
+    def spin(seconds: float, until=None) -> bool:
+        end = time.perf_counter() + seconds
+        while time.perf_counter() < end:
+            QCoreApplication.processEvents()
+            if until is not None and until():
+                return True
+            time.sleep(0.002)
+        return until is None
+
+    window = MainWindow(str(example_points()), 3)
+    window.resize(1366, 740)
+    window.show()
+    shown: list[str] = []
+    window.canopy_shown.connect(shown.append)
+    assert spin(TIMEOUT_S, lambda: bool(shown)), "no first canopy"
+    view = window.viewport
+    spin(1.0)
+    n0 = view.render_count
+    spin(5.0)
+    out: dict = {"idle_renders_per_s": (view.render_count - n0) / 5.0, "slider_to_view_s": {},
+                 "event_loop_max_gap_ms": {}, "renders_per_level": {}}
+    gaps = GapTimer()
+    current = window.level
+    for level in levels:
+        if level == current:
+            window.slider.setValue(COMPLEXITY_STOPS.index("4" if level != "4" else "8"))
+            assert spin(TIMEOUT_S, lambda: bool(shown) and window.runner.current("build") is None
+                        and not window.canopy_panel.asked_label.text())
+            spin(1.0)
+        before = len(shown)
+        frames_before = view.render_count
+        gaps.start()
+        t0 = time.perf_counter()
+        window.slider.setValue(COMPLEXITY_STOPS.index(level))
+        assert spin(TIMEOUT_S, lambda: len(shown) > before), f"no canopy at {level}"
+        framed = view.render_count
+        spin(TIMEOUT_S, lambda: view.render_count > framed)
+        out["slider_to_view_s"][level] = time.perf_counter() - t0
+        out["event_loop_max_gap_ms"][level] = gaps.stop()
+        spin(1.0)
+        out["renders_per_level"][level] = view.render_count - frames_before
+        current = level
+    out["renders_per_canopy"] = max(out["renders_per_level"].values(), default=None)
+    # a light run at 36 triangles: the event loop while the child traces
+    if "36" in levels:
+        window.slider.setValue(COMPLEXITY_STOPS.index("36"))
+        spin(TIMEOUT_S, lambda: shown[-1] == "36 triangles" and
+             window.runner.current("build") is None)
+        spin(1.0)
+        lit: list = []
+        window.light_shown.connect(lambda: lit.append(1))
+        gaps.start()
+        t0 = time.perf_counter()
+        window.compute_light()
+        spin(TIMEOUT_S, lambda: bool(lit))
+        out["light_36_s"] = time.perf_counter() - t0
+        out["light_event_loop_max_gap_ms"] = gaps.stop()
+    window.close()
+    print(json.dumps(out), flush=True)
+
+
+def gui_part(levels: list[str]) -> dict:
+    env = dict(os.environ, BENCH_CONFIG=f"/tmp/maizeviz-bench-{os.getpid()}-gui")
+    proc = subprocess.run([sys.executable, __file__, "--child", "gui", "--levels",
+                           ",".join(levels)], stdout=subprocess.PIPE, text=True, env=env,
+                          timeout=TIMEOUT_S * 3)
+    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("{")]
+    if proc.returncode != 0 or not lines:
+        raise SystemExit(f"the GUI run failed (exit {proc.returncode})")
+    return json.loads(lines[-1])
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--json", action="store_true")
+    ap.add_argument("--levels", default=STOPS)
+    ap.add_argument("--child", choices=("startup", "gui"), help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    levels = [lv for lv in args.levels.split(",") if lv]
+    if args.child == "startup":
+        return startup_child()
+    if args.child == "gui":
+        return gui_child(levels)
+    if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        raise SystemExit("needs a display: xvfb-run -a -s \"-screen 0 1366x768x24\" python "
+                         "benchmarks/bench_gui.py")
+    out = {"anchor_s": min(anchor() for _ in range(3))}
+    out.update(gil_part())
+    out.update(startup_part())
+    out.update(gui_part(levels))
+    out["targets"] = {"gil_max_block_ms": 100, "idle_renders_per_s": 0, "renders_per_canopy": 1,
+                      "event_loop_max_gap_ms_at_36_and_below": 200, "first_window_s": 3}
+    if args.json:
+        print(json.dumps(out, indent=1))
+        return
+    for k, v in out.items():
+        print(f"{k}: {v}")
+
+
+if __name__ == "__main__":
+    main()

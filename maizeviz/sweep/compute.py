@@ -1,0 +1,310 @@
+"""The sweep's only door into the maizeviz core: the canopy of one group and all its suns.
+
+A *group* is every scenario sharing one canopy: the same points file (by content), tiling or
+layout file, mesh level and area rule. Its work is done once and reused by all its suns:
+
+- leaves are read and fitted once per points file per process (cached by the file's sha256, so
+  a Dask worker fits each file once however many tasks it runs);
+- the canopy is built and measured once per group;
+- one plain Embree scene (``light_scene``) serves the ground cover and every open-field sun of
+  the group, one periodic scene every periodic sun.
+
+Every import of the computing core (leaf, mesh, canopy, light) is in this file, so that moving
+core modules is a one-file change (the rest of the sweep uses only ``maizeviz.errors`` and
+``maizeviz.io.atomic``). The
+numbers equal ``maizeviz canopy --json`` and ``maizeviz light --json`` for the same inputs: the
+same functions with the same arguments, except that tracing runs on one thread (a Dask worker
+is one process per core) and without the hit classes, neither of which changes transmission.
+
+Scenarios are duck-typed (see :class:`maizeviz.sweep.spec.Scenario`); of the sweep this
+module imports only its errors.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import threading
+import time
+from collections import Counter, OrderedDict
+from dataclasses import dataclass, field
+from typing import Any
+
+from maizeviz.canopy.layout import layout_for, parse_shape
+from maizeviz.canopy.measures import measure_canopy
+from maizeviz.canopy.scene import Canopy, build_canopy
+from maizeviz.cost import Cost, canopy_cost, light_cost
+from maizeviz.errors import MaizevizError
+from maizeviz.leaf.fit import read_leaves
+from maizeviz.light.request import LightRequest
+from maizeviz.light.sun import Sun, sun_at
+from maizeviz.light.transmission import light_scene, trace_light
+from maizeviz.mesh.levels import parse_level
+from maizeviz.mesh.raytrace import RayScene
+from maizeviz.sweep.errors import WorkerInputError
+
+#: Points files whose fitted leaves a process keeps (a block of 9 plants is a few MB).
+LEAVES_CACHE_SIZE = 8
+#: Canopies (with their Embree scene) a process keeps: a 9 x 9 canopy at K = 4 is 2.7 M
+#: triangles, about 300 MB with its scene, so only the latest two.
+CANOPY_CACHE_SIZE = 2
+
+
+# ------------------------------------------------------------------------- values of a spec
+def level_label(text) -> str:
+    """Canonical name of a mesh level: ``"K4"`` -> ``"K=4"``, ``"std"`` -> ``"standard"``,
+    ``36`` -> ``"36 triangles"``. Raises MaizevizError naming the text."""
+    return parse_level(str(text)).label
+
+
+def level_order(label: str) -> tuple[int, int]:
+    """Sort key, finest first: interpolated levels by K descending, then budgets descending."""
+    lv = parse_level(label.replace(" triangles", ""))
+    if lv.interp is not None:
+        return (0, -lv.interp)
+    return (1, -(lv.triangles or 0))
+
+
+def parse_tile(text, quantity: str = "tile") -> tuple[int, int]:
+    """``"3x3"`` -> (3, 3); MaizevizError otherwise."""
+    return parse_shape(str(text), quantity)
+
+
+def resolve_sun(table: dict) -> tuple[float, float, str]:
+    """Sun angles of a sweep's sun table: (zenith deg, azimuth deg, when).
+
+    ``{zenith, azimuth}`` as given; ``{date, time | solar_noon, lat, lon, tz, altitude}``
+    through pvlib exactly as ``maizeviz light --date ...`` does. Raises MaizevizError.
+    """
+    if "zenith" in table:
+        sun = Sun(float(table["zenith"]), float(table["azimuth"]))
+    else:
+        sun = sun_at(table["date"], table.get("time"), float(table["lat"]), float(table["lon"]),
+                     table.get("tz", "UTC"), bool(table.get("solar_noon", False)),
+                     float(table.get("altitude", 0.0)))
+    return float(sun.zenith_deg), float(sun.azimuth_deg), sun.when
+
+
+# ---------------------------------------------------------------------------- worker caches
+class _LRU:
+    """A small thread-safe least-recently-used map (a worker may run several threads)."""
+
+    def __init__(self, size: int):
+        self.size = size
+        self.items: OrderedDict = OrderedDict()
+        self.lock = threading.Lock()
+
+    def get(self, key):
+        with self.lock:
+            value = self.items.get(key)
+            if value is not None:
+                self.items.move_to_end(key)
+            return value
+
+    def put(self, key, value):
+        with self.lock:
+            self.items[key] = value
+            self.items.move_to_end(key)
+            while len(self.items) > self.size:
+                self.items.popitem(last=False)
+
+    def clear(self):
+        with self.lock:
+            self.items.clear()
+
+
+_LEAVES = _LRU(LEAVES_CACHE_SIZE)
+_CANOPIES = _LRU(CANOPY_CACHE_SIZE)
+
+
+def clear_caches() -> None:
+    """Forget fitted leaves and canopies of this process (benchmarks start cold with it)."""
+    _LEAVES.clear()
+    _CANOPIES.clear()
+
+
+def file_sha256(path) -> str:
+    """sha256 (hex) of a file's bytes; OSError when it cannot be read."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _leaves(path: str, sha256: str):
+    """Fitted leaves of a points file, once per content per process: (found, seconds)."""
+    found = _LEAVES.get(sha256)
+    if found is not None:
+        return found, 0.0
+    t0 = time.perf_counter()
+    try:
+        now = file_sha256(path)
+    except OSError as exc:            # the driver read it: this machine cannot
+        raise WorkerInputError(f"{path}: cannot be read here ({exc.strerror or exc}); every "
+                               "worker needs the points files at the same path") from None
+    if now != sha256:
+        raise MaizevizError(f"{path}: the file changed since the sweep started (its content "
+                            "hash differs); run the sweep again")
+    found = read_leaves(path)         # the CLI's reader, defaults: skip bad leaves, degree 3
+    if not found.leaves:
+        first = f" ({found.skipped[0]})" if found.skipped else ""
+        raise MaizevizError(f"{path}: no leaf could be reconstructed{first}; the canopy is empty")
+    _LEAVES.put(sha256, found)
+    return found, time.perf_counter() - t0
+
+
+# ------------------------------------------------------------------------------ one group
+@dataclass
+class _GroupState:
+    """A built canopy with its measures and scene; ``seconds`` not yet charged to a row."""
+
+    canopy: Canopy
+    measures: dict[str, Any]
+    scenes: dict[bool, RayScene]
+    leaves_skipped: int
+    warnings: list[str]
+    seconds: dict[str, float] = field(default_factory=dict)
+
+    def scene(self, periodic: bool) -> RayScene:
+        """The scene for plain or periodic requests (a periodic one wraps the leaves that
+        overhang the plot, as ``maizeviz light --periodic`` does), built once."""
+        if periodic not in self.scenes:
+            t0 = time.perf_counter()
+            self.scenes[periodic] = light_scene(self.canopy, periodic=periodic)
+            self.seconds["scene"] = self.seconds.get("scene", 0.0) + time.perf_counter() - t0
+        return self.scenes[periodic]
+
+
+def _layout(s, leaves):
+    """The CLI's ``layout_for``: the layout file, or the digitized block tiled."""
+    a = s.arrangement
+    if a.layout_path:
+        try:
+            now = file_sha256(a.layout_path)
+        except OSError as exc:
+            raise WorkerInputError(f"{a.layout_path}: cannot be read here "
+                                   f"({exc.strerror or exc}); every worker needs the layout "
+                                   "files at the same path") from None
+        if now != a.layout_sha256:
+            raise MaizevizError(f"{a.layout_path}: the file changed since the sweep started "
+                                "(its content hash differs); run the sweep again")
+        return layout_for(leaves, layout_file=a.layout_path)
+    return layout_for(leaves, tuple(a.tile), a.row_spacing, a.plant_spacing,
+                      tuple(a.block) if a.block else None)
+
+
+def _group_state(s) -> _GroupState:
+    """Leaves -> layout -> canopy -> measures (-> scene) for the group of scenario ``s``."""
+    state = _CANOPIES.get(s.group_key)
+    if state is not None:
+        return _GroupState(state.canopy, state.measures, state.scenes, state.leaves_skipped,
+                           state.warnings)                   # nothing left to charge
+    found, fit_s = _leaves(s.points.path, s.points.sha256)
+    t0 = time.perf_counter()
+    layout = _layout(s, found.leaves)
+    t1 = time.perf_counter()
+    canopy = build_canopy(found.leaves, layout, parse_level(s.level), s.preserve_area)
+    t2 = time.perf_counter()
+    scene = light_scene(canopy)                        # plain: the ground cover uses it too
+    t3 = time.perf_counter()
+    m = measure_canopy(canopy, s.cover_resolution, False, scene=scene)
+    t4 = time.perf_counter()
+    warnings = list(found.problems) + [f"skipped: {e}" for e in found.skipped]
+    # the inferred block is a note the CLI prints for every tiling, not a warning
+    warnings += [w for w in layout.warnings if not w.startswith("block inferred")]
+    state = _GroupState(canopy, m.as_dict(), {False: scene}, len(found.skipped), warnings,
+                        {"fit": fit_s, "layout": t1 - t0, "build": t2 - t1, "scene": t3 - t2,
+                         "measure": t4 - t3})
+    _CANOPIES.put(s.group_key, state)
+    return state
+
+
+def _charge(state: _GroupState) -> dict:
+    """The group's stage seconds for the first row that needed them, zeros afterwards, so
+    that seconds summed over rows are the time spent."""
+    spent = {k: 0.0 for k in ("fit", "layout", "build", "scene", "measure")}
+    spent.update(state.seconds)
+    state.seconds = {}
+    return spent
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
+def _error(s, exc: BaseException) -> dict:
+    status = "failed" if isinstance(exc, WorkerInputError) else "error"
+    return {"key": s.key, "status": status, "error": _one_line(exc)}
+
+
+def _light(state: _GroupState, s) -> dict:
+    sun = Sun(s.sun.zenith_deg, s.sun.azimuth_deg, s.sun.when or "")
+    req = LightRequest(sun, tuple(s.heights_cm), s.density, s.rect_cm, s.periodic, threads=1,
+                       classes=False)
+    scene = state.scene(s.periodic)
+    seconds = _charge(state)
+    t0 = time.perf_counter()
+    res = trace_light(state.canopy, req, scene=scene)
+    seconds["trace"] = time.perf_counter() - t0
+    m = state.measures
+    return {"key": s.key, "status": "ok", "error": None, "triangles": m["triangles"],
+            "plants": m["plants"], "leaves": m["leaves"],
+            "leaves_skipped": state.leaves_skipped, "leaf_area_m2": m["leaf_area_m2"],
+            "projected_area_m2": m["projected_area_m2"],
+            "ground_cover_m2": m["ground_cover_m2"], "ground_area_m2": m["ground_area_m2"],
+            "lai": m["lai"], "rays": int(res.rays),
+            "heights_cm": [float(h) for h in res.heights_cm],
+            "transmission": [float(t) for t in res.transmission],
+            "warnings": list(state.warnings) + list(res.warnings), "seconds": seconds}
+
+
+def compute_scenarios(scenarios) -> list[dict]:
+    """Results of scenarios that share one group, in the order given.
+
+    Returns one dict per scenario: ``key``, ``status`` ("ok"; "error": bad input; "failed":
+    an input file this process cannot read, worth retrying elsewhere), ``error`` (one line
+    or None) and, when ok, the canopy measures (``triangles``, ``leaf_area_m2``, ``lai``, ...,
+    areas in m2), ``rays``, ``heights_cm`` (H,) and ``transmission`` (H,) in [0, 1],
+    ``warnings`` (list of str) and ``seconds`` per stage (fit, layout, build, scene, measure,
+    trace; the group stages are charged to the first scenario that needed them).
+
+    Bad input (an unreadable points file, a level the leaves cannot take, a sample rectangle
+    outside the plot, ...) gives "error" results; anything else is a bug and is raised.
+    """
+    if not scenarios:
+        return []
+    keys = {s.group_key for s in scenarios}
+    if len(keys) != 1:
+        raise ValueError(f"compute_scenarios takes one group, got {len(keys)}")
+    try:
+        state = _group_state(scenarios[0])
+    except MaizevizError as exc:                    # LeafError, PointsFileError, LayoutError
+        return [_error(s, exc) for s in scenarios]
+    out = []
+    for s in scenarios:
+        try:
+            out.append(_light(state, s))
+        except MaizevizError as exc:
+            out.append(_error(s, exc))
+    return out
+
+
+# ------------------------------------------------------------------------------- estimates
+def group_costs(scenarios) -> list[Cost]:
+    """What one group costs (``maizeviz.cost``, the same estimate as the command line's):
+    its canopy, its ground-cover rays and each scenario's tracing, without building anything
+    (the leaves are fitted, and cached, to know their grid shapes)."""
+    s = scenarios[0]
+    found, _ = _leaves(s.points.path, s.points.sha256)
+    layout = _layout(s, found.leaves)
+    placed = dict(Counter(p.plant for p in layout.placements))
+    rect = s.rect_cm or layout.centre_bounds
+    return [canopy_cost(found.leaves, placed, parse_level(s.level)),
+            light_cost(layout.bounds, 1 / s.cover_resolution**2, 1),
+            *(light_cost(rect, sc.density, len(sc.heights_cm)) for sc in scenarios)]
+
+
+def describe_core() -> dict:
+    """What the core offers the sweep (recorded in sweep.json)."""
+    return {"scene_reuse": {"measure_canopy": True, "trace_light": True}}
+

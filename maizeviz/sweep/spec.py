@@ -1,0 +1,560 @@
+"""A sweep file: axes of canopies, mesh levels and suns, checked before anything runs.
+
+The file is TOML (standard library ``tomllib``). Every list is an axis and the scenarios are the
+product of the axes, minus the ``exclude`` entries. A single value is a one-value axis.
+Defaults are those of ``maizeviz canopy`` and ``maizeviz light``::
+
+    [canopy]
+    points = ["block3x3.csv", "genotypes/*.csv"]  # required; globs; relative to this file
+    tile = ["3x3"]                 # AxB copies of the digitized block (default "1x1")
+    row_spacing = [60]             # cm between rows (default 60)
+    plant_spacing = [30]           # cm between plants of a row (default 30)
+    block = "3x3"                  # rows x plants of the digitized block (default: inferred)
+    layout = ["field.json"]        # layout files: arrangements besides (or instead of) tilings
+    level = ["K4", "standard", "36", "8"]   # required; as the app's slider names them
+    preserve_area = true           # below the standard mesh, keep the smooth area (default)
+    cover_resolution = 0.5         # cm, ground-cover pixel (not an axis)
+
+    [light]
+    sun = [{zenith = 30, azimuth = 180},                # required; angles in degrees, or
+           {date = "2005-08-01", time = "12:00", lat = 39.9, lon = 116.4, tz = "Asia/Shanghai"},
+           {date = "2005-08-01", solar_noon = true, lat = 39.9, lon = 116.4, tz = "Asia/Shanghai"}]
+    density = [4]                  # rays per cm2 (default 4)
+    heights = [0, 50, 100, 150, 200, 225]   # cm; not an axis: every scenario reports all
+    periodic = true                # rays leaving the plot re-enter it (default false)
+    rect = [0, 0, 180, 90]         # sample rectangle x0, y0, x1, y1 in cm (default: centre tile)
+
+    [[exclude]]                    # partial scenarios to drop (or, before [canopy]:
+    level = "K4"                   # exclude = [{level = "K4", density = 16}])
+    density = 16
+
+Each scenario has a stable key: a hash of everything that determines its numbers (the points
+and layout files by content, not by name; every parameter; maizeviz's major.minor version), so
+results on disk can be matched to scenarios whatever the files are called.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import glob
+import hashlib
+import itertools
+import json
+import math
+import os
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from datetime import date, datetime
+from datetime import time as dtime
+from pathlib import Path
+from typing import Any, NoReturn
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10: the tomli backport (the sweep extra installs it)
+    import tomli as tomllib
+
+import maizeviz
+from maizeviz.errors import MaizevizError
+from maizeviz.sweep import compute
+from maizeviz.sweep.errors import SweepSpecError
+
+#: More scenarios than this are refused unless confirmed (``yes=True``, ``--yes``).
+MAX_SCENARIOS = 10_000
+#: More combinations than this are refused outright: split the sweep.
+HARD_MAX_SCENARIOS = 1_000_000
+
+DEFAULT_HEIGHTS = (0.0, 50.0, 100.0, 150.0, 200.0, 225.0)
+
+CANOPY_KEYS = ("points", "tile", "row_spacing", "plant_spacing", "block", "layout", "level",
+               "preserve_area", "cover_resolution")
+LIGHT_KEYS = ("sun", "density", "heights", "periodic", "rect")
+TOP_KEYS = ("canopy", "light", "exclude")
+AXES = ("points", "tile", "row_spacing", "plant_spacing", "layout", "level", "preserve_area",
+        "sun", "density", "periodic")
+SUN_ANGLE_KEYS = ("zenith", "azimuth")
+SUN_PLACE_KEYS = ("date", "time", "solar_noon", "lat", "lon", "tz", "altitude")
+
+
+def version_tag() -> str:
+    """maizeviz major.minor: results of other patch releases are reused, not of others."""
+    return ".".join(maizeviz.__version__.split(".")[:2])
+
+
+def _digest(obj) -> str:
+    text = json.dumps(obj, sort_keys=True, separators=(",", ":"), default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+@dataclass(frozen=True)
+class PointsFile:
+    """A points file: ``name`` as shown (relative to the sweep file), absolute ``path``."""
+
+    name: str
+    path: str
+    sha256: str
+
+
+@dataclass(frozen=True)
+class Arrangement:
+    """Where the plants stand: a tiling of the digitized block, or a layout file.
+
+    ``tile`` (A, B); spacings in cm; ``block`` (rows, plants per row) or None (inferred); or
+    ``layout`` (as shown), ``layout_path`` (absolute) and its content hash.
+    """
+
+    tile: tuple | None = None
+    row_spacing: float | None = None
+    plant_spacing: float | None = None
+    block: tuple | None = None
+    layout: str | None = None
+    layout_path: str | None = None
+    layout_sha256: str | None = None
+
+    @property
+    def label(self) -> str:
+        if self.layout or self.tile is None:
+            return self.layout or "?"
+        return f"{self.tile[0]}x{self.tile[1]} at {self.row_spacing:g} x {self.plant_spacing:g} cm"
+
+    def canonical(self) -> dict:
+        if self.layout or self.tile is None:
+            return {"layout_sha256": self.layout_sha256}
+        return {"tile": list(self.tile), "row_spacing": self.row_spacing,
+                "plant_spacing": self.plant_spacing,
+                "block": list(self.block) if self.block else None}
+
+
+@dataclass(frozen=True)
+class SunSpec:
+    """A sun: angles in degrees (zenith from vertical, azimuth clockwise from north), ``when``
+    (ISO time when it came from a place and date, else None) and the table as given."""
+
+    zenith_deg: float
+    azimuth_deg: float
+    when: str | None
+    given: tuple
+
+    @property
+    def label(self) -> str:
+        angles = f"z {self.zenith_deg:.2f} az {self.azimuth_deg:.2f}"
+        return f"{angles} ({self.when})" if self.when else angles
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One light computation of a sweep; ``key`` identifies its inputs, ``group_key`` its
+    canopy (scenarios of a group share leaves, canopy, measures and Embree scene)."""
+
+    index: int
+    key: str
+    group_key: str
+    points: PointsFile
+    arrangement: Arrangement
+    level: str
+    preserve_area: bool
+    sun: SunSpec
+    density: float
+    periodic: bool
+    heights_cm: tuple
+    rect_cm: tuple | None
+    cover_resolution: float
+
+    @property
+    def canopy_key(self) -> tuple:
+        """What the summary compares levels within: everything but the level and the sun."""
+        return (self.points.sha256, self.points.name, self.arrangement, self.preserve_area,
+                self.density, self.periodic)
+
+    def axes(self) -> dict:
+        """The axis values as result columns."""
+        a = self.arrangement
+        return {"points": self.points.name, "points_sha256": self.points.sha256,
+                "layout": a.layout, "tile": f"{a.tile[0]}x{a.tile[1]}" if a.tile else None,
+                "row_spacing": a.row_spacing, "plant_spacing": a.plant_spacing,
+                "block": f"{a.block[0]}x{a.block[1]}" if a.block else None,
+                "level": self.level, "preserve_area": self.preserve_area,
+                "sun_zenith_deg": self.sun.zenith_deg, "sun_azimuth_deg": self.sun.azimuth_deg,
+                "sun_when": self.sun.when, "density": self.density, "periodic": self.periodic}
+
+
+def _scenario_inputs(points, arr, level, preserve, sun, density, periodic, heights, rect,
+                     cover) -> tuple[dict, dict]:
+    group = {"points_sha256": points.sha256, **arr.canonical(), "level": level,
+             "preserve_area": preserve, "cover_resolution": cover, "maizeviz": version_tag()}
+    full = dict(group, sun_zenith_deg=sun.zenith_deg, sun_azimuth_deg=sun.azimuth_deg,
+                sun_when=sun.when, density=density, periodic=periodic, heights_cm=list(heights),
+                rect_cm=list(rect) if rect else None)
+    return group, full
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    """A validated sweep: the scenarios in a stable order (scenarios of a group together).
+
+    Attributes
+    ----------
+    source : str, the sweep file as given
+    document : dict, the file's content with globs resolved (JSON-ready, for sweep.json)
+    scenarios : tuple of Scenario
+    excluded : int, combinations dropped by ``exclude``
+    fingerprint : str, hash of the scenario keys: two specs with the same one compute the same
+    """
+
+    source: str
+    document: dict
+    scenarios: tuple
+    excluded: int
+    fingerprint: str
+
+    def groups(self) -> list[list[Scenario]]:
+        """Scenarios by group (points content, arrangement, level, area rule), in order."""
+        out: dict[str, list] = {}
+        for s in self.scenarios:
+            out.setdefault(s.group_key, []).append(s)
+        return list(out.values())
+
+
+# ------------------------------------------------------------------------------- checking
+class _Checker:
+    """Converts and checks values, naming ``source: key`` in every message."""
+
+    def __init__(self, source: str, base: Path):
+        self.source = source
+        self.base = base
+
+    def fail(self, where: str, msg: str) -> NoReturn:
+        raise SweepSpecError(f"{self.source}: {where}: {msg}")
+
+    def known(self, table: dict, known: tuple, where: str):
+        for k in table:
+            if k == "exclude" and where in ("canopy", "light"):
+                raise SweepSpecError(f"{self.source}: '{where}.exclude': exclude belongs at the "
+                                     "top of the file, before [canopy], or in [[exclude]] tables")
+            if k not in known:
+                name = f"{where}.{k}" if where else k
+                raise SweepSpecError(f"{self.source}: unknown key '{name}' (known"
+                                     f"{' in ' + where if where else ''}: {', '.join(known)})")
+
+    def axis(self, section: dict, key: str, where: str, convert, default=None) -> list:
+        name = f"{where}.{key}"
+        if key not in section:
+            if default is None:
+                self.fail(name, "is missing")
+            return list(default)
+        raw = section[key]
+        values = raw if isinstance(raw, list) else [raw]
+        if not values:
+            self.fail(name, "is empty: give at least one value")
+        out: list[Any] = []
+        seen: dict[str, int] = {}
+        for i, v in enumerate(values):
+            item = f"{name}[{i}]" if isinstance(raw, list) else name
+            c = convert(v, item)
+            token = json.dumps(c, sort_keys=True, default=str)
+            if token in seen:
+                self.fail(item, f"repeats {name}[{seen[token]}]")
+            seen[token] = i
+            out.append(c)
+        return out
+
+    # converters: (value, where) -> canonical value
+    def number(self, v, where, positive=True, minimum=None):
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            self.fail(where, f"must be a number, got {json.dumps(v, default=str)}")
+        if positive and v <= 0:
+            self.fail(where, f"must be > 0, got {v}")
+        if minimum is not None and v < minimum:
+            self.fail(where, f"must be >= {minimum:g}, got {v}")
+        return float(v)
+
+    def boolean(self, v, where):
+        if not isinstance(v, bool):
+            self.fail(where, f"must be true or false, got {json.dumps(v, default=str)}")
+        return v
+
+    def shape(self, v, where):
+        if not isinstance(v, str):
+            self.fail(where, f"must be a string such as \"3x3\", got {json.dumps(v, default=str)}")
+        try:
+            return compute.parse_tile(v, "block" if where.endswith("block") else "tile")
+        except MaizevizError:
+            self.fail(where, f"must look like 3x3 (whole numbers >= 1), got '{v}'")
+
+    def level(self, v, where):
+        if isinstance(v, bool) or not isinstance(v, (str, int)):
+            self.fail(where, f"must be a level name such as \"K4\", \"standard\" or \"36\", "
+                             f"got {json.dumps(v, default=str)}")
+        try:
+            return compute.level_label(v)
+        except (MaizevizError, ValueError) as exc:         # the core has raised both
+            self.fail(where, str(exc))
+
+    def text(self, v, where):
+        if not isinstance(v, str) or not v.strip():
+            self.fail(where, f"must be a non-empty string, got {json.dumps(v, default=str)}")
+        return v
+
+    def sun_table(self, v, where) -> dict:
+        if not isinstance(v, dict):
+            self.fail(where, "must be a table such as {zenith = 30, azimuth = 180} or {date = "
+                             "\"2005-08-01\", time = \"12:00\", lat = 39.9, lon = 116.4, tz = "
+                             "\"Asia/Shanghai\"}")
+        self.known(v, SUN_ANGLE_KEYS + SUN_PLACE_KEYS, where)
+        t = {}
+        for k, x in v.items():
+            if isinstance(x, (date, datetime, dtime)):
+                x = x.isoformat()                       # TOML date and time literals
+            t[k] = x
+        angles = [k for k in t if k in SUN_ANGLE_KEYS]
+        place = [k for k in t if k in SUN_PLACE_KEYS]
+        if angles and place:
+            self.fail(where, "give either zenith and azimuth or a place and time, not both")
+        if angles:
+            for k in SUN_ANGLE_KEYS:
+                if k not in t:
+                    self.fail(f"{where}.{k}", "is missing")
+                t[k] = self.number(t[k], f"{where}.{k}", positive=False)
+        else:
+            for k in ("date", "lat", "lon"):
+                if k not in t:
+                    self.fail(f"{where}.{k}", "is missing (a sun from a place needs date, lat, "
+                                              "lon and time or solar_noon)")
+            for k in ("date", "time", "tz"):
+                if k in t:
+                    t[k] = self.text(t[k], f"{where}.{k}")
+            for k in ("lat", "lon", "altitude"):
+                if k in t:
+                    t[k] = self.number(t[k], f"{where}.{k}", positive=False)
+            if "solar_noon" in t:
+                t["solar_noon"] = self.boolean(t["solar_noon"], f"{where}.solar_noon")
+            if "time" not in t and not t.get("solar_noon"):
+                self.fail(f"{where}.time", "is missing (or set solar_noon = true)")
+        return t
+
+    def sun(self, v, where) -> SunSpec:
+        t = self.sun_table(v, where)
+        try:
+            z, a, when = compute.resolve_sun(t)
+        except MaizevizError as exc:
+            self.fail(where, str(exc))
+        return SunSpec(z, a, when or None, tuple(sorted(t.items())))
+
+    def files(self, v, where) -> list[str]:
+        """Absolute paths of the files a path or glob names (relative to the sweep file)."""
+        pattern = self.text(v, where)
+        full = Path(os.path.expanduser(pattern))
+        if not full.is_absolute():
+            full = self.base / full
+        if any(c in pattern for c in "*?["):
+            found = sorted(p for p in glob.glob(str(full), recursive=True) if os.path.isfile(p))
+            if not found:
+                self.fail(where, f"'{pattern}' matches no file (in {full.parent})")
+            return [str(Path(p).resolve()) for p in found]
+        if full.is_dir():
+            self.fail(where, f"{pattern}: is a folder, not a file")
+        if not full.is_file():
+            self.fail(where, f"{pattern}: no such file (looked for {full})")
+        return [str(full.resolve())]
+
+    def shown(self, path: str) -> str:
+        try:
+            return os.path.relpath(path, self.base)
+        except ValueError:  # pragma: no cover - another drive on Windows
+            return path
+
+    def sha(self, path: str, where: str) -> str:
+        try:
+            return compute.file_sha256(path)
+        except OSError as exc:
+            self.fail(where, f"{self.shown(path)}: cannot be read ({exc.strerror or exc})")
+
+
+def read_toml(path) -> tuple[dict, str]:
+    """The parsed sweep file and its text; SweepSpecError for a missing file or bad TOML."""
+    p = Path(path)
+    try:
+        raw = p.read_bytes()
+    except FileNotFoundError:
+        raise SweepSpecError(f"{path}: no such sweep file") from None
+    except IsADirectoryError:
+        raise SweepSpecError(f"{path}: is a folder, not a sweep file") from None
+    except OSError as exc:
+        raise SweepSpecError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise SweepSpecError(f"{path}: not a TOML text file (not UTF-8)") from None
+    try:
+        return tomllib.loads(text), text
+    except tomllib.TOMLDecodeError as exc:
+        raise SweepSpecError(f"{path}: not valid TOML: {' '.join(str(exc).split())}") from None
+
+
+def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> SweepSpec:
+    """Read and check a sweep file and list its scenarios.
+
+    Every key is checked before anything runs; points and layout files are hashed; suns given
+    by place and time are resolved through pvlib.
+
+    Raises
+    ------
+    SweepSpecError
+        One line naming the file and the key (``canopy.level[2]``) or path that is wrong;
+        also for more than ``max_scenarios`` scenarios unless ``yes``.
+    """
+    doc, _ = read_toml(path)
+    source = str(path)
+    ck = _Checker(source, Path(path).resolve().parent)
+    ck.known(doc, TOP_KEYS, "")
+    for sec in ("canopy", "light"):
+        if sec not in doc:
+            raise SweepSpecError(f"{source}: the [{sec}] table is missing")
+        if not isinstance(doc[sec], dict):
+            raise SweepSpecError(f"{source}: '{sec}' must be a table ([{sec}])")
+    canopy, light = doc["canopy"], doc["light"]
+    ck.known(canopy, CANOPY_KEYS, "canopy")
+    ck.known(light, LIGHT_KEYS, "light")
+
+    # --- canopy axes
+    paths = ck.axis(canopy, "points", "canopy", ck.files)
+    points: list[PointsFile] = []
+    by_sha: dict[str, str] = {}
+    for i, group in enumerate(paths):
+        for p in group:
+            if any(q.path == p for q in points):
+                continue                                  # two patterns naming one file
+            sha = ck.sha(p, f"canopy.points[{i}]")
+            if sha in by_sha:
+                ck.fail(f"canopy.points[{i}]", f"{ck.shown(p)} has the same content as "
+                        f"{by_sha[sha]}: keep one of them")
+            by_sha[sha] = ck.shown(p)
+            points.append(PointsFile(ck.shown(p), p, sha))
+    tiling_given = any(k in canopy for k in ("tile", "row_spacing", "plant_spacing", "block"))
+    arrangements = []
+    if tiling_given or "layout" not in canopy:
+        tiles = ck.axis(canopy, "tile", "canopy", ck.shape, [(1, 1)])
+        rows = ck.axis(canopy, "row_spacing", "canopy", ck.number, [60.0])
+        plants = ck.axis(canopy, "plant_spacing", "canopy", ck.number, [30.0])
+        block = None
+        if "block" in canopy:
+            block = ck.shape(canopy["block"], "canopy.block")
+        arrangements += [Arrangement(t, r, p, block) for t in tiles for r in rows for p in plants]
+    if "layout" in canopy:
+        for i, group in enumerate(ck.axis(canopy, "layout", "canopy", ck.files)):
+            for p in group:
+                arrangements.append(Arrangement(layout=ck.shown(p), layout_path=p,
+                                                layout_sha256=ck.sha(p, f"canopy.layout[{i}]")))
+    levels = ck.axis(canopy, "level", "canopy", ck.level)
+    preserve = ck.axis(canopy, "preserve_area", "canopy", ck.boolean, [True])
+    cover = 0.5
+    if "cover_resolution" in canopy:
+        cover = ck.number(canopy["cover_resolution"], "canopy.cover_resolution")
+
+    # --- light axes
+    suns = ck.axis(light, "sun", "light", ck.sun)
+    densities = ck.axis(light, "density", "light", ck.number, [4.0])
+    periodic = ck.axis(light, "periodic", "light", ck.boolean, [False])
+    heights = DEFAULT_HEIGHTS
+    if "heights" in light:
+        raw = light["heights"]
+        if not isinstance(raw, list):
+            ck.fail("light.heights", "must be a list of heights in cm, such as [0, 50, 100]")
+        if not raw:
+            ck.fail("light.heights", "is empty: give at least one height")
+        heights = tuple(ck.number(h, f"light.heights[{i}]", positive=False, minimum=0)
+                        for i, h in enumerate(raw))
+    rect = None
+    if "rect" in light:
+        raw = light["rect"]
+        if not isinstance(raw, list) or len(raw) != 4:
+            ck.fail("light.rect", "must be [x0, y0, x1, y1] in cm")
+        rect = tuple(ck.number(v, f"light.rect[{i}]", positive=False) for i, v in enumerate(raw))
+        if rect[2] <= rect[0] or rect[3] <= rect[1]:
+            ck.fail("light.rect", f"must have x1 > x0 and y1 > y0, got {list(rect)}")
+
+    # --- exclude
+    excludes = doc.get("exclude", [])
+    if not isinstance(excludes, list) or not all(isinstance(e, dict) for e in excludes):
+        ck.fail("exclude", "must be a list of tables such as [{level = \"K4\", density = 16}]")
+    matchers = [_matcher(ck, e, f"exclude[{i}]") for i, e in enumerate(excludes)]
+
+    axes: list[list[Any]] = [points, arrangements, levels, preserve, densities, periodic, suns]
+    total = math.prod(len(a) for a in axes)
+    if total > HARD_MAX_SCENARIOS:
+        raise SweepSpecError(f"{source}: the axes make {total:,} combinations, beyond the "
+                             f"{HARD_MAX_SCENARIOS:,} one sweep file may hold: split the sweep")
+    if total > max_scenarios and not yes and not matchers:      # refused before listing
+        raise SweepSpecError(f"{source}: {total:,} scenarios is more than {max_scenarios:,}: "
+                             "confirm with --yes, or narrow the axes")
+    scenarios: list[Scenario] = []
+    used, excluded = [False] * len(matchers), 0
+    for pf, arr, lv, pa, dens, per, sun in itertools.product(*axes):
+        values = {"points": pf, "arrangement": arr, "level": lv, "preserve_area": pa,
+                  "density": dens, "periodic": per, "sun": sun}
+        hit = [i for i, m in enumerate(matchers) if m(values)]
+        if hit:
+            for i in hit:
+                used[i] = True
+            excluded += 1
+            continue
+        group, full = _scenario_inputs(pf, arr, lv, pa, sun, dens, per, heights, rect, cover)
+        scenarios.append(Scenario(len(scenarios), _digest(full)[:24], _digest(group)[:24], pf, arr,
+                                  lv, pa, sun, dens, per, heights, rect, cover))
+    for i, u in enumerate(used):
+        if not u:
+            ck.fail(f"exclude[{i}]", "matches no scenario (a typo in a value?)")
+    if not scenarios:
+        raise SweepSpecError(f"{source}: exclude drops every scenario: nothing to run")
+    if len(scenarios) > max_scenarios and not yes:
+        raise SweepSpecError(f"{source}: {len(scenarios):,} scenarios is more than "
+                             f"{max_scenarios:,}: confirm with --yes, or narrow the axes")
+    document = json.loads(json.dumps(doc, default=str))
+    document["canopy"]["points"] = [{"name": p.name, "sha256": p.sha256} for p in points]
+    fingerprint = _digest(sorted(s.key for s in scenarios))[:24]
+    return SweepSpec(source, document, tuple(scenarios), excluded, fingerprint)
+
+
+def _matcher(ck: _Checker, entry: dict, where: str) -> Callable[[dict[str, Any]], bool]:
+    """A predicate over a scenario's axis values for one ``exclude`` entry."""
+    ck.known(entry, AXES, where)
+    if not entry:
+        ck.fail(where, "is empty: name at least one axis value")
+    wants: list[tuple[str, Any]] = []
+    for key, v in entry.items():
+        w = f"{where}.{key}"
+        want: Any
+        if key in ("points", "layout"):
+            want = ck.text(v, w)                           # a name or a glob
+        elif key == "tile":
+            want = ck.shape(v, w)
+        elif key in ("row_spacing", "plant_spacing", "density"):
+            want = ck.number(v, w)
+        elif key == "level":
+            want = ck.level(v, w)
+        elif key in ("preserve_area", "periodic"):
+            want = ck.boolean(v, w)
+        else:                                              # sun: every key given must agree
+            if not isinstance(v, dict) or not v:
+                ck.fail(w, "must be a table of sun keys, such as {zenith = 30}")
+            ck.known(v, SUN_ANGLE_KEYS + SUN_PLACE_KEYS, w)
+            want = {k: (x.isoformat() if isinstance(x, (date, datetime, dtime)) else
+                        float(x) if isinstance(x, int) and not isinstance(x, bool) else x)
+                    for k, x in v.items()}
+        wants.append((key, want))
+    return lambda vals: all(_matches(vals, key, want) for key, want in wants)
+
+
+def _matches(vals: dict[str, Any], key: str, want: Any) -> bool:
+    arr = vals["arrangement"]
+    if key in ("points", "layout"):
+        name = vals["points"].name if key == "points" else arr.layout
+        return name is not None and (fnmatch.fnmatch(name, want)
+                                     or fnmatch.fnmatch(Path(name).name, want))
+    if key in ("tile", "row_spacing", "plant_spacing"):
+        return bool(getattr(arr, key) == want)
+    if key == "sun":
+        given = dict(vals["sun"].given)
+        return all(given.get(k) == x for k, x in want.items())
+    return bool(vals[key] == want)

@@ -1,0 +1,118 @@
+"""The question the paper asked, for every canopy of a sweep: how coarse may the mesh be?
+
+For each canopy (points file x arrangement x area rule x ray density x periodic setting) and
+each sun, the *finest* level is the one with the most triangles; a level is *within tolerance*
+when its transmission differs from the finest level's by at most ``tolerance`` at every height.
+The answer is the cheapest level (fewest triangles) within tolerance, per sun and over all suns
+at once ("all suns": within tolerance for every sun the finest level was computed for).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from pathlib import Path
+
+from maizeviz.sweep.store import write_atomic
+
+DEFAULT_TOLERANCE = 0.02
+
+SUMMARY_COLUMNS = ("points", "arrangement", "preserve_area", "density", "periodic", "sun",
+                   "levels", "finest_level", "finest_triangles", "cheapest_level",
+                   "cheapest_triangles", "triangle_fraction", "max_abs_difference",
+                   "tolerance")
+
+
+def _arrangement(r: dict) -> str:
+    if r.get("layout"):
+        return r["layout"]
+    return f"{r['tile']} at {r['row_spacing']:g} x {r['plant_spacing']:g} cm"
+
+
+def _sun(r: dict) -> str:
+    s = f"z {r['sun_zenith_deg']:.2f} az {r['sun_azimuth_deg']:.2f}"
+    return f"{s} ({r['sun_when']})" if r.get("sun_when") else s
+
+
+def summarize(rows: list[dict], tolerance: float = DEFAULT_TOLERANCE) -> list[dict]:
+    """Summary rows (:data:`SUMMARY_COLUMNS`) from result rows (status "ok" only).
+
+    ``max_abs_difference`` is the cheapest level's largest |T - T_finest| over the heights
+    (and the suns, for the "all suns" row); ``triangle_fraction`` its triangles / the finest's.
+    """
+    # canopy -> sun -> level -> (triangles, {height: T})
+    tree: dict = {}
+    for r in rows:
+        if r.get("status") != "ok" or r.get("transmission") is None:
+            continue
+        canopy = (r["points"], _arrangement(r), r["preserve_area"], r["density"], r["periodic"])
+        per_level = tree.setdefault(canopy, {}).setdefault(_sun(r), {})
+        tri, ts = per_level.setdefault(r["level"], (r["triangles"], {}))
+        ts[r["height_cm"]] = r["transmission"]
+    out = []
+    for canopy, suns in tree.items():
+        overall: dict[str, float] = {}          # level -> worst difference over suns
+        tri_of: dict[str, int] = {}
+        counted: dict[str, int] = {}
+        n_suns = 0
+        for sun, levels in suns.items():
+            finest = max(levels, key=lambda lv: levels[lv][0])
+            f_tri, f_t = levels[finest]
+            diffs = {}
+            for lv, (tri, ts) in levels.items():
+                common = set(ts) & set(f_t)
+                diffs[lv] = max((abs(ts[h] - f_t[h]) for h in common), default=float("inf"))
+                tri_of[lv] = tri
+                overall[lv] = max(overall.get(lv, 0.0), diffs[lv])
+                counted[lv] = counted.get(lv, 0) + 1
+            n_suns += 1
+            out.append(_row(canopy, sun, levels.keys(), finest, f_tri, diffs, tri_of, tolerance))
+        if n_suns > 1:
+            # a level missing for some sun cannot be vouched for over all suns
+            worst = {lv: d if counted[lv] == n_suns else float("inf")
+                     for lv, d in overall.items()}
+            finest = max(tri_of, key=lambda lv: tri_of[lv])
+            out.append(_row(canopy, f"all {n_suns} suns", tri_of.keys(), finest, tri_of[finest],
+                            worst, tri_of, tolerance))
+    return out
+
+
+def _row(canopy, sun, levels, finest, f_tri, diffs, tri_of, tolerance) -> dict:
+    ok = [lv for lv in levels if diffs[lv] <= tolerance + 1e-12]
+    cheapest = min(ok, key=lambda lv: tri_of[lv])
+    points, arrangement, preserve, density, periodic = canopy
+    return {"points": points, "arrangement": arrangement, "preserve_area": preserve,
+            "density": density, "periodic": periodic, "sun": sun,
+            "levels": len(list(levels)), "finest_level": finest, "finest_triangles": f_tri,
+            "cheapest_level": cheapest, "cheapest_triangles": tri_of[cheapest],
+            "triangle_fraction": tri_of[cheapest] / f_tri if f_tri else float("nan"),
+            "max_abs_difference": diffs[cheapest], "tolerance": tolerance}
+
+
+def format_summary(summary: list[dict]) -> str:
+    """A small table: one line per canopy and sun."""
+    if not summary:
+        return "summary: no canopy has results to compare"
+    head = ["points", "arrangement", "density", "sun", "finest", "cheapest within tol",
+            "triangles", "max |dT|"]
+    rows = [[s["points"], s["arrangement"] + ("" if s["preserve_area"] else ", widths unscaled")
+             + (", periodic" if s["periodic"] else ""), f"{s['density']:g}", s["sun"],
+             s["finest_level"], s["cheapest_level"],
+             f"{s['cheapest_triangles']:,} ({s['triangle_fraction']:.1%})",
+             f"{s['max_abs_difference']:.4f}"] for s in summary]
+    cells = [head] + rows
+    widths = [max(len(str(r[i])) for r in cells) for i in range(len(head))]
+    lines = ["  ".join(str(c).ljust(w) for c, w in zip(r, widths)).rstrip() for r in cells]
+    lines.insert(1, "  ".join("-" * w for w in widths))
+    tol = summary[0]["tolerance"]
+    return (f"cheapest level whose transmission is within {tol:g} of the finest level's at "
+            "every height:\n" + "\n".join(lines))
+
+
+def write_summary(path, summary: list[dict]) -> None:
+    """``summary.csv`` (atomically)."""
+    buf = io.StringIO()
+    w = csv.DictWriter(buf, fieldnames=SUMMARY_COLUMNS, lineterminator="\n")
+    w.writeheader()
+    w.writerows(summary)
+    write_atomic(Path(path), buf.getvalue().encode())

@@ -1,0 +1,207 @@
+"""The canopy-layout editor as a widget over a two-plant layout: exact positions, dragging and
+turning in the top view, undo/redo, tiling presets that ask before discarding edits; and once in
+the window, the 3D view following an edit."""
+
+import json
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QPoint, QPointF, Qt, QTimer
+from PySide6.QtGui import QWheelEvent
+from PySide6.QtWidgets import QApplication, QMessageBox
+
+from maizeviz.canopy.layout import layout_to_dict, load_layout, tiled_layout
+
+#: Stalk bases with every bit of their floats used: rounding anywhere would show.
+BASES = {1: (30.023456789012345, 15.330000000000002), 2: (29.001, 44.69912345678901)}
+
+
+@pytest.fixture
+def panel(qtbot):
+    from maizeviz_app.panels.layout import LayoutPanel
+
+    p = LayoutPanel()
+    qtbot.addWidget(p)
+    p.resize(900, 500)
+    p.show()
+    qtbot.waitExposed(p)
+    p.show_layout(tiled_layout(BASES, (1, 1)), set(BASES))
+    return p
+
+
+def _answer(button):
+    """Click ``button`` of the next message box (run before the call that opens it)."""
+    def click():
+        box = QApplication.activeModalWidget()
+        if isinstance(box, QMessageBox):
+            box.button(button).click()
+        else:
+            QTimer.singleShot(20, click)
+    QTimer.singleShot(0, click)
+
+
+def test_apply_without_edits_changes_nothing(panel, qtbot):
+    original = panel.layout_.placements
+    # the table shows 0.1 cm, the editor gets every digit: opening and closing it is no edit
+    idx = panel.rows.index(0, 0)
+    assert panel.rows.data(idx) == "30.0"
+    assert float(panel.rows.data(idx, Qt.EditRole)) == BASES[1][0]
+    assert panel.rows.setData(idx, panel.rows.data(idx, Qt.EditRole))
+    assert panel.undo_stack.count() == 0
+    with qtbot.waitSignal(panel.applied) as applied:
+        panel.apply_button.click()
+    new = applied.args[0]
+    assert new.placements == original                     # exactly, not to 0.1 cm
+    assert layout_to_dict(new) == layout_to_dict(panel.layout_)
+    assert new.ground_area == panel.layout_.ground_area
+
+
+def test_labels_never_say_minus_zero(qtbot):
+    from maizeviz_app.panels.layout import LayoutPanel
+
+    p = LayoutPanel()
+    qtbot.addWidget(p)
+    bases = {1: (-0.04, 15.0), 2: (0.01, 45.0)}
+    p.show_layout(tiled_layout(bases, (1, 1)), set(bases))
+    assert "field x -30..30 cm" in p.info.text()
+    assert p.rows.data(p.rows.index(0, 0)) == "0.0"                      # not "-0.0"
+    assert p.rows.data(p.rows.index(0, 0), Qt.EditRole) == "-0.04"
+    layout = tiled_layout({1: (29.6, 15.0), 2: (29.7, 45.0)}, (1, 1))
+    p.show_layout(layout, {1, 2})
+    assert layout.bounds[0] < 0 and "field x 0..60 cm" in p.info.text()   # was "-0..60"
+
+
+def test_drag_moves_a_plant_in_the_document_and_undo_restores_it_exactly(panel, qtbot):
+    view = panel.view
+    item = view.items_[0]
+    start = view.mapFromScene(item.scenePos())
+    scale = abs(view.transform().m11())                   # pixels per cm
+    qtbot.mousePress(view.viewport(), Qt.LeftButton, pos=start)
+    for k in range(1, 6):
+        qtbot.mouseMove(view.viewport(), start + QPoint(8 * k, 0))
+    qtbot.mouseRelease(view.viewport(), Qt.LeftButton, pos=start + QPoint(40, 0))
+    p = panel.model.placements[0]
+    assert p.x - BASES[1][0] == pytest.approx(40 / scale, abs=1.5 / scale)
+    assert p.y == pytest.approx(BASES[1][1], abs=1.5 / scale)
+    assert panel.model.placements[1] == panel.layout_.placements[1]
+    xs = [r["x"] for r in panel.document()["rows"]]
+    assert p.x in xs and BASES[1][0] not in xs
+    assert panel.undo_stack.count() == 1 and "1 plant edited" in panel.state.text()
+    panel.undo_action.trigger()
+    assert panel.model.placements == list(panel.layout_.placements)
+    assert view.items_[0].pos() == QPointF(*BASES[1])
+    panel.redo_action.trigger()
+    assert panel.model.placements[0] == p
+
+
+def test_wheel_turns_a_plant_and_its_steps_are_one_undo(panel, qtbot):
+    view = panel.view
+    at = QPointF(view.mapFromScene(view.items_[1].scenePos()))
+    for _ in range(3):
+        ev = QWheelEvent(at, QPointF(view.viewport().mapToGlobal(at.toPoint())), QPoint(0, 0),
+                         QPoint(0, 120), Qt.NoButton, Qt.NoModifier, Qt.NoScrollPhase, False)
+        QApplication.sendEvent(view.viewport(), ev)
+    assert panel.model.placements[1].azimuth_deg == 15.0
+    assert view.items_[1].arrow.rotation() == 15.0
+    assert panel.rows.data(panel.rows.index(1, 3)) == "15.0"
+    assert panel.undo_stack.count() == 1
+    panel.undo_action.trigger()
+    assert panel.model.placements[1].azimuth_deg == 0.0
+
+
+def test_knob_turns_a_plant(panel, qtbot):
+    view = panel.view
+    item = view.items_[0]
+    knob = view.mapFromScene(item.knob.scenePos())
+    centre = view.mapFromScene(item.scenePos())
+    up = centre + QPoint(0, -(knob.x() - centre.x()))      # north of the plant on screen
+    qtbot.mousePress(view.viewport(), Qt.LeftButton, pos=knob)
+    qtbot.mouseMove(view.viewport(), up)
+    qtbot.mouseRelease(view.viewport(), Qt.LeftButton, pos=up)
+    assert panel.model.placements[0].azimuth_deg == 90.0  # counter-clockwise from east
+    assert (panel.model.placements[0].x, panel.model.placements[0].y) == BASES[1]
+
+
+def test_keys_undo_and_redo_table_edits(panel, qtbot):
+    panel.rows.setData(panel.rows.index(0, 1), "20")
+    panel.rows.setData(panel.rows.index(1, 2), "1")
+    assert [p.plant for p in panel.model.placements] == [1, 1]
+    panel.activateWindow()
+    panel.table.setFocus()
+    qtbot.waitUntil(panel.table.hasFocus)
+    qtbot.keyClick(panel.table, Qt.Key_Z, Qt.ControlModifier)
+    assert [p.plant for p in panel.model.placements] == [1, 2]
+    qtbot.keyClick(panel.table, Qt.Key_Z, Qt.ControlModifier)
+    assert panel.model.placements[0].y == BASES[1][1]
+    qtbot.keyClick(panel.table, Qt.Key_Z, Qt.ControlModifier | Qt.ShiftModifier)
+    assert panel.model.placements[0].y == 20.0
+    assert panel.rows.data(panel.rows.index(0, 1)) == "20.0"
+
+
+def test_bad_cells_are_refused_with_the_cell_named(panel, qtbot):
+    said = []
+    panel.problem.connect(said.append)
+    assert not panel.rows.setData(panel.rows.index(1, 2), "x")
+    assert not panel.rows.setData(panel.rows.index(1, 2), "77")
+    assert not panel.rows.setData(panel.rows.index(0, 0), "nan")
+    assert said[0] == "row 2, plant: 'x' is not a number"
+    assert "plant 77 is not in the points file (it has 1, 2)" in said[1]
+    assert "row 1, x cm" in said[2]
+    assert panel.undo_stack.count() == 0
+
+
+def test_tiling_change_asks_before_discarding_edits(panel, qtbot):
+    assert panel.tiling.currentData() == 1 and panel.tiling.isEnabled()
+    panel.rows.setData(panel.rows.index(0, 3), "45")
+    edited = list(panel.model.placements)
+    _answer(QMessageBox.Cancel)
+    assert not panel.set_tiling(3)                       # cancelled: nothing changed
+    assert panel.model.placements == edited and panel.tiling.currentData() == 1
+    _answer(QMessageBox.Discard)
+    assert panel.set_tiling(3)
+    assert len(panel.model.placements) == 18 and panel.tiling.currentData() == 3
+    assert panel.model.edits() == 0 and len(panel.view.items_) == 18
+    panel.undo_action.trigger()                          # the edits come back, exactly
+    assert panel.model.placements == edited and panel.tiling.currentData() == 1
+    # no edits, no question
+    panel.undo_action.trigger()
+    assert panel.set_tiling(5) and len(panel.model.placements) == 50
+
+
+def test_edits_follow_into_the_3d_view_and_save(panel, qtbot, tmp_path):
+    with qtbot.waitSignal(panel.applied, timeout=5000) as applied:
+        panel.rows.setData(panel.rows.index(1, 3), "90")
+    assert [p.azimuth_deg for p in applied.args[0].placements] == [0.0, 90.0]
+    assert "not applied" not in panel.state.text()
+    path = tmp_path / "lay.json"
+    assert panel.save(path)
+    back = load_layout(path, {1, 2})
+    assert sorted((p.plant, p.x, p.y, p.azimuth_deg) for p in back.placements) == \
+        sorted((p.plant, p.x, p.y, p.azimuth_deg) for p in applied.args[0].placements)
+    assert json.loads(path.read_text())["maizeviz_layout"] == 1
+    # a layout file replaces the tiling, undoably
+    other = tmp_path / "other.json"
+    doc = layout_to_dict(panel.layout_)
+    doc["rows"] = [{"x": 10.5, "plants": [{"y": 20.25, "plant": 2, "azimuth_deg": 30}]}]
+    other.write_text(json.dumps(doc))
+    _answer(QMessageBox.Discard)
+    assert panel.load(other)
+    assert [(p.plant, p.x, p.y) for p in panel.model.placements] == [(2, 10.5, 20.25)]
+    assert panel.tiling.currentData() is None
+    panel.undo_action.trigger()
+    assert len(panel.model.placements) == 2
+
+
+def test_layout_editor_in_the_window_turns_a_plant(window, two_plants, qtbot):
+    w = window(two_plants, tile=1)
+    qtbot.waitSignal(w.canopy_shown, timeout=120_000).wait()
+    panel = w.layout_panel
+    assert panel.rows.rowCount() == 2
+    first = panel.model.placements[0].plant
+    before = w.canopy.vertices[w.canopy.faces[w.canopy.face_plant == first]].copy()
+    with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
+        panel.rows.setData(panel.rows.index(0, 3), "90")      # the 3D view follows
+    after = w.canopy.vertices[w.canopy.faces[w.canopy.face_plant == first]]
+    assert not np.allclose(before, after)
+    assert [p.azimuth_deg for p in w.loaded.layout.placements if p.plant == first] == [90]
+    assert w.loaded.layout.ground_area_cm2 == pytest.approx(60 * 60)   # the tiling's ground
