@@ -16,6 +16,7 @@ from maizeviz.io.atomic import atomic_open, check_output
 from maizeviz.io.meshfile import check_mesh_path
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.mesh.levels import Level, parse_levels
+from maizeviz.progress import ProgressCallback
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_PARTIAL = 0, 1, 2, 3
 
@@ -148,10 +149,10 @@ def check_canopy_costs(leaves: list[Leaf], layout: CanopyLayout, levels: list[Le
     check([[canopy_cost(leaves, placed, level), *per_level] for level in levels], force)
 
 
-def load_leaves(path: str, strict: bool = False, degree: int = 3,
-                method: str = "chord") -> tuple[list[Leaf], list[LeafError]]:
+def load_leaves(path: str, strict: bool = False, degree: int = 3, method: str = "chord",
+                progress: ProgressCallback | None = None) -> tuple[list[Leaf], list[LeafError]]:
     """Read, grid and fit a points file, saying skipped lines and repairs on stderr."""
-    found = read_leaves(path, strict, degree, method)
+    found = read_leaves(path, strict, degree, method, progress)
     for problem in found.problems:
         say(f"warning: {problem}")
     for note in found.notes:

@@ -6,6 +6,7 @@ import argparse
 import json
 
 from maizeviz.cli.common import (
+    Progress,
     add_level_options,
     check_export,
     fmt_table,
@@ -16,11 +17,15 @@ from maizeviz.cli.common import (
 )
 from maizeviz.io.atomic import refuse_overwriting_inputs
 from maizeviz.io.meshfile import write_mesh
-from maizeviz.mesh.levels import DEFAULT_LEVELS, measure, mesh_leaves
+from maizeviz.mesh.levels import DEFAULT_LEVELS, measure_leaves, mesh_leaves, reference_areas
 from maizeviz.mesh.tessellate import merge_meshes
+from maizeviz.progress import ProgressCallback
 
 #: The subcommand.
 NAME = "leaf"
+#: Files with at least this many leaves get progress bars (on a terminal): 2,000 leaves take
+#: a few seconds.
+LONG_FILE_LEAVES = 2000
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -46,16 +51,18 @@ def run(args: argparse.Namespace) -> int:
     levels = levels_from(args)
     check_export(args.export, levels)
     refuse_overwriting_inputs([("the mesh export", args.export)], [args.points])
-    leaves, skipped = load_leaves(args.points, args.strict, args.degree, args.params)
+    leaves, skipped = load_leaves(args.points, args.strict, args.degree, args.params,
+                                  progress=_bar("gathering leaves"))
+    reference_areas(leaves)           # in batches, before a triangle budget asks leaf by leaf
     per_level = []
     for level in levels:
-        meshes = mesh_leaves(leaves, level, args.preserve_area)
-        per_level.append((level, meshes, [measure(lf, m) for lf, m in zip(leaves, meshes)]))
-
-    if args.export and leaves:
-        path = write_mesh(args.export, *merge_meshes(per_level[0][1]))
-        say(f"wrote {sum(m.n_triangles for m in per_level[0][1])} triangles of "
-            f"{len(leaves)} leaves to {path}")
+        meshes = mesh_leaves(leaves, level, args.preserve_area, progress=_bar(f"meshing {level}"))
+        per_level.append((level, measure_leaves(leaves, meshes, _bar(f"measuring {level}"))))
+        if args.export and leaves:    # one level (check_export); meshes are not kept
+            path = write_mesh(args.export, *merge_meshes(meshes))
+            say(f"wrote {sum(m.n_triangles for m in meshes)} triangles of "
+                f"{len(leaves)} leaves to {path}")
+        del meshes
 
     skipped_json = [{"plant": e.plant, "leaf": e.leaf, "error": e.detail} for e in skipped]
     if args.json:
@@ -64,12 +71,12 @@ def run(args: argparse.Namespace) -> int:
             out = {"levels": [str(lv) for lv in levels], "leaves": [
                 {"plant": lf.grid.plant, "leaf": lf.grid.leaf, "rows": lf.grid.shape[0],
                  "cols": lf.grid.shape[1], "notes": list(lf.grid.notes),
-                 "levels": [ms[i].as_dict() for _, _, ms in per_level]}
+                 "levels": [ms[i].as_dict() for _, ms in per_level]}
                 for i, lf in enumerate(leaves)]}
         else:
             out = {"level": str(levels[0]),
                    "leaves": [dict(ms.as_dict(), notes=list(lf.grid.notes))
-                              for lf, ms in zip(leaves, per_level[0][2])]}
+                              for lf, ms in zip(leaves, per_level[0][1])]}
         out["skipped"] = skipped_json
         print(json.dumps(out, indent=1))
     elif args.levels is not None:
@@ -81,10 +88,10 @@ def run(args: argparse.Namespace) -> int:
                  "max dev cm"],
                 [[ms[i].level, ms[i].triangles, f"{ms[i].area_cm2:.1f}",
                   f"{ms[i].area_error_pct:+.1f}", f"{ms[i].projected_area_cm2:.1f}",
-                  f"{ms[i].max_deviation_cm:.2f}"] for _, _, ms in per_level]))
+                  f"{ms[i].max_deviation_cm:.2f}"] for _, ms in per_level]))
             print()
     else:
-        ms = per_level[0][2]
+        ms = per_level[0][1]
         print(f"level: {levels[0]}")
         print(fmt_table(
             ["plant", "leaf", "rows x cols", "triangles", "area cm2", "projected cm2",
@@ -95,3 +102,9 @@ def run(args: argparse.Namespace) -> int:
             print(f"total: {len(ms)} leaves, {sum(m.triangles for m in ms)} triangles, "
                   f"{sum(m.area_cm2 for m in ms):.1f} cm2 of leaf")
     return leaves_summary(len(leaves), skipped)
+
+
+def _bar(label: str) -> ProgressCallback:
+    """A terminal progress bar for work over :data:`LONG_FILE_LEAVES` leaves or more."""
+    bar = Progress(label)
+    return lambda done, total: bar(done, total) if total >= LONG_FILE_LEAVES else None

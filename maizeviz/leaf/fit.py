@@ -17,6 +17,7 @@ from maizeviz.errors import LeafError, MaizevizError
 from maizeviz.io.points import read_points
 from maizeviz.leaf.grid import LeafGrid, build_grids
 from maizeviz.leaf.nurbs import NurbsSurfaces, fit_surfaces
+from maizeviz.progress import ProgressCallback
 
 #: Parameterisations of the data points (The NURBS Book, eqs. 9.5 and 9.6).
 PARAMETER_METHODS = ("chord", "centripetal")
@@ -96,8 +97,12 @@ class LeavesFromFile:
 
 
 def read_leaves(path: str | Path, strict: bool = False, degree: int = 3,
-                method: str = "chord") -> LeavesFromFile:
+                method: str = "chord",
+                progress: ProgressCallback | None = None) -> LeavesFromFile:
     """Read, grid and fit a points file.
+
+    ``progress(done, total)`` follows the gathering of leaf grids (in leaves); returning
+    ``False`` stops with :class:`InterruptedError`.
 
     Raises
     ------
@@ -114,7 +119,7 @@ def read_leaves(path: str | Path, strict: bool = False, degree: int = 3,
     problems = [f"{table.source}: {p}" for p in table.problems]
     if strict and problems:
         raise MaizevizError(problems[0])
-    grids, errors = build_grids(table, strict=strict)
+    grids, errors = build_grids(table, strict=strict, progress=progress)
     notes = [f"plant {g.plant}, leaf {g.leaf}: {n}" for g in grids for n in g.notes]
     leaves, fit_errors = fit_leaves(grids, degree, method, strict=strict)
     return LeavesFromFile(leaves, errors + fit_errors, problems, notes)

@@ -300,7 +300,6 @@ def _regular_grids(seg: _Segments, xyz: np.ndarray) -> dict[int, LeafGrid]:
     last = seg.first_row[1:] - 1
     n = row_len[first]
     tip = row_len[last] == 1
-    full_rows = nrows - tip
     bad_leaf |= (nrows < 2) | (n < 2)
     wrong = row_len != n[seg.row_leaf]
     wrong[last[tip]] = False
