@@ -332,18 +332,16 @@ def max_deviations(vertices: np.ndarray, u: np.ndarray, v: np.ndarray, ref_point
     pcols = tuple(np.ascontiguousarray(ref_points[..., k]).reshape(-1) for k in range(3))
     bound = _distances(pcols, tri, own.reshape(-1)).reshape(nl, npts)
 
+    step = np.arange(-1, 2)
+
     def exact(leaf: np.ndarray, point: np.ndarray) -> np.ndarray:
         """Smallest distance over the 18 candidate triangles of the points (leaf, point)."""
-        best = np.full(len(leaf), np.inf)
-        i0, j0 = ci[leaf, point // nb], cj[leaf, point % nb]
-        p = tuple(c[leaf * npts + point] for c in pcols)
-        for di in (-1, 0, 1):
-            ii = np.clip(i0 + di, 0, a - 2)
-            for dj in (-1, 0, 1):
-                cell = leaf * nf + 2 * (ii * (b - 1) + np.clip(j0 + dj, 0, b - 2))
-                for t in (0, 1):
-                    np.fmin(best, _distances(p, tri, cell + t), out=best)
-        return best
+        ii = np.clip(ci[leaf, point // nb][:, None] + step, 0, a - 2)           # (N, 3)
+        jj = np.clip(cj[leaf, point % nb][:, None] + step, 0, b - 2)
+        cell = (leaf * nf)[:, None, None] + 2 * (ii[:, :, None] * (b - 1) + jj[:, None, :])
+        which = (cell[..., None] + np.arange(2)).reshape(-1)                   # (N * 18,)
+        p = tuple(np.repeat(c[leaf * npts + point], 18) for c in pcols)
+        return np.fmin.reduce(_distances(p, tri, which).reshape(len(leaf), 18), axis=1)
 
     k = min(_TOP_POINTS, npts)
     top = np.argpartition(bound, npts - k, axis=1)[:, npts - k:]         # (L, k)
