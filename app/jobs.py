@@ -166,7 +166,9 @@ class DaySpec:
 class Diffuse:
     """A sky or period result with what the window shows of it, made in the child: per-leaf
     rows (``leaf_rows``), per-plant rows (``plant_rows``), and each leaf triangle's value for
-    colouring the canopy (``leaf_value`` (F,) float32: the leaf's light per m2 of leaf)."""
+    colouring the canopy (``leaf_value`` (F,) float32: its leaf's light per unit leaf area;
+    a day: PAR mol per m2 of leaf; a sky: the leaf's mean diffuse irradiance as a fraction of
+    the sky's on open ground)."""
 
     light: Any
     leaf_rows: list
@@ -182,6 +184,8 @@ def _diffuse(state: dict, light, rows: list, column: str, build_s: float) -> Dif
     from maizeviz.light.reports import leaf_values
 
     values = leaf_values(state["canopy"], rows, column, light.rect, light.periodic)
+    if column == "diffuse_intercepted_cm2":
+        values *= 1e-4          # cm2 of ground per m2 of leaf -> per unit leaf area
     return Diffuse(light, rows, plant_light(rows), values.astype(np.float32), build_s)
 
 

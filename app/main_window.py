@@ -319,12 +319,11 @@ class MainWindow(QMainWindow):
         self.layout_panel = LayoutPanel()
         self.layout_panel.applied.connect(self._on_layout)
         self.layout_panel.problem.connect(self.say)
-        self.digitizer = DigitizerPanel(None)
+        self.digitizer = DigitizerPanel(self.viewport)
         self.digitizer.alert.connect(lambda text: self.say(text, error=True, status_only=True))
         self.digitizer.stopped.connect(self._digitizing_stopped)
         self.docks["layout"].setWidget(_scrolled(self.layout_panel))
         self.docks["digitizer"].setWidget(_scrolled(self.digitizer))
-        self.digitizer.viewport = self.viewport
         if self.loaded is not None:
             self.layout_panel.show_layout(self.loaded.layout, self.loaded.plants)
 
@@ -1177,29 +1176,30 @@ def _value_legend(run: Run) -> tuple[str, str]:
     """Colour-bar title and unit of a sky's or day's light per leaf."""
     if run.kind == "day":
         return "PAR intercepted per leaf over the day", "mol/m² leaf"
-    return "diffuse light per leaf (× the sky's, per m² of leaf)", ""
+    return "diffuse light per leaf area (1: the sky's on open ground)", ""
 
 
 def _run_info(run: Run) -> str:
     """What was traced and how long it took, for the light panel."""
     r = run.result
     secs = r.seconds
-    build = run.extra.build_s if run.extra is not None else secs.get("build", 0)
+    build_s = run.extra.build_s if run.extra is not None else secs.get("build", 0)
+    build = f"{build_s:.2f} s" if build_s > 0 else "kept from the last run"
     if run.kind == "sun":
         info = (f"{r.rays:,} rays on the central tile at {r.density_per_cm2:.2f} per cm²; "
-                f"level {run.label}; Embree scene {build:.2f} s, tracing "
+                f"level {run.label}; Embree scene {build}, tracing "
                 f"{secs.get('trace', 0) + secs.get('second', 0):.2f} s")
         share = r.sunlit_intercepted_fraction
         if share is not None:
             info += f"; leaves take {share:.1%} of the direct light"
     elif run.kind == "sky":
         info = (f"{r.sky.description}; {r.rays:,} rays per direction; level {run.label}; "
-                f"Embree scene {build:.2f} s, tracing {secs.get('trace', 0):.2f} s; leaves "
+                f"Embree scene {build}, tracing {secs.get('trace', 0):.2f} s; leaves "
                 f"take {r.intercepted_fraction:.1%} of the diffuse light")
     else:
         sky = r.sky.sky.description if r.sky is not None else "no sky"
         info = (f"{r.n_steps} time steps and the sky ({sky}); {r.rays:,} rays per "
-                f"direction; level {run.label}; Embree scene {build:.2f} s, tracing "
+                f"direction; level {run.label}; Embree scene {build}, tracing "
                 f"{secs.get('trace', 0):.2f} s")
     return info + "".join(f"\n⚠ {w}" for w in r.warnings if "sun never rises" not in w)
 

@@ -65,8 +65,12 @@ def transmission_figure(curves: Sequence[Curve], title: str = "", width_in: floa
                 ha="center", va="center", transform=ax.transAxes, fontsize=9, color="0.4")
     default = ("transmission by height, per mesh level (the paper's Table 3)"
                if kinds <= {"sun"} else "transmission by height, per mesh level and light")
-    ax.set_title(title or default, fontsize=9)
-    fig.subplots_adjust(left=0.12, right=0.97, bottom=0.14, top=0.9)   # tight_layout: 2 draws
+    import textwrap
+
+    lines = textwrap.wrap(title or default, int(11 * width_in))
+    ax.set_title("\n".join(lines), fontsize=9)
+    fig.subplots_adjust(left=0.12, right=0.97, bottom=0.14,            # tight_layout: 2 draws
+                        top=0.9 - 0.05 * (len(lines) - 1))
     return fig
 
 

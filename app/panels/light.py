@@ -869,6 +869,7 @@ class LightPlots(QWidget):
         self.source = QComboBox()
         self.source.setToolTip("which light's map: the direct sun, the diffuse sky or the "
                                "day's PAR")
+        self.source.setSizeAdjustPolicy(QComboBox.AdjustToContents)
         self.source.currentIndexChanged.connect(lambda _i: self._show_height(
             self.height.currentIndex()))
         top.addWidget(self.source)
