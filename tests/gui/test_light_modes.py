@@ -51,6 +51,7 @@ def test_sky_mode_adds_a_diffuse_curve_maps_and_colours(window, qtbot, small_poi
     assert panel.compute_button.text() == "Compute diffuse light"
     compute(qtbot, w)
     assert headers(panel.table) == ["height cm", "36 triangles", "36 triangles, overcast sky"]
+    assert "Embree scene kept from the last run" in panel.info.text()   # the sun's scene
     diffuse = column(panel.table, "36 triangles, overcast sky")
     assert all(0 <= t <= 1 for t in diffuse) and diffuse == sorted(diffuse)
     assert diffuse[0] < 0.3 and diffuse[-1] > 0.5
