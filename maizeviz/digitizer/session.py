@@ -60,6 +60,11 @@ HEADER = (",".join(COLUMNS) + "\r\n").encode("ascii")
 MAX_JOURNAL_LINES = 1_000_000
 
 
+def _count(n: int, word: str) -> str:
+    """``1 point``, ``2 points``."""
+    return f"{n} {word}{'' if n == 1 else 's'}"
+
+
 class SessionError(MaizevizError):
     """The session cannot record (output not writable, disk full, bad resume file)."""
 
@@ -579,8 +584,10 @@ class Session:
 
     def summary(self) -> str:
         c = self.count
-        return (f"{c.points} points, {len(c.leaves)} leaves, {len(c.plants)} plants recorded "
-                f"in {self.path}; {c.undone} undone, {c.refused} refused, {c.garbled} garbled")
+        leaves = f"{len(c.leaves)} {'leaf' if len(c.leaves) == 1 else 'leaves'}"
+        return (f"{_count(c.points, 'point')}, {leaves}, {_count(len(c.plants), 'plant')} "
+                f"recorded in {self.path}; {c.undone} undone, {c.refused} refused, "
+                f"{c.garbled} garbled")
 
     def close(self) -> None:
         """Close the file and let go of the lock; safe to call twice."""

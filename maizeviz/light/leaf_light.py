@@ -88,35 +88,21 @@ def leaf_light(canopy: Canopy, result: LightResult) -> list[LightRow]:
     """
     if result.first_hits is None or result.second_hits is None:
         raise MaizevizError("hit classes were not traced")
-    area, normals = triangle_areas_normals(canopy.vertices, canopy.faces)
+    _, normals = triangle_areas_normals(canopy.vertices, canopy.faces)
     s = result.direction
-    cos_inc = np.abs(normals @ s)
-    beam = result.ray_area_cm2 * s[2]
+    # a ray on a grazing triangle stands for more than the triangle: capped per leaf below
+    lit = result.ray_area_cm2 * s[2] / np.maximum(np.abs(normals @ s), 1e-6)
     nf = canopy.n_triangles
-    rep = tile_representatives(canopy.layout, result.rect, result.periodic)
-    keys = rep[canopy.face_instance] * 10_000 + canopy.face_leaf
-    first = result.first_hits[:nf]
-    second = result.second_hits[:nf]
-    # a grazing triangle can collect a ray "worth" more than its area; cap by leaf below
-    lit1 = first * beam / np.maximum(cos_inc, 1e-6)
-    lit2 = second * beam / np.maximum(cos_inc, 1e-6)
-    touched = np.unique(keys[(first > 0) | (second > 0)])
-    order = np.argsort(keys, kind="stable")
-    sk = keys[order]
-    rows: list[LightRow] = []
-    for key in touched:
-        a, b = np.searchsorted(sk, key, "left"), np.searchsorted(sk, key, "right")
-        idx = order[a:b]
-        inst = int(key // 10_000)
-        leaf_area = float(area[idx].sum()) / len(np.unique(canopy.face_instance[idx]))
-        rows.append({"instance": inst + 1, "plant": int(canopy.face_plant[idx[0]]),
-                     "leaf": int(key % 10_000), "x_cm": canopy.layout.placements[inst].x,
-                     "y_cm": canopy.layout.placements[inst].y,
-                     "leaf_area_cm2": leaf_area,
-                     "sunlit_area_cm2": min(float(lit1[idx].sum()), leaf_area),
-                     "second_class_area_cm2": min(float(lit2[idx].sum()), leaf_area),
-                     "sunlit_intercepted_cm2": float(first[idx].sum() * result.ray_area_cm2),
-                     "second_class_intercepted_cm2": float(second[idx].sum() * result.ray_area_cm2)})
+    first = result.first_hits[:nf].astype(np.float64)
+    second = result.second_hits[:nf].astype(np.float64)
+    rows = leaf_sums(canopy, {"sunlit_area_cm2": first * lit,
+                              "second_class_area_cm2": second * lit,
+                              "sunlit_intercepted_cm2": first * result.ray_area_cm2,
+                              "second_class_intercepted_cm2": second * result.ray_area_cm2},
+                     result.rect, result.periodic)
+    for r in rows:
+        for k in ("sunlit_area_cm2", "second_class_area_cm2"):
+            r[k] = min(float(r[k]), float(r["leaf_area_cm2"]))
     return rows
 
 
