@@ -815,6 +815,7 @@ class ImageView(QLabel):
 
     def __init__(self, placeholder: str = "", parent=None):
         super().__init__(placeholder, parent)
+        self._placeholder = placeholder
         self._image: QImage | None = None
         self.setAlignment(Qt.AlignCenter)
         self.setMinimumSize(160, 120)
@@ -825,6 +826,7 @@ class ImageView(QLabel):
         if rgba is None:
             self._image = None
             self.clear()
+            self.setText(self._placeholder)         # what will appear here
             return
         h, w = rgba.shape[:2]
         self._image = QImage(np.ascontiguousarray(rgba).data, w, h, 4 * w,
