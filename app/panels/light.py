@@ -420,7 +420,7 @@ class LightPanel(QWidget):
         self.sky_split.setCurrentIndex(list(SKY_SPLITS).index(46))
         self.sky_split.setToolTip("the directions the sky is traced from, each weighted by its "
                                   "share of the horizontal diffuse light (the weights sum to 1)")
-        self.sky_n = QSpinBox(minimum=0, maximum=400, value=46, suffix=" directions")
+        self.sky_n = QSpinBox(minimum=0, maximum=1000, value=46, suffix=" directions")
         self.sky_n.setToolTip("directions of an equal-area split of the sky (each cell the "
                               "same solid angle)")
         split_row = QHBoxLayout()
