@@ -15,7 +15,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from maizeviz_app.options import TILINGS, tiling_of  # noqa: F401 - tiling_of: re-exported
+from maizeviz_app.options import TILINGS, tiling_of
 from maizeviz_app.panels.field_view import FieldView
 from maizeviz_app.panels.layout_model import (
     EditedLayout,

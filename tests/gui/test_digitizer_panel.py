@@ -131,7 +131,7 @@ def test_q_in_the_same_tick_as_a_point(qtbot, make_panel, sim, tmp_path):
     assert stopped.args == ["finished"]
     pts = read_points(out)
     assert len(pts) == 1 and np.allclose(pts.xyz[0], (1.0, 2.0, 3.0))
-    assert "1 points" in panel.counts.text()
+    assert "1 point, 1 leaf" in panel.counts.text()     # the session summary says 1 point
 
 
 def test_refused_point_and_garbled_record_are_loud(qtbot, make_panel, sim, tmp_path):
