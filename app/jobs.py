@@ -91,22 +91,154 @@ def op_measure(state: dict, progress: ProgressCallback, cover_resolution: float)
     return measure_canopy(state["canopy"], cover_resolution=cover_resolution)
 
 
+def _scene(state: dict, periodic: bool):
+    """The child's Embree scene for its canopy (a periodic field's holds copies of the leaves
+    overhanging the plot edges), built once and kept for every later sun, sky or day; and the
+    seconds it took here (0 when it was kept)."""
+    key = ("scene", bool(periodic))
+    if key in state:
+        return state[key], 0.0
+    t0 = time.perf_counter()
+    state[key] = light_scene(state["canopy"], False, bool(periodic))
+    return state[key], time.perf_counter() - t0
+
+
 def op_light(state: dict, progress: ProgressCallback, request: LightRequest) -> LightResult:
-    """Trace the sun through the child's canopy; the scene (a periodic field's holds copies of
-    the leaves overhanging the plot edges) is kept for the next sun."""
-    build_s = 0.0
-    key = ("scene", bool(request.periodic))
-    if key not in state:
-        t0 = time.perf_counter()
-        state[key] = light_scene(state["canopy"], False, bool(request.periodic))
-        build_s = time.perf_counter() - t0
-    result = trace_light(state["canopy"], request, progress, False, state[key])
-    result.seconds["build"] = build_s              # the scene kept from an earlier sun: 0
+    """Trace the sun through the child's canopy (on the scene it keeps)."""
+    scene, build_s = _scene(state, request.periodic)
+    result = trace_light(state["canopy"], request, progress, False, scene)
+    result.seconds["build"] = build_s              # the scene kept from an earlier run: 0
     return result
+
+
+@dataclass(frozen=True)
+class SkySpec:
+    """A discretised sky: ``kind`` "soc" or "uoc", ``directions`` (16, 46, 145 or any n for
+    an equal-area split), ``split`` "auto" or "equal" (see maizeviz.light.sky.make_sky)."""
+
+    kind: str = "soc"
+    directions: int = 46
+    split: str = "auto"
+
+    def sky(self):
+        from maizeviz.light.sky import make_sky
+
+        return make_sky(self.kind, self.directions, self.split)
+
+
+@dataclass(frozen=True)
+class DaySpec:
+    """A day (or part of it) at a place: clear sky (Ineichen-Perez, ``linke`` turbidity) or a
+    weather file (``weather``: its path; it sets the period and its steps)."""
+
+    date: str = "2005-08-01"
+    lat: float = 39.9
+    lon: float = 116.4
+    tz: str = "Asia/Shanghai"
+    step_min: float = 30.0
+    start: str | None = None
+    end: str | None = None
+    linke: float = 3.0
+    par_factor: float = 2.1936
+    weather: str | None = None
+
+    def period(self):
+        """The Period (maizeviz.light.irradiance) the spec describes; refused with a
+        MaizevizError naming the quantity (date, tz, step, period, weather...)."""
+        from maizeviz.errors import MaizevizError
+        from maizeviz.light import irradiance as irr
+
+        if self.weather:
+            weather = irr.read_weather(self.weather, tz=self.tz or None)
+            period = irr.weather_period(weather, self.lat, self.lon, 0.0, self.par_factor)
+        else:
+            period = irr.clear_sky_period(self.date, self.lat, self.lon, self.tz or "UTC",
+                                          self.step_min, self.start or None, self.end or None,
+                                          0.0, self.linke, self.par_factor)
+        if period.n_steps == 0:
+            note = period.notes[0] if period.notes else "the sun never rises in this period"
+            raise MaizevizError(f"{note}; choose another date or place",
+                                quantity="place" if self.weather else "date")
+        return period
+
+
+@dataclass(frozen=True)
+class Diffuse:
+    """A sky or period result with what the window shows of it, made in the child: per-leaf
+    rows (``leaf_rows``), per-plant rows (``plant_rows``), and each leaf triangle's value for
+    colouring the canopy (``leaf_value`` (F,) float32: its leaf's light per unit leaf area;
+    a day: PAR mol per m2 of leaf; a sky: the leaf's mean diffuse irradiance as a fraction of
+    the sky's on open ground)."""
+
+    light: Any
+    leaf_rows: list
+    plant_rows: list
+    leaf_value: Any
+    build_s: float = 0.0
+
+
+def _diffuse(state: dict, light, rows: list, column: str, build_s: float) -> Diffuse:
+    import numpy as np
+
+    from maizeviz.light.leaf_light import plant_light
+    from maizeviz.light.reports import leaf_values
+
+    values = leaf_values(state["canopy"], rows, column, light.rect, light.periodic)
+    if column == "diffuse_intercepted_cm2":
+        values *= 1e-4          # cm2 of ground per m2 of leaf -> per unit leaf area
+    return Diffuse(light, rows, plant_light(rows), values.astype(np.float32), build_s)
+
+
+def _sky_key(spec: SkySpec, sampling) -> tuple:
+    return (spec, tuple(float(h) for h in sampling.heights_cm), float(sampling.density),
+            sampling.rect, bool(sampling.periodic))
+
+
+def op_sky(state: dict, progress, sampling, spec: SkySpec) -> Diffuse:
+    """Diffuse light under a sky (one scene, every direction traced like the sun); the result
+    is kept so a day on the same canopy, sampling and sky reuses it."""
+    from maizeviz.light.daylight import trace_sky
+    from maizeviz.light.reports import sky_leaf_rows
+
+    sky = spec.sky()
+    scene, build_s = _scene(state, sampling.periodic)
+
+    def steps(done: int, total: int):
+        return progress(done, total, f"sky direction {done} of {total}")
+
+    light = trace_sky(state["canopy"], sky, sampling, steps, False, scene)
+    state["sky_light"] = (_sky_key(spec, sampling), light)
+    return _diffuse(state, light, sky_leaf_rows(state["canopy"], light),
+                    "diffuse_intercepted_cm2", build_s)
+
+
+def op_period(state: dict, progress, sampling, sky: SkySpec, day: DaySpec) -> Diffuse:
+    """Light over a day: the sun traced at every step, the sky once (or the sky result kept
+    from a sky run with the same settings)."""
+    from maizeviz.light.daylight import SkyLight, trace_period
+    from maizeviz.light.reports import period_leaf_rows
+
+    period = day.period()
+    kept = state.get("sky_light")
+    diffuse = kept[1] if kept is not None and kept[0] == _sky_key(sky, sampling) else sky.sky()
+    n_sky = 0 if isinstance(diffuse, SkyLight) else diffuse.n
+    scene, build_s = _scene(state, sampling.periodic)
+
+    def steps(done: int, total: int):
+        if done <= n_sky:
+            return progress(done, total, f"sky direction {done} of {n_sky}")
+        return progress(done, total, f"time step {done - n_sky} of {total - n_sky}")
+
+    light = trace_period(state["canopy"], period, sampling, diffuse, steps, False, scene)
+    if light.sky is not None:
+        state["sky_light"] = (_sky_key(sky, sampling), light.sky)
+    return _diffuse(state, light, period_leaf_rows(state["canopy"], light),
+                    "par_intercepted_mol", build_s)
 
 
 def op_ping(state: dict, progress: ProgressCallback) -> str:
     return "pong"
 
 
-OPS = {"measure": op_measure, "light": op_light, "ping": op_ping}
+OPS = {"measure": op_measure, "light": op_light, "sky": op_sky, "period": op_period,
+       "ping": op_ping}

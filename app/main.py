@@ -49,8 +49,9 @@ def run(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("points", nargs="?",
                     help="points CSV or .maizeviz project (default: the last one opened, or "
                          "the bundled 3x3 block)")
-    ap.add_argument("--tile", type=int, default=3, choices=(1, 3, 5),
-                    help="tiling of the digitized block (default 3: the paper's 81 plants)")
+    ap.add_argument("--tile", type=int, default=3, choices=(1, 3, 5, 7, 9),
+                    help="tiling of the digitized block, N x N (default 3: the paper's 81 "
+                         "plants)")
     ap.add_argument("--screenshot", metavar="PNG", help="save the window and quit")
     ap.add_argument("--size", default="1366x768", metavar="WxH",
                     help="window size for --screenshot (default 1366x768, a laptop screen)")

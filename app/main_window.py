@@ -11,7 +11,9 @@ How it stays responsive:
   (:mod:`maizeviz_app.process`). The GUI thread only swaps in results: a new canopy's mesh is
   prepared by the worker, the figures are drawn by the worker.
 - The 3D view renders once per change and never when idle (:mod:`maizeviz_app.viewport`).
-- The level label, Table 2 and the view change together when a built canopy arrives.
+- The level label, Table 2 and the view change together when a built canopy arrives (while
+  the digitizer records, the view keeps the plant being digitized and the new canopy waits
+  until the session stops).
 
 Errors go to the status bar and the Messages panel as one line for people
 (:mod:`maizeviz_app.messages`), never as a modal box that would stop a technician in the field;
@@ -27,6 +29,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 from PySide6.QtCore import QSettings, Qt, QTimer, Signal
 from PySide6.QtWidgets import (QApplication, QDockWidget, QFileDialog, QHBoxLayout, QLabel,
                                QMainWindow, QMessageBox, QPlainTextEdit,
@@ -38,7 +41,8 @@ from maizeviz.mesh.levels import COMPLEXITY_STOPS as LEVELS  # noqa: F401 - the 
 from maizeviz.resources import example_points
 from maizeviz_app.messages import user_message
 from maizeviz_app.panels.canopy import CanopyPanel
-from maizeviz_app.panels.light import InputProblem, LightPanel, LightPlots, LightRuns, Run
+from maizeviz_app.panels.light import (COMPUTE_TEXT, InputProblem, LightPanel, LightPlots,
+                                       LightRuns, Run)
 from maizeviz_app.workers import JobRunner, describe_internal
 
 #: Version of the saved dock layout; bump when docks change so an old layout is not applied.
@@ -99,6 +103,8 @@ class MainWindow(QMainWindow):
         self.built = None
         self.measures_rows: dict[str, dict] = {}
         self.runs = LightRuns()
+        self._tile = tile                 # tiling until a layout is on screen (then: its own)
+        self._view_pending = None         # (canopy, mesh) built while the digitizer records
         self.project_path: str | None = None
         self._serial = 0                  # changes whenever the points or layout change
         self._pending_runs: list = []     # light results of a project, waiting for a canopy
@@ -109,7 +115,7 @@ class MainWindow(QMainWindow):
         self._points_origin = ""          # where the points came from (a project's original)
         self._layout_edited = False       # the layout is not the tiling of the settings
         self._project_layout = False
-        self._heatmaps_for: object = None
+        self._heatmaps_for: dict[str, Run] = {}    # light -> the run whose maps are shown
 
         placeholder = QLabel("starting the 3D view…", alignment=Qt.AlignCenter)
         self._centre = QStackedWidget()
@@ -117,7 +123,7 @@ class MainWindow(QMainWindow):
         self._centre.addWidget(placeholder)
         self.setCentralWidget(self._centre)
         self.docks: dict[str, QDockWidget] = {}
-        self._build_panels(tile)
+        self._build_panels()
         self._build_status()
         from maizeviz_app.menus import build_menus
 
@@ -140,13 +146,12 @@ class MainWindow(QMainWindow):
         self.docks[name] = dock
         return dock
 
-    def _build_panels(self, tile: int) -> None:
+    def _build_panels(self) -> None:
         self.setCorner(Qt.BottomRightCorner, Qt.RightDockWidgetArea)
         self.setCorner(Qt.TopRightCorner, Qt.RightDockWidgetArea)
         self.setDockOptions(QMainWindow.AnimatedDocks | QMainWindow.AllowTabbedDocks)
-        self.canopy_panel = CanopyPanel(tile)
+        self.canopy_panel = CanopyPanel()
         self.canopy_panel.open_requested.connect(self.choose_points)
-        self.canopy_panel.tile_changed.connect(lambda _n: self.reload())
         self.canopy_panel.level_requested.connect(lambda _lv: self.rebuild())
         self.canopy_panel.preserve_changed.connect(lambda _b: self.rebuild())
         self.light_panel = LightPanel()
@@ -154,6 +159,7 @@ class MainWindow(QMainWindow):
         self.light_panel.cancel_requested.connect(lambda: self.cancel_jobs("light"))
         self.light_panel.place_requested.connect(lambda _t: self.sun_from_place())
         self.light_panel.export_requested.connect(self.choose_export)
+        self.light_panel.mode_changed.connect(lambda _m: self.light_panel.clear_problem())
         # the layout editor and the digitizer import much of the core: they are made once the
         # window is on screen (see _make_late_panels)
         self.layout_panel = None
@@ -313,12 +319,11 @@ class MainWindow(QMainWindow):
         self.layout_panel = LayoutPanel()
         self.layout_panel.applied.connect(self._on_layout)
         self.layout_panel.problem.connect(self.say)
-        self.digitizer = DigitizerPanel(None)
+        self.digitizer = DigitizerPanel(self.viewport)
         self.digitizer.alert.connect(lambda text: self.say(text, error=True, status_only=True))
         self.digitizer.stopped.connect(self._digitizing_stopped)
         self.docks["layout"].setWidget(_scrolled(self.layout_panel))
         self.docks["digitizer"].setWidget(_scrolled(self.digitizer))
-        self.digitizer.viewport = self.viewport
         if self.loaded is not None:
             self.layout_panel.show_layout(self.loaded.layout, self.loaded.plants)
 
@@ -348,8 +353,10 @@ class MainWindow(QMainWindow):
         bar.setStyleSheet("QStatusBar { color: #b3261e; font-weight: bold; }" if error else "")
         bar.showMessage(text.splitlines()[0], 15000 if error else 8000)
 
-    def _fail(self, exc: BaseException, doing: str) -> None:
-        """An error from a job: one line for people; the traceback on stderr if it is a bug."""
+    def _fail(self, exc: BaseException, doing: str, mode: str | None = None) -> None:
+        """An error from a job: one line for people; the traceback on stderr if it is a bug.
+        An error about a light setting is also said in the light panel, its field marked
+        (``mode``: the light it was computed for; the sun for "Sun from place")."""
         if self._closing:
             return
         if not isinstance(exc, (MaizevizError, OSError, MemoryError)):
@@ -357,8 +364,11 @@ class MainWindow(QMainWindow):
         text = user_message(exc, doing)
         self.say(f"error: {text}", error=True)
         quantity = getattr(exc, "quantity", None)
+        if doing in ("light", "sun"):
+            self.light_panel.show_problem(text)
         if quantity:
-            if self.light_panel.point_at(quantity, text):
+            mode = mode or ("sun" if doing == "sun" else None)
+            if self.light_panel.point_at(quantity, text, mode):
                 self.docks["light"].raise_()
         self.failed.emit(text)
 
@@ -390,7 +400,7 @@ class MainWindow(QMainWindow):
         from maizeviz_app import jobs
 
         path = str(path)
-        n = self.canopy_panel.tile_n
+        n = self.tile_n
         self.say(f"reading {path}")
 
         def load(job, p):
@@ -401,12 +411,17 @@ class MainWindow(QMainWindow):
                         on_done=lambda r: self._on_loaded(r[0], r[1], None, r[0].path),
                         on_error=lambda e: self._fail(e, "open points"))
 
-    def reload(self) -> None:
-        """The same points with the tiling now chosen (edits of the layout are replaced)."""
-        if self.loaded is not None:
-            if self.project_path is not None:
-                self.project_path = None
-            self.open_points(self.loaded.path)
+    @property
+    def tile_n(self) -> int:
+        """Tiles along each side of the layout on screen, as the layout panel's presets set
+        it (the one place to choose a tiling); a points file opens with it. Before a layout
+        (or for a layout that is not a square tiling): the tiling the window started with."""
+        from maizeviz_app.options import tiling_of
+
+        tiles = tiling_of(self.loaded.layout) if self.loaded is not None else None
+        if tiles is not None and tiles[0] == tiles[1]:
+            return tiles[0]
+        return self._tile
 
     def _on_loaded(self, loaded, points_bytes: bytes, project: str | None,
                    origin: str) -> None:
@@ -418,7 +433,8 @@ class MainWindow(QMainWindow):
         self.measures_rows.clear()
         self.canopy_panel.clear_rows()
         self.light_panel.show_runs(self.runs)
-        self.plots.set_heatmaps([])
+        self._heatmaps_for.clear()
+        self.plots.clear()
         self.plots.set_transmission(None)
         self.canopy_panel.set_file(Path(loaded.shown_name).name if project is None
                                    else loaded.shown_name, loaded.path)
@@ -451,6 +467,9 @@ class MainWindow(QMainWindow):
                      "cleared")
         self.runs.clear()
         self.light_panel.show_runs(self.runs)
+        self._heatmaps_for.clear()
+        self.plots.clear()
+        self.plots.set_transmission(None)
         self.measures_rows.clear()
         self.canopy_panel.clear_rows()
         self.say(f"layout applied: {len(layout.placements)} plants")
@@ -516,25 +535,54 @@ class MainWindow(QMainWindow):
                         on_done=self._on_built, on_error=lambda e: self._fail(e, "build"))
 
     def _on_built(self, built) -> None:
+        """A canopy built: the level label, Table 2 and the view change together; while the
+        digitizer records, the view keeps the plant being digitized and the canopy waits
+        (``canopy_shown`` is emitted either way: the canopy is the window's)."""
         mesh, columns, row, serial = built.mesh
         if serial != self._serial or self.viewport is None:
             return
         self.canopy = built.canopy
         self.built = built
         self._canopy_id += 1
-        self.viewport.show_canopy(built.canopy, mesh)
         self.canopy_panel.show_built(built.level, columns, row)
         self.measures_rows[built.label] = row
+        if self.digitizing:
+            self._view_pending = (built.canopy, mesh)
+            self.say(f"{built.label} is ready; it shows when the digitizing session stops",
+                     status_only=True)
+        else:
+            self._view_pending = None
+            self.viewport.show_canopy(built.canopy, mesh)
         self._adopt_pending_runs()
-        run = self.runs.for_signature(self.signature(built.label))
-        if run is not None and run.classes is not None:
-            self.viewport.set_light(run.classes)
-        self._sync_colour_actions()
+        self._light_to_view()
         m = built.measures
-        self.say(f"{built.label}: {m.triangles:,} triangles, leaf area {m.leaf_area_m2:.2f} m², "
-                 f"LAI {m.lai:.2f}; built in {built.build_s:.2f} s, measured in "
-                 f"{built.measure_s:.2f} s", status_only=True)
+        if not self.digitizing:
+            self.say(f"{built.label}: {m.triangles:,} triangles, leaf area "
+                     f"{m.leaf_area_m2:.2f} m², LAI {m.lai:.2f}; built in {built.build_s:.2f} s, "
+                     f"measured in {built.measure_s:.2f} s", status_only=True)
         self.canopy_shown.emit(built.label)
+
+    @property
+    def digitizing(self) -> bool:
+        """A digitizing session is recording (the view shows the plant being digitized)."""
+        return self.digitizer is not None and self.digitizer.recording
+
+    def _light_to_view(self, colour: bool = False) -> None:
+        """Colour the canopy in view by the light last computed on it (the sun's classes, or a
+        sky's or day's light per leaf), unless the view is busy with the digitizer;
+        ``colour``: switch the colouring to light."""
+        if self.viewport is None or self.built is None or self.digitizing or \
+                self._view_pending is not None:
+            return
+        run = self.runs.latest(self.signature(self.built.label))
+        if run is not None and run.kind == "sun" and run.classes is not None:
+            self.viewport.set_light(run.classes)
+        elif run is not None and run.extra is not None:
+            title, unit = _value_legend(run)
+            self.viewport.set_light_values(run.extra.leaf_value, title, unit)
+        if colour and run is not None:
+            self.colour_by("light")
+        self._sync_colour_actions()
 
     def step_level(self, step: int) -> None:
         s = self.canopy_panel.slider
@@ -542,87 +590,113 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ light
     def compute_light(self) -> None:
-        """Trace the sun through the canopy shown (hit classes on, to colour the leaves)."""
+        """Compute the light of the mode chosen in the light panel (sun, sky or day) on the
+        canopy shown, in the light process (which keeps the canopy's Embree scene)."""
         if self._closing:
             return
         if self.canopy is None or self.built is None:
             self.say("error: no canopy yet: open a points file first", error=True)
             return
-        self.light_panel.clear_problem()
+        panel = self.light_panel
+        panel.clear_problem()
+        mode = panel.mode
         try:
-            request = self.light_panel.request()
+            if mode == "sun":
+                request = panel.request()
+                heights = request.heights_cm
+                settings = (round(request.sun.zenith_deg, 6), round(request.sun.azimuth_deg, 6))
+                op, args = "light", (request,)
+            else:
+                sampling = panel.sampling()
+                heights = sampling.heights_cm
+                sky = panel.sky_spec()
+                if mode == "sky":
+                    settings, op, args = sky, "sky", (sampling, sky)
+                else:
+                    day = panel.day_spec()
+                    settings, op, args = (day, sky), "period", (sampling, sky, day)
         except (InputProblem, MaizevizError) as exc:
-            self._fail(exc, "light")
+            self._fail(exc, "light", mode)
             return
         from maizeviz_app import plots
 
         canopy, built = self.canopy, self.built
         label = built.label
         signature = self.signature(label)
-        settings_key = self.light_panel.settings_key(request)
-        prior = self.runs.curves() if self.runs.settings == settings_key else []
+        sampling_key = panel.sampling_key(heights)
+        runs = self.runs.copy()
         key = self._canopy_id
         runner = self.runner
         shown_height = max(self.plots.height.currentIndex(), 0)
 
         def work(job):
-            from maizeviz.light.leaf_light import triangle_light
-            from maizeviz_app.panels.light import level_order
-
-            result = runner.light_process.call("light", key, canopy, (request,), job)
+            out = runner.light_process.call(op, key, canopy, args, job)
             job.check()
-            classes = triangle_light(canopy, result)
-            maps = plots.heatmap_images(result, first=shown_height, check=job.check)
-            curves = [c for c in prior if c.label != label]
-            curves.append(plots.Curve(label, tuple(map(float, result.heights_cm)),
-                                      tuple(map(float, result.transmission))))
-            curves.sort(key=lambda c: level_order(c.label))
-            plot = plots.rgba(plots.transmission_figure(curves, _plot_title(result)))
-            return Run(label, signature, result, classes), settings_key, maps, plot
+            if mode == "sun":
+                from maizeviz.light.leaf_light import triangle_light
 
-        self.light_panel.set_running(True)
+                run = Run(label, signature, out, triangle_light(canopy, out))
+            else:
+                run = Run(label, signature, out.light, None, mode, out)
+            maps = plots.heatmap_images(run.result, first=shown_height, check=job.check,
+                                        kind=mode)
+            runs.add(run, settings, sampling_key)
+            plot = plots.rgba(plots.transmission_figure(runs.curves(), _plot_title(runs)))
+            return run, settings, sampling_key, maps, plot
+
+        panel.set_running(True)
+        panel.set_progress(f"{COMPUTE_TEXT[mode].replace('Compute', 'computing')} on {label}…")
         self.docks["light"].raise_()
-        self.runner.run("light", f"light on {label}", work, on_done=self._on_lit,
-                        on_error=self._light_failed)
+        self.runner.run("light", f"{mode} light on {label}", work, on_done=self._on_lit,
+                        on_error=lambda e: self._light_failed(e, mode))
 
-    def _light_failed(self, exc: BaseException) -> None:
+    def _light_failed(self, exc: BaseException, mode: str = "sun") -> None:
         self.light_panel.set_running(False)
-        self._fail(exc, "light")
+        self._fail(exc, "light", mode)
 
     def _on_lit(self, out) -> None:
-        run, settings_key, maps, plot = out
-        self.light_panel.set_running(False)
+        """A light result: table, summary, plants, figures and colours change together;
+        nothing shown is dropped unless a new comparison starts."""
+        run, settings, sampling_key, maps, plot = out
+        panel = self.light_panel
+        panel.set_running(False)
         if run.signature[0] != self._serial:
             return
-        if self.runs.add(run, settings_key):
+        if self.runs.add(run, settings, sampling_key):
             self.say("note: the light settings changed; the comparison starts again")
         r = run.result
-        info = (f"{r.rays:,} rays on the central tile at {r.density_per_cm2:.2f} per cm²; "
-                f"level {run.label}; Embree scene {r.seconds.get('build', 0):.2f} s, tracing "
-                f"{r.seconds.get('trace', 0) + r.seconds.get('second', 0):.2f} s")
-        share = r.sunlit_intercepted_fraction
-        if share is not None:
-            info += f"; leaves take {share:.1%} of the direct light"
-        info += "".join(f"\n⚠ {w}" for w in r.warnings)
-        self.light_panel.show_runs(self.runs, info)
-        self._heatmaps_for = run
-        self.plots.set_heatmaps(maps)
+        panel.show_runs(self.runs, _run_info(run))
+        if run.kind == "day":
+            summary = day_summary(r)
+            panel.show_summary(summary)
+        elif self.runs.of_kind("day") is None:
+            panel.show_summary("")
+        if run.kind != "sun":
+            panel.show_plants(run)
+        elif self.runs.of_kind("sky") is None and self.runs.of_kind("day") is None:
+            panel.show_plants(None)
+        self._heatmaps_for = {k: v for k, v in self._heatmaps_for.items()
+                              if self.runs.of_kind(k) is not None}
+        self._heatmaps_for[run.kind] = run
+        self.plots.keep_only(set(self._heatmaps_for))
+        self.plots.set_heatmaps(maps, run.kind)
         self.plots.set_transmission(plot)
         for w in r.warnings:
-            self.say(f"warning: {w}")
-        if self.viewport is not None and self.built is not None and \
-                self.signature(self.built.label) == run.signature:
-            self.viewport.set_light(run.classes)
-            self.colour_by("light")
+            self.say(f"{'note' if 'sun never rises' in w else 'warning'}: {w}")
+        if self.built is not None and self.signature(self.built.label) == run.signature:
+            self._light_to_view(colour=True)
         self.docks["results"].raise_()
-        self.say(f"light on {run.label}: transmission "
-                 + ", ".join(f"{t:.3f}" for t in r.transmission) + " at "
-                 + ", ".join(f"{h:g}" for h in r.heights_cm) + " cm", status_only=True)
+        if run.kind == "day":
+            self.say(summary.replace("\n", "; "), status_only=True)
+        else:
+            self.say(f"{run.name}: transmission "
+                     + ", ".join(f"{t:.3f}" for t in run.transmission) + " at "
+                     + ", ".join(f"{h:g}" for h in r.heights_cm) + " cm", status_only=True)
         self.light_shown.emit()
 
-    def _draw_heatmap(self, index: int) -> None:
-        """The heatmap of another height of the result shown, drawn in a worker."""
-        run = self._heatmaps_for
+    def _draw_heatmap(self, kind: str, index: int) -> None:
+        """The heatmap of another height of a result shown, drawn in a worker."""
+        run = self._heatmaps_for.get(kind)
         if run is None:
             return
         from maizeviz_app import plots
@@ -631,12 +705,12 @@ class MainWindow(QMainWindow):
         height = float(result.heights_cm[index])
 
         def done(rgba):
-            if self._heatmaps_for is run:
-                self.plots.set_heatmap(index, rgba)
+            if self._heatmaps_for.get(kind) is run:
+                self.plots.set_heatmap(index, rgba, kind)
 
         self.runner.run("heatmap", f"drawing the heatmap at {height:g} cm",
-                        lambda job: plots.heatmap_image(result, height), on_done=done,
-                        on_error=lambda e: self._fail(e, "light"))
+                        lambda job: plots.heatmap_image(result, height, kind=kind),
+                        on_done=done, on_error=lambda e: self._fail(e, "light"))
 
     def sun_from_place(self) -> None:
         """Sun angles from the date, time and place typed (pvlib, in a worker)."""
@@ -688,8 +762,16 @@ class MainWindow(QMainWindow):
                 act.setChecked(self.viewport.colouring == name)
 
     def _digitizing_stopped(self, _why: str) -> None:
-        if self.viewport is not None and self.canopy is not None:
-            self.viewport.restore_canopy()          # the canopy comes back after a session
+        """The canopy comes back after a session: the one built meanwhile if any."""
+        if self.viewport is None or self.canopy is None:
+            return
+        pending, self._view_pending = self._view_pending, None
+        if pending is not None:
+            self.viewport.show_canopy(*pending)
+            self.viewport.camera_preset("perspective")
+        else:
+            self.viewport.restore_canopy()
+        self._light_to_view()
 
     # ------------------------------------------------------------------ jobs
     def cancel_jobs(self, kind: str | None = None) -> None:
@@ -704,13 +786,16 @@ class MainWindow(QMainWindow):
             self.canopy_panel.set_pending("")
         self.say("cancelled: " + ", ".join(j.label for j in running))
 
-    def _on_progress(self, _job_id: int, _kind: str, label: str, done: int, total: int) -> None:
+    def _on_progress(self, _job_id: int, kind: str, label: str, done: int, total: int) -> None:
         # each repaint recomposes the window (see _build_status): twice a second at most
         now = time.perf_counter()
         if now - self._progress_shown < 0.5:
             return
         self._progress_shown = now
-        self.job_label.setText(f"{label}… {100 * done // max(total, 1)}%")
+        text = f"{label} ({100 * done // max(total, 1)}%)"
+        self.job_label.setText(text)
+        if kind == "light":
+            self.light_panel.set_progress(text)
 
     def _on_jobs_changed(self) -> None:
         if self._closing:
@@ -749,10 +834,10 @@ class MainWindow(QMainWindow):
 
         loaded, data, origin = self.loaded, self._points_bytes, self._points_origin
         layout = loaded.layout if self._layout_edited else None   # else: the tiling, exactly
-        canopy = {"tile": self.canopy_panel.tile_n, "level": self.level,
+        canopy = {"tile": self.tile_n, "level": self.level,
                   "preserve_area": self.canopy_panel.preserve.isChecked()}
         light = self.light_panel.settings()
-        runs = [(r.label, r.result) for r in self.runs.runs.values()]
+        runs = [(r.label, r.result) for r in self.runs.runs.values() if r.kind == "sun"]
         path = str(path)
 
         def work(job):
@@ -807,7 +892,7 @@ class MainWindow(QMainWindow):
         opened, loaded, (tile, level, preserve), light = out
         for note in opened.notes:
             self.say(f"note: {note}")
-        self.canopy_panel.set_tile(tile)
+        self._tile = tile
         self.canopy_panel.set_level(level)
         self.canopy_panel.preserve.blockSignals(True)
         self.canopy_panel.preserve.setChecked(preserve)
@@ -832,10 +917,10 @@ class MainWindow(QMainWindow):
             if label == self.built.label and result.first_hits is not None and \
                     len(result.first_hits) >= self.canopy.n_triangles:
                 classes = triangle_light(self.canopy, result)
-            key = (round(result.sun.zenith_deg, 6), round(result.sun.azimuth_deg, 6),
-                   tuple(float(h) for h in result.heights_cm), result.density,
-                   self.light_panel.periodic.isChecked())
-            self.runs.add(Run(label, self.signature(label), result, classes), key)
+            own = (round(result.sun.zenith_deg, 6), round(result.sun.azimuth_deg, 6))
+            sampling = (tuple(float(h) for h in result.heights_cm), result.density,
+                        bool(getattr(result, "periodic", self.light_panel.periodic.isChecked())))
+            self.runs.add(Run(label, self.signature(label), result, classes), own, sampling)
         self.light_panel.show_runs(self.runs, f"{len(pending)} light result(s) from the "
                                               "project")
         last = self.runs.for_signature(self.signature(self.built.label)) or self.runs.last
@@ -843,23 +928,23 @@ class MainWindow(QMainWindow):
             return
         curves = self.runs.curves()
         result = last.result
-        self._heatmaps_for = last
+        title = _plot_title(self.runs)
+        self._heatmaps_for = {"sun": last}
 
         def work(job):
             maps = plots.heatmap_images(result, check=job.check)
-            plot = plots.rgba(plots.transmission_figure(curves, _plot_title(result)))
+            plot = plots.rgba(plots.transmission_figure(curves, title))
             return maps, plot
 
         def done(out):
-            self.plots.set_heatmaps(out[0])
-            self.plots.set_transmission(out[1])
+            if self._heatmaps_for.get("sun") is last:
+                self.plots.set_heatmaps(out[0])
+                self.plots.set_transmission(out[1])
             self.light_shown.emit()
 
         self.runner.run("figures", "drawing the light figures", work, on_done=done,
                         on_error=lambda e: self._fail(e, "light"))
-        if last.classes is not None:
-            self.viewport.set_light(last.classes)
-            self.colour_by("light")
+        self._light_to_view(colour=True)
 
     # ------------------------------------------------------------------ recent files
     def recent_files(self) -> list[str]:
@@ -884,7 +969,11 @@ class MainWindow(QMainWindow):
                  "measures": ("Export the canopy measures", "canopy_measures.csv",
                               "CSV (*.csv)"),
                  "heatmap": ("Export the heatmap", "heatmap.png", "PNG (*.png)"),
-                 "plot": ("Export transmission vs height", "transmission.png", "PNG (*.png)")}
+                 "plot": ("Export transmission vs height", "transmission.png", "PNG (*.png)"),
+                 "steps": ("Export the day's time steps", "steps.csv", "CSV (*.csv)"),
+                 "leaves": ("Export the light per leaf", "leaf_light.csv", "CSV (*.csv)"),
+                 "plants": ("Export the light per plant", "plant_light.csv", "CSV (*.csv)"),
+                 "day": ("Export the day figure", "day.png", "PNG (*.png)")}
         title, default, filt = names[what]
         path, chosen = QFileDialog.getSaveFileName(self, title, str(Path(self._folder()) /
                                                                      default), filt)
@@ -895,7 +984,8 @@ class MainWindow(QMainWindow):
         self.export(what, path)
 
     def export(self, what: str, path: str | Path) -> None:
-        """Write ``what`` (canopy, table, measures, heatmap, plot) to ``path`` in a worker."""
+        """Write ``what`` (canopy, table, measures, heatmap, plot; steps, leaves, plants, day
+        for a sky or a day) to ``path`` in a worker, atomically."""
         path = str(path)
         try:
             work, args = self._export_work(what, path)
@@ -915,13 +1005,19 @@ class MainWindow(QMainWindow):
             if self.canopy is None:
                 raise MaizevizError("no canopy to export yet")
             canopy = self.canopy
-            run = self.runs.for_signature(self.signature(self.built.label))
-            classes = run.classes if run is not None else None
+            signature = self.signature(self.built.label)
+            cells = {}
+            run = self.runs.for_signature(signature)
+            if run is not None and run.classes is not None:
+                cells["light"] = run.classes.astype("int32")
+            for kind, name in (("sky", "diffuse_per_m2_leaf"), ("day", "par_mol_per_m2_leaf")):
+                run = self.runs.for_signature(signature, kind)
+                if run is not None and run.extra is not None:
+                    cells[name] = run.extra.leaf_value.astype("float32")
 
             def work(job):
                 from maizeviz.canopy.export import export_canopy
 
-                cells = {} if classes is None else {"light": classes.astype("int32")}
                 export_canopy(path, canopy, cell_data=cells)
                 return path
             return work, ()
@@ -940,8 +1036,10 @@ class MainWindow(QMainWindow):
                         w.writerow({k: v.replace(",", "") for k, v in r.items()})
                 return path
             return work, ()
+        if what in ("steps", "leaves", "plants", "day"):
+            return self._export_diffuse(what, path)
         if self.runs.last is None:
-            raise MaizevizError("no light result to export yet: compute direct light first")
+            raise MaizevizError("no light result to export yet: compute light first")
         if what == "table":
             header, rows = self.runs.table()
 
@@ -955,7 +1053,9 @@ class MainWindow(QMainWindow):
                 return path
             return work, ()
         if what == "heatmap":
-            run = self._heatmaps_for or self.runs.last
+            kind = self.plots.kind or self.runs.last.kind
+            run = self._heatmaps_for.get(kind) or self.runs.last
+            kind = run.kind
             height = self.plots.shown_height
             if height is None:
                 height = float(run.result.heights_cm[0])
@@ -963,15 +1063,22 @@ class MainWindow(QMainWindow):
 
             def work(job):
                 from maizeviz.light.heatmap import heatmap_figure, save_figure, transmission_map
+                from maizeviz_app.plots import heatmap_title
 
-                save_figure(heatmap_figure(transmission_map(result, height, 5.0), result), path)
+                if kind == "sun":
+                    fig = heatmap_figure(transmission_map(result, height, 5.0), result)
+                else:
+                    what_, title = heatmap_title(result, kind)
+                    fig = heatmap_figure(result.transmission_map(height), title=title,
+                                         what=what_)
+                save_figure(fig, path)
                 return path
             return work, ()
         if what == "plot":
             from maizeviz_app import plots
 
             curves = self.runs.curves()
-            title = _plot_title(self.runs.last.result)
+            title = _plot_title(self.runs)
 
             def work(job):
                 from maizeviz.light.heatmap import save_figure
@@ -980,6 +1087,45 @@ class MainWindow(QMainWindow):
                 return path
             return work, ()
         raise MaizevizError(f"unknown export '{what}'")
+
+    def _export_diffuse(self, what: str, path: str):
+        """The day's steps CSV and figure, the per-leaf and per-plant CSV of the last sky or
+        day (the day when both)."""
+        day = self.runs.of_kind("day")
+        run = day if day is not None else self.runs.of_kind("sky")
+        if what in ("steps", "day") and day is None:
+            raise MaizevizError("no day computed yet: choose Day in the light panel and "
+                                "compute the day's light first")
+        if run is None:
+            raise MaizevizError("no sky or day computed yet: choose Sky or Day in the light "
+                                "panel and compute first")
+        light, extra, label = run.result, run.extra, run.label
+        if what == "steps":
+            def work(job):
+                from maizeviz.light.reports import write_steps
+
+                write_steps(path, light)
+                return path
+            return work, ()
+        if what == "day":
+            title = _day_title(light, label)
+
+            def work(job):
+                from maizeviz.light.heatmap import save_figure
+                from maizeviz.light.plots import day_figure
+
+                save_figure(day_figure(light, title), path)
+                return path
+            return work, ()
+        rows = [dict(r, level=label) for r in extra.leaf_rows]
+
+        def work(job):
+            from maizeviz.light.leaf_light import plant_light
+            from maizeviz.light.reports import write_rows
+
+            write_rows(path, rows if what == "leaves" else plant_light(rows))
+            return path
+        return work, ()
 
     # ------------------------------------------------------------------ help
     def about(self) -> None:
@@ -1004,9 +1150,84 @@ class MainWindow(QMainWindow):
         super().closeEvent(event)
 
 
-def _plot_title(result) -> str:
-    return (f"sun zenith {result.sun.zenith_deg:.1f}°, azimuth {result.sun.azimuth_deg:.1f}°; "
-            f"{result.density:g} rays/cm²")
+def _plot_title(runs: LightRuns) -> str:
+    """What the transmission plot compares: the sun, the sky, the day; rays per cm²."""
+    parts = []
+    sun, sky, day = (runs.of_kind(k) for k in ("sun", "sky", "day"))
+    if sun is not None:
+        r = sun.result
+        parts.append(f"sun zenith {r.sun.zenith_deg:.1f}°, azimuth {r.sun.azimuth_deg:.1f}°")
+    diffuse = sky.result.sky if sky is not None else \
+        (day.result.sky.sky if day is not None and day.result.sky is not None else None)
+    if diffuse is not None:
+        parts.append(f"sky {diffuse.kind.upper()}, {diffuse.n} directions")
+    if day is not None:
+        p = day.result.period
+        parts.append(f"day {p.start:%Y-%m-%d}, {p.n_steps} steps")
+    density = runs.sampling[1] if runs.sampling else None
+    if density is None and runs.last is not None:
+        density = getattr(runs.last.result, "density", None)
+    if density is not None:
+        parts.append(f"{density:g} rays/cm²")
+    return "; ".join(parts)
+
+
+def _value_legend(run: Run) -> tuple[str, str]:
+    """Colour-bar title and unit of a sky's or day's light per leaf."""
+    if run.kind == "day":
+        return "PAR intercepted per leaf over the day", "mol/m² leaf"
+    return "diffuse light per leaf area (1: the sky's on open ground)", ""
+
+
+def _run_info(run: Run) -> str:
+    """What was traced and how long it took, for the light panel."""
+    r = run.result
+    secs = r.seconds
+    build_s = run.extra.build_s if run.extra is not None else secs.get("build", 0)
+    build = f"{build_s:.2f} s" if build_s > 0 else "kept from the last run"
+    if run.kind == "sun":
+        info = (f"{r.rays:,} rays on the central tile at {r.density_per_cm2:.2f} per cm²; "
+                f"level {run.label}; Embree scene {build}, tracing "
+                f"{secs.get('trace', 0) + secs.get('second', 0):.2f} s")
+        share = r.sunlit_intercepted_fraction
+        if share is not None:
+            info += f"; leaves take {share:.1%} of the direct light"
+    elif run.kind == "sky":
+        info = (f"{r.sky.description}; {r.rays:,} rays per direction; level {run.label}; "
+                f"Embree scene {build}, tracing {secs.get('trace', 0):.2f} s; leaves "
+                f"take {r.intercepted_fraction:.1%} of the diffuse light")
+    else:
+        sky = r.sky.sky.description if r.sky is not None else "no sky"
+        info = (f"{r.n_steps} time steps and the sky ({sky}); {r.rays:,} rays per "
+                f"direction; level {run.label}; Embree scene {build}, tracing "
+                f"{secs.get('trace', 0):.2f} s")
+    return info + "".join(f"\n⚠ {w}" for w in r.warnings if "sun never rises" not in w)
+
+
+def day_summary(light) -> str:
+    """The day in two lines: PAR incident, intercepted (fraction), transmitted to the lowest
+    height, mol/m² of ground; and where the irradiance came from."""
+    p = light.period
+    frac = light.fraction_intercepted
+    h = light.heights_cm
+    low = int(np.argmin(h))
+    where = "the ground" if h[low] == 0 else f"{h[low]:g} cm"
+    t_low = float(light.par_transmitted_mol_m2[low])
+    share = f" ({light.transmission_by_height[low]:.1%})" if frac is not None else ""
+    span = (f"{p.start:%Y-%m-%d}" if (p.end - p.start).total_seconds() == 86400 and
+            p.start.hour == 0 and p.start.minute == 0 else
+            f"{p.start:%Y-%m-%d %H:%M} to {p.end:%H:%M}")
+    return (f"{span}: PAR incident {light.par_incident_mol_m2:.1f} mol/m² (direct "
+            f"{light.par_direct_mol_m2:.1f}, diffuse {light.par_diffuse_mol_m2:.1f}); "
+            f"intercepted {light.par_intercepted_mol_m2:.1f} mol/m²"
+            + (f" ({frac:.1%})" if frac is not None else "")
+            + f"; transmitted to {where} {t_low:.2f} mol/m²{share}\n{p.source}")
+
+
+def _day_title(light, label: str) -> str:
+    p = light.period
+    return (f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M} ({p.start.tz}); {p.source}; "
+            f"level {label}")
 
 
 def about_text() -> str:

@@ -54,6 +54,15 @@ def build_menus(w) -> dict[str, QAction]:
                                   lambda: w.choose_export("plot"), "Ctrl+Shift+G")
     acts["export_canopy"] = _action(w, results, "Canopy coloured by light (PLY/VTK)…",
                                     lambda: w.choose_export("canopy"))
+    results.addSeparator()
+    acts["export_steps"] = _action(w, results, "Day: time steps (CSV)…",
+                                   lambda: w.choose_export("steps"))
+    acts["export_leaves"] = _action(w, results, "Sky or day: light per leaf (CSV)…",
+                                    lambda: w.choose_export("leaves"))
+    acts["export_plants"] = _action(w, results, "Sky or day: light per plant (CSV)…",
+                                    lambda: w.choose_export("plants"))
+    acts["export_day"] = _action(w, results, "Day figure (PNG)…",
+                                 lambda: w.choose_export("day"))
     f.addSeparator()
     acts["quit"] = _action(w, f, "&Quit", w.close, QKeySequence.Quit)
 
@@ -82,7 +91,13 @@ def build_menus(w) -> dict[str, QAction]:
         w.docks_menu.addAction(dock.toggleViewAction())
 
     r = bar.addMenu("&Light")
-    acts["compute"] = _action(w, r, "&Compute direct light", w.compute_light, "Ctrl+L")
+    acts["compute"] = _action(w, r, "&Compute light (sun, sky or day, as chosen)",
+                              w.compute_light, "Ctrl+L")
+    for k, mode in enumerate(("sun", "sky", "day"), start=1):
+        acts[f"light_{mode}"] = _action(
+            w, r, {"sun": "Su&n: direct light", "sky": "S&ky: diffuse light",
+                   "day": "&Day: PAR over a day"}[mode],
+            lambda m=mode: w.light_panel.set_mode(m), f"Alt+{k}")
     acts["cancel"] = _action(w, r, "C&ancel", w.cancel_jobs, "Esc",
                              "stop the light computation or rebuild under way")
     acts["sun_place"] = _action(w, r, "&Sun from place", w.sun_from_place, "Ctrl+Shift+L")

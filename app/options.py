@@ -12,3 +12,15 @@ LIGHT_CLASSES = {-2: ("stalk", "#b0875a"), -1: ("not traced", "#c8c8c8"),
                  2: ("direct", "#fbe54b")}
 STALK = -2
 NOT_TRACED = -1
+#: Tilings of the digitized block offered (tiles along each side; the paper's is 3 x 3). The
+#: layout panel's presets are the one place to choose one; the window opens a points file
+#: with the tiling of the layout on screen.
+TILINGS = (1, 3, 5, 7, 9)
+
+
+def tiling_of(layout) -> tuple[int, int] | None:
+    """Tiles (along x, along y) of a tiled layout; None for a layout file."""
+    if layout is None or layout.ground_area is None:
+        return None
+    tiles = {p.tile for p in layout.placements}
+    return len({t[0] for t in tiles}), len({t[1] for t in tiles})

@@ -1,9 +1,10 @@
 """Light figures drawn off the GUI thread (matplotlib's Agg canvas; no Qt here).
 
 The heatmaps are the core's own figures (:func:`maizeviz.light.heatmap.heatmap_figure`, the
-same as ``maizeviz light --heatmaps``); the transmission-vs-height plot compares the mesh
-levels traced under the same sun (the paper's Table 3 as a plot). Figures are drawn to RGBA
-arrays in a worker thread, so the window only wraps pixels.
+same as ``maizeviz light --heatmaps``) for a sun, a sky or a day; the transmission-vs-height
+plot compares the mesh levels and lights traced with the same sampling (the paper's Table 3 as
+a plot, with the diffuse sky and the day's PAR beside it). Figures are drawn to RGBA arrays in
+a worker thread, so the window only wraps pixels.
 """
 
 from __future__ import annotations
@@ -15,39 +16,61 @@ import numpy as np
 
 #: Line styles per level, fine to coarse, so levels keep their look as curves are added.
 _STYLES = ("-o", "--s", "-.^", ":D", "-v", "--P", "-.X", ":*")
+#: With several lights: a line style per light, a colour per level.
+_KIND_STYLES = {"sun": "-o", "sky": "--s", "day": "-.^"}
+_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
+            "tab:pink", "tab:gray", "tab:olive", "tab:cyan")
 
 
 @dataclass(frozen=True)
 class Curve:
-    """One level's transmission by height: label, heights (H,) cm, transmission (H,)."""
+    """One result's transmission by height: label, heights (H,) cm, transmission (H,), the
+    light (``kind``: sun, sky or day) and the mesh level (``level``, default the label)."""
 
     label: str
     heights_cm: tuple[float, ...]
     transmission: tuple[float, ...]
+    kind: str = "sun"
+    level: str = ""
 
 
 def transmission_figure(curves: Sequence[Curve], title: str = "", width_in: float = 5.0,
                         dpi: int = 90):
-    """Transmission (x, 0..1) against height (y, cm), one curve per mesh level."""
+    """Transmission (x, 0..1) against height (y, cm), one curve per mesh level and light."""
     from matplotlib.figure import Figure
 
     fig = Figure(figsize=(width_in, width_in * 0.72), dpi=dpi)
     ax = fig.add_subplot()
+    kinds = {c.kind for c in curves}
+    levels = list(dict.fromkeys(c.level or c.label for c in curves))
     for k, c in enumerate(curves):
-        ax.plot(c.transmission, c.heights_cm, _STYLES[k % len(_STYLES)], label=c.label,
-                markersize=4, linewidth=1.3)
+        if kinds == {"sun"}:
+            style, colour = _STYLES[k % len(_STYLES)], None
+        else:
+            style = _KIND_STYLES.get(c.kind, "-o")
+            colour = _COLOURS[levels.index(c.level or c.label) % len(_COLOURS)]
+        ax.plot(c.transmission, c.heights_cm, style, label=c.label, markersize=4,
+                linewidth=1.3, color=colour)
     ax.set_xlim(0, 1)
-    ax.set_xlabel("direct-light transmission (fraction of rays reaching the height)")
+    ax.set_xlabel("direct-light transmission (fraction of rays reaching the height)"
+                  if kinds <= {"sun"} else
+                  "transmission (fraction of the light reaching the height)")
     ax.set_ylabel("height (cm)")
     ax.grid(True, alpha=0.3)
     if curves:
-        ax.legend(title="mesh level", fontsize=8, title_fontsize=8, loc="lower right")
+        ax.legend(title="mesh level" if kinds == {"sun"} else "mesh level, light", fontsize=8,
+                  title_fontsize=8, loc="lower right")
     else:
-        ax.text(0.5, 0.5, "compute direct light to see transmission by height",
+        ax.text(0.5, 0.5, "compute light to see transmission by height",
                 ha="center", va="center", transform=ax.transAxes, fontsize=9, color="0.4")
-    ax.set_title(title or "transmission by height, per mesh level (the paper's Table 3)",
-                 fontsize=9)
-    fig.subplots_adjust(left=0.12, right=0.97, bottom=0.14, top=0.9)   # tight_layout: 2 draws
+    default = ("transmission by height, per mesh level (the paper's Table 3)"
+               if kinds <= {"sun"} else "transmission by height, per mesh level and light")
+    import textwrap
+
+    lines = textwrap.wrap(title or default, int(11 * width_in))
+    ax.set_title("\n".join(lines), fontsize=9)
+    fig.subplots_adjust(left=0.12, right=0.97, bottom=0.14,            # tight_layout: 2 draws
+                        top=0.9 - 0.05 * (len(lines) - 1))
     return fig
 
 
@@ -60,17 +83,37 @@ def rgba(fig) -> np.ndarray:
     return np.asarray(canvas.buffer_rgba()).copy()
 
 
+def heatmap_title(result, kind: str) -> tuple[str, str]:
+    """(what is mapped, the second title line) for a sky's or a day's maps."""
+    if kind == "sky":
+        from maizeviz.light.sky import SKY_KINDS
+
+        sky = result.sky
+        return ("diffuse transmission",
+                f"{SKY_KINDS[sky.kind].split(',')[0]}, {sky.split} split of {sky.n} "
+                f"directions; level {result.level}; {result.rays:,} sensors per direction")
+    p = result.period
+    return ("fraction of the period's PAR",
+            f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M}, {p.n_steps} steps; "
+            f"level {result.level}")
+
+
 def heatmap_image(result, height: float, bin_cm: float = 5.0, width_in: float = 8.0,
-                  dpi: int = 64) -> np.ndarray:
-    """The core's heatmap of one height of a light result, drawn (RGBA)."""
+                  dpi: int = 64, kind: str = "sun") -> np.ndarray:
+    """The core's heatmap of one height of a light result (a sun's ``LightResult``, a
+    ``SkyLight`` or a ``PeriodLight``), drawn (RGBA)."""
     from maizeviz.light.heatmap import heatmap_figure, transmission_map
 
-    tmap = transmission_map(result, float(height), bin_cm)
-    return rgba(heatmap_figure(tmap, result, width_in=width_in, dpi=dpi))
+    if kind == "sun":
+        tmap = transmission_map(result, float(height), bin_cm)
+        return rgba(heatmap_figure(tmap, result, width_in=width_in, dpi=dpi))
+    what, title = heatmap_title(result, kind)
+    return rgba(heatmap_figure(result.transmission_map(float(height)), width_in=width_in,
+                               dpi=dpi, title=title, what=what))
 
 
-def heatmap_images(result, first: int = 0, all_heights: bool = False,
-                   check=None) -> list[tuple[float, np.ndarray | None]]:
+def heatmap_images(result, first: int = 0, all_heights: bool = False, check=None,
+                   kind: str = "sun") -> list[tuple[float, np.ndarray | None]]:
     """[(height, RGBA or None)] for every height of a light result: the ``first`` one drawn
     (each figure takes 0.3-1 s), the others too with ``all_heights``, else drawn when asked
     for. ``check()`` is called between figures (it may raise InterruptedError)."""
@@ -81,5 +124,5 @@ def heatmap_images(result, first: int = 0, all_heights: bool = False,
         if check is not None:
             check()
         drawn = k == first or all_heights
-        out.append((h, heatmap_image(result, h) if drawn else None))
+        out.append((h, heatmap_image(result, h, kind=kind) if drawn else None))
     return out

@@ -10,7 +10,8 @@ waits on a pipe, which releases the GIL.
   a new child starts in milliseconds and a killed one costs nothing to replace.
 - :meth:`CoreProcess.call` sends the canopy (once per canopy: the child keeps the last one and
   its Embree scene, so a second light run on the same canopy skips the scene build), then the
-  request; it relays the child's progress and checks for cancellation every 50 ms. Cancelling
+  request; it relays the child's progress (done, total and what is being done: "sky direction
+  12 of 46") and checks for cancellation every 50 ms. Cancelling
   kills the child, which stops any work at once, whatever it is doing.
 - Arrays travel out of band (pickle protocol 5 buffers written straight to the pipe), so the
   GUI process never copies a whole canopy while holding the GIL.
@@ -39,7 +40,7 @@ class Ticket(Protocol):
 
     cancel: threading.Event
 
-    def report(self, done: int, total: int) -> bool: ...
+    def report(self, done: int, total: int, text: str = "") -> bool: ...
 
 
 class ChildFailed(RuntimeError):
@@ -84,8 +85,8 @@ def serve(conn) -> None:
             continue
         _, op, args = msg
 
-        def progress(done: int, total: int) -> bool:
-            send(conn, ("progress", done, total))
+        def progress(done: int, total: int, text: str = "") -> bool:
+            send(conn, ("progress", done, total, text))
             return True
 
         try:
@@ -209,7 +210,7 @@ class CoreProcess:
                 continue
             msg = recv(conn)
             if msg[0] == "progress":
-                if not ticket.report(msg[1], msg[2]):
+                if not ticket.report(msg[1], msg[2], msg[3]):
                     self._kill()
                     raise InterruptedError(f"{op} cancelled")
             elif msg[0] == "ok":

@@ -208,24 +208,46 @@ def canopy_settings(opened: Opened) -> tuple[int, str, bool]:
     from maizeviz.mesh.levels import COMPLEXITY_STOPS
 
     c, where = opened.canopy, opened.path
+    from maizeviz_app.options import TILINGS
+
     tile = get(c, "tile", int, 3, where)
     level = get(c, "level", str, "36", where)
     preserve = get(c, "preserve_area", bool, True, where)
-    if tile not in (1, 3, 5):
-        raise ProjectError(f"{where}: tiling {tile} is not one the app offers (1, 3 or 5)")
+    if tile not in TILINGS:
+        raise ProjectError(f"{where}: tiling {tile} is not one the app offers "
+                           f"({', '.join(map(str, TILINGS))})")
     if level not in COMPLEXITY_STOPS:
         raise ProjectError(f"{where}: mesh level '{level}' is not one of the slider's "
                            f"({', '.join(COMPLEXITY_STOPS)})")
     return tile, level, preserve
 
 
+#: Light settings a project may hold, with their JSON types: the sun's (the first six, all a
+#: project of maizeviz 0.2 has), then the light chosen (``mode``: sun, sky or day), the sky's
+#: and the day's. A project without the later ones opens in sun mode with the defaults.
+LIGHT_SETTINGS = (("zenith_deg", (int, float)), ("azimuth_deg", (int, float)), ("place", str),
+                  ("heights", str), ("density", (int, float)), ("periodic", bool),
+                  ("mode", str), ("sky_kind", str), ("sky_split", str),
+                  ("sky_directions", int), ("day_date", str), ("latitude", (int, float)),
+                  ("longitude", (int, float)), ("tz", str), ("step_min", (int, float)),
+                  ("from", str), ("to", str), ("source", str),
+                  ("linke_turbidity", (int, float)), ("weather", str),
+                  ("par_factor", (int, float)))
+#: Allowed values of the light settings that name a choice.
+LIGHT_CHOICES = {"mode": ("sun", "sky", "day"), "sky_kind": ("soc", "uoc"),
+                 "sky_split": ("auto", "equal"), "source": ("clear", "weather")}
+
+
 def light_settings(opened: Opened) -> dict:
-    """Light settings stored in a project, checked field by field."""
+    """Light settings stored in a project, checked field by field (keys it does not know are
+    left out: a newer maizeviz may store more)."""
     s, where = opened.light, opened.path
     out = {}
-    for key, kind in (("zenith_deg", (int, float)), ("azimuth_deg", (int, float)),
-                      ("place", str), ("heights", str), ("density", (int, float)),
-                      ("periodic", bool)):
+    for key, kind in LIGHT_SETTINGS:
         if key in s:
             out[key] = get(s, key, kind, where=where)
+            allowed = LIGHT_CHOICES.get(key)
+            if allowed is not None and out[key] not in allowed:
+                raise ProjectError(f"{where}: light setting '{key}' is '{out[key]}', not one "
+                                   f"of {', '.join(allowed)}")
     return out

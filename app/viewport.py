@@ -95,6 +95,9 @@ class Viewport(QtInteractor):
         self.key.hide()
         self.canopy_mesh: pv.PolyData | None = None
         self.colouring = "leaf"
+        #: What the "light" colouring shows: "classes" (a sun) or "values" (a sky, a day).
+        self.light_variant = "classes"
+        self._light_key: tuple[str, str] = ("", "")        # colour-bar title, unit
         self._canopy_actor = None
         self._ground_bounds = None
         self._layout = None
@@ -131,6 +134,8 @@ class Viewport(QtInteractor):
             self._canopy_actor.mapper.SetInputData(poly)
         self._canopy_actor.SetVisibility(True)
         self._set_ground(canopy.layout)
+        if "light_value" not in poly.cell_data:
+            self.light_variant = "classes"
         if self.colouring == "light" and not self.has_light():
             self.colouring = "leaf"
         self._apply_colouring()
@@ -142,6 +147,8 @@ class Viewport(QtInteractor):
     def has_light(self) -> bool:
         if self.canopy_mesh is None:
             return False
+        if self.light_variant == "values":
+            return "light_value" in self.canopy_mesh.cell_data
         return bool(np.any(self.canopy_mesh.cell_data["light"] >= 0))
 
     def set_light(self, classes: np.ndarray | None) -> None:
@@ -158,6 +165,26 @@ class Viewport(QtInteractor):
                 raise ValueError(f"{len(classes)} light classes for {nf} leaf triangles")
             light[:nf] = classes
         self.canopy_mesh.cell_data["light"] = light          # marks the array modified
+        if classes is not None:
+            self.light_variant = "classes"
+        if self.colouring == "light":
+            self._apply_colouring()
+            self.render()
+
+    def set_light_values(self, values: np.ndarray, title: str, unit: str) -> None:
+        """A value per leaf triangle (F,) (a sky's or a day's light per m2 of leaf, NaN where
+        not traced) for the "light" colouring, with a colour bar titled ``title``; the view
+        follows if coloured by light."""
+        if self.canopy_mesh is None:
+            return
+        nf = int(self.canopy_mesh.field_data["leaf_triangles"][0])
+        if len(values) != nf:
+            raise ValueError(f"{len(values)} light values for {nf} leaf triangles")
+        cells = np.full(self.canopy_mesh.n_cells, -1.0, np.float32)     # stalks below range
+        cells[:nf] = values
+        self.canopy_mesh.cell_data["light_value"] = cells
+        self.light_variant = "values"
+        self._light_key = (title, unit)
         if self.colouring == "light":
             self._apply_colouring()
             self.render()
@@ -181,7 +208,23 @@ class Viewport(QtInteractor):
         mapper = self._canopy_actor.mapper
         what = self.colouring
         cells = self.canopy_mesh.cell_data
-        if what == "light":
+        array = what
+        if what == "light" and self.light_variant == "values":
+            array = "light_value"
+            values = cells["light_value"]
+            leaf = values[np.isfinite(values) & (values >= 0)]
+            lo, hi = 0.0, float(leaf.max()) if len(leaf) and leaf.max() > 0 else 1.0
+            lut = pv.LookupTable(cmap="inferno", n_values=256)
+            lut.SetBelowRangeColor(*pv.Color(LIGHT_CLASSES[STALK][1]).float_rgb, 1.0)
+            lut.UseBelowRangeColorOn()
+            lut.SetNanColor(*pv.Color(LIGHT_CLASSES[NOT_TRACED][1]).float_rgb, 1.0)
+            title, unit = self._light_key
+            items = [LIGHT_CLASSES[STALK]]
+            if np.isnan(values).any():
+                items.append(LIGHT_CLASSES[NOT_TRACED])
+            self.key.set_gradient(title, np.asarray(lut.values), "0", f"{hi:.3g} {unit}",
+                                  items)
+        elif what == "light":
             shown = {k: v for k, v in LIGHT_CLASSES.items() if k != NOT_TRACED}
             lut = _categorical(LIGHT_CLASSES)
             lo, hi = min(LIGHT_CLASSES), max(LIGHT_CLASSES)
@@ -205,7 +248,7 @@ class Viewport(QtInteractor):
         lut.SetTableRange(lo, hi)
         mapper.SetLookupTable(lut)
         mapper.SetScalarModeToUseCellFieldData()
-        mapper.SelectColorArray(what)
+        mapper.SelectColorArray(array)
         mapper.SetScalarRange(lo, hi)
         mapper.SetUseLookupTableScalarRange(True)
         mapper.ScalarVisibilityOn()
@@ -437,10 +480,12 @@ class Legend(QWidget):
         self._title, self._items, self._gradient = title, list(items), None
         self._fit()
 
-    def set_gradient(self, title: str, colours: np.ndarray, lo: int, hi: int,
-                     below: tuple[str, str] | None = None) -> None:
+    def set_gradient(self, title: str, colours: np.ndarray, lo, hi,
+                     below=None) -> None:
+        """A colour bar from ``lo`` to ``hi`` (numbers or text with units); ``below``: a
+        swatch (label, colour) or a list of them for values off the bar."""
         self._title, self._gradient = title, (np.asarray(colours), lo, hi)
-        self._items = [below] if below else []
+        self._items = list(below) if isinstance(below, list) else ([below] if below else [])
         self._fit()
 
     def text(self) -> str:

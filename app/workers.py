@@ -44,11 +44,12 @@ class Job:
     cancel: threading.Event = field(default_factory=threading.Event)
     started: float = field(default_factory=time.perf_counter)
 
-    def report(self, done: int, total: int) -> bool:
-        """Progress from any thread; False once the job is cancelled (the work should stop)."""
+    def report(self, done: int, total: int, text: str = "") -> bool:
+        """Progress from any thread (``text``: what is being done, e.g. "time step 7 of 29";
+        else the job's label); False once the job is cancelled (the work should stop)."""
         if self.cancel.is_set():
             return False
-        self.runner._progress_from_thread(self, done, total)
+        self.runner._progress_from_thread(self, done, total, text)
         return not self.cancel.is_set()
 
     @property
@@ -64,13 +65,13 @@ class Job:
 class JobRunner(QObject):
     """Runs jobs on the thread pool; see the module docstring.
 
-    Signals (GUI thread): ``progressed(job id, kind, label, done, total)``, ``changed()`` when
-    the set of running jobs changes.
+    Signals (GUI thread): ``progressed(job id, kind, text, done, total)`` (text: what the job
+    is doing now, or its label), ``changed()`` when the set of running jobs changes.
     """
 
     progressed = Signal(int, str, str, int, int)
     changed = Signal()
-    _progress_signal = Signal(int, int, int)
+    _progress_signal = Signal(int, int, int, str)
     _delivered = Signal(int, object, object)
 
     def __init__(self, parent=None):
@@ -170,20 +171,20 @@ class JobRunner(QObject):
         self.changed.emit()
 
     # ------------------------------------------------------------------ progress
-    def _progress_from_thread(self, job: Job, done: int, total: int) -> None:
+    def _progress_from_thread(self, job: Job, done: int, total: int, text: str = "") -> None:
         if self._closed:
             return
         try:
-            self._progress_signal.emit(job.id, done, total)
+            self._progress_signal.emit(job.id, done, total, text)
         except RuntimeError:                           # the runner is gone: stop the job
             job.cancel.set()
 
-    def _on_progress(self, job_id: int, done: int, total: int) -> None:
+    def _on_progress(self, job_id: int, done: int, total: int, text: str) -> None:
         if self._closed:
             return
         for job in self._current.values():
             if job.id == job_id and not job.cancelled:
-                self.progressed.emit(job.id, job.kind, job.label, done, total)
+                self.progressed.emit(job.id, job.kind, text or job.label, done, total)
 
     # ------------------------------------------------------------------ closing
     def shutdown(self, timeout_s: float = 10.0) -> bool:

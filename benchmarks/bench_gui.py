@@ -77,7 +77,7 @@ class Ticket:
     def __init__(self) -> None:
         self.cancel = threading.Event()
 
-    def report(self, done: int, total: int) -> bool:
+    def report(self, done: int, total: int, text: str = "") -> bool:
         return True
 
 

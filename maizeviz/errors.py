@@ -103,6 +103,7 @@ QUANTITIES = {
     "par_factor": "PAR photons per joule of shortwave, umol/J",
     "linke_turbidity": "Linke turbidity of the clear sky",
     "altitude": "site altitude, m",
+    "weather": "weather file of irradiance (CSV)",
     "points_across": "points per cross-section of a synthetic leaf",
     "seed": "random seed",
     "plant": "plant id",

@@ -1,4 +1,5 @@
-"""The canopy panel: the points file, the tiling, the mesh-complexity slider and Table 2.
+"""The canopy panel: the points file, area preservation, the mesh-complexity slider and Table 2.
+(The tiling is chosen in the layout panel, its one place.)
 
 The slider says what is asked; the level label says what the 3D view shows. Both change
 together with the table when the window hands over a built canopy (:meth:`CanopyPanel.
@@ -8,15 +9,11 @@ show_built`), so the label never names a level the view does not show yet.
 from __future__ import annotations
 
 from PySide6.QtCore import Qt, QTimer, Signal
-from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QComboBox, QFormLayout, QGroupBox,
+from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QFormLayout, QGroupBox,
                                QHBoxLayout, QHeaderView, QLabel, QPushButton, QSizePolicy,
                                QSlider, QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
 
 from maizeviz.mesh.levels import COMPLEXITY_STOPS, parse_level
-
-#: Tilings of the digitized block offered (the paper's is 3 x 3).
-TILES = (1, 3, 5)
-
 
 def describe(level: str) -> str:
     """A slider stop in words."""
@@ -24,15 +21,14 @@ def describe(level: str) -> str:
 
 
 class CanopyPanel(QWidget):
-    """Signals: ``open_requested()``, ``tile_changed(n)``, ``level_requested(stop)`` (after
-    the slider rests 250 ms), ``preserve_changed(bool)``."""
+    """Signals: ``open_requested()``, ``level_requested(stop)`` (after the slider rests
+    250 ms), ``preserve_changed(bool)``."""
 
     open_requested = Signal()
-    tile_changed = Signal(int)
     level_requested = Signal(str)
     preserve_changed = Signal(bool)
 
-    def __init__(self, tile: int = 3, level: str = "36", parent=None):
+    def __init__(self, level: str = "36", parent=None):
         super().__init__(parent)
         lay = QVBoxLayout(self)
         row = QHBoxLayout()
@@ -46,13 +42,6 @@ class CanopyPanel(QWidget):
         row.addWidget(self.open_button)
         lay.addLayout(row)
         form = QFormLayout()
-        self.tile = QComboBox()
-        self.tile.addItems([f"{n}x{n}" for n in TILES])
-        self.tile.setCurrentText(f"{tile}x{tile}")
-        self.tile.setToolTip("how many times the digitized block is repeated across and along "
-                             "the rows (the paper: 3x3, 81 plants)")
-        self.tile.currentTextChanged.connect(lambda t: self.tile_changed.emit(int(t[0])))
-        form.addRow("tiling of the block", self.tile)
         self.preserve = QCheckBox("keep leaf area below the standard mesh")
         self.preserve.setToolTip("widen the kept cross-sections so a coarse leaf keeps the "
                                  "reference mesh's area (off: the paper's plain splitting)")
@@ -111,15 +100,6 @@ class CanopyPanel(QWidget):
             self.slider.blockSignals(True)
             self.slider.setValue(COMPLEXITY_STOPS.index(level))
             self.slider.blockSignals(False)
-
-    @property
-    def tile_n(self) -> int:
-        return int(self.tile.currentText()[0])
-
-    def set_tile(self, n: int) -> None:
-        self.tile.blockSignals(True)
-        self.tile.setCurrentText(f"{n}x{n}")
-        self.tile.blockSignals(False)
 
     def set_file(self, name: str, tooltip: str = "") -> None:
         self.file_label.setText(name)

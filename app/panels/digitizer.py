@@ -131,7 +131,7 @@ class DigitizerPanel(QWidget):
 
     def __init__(self, viewport=None, parent=None):
         super().__init__(parent)
-        self.viewport = viewport
+        self._viewport = viewport
         self.recorder: Recorder | None = None
         self.sim = None
         self.beeps = 0
@@ -288,6 +288,17 @@ class DigitizerPanel(QWidget):
             sc.setEnabled(False)
             sc.deleteLater()
         self._shortcuts.clear()
+
+    @property
+    def viewport(self):
+        """The 3D view the plant grows in (also the growing plant's: setting it after the
+        panel was made must reach both, or the plant is never drawn)."""
+        return self._viewport
+
+    @viewport.setter
+    def viewport(self, viewport) -> None:
+        self._viewport = viewport
+        self.plant.viewport = viewport
 
     @property
     def session(self) -> Session | None:

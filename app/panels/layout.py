@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from maizeviz_app.options import TILINGS, tiling_of
 from maizeviz_app.panels.field_view import FieldView
 from maizeviz_app.panels.layout_model import (
     EditedLayout,
@@ -52,17 +53,7 @@ from maizeviz.canopy.layout import (
 )
 from maizeviz.errors import MaizevizError
 
-#: Tiling presets: tiles of the digitized block along each side.
-TILINGS = (1, 3, 5, 7, 9)
 FOLLOW_DELAY_MS = 400
-
-
-def tiling_of(layout) -> tuple[int, int] | None:
-    """Tiles (along x, along y) of a tiled layout; None for a layout file."""
-    if layout is None or layout.ground_area is None:
-        return None
-    tiles = {p.tile for p in layout.placements}
-    return len({t[0] for t in tiles}), len({t[1] for t in tiles})
 
 
 class LayoutPanel(QWidget):

@@ -32,7 +32,7 @@ FLAGS = {
     "plants": "--plants", "sections": "--sections", "at": "--at", "periodic": "--periodic",
     "sky": "--sky", "sky_directions": "--sky-directions", "step": "--step",
     "period": "--from/--to", "par_factor": "--par-factor", "linke_turbidity": "--linke-turbidity",
-    "altitude": "--altitude",
+    "altitude": "--altitude", "weather": "--weather",
     "baud": "--baud", "points_across": "--points-across", "seed": "--seed", "plant": "--plant",
     "pace": "--pace", "noise": "--noise", "answer_timeout": "--answer-timeout",
     "resume": "--resume",

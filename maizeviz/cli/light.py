@@ -35,7 +35,7 @@ from maizeviz.cli.common import (
 )
 from maizeviz.cost import heatmap_cost, light_cost
 from maizeviz.errors import MaizevizError
-from maizeviz.io.atomic import atomic_open, refuse_overwriting_inputs
+from maizeviz.io.atomic import refuse_overwriting_inputs
 from maizeviz.light.beer_lambert import beer_lambert, beer_lambert_sky, clumping
 from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
 from maizeviz.light.heatmap import (
@@ -53,7 +53,8 @@ from maizeviz.light.irradiance import (
     read_weather,
     weather_period,
 )
-from maizeviz.light.leaf_light import leaf_light, leaf_sums, merge_rows, plant_light
+from maizeviz.light.leaf_light import leaf_light, merge_rows, plant_light
+from maizeviz.light.reports import period_leaf_rows, sky_leaf_rows, write_steps
 from maizeviz.light.request import LightRequest, Sampling
 from maizeviz.light.sky import SKY_KINDS, Sky, make_sky
 from maizeviz.light.sun import Sun, sun_at
@@ -307,9 +308,7 @@ def run(args: argparse.Namespace) -> int:
         if sky_res is not None:
             rec["diffuse"] = _sky_record(sky_res, canopy, args, heights)
             if want_rows:
-                tables.append(leaf_sums(canopy, {
-                    "diffuse_intercepted_cm2": sky_res.triangle_intercepted_cm2},
-                    sky_res.rect, sky_res.periodic))
+                tables.append(sky_leaf_rows(canopy, sky_res))
         elif sky is not None and period is not None:
             rec["diffuse"] = None                   # the sun never rose: no sky traced
         if per_res is not None:
@@ -400,14 +399,7 @@ def _period_record(pl: PeriodLight, args: argparse.Namespace) -> dict[str, Any]:
 
 
 def _period_rows(canopy: Canopy, pl: PeriodLight) -> list[dict]:
-    rows = leaf_sums(canopy, {"par_intercepted_mol": pl.triangle_mol,
-                              "direct_par_intercepted_mol": pl.triangle_direct_mol,
-                              "diffuse_par_intercepted_mol": pl.triangle_diffuse_mol},
-                     pl.rect, pl.periodic)
-    for r in rows:
-        r["par_mol_per_m2_leaf"] = float(r["par_intercepted_mol"]) / \
-            (float(r["leaf_area_cm2"]) * 1e-4)
-    return rows
+    return period_leaf_rows(canopy, pl)
 
 
 def _jsonable(obj: Any) -> Any:
@@ -494,26 +486,7 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
 
 def _write_steps(path: str | Path, pl: PeriodLight) -> None:
     """One line per time step (sun up), atomically."""
-    import csv
-
-    p = pl.period
-    hs = [f"{h:g}".replace(".", "p") for h in pl.heights_cm]
-    head = (["time", "step_s", "zenith_deg", "azimuth_deg", "ghi_w_m2", "direct_horizontal_w_m2",
-             "diffuse_w_m2", "par_direct_mol_m2", "par_diffuse_mol_m2", "par_intercepted_mol_m2",
-             "fraction_intercepted"] + [f"direct_transmission_h{h}cm" for h in hs]
-            + [f"par_transmitted_mol_m2_h{h}cm" for h in hs])
-    with atomic_open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(head)
-        for j in range(pl.n_steps):
-            w.writerow([p.times[j].isoformat(), f"{p.step_s[j]:g}", f"{p.zenith_deg[j]:.3f}",
-                        f"{p.azimuth_deg[j]:.3f}", f"{p.ghi[j]:.2f}",
-                        f"{p.direct_horizontal[j]:.2f}", f"{p.dhi[j]:.2f}",
-                        f"{pl.step_direct_mol_m2[j]:.6f}", f"{pl.step_diffuse_mol_m2[j]:.6f}",
-                        f"{pl.step_intercepted_mol_m2[j]:.6f}",
-                        f"{pl.step_fraction_intercepted[j]:.5f}"]
-                       + [f"{t:.5f}" for t in pl.step_transmission[j]]
-                       + [f"{t:.6f}" for t in pl.step_transmitted_mol_m2[j]])
+    write_steps(path, pl)
 
 
 # ------------------------------------------------------------------------------ tables

@@ -49,7 +49,7 @@ import io
 import math
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING
@@ -89,7 +89,12 @@ _ZONE_SUFFIX = re.compile(r"\d{2}:\d{2}(?::\d{2}(?:[.,]\d+)?)?\s*(?:Z|[+-]\d{2}(
 
 
 class WeatherFileError(MaizevizError):
-    """A weather file cannot be used: the message names the file, line, time and column."""
+    """A weather file cannot be used: the message names the file, line, time and column.
+    Its ``quantity`` is ``"weather"`` (the file as an input), so the app can mark the field
+    that names the file and the command line can name ``--weather``."""
+
+    def __init__(self, message: str = "", quantity: str | None = "weather"):
+        super().__init__(message, quantity)
 
 
 # --------------------------------------------------------------------------- small helpers
@@ -353,6 +358,13 @@ class Period:
     par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J
     notes: tuple[str, ...] = ()
 
+    def __reduce__(self):
+        # the read-only parameters mapping does not pickle; a period crosses process
+        # boundaries (the app's light process, Dask workers) as its fields, checked again
+        values = {f.name: getattr(self, f.name) for f in fields(self)}
+        values["parameters"] = dict(self.parameters)
+        return (_period_from_fields, (values,))
+
     def __post_init__(self):
         n = len(self.times)
         for name in ("step_s", "zenith_deg", "azimuth_deg", "ghi", "dni", "dhi",
@@ -466,6 +478,10 @@ class Period:
 
         return [Sun(float(z), float(a), t.isoformat())
                 for z, a, t in zip(self.zenith_deg, self.azimuth_deg, self.times, strict=True)]
+
+
+def _period_from_fields(values: dict) -> Period:
+    return Period(**values)
 
 
 # --------------------------------------------------------------------------- clear sky

@@ -131,7 +131,7 @@ def test_q_in_the_same_tick_as_a_point(qtbot, make_panel, sim, tmp_path):
     assert stopped.args == ["finished"]
     pts = read_points(out)
     assert len(pts) == 1 and np.allclose(pts.xyz[0], (1.0, 2.0, 3.0))
-    assert "1 points" in panel.counts.text()
+    assert "1 point, 1 leaf" in panel.counts.text()     # the session summary says 1 point
 
 
 def test_refused_point_and_garbled_record_are_loud(qtbot, make_panel, sim, tmp_path):
@@ -314,3 +314,26 @@ def test_stop_while_connecting_lets_go_of_the_file(qtbot, make_panel, tmp_path):
             panel.stop_button.click()
         assert stopped.args == ["stopped"] and panel.connect_button.isEnabled()
     Session(out, 3, resume=True).close()                  # nobody holds the file any more
+
+
+def test_a_canopy_built_while_digitizing_waits_for_the_session(window, two_plants, qtbot,
+                                                               tmp_path):
+    """Issue: a canopy arriving while the digitizer records was shown at once, wiping the
+    growing plant from the view; it now waits and shows when the session stops."""
+    w = window(two_plants, tile=1)
+    qtbot.waitSignal(w.canopy_shown, timeout=120_000).wait()
+    rec = Recorder(Session(tmp_path / "s.csv", 3), None)
+    w.digitizer.begin(rec)
+    for x in (0.0, 1.0, 2.0):                                # one cross-section
+        rec.events.put(_press(x, 0.0, 50.0))
+    w.digitizer._drain()
+    qtbot.waitUntil(lambda: "digitized" in w.viewport.actors, timeout=TIMEOUT)
+    with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
+        w.slider.setValue(w.slider.value() + 1)             # a rebuild finishes meanwhile
+    assert w.built.label == "16 triangles"
+    assert "canopy" not in w.viewport.actors                 # the plant keeps the view
+    assert "digitized" in w.viewport.actors
+    w.digitizer.stop()
+    assert "canopy" in w.viewport.actors and "digitized" not in w.viewport.actors
+    n_stalk = len(w.canopy.stalk_faces)
+    assert w.viewport.canopy_mesh.n_cells == w.canopy.n_triangles + n_stalk   # the new one

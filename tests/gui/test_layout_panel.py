@@ -205,3 +205,29 @@ def test_layout_editor_in_the_window_turns_a_plant(window, two_plants, qtbot):
     assert not np.allclose(before, after)
     assert [p.azimuth_deg for p in w.loaded.layout.placements if p.plant == first] == [90]
     assert w.loaded.layout.ground_area_cm2 == pytest.approx(60 * 60)   # the tiling's ground
+
+
+def test_the_tiling_has_one_place_and_the_window_follows_it(window, two_plants, qtbot, tmp_path):
+    """Issue: the canopy panel had its own tiling combo, which went stale after a layout
+    preset (a project then saved the old tiling and reopening the points undid the preset)."""
+    import zipfile
+
+    from PySide6.QtWidgets import QComboBox
+
+    w = window(two_plants, tile=1)
+    qtbot.waitSignal(w.canopy_shown, timeout=120_000).wait()
+    tilings = [c for c in w.findChildren(QComboBox)
+               if "repeat" in c.toolTip() or "repeated" in c.toolTip()]
+    assert tilings == [w.layout_panel.tiling]                # one control, in the layout panel
+    with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
+        assert w.layout_panel.set_tiling(3)                  # the preset; the view follows
+    assert w.tile_n == 3 and len(w.canopy.layout.placements) == 18
+    path = tmp_path / "tiled.maizeviz"
+    with qtbot.waitSignal(w.saved, timeout=120_000):
+        w.save_project(path)
+    with zipfile.ZipFile(path) as zf:
+        assert json.loads(zf.read("project.json"))["settings"]["canopy"]["tile"] == 3
+    with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
+        w.open_points(two_plants)                            # reopened with the tiling shown
+    assert len(w.loaded.layout.placements) == 18
+    assert w.layout_panel.tiling.currentData() == 3

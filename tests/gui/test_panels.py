@@ -11,7 +11,7 @@ from maizeviz_app.panels.light import (InputProblem, LightPanel, LightPlots, Lig
 
 
 def test_slider_asks_once_and_the_label_follows_the_view(qtbot):
-    panel = CanopyPanel(tile=3, level="36")
+    panel = CanopyPanel(level="36")
     qtbot.addWidget(panel)
     asked = []
     panel.level_requested.connect(asked.append)
