@@ -31,7 +31,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from bench_read_points import write_points_file  # noqa: E402
+from bench_read_points import old_module, write_points_file  # noqa: E402
 
 CHILD = r"""
 import json, resource, sys, time
@@ -147,18 +147,6 @@ def run_leaf(path: Path, argv: list[str], tmp: Path) -> dict:
     return res
 
 
-def old_measures_file(rev: str, folder: Path) -> Path | None:
-    """maizeviz/mesh/measures.py as it was at ``rev`` (None without git)."""
-    try:
-        text = subprocess.run(["git", "show", f"{rev}:maizeviz/mesh/measures.py"], cwd=ROOT,
-                              capture_output=True, text=True, check=True).stdout
-    except (OSError, subprocess.CalledProcessError):
-        return None
-    path = folder / "old_measures.py"
-    path.write_text(text)
-    return path
-
-
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--json", action="store_true", help="print one JSON object")
@@ -178,7 +166,7 @@ def main(argv=None) -> int:
         small, large = tmp / "small.csv", tmp / "large.csv"
         write_points_file(small, args.small_mb)
         result["small"] = run_leaf(small, ["--interp", "0", "--json"], tmp)
-        old = old_measures_file(args.anchor_rev, tmp)
+        old = old_module(args.anchor_rev, "maizeviz/mesh/measures.py", tmp)
         if old is not None and args.anchor_leaves > 0:
             a = run_child(ANCHOR, str(small), str(old), str(args.anchor_leaves))
             batched = result["small"]["stages"]["measure"] / result["small"]["leaves"]

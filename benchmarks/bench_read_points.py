@@ -84,14 +84,15 @@ def run_reader(which: str, path: Path) -> dict:
     return res
 
 
-def old_reader(rev: str, folder: Path) -> Path | None:
-    """The points reader as it was at ``rev``, written to a file (None without git)."""
+def old_module(rev: str, module: str, folder: Path) -> Path | None:
+    """The file ``module`` (a path in the repository) as it was at ``rev``, written into
+    ``folder`` (None without git)."""
     try:
-        text = subprocess.run(["git", "show", f"{rev}:maizeviz/io/points.py"], cwd=ROOT,
+        text = subprocess.run(["git", "show", f"{rev}:{module}"], cwd=ROOT,
                               capture_output=True, text=True, check=True).stdout
     except (OSError, subprocess.CalledProcessError):
         return None
-    path = folder / "old_points.py"
+    path = folder / f"old_{Path(module).name}"
     path.write_text(text)
     return path
 
@@ -111,7 +112,7 @@ def main(argv=None) -> int:
         write_points_file(small, args.anchor_mb)
         write_points_file(large, args.mb)
         result = {"large": run_reader("new", large), "small_new": run_reader("new", small)}
-        old = old_reader(args.anchor_rev, tmp)
+        old = old_module(args.anchor_rev, "maizeviz/io/points.py", tmp)
         if old is not None:
             result["small_old"] = run_reader(str(old), small)
             a, b = result["small_new"], result["small_old"]
