@@ -1120,8 +1120,8 @@ class MainWindow(QMainWindow):
         rows = [dict(r, level=label) for r in extra.leaf_rows]
 
         def work(job):
+            from maizeviz.io.atomic import write_rows
             from maizeviz.light.leaf_light import plant_light
-            from maizeviz.light.reports import write_rows
 
             write_rows(path, rows if what == "leaves" else plant_light(rows))
             return path

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
 from collections import Counter
 from collections.abc import Sequence
@@ -12,7 +11,7 @@ from pathlib import Path
 from maizeviz.canopy.layout import CanopyLayout, check_tile, layout_for, parse_shape
 from maizeviz.cost import Cost, canopy_cost, check
 from maizeviz.errors import LeafError, MaizevizError
-from maizeviz.io.atomic import atomic_open, check_output
+from maizeviz.io.atomic import check_output
 from maizeviz.io.meshfile import check_mesh_path
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.mesh.levels import Level, parse_levels
@@ -185,15 +184,6 @@ def floats(text: str, what: str, quantity: str, count: int | None = None) -> lis
     if count is not None and len(vals) != count:
         raise MaizevizError(f"{what} needs {count} numbers, got '{text}'", quantity=quantity)
     return vals
-
-
-def write_rows(path: str | Path, rows: list[dict]) -> None:
-    """Rows of dicts as a CSV file with a header (atomically)."""
-    fields = list(rows[0].keys()) if rows else []
-    with atomic_open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=fields)
-        w.writeheader()
-        w.writerows(rows)
 
 
 def suffixed(path: str | Path, label: str) -> Path:

@@ -31,11 +31,10 @@ from maizeviz.cli.common import (
     levels_from,
     say,
     suffixed,
-    write_rows,
 )
 from maizeviz.cost import heatmap_cost, light_cost
 from maizeviz.errors import MaizevizError
-from maizeviz.io.atomic import refuse_overwriting_inputs
+from maizeviz.io.atomic import refuse_overwriting_inputs, write_rows
 from maizeviz.light.beer_lambert import beer_lambert, beer_lambert_sky, clumping
 from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
 from maizeviz.light.heatmap import (

@@ -9,9 +9,10 @@ raises :class:`~maizeviz.errors.MaizevizError` naming the path.
 from __future__ import annotations
 
 import contextlib
+import csv
 import os
 import tempfile
-from collections.abc import Iterable, Iterator
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import IO, Any
 
@@ -111,6 +112,16 @@ def write_text(path: str | Path, text: str) -> None:
     """Write ``text`` (UTF-8) to ``path`` atomically."""
     with atomic_open(path, "w") as fh:
         fh.write(text)
+
+
+def write_rows(path: str | Path, rows: Sequence[Mapping[str, Any]]) -> None:
+    """Rows of dicts as a CSV file with a header, atomically; the columns are the first
+    row's keys (an empty list writes an empty file)."""
+    fields = list(rows[0].keys()) if rows else []
+    with atomic_open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields)
+        w.writeheader()
+        w.writerows(rows)
 
 
 def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str | Path | None]],

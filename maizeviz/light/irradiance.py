@@ -793,12 +793,12 @@ def read_weather(path, tz: str | None = None, label: str = "center",
         raise WeatherFileError(f"{path}: the weather file is empty (no header, no rows)")
     columns = _header(first[0], first[1], path)
     lines, data = [], []
-    for line, fields in rows:
-        if len(fields) != len(columns):
-            raise WeatherFileError(f"{path}, line {line}: {len(fields)} values for "
+    for line, cells in rows:
+        if len(cells) != len(columns):
+            raise WeatherFileError(f"{path}, line {line}: {len(cells)} values for "
                                    f"{len(columns)} columns ({', '.join(columns)})")
         lines.append(line)
-        data.append(fields)
+        data.append(cells)
     if not data:
         raise WeatherFileError(f"{path}: the weather file has a header but no data rows")
     if len(data) < 2:

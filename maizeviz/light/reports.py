@@ -79,15 +79,6 @@ def leaf_values(canopy: Canopy, rows: list[LightRow], column: str, rect=None,
     return out
 
 
-def write_rows(path: str | Path, rows: list[LightRow]) -> None:
-    """Rows of dicts as a CSV file with a header (atomically); columns of the first row."""
-    fields = list(rows[0].keys()) if rows else []
-    with atomic_open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=fields)
-        w.writeheader()
-        w.writerows(rows)
-
-
 def write_steps(path: str | Path, pl: PeriodLight) -> None:
     """One line per time step (sun up), atomically: time, step_s, zenith_deg, azimuth_deg,
     ghi_w_m2, direct_horizontal_w_m2, diffuse_w_m2, par_direct_mol_m2, par_diffuse_mol_m2,

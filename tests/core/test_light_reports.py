@@ -14,7 +14,8 @@ from maizeviz.leaf.synth import block_grids
 from maizeviz.light.daylight import trace_period
 from maizeviz.light.irradiance import WeatherFileError, clear_sky_period, read_weather
 from maizeviz.light.leaf_light import plant_light
-from maizeviz.light.reports import leaf_values, period_leaf_rows, write_rows, write_steps
+from maizeviz.io.atomic import write_rows
+from maizeviz.light.reports import leaf_values, period_leaf_rows, write_steps
 from maizeviz.light.request import Sampling
 from maizeviz.light.sky import make_sky
 from maizeviz.mesh.levels import parse_level
