@@ -32,20 +32,11 @@ import threading
 import time
 from pathlib import Path
 
-import numpy as np
+from anchors import matmul_anchor
 
 ROOT = Path(__file__).resolve().parents[1]
 STOPS = "K4,K2,K1,standard,36,16,8,4"
 TIMEOUT_S = 600
-
-
-def anchor() -> float:
-    a = np.random.default_rng(0).random((400, 400))
-    t0 = time.perf_counter()
-    for _ in range(20):
-        a = a @ a
-        a /= np.abs(a).max()
-    return time.perf_counter() - t0
 
 
 class GilProbe:
@@ -145,7 +136,7 @@ def startup_child() -> None:
     """Launched as a new process: print when the window is exposed and when the first canopy
     is on screen (the parent times from the launch)."""
     os.environ["XDG_CONFIG_HOME"] = os.environ.get("BENCH_CONFIG", "/tmp/maizeviz-bench-cfg")
-    app = _app()
+    app = _app()  # noqa: F841  (keeps the QApplication alive)
     from PySide6.QtCore import QTimer
 
     from maizeviz.resources import example_points
@@ -218,7 +209,7 @@ class GapTimer:
 def gui_child(levels: list[str]) -> None:
     """In a display: idle renders, renders per canopy, slider latency and gaps per level."""
     os.environ["XDG_CONFIG_HOME"] = os.environ.get("BENCH_CONFIG", "/tmp/maizeviz-bench-cfg")
-    app = _app()
+    app = _app()  # noqa: F841  (keeps the QApplication alive)
     from PySide6.QtCore import QCoreApplication
 
     from maizeviz.mesh.levels import COMPLEXITY_STOPS
@@ -311,7 +302,7 @@ def main() -> None:
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         raise SystemExit("needs a display: xvfb-run -a -s \"-screen 0 1366x768x24\" python "
                          "benchmarks/bench_gui.py")
-    out = {"anchor_s": min(anchor() for _ in range(3))}
+    out = {"anchor_s": min(matmul_anchor() for _ in range(3))}
     out.update(gil_part())
     out.update(startup_part())
     out.update(gui_part(levels))
