@@ -161,6 +161,28 @@ class DaySpec:
                                 quantity="place" if self.weather else "date")
         return period
 
+    def steps_bound(self) -> int:
+        """At most how many time steps :meth:`period` will have, known without computing it
+        (for the cost estimate): the span over the step for a clear sky, the rows a weather
+        file of its size can hold (24 bytes a row at the least)."""
+        import math
+        import os
+
+        if self.weather:
+            try:
+                return max(os.path.getsize(self.weather) // 24, 1)
+            except OSError:
+                return 1                                 # refused later, naming the file
+        minutes = 24 * 60.0
+        try:
+            if self.start and self.end:
+                h0, m0 = (int(v) for v in self.start.split(":"))
+                h1, m1 = (int(v) for v in self.end.split(":"))
+                minutes = max((h1 * 60 + m1) - (h0 * 60 + m0), 1)
+        except ValueError:
+            pass
+        return max(math.ceil(minutes / max(self.step_min, 1.0)), 1)
+
 
 @dataclass(frozen=True)
 class Diffuse:

@@ -57,7 +57,6 @@ def run(argv: Sequence[str] | None = None) -> int:
                     help="window size for --screenshot (default 1366x768, a laptop screen)")
     args = ap.parse_args(argv)
     os.environ.setdefault("QT_API", "pyside6")
-    from PySide6.QtCore import QTimer
     from PySide6.QtWidgets import QApplication
 
     gl_format()

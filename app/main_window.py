@@ -528,8 +528,18 @@ class MainWindow(QMainWindow):
             return jobs.Built(level, label, canopy, m, build_s, measure_s,
                               (mesh, list(TABLE2_COLUMNS), row, serial))
 
+        from maizeviz.cost import layout_cost, light_cost
         from maizeviz.mesh.levels import parse_level
 
+        stage = [layout_cost(loaded.leaves, loaded.layout, parse_level(level)),
+                 light_cost(loaded.layout.bounds, 1 / jobs.APP_COVER_RESOLUTION_CM ** 2, 1)]
+        if not self.affordable([stage], "build"):
+            shown = self.built is not None and self.built.mesh[3] == serial
+            if shown:
+                self.canopy_panel.set_level(self.built.level)
+            self.canopy_panel.set_pending("" if shown else
+                                          "not built: choose a coarser level or fewer plants")
+            return
         self.canopy_panel.set_pending(f"building: {parse_level(level).description}…")
         self.runner.run("build", f"building {parse_level(level).label}", work,
                         on_done=self._on_built, on_error=lambda e: self._fail(e, "build"))
@@ -618,6 +628,8 @@ class MainWindow(QMainWindow):
         except (InputProblem, MaizevizError) as exc:
             self._fail(exc, "light", mode)
             return
+        if not self.affordable([self._light_costs(mode, args, heights)], "light"):
+            return
         from maizeviz_app import plots
 
         canopy, built = self.canopy, self.built
@@ -649,6 +661,52 @@ class MainWindow(QMainWindow):
         self.docks["light"].raise_()
         self.runner.run("light", f"{mode} light on {label}", work, on_done=self._on_lit,
                         on_error=lambda e: self._light_failed(e, mode))
+
+    def _light_costs(self, mode: str, args: tuple, heights) -> list:
+        """What a light run of ``mode`` on the canopy shown will cost (``maizeviz.cost``): its
+        rays (times the directions: the sun, the sky's, a day's steps) and its heatmaps."""
+        from maizeviz.cost import heatmap_cost, light_cost
+
+        from maizeviz_app.plots import HEATMAP_BIN_CM
+
+        rect = args[0].rect or self.canopy.layout.centre_bounds
+        directions = 1
+        if mode != "sun":
+            directions = max(args[1].directions, 1)
+            if mode == "day":
+                directions += args[2].steps_bound()
+        return [light_cost(rect, args[0].density, len(heights), directions,
+                           self.built.measures.triangles),
+                heatmap_cost(rect, HEATMAP_BIN_CM, len(heights))]
+
+    def affordable(self, stages, doing: str) -> bool:
+        """Whether to start work estimated as ``stages`` (lists of ``maizeviz.cost.Cost``): no,
+        with a message, when it would not fit in this machine's memory; when merely slow, as
+        the user answers :meth:`confirm_slow`."""
+        from maizeviz.cost import TooSlow, check
+
+        try:
+            check(stages)
+        except TooSlow as exc:
+            if self.confirm_slow(exc.estimate):
+                return True
+            self.say(f"not started: {exc.estimate}", status_only=True)
+            return False
+        except MaizevizError as exc:
+            self._fail(exc, doing)
+            return False
+        return True
+
+    def confirm_slow(self, estimate: str) -> bool:
+        """Ask before starting work estimated at ``estimate`` (more than a quarter of an
+        hour); it runs in the background and can be cancelled."""
+        box = QMessageBox(QMessageBox.Question, "Start a long computation?",
+                          f"{estimate}.\n\nIt runs in the background and can be cancelled; "
+                          "a coarser level, a lower density or fewer directions or steps make "
+                          "it shorter.", QMessageBox.Yes | QMessageBox.Cancel, self)
+        box.button(QMessageBox.Yes).setText("Start")
+        box.setDefaultButton(QMessageBox.Cancel)
+        return box.exec() == QMessageBox.Yes
 
     def _light_failed(self, exc: BaseException, mode: str = "sun") -> None:
         self.light_panel.set_running(False)

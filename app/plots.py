@@ -34,6 +34,10 @@ class Curve:
     level: str = ""
 
 
+#: Side of a heatmap bin drawn in the window, cm.
+HEATMAP_BIN_CM = 5.0
+
+
 def transmission_figure(curves: Sequence[Curve], title: str = "", width_in: float = 5.0,
                         dpi: int = 90):
     """Transmission (x, 0..1) against height (y, cm), one curve per mesh level and light."""
@@ -98,7 +102,7 @@ def heatmap_title(result, kind: str) -> tuple[str, str]:
             f"level {result.level}")
 
 
-def heatmap_image(result, height: float, bin_cm: float = 5.0, width_in: float = 8.0,
+def heatmap_image(result, height: float, bin_cm: float = HEATMAP_BIN_CM, width_in: float = 8.0,
                   dpi: int = 64, kind: str = "sun") -> np.ndarray:
     """The core's heatmap of one height of a light result (a sun's ``LightResult``, a
     ``SkyLight`` or a ``PeriodLight``), drawn (RGBA)."""

@@ -13,9 +13,11 @@ from __future__ import annotations
 
 import math
 import os
+from collections import Counter
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+from maizeviz.canopy.layout import CanopyLayout
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import Leaf
 from maizeviz.light.rays import Rect, ray_count
@@ -35,6 +37,16 @@ RAYS_PER_S = 3_000_000                   # tracing, all heights
 SLOW_SECONDS = 900.0
 #: Share of the available memory one computation may plan to use.
 MEMORY_SHARE = 0.8
+
+
+class TooSlow(MaizevizError):
+    """Work that fits in memory but is estimated to take longer than :data:`SLOW_SECONDS`:
+    the command line runs it with ``--force``, the app after a confirmation. ``estimate``:
+    the estimate in words, without the advice."""
+
+    def __init__(self, message: str, quantity: str | None = None, estimate: str = "") -> None:
+        super().__init__(message, quantity=quantity)
+        self.estimate = estimate or message
 
 
 @dataclass(frozen=True)
@@ -116,6 +128,11 @@ def canopy_cost(leaves: Iterable[Leaf], placements: Mapping[int, int], level: Le
                 tris * BYTES_PER_TRIANGLE, tris / TRIANGLES_PER_S)
 
 
+def layout_cost(leaves: Iterable[Leaf], layout: CanopyLayout, level: Level) -> Cost:
+    """The canopy of ``leaves`` standing as ``layout`` places them, at ``level``."""
+    return canopy_cost(leaves, dict(Counter(p.plant for p in layout.placements)), level)
+
+
 def light_cost(rect: Rect, density: float, heights: int, directions: int = 1,
                triangles: int = 0) -> Cost:
     """Tracing ``directions`` parallel beams (the sun, sky directions, time steps) of rays at
@@ -152,8 +169,9 @@ def check(stages: Iterable[Iterable[Cost]], force: bool = False,
     Raises
     ------
     MaizevizError
-        One line naming the estimate, the limit and the input that drives it (``quantity``);
-        for slow work the message says it can be forced.
+        One line naming the estimate, the limit and the input that drives it (``quantity``).
+    TooSlow
+        For work that fits but is slow; the message says it can be forced.
     """
     stages = [list(s) for s in stages]
     costs = [c for s in stages for c in s]
@@ -168,6 +186,7 @@ def check(stages: Iterable[Iterable[Cost]], force: bool = False,
     seconds = sum(c.seconds for c in costs)
     if seconds > SLOW_SECONDS and not force:
         worst = max(costs, key=lambda c: c.seconds)
-        raise MaizevizError(f"{worst.describe()}: about {_duration(seconds)} in all, more than "
-                            f"{_duration(SLOW_SECONDS)}; force it to run anyway",
-                            quantity=worst.quantity)
+        estimate = (f"{worst.describe()}: about {_duration(seconds)} in all, more than "
+                    f"{_duration(SLOW_SECONDS)}")
+        raise TooSlow(f"{estimate}; force it to run anyway", quantity=worst.quantity,
+                      estimate=estimate)

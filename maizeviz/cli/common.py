@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import argparse
 import sys
-from collections import Counter
 from collections.abc import Sequence
 from pathlib import Path
 
 from maizeviz.canopy.layout import CanopyLayout, check_tile, layout_for, parse_shape
-from maizeviz.cost import Cost, canopy_cost, check
+from maizeviz.cost import Cost, check, layout_cost
 from maizeviz.errors import LeafError, MaizevizError
 from maizeviz.io.atomic import check_output
 from maizeviz.io.meshfile import check_mesh_path
@@ -144,8 +143,7 @@ def check_canopy_costs(leaves: list[Leaf], layout: CanopyLayout, levels: list[Le
                        force: bool, per_level: Sequence[Cost] = ()) -> None:
     """Refuse, before building anything, canopies (plus ``per_level`` work on each) that would
     not fit in memory, or take too long unless ``force``."""
-    placed = dict(Counter(p.plant for p in layout.placements))
-    check([[canopy_cost(leaves, placed, level), *per_level] for level in levels], force)
+    check([[layout_cost(leaves, layout, level), *per_level] for level in levels], force)
 
 
 def load_leaves(path: str, strict: bool = False, degree: int = 3, method: str = "chord",

@@ -25,14 +25,14 @@ from __future__ import annotations
 import hashlib
 import threading
 import time
-from collections import Counter, OrderedDict
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import Any
 
 from maizeviz.canopy.layout import layout_for, parse_shape
 from maizeviz.canopy.measures import measure_canopy
 from maizeviz.canopy.scene import Canopy, build_canopy
-from maizeviz.cost import Cost, canopy_cost, light_cost
+from maizeviz.cost import Cost, layout_cost, light_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.request import LightRequest
@@ -297,9 +297,8 @@ def group_costs(scenarios) -> list[Cost]:
     s = scenarios[0]
     found, _ = _leaves(s.points.path, s.points.sha256)
     layout = _layout(s, found.leaves)
-    placed = dict(Counter(p.plant for p in layout.placements))
     rect = s.rect_cm or layout.centre_bounds
-    return [canopy_cost(found.leaves, placed, parse_level(s.level)),
+    return [layout_cost(found.leaves, layout, parse_level(s.level)),
             light_cost(layout.bounds, 1 / s.cover_resolution**2, 1),
             *(light_cost(rect, sc.density, len(sc.heights_cm)) for sc in scenarios)]
 

@@ -91,3 +91,21 @@ def test_work_that_would_not_fit_is_refused_with_its_option(capsys, tmp_path, ar
     line = [ln for ln in err.splitlines() if ln.startswith("error:")]
     assert len(line) == 1 and says in line[0] and line[0].endswith(f"({flag})")
     assert not out and not (tmp_path / "maps").exists()
+
+
+def test_slow_work_is_its_own_error_with_the_estimate_apart_from_the_advice(block):
+    from maizeviz.cost import TooSlow, layout_cost
+
+    slow = Cost("tracing", "density", 10**10, "rays", 2**20, 4000.0)
+    with pytest.raises(TooSlow) as err:
+        check([[slow]], available=16 * 2**30)
+    assert isinstance(err.value, MaizevizError) and err.value.quantity == "density"
+    assert "force it" in str(err.value) and "force" not in err.value.estimate
+    assert err.value.estimate.startswith("tracing: 10,000,000,000 rays")
+    big = Cost("the canopy", "tile", 10**9, "triangles", 400 * 10**9, 1.0)
+    with pytest.raises(MaizevizError) as err:                   # memory: never just slow
+        check([[big]], available=16 * 2**30)
+    assert not isinstance(err.value, TooSlow)
+    layout = layout_for(block, (3, 2))
+    assert layout_cost(block, layout, Level(interp=0)).count == \
+        build_canopy(block, layout, Level(interp=0)).n_triangles
