@@ -117,10 +117,6 @@ def day_record(label: str, light, settings: dict | None = None) -> Record:
     as :func:`sky_record`."""
     p = light.period
     meta = _common_meta(label, light)
-    density = light.sky.density if light.sky is not None else \
-        light.rays / max((light.rect[2] - light.rect[0]) * (light.rect[3] - light.rect[1]),
-                         1e-300)
-    meta["density"] = float(density)
     meta["period"] = {"times": [t.isoformat() for t in p.times],
                       "tz": _zone_name(p.times.tz if p.times.tz is not None else p.start.tz),
                       "start": p.start.isoformat(), "end": p.end.isoformat(),
