@@ -301,11 +301,12 @@ def _time(text: Any, where: str, what: str):
                            f"(2005-08-01T12:00:00+08:00), got {shown}")
     try:
         t = pd.Timestamp(text.strip())
+        t = None if t is pd.NaT or t.tz is None else t.as_unit("ns")   # years 1678-2261
     except (ValueError, TypeError, OverflowError):
         t = None
-    if t is None or t is pd.NaT or t.tz is None:
+    if t is None:
         raise ProjectError(f"{where}: {what} '{text[:40]}' is not a valid ISO 8601 time with "
-                           "its UTC offset")
+                           "its UTC offset (years 1678 to 2261)")
     return t.tz_convert("UTC")
 
 

@@ -240,6 +240,7 @@ DAY_DAMAGE = [
     (lambda m, a: _times(m, 0, "2005-08-01T07:30:00"), "got \"2005-08-01T07:30:00\""),
     (lambda m, a: _times(m, 0, "2005-13-45T07:30:00+08:00"), "is not a valid ISO 8601 time"),
     (lambda m, a: _times(m, 1, 12), "time step 2 must be an ISO 8601 time"),
+    (lambda m, a: _times(m, 0, "1600-01-01T00:00:00+00:00"), "years 1678 to 2261"),
     (lambda m, a: m["period"]["times"].reverse(), "not in increasing order"),
     (lambda m, a: _set(m["period"], "tz", "Mars/Olympus"), "time zone 'Mars/Olympus'"),
     (lambda m, a: _set(m["period"], "end", m["period"]["start"]), "ends before it starts"),
