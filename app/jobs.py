@@ -211,6 +211,21 @@ def _diffuse(state: dict, light, rows: list, column: str, build_s: float) -> Dif
     return Diffuse(light, rows, plant_light(rows), values.astype(np.float32), build_s)
 
 
+def diffuse_of(canopy, light, kind: str) -> Diffuse:
+    """What the window shows of a sky (``kind`` "sky") or day ("day") result on the canopy it
+    was traced on, as :func:`op_sky` and :func:`op_period` make it (for a result read from a
+    project)."""
+    from maizeviz.light.reports import period_leaf_rows, sky_leaf_rows
+
+    state = {"canopy": canopy}
+    build_s = float(light.seconds.get("build", 0.0))
+    if kind == "sky":
+        return _diffuse(state, light, sky_leaf_rows(canopy, light), "diffuse_intercepted_cm2",
+                        build_s)
+    return _diffuse(state, light, period_leaf_rows(canopy, light), "par_intercepted_mol",
+                    build_s)
+
+
 def _sky_key(spec: SkySpec, sampling) -> tuple:
     return (spec, tuple(float(h) for h in sampling.heights_cm), float(sampling.density),
             sampling.rect, bool(sampling.periodic))

@@ -41,8 +41,8 @@ from maizeviz.mesh.levels import COMPLEXITY_STOPS as LEVELS  # noqa: F401 - the 
 from maizeviz.resources import example_points
 from maizeviz_app.messages import user_message
 from maizeviz_app.panels.canopy import CanopyPanel
-from maizeviz_app.panels.light import (COMPUTE_TEXT, InputProblem, LightPanel, LightPlots,
-                                       LightRuns, Run)
+from maizeviz_app.panels.light import (COMPUTE_TEXT, MODES, InputProblem, LightPanel,
+                                       LightPlots, LightRuns, Run)
 from maizeviz_app.workers import JobRunner, describe_internal
 
 #: Version of the saved dock layout; bump when docks change so an old layout is not applied.
@@ -563,6 +563,8 @@ class MainWindow(QMainWindow):
         else:
             self._view_pending = None
             self.viewport.show_canopy(built.canopy, mesh)
+        if self._complete_runs() and not self._pending_runs:
+            self.light_panel.show_plants(self.runs.latest(None, ("sky", "day")))
         self._adopt_pending_runs()
         self._light_to_view()
         m = built.measures
@@ -888,14 +890,16 @@ class MainWindow(QMainWindow):
         if self.loaded is None:
             self.say("error: nothing to save yet: open a points file first", error=True)
             return
-        from maizeviz_app import project
+        from maizeviz_app import project, project_light
 
         loaded, data, origin = self.loaded, self._points_bytes, self._points_origin
         layout = loaded.layout if self._layout_edited else None   # else: the tiling, exactly
         canopy = {"tile": self.tile_n, "level": self.level,
                   "preserve_area": self.canopy_panel.preserve.isChecked()}
         light = self.light_panel.settings()
-        runs = [(r.label, r.result) for r in self.runs.runs.values() if r.kind == "sun"]
+        runs = [(r.label, r.result, project_light.settings_doc(r.kind,
+                                                               self.runs.settings.get(r.kind)))
+                for r in self.runs.in_order()]
         path = str(path)
 
         def work(job):
@@ -962,47 +966,91 @@ class MainWindow(QMainWindow):
         self._pending_runs = list(opened.runs)
 
     def _adopt_pending_runs(self) -> None:
-        """Light results of an opened project join the comparison once its canopy is built
-        (their triangle classes are computed against the canopy they were traced on)."""
+        """Light results of an opened project (sun, sky and day) join the comparison once its
+        canopy is built, shown as after a fresh run: table, plot, heatmaps, the day's summary,
+        the plants' light and the canopy's colours (those of the results traced on the canopy
+        shown are computed against it, the others' when their level is shown)."""
         if not self._pending_runs or self.built is None:
             return
-        from maizeviz.light.leaf_light import triangle_light
         from maizeviz_app import plots
 
         pending, self._pending_runs = self._pending_runs, []
-        for label, result in pending:
-            classes = None
-            if label == self.built.label and result.first_hits is not None and \
-                    len(result.first_hits) >= self.canopy.n_triangles:
-                classes = triangle_light(self.canopy, result)
-            own = (round(result.sun.zenith_deg, 6), round(result.sun.azimuth_deg, 6))
-            sampling = (tuple(float(h) for h in result.heights_cm), result.density,
+        for stored in pending:
+            label, result, kind, settings = stored
+            if kind == "sun":
+                settings = (round(result.sun.zenith_deg, 6), round(result.sun.azimuth_deg, 6))
+                density = result.density
+            elif kind == "sky":
+                density = result.density
+            else:
+                density = result.sky.density if result.sky is not None else \
+                    self.light_panel.density.value()
+            sampling = (tuple(float(h) for h in result.heights_cm), density,
                         bool(getattr(result, "periodic", self.light_panel.periodic.isChecked())))
-            self.runs.add(Run(label, self.signature(label), result, classes), own, sampling)
+            self.runs.add(Run(label, self.signature(label), result, None, kind), settings,
+                          sampling)
+        self._complete_runs()
         self.light_panel.show_runs(self.runs, f"{len(pending)} light result(s) from the "
                                               "project")
-        last = self.runs.for_signature(self.signature(self.built.label)) or self.runs.last
-        if last is None:
+        here = self.signature(self.built.label)
+        shown = {}
+        for kind in MODES:
+            run = self.runs.for_signature(here, kind) or self.runs.of_kind(kind)
+            if run is not None:
+                shown[kind] = run
+        if not shown:
             return
+        day = shown.get("day")
+        self.light_panel.show_summary(day_summary(day.result) if day is not None else "")
+        self.light_panel.show_plants(self.runs.latest(None, ("sky", "day")))
+        latest = self.runs.latest(here) or self.runs.last
+        order = sorted(shown, key=lambda k: latest is not None and k == latest.kind)
         curves = self.runs.curves()
-        result = last.result
         title = _plot_title(self.runs)
-        self._heatmaps_for = {"sun": last}
+        self._heatmaps_for = dict(shown)
+        results = [(k, shown[k].result) for k in order]
 
         def work(job):
-            maps = plots.heatmap_images(result, check=job.check)
+            maps = [(k, plots.heatmap_images(r, check=job.check, kind=k)) for k, r in results]
             plot = plots.rgba(plots.transmission_figure(curves, title))
             return maps, plot
 
         def done(out):
-            if self._heatmaps_for.get("sun") is last:
-                self.plots.set_heatmaps(out[0])
-                self.plots.set_transmission(out[1])
+            for kind, maps in out[0]:
+                if self._heatmaps_for.get(kind) is shown[kind]:
+                    self.plots.set_heatmaps(maps, kind)
+            self.plots.set_transmission(out[1])
             self.light_shown.emit()
 
         self.runner.run("figures", "drawing the light figures", work, on_done=done,
                         on_error=lambda e: self._fail(e, "light"))
         self._light_to_view(colour=True)
+
+    def _complete_runs(self) -> bool:
+        """Results read from a project that were traced on the canopy shown get what the
+        window shows of them, computed against it: a sun's light class per triangle, a sky's
+        or day's light per leaf and plant. True if any did."""
+        if self.built is None or self.canopy is None:
+            return False
+        from maizeviz.light.leaf_light import triangle_light
+        from maizeviz_app import jobs
+
+        here, n = self.signature(self.built.label), self.canopy.n_triangles
+        done = False
+        for run in self.runs.runs.values():
+            if run.signature != here:
+                continue
+            r = run.result
+            if run.kind == "sun" and run.classes is None:
+                if r.first_hits is not None and len(r.first_hits) >= n:
+                    run.classes = triangle_light(self.canopy, r)
+                    done = True
+            elif run.kind != "sun" and run.extra is None:
+                per_triangle = r.triangle_share if run.kind == "sky" else r.triangle_direct_mol
+                if len(per_triangle) >= n:
+                    run.extra = jobs.diffuse_of(self.canopy, r, run.kind)
+                    done = True
+        return done
 
     # ------------------------------------------------------------------ recent files
     def recent_files(self) -> list[str]:
@@ -1175,6 +1223,9 @@ class MainWindow(QMainWindow):
                 save_figure(day_figure(light, title), path)
                 return path
             return work, ()
+        if extra is None:
+            raise MaizevizError(f"the light per leaf of the {run.kind} on {label} is computed "
+                                f"against its canopy: show level {label} first")
         rows = [dict(r, level=label) for r in extra.leaf_rows]
 
         def work(job):

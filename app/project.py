@@ -2,8 +2,9 @@
 
 A project holds the points (embedded, with their original path and hash), the layout (as a
 layout document plus its ground cells, so a tiling keeps its exact ground area), the canopy
-and light settings, and every light result of the comparison (transmission by height, and the
-arrays that colour the canopy and draw the heatmaps).
+and light settings, and every light result of the comparison: sun, sky and day (transmission
+by height, and the arrays that colour the canopy and draw the heatmaps; a sky's or day's in
+:mod:`maizeviz_app.project_light`).
 
 Opening uses the original points file when it is still there with the same content, and the
 project's own copy otherwise (written to a cache folder, said to the user).
@@ -15,7 +16,7 @@ import hashlib
 import tempfile
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -134,12 +135,54 @@ def layout_from_parts(doc: dict, arrays: dict[str, np.ndarray], plants: set[int]
                    centre_cells=np.array(centre, np.float64), ground_area=float(area[0]))
 
 
+#: Record kind of a sun result (the only kind of maizeviz 0.2's projects).
+SUN_KIND = "light"
+
+
+class StoredRun(NamedTuple):
+    """A light result read from a project: the level it was traced on, the result, its light
+    (``kind``: sun, sky or day) and the light panel's settings it was computed with, as the
+    window compares them (a ``SkySpec``, ``(DaySpec, SkySpec)``; None for a sun, or a day of
+    a project that did not store them)."""
+
+    label: str
+    result: Any
+    kind: str = "sun"
+    settings: Any = None
+
+
+def run_record(label: str, result, settings: dict | None = None) -> Record:
+    """The record of any light result: a sun's ``LightResult``, a ``SkyLight`` or a
+    ``PeriodLight`` (``settings``: the app's settings of a sky or day as JSON,
+    :func:`~maizeviz_app.project_light.settings_doc`)."""
+    from maizeviz_app import project_light
+
+    rec = project_light.record_of(label, result, settings)
+    return rec if rec is not None else light_record(label, result)
+
+
 def make_project(points_path: str, points_bytes: bytes, layout, canopy: dict, light: dict,
-                 runs: list[tuple[str, Any]]) -> Project:
-    """The project of the window's state: ``runs`` are (label, LightResult) pairs."""
+                 runs: list[tuple]) -> Project:
+    """The project of the window's state: ``runs`` are (label, result) or (label, result,
+    settings) tuples, results of any light (see :func:`run_record`)."""
     doc, arrays = layout_parts(layout) if layout is not None else (None, {})
     return Project(points_bytes, str(points_path), doc, {CANOPY: canopy, LIGHT: light}, arrays,
-                   tuple(light_record(label, r) for label, r in runs))
+                   tuple(run_record(*run) for run in runs))
+
+
+def run_from_record(rec: Record, where: str) -> StoredRun | None:
+    """The light result of a record, or None for a kind this maizeviz does not know."""
+    from maizeviz_app import project_light as pl
+
+    if rec.kind == SUN_KIND:
+        return StoredRun(*light_from_record(rec, where))
+    if rec.kind == pl.SKY_KIND:
+        label, result, stored = pl.sky_from_record(rec, where)
+        return StoredRun(label, result, "sky", pl.run_settings("sky", result, stored, where))
+    if rec.kind == pl.DAY_KIND:
+        label, result, stored = pl.day_from_record(rec, where)
+        return StoredRun(label, result, "day", pl.run_settings("day", result, stored, where))
+    return None
 
 
 @dataclass
@@ -154,7 +197,7 @@ class Opened:
     notes: list[str] = field(default_factory=list)
     canopy: dict = field(default_factory=dict)
     light: dict = field(default_factory=dict)
-    runs: list[tuple[str, Any]] = field(default_factory=list)
+    runs: list[StoredRun] = field(default_factory=list)
 
 
 def open_project(path: str | Path, cache: str | Path | None = None) -> Opened:
@@ -194,11 +237,12 @@ def open_project(path: str | Path, cache: str | Path | None = None) -> Opened:
     light = get(settings, LIGHT, dict, {}, where)
     runs = []
     for i, rec in enumerate(project.results):
-        if rec.kind != "light":
+        run = run_from_record(rec, where)
+        if run is None:
             notes.append(f"result {i + 1} is of a kind this maizeviz does not know "
                          f"('{rec.kind}'); left out")
             continue
-        runs.append(light_from_record(rec, where))
+        runs.append(run)
     shown = f"{original.name} (project {Path(path).name})"
     return Opened(where, project, points_path, shown, notes, canopy, light, runs)
 

@@ -180,6 +180,10 @@ class LightRuns:
                 (signature is None or r.signature == signature)]
         return max(runs, key=lambda r: self._order.get(id(r), 0)) if runs else None
 
+    def in_order(self) -> list[Run]:
+        """The runs in the order they were added (the last one is :attr:`last`)."""
+        return sorted(self.runs.values(), key=lambda r: self._order.get(id(r), 0))
+
     def of_kind(self, kind: str) -> Run | None:
         return self.latest(None, (kind,))
 

@@ -1,0 +1,434 @@
+"""Sky and day light results to and from project records (:mod:`maizeviz.io.project`); no Qt.
+
+A sky result (:class:`~maizeviz.light.daylight.SkyLight`) is stored as a ``light_sky`` record,
+a day (:class:`~maizeviz.light.daylight.PeriodLight`, its :class:`~maizeviz.light.irradiance.
+Period` and the sky light of its diffuse part) as a ``light_day`` record: JSON metadata
+(numbers, text, times as ISO 8601 with their UTC offset, the time zone's name) and numeric
+arrays; no pickle. Reading checks every size, type and value before the objects are made
+through their constructors (so :class:`~maizeviz.light.sky.Sky` and ``Period`` validate
+themselves too); anything wrong is a :class:`~maizeviz.io.project.ProjectError` naming it.
+
+Each record may also hold the app's settings of that light (``settings``: the sky chosen, the
+day's date and place), so a reopened comparison goes on as if the runs had just been made.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import json
+import math
+import re
+from typing import Any
+
+import numpy as np
+
+from maizeviz.errors import MaizevizError
+from maizeviz.io.project import ProjectError, Record, get, get_numbers
+
+#: Record kinds of a sky and a day result (a sun result is ``"light"``).
+SKY_KIND, DAY_KIND = "light_sky", "light_day"
+#: Arrays of a Sky, under the record's prefix.
+_SKY_ARRAYS = ("zenith_deg", "azimuth_deg", "solid_angle_sr", "weights")
+#: Arrays of a Period (each (n,) float64), stored as ``period_<name>``.
+_PERIOD_ARRAYS = ("step_s", "zenith_deg", "azimuth_deg", "ghi", "dni", "dhi",
+                  "direct_horizontal")
+#: Prefix of the arrays of a day's sky light.
+_DIFFUSE = "diffuse_"
+_OFFSET = re.compile(r"(Z|[+-]\d\d:?\d\d(:?\d\d(\.\d+)?)?)$")
+_FIXED_ZONE = re.compile(r"UTC([+-])(\d\d):(\d\d)")
+#: Fractions may exceed 1 by rounding (weighted sums): the bound checked on reading.
+_ONE = 1.0 + 1e-9
+
+
+# ------------------------------------------------------------------------------ writing
+def _floats(values) -> list[float]:
+    return [float(v) for v in np.asarray(values, dtype=np.float64).ravel()]
+
+
+def _jsonable(value: Any) -> Any:
+    """A period parameter as a JSON value (text for what JSON cannot hold)."""
+    if isinstance(value, (str, bool)) or value is None:
+        return value
+    if isinstance(value, (int, np.integer)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else str(value)
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    return str(value)
+
+
+def _zone_name(tz) -> str:
+    """An IANA name (``Asia/Shanghai``), ``UTC`` or a fixed offset ``UTC+08:00``."""
+    key = getattr(tz, "key", None) or getattr(tz, "zone", None)
+    return str(key) if key else str(tz)
+
+
+def _common_meta(label: str, light) -> dict:
+    return {"label": label, "level": str(light.level),
+            "heights_cm": _floats(light.heights_cm), "rect": _floats(light.rect),
+            "rays": int(light.rays),
+            "seconds": {str(k): float(v) for k, v in light.seconds.items()
+                        if isinstance(v, (int, float)) and math.isfinite(v)},
+            "warnings": [str(w) for w in light.warnings], "periodic": bool(light.periodic)}
+
+
+def _map_arrays(light, prefix: str = "") -> dict[str, np.ndarray]:
+    xe, ye = light.map_edges
+    return {f"{prefix}maps": np.asarray(light.maps, np.float64),
+            f"{prefix}map_x_edges": np.asarray(xe, np.float64),
+            f"{prefix}map_y_edges": np.asarray(ye, np.float64),
+            f"{prefix}map_rays": np.asarray(light.map_rays, np.int64)}
+
+
+def _sky_parts(light, prefix: str = "") -> tuple[dict, dict[str, np.ndarray]]:
+    """Metadata and arrays of a SkyLight (arrays named with ``prefix``)."""
+    sky = light.sky
+    meta = _common_meta("", light)
+    del meta["label"]
+    meta.update({"sky": {"kind": str(sky.kind), "split": str(sky.split)},
+                 "transmission": _floats(light.transmission),
+                 "density": float(light.density),
+                 "intercepted_fraction": float(light.intercepted_fraction)})
+    arrays = {f"{prefix}sky_{name}": np.asarray(getattr(sky, name), np.float64)
+              for name in _SKY_ARRAYS}
+    arrays.update({f"{prefix}per_direction": np.asarray(light.per_direction, np.float64),
+                   f"{prefix}per_direction_intercepted":
+                       np.asarray(light.per_direction_intercepted, np.float64),
+                   f"{prefix}triangle_share": np.asarray(light.triangle_share, np.float64)})
+    arrays.update(_map_arrays(light, prefix))
+    return meta, arrays
+
+
+def sky_record(label: str, light, settings: dict | None = None) -> Record:
+    """A sky result (``SkyLight`` traced on the canopy labelled ``label``); ``settings``: the
+    app's sky settings of the run (JSON), kept for reopening."""
+    meta, arrays = _sky_parts(light)
+    meta = {"label": label, **meta}
+    if settings is not None:
+        meta["settings"] = _jsonable(settings)
+    return Record(SKY_KIND, meta, arrays)
+
+
+def day_record(label: str, light, settings: dict | None = None) -> Record:
+    """A day result (``PeriodLight`` traced on the canopy labelled ``label``); ``settings``
+    as :func:`sky_record`."""
+    p = light.period
+    meta = _common_meta(label, light)
+    meta["period"] = {"times": [t.isoformat() for t in p.times],
+                      "tz": _zone_name(p.times.tz if p.times.tz is not None else p.start.tz),
+                      "start": p.start.isoformat(), "end": p.end.isoformat(),
+                      "source": str(p.source), "parameters": _jsonable(dict(p.parameters)),
+                      "par_umol_per_j": float(p.par_umol_per_j),
+                      "notes": [str(n) for n in p.notes]}
+    arrays = {f"period_{name}": np.asarray(getattr(p, name), np.float64)
+              for name in _PERIOD_ARRAYS}
+    arrays.update({"step_transmission": np.asarray(light.step_transmission, np.float64),
+                   "step_intercepted_fraction":
+                       np.asarray(light.step_intercepted_fraction, np.float64),
+                   "triangle_direct_mol": np.asarray(light.triangle_direct_mol, np.float64),
+                   "triangle_diffuse_mol": np.asarray(light.triangle_diffuse_mol, np.float64)})
+    arrays.update(_map_arrays(light))
+    if light.sky is not None:
+        sky_meta, sky_arrays = _sky_parts(light.sky, _DIFFUSE)
+        meta["sky"] = sky_meta
+        arrays.update(sky_arrays)
+    else:
+        meta["sky"] = None
+    if settings is not None:
+        meta["settings"] = _jsonable(settings)
+    return Record(DAY_KIND, meta, arrays)
+
+
+def record_of(label: str, result, settings: dict | None = None) -> Record | None:
+    """The record of a SkyLight or a PeriodLight; None for any other result."""
+    from maizeviz.light.daylight import PeriodLight, SkyLight
+
+    if isinstance(result, SkyLight):
+        return sky_record(label, result, settings)
+    if isinstance(result, PeriodLight):
+        return day_record(label, result, settings)
+    return None
+
+
+# ------------------------------------------------------------------------------ reading
+def _array(rec: Record, name: str, where: str, what: str, shape: tuple, *,
+           counts: bool = False, nan: bool = False, lo: float | None = None,
+           hi: float | None = None) -> np.ndarray:
+    """Array ``name`` of the record, checked: present, numeric, of ``shape`` (None: any
+    size), finite (NaN allowed with ``nan``), within [lo, hi]; a float64 (int64 for
+    ``counts``) copy."""
+    a = rec.arrays.get(name)
+    if a is None:
+        raise ProjectError(f"{where}: {what} has no array '{name}'; the project is damaged")
+    if a.dtype.kind not in ("iu" if counts else "iuf"):
+        raise ProjectError(f"{where}: {what}: array '{name}' holds {a.dtype}, not "
+                           f"{'whole numbers' if counts else 'numbers'}; the project is damaged")
+    if a.ndim != len(shape) or any(s is not None and s != n for s, n in zip(shape, a.shape)):
+        want = " x ".join("any" if s is None else str(s) for s in shape) or "a single value"
+        raise ProjectError(f"{where}: {what}: array '{name}' is {' x '.join(map(str, a.shape))}"
+                           f", expected {want}; the project is damaged")
+    out = np.array(a, dtype=np.int64 if counts else np.float64)
+    finite = np.isfinite(out)
+    if not nan and not finite.all() or nan and np.isinf(out).any():
+        raise ProjectError(f"{where}: {what}: array '{name}' holds "
+                           f"{'infinite' if nan else 'NaN or infinite'} values; the project is "
+                           "damaged")
+    vals = out[finite]
+    if (lo is not None and np.any(vals < lo)) or (hi is not None and np.any(vals > hi)):
+        rng = f"[{lo:g}, {hi:g}]" if lo is not None and hi is not None else \
+            (f">= {lo:g}" if lo is not None else f"<= {hi:g}")
+        raise ProjectError(f"{where}: {what}: array '{name}' has values outside {rng}; the "
+                           "project is damaged")
+    return out
+
+
+def _number(m: dict, key: str, where: str, what: str, lo: float | None = None,
+            hi: float | None = None, default: Any = ...) -> float:
+    value = get(m, key, (int, float), where=f"{where}: {what}") if default is ... else \
+        get(m, key, (int, float), default, f"{where}: {what}")
+    value = float(value)
+    if (lo is not None and value < lo) or (hi is not None and value > hi):
+        raise ProjectError(f"{where}: {what}: '{key}' is {value:g}, out of range; the project "
+                           "is damaged")
+    return value
+
+
+def _common(m: dict, where: str, what: str) -> dict:
+    """Heights, rectangle, rays, seconds, warnings, level and periodic flag, checked."""
+    at = f"{where}: {what}"
+    heights = get_numbers(m, "heights_cm", where=at)
+    rect = get_numbers(m, "rect", where=at)
+    rays = get(m, "rays", int, where=at)
+    if not heights:
+        raise ProjectError(f"{at} has no heights; the project is damaged")
+    if len(rect) != 4 or not (rect[2] > rect[0] and rect[3] > rect[1]):
+        raise ProjectError(f"{at}: 'rect' must be 4 numbers x0, y0, x1, y1 with x1 > x0 and "
+                           "y1 > y0; the project is damaged")
+    if rays < 1:
+        raise ProjectError(f"{at}: 'rays' must be at least 1, got {rays}")
+    seconds = get(m, "seconds", dict, {}, at)
+    return {"heights_cm": np.array(heights, np.float64), "rect": tuple(rect), "rays": rays,
+            "level": str(get(m, "level", str, "", at)),
+            "warnings": tuple(str(get({"w": w}, "w", str, where=f"{at}: warnings"))
+                              for w in get(m, "warnings", list, [], at)),
+            "seconds": {str(k): float(v) for k, v in seconds.items()
+                        if isinstance(v, (int, float)) and not isinstance(v, bool)
+                        and math.isfinite(v)},
+            "periodic": bool(get(m, "periodic", bool, False, at))}
+
+
+def _maps(rec: Record, prefix: str, n_heights: int, where: str, what: str) -> dict:
+    xe = _array(rec, f"{prefix}map_x_edges", where, what, (None,))
+    ye = _array(rec, f"{prefix}map_y_edges", where, what, (None,))
+    if len(xe) < 2 or len(ye) < 2 or np.any(np.diff(xe) <= 0) or np.any(np.diff(ye) <= 0):
+        raise ProjectError(f"{where}: {what}: the heatmap's bin edges are not increasing; the "
+                           "project is damaged")
+    a, b = len(xe) - 1, len(ye) - 1
+    maps = _array(rec, f"{prefix}maps", where, what, (n_heights, a, b), nan=True, lo=0, hi=_ONE)
+    rays = _array(rec, f"{prefix}map_rays", where, what, (a, b), counts=True, lo=0)
+    return {"maps": maps, "map_edges": (xe, ye), "map_rays": rays}
+
+
+def _sky_light(rec: Record, m: dict, prefix: str, where: str, what: str):
+    """A SkyLight from its metadata ``m`` and the record's arrays named with ``prefix``."""
+    from maizeviz.light.daylight import SkyLight
+    from maizeviz.light.sky import Sky
+
+    at = f"{where}: {what}"
+    c = _common(m, where, what)
+    n_h = len(c["heights_cm"])
+    transmission = np.array(get_numbers(m, "transmission", where=at), np.float64)
+    if len(transmission) != n_h or np.any(transmission < 0) or np.any(transmission > _ONE):
+        raise ProjectError(f"{at}: 'transmission' must be {n_h} numbers in [0, 1], one per "
+                           "height; the project is damaged")
+    sky_meta = get(m, "sky", dict, where=at)
+    kind = get(sky_meta, "kind", str, where=f"{at}: sky")
+    split = get(sky_meta, "split", str, where=f"{at}: sky")
+    parts = {name: _array(rec, f"{prefix}sky_{name}", where, what, (None,))
+             for name in _SKY_ARRAYS}
+    try:
+        sky = Sky(kind, split, **parts)
+    except MaizevizError as exc:
+        raise ProjectError(f"{at}: the stored sky cannot be used ({exc})") from None
+    n = sky.n
+    per_direction = _array(rec, f"{prefix}per_direction", where, what, (n, n_h), lo=0, hi=_ONE)
+    per_int = _array(rec, f"{prefix}per_direction_intercepted", where, what, (n,), lo=0, hi=_ONE)
+    share = _array(rec, f"{prefix}triangle_share", where, what, (None,), lo=0)
+    return SkyLight(sky=sky, transmission=transmission, per_direction=per_direction,
+                    intercepted_fraction=_number(m, "intercepted_fraction", where, what, 0, _ONE),
+                    per_direction_intercepted=per_int, triangle_share=share,
+                    density=_number(m, "density", where, what, lo=1e-300),
+                    **_maps(rec, prefix, n_h, where, what), **c)
+
+
+def sky_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None]:
+    """(label, SkyLight, stored settings or None) from a ``light_sky`` record; refused with
+    ProjectError if malformed."""
+    m = rec.meta
+    light = _sky_light(rec, m, "", where, "a sky result")
+    return (str(get(m, "label", str, light.level, where)), light,
+            get(m, "settings", dict, None, where))
+
+
+def _zone(name: str, where: str):
+    import zoneinfo
+
+    try:
+        return zoneinfo.ZoneInfo(name)
+    except (zoneinfo.ZoneInfoNotFoundError, ValueError, TypeError, OSError):
+        pass
+    fixed = _FIXED_ZONE.fullmatch(name)
+    if fixed:
+        sign = -1 if fixed.group(1) == "-" else 1
+        offset = _dt.timedelta(hours=int(fixed.group(2)), minutes=int(fixed.group(3)))
+        if offset < _dt.timedelta(hours=24):
+            return _dt.timezone(sign * offset)
+    raise ProjectError(f"{where}: a day result's time zone '{name[:40]}' is not one this "
+                       "computer knows (an IANA name such as Asia/Shanghai, or UTC+08:00)")
+
+
+def _time(text: Any, where: str, what: str):
+    """An ISO 8601 time with its UTC offset, as a UTC pandas Timestamp."""
+    import pandas as pd
+
+    if not isinstance(text, str) or not _OFFSET.search(text.strip()):
+        shown = json.dumps(text)[:40] if isinstance(text, (str, int, float, bool)) or \
+            text is None else "something else"
+        raise ProjectError(f"{where}: {what} must be an ISO 8601 time with its UTC offset "
+                           f"(2005-08-01T12:00:00+08:00), got {shown}")
+    try:
+        t = pd.Timestamp(text.strip())
+        t = None if t is pd.NaT or t.tz is None else t.as_unit("ns")   # years 1678-2261
+    except (ValueError, TypeError, OverflowError):
+        t = None
+    if t is None:
+        raise ProjectError(f"{where}: {what} '{text[:40]}' is not a valid ISO 8601 time with "
+                           "its UTC offset (years 1678 to 2261)")
+    return t.tz_convert("UTC")
+
+
+def _period(rec: Record, m: dict, where: str):
+    import pandas as pd
+
+    from maizeviz.light.irradiance import Period
+
+    at = f"{where}: a day result's period"
+    p = get(m, "period", dict, where=f"{where}: a day result")
+    texts = get(p, "times", list, where=at)
+    zone = _zone(get(p, "tz", str, where=at), where)
+    utc = [_time(t, at, f"time step {i + 1}") for i, t in enumerate(texts)]
+    times = pd.DatetimeIndex(utc, dtype="datetime64[ns, UTC]") if utc else \
+        pd.DatetimeIndex([], dtype="datetime64[ns, UTC]")
+    if len(times) > 1 and not np.all(np.diff(times.asi8) > 0):
+        raise ProjectError(f"{at}: its time steps are not in increasing order; the project is "
+                           "damaged")
+    start = _time(get(p, "start", str, where=at), at, "'start'").tz_convert(zone)
+    end = _time(get(p, "end", str, where=at), at, "'end'").tz_convert(zone)
+    if end <= start:
+        raise ProjectError(f"{at}: it ends before it starts; the project is damaged")
+    n = len(times)
+    arrays = {name: _array(rec, f"period_{name}", where, "a day result's period", (n,))
+              for name in _PERIOD_ARRAYS}
+    notes = tuple(str(get({"n": v}, "n", str, where=f"{at}: notes"))
+                  for v in get(p, "notes", list, [], at))
+    try:
+        return Period(times=times.tz_convert(zone), start=start, end=end,
+                      source=str(get(p, "source", str, where=at)),
+                      parameters=dict(get(p, "parameters", dict, {}, at)),
+                      par_umol_per_j=_number(p, "par_umol_per_j", where,
+                                             "a day result's period"),
+                      notes=notes, **arrays)
+    except MaizevizError as exc:
+        raise ProjectError(f"{at} cannot be used ({exc})") from None
+
+
+def day_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None]:
+    """(label, PeriodLight, stored settings or None) from a ``light_day`` record; refused with
+    ProjectError if malformed."""
+    from maizeviz.light.daylight import PeriodLight
+
+    m = rec.meta
+    what = "a day result"
+    c = _common(m, where, what)
+    n_h = len(c["heights_cm"])
+    period = _period(rec, m, where)
+    n = period.n_steps
+    step_t = _array(rec, "step_transmission", where, what, (n, n_h), lo=0, hi=_ONE)
+    step_f = _array(rec, "step_intercepted_fraction", where, what, (n,), lo=0, hi=_ONE)
+    direct = _array(rec, "triangle_direct_mol", where, what, (None,), lo=0)
+    diffuse = _array(rec, "triangle_diffuse_mol", where, what, (len(direct),), lo=0)
+    sky = None
+    if m.get("sky") is not None:
+        sky_meta = get(m, "sky", dict, where=f"{where}: {what}")
+        sky = _sky_light(rec, sky_meta, _DIFFUSE, where, "a day result's sky")
+        if not (np.array_equal(sky.heights_cm, c["heights_cm"]) and sky.rect == c["rect"]
+                and sky.rays == c["rays"] and len(sky.triangle_share) == len(direct)):
+            raise ProjectError(f"{where}: a day result's sky does not match its heights, "
+                               "rectangle, rays or triangles; the project is damaged")
+    elif n:
+        raise ProjectError(f"{where}: a day result with time steps has no sky light; the "
+                           "project is damaged")
+    light = PeriodLight(period=period, sky=sky, step_transmission=step_t,
+                        step_intercepted_fraction=step_f, triangle_direct_mol=direct,
+                        triangle_diffuse_mol=diffuse, **_maps(rec, "", n_h, where, what), **c)
+    return (str(get(m, "label", str, light.level, where)), light,
+            get(m, "settings", dict, None, where))
+
+
+# ------------------------------------------------------------------------ the app's settings
+def settings_doc(kind: str, settings: Any) -> dict | None:
+    """The window's settings of a sky run (a ``SkySpec``) or a day run (``(DaySpec,
+    SkySpec)``) as JSON, or None when they are not those."""
+    from dataclasses import asdict, is_dataclass
+
+    if kind == "sky" and is_dataclass(settings) and not isinstance(settings, type):
+        return {"sky": asdict(settings)}
+    if kind == "day" and isinstance(settings, tuple) and len(settings) == 2 and \
+            all(is_dataclass(s) and not isinstance(s, type) for s in settings):
+        return {"day": asdict(settings[0]), "sky": asdict(settings[1])}
+    return None
+
+
+def _sky_spec(doc: dict, where: str):
+    from maizeviz_app.jobs import SkySpec
+
+    at = f"{where}: the sky settings of a light result"
+    return SkySpec(get(doc, "kind", str, where=at), get(doc, "directions", int, where=at),
+                   get(doc, "split", str, where=at))
+
+
+def _day_spec(doc: dict, where: str):
+    from maizeviz_app.jobs import DaySpec
+
+    at = f"{where}: the day settings of a light result"
+
+    def text_or_none(key: str):
+        value = doc.get(key)
+        return None if value is None else get(doc, key, str, where=at)
+
+    return DaySpec(get(doc, "date", str, where=at), float(get(doc, "lat", (int, float), where=at)),
+                   float(get(doc, "lon", (int, float), where=at)), get(doc, "tz", str, where=at),
+                   float(get(doc, "step_min", (int, float), where=at)), text_or_none("start"),
+                   text_or_none("end"), float(get(doc, "linke", (int, float), where=at)),
+                   float(get(doc, "par_factor", (int, float), where=at)),
+                   text_or_none("weather"))
+
+
+def run_settings(kind: str, result, stored: dict | None, where: str) -> Any:
+    """The settings a sky or day run is compared with in the window (what the light panel
+    gives for the same choice): from the stored ``settings``, else (an older record) the
+    sky's from the result and None for a day. Bad stored settings: ProjectError."""
+    from maizeviz_app.jobs import SkySpec
+
+    if stored is not None:
+        sky = _sky_spec(get(stored, "sky", dict, where=where), where)
+        if kind == "sky":
+            return sky
+        return (_day_spec(get(stored, "day", dict, where=where), where), sky)
+    if kind == "sky":
+        s = result.sky
+        return SkySpec(s.kind, s.n, "equal" if s.split == "equal" else "auto")
+    return None
