@@ -42,6 +42,7 @@ import numpy as np
 from maizeviz import __version__
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import atomic_path
+from maizeviz.io.inputs import open_input
 
 #: Version of the project format this maizeviz writes and reads.
 PROJECT_FORMAT = 1
@@ -323,18 +324,13 @@ def load_project(path: str | Path) -> Project:
         One line naming the file and what is wrong with it.
     """
     where = str(path)
+    fh, _ = open_input(path, "project file", ProjectError)   # a FIFO or device: refused at once
     try:
-        with zipfile.ZipFile(path) as zf:
+        with fh, zipfile.ZipFile(fh) as zf:
             found = _members(zf, where)
             raw = {name: _read_member(zf, info, MAX_MEMBER_BYTES[name], where,
                                       text=name != "arrays.npz")
                    for name, info in found.items()}
-    except FileNotFoundError:
-        raise _refuse(where, "no such project file") from None
-    except IsADirectoryError:
-        raise _refuse(where, "is a folder, not a project file") from None
-    except PermissionError:
-        raise _refuse(where, "cannot be read (permission denied)") from None
     except zipfile.BadZipFile as exc:
         text = str(exc)
         what = ("a file in it is damaged (checksum mismatch)" if "CRC" in text or "Bad" in text

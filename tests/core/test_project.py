@@ -205,6 +205,10 @@ def test_not_a_project(tmp_path):
         load_project(tmp_path / "absent.maizeviz")
     with pytest.raises(ProjectError, match="is a folder"):
         load_project(tmp_path)
+    fifo = tmp_path / "pipe.maizeviz"
+    os.mkfifo(fifo)                              # with nothing writing: reading would hang
+    with pytest.raises(ProjectError, match="is a FIFO .* not a regular file"):
+        load_project(fifo)
 
 
 def test_typed_lookups():
