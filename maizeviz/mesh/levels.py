@@ -144,25 +144,6 @@ def reference_areas(leaves: list[Leaf]) -> np.ndarray:
     return out
 
 
-def deviation_samples(leaf: Leaf) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The smooth surface sampled at K = 8 (computed once per leaf): points (A, B, 3) cm,
-    u (A,), v (B,)."""
-    if "deviation_samples" not in leaf.cache:
-        pts, u, v = _sample(leaf.surface, DEVIATION_K)
-        leaf.cache["deviation_samples"] = (pts[0], u[0], v[0])
-    return leaf.cache["deviation_samples"]
-
-
-def _deviation_samples(leaves: list[Leaf]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The surfaces of leaves of one grid shape sampled at K = 8, from ``leaf.cache`` where
-    :func:`deviation_samples` left them: points (L, A, B, 3) cm, u (L, A), v (L, B). Not kept
-    (100 kB a leaf)."""
-    if all("deviation_samples" in lf.cache for lf in leaves):
-        pts, u, v = zip(*(lf.cache["deviation_samples"] for lf in leaves))
-        return np.stack(pts), np.stack(u), np.stack(v)
-    return _sample(_stack([lf.surface for lf in leaves]), DEVIATION_K)
-
-
 def _chunks(idx: list[int], per_leaf: int) -> list[list[int]]:
     """``idx`` cut in runs of about :data:`MEASURE_POINTS` // ``per_leaf`` (at least 1)."""
     step = max(1, MEASURE_POINTS // max(per_leaf, 1))
@@ -309,7 +290,7 @@ def measure_leaves(leaves: list[Leaf], meshes: list[LeafMesh],
         for chunk in _chunks(idx, per_leaf):
             part = [meshes[i] for i in chunk]
             area[chunk], projected[chunk] = measures.areas(part)
-            pts, u, v = _deviation_samples([leaves[i] for i in chunk])
+            pts, u, v = _sample(_stack([leaves[i].surface for i in chunk]), DEVIATION_K)
             deviation[chunk] = measures.max_deviations(
                 np.stack([ms.vertices for ms in part]), np.stack([ms.u for ms in part]),
                 np.stack([ms.v for ms in part]), pts, u, v)

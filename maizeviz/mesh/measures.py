@@ -351,19 +351,3 @@ def max_deviations(vertices: np.ndarray, u: np.ndarray, v: np.ndarray, ref_point
     if len(leaf):
         np.maximum.at(out, leaf, exact(leaf, point))
     return out
-
-
-def max_deviation(mesh: LeafMesh, ref_points: np.ndarray, ref_u: np.ndarray,
-                  ref_v: np.ndarray) -> float:
-    """Largest distance (cm) from points of the smooth surface to the mesh: one leaf of
-    :func:`max_deviations`.
-
-    Parameters
-    ----------
-    mesh : the leaf's mesh (a vertex grid over its u and v lines)
-    ref_points : (A, B, 3) float64, cm: the surface sampled on the grid ``ref_u`` x ``ref_v``.
-    ref_u : (A,), ref_v : (B,) float64 in [0, 1]
-    """
-    return float(max_deviations(mesh.vertices[None], mesh.u[None], mesh.v[None],
-                                np.asarray(ref_points)[None], np.asarray(ref_u)[None],
-                                np.asarray(ref_v)[None])[0])

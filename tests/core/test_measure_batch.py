@@ -287,16 +287,3 @@ def test_memory_bounded_chunks(monkeypatch):
     fresh = [Leaf(lf.grid, lf.surface) for lf in leaves]
     again = [as_tuple(m) for m in measure_leaves(fresh, meshes)]
     assert np.allclose(again, whole, rtol=1e-13, atol=0)
-
-
-def test_cached_deviation_samples_are_used_and_agree():
-    from maizeviz.mesh.levels import deviation_samples
-
-    leaves = random_leaves(6, count=4)
-    meshes = mesh_leaves(leaves, Level(interp=0))
-    fresh = [as_tuple(m) for m in measure_leaves([Leaf(lf.grid, lf.surface) for lf in leaves],
-                                                 meshes)]
-    for lf in leaves:
-        deviation_samples(lf)                       # the one-leaf cache, as the app may fill it
-    cached = [as_tuple(m) for m in measure_leaves(leaves, meshes)]
-    assert np.allclose(cached, fresh, rtol=1e-12, atol=1e-12)
