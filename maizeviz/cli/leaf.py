@@ -63,7 +63,7 @@ def run(args: argparse.Namespace) -> int:
     refuse_overwriting_inputs([("the mesh export", args.export)], [args.points])
     leaves, skipped = load_leaves(args.points, args.strict, args.degree, args.params,
                                   progress=_bar("gathering leaves"))
-    reference_areas(leaves)           # in batches, before a triangle budget asks leaf by leaf
+    reference_areas(leaves)           # every leaf's, once, for all levels (kept in leaf.cache)
     per_level = []
     n = len(leaves)
     for level in levels:

@@ -112,14 +112,6 @@ def parse_levels(text: str) -> list[Level]:
     return levels
 
 
-def reference_area_cm2(leaf: Leaf) -> float:
-    """Area (cm2) of the leaf's reference mesh (K = 4); computed once per leaf, so a
-    complexity slider does not pay for it at every rebuild."""
-    if "reference_area_cm2" not in leaf.cache:
-        reference_areas([leaf])
-    return float(leaf.cache["reference_area_cm2"])
-
-
 def reference_areas(leaves: list[Leaf]) -> np.ndarray:
     """Areas (L,) cm2 of the leaves' reference meshes (K = 4), leaves of equal grid shape
     sampled together, :data:`MEASURE_POINTS` surface points at a time.
@@ -189,9 +181,10 @@ def mesh_leaves(leaves: list[Leaf], level: Level, preserve_area: bool = True,
             continue
         budget = level.triangles
         assert budget is not None                    # a level is K or a budget
+        targets = reference_areas([leaves[i] for i in idx]) if preserve_area else None
         for k, i in enumerate(idx):
             g = leaves[i].grid
-            target = reference_area_cm2(leaves[i]) if preserve_area else None
+            target = float(targets[k]) if targets is not None else None
             try:
                 out[i] = simplify(g.points, surf.params_u[k], surf.params_v[k], budget,
                                   g.tip_collapsed, target, g.plant, g.leaf)
