@@ -528,11 +528,11 @@ class MainWindow(QMainWindow):
             return jobs.Built(level, label, canopy, m, build_s, measure_s,
                               (mesh, list(TABLE2_COLUMNS), row, serial))
 
-        from maizeviz.cost import layout_cost, light_cost
+        from maizeviz.cost import cover_cost, layout_cost
         from maizeviz.mesh.levels import parse_level
 
         stage = [layout_cost(loaded.leaves, loaded.layout, parse_level(level)),
-                 light_cost(loaded.layout.bounds, 1 / jobs.APP_COVER_RESOLUTION_CM ** 2, 1)]
+                 cover_cost(loaded.layout, jobs.APP_COVER_RESOLUTION_CM)]
         if not self.affordable([stage], "build"):
             shown = self.built is not None and self.built.mesh[3] == serial
             if shown:

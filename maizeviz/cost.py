@@ -18,6 +18,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
 from maizeviz.canopy.layout import CanopyLayout
+from maizeviz.canopy.measures import check_cover_resolution
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import Leaf
 from maizeviz.light.rays import Rect, ray_count
@@ -146,6 +147,13 @@ def light_cost(rect: Rect, density: float, heights: int, directions: int = 1,
     return Cost(f"{what} at {density:g} rays per cm2", "density", rays * directions,
                 "rays", rays * BYTES_PER_RAY + triangles * BYTES_PER_TRIANGLE // 4,
                 work / RAYS_PER_S)
+
+
+def cover_cost(layout: CanopyLayout, resolution_cm: float) -> Cost:
+    """Measuring the ground cover of ``layout``'s plot with one vertical ray per
+    ``resolution_cm`` pixel (:func:`maizeviz.canopy.measures.ground_cover`)."""
+    check_cover_resolution(resolution_cm)
+    return light_cost(layout.bounds, 1 / resolution_cm**2, 1)
 
 
 def heatmap_cost(rect: Rect, bin_cm: float, heights: int) -> Cost:

@@ -53,6 +53,13 @@ def table2_row(m: CanopyMeasures, build_s: float, label: str | None = None) -> d
             "build_s": f"{build_s:.2f}"}
 
 
+def check_cover_resolution(resolution: float) -> None:
+    """Refuse a ground-cover pixel side (cm) that is not > 0."""
+    if not resolution > 0:
+        raise MaizevizError(f"the ground-cover pixel must be > 0 cm, got {resolution}",
+                            quantity="cover_resolution")
+
+
 def ground_cover(canopy: Canopy, resolution: float = COVER_RESOLUTION_CM,
                  scene: RayScene | None = None) -> float:
     """Area (cm2) of the ground covered by the union of the leaves' vertical shadows.
@@ -62,9 +69,7 @@ def ground_cover(canopy: Canopy, resolution: float = COVER_RESOLUTION_CM,
     fall outside the plot are not counted. The error is about one pixel row along each
     shadow's outline.
     """
-    if not resolution > 0:
-        raise MaizevizError(f"the ground-cover pixel must be > 0 cm, got {resolution}",
-                            quantity="cover_resolution")
+    check_cover_resolution(resolution)
     if canopy.n_triangles == 0:
         return 0.0
     scene = scene or RayScene(canopy.vertices, canopy.faces)

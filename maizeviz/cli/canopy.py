@@ -8,7 +8,12 @@ import time
 
 from maizeviz.canopy.export import export_canopy
 from maizeviz.canopy.layout import save_layout
-from maizeviz.canopy.measures import TABLE2_COLUMNS, measure_canopy, table2_row
+from maizeviz.canopy.measures import (
+    TABLE2_COLUMNS,
+    check_cover_resolution,
+    measure_canopy,
+    table2_row,
+)
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.cli.common import (
     Progress,
@@ -23,8 +28,7 @@ from maizeviz.cli.common import (
     levels_from,
     say,
 )
-from maizeviz.cost import light_cost
-from maizeviz.errors import MaizevizError
+from maizeviz.cost import cover_cost
 from maizeviz.io.atomic import refuse_overwriting_inputs
 from maizeviz.mesh.levels import CANOPY_LEVELS
 
@@ -53,15 +57,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     levels = levels_from(args)
     check_export(args.export, levels)
-    if not args.cover_resolution > 0:
-        raise MaizevizError(f"the ground-cover pixel must be > 0 cm, got {args.cover_resolution}",
-                            quantity="cover_resolution")
+    check_cover_resolution(args.cover_resolution)            # before the file is read
     check_outputs(args.save_layout)
     refuse_overwriting_inputs([("the mesh export", args.export),
                                ("the saved layout", args.save_layout)], [args.points, args.layout])
     leaves, skipped, layout = canopy_setup(args)
-    cover = light_cost(layout.bounds, 1 / args.cover_resolution**2, 1)
-    check_canopy_costs(leaves, layout, levels, args.force, [cover])
+    check_canopy_costs(leaves, layout, levels, args.force,
+                       [cover_cost(layout, args.cover_resolution)])
     if args.save_layout:
         save_layout(args.save_layout, layout)
     runs = []

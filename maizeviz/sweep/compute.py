@@ -32,7 +32,7 @@ from typing import Any
 from maizeviz.canopy.layout import layout_for, parse_shape
 from maizeviz.canopy.measures import measure_canopy
 from maizeviz.canopy.scene import Canopy, build_canopy
-from maizeviz.cost import Cost, layout_cost, light_cost
+from maizeviz.cost import Cost, cover_cost, layout_cost, light_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.request import LightRequest
@@ -299,7 +299,7 @@ def group_costs(scenarios) -> list[Cost]:
     layout = _layout(s, found.leaves)
     rect = s.rect_cm or layout.centre_bounds
     return [layout_cost(found.leaves, layout, parse_level(s.level)),
-            light_cost(layout.bounds, 1 / s.cover_resolution**2, 1),
+            cover_cost(layout, s.cover_resolution),
             *(light_cost(rect, sc.density, len(sc.heights_cm)) for sc in scenarios)]
 
 
