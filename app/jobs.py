@@ -168,19 +168,20 @@ class DaySpec:
         import math
         import os
 
+        from maizeviz.errors import MaizevizError
+        from maizeviz.light.irradiance import parse_clock
+
         if self.weather:
             try:
                 return max(os.path.getsize(self.weather) // 24, 1)
             except OSError:
                 return 1                                 # refused later, naming the file
-        minutes = 24 * 60.0
         try:
-            if self.start and self.end:
-                h0, m0 = (int(v) for v in self.start.split(":"))
-                h1, m1 = (int(v) for v in self.end.split(":"))
-                minutes = max((h1 * 60 + m1) - (h0 * 60 + m0), 1)
-        except ValueError:
-            pass
+            span = parse_clock(self.end or "24:00", "end") - parse_clock(self.start or "00:00",
+                                                                         "start")
+            minutes = max(span.total_seconds() / 60, 1.0)
+        except MaizevizError:
+            minutes = 24 * 60.0                          # refused when the period is made
         return max(math.ceil(minutes / max(self.step_min, 1.0)), 1)
 
 

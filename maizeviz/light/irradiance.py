@@ -152,24 +152,34 @@ def _time_zone(tz: str):
                             f"Asia/Shanghai, or UTC)", quantity="tz") from None
 
 
-def _localize(day: _dt.date, clock: str, tz, what: str):
-    """Local clock time ``clock`` ("HH:MM[:SS]" or "24:00") on ``day`` as a tz-aware Timestamp."""
-    import pandas as pd
-
+def parse_clock(clock: str, what: str) -> _dt.timedelta:
+    """A local clock time "HH:MM[:SS]" (or "24:00", the end of the day) as the time since
+    midnight; ``what`` ("start", "end") names it in the message. A time carrying a UTC offset
+    is refused: the period's time zone says where the clock is."""
     text = str(clock).strip()
     if text in ("24:00", "24:00:00"):
-        day, text = day + _dt.timedelta(days=1), "00:00"
+        return _dt.timedelta(days=1)
     try:
-        t = _dt.time.fromisoformat(text)
+        t: _dt.time | None = _dt.time.fromisoformat(text)
     except ValueError:
+        t = None
+    if t is None or t.tzinfo is not None:
         raise MaizevizError(f"the {what} time must be HH:MM (local clock), got '{clock}'",
-                            quantity="period") from None
-    naive = pd.Timestamp(_dt.datetime.combine(day, t))
+                            quantity="period")
+    return _dt.timedelta(hours=t.hour, minutes=t.minute, seconds=t.second,
+                         microseconds=t.microsecond)
+
+
+def _localize(day: _dt.date, clock: str, tz, what: str):
+    """Local clock time ``clock`` (:func:`parse_clock`) on ``day`` as a tz-aware Timestamp."""
+    import pandas as pd
+
+    naive = pd.Timestamp(_dt.datetime.combine(day, _dt.time()) + parse_clock(clock, what))
     try:
         return naive.tz_localize(tz, ambiguous="raise", nonexistent="raise")
     except ValueError:  # pandas' NonExistentTimeError / AmbiguousTimeError
-        raise MaizevizError(f"the {what} time {text} on {day} does not exist or occurs twice "
-                            f"in {tz} (a daylight-saving change); pick another time",
+        raise MaizevizError(f"the {what} time {naive:%H:%M} on {naive.date()} does not exist or "
+                            f"occurs twice in {tz} (a daylight-saving change); pick another time",
                             quantity="period") from None
 
 

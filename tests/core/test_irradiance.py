@@ -101,6 +101,8 @@ def test_polar_day_keeps_every_step():
      "the time step (90 min) is longer than the period (1 h)"),
     (dict(start="18:00", end="06:00"), "the period must end after it starts, got 18:00 to 06:00"),
     (dict(start="6h"), "the start time must be HH:MM (local clock), got '6h'"),
+    (dict(start="06:00+05:00"),                   # a TypeError from pandas before
+     "the start time must be HH:MM (local clock), got '06:00+05:00'"),
     (dict(step_min=0.001), "a time step of 0.001 min gives 1440000 steps, more than 1000000"),
     (dict(date="2005-02-30"), "the date must be YYYY-MM-DD, got '2005-02-30'"),
     (dict(tz="Mars/Olympus"), "unknown time zone 'Mars/Olympus'"),
@@ -117,7 +119,7 @@ def test_bad_periods_are_refused_in_one_line(kwargs, message):
 def test_a_clock_time_skipped_by_daylight_saving_is_refused():
     with pytest.raises(MaizevizError) as err:
         sun_track("2005-03-27", 48.85, 2.35, "Europe/Paris", start="02:30")
-    assert "does not exist or occurs twice in Europe/Paris" in one_line(err)
+    assert "02:30 on 2005-03-27 does not exist or occurs twice in Europe/Paris" in one_line(err)
 
 
 # --------------------------------------------------------------------------- clear sky

@@ -54,6 +54,8 @@ def test_a_day_is_estimated_from_its_steps(window, qtbot, small_points, monkeypa
 
     assert DaySpec(step_min=30.0).steps_bound() == 48
     assert DaySpec(step_min=10.0, start="06:00", end="18:00").steps_bound() == 72
+    assert DaySpec(step_min=30.0, start="12:00").steps_bound() == 24       # noon to midnight
+    assert DaySpec(step_min=60.0, start="06:00:00", end="18:30").steps_bound() == 13
     w = shown(qtbot, window(small_points, tile=1))
     monkeypatch.setattr(cost, "SLOW_SECONDS", 1e-9)
     asked = []
