@@ -1133,13 +1133,9 @@ class MainWindow(QMainWindow):
             rows = list(self.measures_rows.values())
 
             def work(job):
-                from maizeviz.io.atomic import atomic_open
+                from maizeviz.io.atomic import write_rows
 
-                with atomic_open(path, "w", newline="") as fh:
-                    w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-                    w.writeheader()
-                    for r in rows:
-                        w.writerow({k: v.replace(",", "") for k, v in r.items()})
+                write_rows(path, [{k: v.replace(",", "") for k, v in r.items()} for r in rows])
                 return path
             return work, ()
         if what in ("steps", "leaves", "plants", "day"):
