@@ -11,10 +11,10 @@ layout file, mesh level and area rule. Its work is done once and reused by all i
 
 Every import of the computing core (leaf, mesh, canopy, light) is in this file, so that moving
 core modules is a one-file change (the rest of the sweep uses only ``maizeviz.errors`` and
-``maizeviz.io.atomic``). The
-numbers equal ``maizeviz canopy --json`` and ``maizeviz light --json`` for the same inputs: the
-same functions with the same arguments, except that tracing runs on one thread (a Dask worker
-is one process per core) and without the hit classes, neither of which changes transmission.
+``maizeviz.io``). The numbers equal ``maizeviz canopy --json`` and ``maizeviz light --json``
+for the same inputs: the same functions with the same arguments, except that tracing runs on
+one thread (a Dask worker is one process per core) and without the hit classes, neither of
+which changes transmission.
 
 Scenarios are duck-typed (see :class:`maizeviz.sweep.spec.Scenario`); of the sweep this
 module imports only its errors.

@@ -57,9 +57,12 @@ else:  # pragma: no cover - Python 3.10: the tomli backport (the sweep extra ins
 
 import maizeviz
 from maizeviz.errors import MaizevizError
+from maizeviz.io.inputs import read_input
 from maizeviz.sweep import compute
 from maizeviz.sweep.errors import SweepSpecError
 
+#: Largest sweep file (bytes): a hand-written or generated file is far smaller.
+MAX_SPEC_BYTES = 4 * 2**20
 #: More scenarios than this are refused unless confirmed (``yes=True``, ``--yes``).
 MAX_SCENARIOS = 10_000
 #: More combinations than this are refused outright: split the sweep.
@@ -372,16 +375,10 @@ class _Checker:
 
 
 def read_toml(path) -> tuple[dict, str]:
-    """The parsed sweep file and its text; SweepSpecError for a missing file or bad TOML."""
-    p = Path(path)
-    try:
-        raw = p.read_bytes()
-    except FileNotFoundError:
-        raise SweepSpecError(f"{path}: no such sweep file") from None
-    except IsADirectoryError:
-        raise SweepSpecError(f"{path}: is a folder, not a sweep file") from None
-    except OSError as exc:
-        raise SweepSpecError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    """The parsed sweep file and its text; SweepSpecError for a file that is missing, not a
+    regular file (a FIFO is refused at once, not waited on), over :data:`MAX_SPEC_BYTES`, or
+    not TOML."""
+    raw = read_input(path, "sweep file", MAX_SPEC_BYTES, SweepSpecError)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:

@@ -264,6 +264,21 @@ def test_missing_sweep_file(tmp_path):
         load_spec(tmp_path / "nope.toml")
 
 
+def test_a_fifo_as_the_sweep_file_is_refused_at_once_in_one_line(tmp_path):
+    fifo = tmp_path / "sweep.toml"
+    os.mkfifo(fifo)                                  # nobody writes: reading it would wait
+    # in a subprocess first, so that a regression fails on the timeout instead of hanging
+    proc = subprocess.run([sys.executable, "-m", "maizeviz.sweep", str(fifo), "--dry-run"],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 1, proc.stderr
+    assert proc.stderr.strip().splitlines() == [f"error: {fifo}: is a FIFO (named pipe), not a "
+                                                "regular file; a sweep file must be a regular "
+                                                "file"]
+    with pytest.raises(SweepSpecError, match=r"sweep.toml: is a FIFO \(named pipe\), not a "
+                                             r"regular file; a sweep file must be a regular"):
+        load_spec(fifo)
+
+
 def test_too_many_scenarios_need_yes(blocks, tmp_path):
     many = SPEC.replace("density = [0.5]", f"density = {list(range(1, 18))}").replace(
         'tile = ["1x1"]', f'tile = ["1x1"]\nrow_spacing = {list(range(40, 90))}')
