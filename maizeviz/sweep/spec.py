@@ -264,7 +264,13 @@ class _Checker:
 
     # converters: (value, where) -> canonical value
     def number(self, v, where, positive=True, minimum=None):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            self.fail(where, f"must be a number, got {json.dumps(v, default=str)}")
+        try:
+            finite = math.isfinite(v)
+        except OverflowError:                              # an integer such as 10**400
+            self.fail(where, "must be a number, got an integer too large for one")
+        if not finite:
             self.fail(where, f"must be a number, got {json.dumps(v, default=str)}")
         if positive and v <= 0:
             self.fail(where, f"must be > 0, got {v}")
@@ -278,12 +284,27 @@ class _Checker:
         return v
 
     def shape(self, v, where):
+        """A tile count or, for ``canopy.block``, a block shape, checked as the canopy does."""
         if not isinstance(v, str):
             self.fail(where, f"must be a string such as \"3x3\", got {json.dumps(v, default=str)}")
+        quantity = "block" if where.endswith("block") else "tile"
         try:
-            return compute.parse_tile(v, "block" if where.endswith("block") else "tile")
+            shape = compute.parse_tile(v, quantity)
         except MaizevizError:
             self.fail(where, f"must look like 3x3 (whole numbers >= 1), got '{v}'")
+        try:
+            return compute.check_shape(shape, quantity)
+        except MaizevizError as exc:
+            self.fail(where, str(exc))
+
+    def spacing(self, v, where):
+        """A row or plant spacing in cm, checked as the canopy does."""
+        value = self.number(v, where)
+        try:
+            return compute.check_spacing(
+                value, "plant spacing" if "plant_spacing" in where else "row spacing")
+        except MaizevizError as exc:
+            self.fail(where, str(exc))
 
     def level(self, v, where):
         if isinstance(v, bool) or not isinstance(v, (str, int)):
@@ -432,8 +453,8 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
     arrangements = []
     if tiling_given or "layout" not in canopy:
         tiles = ck.axis(canopy, "tile", "canopy", ck.shape, [(1, 1)])
-        rows = ck.axis(canopy, "row_spacing", "canopy", ck.number, [60.0])
-        plants = ck.axis(canopy, "plant_spacing", "canopy", ck.number, [30.0])
+        rows = ck.axis(canopy, "row_spacing", "canopy", ck.spacing, [60.0])
+        plants = ck.axis(canopy, "plant_spacing", "canopy", ck.spacing, [30.0])
         block = None
         if "block" in canopy:
             block = ck.shape(canopy["block"], "canopy.block")
@@ -526,7 +547,9 @@ def _matcher(ck: _Checker, entry: dict, where: str) -> Callable[[dict[str, Any]]
             want = ck.text(v, w)                           # a name or a glob
         elif key == "tile":
             want = ck.shape(v, w)
-        elif key in ("row_spacing", "plant_spacing", "density"):
+        elif key in ("row_spacing", "plant_spacing"):
+            want = ck.spacing(v, w)
+        elif key == "density":
             want = ck.number(v, w)
         elif key == "level":
             want = ck.level(v, w)
@@ -537,7 +560,8 @@ def _matcher(ck: _Checker, entry: dict, where: str) -> Callable[[dict[str, Any]]
                 ck.fail(w, "must be a table of sun keys, such as {zenith = 30}")
             ck.known(v, SUN_ANGLE_KEYS + SUN_PLACE_KEYS, w)
             want = {k: (x.isoformat() if isinstance(x, (date, datetime, dtime)) else
-                        float(x) if isinstance(x, int) and not isinstance(x, bool) else x)
+                        ck.number(x, f"{w}.{k}", positive=False)
+                        if isinstance(x, int) and not isinstance(x, bool) else x)
                     for k, x in v.items()}
         wants.append((key, want))
     return lambda vals: all(_matches(vals, key, want) for key, want in wants)

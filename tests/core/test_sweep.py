@@ -251,6 +251,24 @@ def test_ctrl_c_on_the_command_stops_cleanly_and_the_rerun_finishes(blocks, clie
     (SPEC + '[[exclude]]\ncolour = "red"\n', r"unknown key 'exclude\[0\].colour'"),
     (SPEC + 'exclude = [{level = "8"}]\n', r"'light.exclude': exclude belongs at the top"),
     (SPEC.replace("[canopy]", "[canopee]"), r"unknown key 'canopee' \(known: canopy, "),
+    # the canopy's own checks, at load rather than on every worker
+    (SPEC.replace('tile = ["1x1"]', 'tile = ["1x1"]\nrow_spacing = [60, 0.5]'),
+     r"canopy.row_spacing\[1\]: row spacing is 0.5 cm; it must be from 1 to 100000 cm"),
+    (SPEC.replace('tile = ["1x1"]', 'tile = ["1x1"]\nplant_spacing = 2e6'),
+     r"canopy.plant_spacing: plant spacing is 2e\+06 cm; it must be from 1 to 100000 cm"),
+    (SPEC.replace('tile = ["1x1"]', 'tile = ["1000x1000"]'),
+     r"canopy.tile\[0\]: 1000 x 1000 tiles of one plant make 1,000,000 plants; a canopy holds "
+     r"at most 100,000"),
+    (SPEC.replace('tile = ["1x1"]', 'tile = ["1x1"]\nblock = "1x200000"'),
+     r"canopy.block: the block shape must be a whole number from 1 to 100,000"),
+    (SPEC.replace('tile = ["1x1"]', 'tile = ["1x1"]\nrow_spacing = [1' + "0" * 400 + "]"),
+     r"canopy.row_spacing\[0\]: must be a number, got an integer too large"),
+    (SPEC.replace("density = [0.5]", "density = 1" + "0" * 400),
+     r"light.density: must be a number, got an integer too large"),
+    (SPEC + "[[exclude]]\nsun = {zenith = 1" + "0" * 400 + "}\n",
+     r"exclude\[0\].sun.zenith: must be a number, got an integer too large"),
+    (SPEC + "[[exclude]]\nrow_spacing = 0.5\n",
+     r"exclude\[0\].row_spacing: row spacing is 0.5 cm; it must be from 1"),
 ])
 def test_bad_sweep_files_say_one_line_naming_the_key(blocks, tmp_path, text, says):
     (tmp_path / "b0.csv").write_bytes((blocks / "b0.csv").read_bytes())
