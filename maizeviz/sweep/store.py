@@ -92,6 +92,40 @@ def scenario_rows(s, result: dict, worker: str | None, finished_at: str) -> list
     return rows
 
 
+def done_parts(folder, spec) -> dict[str, list[dict]]:
+    """Rows of the spec's scenarios whose part file in ``folder/parts`` is whole, its own and
+    done (status ok or error), by scenario key; missing, damaged or foreign parts are left out
+    (computed again)."""
+    parts = Path(folder) / "parts"
+    out: dict[str, list[dict]] = {}
+    if not parts.is_dir():
+        return out
+    for s in spec.scenarios:
+        try:
+            part = json.loads((parts / f"{s.key}.json").read_text())
+        except (OSError, ValueError):
+            continue                            # missing, not ours or damaged
+        if not isinstance(part, dict) or part.get("scenario") != s.key:
+            continue
+        rows = part.get("rows")
+        if isinstance(rows, list) and rows and isinstance(rows[0], dict) \
+                and rows[0].get("status") in DONE:
+            out[s.key] = rows
+    return out
+
+
+def done_keys_on_disk(folder, spec) -> set[str]:
+    """Keys of the scenarios a resumed run in ``folder`` would skip: those of
+    :func:`done_parts` when ``folder/sweep.json`` holds the same sweep (same fingerprint),
+    else none (a run would refuse the folder without ``force``)."""
+    try:
+        same = json.loads((Path(folder) / "sweep.json").read_text()).get(
+            "fingerprint") == spec.fingerprint
+    except (OSError, ValueError, AttributeError):
+        same = False
+    return set(done_parts(folder, spec)) if same else set()
+
+
 class ResultStore:
     """The output folder of one sweep spec.
 
@@ -158,19 +192,7 @@ class ResultStore:
         return info
 
     def _load_parts(self) -> None:
-        if not self.parts.is_dir():
-            return
-        for s in self.spec.scenarios:
-            p = self.parts / f"{s.key}.json"
-            try:
-                part = json.loads(p.read_text())
-            except FileNotFoundError:
-                continue
-            except (OSError, ValueError):
-                continue                        # not ours or damaged: compute it again
-            rows = part.get("rows")
-            if part.get("scenario") == s.key and rows and rows[0].get("status") in DONE:
-                self.rows[s.key] = rows
+        self.rows.update(done_parts(self.folder, self.spec))
 
     # ---------------------------------------------------------------- recording
     def done_keys(self) -> set[str]:

@@ -22,7 +22,7 @@ from maizeviz.sweep.command import main as sweep_main  # noqa: E402
 from maizeviz.sweep.errors import SchedulerError, SweepSpecError, SweepStoreError  # noqa: E402
 from maizeviz.sweep.run import dask_client, plan_tasks, run_sweep  # noqa: E402
 from maizeviz.sweep.spec import load_spec  # noqa: E402
-from maizeviz.sweep.store import ResultStore, read_results  # noqa: E402
+from maizeviz.sweep.store import ResultStore, done_keys_on_disk, read_results  # noqa: E402
 from maizeviz.sweep.summary import summarize  # noqa: E402
 
 HEIGHTS = [0, 50, 100, 150, 200, 250]
@@ -351,6 +351,28 @@ def test_an_output_folder_of_another_sweep_is_refused_unless_forced(blocks, tmp_
     (other / "thesis.tex").write_text("x")
     with pytest.raises(SweepStoreError, match=r"holds other files \(thesis.tex\)"):
         ResultStore(other, a)
+
+
+def test_the_dry_run_and_the_store_agree_on_what_is_done(blocks, tmp_path, capsys):
+    spec = spec_file(blocks)
+    a = load_spec(spec)
+    out = tmp_path / "r"
+    store = ResultStore(out, a)
+    store.start_run({})
+    first, second, third = a.scenarios[:3]
+    store.add(first, {"status": "error", "error": "bad input"})      # done: not retried
+    store.add(third, {"status": "failed", "error": "worker died"})   # retried
+    # a part under another scenario's name (a copy, a renamed file) is not that scenario's
+    (out / "parts" / f"{second.key}.json").write_bytes(
+        (out / "parts" / f"{first.key}.json").read_bytes())
+    assert done_keys_on_disk(out, a) == {first.key} == ResultStore(out, a).done_keys()
+    assert sweep_main([str(spec), "--dry-run", "--out", str(out)]) == 0
+    listing = capsys.readouterr().out
+    assert f"12 scenarios (0 excluded, 1 already in {out})" in listing
+    assert [ln.split()[1] for ln in listing.splitlines() if ln.rstrip().endswith(" done")] \
+        == [first.key[:12]]
+    b = load_spec(spec_file(blocks, SPEC.replace("density = [0.5]", "density = [1]"), "b.toml"))
+    assert done_keys_on_disk(out, b) == set()       # another sweep's folder: nothing skipped
 
 
 def test_tasks_are_groups_split_only_when_workers_would_idle(blocks):
