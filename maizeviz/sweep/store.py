@@ -21,14 +21,13 @@ from __future__ import annotations
 
 import csv
 import datetime as dt
-import io
 import json
 import os
 from pathlib import Path
 from typing import Any
 
 import maizeviz
-from maizeviz.io.atomic import atomic_open, atomic_path
+from maizeviz.io.atomic import atomic_open, atomic_path, write_text
 from maizeviz.sweep.errors import SweepStoreError
 
 SCHEMA = 1
@@ -58,13 +57,6 @@ OWN_FILES = {"sweep.json", "parts", "results.parquet", "results.csv", "summary.c
 
 def now_iso() -> str:
     return dt.datetime.now(dt.timezone.utc).astimezone().isoformat(timespec="seconds")
-
-
-def write_atomic(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` atomically (:mod:`maizeviz.io.atomic`): readers see the old
-    file or the new one, never half of it."""
-    with atomic_open(path, "wb") as fh:
-        fh.write(data)
 
 
 def scenario_rows(s, result: dict, worker: str | None, finished_at: str) -> list[dict]:
@@ -203,8 +195,7 @@ class ResultStore:
         """Record one scenario's result: its part file first (atomically), then memory."""
         rows = scenario_rows(s, result, worker, now_iso())
         part = {"scenario": s.key, "index": s.index, "rows": rows}
-        write_atomic(self.parts / f"{s.key}.json",
-                     json.dumps(part, allow_nan=True).encode())
+        write_text(self.parts / f"{s.key}.json", json.dumps(part, allow_nan=True))
         self.rows[s.key] = rows
         return rows
 
@@ -218,7 +209,7 @@ class ResultStore:
     def flush(self) -> None:
         """Rebuild results.parquet and results.csv from the rows on record (atomically)."""
         rows = self.all_rows()
-        write_atomic(self.folder / "results.csv", _csv_bytes(rows))
+        _write_csv(self.folder / "results.csv", rows)
         write_parquet(self.folder / "results.parquet", rows)
 
     def start_run(self, cluster: dict) -> dict:
@@ -237,17 +228,16 @@ class ResultStore:
         return run
 
     def write_info(self) -> None:
-        write_atomic(self.folder / "sweep.json",
-                     json.dumps(self.info, indent=1, default=str).encode())
+        write_text(self.folder / "sweep.json", json.dumps(self.info, indent=1, default=str))
 
 
-def _csv_bytes(rows: list[dict]) -> bytes:
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(COLUMN_NAMES)
-    for r in rows:
-        w.writerow(["" if r.get(c) is None else r[c] for c in COLUMN_NAMES])
-    return buf.getvalue().encode()
+def _write_csv(path: Path, rows: list[dict]) -> None:
+    """All rows as CSV with a header (empty cells for missing values), atomically."""
+    with atomic_open(path, "w", newline="") as fh:
+        w = csv.writer(fh, lineterminator="\n")
+        w.writerow(COLUMN_NAMES)
+        for r in rows:
+            w.writerow(["" if r.get(c) is None else r[c] for c in COLUMN_NAMES])
 
 
 def write_parquet(path: Path, rows: list[dict]) -> None:

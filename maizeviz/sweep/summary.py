@@ -10,10 +10,8 @@ at once ("all suns": within tolerance for every sun the finest level was compute
 from __future__ import annotations
 
 import csv
-import io
-from pathlib import Path
 
-from maizeviz.sweep.store import write_atomic
+from maizeviz.io.atomic import atomic_open
 
 DEFAULT_TOLERANCE = 0.02
 
@@ -111,8 +109,7 @@ def format_summary(summary: list[dict]) -> str:
 
 def write_summary(path, summary: list[dict]) -> None:
     """``summary.csv`` (atomically)."""
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=SUMMARY_COLUMNS, lineterminator="\n")
-    w.writeheader()
-    w.writerows(summary)
-    write_atomic(Path(path), buf.getvalue().encode())
+    with atomic_open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=SUMMARY_COLUMNS, lineterminator="\n")
+        w.writeheader()
+        w.writerows(summary)
