@@ -90,6 +90,21 @@ def _digest(obj) -> str:
     return hashlib.sha256(text.encode()).hexdigest()
 
 
+def arrangement_label(layout: str | None, tile: str | None, row_spacing: float | None,
+                      plant_spacing: float | None) -> str:
+    """An arrangement in words, as listings and the summary show it: the layout file's name,
+    or ``"3x3 at 60 x 30 cm"`` for a tiling (``tile`` as ``"AxB"``)."""
+    if layout or tile is None:
+        return layout or "?"
+    return f"{tile} at {row_spacing:g} x {plant_spacing:g} cm"
+
+
+def sun_label(zenith_deg: float, azimuth_deg: float, when: str | None) -> str:
+    """A sun in words: ``"z 30.00 az 180.00"``, with its time when it came from one."""
+    angles = f"z {zenith_deg:.2f} az {azimuth_deg:.2f}"
+    return f"{angles} ({when})" if when else angles
+
+
 @dataclass(frozen=True)
 class PointsFile:
     """A points file: ``name`` as shown (relative to the sweep file), absolute ``path``."""
@@ -117,9 +132,8 @@ class Arrangement:
 
     @property
     def label(self) -> str:
-        if self.layout or self.tile is None:
-            return self.layout or "?"
-        return f"{self.tile[0]}x{self.tile[1]} at {self.row_spacing:g} x {self.plant_spacing:g} cm"
+        return arrangement_label(self.layout, f"{self.tile[0]}x{self.tile[1]}" if self.tile
+                                 else None, self.row_spacing, self.plant_spacing)
 
     def canonical(self) -> dict:
         if self.layout or self.tile is None:
@@ -141,8 +155,7 @@ class SunSpec:
 
     @property
     def label(self) -> str:
-        angles = f"z {self.zenith_deg:.2f} az {self.azimuth_deg:.2f}"
-        return f"{angles} ({self.when})" if self.when else angles
+        return sun_label(self.zenith_deg, self.azimuth_deg, self.when)
 
 
 @dataclass(frozen=True)
@@ -163,12 +176,6 @@ class Scenario:
     heights_cm: tuple
     rect_cm: tuple | None
     cover_resolution: float
-
-    @property
-    def canopy_key(self) -> tuple:
-        """What the summary compares levels within: everything but the level and the sun."""
-        return (self.points.sha256, self.points.name, self.arrangement, self.preserve_area,
-                self.density, self.periodic)
 
     def axes(self) -> dict:
         """The axis values as result columns."""
