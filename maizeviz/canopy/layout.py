@@ -138,16 +138,23 @@ def _cell(x, y, row_spacing, plant_spacing):
     return [x - row_spacing / 2, y - plant_spacing / 2, x + row_spacing / 2, y + plant_spacing / 2]
 
 
+def check_spacing(value, name: str = "row spacing") -> float:
+    """A spacing (``name``: "row spacing" or "plant spacing") as a number of cm within
+    :data:`MIN_LENGTH_CM` .. :data:`MAX_COORD_CM`; LayoutError otherwise."""
+    f = _finite(value)
+    if f is None or f <= 0:
+        raise LayoutError(f"{name} must be a positive number of cm, got {_shown(value)}",
+                          quantity=name.replace(" ", "_"))
+    if not MIN_LENGTH_CM <= f <= MAX_COORD_CM:
+        raise LayoutError(f"{name} is {f:g} cm; it must be from {MIN_LENGTH_CM:g} to "
+                          f"{MAX_COORD_CM:g} cm (1 km)", quantity=name.replace(" ", "_"))
+    return f
+
+
 def _check_spacing(row_spacing, plant_spacing):
     """Both spacings numbers of cm within :data:`MIN_LENGTH_CM` .. :data:`MAX_COORD_CM`."""
-    for name, v in (("row spacing", row_spacing), ("plant spacing", plant_spacing)):
-        f = _finite(v)
-        if f is None or f <= 0:
-            raise LayoutError(f"{name} must be a positive number of cm, got {_shown(v)}",
-                              quantity=name.replace(" ", "_"))
-        if not MIN_LENGTH_CM <= f <= MAX_COORD_CM:
-            raise LayoutError(f"{name} is {f:g} cm; it must be from {MIN_LENGTH_CM:g} to "
-                              f"{MAX_COORD_CM:g} cm (1 km)", quantity=name.replace(" ", "_"))
+    check_spacing(row_spacing, "row spacing")
+    check_spacing(plant_spacing, "plant spacing")
 
 
 def _check_count(v, what: str, limit: int, quantity: str | None = None) -> int:
@@ -211,6 +218,15 @@ def check_tile(tile, plants: int = 1) -> tuple[int, int]:
     return a, b
 
 
+def check_block(block) -> tuple[int, int]:
+    """The shape of a digitized block (rows, plants per row) as whole numbers 1 ..
+    :data:`MAX_PLANTS`; LayoutError otherwise."""
+    if len(block) != 2:
+        raise LayoutError(f"the block shape must be two numbers, got {_shown(block)}")
+    return (_check_count(block[0], "the block shape", MAX_PLANTS, "block"),
+            _check_count(block[1], "the block shape", MAX_PLANTS, "block"))
+
+
 def block_lattice(bases: dict[int, tuple[float, float]], row_spacing: float,
                   plant_spacing: float) -> tuple[tuple[int, int], dict[int, tuple[float, float]]]:
     """Rows x plants per row of a digitized block, and each plant's lattice position (cm).
@@ -256,10 +272,7 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
                               f"{MAX_COORD_CM:g} cm (1 km) of the origin")
     a, b = check_tile(tile, len(bases))
     if block is not None:
-        if len(block) != 2:
-            raise LayoutError(f"the block shape must be two numbers, got {_shown(block)}")
-        block = (_check_count(block[0], "the block shape", MAX_PLANTS, "block"),
-                 _check_count(block[1], "the block shape", MAX_PLANTS, "block"))
+        block = check_block(block)
     north_deg = _angle(north_deg, "north")
     warnings = []
     inferred, lattice = block_lattice(bases, row_spacing, plant_spacing)

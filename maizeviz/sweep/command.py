@@ -134,25 +134,9 @@ def _run(spec, args) -> int:
 
 def _dry_run(spec, args) -> int:
     from maizeviz.sweep import compute
-    from maizeviz.sweep.store import DONE
+    from maizeviz.sweep.store import done_keys_on_disk
 
-    done = set()
-    if args.out:
-        import json
-
-        meta = Path(args.out) / "sweep.json"
-        try:
-            same = json.loads(meta.read_text()).get("fingerprint") == spec.fingerprint
-        except (OSError, ValueError):
-            same = False
-        if same:
-            for s in spec.scenarios:
-                try:
-                    part = json.loads((Path(args.out) / "parts" / f"{s.key}.json").read_text())
-                except (OSError, ValueError):
-                    continue
-                if part.get("rows") and part["rows"][0].get("status") in DONE:
-                    done.add(s.key)
+    done = done_keys_on_disk(args.out, spec) if args.out else set()
     head = ["#", "key", "points", "arrangement", "level", "sun", "density", "periodic", ""]
     rows = [[s.index + 1, s.key[:12], s.points.name, s.arrangement.label, s.level, s.sun.label,
              f"{s.density:g}", "yes" if s.periodic else "no",

@@ -11,10 +11,10 @@ layout file, mesh level and area rule. Its work is done once and reused by all i
 
 Every import of the computing core (leaf, mesh, canopy, light) is in this file, so that moving
 core modules is a one-file change (the rest of the sweep uses only ``maizeviz.errors`` and
-``maizeviz.io.atomic``). The
-numbers equal ``maizeviz canopy --json`` and ``maizeviz light --json`` for the same inputs: the
-same functions with the same arguments, except that tracing runs on one thread (a Dask worker
-is one process per core) and without the hit classes, neither of which changes transmission.
+``maizeviz.io``). The numbers equal ``maizeviz canopy --json`` and ``maizeviz light --json``
+for the same inputs: the same functions with the same arguments, except that tracing runs on
+one thread (a Dask worker is one process per core) and without the hit classes, neither of
+which changes transmission.
 
 Scenarios are duck-typed (see :class:`maizeviz.sweep.spec.Scenario`); of the sweep this
 module imports only its errors.
@@ -29,7 +29,8 @@ from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import Any
 
-from maizeviz.canopy.layout import layout_for, parse_shape
+from maizeviz.canopy.layout import check_block, check_tile, layout_for, parse_shape
+from maizeviz.canopy.layout import check_spacing as _core_check_spacing
 from maizeviz.canopy.measures import measure_canopy
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.cost import Cost, cover_cost, layout_cost, light_cost
@@ -67,6 +68,17 @@ def level_order(label: str) -> tuple[int, int]:
 def parse_tile(text, quantity: str = "tile") -> tuple[int, int]:
     """``"3x3"`` -> (3, 3); MaizevizError otherwise."""
     return parse_shape(str(text), quantity)
+
+
+def check_shape(shape: tuple[int, int], quantity: str = "tile") -> tuple[int, int]:
+    """A parsed tile count or block shape (``quantity``: "tile" or "block") checked as the
+    canopy checks it (at most ``MAX_PLANTS`` plants); MaizevizError otherwise."""
+    return check_block(shape) if quantity == "block" else check_tile(shape)
+
+
+def check_spacing(value, name: str = "row spacing") -> float:
+    """A row or plant spacing (cm) checked as the canopy checks it; MaizevizError otherwise."""
+    return _core_check_spacing(value, name)
 
 
 def resolve_sun(table: dict) -> tuple[float, float, str]:

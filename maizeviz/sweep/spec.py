@@ -57,9 +57,12 @@ else:  # pragma: no cover - Python 3.10: the tomli backport (the sweep extra ins
 
 import maizeviz
 from maizeviz.errors import MaizevizError
+from maizeviz.io.inputs import read_input
 from maizeviz.sweep import compute
 from maizeviz.sweep.errors import SweepSpecError
 
+#: Largest sweep file (bytes): a hand-written or generated file is far smaller.
+MAX_SPEC_BYTES = 4 * 2**20
 #: More scenarios than this are refused unless confirmed (``yes=True``, ``--yes``).
 MAX_SCENARIOS = 10_000
 #: More combinations than this are refused outright: split the sweep.
@@ -85,6 +88,21 @@ def version_tag() -> str:
 def _digest(obj) -> str:
     text = json.dumps(obj, sort_keys=True, separators=(",", ":"), default=str)
     return hashlib.sha256(text.encode()).hexdigest()
+
+
+def arrangement_label(layout: str | None, tile: str | None, row_spacing: float | None,
+                      plant_spacing: float | None) -> str:
+    """An arrangement in words, as listings and the summary show it: the layout file's name,
+    or ``"3x3 at 60 x 30 cm"`` for a tiling (``tile`` as ``"AxB"``)."""
+    if layout or tile is None:
+        return layout or "?"
+    return f"{tile} at {row_spacing:g} x {plant_spacing:g} cm"
+
+
+def sun_label(zenith_deg: float, azimuth_deg: float, when: str | None) -> str:
+    """A sun in words: ``"z 30.00 az 180.00"``, with its time when it came from one."""
+    angles = f"z {zenith_deg:.2f} az {azimuth_deg:.2f}"
+    return f"{angles} ({when})" if when else angles
 
 
 @dataclass(frozen=True)
@@ -114,9 +132,8 @@ class Arrangement:
 
     @property
     def label(self) -> str:
-        if self.layout or self.tile is None:
-            return self.layout or "?"
-        return f"{self.tile[0]}x{self.tile[1]} at {self.row_spacing:g} x {self.plant_spacing:g} cm"
+        return arrangement_label(self.layout, f"{self.tile[0]}x{self.tile[1]}" if self.tile
+                                 else None, self.row_spacing, self.plant_spacing)
 
     def canonical(self) -> dict:
         if self.layout or self.tile is None:
@@ -138,8 +155,7 @@ class SunSpec:
 
     @property
     def label(self) -> str:
-        angles = f"z {self.zenith_deg:.2f} az {self.azimuth_deg:.2f}"
-        return f"{angles} ({self.when})" if self.when else angles
+        return sun_label(self.zenith_deg, self.azimuth_deg, self.when)
 
 
 @dataclass(frozen=True)
@@ -160,12 +176,6 @@ class Scenario:
     heights_cm: tuple
     rect_cm: tuple | None
     cover_resolution: float
-
-    @property
-    def canopy_key(self) -> tuple:
-        """What the summary compares levels within: everything but the level and the sun."""
-        return (self.points.sha256, self.points.name, self.arrangement, self.preserve_area,
-                self.density, self.periodic)
 
     def axes(self) -> dict:
         """The axis values as result columns."""
@@ -261,7 +271,13 @@ class _Checker:
 
     # converters: (value, where) -> canonical value
     def number(self, v, where, positive=True, minimum=None):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            self.fail(where, f"must be a number, got {json.dumps(v, default=str)}")
+        try:
+            finite = math.isfinite(v)
+        except OverflowError:                              # an integer such as 10**400
+            self.fail(where, "must be a number, got an integer too large for one")
+        if not finite:
             self.fail(where, f"must be a number, got {json.dumps(v, default=str)}")
         if positive and v <= 0:
             self.fail(where, f"must be > 0, got {v}")
@@ -275,12 +291,27 @@ class _Checker:
         return v
 
     def shape(self, v, where):
+        """A tile count or, for ``canopy.block``, a block shape, checked as the canopy does."""
         if not isinstance(v, str):
             self.fail(where, f"must be a string such as \"3x3\", got {json.dumps(v, default=str)}")
+        quantity = "block" if where.endswith("block") else "tile"
         try:
-            return compute.parse_tile(v, "block" if where.endswith("block") else "tile")
+            shape = compute.parse_tile(v, quantity)
         except MaizevizError:
             self.fail(where, f"must look like 3x3 (whole numbers >= 1), got '{v}'")
+        try:
+            return compute.check_shape(shape, quantity)
+        except MaizevizError as exc:
+            self.fail(where, str(exc))
+
+    def spacing(self, v, where):
+        """A row or plant spacing in cm, checked as the canopy does."""
+        value = self.number(v, where)
+        try:
+            return compute.check_spacing(
+                value, "plant spacing" if "plant_spacing" in where else "row spacing")
+        except MaizevizError as exc:
+            self.fail(where, str(exc))
 
     def level(self, v, where):
         if isinstance(v, bool) or not isinstance(v, (str, int)):
@@ -372,16 +403,10 @@ class _Checker:
 
 
 def read_toml(path) -> tuple[dict, str]:
-    """The parsed sweep file and its text; SweepSpecError for a missing file or bad TOML."""
-    p = Path(path)
-    try:
-        raw = p.read_bytes()
-    except FileNotFoundError:
-        raise SweepSpecError(f"{path}: no such sweep file") from None
-    except IsADirectoryError:
-        raise SweepSpecError(f"{path}: is a folder, not a sweep file") from None
-    except OSError as exc:
-        raise SweepSpecError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    """The parsed sweep file and its text; SweepSpecError for a file that is missing, not a
+    regular file (a FIFO is refused at once, not waited on), over :data:`MAX_SPEC_BYTES`, or
+    not TOML."""
+    raw = read_input(path, "sweep file", MAX_SPEC_BYTES, SweepSpecError)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError:
@@ -435,8 +460,8 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
     arrangements = []
     if tiling_given or "layout" not in canopy:
         tiles = ck.axis(canopy, "tile", "canopy", ck.shape, [(1, 1)])
-        rows = ck.axis(canopy, "row_spacing", "canopy", ck.number, [60.0])
-        plants = ck.axis(canopy, "plant_spacing", "canopy", ck.number, [30.0])
+        rows = ck.axis(canopy, "row_spacing", "canopy", ck.spacing, [60.0])
+        plants = ck.axis(canopy, "plant_spacing", "canopy", ck.spacing, [30.0])
         block = None
         if "block" in canopy:
             block = ck.shape(canopy["block"], "canopy.block")
@@ -529,7 +554,9 @@ def _matcher(ck: _Checker, entry: dict, where: str) -> Callable[[dict[str, Any]]
             want = ck.text(v, w)                           # a name or a glob
         elif key == "tile":
             want = ck.shape(v, w)
-        elif key in ("row_spacing", "plant_spacing", "density"):
+        elif key in ("row_spacing", "plant_spacing"):
+            want = ck.spacing(v, w)
+        elif key == "density":
             want = ck.number(v, w)
         elif key == "level":
             want = ck.level(v, w)
@@ -540,7 +567,8 @@ def _matcher(ck: _Checker, entry: dict, where: str) -> Callable[[dict[str, Any]]
                 ck.fail(w, "must be a table of sun keys, such as {zenith = 30}")
             ck.known(v, SUN_ANGLE_KEYS + SUN_PLACE_KEYS, w)
             want = {k: (x.isoformat() if isinstance(x, (date, datetime, dtime)) else
-                        float(x) if isinstance(x, int) and not isinstance(x, bool) else x)
+                        ck.number(x, f"{w}.{k}", positive=False)
+                        if isinstance(x, int) and not isinstance(x, bool) else x)
                     for k, x in v.items()}
         wants.append((key, want))
     return lambda vals: all(_matches(vals, key, want) for key, want in wants)

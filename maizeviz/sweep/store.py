@@ -21,14 +21,13 @@ from __future__ import annotations
 
 import csv
 import datetime as dt
-import io
 import json
 import os
 from pathlib import Path
 from typing import Any
 
 import maizeviz
-from maizeviz.io.atomic import atomic_open, atomic_path
+from maizeviz.io.atomic import atomic_open, atomic_path, write_text
 from maizeviz.sweep.errors import SweepStoreError
 
 SCHEMA = 1
@@ -60,13 +59,6 @@ def now_iso() -> str:
     return dt.datetime.now(dt.timezone.utc).astimezone().isoformat(timespec="seconds")
 
 
-def write_atomic(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` atomically (:mod:`maizeviz.io.atomic`): readers see the old
-    file or the new one, never half of it."""
-    with atomic_open(path, "wb") as fh:
-        fh.write(data)
-
-
 def scenario_rows(s, result: dict, worker: str | None, finished_at: str) -> list[dict]:
     """Result rows of a scenario, one per height, every column of :data:`COLUMNS`."""
     ok = result.get("status") == "ok"
@@ -90,6 +82,40 @@ def scenario_rows(s, result: dict, worker: str | None, finished_at: str) -> list
             r["transmission"] = float(result["transmission"][i])
         rows.append(r)
     return rows
+
+
+def done_parts(folder, spec) -> dict[str, list[dict]]:
+    """Rows of the spec's scenarios whose part file in ``folder/parts`` is whole, its own and
+    done (status ok or error), by scenario key; missing, damaged or foreign parts are left out
+    (computed again)."""
+    parts = Path(folder) / "parts"
+    out: dict[str, list[dict]] = {}
+    if not parts.is_dir():
+        return out
+    for s in spec.scenarios:
+        try:
+            part = json.loads((parts / f"{s.key}.json").read_text())
+        except (OSError, ValueError):
+            continue                            # missing, not ours or damaged
+        if not isinstance(part, dict) or part.get("scenario") != s.key:
+            continue
+        rows = part.get("rows")
+        if isinstance(rows, list) and rows and isinstance(rows[0], dict) \
+                and rows[0].get("status") in DONE:
+            out[s.key] = rows
+    return out
+
+
+def done_keys_on_disk(folder, spec) -> set[str]:
+    """Keys of the scenarios a resumed run in ``folder`` would skip: those of
+    :func:`done_parts` when ``folder/sweep.json`` holds the same sweep (same fingerprint),
+    else none (a run would refuse the folder without ``force``)."""
+    try:
+        same = json.loads((Path(folder) / "sweep.json").read_text()).get(
+            "fingerprint") == spec.fingerprint
+    except (OSError, ValueError, AttributeError):
+        same = False
+    return set(done_parts(folder, spec)) if same else set()
 
 
 class ResultStore:
@@ -158,19 +184,7 @@ class ResultStore:
         return info
 
     def _load_parts(self) -> None:
-        if not self.parts.is_dir():
-            return
-        for s in self.spec.scenarios:
-            p = self.parts / f"{s.key}.json"
-            try:
-                part = json.loads(p.read_text())
-            except FileNotFoundError:
-                continue
-            except (OSError, ValueError):
-                continue                        # not ours or damaged: compute it again
-            rows = part.get("rows")
-            if part.get("scenario") == s.key and rows and rows[0].get("status") in DONE:
-                self.rows[s.key] = rows
+        self.rows.update(done_parts(self.folder, self.spec))
 
     # ---------------------------------------------------------------- recording
     def done_keys(self) -> set[str]:
@@ -181,8 +195,7 @@ class ResultStore:
         """Record one scenario's result: its part file first (atomically), then memory."""
         rows = scenario_rows(s, result, worker, now_iso())
         part = {"scenario": s.key, "index": s.index, "rows": rows}
-        write_atomic(self.parts / f"{s.key}.json",
-                     json.dumps(part, allow_nan=True).encode())
+        write_text(self.parts / f"{s.key}.json", json.dumps(part, allow_nan=True))
         self.rows[s.key] = rows
         return rows
 
@@ -196,7 +209,7 @@ class ResultStore:
     def flush(self) -> None:
         """Rebuild results.parquet and results.csv from the rows on record (atomically)."""
         rows = self.all_rows()
-        write_atomic(self.folder / "results.csv", _csv_bytes(rows))
+        _write_csv(self.folder / "results.csv", rows)
         write_parquet(self.folder / "results.parquet", rows)
 
     def start_run(self, cluster: dict) -> dict:
@@ -215,17 +228,16 @@ class ResultStore:
         return run
 
     def write_info(self) -> None:
-        write_atomic(self.folder / "sweep.json",
-                     json.dumps(self.info, indent=1, default=str).encode())
+        write_text(self.folder / "sweep.json", json.dumps(self.info, indent=1, default=str))
 
 
-def _csv_bytes(rows: list[dict]) -> bytes:
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(COLUMN_NAMES)
-    for r in rows:
-        w.writerow(["" if r.get(c) is None else r[c] for c in COLUMN_NAMES])
-    return buf.getvalue().encode()
+def _write_csv(path: Path, rows: list[dict]) -> None:
+    """All rows as CSV with a header (empty cells for missing values), atomically."""
+    with atomic_open(path, "w", newline="") as fh:
+        w = csv.writer(fh, lineterminator="\n")
+        w.writerow(COLUMN_NAMES)
+        for r in rows:
+            w.writerow(["" if r.get(c) is None else r[c] for c in COLUMN_NAMES])
 
 
 def write_parquet(path: Path, rows: list[dict]) -> None:

@@ -10,10 +10,9 @@ at once ("all suns": within tolerance for every sun the finest level was compute
 from __future__ import annotations
 
 import csv
-import io
-from pathlib import Path
 
-from maizeviz.sweep.store import write_atomic
+from maizeviz.io.atomic import atomic_open
+from maizeviz.sweep.spec import arrangement_label, sun_label
 
 DEFAULT_TOLERANCE = 0.02
 
@@ -24,14 +23,12 @@ SUMMARY_COLUMNS = ("points", "arrangement", "preserve_area", "density", "periodi
 
 
 def _arrangement(r: dict) -> str:
-    if r.get("layout"):
-        return r["layout"]
-    return f"{r['tile']} at {r['row_spacing']:g} x {r['plant_spacing']:g} cm"
+    return arrangement_label(r.get("layout"), r.get("tile"), r.get("row_spacing"),
+                             r.get("plant_spacing"))
 
 
 def _sun(r: dict) -> str:
-    s = f"z {r['sun_zenith_deg']:.2f} az {r['sun_azimuth_deg']:.2f}"
-    return f"{s} ({r['sun_when']})" if r.get("sun_when") else s
+    return sun_label(r["sun_zenith_deg"], r["sun_azimuth_deg"], r.get("sun_when"))
 
 
 def summarize(rows: list[dict], tolerance: float = DEFAULT_TOLERANCE) -> list[dict]:
@@ -111,8 +108,7 @@ def format_summary(summary: list[dict]) -> str:
 
 def write_summary(path, summary: list[dict]) -> None:
     """``summary.csv`` (atomically)."""
-    buf = io.StringIO()
-    w = csv.DictWriter(buf, fieldnames=SUMMARY_COLUMNS, lineterminator="\n")
-    w.writeheader()
-    w.writerows(summary)
-    write_atomic(Path(path), buf.getvalue().encode())
+    with atomic_open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=SUMMARY_COLUMNS, lineterminator="\n")
+        w.writeheader()
+        w.writerows(summary)

@@ -22,7 +22,7 @@ from maizeviz.sweep.command import main as sweep_main  # noqa: E402
 from maizeviz.sweep.errors import SchedulerError, SweepSpecError, SweepStoreError  # noqa: E402
 from maizeviz.sweep.run import dask_client, plan_tasks, run_sweep  # noqa: E402
 from maizeviz.sweep.spec import load_spec  # noqa: E402
-from maizeviz.sweep.store import ResultStore, read_results  # noqa: E402
+from maizeviz.sweep.store import ResultStore, done_keys_on_disk, read_results  # noqa: E402
 from maizeviz.sweep.summary import summarize  # noqa: E402
 
 HEIGHTS = [0, 50, 100, 150, 200, 250]
@@ -251,6 +251,24 @@ def test_ctrl_c_on_the_command_stops_cleanly_and_the_rerun_finishes(blocks, clie
     (SPEC + '[[exclude]]\ncolour = "red"\n', r"unknown key 'exclude\[0\].colour'"),
     (SPEC + 'exclude = [{level = "8"}]\n', r"'light.exclude': exclude belongs at the top"),
     (SPEC.replace("[canopy]", "[canopee]"), r"unknown key 'canopee' \(known: canopy, "),
+    # the canopy's own checks, at load rather than on every worker
+    (SPEC.replace('tile = ["1x1"]', 'tile = ["1x1"]\nrow_spacing = [60, 0.5]'),
+     r"canopy.row_spacing\[1\]: row spacing is 0.5 cm; it must be from 1 to 100000 cm"),
+    (SPEC.replace('tile = ["1x1"]', 'tile = ["1x1"]\nplant_spacing = 2e6'),
+     r"canopy.plant_spacing: plant spacing is 2e\+06 cm; it must be from 1 to 100000 cm"),
+    (SPEC.replace('tile = ["1x1"]', 'tile = ["1000x1000"]'),
+     r"canopy.tile\[0\]: 1000 x 1000 tiles of one plant make 1,000,000 plants; a canopy holds "
+     r"at most 100,000"),
+    (SPEC.replace('tile = ["1x1"]', 'tile = ["1x1"]\nblock = "1x200000"'),
+     r"canopy.block: the block shape must be a whole number from 1 to 100,000"),
+    (SPEC.replace('tile = ["1x1"]', 'tile = ["1x1"]\nrow_spacing = [1' + "0" * 400 + "]"),
+     r"canopy.row_spacing\[0\]: must be a number, got an integer too large"),
+    (SPEC.replace("density = [0.5]", "density = 1" + "0" * 400),
+     r"light.density: must be a number, got an integer too large"),
+    (SPEC + "[[exclude]]\nsun = {zenith = 1" + "0" * 400 + "}\n",
+     r"exclude\[0\].sun.zenith: must be a number, got an integer too large"),
+    (SPEC + "[[exclude]]\nrow_spacing = 0.5\n",
+     r"exclude\[0\].row_spacing: row spacing is 0.5 cm; it must be from 1"),
 ])
 def test_bad_sweep_files_say_one_line_naming_the_key(blocks, tmp_path, text, says):
     (tmp_path / "b0.csv").write_bytes((blocks / "b0.csv").read_bytes())
@@ -262,6 +280,21 @@ def test_bad_sweep_files_say_one_line_naming_the_key(blocks, tmp_path, text, say
 def test_missing_sweep_file(tmp_path):
     with pytest.raises(SweepSpecError, match=r"nope.toml: no such sweep file"):
         load_spec(tmp_path / "nope.toml")
+
+
+def test_a_fifo_as_the_sweep_file_is_refused_at_once_in_one_line(tmp_path):
+    fifo = tmp_path / "sweep.toml"
+    os.mkfifo(fifo)                                  # nobody writes: reading it would wait
+    # in a subprocess first, so that a regression fails on the timeout instead of hanging
+    proc = subprocess.run([sys.executable, "-m", "maizeviz.sweep", str(fifo), "--dry-run"],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 1, proc.stderr
+    assert proc.stderr.strip().splitlines() == [f"error: {fifo}: is a FIFO (named pipe), not a "
+                                                "regular file; a sweep file must be a regular "
+                                                "file"]
+    with pytest.raises(SweepSpecError, match=r"sweep.toml: is a FIFO \(named pipe\), not a "
+                                             r"regular file; a sweep file must be a regular"):
+        load_spec(fifo)
 
 
 def test_too_many_scenarios_need_yes(blocks, tmp_path):
@@ -318,6 +351,28 @@ def test_an_output_folder_of_another_sweep_is_refused_unless_forced(blocks, tmp_
     (other / "thesis.tex").write_text("x")
     with pytest.raises(SweepStoreError, match=r"holds other files \(thesis.tex\)"):
         ResultStore(other, a)
+
+
+def test_the_dry_run_and_the_store_agree_on_what_is_done(blocks, tmp_path, capsys):
+    spec = spec_file(blocks)
+    a = load_spec(spec)
+    out = tmp_path / "r"
+    store = ResultStore(out, a)
+    store.start_run({})
+    first, second, third = a.scenarios[:3]
+    store.add(first, {"status": "error", "error": "bad input"})      # done: not retried
+    store.add(third, {"status": "failed", "error": "worker died"})   # retried
+    # a part under another scenario's name (a copy, a renamed file) is not that scenario's
+    (out / "parts" / f"{second.key}.json").write_bytes(
+        (out / "parts" / f"{first.key}.json").read_bytes())
+    assert done_keys_on_disk(out, a) == {first.key} == ResultStore(out, a).done_keys()
+    assert sweep_main([str(spec), "--dry-run", "--out", str(out)]) == 0
+    listing = capsys.readouterr().out
+    assert f"12 scenarios (0 excluded, 1 already in {out})" in listing
+    assert [ln.split()[1] for ln in listing.splitlines() if ln.rstrip().endswith(" done")] \
+        == [first.key[:12]]
+    b = load_spec(spec_file(blocks, SPEC.replace("density = [0.5]", "density = [1]"), "b.toml"))
+    assert done_keys_on_disk(out, b) == set()       # another sweep's folder: nothing skipped
 
 
 def test_tasks_are_groups_split_only_when_workers_would_idle(blocks):
