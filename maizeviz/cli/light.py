@@ -34,16 +34,10 @@ from maizeviz.cli.common import (
 )
 from maizeviz.cost import heatmap_cost, light_cost
 from maizeviz.errors import MaizevizError
-from maizeviz.io.atomic import refuse_overwriting_inputs, write_rows
+from maizeviz.io.atomic import file_tag, make_folder, refuse_overwriting_inputs, write_rows
 from maizeviz.light.beer_lambert import beer_lambert, beer_lambert_sky, clumping
 from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
-from maizeviz.light.heatmap import (
-    TransmissionMap,
-    heatmap_figure,
-    save_figure,
-    write_heatmaps,
-    write_map_csv,
-)
+from maizeviz.light.heatmap import save_figure, write_heatmaps
 from maizeviz.light.irradiance import (
     DEFAULT_LINKE_TURBIDITY,
     DEFAULT_PAR_UMOL_PER_J,
@@ -414,50 +408,18 @@ def _jsonable(obj: Any) -> Any:
 
 
 # ------------------------------------------------------------------------------ files
-def _folder(path: str) -> Path:
-    folder = Path(path)
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise MaizevizError(f"{folder}: cannot create the folder ({exc.strerror})") from None
-    return folder
-
-
-def _tag(text: str) -> str:
-    return "".join(c if c.isalnum() else "_" for c in text).strip("_") or "level"
-
-
-def _write_maps(folder: Path, prefix: str, label: str, maps: list[TransmissionMap],
-                what: str, title: str) -> int:
-    for tmap in maps:
-        stem = f"{prefix}_{_tag(label)}_h{tmap.height_cm:g}cm".replace(".", "p")
-        save_figure(heatmap_figure(tmap, title=title, what=what), folder / f"{stem}.png")
-        write_map_csv(folder / f"{stem}.csv", tmap)
-    return len(maps)
-
-
 def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_levels: int,
                    res: LightResult | None, sky: SkyLight | None, pl: PeriodLight | None,
                    tables: list[list[dict]]) -> None:
     if args.heatmaps:
-        folder = _folder(args.heatmaps)
+        folder = make_folder(args.heatmaps)
         n = 0
         if res is not None:
             n += len(write_heatmaps(folder, res, args.heatmap_bin)) // 2
         if sky is not None:
-            n += _write_maps(folder, "diffuse", label,
-                             [sky.transmission_map(float(h)) for h in sky.heights_cm],
-                             "diffuse transmission",
-                             f"{SKY_KINDS[sky.sky.kind].split(',')[0]}, {sky.sky.split} split of "
-                             f"{sky.sky.n} directions; level {label}; {sky.rays:,} sensors per "
-                             "direction")
+            n += len(write_heatmaps(folder, sky, kind="sky")) // 2
         if pl is not None and pl.n_steps:
-            p = pl.period
-            n += _write_maps(folder, "period", label,
-                             [pl.transmission_map(float(h)) for h in pl.heights_cm],
-                             "fraction of the period's PAR",
-                             f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M}, "
-                             f"{p.n_steps} steps; level {label}")
+            n += len(write_heatmaps(folder, pl, kind="period")) // 2
         say(f"wrote {n} transmission maps (PNG + CSV) to {folder}")
     if pl is not None and args.steps:
         path = args.steps if n_levels == 1 else suffixed(args.steps, label)
@@ -465,11 +427,11 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
     if pl is not None and args.plots:
         from maizeviz.light.plots import day_figure
 
-        folder = _folder(args.plots)
+        folder = make_folder(args.plots)
         p = pl.period
         title = (f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M} ({p.start.tz}); "
                  f"{p.source}; level {label}")
-        path = folder / f"day_{_tag(label)}.png"
+        path = folder / f"day_{file_tag(label) or 'level'}.png"
         save_figure(day_figure(pl, title), path)
         say(f"wrote {path}")
     if tables:
