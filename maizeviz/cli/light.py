@@ -12,7 +12,6 @@ import json
 import math
 import os
 import time
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -35,7 +34,7 @@ from maizeviz.cli.common import (
 from maizeviz.cost import heatmap_cost, light_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import file_tag, make_folder, refuse_overwriting_inputs, write_rows
-from maizeviz.light.beer_lambert import beer_lambert, beer_lambert_sky, clumping
+from maizeviz.light.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping
 from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
 from maizeviz.light.heatmap import save_figure, write_heatmaps
 from maizeviz.light.irradiance import (
@@ -307,7 +306,7 @@ def run(args: argparse.Namespace) -> int:
         if per_res is not None:
             rec["period"] = _period_record(per_res, args)
             if want_rows:
-                tables.append(_period_rows(canopy, per_res))
+                tables.append(period_leaf_rows(canopy, per_res))
         for w in warnings:
             if w not in said:
                 said.add(w)
@@ -338,9 +337,7 @@ def _sun_record(res: LightResult, sun: Sun, canopy: Canopy, args: argparse.Names
         "transmission": [float(t) for t in res.transmission], "rays": res.rays,
         "density_per_cm2": res.density_per_cm2, "rect_cm": list(res.rect)}
     if args.check:
-        bl = beer_lambert(canopy, sun, heights)
-        rec["beer_lambert"] = {"G": bl.G, "lai_above": [float(v) for v in bl.lai_above],
-                               "transmission": [float(v) for v in bl.transmission]}
+        rec["beer_lambert"] = _beer_lambert_record(beer_lambert(canopy, sun, heights))
     if res.sunlit_intercepted_fraction is not None:
         rec["sunlit_intercepted_fraction"] = res.sunlit_intercepted_fraction
     return rec
@@ -359,10 +356,13 @@ def _sky_record(sky: SkyLight, canopy: Canopy, args: argparse.Namespace,
         "zenith_deg": [float(z) for z in sky.sky.zenith_deg],
         "azimuth_deg": [float(a) for a in sky.sky.azimuth_deg]}
     if args.check:
-        bl = beer_lambert_sky(canopy, sky.sky, heights)
-        rec["beer_lambert"] = {"G": bl.G, "lai_above": [float(v) for v in bl.lai_above],
-                               "transmission": [float(v) for v in bl.transmission]}
+        rec["beer_lambert"] = _beer_lambert_record(beer_lambert_sky(canopy, sky.sky, heights))
     return rec
+
+
+def _beer_lambert_record(bl: BeerLambert) -> dict[str, Any]:
+    return {"G": bl.G, "lai_above": [float(v) for v in bl.lai_above],
+            "transmission": [float(v) for v in bl.transmission]}
 
 
 def _period_record(pl: PeriodLight, args: argparse.Namespace) -> dict[str, Any]:
@@ -389,10 +389,6 @@ def _period_record(pl: PeriodLight, args: argparse.Namespace) -> dict[str, Any]:
     else:
         rec["clear_sky_model"] = dict(p.parameters)
     return rec
-
-
-def _period_rows(canopy: Canopy, pl: PeriodLight) -> list[dict]:
-    return period_leaf_rows(canopy, pl)
 
 
 def _jsonable(obj: Any) -> Any:
@@ -423,7 +419,7 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
         say(f"wrote {n} transmission maps (PNG + CSV) to {folder}")
     if pl is not None and args.steps:
         path = args.steps if n_levels == 1 else suffixed(args.steps, label)
-        _write_steps(path, pl)
+        write_steps(path, pl)
     if pl is not None and args.plots:
         from maizeviz.light.plots import day_figure
 
@@ -443,11 +439,6 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
         if args.plant_light:
             write_rows(args.plant_light if n_levels == 1 else suffixed(args.plant_light, label),
                        plant_light(rows))
-
-
-def _write_steps(path: str | Path, pl: PeriodLight) -> None:
-    """One line per time step (sun up), atomically."""
-    write_steps(path, pl)
 
 
 # ------------------------------------------------------------------------------ tables
@@ -496,16 +487,8 @@ def _print_sun(records: list[dict], sun: Sun, heights: tuple[float, ...],
     print(f"direct light: {r0['rays']:,} sensors per plane over x0,y0,x1,y1 = {rc} cm "
           f"({r0['density_per_cm2']:.2f} per cm2), sun zenith {sun.zenith_deg:.2f} deg, "
           f"azimuth {sun.azimuth_deg:.2f} deg{', periodic field' if args.periodic else ''}")
-    head = ["height cm"] + [r["level"] for r in records]
-    if args.check:
-        head += ["Beer-Lambert"]
-    rows = []
-    for i, h in enumerate(heights):
-        row = [f"{h:g}"] + [f"{r['transmission'][i]:.3f}" for r in records]
-        if args.check:
-            row.append(f"{r0['beer_lambert']['transmission'][i]:.3f}")
-        rows.append(row)
-    print(fmt_table(head, rows))
+    _print_heights(heights, [(r["level"], r["transmission"]) for r in records],
+                   r0["beer_lambert"] if args.check else None)
     if args.check:
         bl = r0["beer_lambert"]
         omega = clumping(r0["transmission"][0], bl["transmission"][0])
@@ -523,16 +506,9 @@ def _print_sky(records: list[dict], heights: tuple[float, ...],
     print(f"diffuse light: {d0['description']}; {d0['rays_per_direction']:,} sensors per plane "
           f"and direction over x0,y0,x1,y1 = {rc} cm"
           f"{', periodic field' if args.periodic else ''}")
-    head = ["height cm"] + [f"{r['level']} diffuse T" for r in records]
-    if args.check:
-        head += ["Beer-Lambert"]
-    rows = []
-    for i, h in enumerate(heights):
-        row = [f"{h:g}"] + [f"{r['diffuse']['transmission'][i]:.3f}" for r in records]
-        if args.check:
-            row.append(f"{d0['beer_lambert']['transmission'][i]:.3f}")
-        rows.append(row)
-    print(fmt_table(head, rows))
+    _print_heights(heights, [(f"{r['level']} diffuse T", r["diffuse"]["transmission"])
+                             for r in records],
+                   d0["beer_lambert"] if args.check else None)
     print("leaves intercept " + ", ".join(
         f"{r['diffuse']['intercepted_fraction']:.3f}" + (f" ({r['level']})" if len(records) > 1
                                                          else "")
@@ -542,6 +518,21 @@ def _print_sky(records: list[dict], heights: tuple[float, ...],
         print(f"Beer-Lambert under the same sky: sum of w_i exp(-G_i L(h)/cos theta_i), G_i "
               f"from the {records[0]['level']} mesh (weighted mean {bl['G']:.3f})")
     print()
+
+
+def _print_heights(heights: tuple[float, ...], columns: list[tuple[str, list[float]]],
+                   bl: dict | None) -> None:
+    """Transmission by height: a column per (name, transmission) and, when ``bl`` (a Beer-Lambert
+    record) is given, Beer-Lambert's."""
+    head = ["height cm"] + [name for name, _ in columns]
+    head += ["Beer-Lambert"] if bl is not None else []
+    rows = []
+    for i, h in enumerate(heights):
+        row = [f"{h:g}"] + [f"{t[i]:.3f}" for _, t in columns]
+        if bl is not None:
+            row.append(f"{bl['transmission'][i]:.3f}")
+        rows.append(row)
+    print(fmt_table(head, rows))
 
 
 def _print_period(r: dict, label: bool) -> None:
