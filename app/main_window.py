@@ -1164,16 +1164,10 @@ class MainWindow(QMainWindow):
             result = run.result
 
             def work(job):
-                from maizeviz.light.heatmap import heatmap_figure, save_figure, transmission_map
-                from maizeviz_app.plots import heatmap_title
+                from maizeviz.light.heatmap import save_figure
+                from maizeviz_app.plots import heatmap_figure_of
 
-                if kind == "sun":
-                    fig = heatmap_figure(transmission_map(result, height, 5.0), result)
-                else:
-                    what_, title = heatmap_title(result, kind)
-                    fig = heatmap_figure(result.transmission_map(height), title=title,
-                                         what=what_)
-                save_figure(fig, path)
+                save_figure(heatmap_figure_of(result, height, kind), path)
                 return path
             return work, ()
         if what == "plot":

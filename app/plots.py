@@ -1,6 +1,6 @@
 """Light figures drawn off the GUI thread (matplotlib's Agg canvas; no Qt here).
 
-The heatmaps are the core's own figures (:func:`maizeviz.light.heatmap.heatmap_figure`, the
+The heatmaps are the core's own figures (:func:`maizeviz.light.heatmap.result_figure`, the
 same as ``maizeviz light --heatmaps``) for a sun, a sky or a day; the transmission-vs-height
 plot compares the mesh levels and lights traced with the same sampling (the paper's Table 3 as
 a plot, with the diffuse sky and the day's PAR beside it). Figures are drawn to RGBA arrays in
@@ -87,33 +87,21 @@ def rgba(fig) -> np.ndarray:
     return np.asarray(canvas.buffer_rgba()).copy()
 
 
-def heatmap_title(result, kind: str) -> tuple[str, str]:
-    """(what is mapped, the second title line) for a sky's or a day's maps."""
-    if kind == "sky":
-        from maizeviz.light.sky import SKY_KINDS
+def heatmap_figure_of(result, height: float, kind: str = "sun", width_in: float = 8.0,
+                      dpi: int = 110, bin_cm: float = HEATMAP_BIN_CM):
+    """The core's heatmap figure of one height of a light result (a sun's ``LightResult``, a
+    ``SkyLight`` or a ``PeriodLight``; ``kind`` sun, sky or day), a sun's in ``bin_cm`` bins
+    (:func:`maizeviz.light.heatmap.result_figure`, titled as ``maizeviz light --heatmaps``)."""
+    from maizeviz.light.heatmap import result_figure
 
-        sky = result.sky
-        return ("diffuse transmission",
-                f"{SKY_KINDS[sky.kind].split(',')[0]}, {sky.split} split of {sky.n} "
-                f"directions; level {result.level}; {result.rays:,} sensors per direction")
-    p = result.period
-    return ("fraction of the period's PAR",
-            f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M}, {p.n_steps} steps; "
-            f"level {result.level}")
+    return result_figure(result, float(height), kind, bin_cm, width_in=width_in, dpi=dpi)
 
 
 def heatmap_image(result, height: float, bin_cm: float = HEATMAP_BIN_CM, width_in: float = 8.0,
                   dpi: int = 64, kind: str = "sun") -> np.ndarray:
-    """The core's heatmap of one height of a light result (a sun's ``LightResult``, a
-    ``SkyLight`` or a ``PeriodLight``), drawn (RGBA)."""
-    from maizeviz.light.heatmap import heatmap_figure, transmission_map
-
-    if kind == "sun":
-        tmap = transmission_map(result, float(height), bin_cm)
-        return rgba(heatmap_figure(tmap, result, width_in=width_in, dpi=dpi))
-    what, title = heatmap_title(result, kind)
-    return rgba(heatmap_figure(result.transmission_map(float(height)), width_in=width_in,
-                               dpi=dpi, title=title, what=what))
+    """The core's heatmap of one height of a light result (:func:`heatmap_figure_of`),
+    drawn (RGBA)."""
+    return rgba(heatmap_figure_of(result, height, kind, width_in, dpi, bin_cm))
 
 
 def heatmap_images(result, first: int = 0, all_heights: bool = False, check=None,

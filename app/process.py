@@ -81,7 +81,7 @@ def serve(conn) -> None:
             return
         if msg[0] == "canopy":
             state.clear()
-            state["key"], state["canopy"] = msg[1], msg[2]
+            state["canopy"] = msg[1]
             continue
         _, op, args = msg
 
@@ -187,7 +187,7 @@ class CoreProcess:
             self._ensure()
             try:
                 if self._key != key:
-                    send(self._conn, ("canopy", key, canopy))
+                    send(self._conn, ("canopy", canopy))
                     self._key = key
                 send(self._conn, ("call", op, args))
                 return self._wait(op, ticket)

@@ -676,10 +676,6 @@ class LightPanel(QWidget):
         return (tuple(float(h) for h in heights), self.density.value(),
                 self.periodic.isChecked())
 
-    def settings_key(self, request) -> tuple:
-        return (round(request.sun.zenith_deg, 6), round(request.sun.azimuth_deg, 6),
-                tuple(request.heights_cm), request.density, request.periodic)
-
     # ------------------------------------------------------------------ problems
     def point_at(self, quantity: str | None, message: str, mode: str | None = None) -> bool:
         """Mark the field(s) a problem is about (red frame, tooltip, focus), among the shared

@@ -10,7 +10,7 @@ from pathlib import Path
 from maizeviz.canopy.layout import CanopyLayout, check_tile, layout_for, parse_shape
 from maizeviz.cost import Cost, check, layout_cost
 from maizeviz.errors import LeafError, MaizevizError
-from maizeviz.io.atomic import check_output
+from maizeviz.io.atomic import check_output, file_tag
 from maizeviz.io.meshfile import check_mesh_path
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.mesh.levels import Level, parse_levels
@@ -187,8 +187,7 @@ def floats(text: str, what: str, quantity: str, count: int | None = None) -> lis
 def suffixed(path: str | Path, label: str) -> Path:
     """``light.csv`` + ``"K=4"`` -> ``light_K_4.csv`` (one file per level)."""
     p = Path(path)
-    tag = "".join(c if c.isalnum() else "_" for c in label).strip("_")
-    return p.with_name(f"{p.stem}_{tag}{p.suffix}")
+    return p.with_name(f"{p.stem}_{file_tag(label)}{p.suffix}")
 
 
 def leaves_summary(done: int, skipped: list[LeafError]) -> int:

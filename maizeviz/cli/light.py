@@ -12,7 +12,6 @@ import json
 import math
 import os
 import time
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -34,16 +33,10 @@ from maizeviz.cli.common import (
 )
 from maizeviz.cost import heatmap_cost, light_cost
 from maizeviz.errors import MaizevizError
-from maizeviz.io.atomic import refuse_overwriting_inputs, write_rows
-from maizeviz.light.beer_lambert import beer_lambert, beer_lambert_sky, clumping
+from maizeviz.io.atomic import file_tag, make_folder, refuse_overwriting_inputs, write_rows
+from maizeviz.light.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping
 from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
-from maizeviz.light.heatmap import (
-    TransmissionMap,
-    heatmap_figure,
-    save_figure,
-    write_heatmaps,
-    write_map_csv,
-)
+from maizeviz.light.heatmap import save_figure, write_heatmaps
 from maizeviz.light.irradiance import (
     DEFAULT_LINKE_TURBIDITY,
     DEFAULT_PAR_UMOL_PER_J,
@@ -313,7 +306,7 @@ def run(args: argparse.Namespace) -> int:
         if per_res is not None:
             rec["period"] = _period_record(per_res, args)
             if want_rows:
-                tables.append(_period_rows(canopy, per_res))
+                tables.append(period_leaf_rows(canopy, per_res))
         for w in warnings:
             if w not in said:
                 said.add(w)
@@ -344,9 +337,7 @@ def _sun_record(res: LightResult, sun: Sun, canopy: Canopy, args: argparse.Names
         "transmission": [float(t) for t in res.transmission], "rays": res.rays,
         "density_per_cm2": res.density_per_cm2, "rect_cm": list(res.rect)}
     if args.check:
-        bl = beer_lambert(canopy, sun, heights)
-        rec["beer_lambert"] = {"G": bl.G, "lai_above": [float(v) for v in bl.lai_above],
-                               "transmission": [float(v) for v in bl.transmission]}
+        rec["beer_lambert"] = _beer_lambert_record(beer_lambert(canopy, sun, heights))
     if res.sunlit_intercepted_fraction is not None:
         rec["sunlit_intercepted_fraction"] = res.sunlit_intercepted_fraction
     return rec
@@ -365,10 +356,13 @@ def _sky_record(sky: SkyLight, canopy: Canopy, args: argparse.Namespace,
         "zenith_deg": [float(z) for z in sky.sky.zenith_deg],
         "azimuth_deg": [float(a) for a in sky.sky.azimuth_deg]}
     if args.check:
-        bl = beer_lambert_sky(canopy, sky.sky, heights)
-        rec["beer_lambert"] = {"G": bl.G, "lai_above": [float(v) for v in bl.lai_above],
-                               "transmission": [float(v) for v in bl.transmission]}
+        rec["beer_lambert"] = _beer_lambert_record(beer_lambert_sky(canopy, sky.sky, heights))
     return rec
+
+
+def _beer_lambert_record(bl: BeerLambert) -> dict[str, Any]:
+    return {"G": bl.G, "lai_above": [float(v) for v in bl.lai_above],
+            "transmission": [float(v) for v in bl.transmission]}
 
 
 def _period_record(pl: PeriodLight, args: argparse.Namespace) -> dict[str, Any]:
@@ -397,10 +391,6 @@ def _period_record(pl: PeriodLight, args: argparse.Namespace) -> dict[str, Any]:
     return rec
 
 
-def _period_rows(canopy: Canopy, pl: PeriodLight) -> list[dict]:
-    return period_leaf_rows(canopy, pl)
-
-
 def _jsonable(obj: Any) -> Any:
     if isinstance(obj, dict):
         return {k: _jsonable(v) for k, v in obj.items()}
@@ -414,62 +404,30 @@ def _jsonable(obj: Any) -> Any:
 
 
 # ------------------------------------------------------------------------------ files
-def _folder(path: str) -> Path:
-    folder = Path(path)
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise MaizevizError(f"{folder}: cannot create the folder ({exc.strerror})") from None
-    return folder
-
-
-def _tag(text: str) -> str:
-    return "".join(c if c.isalnum() else "_" for c in text).strip("_") or "level"
-
-
-def _write_maps(folder: Path, prefix: str, label: str, maps: list[TransmissionMap],
-                what: str, title: str) -> int:
-    for tmap in maps:
-        stem = f"{prefix}_{_tag(label)}_h{tmap.height_cm:g}cm".replace(".", "p")
-        save_figure(heatmap_figure(tmap, title=title, what=what), folder / f"{stem}.png")
-        write_map_csv(folder / f"{stem}.csv", tmap)
-    return len(maps)
-
-
 def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_levels: int,
                    res: LightResult | None, sky: SkyLight | None, pl: PeriodLight | None,
                    tables: list[list[dict]]) -> None:
     if args.heatmaps:
-        folder = _folder(args.heatmaps)
+        folder = make_folder(args.heatmaps)
         n = 0
         if res is not None:
             n += len(write_heatmaps(folder, res, args.heatmap_bin)) // 2
         if sky is not None:
-            n += _write_maps(folder, "diffuse", label,
-                             [sky.transmission_map(float(h)) for h in sky.heights_cm],
-                             "diffuse transmission",
-                             f"{SKY_KINDS[sky.sky.kind].split(',')[0]}, {sky.sky.split} split of "
-                             f"{sky.sky.n} directions; level {label}; {sky.rays:,} sensors per "
-                             "direction")
+            n += len(write_heatmaps(folder, sky, kind="sky")) // 2
         if pl is not None and pl.n_steps:
-            p = pl.period
-            n += _write_maps(folder, "period", label,
-                             [pl.transmission_map(float(h)) for h in pl.heights_cm],
-                             "fraction of the period's PAR",
-                             f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M}, "
-                             f"{p.n_steps} steps; level {label}")
+            n += len(write_heatmaps(folder, pl, kind="period")) // 2
         say(f"wrote {n} transmission maps (PNG + CSV) to {folder}")
     if pl is not None and args.steps:
         path = args.steps if n_levels == 1 else suffixed(args.steps, label)
-        _write_steps(path, pl)
+        write_steps(path, pl)
     if pl is not None and args.plots:
         from maizeviz.light.plots import day_figure
 
-        folder = _folder(args.plots)
+        folder = make_folder(args.plots)
         p = pl.period
         title = (f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M} ({p.start.tz}); "
                  f"{p.source}; level {label}")
-        path = folder / f"day_{_tag(label)}.png"
+        path = folder / f"day_{file_tag(label) or 'level'}.png"
         save_figure(day_figure(pl, title), path)
         say(f"wrote {path}")
     if tables:
@@ -481,11 +439,6 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
         if args.plant_light:
             write_rows(args.plant_light if n_levels == 1 else suffixed(args.plant_light, label),
                        plant_light(rows))
-
-
-def _write_steps(path: str | Path, pl: PeriodLight) -> None:
-    """One line per time step (sun up), atomically."""
-    write_steps(path, pl)
 
 
 # ------------------------------------------------------------------------------ tables
@@ -534,16 +487,8 @@ def _print_sun(records: list[dict], sun: Sun, heights: tuple[float, ...],
     print(f"direct light: {r0['rays']:,} sensors per plane over x0,y0,x1,y1 = {rc} cm "
           f"({r0['density_per_cm2']:.2f} per cm2), sun zenith {sun.zenith_deg:.2f} deg, "
           f"azimuth {sun.azimuth_deg:.2f} deg{', periodic field' if args.periodic else ''}")
-    head = ["height cm"] + [r["level"] for r in records]
-    if args.check:
-        head += ["Beer-Lambert"]
-    rows = []
-    for i, h in enumerate(heights):
-        row = [f"{h:g}"] + [f"{r['transmission'][i]:.3f}" for r in records]
-        if args.check:
-            row.append(f"{r0['beer_lambert']['transmission'][i]:.3f}")
-        rows.append(row)
-    print(fmt_table(head, rows))
+    _print_heights(heights, [(r["level"], r["transmission"]) for r in records],
+                   r0["beer_lambert"] if args.check else None)
     if args.check:
         bl = r0["beer_lambert"]
         omega = clumping(r0["transmission"][0], bl["transmission"][0])
@@ -561,16 +506,9 @@ def _print_sky(records: list[dict], heights: tuple[float, ...],
     print(f"diffuse light: {d0['description']}; {d0['rays_per_direction']:,} sensors per plane "
           f"and direction over x0,y0,x1,y1 = {rc} cm"
           f"{', periodic field' if args.periodic else ''}")
-    head = ["height cm"] + [f"{r['level']} diffuse T" for r in records]
-    if args.check:
-        head += ["Beer-Lambert"]
-    rows = []
-    for i, h in enumerate(heights):
-        row = [f"{h:g}"] + [f"{r['diffuse']['transmission'][i]:.3f}" for r in records]
-        if args.check:
-            row.append(f"{d0['beer_lambert']['transmission'][i]:.3f}")
-        rows.append(row)
-    print(fmt_table(head, rows))
+    _print_heights(heights, [(f"{r['level']} diffuse T", r["diffuse"]["transmission"])
+                             for r in records],
+                   d0["beer_lambert"] if args.check else None)
     print("leaves intercept " + ", ".join(
         f"{r['diffuse']['intercepted_fraction']:.3f}" + (f" ({r['level']})" if len(records) > 1
                                                          else "")
@@ -580,6 +518,21 @@ def _print_sky(records: list[dict], heights: tuple[float, ...],
         print(f"Beer-Lambert under the same sky: sum of w_i exp(-G_i L(h)/cos theta_i), G_i "
               f"from the {records[0]['level']} mesh (weighted mean {bl['G']:.3f})")
     print()
+
+
+def _print_heights(heights: tuple[float, ...], columns: list[tuple[str, list[float]]],
+                   bl: dict | None) -> None:
+    """Transmission by height: a column per (name, transmission) and, when ``bl`` (a Beer-Lambert
+    record) is given, Beer-Lambert's."""
+    head = ["height cm"] + [name for name, _ in columns]
+    head += ["Beer-Lambert"] if bl is not None else []
+    rows = []
+    for i, h in enumerate(heights):
+        row = [f"{h:g}"] + [f"{t[i]:.3f}" for _, t in columns]
+        if bl is not None:
+            row.append(f"{bl['transmission'][i]:.3f}")
+        rows.append(row)
+    print(fmt_table(head, rows))
 
 
 def _print_period(r: dict, label: bool) -> None:

@@ -44,6 +44,22 @@ def cannot_write(path: str | Path, exc: OSError) -> MaizevizError:
                          "there")
 
 
+def file_tag(text: str) -> str:
+    """``"K=4"`` -> ``"K_4"``: a label made fit for a file name (other than letters and digits,
+    characters become ``_``; leading and trailing ones are dropped)."""
+    return "".join(c if c.isalnum() else "_" for c in text).strip("_")
+
+
+def make_folder(path: str | Path) -> Path:
+    """The output folder ``path``, created (with its parents) if needed."""
+    folder = Path(path)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise MaizevizError(f"{folder}: cannot create the folder ({exc.strerror})") from None
+    return folder
+
+
 def check_output(path: str | Path) -> Path:
     """Refuse, before any work, an output whose folder is missing or that is a folder."""
     path = Path(path)

@@ -7,16 +7,25 @@ from __future__ import annotations
 import csv
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeAlias, cast
 
 import numpy as np
 
 from maizeviz.errors import MaizevizError
-from maizeviz.io.atomic import atomic_open, atomic_path
+from maizeviz.io.atomic import atomic_open, atomic_path, file_tag, make_folder
+from maizeviz.light.sky import SKY_KINDS
 from maizeviz.light.transmission import LightResult
 
 if TYPE_CHECKING:                                   # matplotlib is imported when drawing
     from matplotlib.figure import Figure
+
+    from maizeviz.light.daylight import PeriodLight, SkyLight
+
+    AnyLight: TypeAlias = LightResult | SkyLight | PeriodLight
+
+#: The kinds of light results mapped (the app calls a period a ``day``), and the file-name
+#: prefix of each kind's maps.
+MAP_PREFIXES = {"sun": "transmission", "sky": "diffuse", "period": "period", "day": "period"}
 
 
 @dataclass(frozen=True)
@@ -102,11 +111,8 @@ def heatmap_figure(tmap: TransmissionMap, result: LightResult | None = None,
     ax.set_aspect("equal")
     ax.set_xlabel("x (cm, across rows)")
     ax.set_ylabel("y (cm, along rows)")
-    bin_cm = (xe[-1] - xe[0]) / max(len(xe) - 1, 1)
     if title is None and result is not None:
-        title = (f"sun zenith {result.sun.zenith_deg:.1f} deg, azimuth "
-                 f"{result.sun.azimuth_deg:.1f} deg; level {result.level}; "
-                 f"{result.rays:,} sensors, {bin_cm:.3g} cm bins")
+        title = map_title(result, "sun", (xe[-1] - xe[0]) / max(len(xe) - 1, 1))[1]
     import textwrap
 
     ax.set_title(f"{what} at {tmap.height_cm:g} cm: {tmap.total:.3f}"
@@ -138,35 +144,82 @@ def save_figure(fig: Figure, path: str | Path) -> None:
         fig.savefig(tmp, format=Path(path).suffix.lstrip(".") or "png")
 
 
-def _tag(text: str) -> str:
-    return "".join(c if c.isalnum() else "_" for c in text).strip("_")
+def map_title(result: AnyLight, kind: str, bin_cm: float = 5.0) -> tuple[str, str]:
+    """(what is mapped, the second title line) of the maps of a sun's ``LightResult``
+    (``kind`` sun; ``bin_cm``, the bin named in the title), a ``SkyLight`` (sky) or a
+    ``PeriodLight`` (period, or day)."""
+    _check_kind(kind)
+    if kind == "sun":
+        sun_res = cast(LightResult, result)
+        sun = sun_res.sun
+        return ("direct-light transmission",
+                f"sun zenith {sun.zenith_deg:.1f} deg, azimuth {sun.azimuth_deg:.1f} deg; "
+                f"level {result.level}; {sun_res.rays:,} sensors, {bin_cm:.3g} cm bins")
+    if kind == "sky":
+        sky_res = cast("SkyLight", result)
+        sky = sky_res.sky
+        return ("diffuse transmission",
+                f"{SKY_KINDS[sky.kind].split(',')[0]}, {sky.split} split of {sky.n} "
+                f"directions; level {result.level}; {sky_res.rays:,} sensors per direction")
+    p = cast("PeriodLight", result).period
+    return ("fraction of the period's PAR",
+            f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M}, {p.n_steps} steps; "
+            f"level {result.level}")
 
 
-def heatmap_stems(result: LightResult) -> list[str]:
-    """Distinct file stems, one per height: ``transmission_<level>_h<height>cm``."""
-    level = _tag(result.level) or "level"
+def _check_kind(kind: str) -> None:
+    if kind not in MAP_PREFIXES:
+        raise ValueError(f"unknown kind of light result {kind!r} (one of "
+                         f"{', '.join(MAP_PREFIXES)})")
+
+
+def result_map(result: AnyLight, height: float, kind: str = "sun",
+               bin_cm: float = 5.0) -> TransmissionMap:
+    """The map of one traced height of a light result: a sun's binned in ``bin_cm`` bins, a
+    sky's or a period's as binned when traced."""
+    _check_kind(kind)
+    if kind == "sun":
+        return transmission_map(cast(LightResult, result), float(height), bin_cm)
+    return cast("SkyLight | PeriodLight", result).transmission_map(float(height))
+
+
+def result_figure(result: AnyLight, height: float, kind: str = "sun", bin_cm: float = 5.0,
+                  width_in: float = 8.0, dpi: int = 110,
+                  tmap: TransmissionMap | None = None) -> Figure:
+    """The figure of one height of a light result (:func:`result_map`, or ``tmap`` when
+    already made), titled by :func:`map_title`."""
+    tmap = result_map(result, height, kind, bin_cm) if tmap is None else tmap
+    if kind == "sun":
+        return heatmap_figure(tmap, cast(LightResult, result), width_in=width_in, dpi=dpi)
+    what, title = map_title(result, kind)
+    return heatmap_figure(tmap, width_in=width_in, dpi=dpi, title=title, what=what)
+
+
+def heatmap_stems(result: AnyLight, kind: str = "sun") -> list[str]:
+    """Distinct file stems, one per height: ``transmission_<level>_h<height>cm`` (a sun's
+    maps), ``diffuse_...`` (a sky's) or ``period_...`` (a period's)."""
+    _check_kind(kind)
+    level = file_tag(result.level) or "level"
     stems: list[str] = []
     for h in result.heights_cm:
-        stem = f"transmission_{level}_h{h:g}cm".replace(".", "p")
+        stem = f"{MAP_PREFIXES[kind]}_{level}_h{h:g}cm".replace(".", "p")
         while stem in stems:                         # heights equal to %g precision
             stem += "_"
         stems.append(stem)
     return stems
 
 
-def write_heatmaps(folder: str | Path, result: LightResult, bin_cm: float = 5.0) -> list[Path]:
-    """One PNG and one CSV per height in ``folder`` (created if needed); returns the paths
-    written, PNG and CSV alternating."""
-    folder = Path(folder)
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise MaizevizError(f"{folder}: cannot create the folder ({exc.strerror})") from None
+def write_heatmaps(folder: str | Path, result: AnyLight, bin_cm: float = 5.0,
+                   kind: str = "sun") -> list[Path]:
+    """One PNG and one CSV per height of a light result (``kind`` as for :func:`map_title`)
+    in ``folder`` (created if needed); returns the paths written, PNG and CSV alternating."""
+    _check_kind(kind)
+    folder = make_folder(folder)
     written = []
-    for h, stem in zip(result.heights_cm, heatmap_stems(result)):
-        tmap = transmission_map(result, float(h), bin_cm)
+    for h, stem in zip(result.heights_cm, heatmap_stems(result, kind)):
+        tmap = result_map(result, float(h), kind, bin_cm)
         png, csv_path = folder / f"{stem}.png", folder / f"{stem}.csv"
-        save_figure(heatmap_figure(tmap, result), png)
+        save_figure(result_figure(result, float(h), kind, tmap=tmap), png)
         write_map_csv(csv_path, tmap)
         written += [png, csv_path]
     return written

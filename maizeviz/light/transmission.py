@@ -117,11 +117,6 @@ class LightResult:
         """Where each ray meets the ground (N, 2) cm, in ray grid order."""
         return ray_grid(self.rect, self.density)[0]
 
-    def crossings(self, height: float) -> np.ndarray:
-        """Where each ground ray crosses the plane at ``height`` (N, 2) cm (ray grid order): the
-        rectangle shifted toward the sun, where version 0.1 measured transmission."""
-        return self.ground_xy + self.direction[:2] * (height / self.direction[2])
-
     def height_index(self, height: float) -> int:
         """Index of ``height`` (cm) among the traced heights; MaizevizError if not traced."""
         from maizeviz.errors import MaizevizError
