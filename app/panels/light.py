@@ -656,8 +656,8 @@ class LightPanel(QWidget):
                        "equal" if equal else "auto")
 
     def day_spec(self):
-        """The day chosen (:class:`maizeviz_app.jobs.DaySpec`); an empty weather file or a
-        clock time that is not HH:MM is refused here, the rest by the core."""
+        """The day chosen (:class:`maizeviz_app.jobs.DaySpec`); an empty weather file field is
+        refused here, the rest (clock times included) by the core when the period is made."""
         from maizeviz_app.jobs import DaySpec
 
         weather = None
