@@ -169,7 +169,7 @@ class DaySpec:
         import os
 
         from maizeviz.errors import MaizevizError
-        from maizeviz.light.irradiance import parse_clock
+        from maizeviz.light.clock import parse_clock
 
         if self.weather:
             try:
@@ -177,8 +177,8 @@ class DaySpec:
             except OSError:
                 return 1                                 # refused later, naming the file
         try:
-            span = parse_clock(self.end or "24:00", "end") - parse_clock(self.start or "00:00",
-                                                                         "start")
+            span = (parse_clock(self.end or "24:00", "end")[0]
+                    - parse_clock(self.start or "00:00", "start")[0])
             minutes = max(span.total_seconds() / 60, 1.0)
         except MaizevizError:
             minutes = 24 * 60.0                          # refused when the period is made

@@ -58,6 +58,9 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.io.inputs import read_input
+from maizeviz.light.clock import check_place as _check_place
+from maizeviz.light.clock import local_time
+from maizeviz.light.clock import zone as _time_zone
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -114,18 +117,6 @@ def _fmt_duration(seconds: float) -> str:
     return f"{seconds:g} s"
 
 
-def _check_place(lat, lon) -> tuple[float, float]:
-    try:
-        lat, lon = float(lat), float(lon)
-    except (TypeError, ValueError):
-        raise MaizevizError(f"latitude and longitude must be numbers, got {lat!r}, {lon!r}",
-                            quantity="place") from None
-    if not (-90 <= lat <= 90) or not (-180 <= lon <= 360):
-        raise MaizevizError(f"latitude must be in [-90, 90] and longitude in [-180, 360], "
-                            f"got {lat}, {lon}", quantity="place")
-    return lat, lon
-
-
 def _check_altitude(altitude) -> float:
     if not isinstance(altitude, (int, float, np.floating, np.integer)) \
             or not math.isfinite(altitude) or not (-500 <= altitude <= 9000):
@@ -142,45 +133,10 @@ def _check_par_factor(par_umol_per_j) -> float:
     return float(par_umol_per_j)
 
 
-def _time_zone(tz: str):
-    import zoneinfo
-
-    try:
-        return zoneinfo.ZoneInfo(str(tz))
-    except (zoneinfo.ZoneInfoNotFoundError, ValueError, TypeError):
-        raise MaizevizError(f"unknown time zone '{tz}' (give an IANA name such as "
-                            f"Asia/Shanghai, or UTC)", quantity="tz") from None
-
-
-def parse_clock(clock: str, what: str) -> _dt.timedelta:
-    """A local clock time "HH:MM[:SS]" (or "24:00", the end of the day) as the time since
-    midnight; ``what`` ("start", "end") names it in the message. A time carrying a UTC offset
-    is refused: the period's time zone says where the clock is."""
-    text = str(clock).strip()
-    if text in ("24:00", "24:00:00"):
-        return _dt.timedelta(days=1)
-    try:
-        t: _dt.time | None = _dt.time.fromisoformat(text)
-    except ValueError:
-        t = None
-    if t is None or t.tzinfo is not None:
-        raise MaizevizError(f"the {what} time must be HH:MM (local clock), got '{clock}'",
-                            quantity="period")
-    return _dt.timedelta(hours=t.hour, minutes=t.minute, seconds=t.second,
-                         microseconds=t.microsecond)
-
-
 def _localize(day: _dt.date, clock: str, tz, what: str):
-    """Local clock time ``clock`` (:func:`parse_clock`) on ``day`` as a tz-aware Timestamp."""
-    import pandas as pd
-
-    naive = pd.Timestamp(_dt.datetime.combine(day, _dt.time()) + parse_clock(clock, what))
-    try:
-        return naive.tz_localize(tz, ambiguous="raise", nonexistent="raise")
-    except ValueError:  # pandas' NonExistentTimeError / AmbiguousTimeError
-        raise MaizevizError(f"the {what} time {naive:%H:%M} on {naive.date()} does not exist or "
-                            f"occurs twice in {tz} (a daylight-saving change); pick another time",
-                            quantity="period") from None
+    """Local clock time ``clock`` on ``day`` in zone ``tz``, a tz-aware Timestamp
+    (:func:`maizeviz.light.clock.local_time`)."""
+    return local_time(day, clock, tz, what, quantity="period")
 
 
 def _solar_position(times, lat, lon, altitude):

@@ -8,12 +8,12 @@ angle from north to the field's +y axis).
 from __future__ import annotations
 
 import datetime as _dt
-import zoneinfo
 from dataclasses import dataclass
 
 import numpy as np
 
 from maizeviz.errors import MaizevizError
+from maizeviz.light.clock import check_place, local_time, zone
 
 
 @dataclass(frozen=True)
@@ -42,38 +42,6 @@ class Sun:
         return np.array([np.sin(z) * np.sin(a), np.sin(z) * np.cos(a), np.cos(z)])
 
 
-def _zone(tz: str) -> _dt.tzinfo:
-    try:
-        return zoneinfo.ZoneInfo(tz)
-    except (zoneinfo.ZoneInfoNotFoundError, ValueError, TypeError):
-        raise MaizevizError(f"unknown time zone '{tz}': use an IANA name such as "
-                            "Asia/Shanghai or Europe/Paris", quantity="tz") from None
-
-
-def local_time(day: _dt.date, clock: str, tz: str | None) -> _dt.datetime:
-    """A timezone-aware time from a date, a clock time ``HH:MM[:SS][+HH:MM]`` and a zone.
-
-    A clock time with its own UTC offset needs no zone; with a zone too, both must agree.
-    Without either, the time is UTC.
-    """
-    try:
-        t = _dt.time.fromisoformat(str(clock).strip())
-    except ValueError:
-        raise MaizevizError(f"the clock time must be HH:MM or HH:MM:SS, got '{clock}'",
-                            quantity="time") from None
-    when = _dt.datetime.combine(day, t)
-    if when.tzinfo is not None:
-        if tz is not None:
-            zoned = when.replace(tzinfo=None).replace(tzinfo=_zone(tz))
-            if zoned.utcoffset() != when.utcoffset():
-                raise MaizevizError(
-                    f"the time {clock} carries UTC offset {when.strftime('%z')} but the zone "
-                    f"{tz} is at {zoned.strftime('%z')} on {day}: give one of them",
-                    quantity="time")
-        return when
-    return when.replace(tzinfo=_zone(tz) if tz is not None else _dt.timezone.utc)
-
-
 def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None = None,
            solar_noon: bool = False, altitude: float = 0.0) -> Sun:
     """Sun position at a place and local clock time (or that day's true solar noon).
@@ -81,30 +49,28 @@ def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None =
     Parameters
     ----------
     date : "YYYY-MM-DD"; time : "HH:MM" or "HH:MM:SS" local clock time in ``tz`` (or with
-        its own offset, "12:00+08:00")
+        its own offset, "12:00+08:00"), read by :func:`maizeviz.light.clock.local_time`
     lat, lon : degrees (north, east positive); tz : IANA zone such as "Asia/Shanghai" (UTC
         when neither the time nor ``tz`` says)
     """
     import pandas as pd
     import pvlib
 
-    if not (-90 <= lat <= 90) or not (-180 <= lon <= 360):
-        raise MaizevizError(f"latitude must be in [-90, 90] and longitude in [-180, 360], "
-                            f"got {lat}, {lon}", quantity="place")
+    lat, lon = check_place(lat, lon)
     try:
         day = _dt.date.fromisoformat(str(date))
     except (TypeError, ValueError):
         raise MaizevizError(f"the date must be YYYY-MM-DD, got '{date}'", quantity="date") from None
     if solar_noon:
-        zone = _zone(tz) if tz is not None else _dt.timezone.utc
-        midnight = pd.DatetimeIndex([pd.Timestamp(_dt.datetime.combine(day, _dt.time(), zone))])
+        where = zone(tz) if tz is not None else _dt.timezone.utc
+        midnight = pd.DatetimeIndex([pd.Timestamp(_dt.datetime.combine(day, _dt.time(), where))])
         transit = pvlib.solarposition.sun_rise_set_transit_spa(midnight, lat, lon)
         when = pd.Timestamp(transit["transit"].iloc[0])
     else:
         if not time:
             raise MaizevizError("give a clock time HH:MM, or ask for the day's solar noon",
                                 quantity="time")
-        when = pd.Timestamp(local_time(day, time, tz))
+        when = local_time(day, time, tz)
     pos = pvlib.solarposition.get_solarposition(pd.DatetimeIndex([when]), lat, lon, altitude)
     return Sun(float(pos["apparent_zenith"].iloc[0]), float(pos["azimuth"].iloc[0]),
                when.isoformat())

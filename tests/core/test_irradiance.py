@@ -101,8 +101,9 @@ def test_polar_day_keeps_every_step():
      "the time step (90 min) is longer than the period (1 h)"),
     (dict(start="18:00", end="06:00"), "the period must end after it starts, got 18:00 to 06:00"),
     (dict(start="6h"), "the start time must be HH:MM (local clock), got '6h'"),
-    (dict(start="06:00+05:00"),                   # a TypeError from pandas before
-     "the start time must be HH:MM (local clock), got '06:00+05:00'"),
+    (dict(start="06:00+05:00"),                   # one clock rule: the offset must be the zone's
+     "the start time 06:00+05:00 carries UTC offset +0500 but the zone Asia/Shanghai is at "
+     "+0800 on 2005-08-01"),
     (dict(step_min=0.001), "a time step of 0.001 min gives 1440000 steps, more than 1000000"),
     (dict(date="2005-02-30"), "the date must be YYYY-MM-DD, got '2005-02-30'"),
     (dict(tz="Mars/Olympus"), "unknown time zone 'Mars/Olympus'"),
