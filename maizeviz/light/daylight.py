@@ -33,7 +33,6 @@ import math
 import threading
 import time
 from collections.abc import Iterator, Sequence
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
 
@@ -54,7 +53,7 @@ from maizeviz.light.request import (
 from maizeviz.light.sky import Sky
 from maizeviz.light.transmission import Sampler, sampler, scene_for, trace_direction
 from maizeviz.mesh.raytrace import RayScene
-from maizeviz.progress import ProgressCallback, report
+from maizeviz.progress import ProgressCallback, ordered_map, report
 
 # --------------------------------------------------------------------------- one beam
 
@@ -107,23 +106,8 @@ def _beams(smp: Sampler, towards: Sequence[np.ndarray], threads: int,
 
     ground_xy = ray_grid(smp.rect, smp.density)[0]
     stop = threading.Event()
-    total = len(towards)
-    if threads <= 1:
-        for i, s in enumerate(towards):
-            yield _beam(smp, s, edges, ground_xy, stop)
-            report(progress, i + 1, total, what)
-        return
-    with ThreadPoolExecutor(max_workers=threads) as pool:
-        futures = [pool.submit(_beam, smp, s, edges, ground_xy, stop) for s in towards]
-        try:
-            for i, f in enumerate(futures):
-                yield f.result()
-                report(progress, i + 1, total, what)
-        except BaseException:
-            stop.set()
-            for f in futures:
-                f.cancel()
-            raise
+    return ordered_map(lambda s: _beam(smp, s, edges, ground_xy, stop), towards, threads,
+                       lambda k: report(progress, k, len(towards), what), stop)
 
 
 # --------------------------------------------------------------------------- results

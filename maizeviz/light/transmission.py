@@ -30,7 +30,6 @@ from __future__ import annotations
 import threading
 import time
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from functools import cached_property
 from typing import TypeVar
@@ -43,7 +42,7 @@ from maizeviz.light.rays import Rect, Tracer, ray_grid, sensor_offsets
 from maizeviz.light.request import LightRequest, canopy_top, check_request
 from maizeviz.light.sun import Sun
 from maizeviz.mesh.raytrace import RayScene
-from maizeviz.progress import ProgressCallback, report
+from maizeviz.progress import ProgressCallback, ordered_map, report
 
 #: Rays traced per chunk: bounds memory and sets the progress step (a multiple of 8, so that
 #: the sensors' bits of a chunk pack into whole bytes).
@@ -243,30 +242,6 @@ def _chunks(n: int) -> list[tuple[int, int]]:
     return [(a, min(a + size, n)) for a in range(0, n, size)]
 
 
-def _in_chunks(fn: Callable[[int, int], T], chunks: list[tuple[int, int]], threads: int,
-               progress: Callable[[], None]) -> list[T]:
-    """``fn(a, b)`` over ``chunks`` of rays on ``threads`` threads, in order; ``progress()``
-    after each chunk (it may raise InterruptedError to stop)."""
-    if threads <= 1 or len(chunks) <= 1:
-        out = []
-        for a, b in chunks:
-            out.append(fn(a, b))
-            progress()
-        return out
-    out = []
-    with ThreadPoolExecutor(max_workers=threads) as pool:
-        futures = [pool.submit(fn, a, b) for a, b in chunks]
-        try:
-            for f in futures:
-                out.append(f.result())
-                progress()
-        except BaseException:
-            for f in futures:
-                f.cancel()
-            raise
-    return out
-
-
 @dataclass(frozen=True)
 class Sampler:
     """What every direction traced through one canopy shares: the scene, the sample rectangle
@@ -404,9 +379,8 @@ def _plane_rays(fam: _Family, k: int) -> np.ndarray:
 
 
 def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second: bool = False,
-                    threads: int = 1, tick: Callable[[], None] | None = None,
-                    stop: threading.Event | None = None,
-                    chunks_out: list[int] | None = None) -> DirectionTrace:
+                    threads: int = 1, progress: ProgressCallback | None = None,
+                    stop: threading.Event | None = None) -> DirectionTrace:
     """Trace one parallel beam through the canopy: ground rays and every sensor plane.
 
     Each sensor's path to the light is asked of Embree as an occlusion query, or, where fewer
@@ -419,10 +393,10 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
     smp : Sampler
     toward : (3,) unit vector toward the light, z > 0 (field coordinates)
     ids : keep each ground ray's first triangle; second : also trace second hits (needs ids)
-    threads : threads over chunks of rays
-    tick : called after each chunk (it may raise InterruptedError to stop)
+    threads : threads over chunks of rays (:func:`maizeviz.progress.ordered_map`)
+    progress : ``progress(done, total)`` after each chunk of rays; returning ``False`` cancels
+        with InterruptedError
     stop : when set, the next chunk raises InterruptedError (cancellation from another thread)
-    chunks_out : if given, receives the number of chunks this call will tick, before the first
     """
     t0 = time.perf_counter()
     s = np.asarray(toward, dtype=np.float64)
@@ -436,15 +410,20 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
     offsets = sensor_offsets(heights, s, smp.rect, smp.density)
     chunks = _chunks(n if fam is None else len(fam.cells))
     ground_chunks = _chunks(n)
-    if chunks_out is not None:
-        chunks_out.append(len(chunks) + (len(ground_chunks) if second else 0))
+    total = len(chunks) + (len(ground_chunks) if second else 0)
+
+    def in_chunks(fn: Callable[[int, int], T], parts: list[tuple[int, int]],
+                  before: int) -> list[T]:
+        def done(k: int) -> None:
+            report(progress, before + k, total, "light computation")
+
+        return list(ordered_map(lambda ab: fn(*ab), parts, threads, done, stop))
     size = chunks[0][1]
     down = Tracer(smp.scene, -s, smp.bounds, smp.periodic, max(size, ground_chunks[0][1]))
     first_z = np.empty(n, dtype=np.float32)
     keep_ids = ids or second
     first_prim = np.empty(n, dtype=np.int32) if keep_ids else None
     packed = np.zeros((len(heights), (n + 7) // 8), dtype=np.uint8)
-    tick = tick or (lambda: None)
 
     def check() -> None:
         if stop is not None and stop.is_set():
@@ -477,7 +456,7 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
                 packed[k, a // 8:(b + 7) // 8] = np.packbits(lit)
             return counts
 
-        transmission = np.sum(_in_chunks(chunk, chunks, threads, tick), axis=0) / n
+        transmission = np.sum(in_chunks(chunk, chunks, 0), axis=0) / n
     else:
         family = fam
         fz = np.empty(len(family.cells), dtype=np.float32)
@@ -493,7 +472,7 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
             if fp is not None and prim is not None:
                 fp[a:b] = prim
 
-        _in_chunks(fchunk, chunks, threads, tick)
+        in_chunks(fchunk, chunks, 0)
         g = family.index[-family.lo[0]:-family.lo[0] + family.size[0],
                          -family.lo[1]:-family.lo[1] + family.size[1]].ravel()
         first_z[:] = fz[g]
@@ -519,7 +498,7 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
             check()
             return second_hits(down, rays, a, b, fprim[a:b], first_z[a:b])
 
-        seconds_prims = _in_chunks(chunk2, ground_chunks, threads, tick)
+        seconds_prims = in_chunks(chunk2, ground_chunks, len(chunks))
         seconds["second"] = time.perf_counter() - t2
     return DirectionTrace(s, transmission.astype(np.float64), first_z,
                           first_prim if keep_ids else None, seconds_prims, packed, offsets,
@@ -546,16 +525,8 @@ def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | 
     s = req.sun.direction(canopy.layout.north_deg)
     smp = sampler(canopy, scene, rect, req.density, req.heights_cm, req.periodic, with_stalks)
     n = smp.n
-    total: list[int] = []
-    done = 0
-
-    def tick() -> None:
-        nonlocal done
-        done += 1
-        report(progress, done, total[0], "light computation")
-
     tr = trace_direction(smp, s, ids=req.classes, second=req.classes, threads=req.threads,
-                         tick=tick, chunks_out=total)
+                         progress=progress)
     seconds = {"build": build_s, **tr.seconds}
     counts: tuple[np.ndarray, np.ndarray] | tuple[None, None] = (None, None)
     if tr.first_prim is not None and tr.second_prim is not None:
