@@ -1,0 +1,273 @@
+"""One light engine over a canopy: its Embree scenes built once, every sun, sky and day traced
+on them.
+
+A scene (:func:`~maizeviz.light.transmission.light_scene`) costs about as much as tracing one
+sun, and is the same for every direction traced through the canopy; an engine builds it when a
+request first needs it (one for an open field, one with the overhanging leaves copied for a
+periodic field) and keeps it. The command line, the sweep's workers and the app's core process
+all trace through an engine; so does the package's façade (``maizeviz.LightEngine``).
+
+The engine also keeps the last sky light it traced, so that a day traced with the same sky and
+sampling reuses it (the sky of a period does not depend on the day).
+
+Example
+-------
+>>> engine = LightEngine(canopy, periodic=True)                      # doctest: +SKIP
+>>> noon = engine.sun(date="2005-08-01", time="12:00", lat=39.9, lon=116.4,
+...                   tz="Asia/Shanghai")                                # doctest: +SKIP
+>>> noon.table()                                                     # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from dataclasses import fields, replace
+
+from maizeviz.canopy.scene import Canopy
+from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
+from maizeviz.light.irradiance import DEFAULT_LINKE_TURBIDITY, DEFAULT_PAR_UMOL_PER_J, Period
+from maizeviz.light.request import LightRequest, Sampling
+from maizeviz.light.sky import Sky, make_sky
+from maizeviz.light.sun import Sun, sun_at
+from maizeviz.light.transmission import LightResult, light_scene, trace_light
+from maizeviz.mesh.raytrace import RayScene
+from maizeviz.progress import ProgressCallback
+
+
+class LightEngine:
+    """Sun, sky and day light through one canopy, on Embree scenes built once.
+
+    Parameters
+    ----------
+    canopy : Canopy
+        From :func:`maizeviz.canopy.scene.build_canopy` (``maizeviz.build_canopy``).
+    sampling : Sampling, optional
+        Sensor heights (cm), ray density (rays per cm2), sample rectangle (cm), periodic field
+        and threads shared by every request; fields given as keywords replace its fields
+        (``LightEngine(canopy, periodic=True, density=2.0)``).
+    with_stalks : bool
+        Stalks intercept light too (their triangles follow the leaves' in per-triangle
+        results).
+    **fields
+        Any field of :class:`~maizeviz.light.request.Sampling`: ``heights_cm``, ``density``,
+        ``rect``, ``periodic``, ``threads``.
+
+    Attributes
+    ----------
+    canopy : Canopy
+    sampling : Sampling
+    with_stalks : bool
+    build_seconds : dict[bool, float]
+        Seconds spent building the scene of an open (False) and a periodic (True) field.
+
+    Notes
+    -----
+    Thread-safe: several threads may trace through one engine (a sweep worker's threads); a
+    scene is built by the first thread that needs it.
+    """
+
+    def __init__(self, canopy: Canopy, sampling: Sampling | None = None, *,
+                 with_stalks: bool = False, **fields_):
+        self.canopy = canopy
+        self.sampling = self._sampling(sampling or Sampling(), fields_)
+        self.with_stalks = bool(with_stalks)
+        self.build_seconds: dict[bool, float] = {}
+        self._scenes: dict[bool, RayScene] = {}
+        self._lock = threading.Lock()
+        self._sky: tuple[tuple, SkyLight] | None = None
+
+    @staticmethod
+    def _sampling(base: Sampling, changes: dict) -> Sampling:
+        known = {f.name for f in fields(Sampling)}
+        unknown = sorted(set(changes) - known)
+        if unknown:
+            raise TypeError(f"unknown sampling field(s) {', '.join(unknown)} (known: "
+                            f"{', '.join(sorted(known))})")
+        if "heights_cm" in changes:
+            changes = {**changes, "heights_cm": tuple(float(h) for h in changes["heights_cm"])}
+        return replace(base, **changes) if changes else base
+
+    # ------------------------------------------------------------------ scenes
+    def scene(self, periodic: bool | None = None) -> RayScene:
+        """The Embree scene for an open (``periodic`` False) or periodic field, built on
+        first use and kept (``periodic`` None: the engine's sampling says)."""
+        key = self.sampling.periodic if periodic is None else bool(periodic)
+        with self._lock:
+            if key not in self._scenes:
+                t0 = time.perf_counter()
+                self._scenes[key] = light_scene(self.canopy, self.with_stalks, key)
+                self.build_seconds[key] = time.perf_counter() - t0
+            return self._scenes[key]
+
+    def _scene_and_build(self, periodic: bool) -> tuple[RayScene, float]:
+        """The scene, and the seconds spent building it in this call (0 when kept)."""
+        built = periodic in self._scenes
+        scene = self.scene(periodic)
+        return scene, 0.0 if built else self.build_seconds[periodic]
+
+    # ------------------------------------------------------------------ light
+    def sun(self, sun: Sun | None = None, *, date: str | None = None, time: str | None = None,
+            lat: float | None = None, lon: float | None = None, tz: str | None = None,
+            solar_noon: bool = False, altitude: float = 0.0, zenith: float | None = None,
+            azimuth: float | None = None, classes: bool = True,
+            sampling: Sampling | None = None,
+            progress: ProgressCallback | None = None, **fields_) -> LightResult:
+        """Direct sunlight: transmission by height and the hit classes of one sun.
+
+        Parameters
+        ----------
+        sun : Sun, optional
+            The sun's angles; else ``zenith`` and ``azimuth`` (deg), or a place and time.
+        date, time : str
+            "YYYY-MM-DD" and local clock time "HH:MM" (:mod:`maizeviz.light.clock`).
+        lat, lon : float
+            deg north and east. ``tz``: IANA time zone. ``solar_noon``: the day's true solar
+            noon instead of ``time``. ``altitude``: m above sea level.
+        zenith, azimuth : float
+            deg, zenith from the vertical, azimuth clockwise from north.
+        classes : bool
+            Also trace second hits and per-triangle counts (the hit classes).
+        sampling : Sampling, optional
+            Instead of the engine's; keywords (``heights_cm=...``) replace its fields.
+        progress : callable, optional
+            ``progress(done, total)`` after each chunk of rays; ``False`` cancels.
+
+        Returns
+        -------
+        LightResult
+            ``transmission`` (H,) in [0, 1] at ``heights_cm`` (H,) cm; ``table()`` as a
+            DataFrame. ``seconds["build"]`` is the scene's build time when this call built it.
+
+        References
+        ----------
+        Reda, I. & Andreas, A. (2004). Solar position algorithm for solar radiation
+        applications. Solar Energy 76(5), 577-589 (pvlib's ``get_solarposition``).
+        """
+        if sun is None:
+            if zenith is not None:
+                sun = Sun(float(zenith), float(azimuth if azimuth is not None else 180.0))
+            else:
+                if date is None or lat is None or lon is None:
+                    raise TypeError("give a Sun, zenith and azimuth, or date, time, lat and "
+                                    "lon")
+                sun = sun_at(date, time, lat, lon, tz, solar_noon, altitude)
+        smp = self._sampling(sampling or self.sampling, fields_)
+        scene, build_s = self._scene_and_build(smp.periodic)
+        result = trace_light(self.canopy, _request(sun, smp, classes),
+                             progress, self.with_stalks, scene)
+        result.seconds["build"] = build_s
+        return result
+
+    def sky(self, sky: Sky | str = "soc", directions: int = 46, split: str = "auto", *,
+            sampling: Sampling | None = None, progress: ProgressCallback | None = None,
+            bin_cm: float = 5.0, **fields_) -> SkyLight:
+        """Diffuse light under a sky: every sky direction traced like the sun.
+
+        Parameters
+        ----------
+        sky : Sky or str
+            A :class:`~maizeviz.light.sky.Sky`, or its kind: "soc" (standard overcast) or
+            "uoc" (uniform overcast), split into ``directions`` directions (``split``: "auto",
+            "turtle", "tregenza", "equal").
+        sampling, progress, **fields_ : as :meth:`sun` (``progress`` after each direction).
+        bin_cm : float
+            Bin edge of the transmission maps, cm.
+
+        Returns
+        -------
+        SkyLight
+            ``transmission`` (H,): share of the horizontal diffuse irradiance reaching each
+            height; ``table()`` as a DataFrame.
+
+        References
+        ----------
+        Moon, P. & Spencer, D. E. (1942). Illumination from a non-uniform sky. Illuminating
+        Engineering 37, 707-726 (the standard overcast sky).
+        """
+        sky_obj = sky if isinstance(sky, Sky) else make_sky(sky, directions, split)
+        smp = self._sampling(sampling or self.sampling, fields_)
+        scene, build_s = self._scene_and_build(smp.periodic)
+        light = trace_sky(self.canopy, sky_obj, smp, progress, self.with_stalks, scene, bin_cm)
+        light.seconds["build"] = build_s
+        self._sky = (_sky_key(sky_obj, smp, bin_cm), light)
+        return light
+
+    def day(self, period: Period | None = None, *, date: str | None = None,
+            lat: float | None = None, lon: float | None = None, tz: str = "UTC",
+            step_min: float = 30.0, start: str | None = None, end: str | None = None,
+            altitude: float = 0.0, linke: float = DEFAULT_LINKE_TURBIDITY,
+            par_factor: float = DEFAULT_PAR_UMOL_PER_J, sky: Sky | str | None = None,
+            sampling: Sampling | None = None, progress: ProgressCallback | None = None,
+            bin_cm: float = 5.0, **fields_) -> PeriodLight:
+        """Light over a day (or any period): the sun traced at every time step, the sky once.
+
+        Parameters
+        ----------
+        period : Period, optional
+            From :func:`~maizeviz.light.irradiance.clear_sky_period` or
+            :func:`~maizeviz.light.irradiance.weather_period`; else a clear day from ``date``
+            ("YYYY-MM-DD"), ``lat``, ``lon`` (deg), ``tz`` (IANA), ``step_min`` (min),
+            ``start``/``end`` (local "HH:MM"), ``altitude`` (m), ``linke`` (Linke turbidity)
+            and ``par_factor`` (umol of PAR per J of shortwave).
+        sky : Sky or str, optional
+            The sky of the diffuse part (default: standard overcast, 46 directions); the sky
+            light this engine last traced is reused when its sky, sampling and bins match.
+        sampling, progress, bin_cm, **fields_ : as :meth:`sky` (``progress`` after each
+            direction: sky directions first, then the time steps).
+
+        Returns
+        -------
+        PeriodLight
+            PAR doses in mol/m2 of ground (``par_incident_mol_m2``,
+            ``par_transmitted_mol_m2`` (H,), ...); ``table()`` as a DataFrame.
+
+        References
+        ----------
+        Ineichen, P. & Perez, R. (2002). A new airmass independent formulation for the Linke
+        turbidity coefficient. Solar Energy 73(3), 151-157 (the clear sky).
+        """
+        from maizeviz.light.irradiance import clear_sky_period
+
+        if period is None:
+            if date is None or lat is None or lon is None:
+                raise TypeError("give a Period, or date, lat and lon")
+            period = clear_sky_period(date, lat, lon, tz, step_min, start, end, altitude,
+                                      linke, par_factor)
+        smp = self._sampling(sampling or self.sampling, fields_)
+        sky_obj = sky if isinstance(sky, Sky) else make_sky(sky or "soc", 46)
+        diffuse: Sky | SkyLight = self.kept_sky(sky_obj, smp, bin_cm) or sky_obj
+        scene, build_s = self._scene_and_build(smp.periodic)
+        light = trace_period(self.canopy, period, smp, diffuse, progress, self.with_stalks,
+                             scene, bin_cm)
+        light.seconds["build"] = build_s
+        if light.sky is not None:
+            self._sky = (_sky_key(sky_obj, smp, bin_cm), light.sky)
+        return light
+
+    def kept_sky(self, sky: Sky, sampling: Sampling | None = None,
+                 bin_cm: float = 5.0) -> SkyLight | None:
+        """The sky light this engine last traced, if it was traced with this sky, sampling
+        (threads aside) and bin edge: what :meth:`day` reuses; else None."""
+        smp = sampling or self.sampling
+        if self._sky is not None and self._sky[0] == _sky_key(sky, smp, bin_cm):
+            return self._sky[1]
+        return None
+
+    # ------------------------------------------------------------------ scattering
+    # Light scattered by the leaves (the physics issue) is traced here too, on the same
+    # scenes: ``def scatter(self, ...)`` calling the scattering module with
+    # ``self.scene(periodic)``, as sun, sky and day do.
+
+
+def _request(sun: Sun, s: Sampling, classes: bool) -> LightRequest:
+    return LightRequest(sun, s.heights_cm, s.density, s.rect, s.periodic, s.threads, classes)
+
+
+def _sky_key(sky: Sky, s: Sampling, bin_cm: float) -> tuple:
+    """What makes a traced sky light reusable: the sky's directions and weights and the
+    sampling (threads aside)."""
+    return (sky.kind, sky.split, tuple(map(float, sky.zenith_deg)),
+            tuple(map(float, sky.azimuth_deg)), tuple(map(float, sky.weights)),
+            tuple(float(h) for h in s.heights_cm), float(s.density), s.rect, bool(s.periodic),
+            float(bin_cm))
