@@ -6,8 +6,9 @@ layout file, mesh level and area rule. Its work is done once and reused by all i
 - leaves are read and fitted once per points file per process (cached by the file's sha256, so
   a Dask worker fits each file once however many tasks it runs);
 - the canopy is built and measured once per group;
-- one plain Embree scene (``light_scene``) serves the ground cover and every open-field sun of
-  the group, one periodic scene every periodic sun.
+- one :class:`~maizeviz.light.engine.LightEngine` per group keeps its Embree scenes: the plain
+  one serves the ground cover and every open-field sun of the group, the periodic one every
+  periodic sun.
 
 Every import of the computing core (leaf, mesh, canopy, light) is in this file, so that moving
 core modules is a one-file change (the rest of the sweep uses only ``maizeviz.errors`` and
@@ -36,11 +37,10 @@ from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.cost import Cost, cover_cost, layout_cost, light_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import read_leaves
-from maizeviz.light.request import LightRequest
+from maizeviz.light.engine import LightEngine
+from maizeviz.light.request import Sampling
 from maizeviz.light.sun import Sun, sun_at
-from maizeviz.light.transmission import light_scene, trace_light
 from maizeviz.mesh.levels import parse_level
-from maizeviz.mesh.raytrace import RayScene
 from maizeviz.sweep.errors import WorkerInputError
 
 #: Points files whose fitted leaves a process keeps (a block of 9 plants is a few MB).
@@ -172,19 +172,10 @@ class _GroupState:
 
     canopy: Canopy
     measures: dict[str, Any]
-    scenes: dict[bool, RayScene]
+    engine: LightEngine
     leaves_skipped: int
     warnings: list[str]
     seconds: dict[str, float] = field(default_factory=dict)
-
-    def scene(self, periodic: bool) -> RayScene:
-        """The scene for plain or periodic requests (a periodic one wraps the leaves that
-        overhang the plot, as ``maizeviz light --periodic`` does), built once."""
-        if periodic not in self.scenes:
-            t0 = time.perf_counter()
-            self.scenes[periodic] = light_scene(self.canopy, periodic=periodic)
-            self.seconds["scene"] = self.seconds.get("scene", 0.0) + time.perf_counter() - t0
-        return self.scenes[periodic]
 
 
 def _layout(s, leaves):
@@ -209,7 +200,7 @@ def _group_state(s) -> _GroupState:
     """Leaves -> layout -> canopy -> measures (-> scene) for the group of scenario ``s``."""
     state = _CANOPIES.get(s.group_key)
     if state is not None:
-        return _GroupState(state.canopy, state.measures, state.scenes, state.leaves_skipped,
+        return _GroupState(state.canopy, state.measures, state.engine, state.leaves_skipped,
                            state.warnings)                   # nothing left to charge
     found, fit_s = _leaves(s.points.path, s.points.sha256)
     t0 = time.perf_counter()
@@ -217,14 +208,15 @@ def _group_state(s) -> _GroupState:
     t1 = time.perf_counter()
     canopy = build_canopy(found.leaves, layout, parse_level(s.level), s.preserve_area)
     t2 = time.perf_counter()
-    scene = light_scene(canopy)                        # plain: the ground cover uses it too
+    engine = LightEngine(canopy)
+    scene = engine.scene(periodic=False)               # plain: the ground cover uses it too
     t3 = time.perf_counter()
     m = measure_canopy(canopy, s.cover_resolution, False, scene=scene)
     t4 = time.perf_counter()
     warnings = list(found.problems) + [f"skipped: {e}" for e in found.skipped]
     # the inferred block is a note the CLI prints for every tiling, not a warning
     warnings += [w for w in layout.warnings if not w.startswith("block inferred")]
-    state = _GroupState(canopy, m.as_dict(), {False: scene}, len(found.skipped), warnings,
+    state = _GroupState(canopy, m.as_dict(), engine, len(found.skipped), warnings,
                         {"fit": fit_s, "layout": t1 - t0, "build": t2 - t1, "scene": t3 - t2,
                          "measure": t4 - t3})
     _CANOPIES.put(s.group_key, state)
@@ -251,13 +243,12 @@ def _error(s, exc: BaseException) -> dict:
 
 def _light(state: _GroupState, s) -> dict:
     sun = Sun(s.sun.zenith_deg, s.sun.azimuth_deg, s.sun.when or "")
-    req = LightRequest(sun, tuple(s.heights_cm), s.density, s.rect_cm, s.periodic, threads=1,
-                       classes=False)
-    scene = state.scene(s.periodic)
+    sampling = Sampling(tuple(s.heights_cm), s.density, s.rect_cm, s.periodic, threads=1)
     seconds = _charge(state)
     t0 = time.perf_counter()
-    res = trace_light(state.canopy, req, scene=scene)
-    seconds["trace"] = time.perf_counter() - t0
+    res = state.engine.sun(sun, classes=False, sampling=sampling)
+    seconds["scene"] += res.seconds["build"]           # a periodic scene built for this row
+    seconds["trace"] = time.perf_counter() - t0 - res.seconds["build"]
     m = state.measures
     return {"key": s.key, "status": "ok", "error": None, "triangles": m["triangles"],
             "plants": m["plants"], "leaves": m["leaves"],
