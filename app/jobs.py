@@ -3,7 +3,7 @@ process run.
 
 Each function takes everything it needs and returns new objects; the window keeps the results
 and drops stale ones by job id. Functions meant for the core process (:data:`OPS`) receive the
-child's ``state`` (the canopy it holds, and the Embree scene it built from it) and a
+child's ``state`` (the canopy it holds, and the light engine keeping its Embree scenes) and a
 ``progress(done, total)`` callback.
 """
 
@@ -17,8 +17,9 @@ from maizeviz.canopy.layout import CanopyLayout, layout_for
 from maizeviz.canopy.measures import CanopyMeasures, measure_canopy
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.leaf.fit import Leaf, read_leaves
+from maizeviz.light.engine import LightEngine
 from maizeviz.light.request import LightRequest
-from maizeviz.light.transmission import LightResult, light_scene, trace_light
+from maizeviz.light.transmission import LightResult
 from maizeviz.mesh.levels import parse_level
 from maizeviz.progress import ProgressCallback
 
@@ -91,24 +92,19 @@ def op_measure(state: dict, progress: ProgressCallback, cover_resolution: float)
     return measure_canopy(state["canopy"], cover_resolution=cover_resolution)
 
 
-def _scene(state: dict, periodic: bool):
-    """The child's Embree scene for its canopy (a periodic field's holds copies of the leaves
-    overhanging the plot edges), built once and kept for every later sun, sky or day; and the
-    seconds it took here (0 when it was kept)."""
-    key = ("scene", bool(periodic))
-    if key in state:
-        return state[key], 0.0
-    t0 = time.perf_counter()
-    state[key] = light_scene(state["canopy"], False, bool(periodic))
-    return state[key], time.perf_counter() - t0
+def _engine(state: dict) -> LightEngine:
+    """The child's light engine over its canopy: it builds each Embree scene once and keeps it
+    (and the last sky light) for every later sun, sky or day."""
+    if "engine" not in state:
+        state["engine"] = LightEngine(state["canopy"])
+    return state["engine"]
 
 
 def op_light(state: dict, progress: ProgressCallback, request: LightRequest) -> LightResult:
-    """Trace the sun through the child's canopy (on the scene it keeps)."""
-    scene, build_s = _scene(state, request.periodic)
-    result = trace_light(state["canopy"], request, progress, False, scene)
-    result.seconds["build"] = build_s              # the scene kept from an earlier run: 0
-    return result
+    """Trace the sun through the child's canopy (on the scene its engine keeps; the result's
+    ``seconds["build"]`` is 0 when the scene was kept from an earlier run)."""
+    return _engine(state).sun(request.sun, sampling=request.sampling, classes=request.classes,
+                              progress=progress)
 
 
 @dataclass(frozen=True)
@@ -227,51 +223,37 @@ def diffuse_of(canopy, light, kind: str) -> Diffuse:
                     build_s)
 
 
-def _sky_key(spec: SkySpec, sampling) -> tuple:
-    return (spec, tuple(float(h) for h in sampling.heights_cm), float(sampling.density),
-            sampling.rect, bool(sampling.periodic))
-
-
 def op_sky(state: dict, progress, sampling, spec: SkySpec) -> Diffuse:
-    """Diffuse light under a sky (one scene, every direction traced like the sun); the result
-    is kept so a day on the same canopy, sampling and sky reuses it."""
-    from maizeviz.light.daylight import trace_sky
+    """Diffuse light under a sky (one scene, every direction traced like the sun); the engine
+    keeps the result, so a day on the same canopy, sampling and sky reuses it."""
     from maizeviz.light.reports import sky_leaf_rows
-
-    sky = spec.sky()
-    scene, build_s = _scene(state, sampling.periodic)
 
     def steps(done: int, total: int):
         return progress(done, total, f"sky direction {done} of {total}")
 
-    light = trace_sky(state["canopy"], sky, sampling, steps, False, scene)
-    state["sky_light"] = (_sky_key(spec, sampling), light)
+    light = _engine(state).sky(spec.sky(), sampling=sampling, progress=steps)
     return _diffuse(state, light, sky_leaf_rows(state["canopy"], light),
-                    "diffuse_intercepted_cm2", build_s)
+                    "diffuse_intercepted_cm2", light.seconds["build"])
 
 
 def op_period(state: dict, progress, sampling, sky: SkySpec, day: DaySpec) -> Diffuse:
-    """Light over a day: the sun traced at every step, the sky once (or the sky result kept
-    from a sky run with the same settings)."""
-    from maizeviz.light.daylight import SkyLight, trace_period
+    """Light over a day: the sun traced at every step, the sky once (or the sky light the
+    engine kept from a sky run with the same settings)."""
     from maizeviz.light.reports import period_leaf_rows
 
     period = day.period()
-    kept = state.get("sky_light")
-    diffuse = kept[1] if kept is not None and kept[0] == _sky_key(sky, sampling) else sky.sky()
-    n_sky = 0 if isinstance(diffuse, SkyLight) else diffuse.n
-    scene, build_s = _scene(state, sampling.periodic)
+    engine = _engine(state)
+    sky_obj = sky.sky()
+    n_sky = 0 if engine.kept_sky(sky_obj, sampling) is not None else sky_obj.n
 
     def steps(done: int, total: int):
         if done <= n_sky:
             return progress(done, total, f"sky direction {done} of {n_sky}")
         return progress(done, total, f"time step {done - n_sky} of {total - n_sky}")
 
-    light = trace_period(state["canopy"], period, sampling, diffuse, steps, False, scene)
-    if light.sky is not None:
-        state["sky_light"] = (_sky_key(sky, sampling), light.sky)
+    light = engine.day(period, sky=sky_obj, sampling=sampling, progress=steps)
     return _diffuse(state, light, period_leaf_rows(state["canopy"], light),
-                    "par_intercepted_mol", build_s)
+                    "par_intercepted_mol", light.seconds["build"])
 
 
 def op_ping(state: dict, progress: ProgressCallback) -> str:
