@@ -35,7 +35,8 @@ from maizeviz.cost import heatmap_cost, light_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import file_tag, make_folder, refuse_overwriting_inputs, write_rows
 from maizeviz.light.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping
-from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
+from maizeviz.light.daylight import PeriodLight, SkyLight
+from maizeviz.light.engine import LightEngine
 from maizeviz.light.heatmap import save_figure, write_heatmaps
 from maizeviz.light.irradiance import (
     DEFAULT_LINKE_TURBIDITY,
@@ -47,10 +48,10 @@ from maizeviz.light.irradiance import (
 )
 from maizeviz.light.leaf_light import leaf_light, merge_rows, plant_light
 from maizeviz.light.reports import period_leaf_rows, sky_leaf_rows, write_steps
-from maizeviz.light.request import LightRequest, Sampling
+from maizeviz.light.request import Sampling
 from maizeviz.light.sky import SKY_KINDS, Sky, make_sky
 from maizeviz.light.sun import Sun, sun_at
-from maizeviz.light.transmission import LightResult, light_scene, trace_light
+from maizeviz.light.transmission import LightResult
 from maizeviz.mesh.levels import CANOPY_LEVELS
 
 #: The subcommand.
@@ -263,10 +264,10 @@ def run(args: argparse.Namespace) -> int:
         canopy = build_canopy(leaves, layout, level, args.preserve_area,
                               Progress(f"building {level}"))
         canopy_s = time.perf_counter() - t0
-        t1 = time.perf_counter()
-        scene = light_scene(canopy, args.with_stalks, args.periodic)
-        scene_s = time.perf_counter() - t1
         sampling = Sampling(heights, args.density, rect, args.periodic, args.threads)  # type: ignore[arg-type]
+        engine = LightEngine(canopy, sampling, with_stalks=args.with_stalks)
+        engine.scene()
+        scene_s = engine.build_seconds[args.periodic]
         rec: dict[str, Any] = {"level": level.label, "triangles": canopy.n_triangles,
                                "heights_cm": [float(h) for h in heights],
                                "periodic": args.periodic, "threads": args.threads,
@@ -275,10 +276,8 @@ def run(args: argparse.Namespace) -> int:
         tables: list[list[dict]] = []
         res = sky_res = per_res = None
         if sun is not None:
-            req = LightRequest(sun, heights, args.density, rect, args.periodic,  # type: ignore[arg-type]
-                               args.threads, classes=want_rows or len(levels) == 1)
-            res = trace_light(canopy, req, Progress(f"tracing {level}"), args.with_stalks,
-                              scene=scene)
+            res = engine.sun(sun, classes=want_rows or len(levels) == 1,
+                             progress=Progress(f"tracing {level}"))
             warnings += res.warnings
             rec.update(_sun_record(res, sun, canopy, args, heights))
             rec["seconds"].update(trace=res.seconds["trace"],
@@ -286,15 +285,14 @@ def run(args: argparse.Namespace) -> int:
             if want_rows:
                 tables.append(leaf_light(canopy, res))
         if period is not None:
-            per_res = trace_period(canopy, period, sampling, sky,
-                                   Progress(f"tracing the period, {level}"), args.with_stalks,
-                                   scene=scene, bin_cm=args.heatmap_bin)
+            per_res = engine.day(period, sky=sky, bin_cm=args.heatmap_bin,
+                                 progress=Progress(f"tracing the period, {level}"))
             sky_res = per_res.sky
             warnings += per_res.warnings
             rec["seconds"]["period"] = per_res.seconds["trace"]
         elif sky is not None:
-            sky_res = trace_sky(canopy, sky, sampling, Progress(f"tracing the sky, {level}"),
-                                args.with_stalks, scene=scene, bin_cm=args.heatmap_bin)
+            sky_res = engine.sky(sky, progress=Progress(f"tracing the sky, {level}"),
+                                 bin_cm=args.heatmap_bin)
             warnings += sky_res.warnings
             rec["seconds"]["sky"] = sky_res.seconds["trace"]
         if sky_res is not None:
