@@ -33,23 +33,23 @@ import math
 import threading
 import time
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
-from maizeviz.light.heatmap import TransmissionMap, bin_edges, binned
+from maizeviz.light.bins import TransmissionMap, bin_edges, binned
 from maizeviz.light.irradiance import Period
 from maizeviz.light.request import (
     LightRequest,
-    Rect,
     Sampling,
     canopy_top,
     check_sampling,
     edge_reach,
 )
+from maizeviz.light.result import MappedLight
 from maizeviz.light.sky import Sky
 from maizeviz.light.transmission import Sampler, sampler, scene_for, trace_direction
 from maizeviz.mesh.raytrace import RayScene
@@ -113,14 +113,15 @@ def _beams(smp: Sampler, towards: Sequence[np.ndarray], threads: int,
 # --------------------------------------------------------------------------- results
 
 
-@dataclass(frozen=True, eq=False)
-class SkyLight:
-    """Diffuse light under a sky, from :func:`trace_sky`.
+@dataclass(frozen=True, eq=False, kw_only=True)
+class SkyLight(MappedLight):
+    """Diffuse light under a sky, from :func:`trace_sky` (with the shared fields of
+    :class:`~maizeviz.light.result.MappedLight`: heights_cm, rect, rays, maps, map_edges,
+    map_rays, level, warnings, seconds, periodic).
 
     Attributes
     ----------
     sky : Sky
-    heights_cm : (H,) float64 cm
     transmission : (H,) float64 in [0, 1]: sum_i w_i T_i(h), the fraction of the horizontal
         diffuse irradiance reaching each sensor plane
     per_direction : (n, H) float64: T_i(h) of each sky direction
@@ -129,35 +130,19 @@ class SkyLight:
     per_direction_intercepted : (n,) float64: the same per direction (leaves' share of its beam)
     triangle_share : (F,) float64: share of the rectangle's diffuse light each scene triangle
         intercepts (leaf triangles first, then stalks)
-    rect : (x0, y0, x1, y1) cm; rays : rays per direction; density : rays per cm2 asked for
-    maps : (H, a, b) float64: diffuse transmission per bin (NaN: no sensor); map_edges : x and
-        y bin edges, cm; map_rays : (a, b) int64, sensors per bin (ground grid)
-    level : mesh level; warnings : tuple of str; seconds : "build", "trace" (wall clock), s
-    periodic : rays and sensor paths wrapped across the plot
+    density : rays per cm2 asked for
+
+    ``maps`` hold the diffuse transmission per bin; ``seconds`` "build", "trace" (wall
+    clock), s.
     """
 
     sky: Sky
-    heights_cm: np.ndarray
     transmission: np.ndarray
     per_direction: np.ndarray
     intercepted_fraction: float
     per_direction_intercepted: np.ndarray
     triangle_share: np.ndarray
-    rect: Rect
-    rays: int
     density: float
-    maps: np.ndarray
-    map_edges: tuple[np.ndarray, np.ndarray]
-    map_rays: np.ndarray
-    level: str = ""
-    warnings: tuple[str, ...] = ()
-    seconds: dict[str, float] = field(default_factory=dict)
-    periodic: bool = False
-
-    @property
-    def rect_area_cm2(self) -> float:
-        x0, y0, x1, y1 = self.rect
-        return (x1 - x0) * (y1 - y0)
 
     @property
     def triangle_intercepted_cm2(self) -> np.ndarray:
@@ -167,45 +152,40 @@ class SkyLight:
 
     def transmission_map(self, height: float) -> TransmissionMap:
         """Diffuse transmission binned over the sensor plane at ``height`` (a traced height)."""
-        return _map(self.heights_cm, self.maps, self.map_edges, self.transmission, height,
-                    self.map_rays)
+        return self._map_at(height, self.transmission)
+
+    def _height_columns(self) -> dict[str, np.ndarray]:
+        return {"diffuse_transmission": self.transmission}
+
+    def _leaf_rows(self, canopy: Canopy) -> list[dict]:
+        from maizeviz.light.reports import sky_leaf_rows
+
+        return sky_leaf_rows(canopy, self)
 
 
-@dataclass(frozen=True, eq=False)
-class PeriodLight:
-    """Light over a period, from :func:`trace_period`. PAR doses are mol/m2 of ground.
+@dataclass(frozen=True, eq=False, kw_only=True)
+class PeriodLight(MappedLight):
+    """Light over a period, from :func:`trace_period`. PAR doses are mol/m2 of ground. With the
+    shared fields of :class:`~maizeviz.light.result.MappedLight` (heights_cm, rect, rays, maps:
+    fraction of the period's PAR reaching each bin, map_edges, map_rays, level, warnings,
+    seconds "build" and "trace", periodic).
 
     Attributes
     ----------
     period : Period (times, sun, irradiance, PAR factor)
     sky : SkyLight used for the diffuse part (None when the sun never rises)
-    heights_cm : (H,) float64 cm
     step_transmission : (n, H) float64: direct-sun transmission at each step
     step_intercepted_fraction : (n,) float64: leaves' share of the direct beam at each step
     triangle_direct_mol, triangle_diffuse_mol : (F,) float64 mol: PAR intercepted by each scene
         triangle over the period (leaf triangles first, then stalks)
-    rect : (x0, y0, x1, y1) cm; rays : rays per direction
-    maps : (H, a, b) float64: fraction of the period's PAR reaching each bin; map_edges : x and
-        y bin edges, cm; map_rays : (a, b) int64, sensors per bin (ground grid)
-    level, warnings, seconds ("build", "trace", s); periodic : as :class:`SkyLight`
     """
 
     period: Period
     sky: SkyLight | None
-    heights_cm: np.ndarray
     step_transmission: np.ndarray
     step_intercepted_fraction: np.ndarray
     triangle_direct_mol: np.ndarray
     triangle_diffuse_mol: np.ndarray
-    rect: Rect
-    rays: int
-    maps: np.ndarray
-    map_edges: tuple[np.ndarray, np.ndarray]
-    map_rays: np.ndarray
-    level: str = ""
-    warnings: tuple[str, ...] = ()
-    seconds: dict[str, float] = field(default_factory=dict)
-    periodic: bool = False
 
     @property
     def n_steps(self) -> int:
@@ -213,8 +193,7 @@ class PeriodLight:
 
     @property
     def rect_area_m2(self) -> float:
-        x0, y0, x1, y1 = self.rect
-        return (x1 - x0) * (y1 - y0) * 1e-4
+        return self.rect_area_cm2 * 1e-4
 
     # ---- per step, mol/m2 of ground
     @cached_property
@@ -296,19 +275,16 @@ class PeriodLight:
 
     def transmission_map(self, height: float) -> TransmissionMap:
         """Fraction of the period's PAR reaching each bin of the sensor plane at ``height``."""
-        return _map(self.heights_cm, self.maps, self.map_edges, self.transmission_by_height,
-                    height, self.map_rays)
+        return self._map_at(height, self.transmission_by_height)
 
+    def _height_columns(self) -> dict[str, np.ndarray]:
+        return {"par_transmitted_mol_m2": self.par_transmitted_mol_m2,
+                "transmission": self.transmission_by_height}
 
-def _map(heights: np.ndarray, maps: np.ndarray, edges: tuple[np.ndarray, np.ndarray],
-         totals: np.ndarray, height: float, rays: np.ndarray) -> TransmissionMap:
-    k = np.flatnonzero(np.isclose(heights, height, rtol=0, atol=1e-9))
-    if not len(k):
-        raise MaizevizError(f"height {height:g} cm was not traced (traced: "
-                            f"{', '.join(f'{h:g}' for h in heights)} cm)", quantity="heights")
-    i = int(k[0])
-    xe, ye = edges
-    return TransmissionMap(float(heights[i]), xe, ye, maps[i], rays, float(totals[i]))
+    def _leaf_rows(self, canopy: Canopy) -> list[dict]:
+        from maizeviz.light.reports import period_leaf_rows
+
+        return period_leaf_rows(canopy, self)
 
 
 # --------------------------------------------------------------------------- entry points
@@ -365,9 +341,12 @@ def _sky_light(sky: Sky, smp: Sampler, beams: list[_Beam], bins: _Bins, level: s
         np.add.at(share, b.ids, wi * b.hits / smp.n)
         maps += wi * b.lit_bins
     trans = np.array([math.fsum(w * per_dir[:, k]) for k in range(per_dir.shape[1])])
-    return SkyLight(sky, smp.heights_cm, np.clip(trans, 0.0, 1.0), per_dir,
-                    math.fsum(w * per_int), per_int, share, smp.rect, smp.n, smp.density, maps,
-                    edges, bins.rays, level, tuple(warnings), seconds, smp.periodic)
+    return SkyLight(sky=sky, heights_cm=smp.heights_cm, transmission=np.clip(trans, 0.0, 1.0),
+                    per_direction=per_dir, intercepted_fraction=math.fsum(w * per_int),
+                    per_direction_intercepted=per_int, triangle_share=share, rect=smp.rect,
+                    rays=smp.n, density=smp.density, maps=maps, map_edges=edges,
+                    map_rays=bins.rays, level=level, warnings=tuple(warnings), seconds=seconds,
+                    periodic=smp.periodic)
 
 
 def trace_sky(canopy: Canopy, sky: Sky, sampling: Sampling | LightRequest,
@@ -439,10 +418,13 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
     shape = (n_h, len(edges[0]) - 1, len(edges[1]) - 1)
     zeros = np.zeros(smp.n_triangles)
     if period.n_steps == 0:
-        return PeriodLight(period, None, smp.heights_cm, np.zeros((0, n_h)), np.zeros(0),
-                           zeros, zeros.copy(), smp.rect, smp.n, np.full(shape, np.nan), edges,
-                           bins.rays, canopy.level, tuple(warnings), {"build": build_s, "trace": 0.0},
-                           smp.periodic)
+        return PeriodLight(period=period, sky=None, heights_cm=smp.heights_cm,
+                           step_transmission=np.zeros((0, n_h)),
+                           step_intercepted_fraction=np.zeros(0), triangle_direct_mol=zeros,
+                           triangle_diffuse_mol=zeros.copy(), rect=smp.rect, rays=smp.n,
+                           maps=np.full(shape, np.nan), map_edges=edges, map_rays=bins.rays,
+                           level=canopy.level, warnings=tuple(warnings),
+                           seconds={"build": build_s, "trace": 0.0}, periodic=smp.periodic)
     sky_light = sky if isinstance(sky, SkyLight) else None
     if sky_light is not None:
         if not (np.array_equal(sky_light.heights_cm, smp.heights_cm)
@@ -482,8 +464,11 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
     for dose, b in zip(direct_mol, steps):
         maps = maps + dose * b.lit_bins
     maps = maps / incident if incident > 0 else np.full(shape, np.nan)
-    return PeriodLight(period, sky_light, smp.heights_cm,
-                       np.array([b.transmission for b in steps]).reshape(len(steps), n_h),
-                       np.array([b.leaf_fraction for b in steps]), tri_direct, tri_diffuse,
-                       smp.rect, smp.n, maps, edges, bins.rays, canopy.level, tuple(warnings),
-                       {"build": build_s, "trace": trace_s}, smp.periodic)
+    return PeriodLight(
+        period=period, sky=sky_light, heights_cm=smp.heights_cm,
+        step_transmission=np.array([b.transmission for b in steps]).reshape(len(steps), n_h),
+        step_intercepted_fraction=np.array([b.leaf_fraction for b in steps]),
+        triangle_direct_mol=tri_direct, triangle_diffuse_mol=tri_diffuse, rect=smp.rect,
+        rays=smp.n, maps=maps, map_edges=edges, map_rays=bins.rays, level=canopy.level,
+        warnings=tuple(warnings), seconds={"build": build_s, "trace": trace_s},
+        periodic=smp.periodic)

@@ -14,7 +14,7 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError, check_range
-from maizeviz.light.rays import ray_count
+from maizeviz.light.rays import Rect, ray_count
 from maizeviz.light.sun import Sun
 
 #: More rays than this are refused (minutes of tracing and GiB of results).
@@ -25,7 +25,6 @@ MAX_THREADS = 1024
 #: ray and sensor plane.
 BYTES_PER_RAY = 16
 
-Rect = tuple[float, float, float, float]
 
 
 @dataclass(frozen=True)

@@ -40,6 +40,7 @@ from maizeviz.canopy.scene import Canopy
 from maizeviz.light.hits import SunRays, first_hits, hit_counts, lattice_first_hits, second_hits
 from maizeviz.light.rays import Rect, Tracer, ray_grid, sensor_offsets
 from maizeviz.light.request import LightRequest, canopy_top, check_request
+from maizeviz.light.result import TracedLight
 from maizeviz.light.sun import Sun
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, ordered_map, report
@@ -51,52 +52,40 @@ CHUNK = 1 << 18
 T = TypeVar("T")
 
 
-@dataclass(frozen=True)
-class LightResult:
-    """Output of :func:`trace_light`.
+@dataclass(frozen=True, kw_only=True)
+class LightResult(TracedLight):
+    """Output of :func:`trace_light` (and the shared fields of
+    :class:`~maizeviz.light.result.TracedLight`: heights_cm, rect, rays, level, warnings,
+    seconds, periodic).
 
     Attributes
     ----------
     sun : Sun
-    heights_cm : (H,) float64; transmission : (H,) float64 in [0, 1], on the sensor planes
-    rays : int, rays (and sensors per plane); rect : (x0, y0, x1, y1) cm;
+    transmission : (H,) float64 in [0, 1], on the sensor planes at ``heights_cm`` (H,) cm
     ray_area_cm2 : horizontal footprint of a ray (and of a sensor)
     first_z : (N,) float32, height (cm) of each ground ray's first hit, -inf where none
     first_hits, second_hits : (F,) int64, rays whose first / second hit is each triangle
         (None unless the request asked for hit classes)
-    seconds : "build" and "trace" (and "second" for second hits), s
-    warnings : what the user should know about this result
-    level : mesh level label; density : rays per cm2 asked for
     direction : (3,) unit vector toward the sun in field coordinates
+    density : rays per cm2 asked for
     sensor_lit : (H, ceil(N / 8)) uint8, the sensors of each plane whose path to the sun is
         clear, bits packed in ray grid order (:meth:`lit`); None for results made elsewhere
     sensor_offset_cm : (H, 2) float64 cm, where each plane's grid sits relative to the ground
         grid's cell centres (:meth:`sensor_xy`)
-    periodic : rays and sensor paths wrapped across the plot
+
+    ``seconds`` has "build" and "trace" (and "second" for second hits), s.
     """
 
     sun: Sun
-    heights_cm: np.ndarray
     transmission: np.ndarray
-    rays: int
-    rect: Rect
     ray_area_cm2: float
     first_z: np.ndarray
     first_hits: np.ndarray | None
     second_hits: np.ndarray | None
     direction: np.ndarray
-    seconds: dict[str, float] = field(default_factory=dict)
-    warnings: tuple[str, ...] = ()
-    level: str = ""
     density: float = 0.0
     sensor_lit: np.ndarray | None = None
     sensor_offset_cm: np.ndarray | None = None
-    periodic: bool = False
-
-    @property
-    def rect_area_cm2(self) -> float:
-        x0, y0, x1, y1 = self.rect
-        return (x1 - x0) * (y1 - y0)
 
     @property
     def density_per_cm2(self) -> float:
@@ -116,17 +105,6 @@ class LightResult:
         """Where each ray meets the ground (N, 2) cm, in ray grid order."""
         return ray_grid(self.rect, self.density)[0]
 
-    def height_index(self, height: float) -> int:
-        """Index of ``height`` (cm) among the traced heights; MaizevizError if not traced."""
-        from maizeviz.errors import MaizevizError
-
-        k = np.flatnonzero(np.isclose(self.heights_cm, height, rtol=0, atol=1e-9))
-        if not len(k):
-            raise MaizevizError(f"height {height:g} cm was not traced (traced: "
-                                f"{', '.join(f'{h:g}' for h in self.heights_cm)} cm)",
-                                quantity="heights")
-        return int(k[0])
-
     def sensor_xy(self, k: int) -> np.ndarray:
         """Sensor positions (N, 2) cm of the plane of height index ``k``, in ray grid order."""
         off = np.zeros(2) if self.sensor_offset_cm is None else self.sensor_offset_cm[k]
@@ -139,6 +117,14 @@ class LightResult:
 
             raise MaizevizError("this result carries no sensor planes")
         return np.unpackbits(self.sensor_lit[k], count=self.rays).astype(bool)
+
+    def _height_columns(self) -> dict[str, np.ndarray]:
+        return {"transmission": self.transmission}
+
+    def _leaf_rows(self, canopy: Canopy) -> list[dict]:
+        from maizeviz.light.leaf_light import leaf_light
+
+        return leaf_light(canopy, self)
 
 
 class CanopyScene(RayScene):
@@ -531,7 +517,9 @@ def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | 
     counts: tuple[np.ndarray, np.ndarray] | tuple[None, None] = (None, None)
     if tr.first_prim is not None and tr.second_prim is not None:
         counts = hit_counts(tr.first_prim, tr.second_prim, smp.n_triangles)
-    return LightResult(req.sun, smp.heights_cm, tr.transmission, n, rect, smp.ray_area_cm2,
-                       tr.first_z, counts[0], counts[1], s, seconds, tuple(warnings),
-                       canopy.level, req.density, tr.sensor_lit, tr.sensor_offset_cm,
-                       req.periodic)
+    return LightResult(sun=req.sun, heights_cm=smp.heights_cm, transmission=tr.transmission,
+                       rays=n, rect=rect, ray_area_cm2=smp.ray_area_cm2, first_z=tr.first_z,
+                       first_hits=counts[0], second_hits=counts[1], direction=s,
+                       seconds=seconds, warnings=tuple(warnings), level=canopy.level,
+                       density=req.density, sensor_lit=tr.sensor_lit,
+                       sensor_offset_cm=tr.sensor_offset_cm, periodic=req.periodic)
