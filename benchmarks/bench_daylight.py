@@ -61,7 +61,8 @@ def main() -> None:
     sky = make_sky("soc", 46)
     sampling = Sampling(HEIGHTS, args.density, None, True, args.threads)
     noon = sun_at("2005-08-01", "12:00", 39.9, 116.4, "Asia/Shanghai")
-    req = LightRequest(noon, HEIGHTS, args.density, None, True, args.threads, classes=False)
+    req = LightRequest(noon, Sampling(HEIGHTS, args.density, None, True, args.threads),
+                       classes=False)
 
     single, single_trace, builds, periods = [], [], [], []
     for _ in range(args.repeat):

@@ -76,7 +76,7 @@ def gil_part() -> dict:
     """The app's build and light jobs at K = 4, no Qt: the longest stall of a Python thread."""
     sys.setswitchinterval(0.005)
     from maizeviz.light.leaf_light import triangle_light
-    from maizeviz.light.request import LightRequest
+    from maizeviz.light.request import LightRequest, Sampling
     from maizeviz.light.sun import Sun
     from maizeviz.resources import example_points
     from maizeviz_app import jobs
@@ -107,8 +107,8 @@ def gil_part() -> dict:
         canopy, build_s, label = jobs.build(loaded, "K4", True)
         cover.call("measure", 1, canopy, (jobs.APP_COVER_RESOLUTION_CM,), Ticket())
         t1 = time.perf_counter()
-        req = LightRequest(Sun(22.34, 166.95), (0, 50, 100, 150, 200, 225), 2.0, None, True,
-                           2, classes=True)
+        req = LightRequest(Sun(22.34, 166.95),
+                           Sampling((0, 50, 100, 150, 200, 225), 2.0, None, True, 2), classes=True)
         result = light.call("light", 1, canopy, (req,), Ticket())
         triangle_light(canopy, result)
         t2 = time.perf_counter()

@@ -32,7 +32,7 @@ from maizeviz.io.points import read_points
 from maizeviz.leaf.fit import fit_leaves
 from maizeviz.leaf.grid import build_grids
 from maizeviz.light.rays import ray_grid
-from maizeviz.light.request import LightRequest
+from maizeviz.light.request import LightRequest, Sampling
 from maizeviz.light.sun import Sun
 from maizeviz.light.transmission import trace_light
 from maizeviz.mesh.levels import parse_level
@@ -63,8 +63,8 @@ def main():
     layout = tiled_layout(plant_bases(leaves), (3, 3))
     canopy = build_canopy(leaves, layout, parse_level(args.level))
     sun = Sun(22.35, 166.95)
-    req = LightRequest(sun, (0.0,), density=args.density, classes=False, threads=1)
-    req6 = LightRequest(sun, density=args.density, classes=False, threads=1)
+    req = LightRequest(sun, Sampling((0.0,), density=args.density, threads=1), classes=False)
+    req6 = LightRequest(sun, Sampling(density=args.density, threads=1), classes=False)
     rect = layout.centre_bounds
 
     t0 = time.perf_counter()
@@ -85,13 +85,12 @@ def main():
 
     bare_s = best(lambda: scene._scene.run(org, dirs, dists=dists.copy()))
     ours_1 = best(lambda: trace_light(canopy, req))
-    ours_2 = best(lambda: trace_light(canopy, LightRequest(sun, (0.0,), density=args.density,
-                                                           classes=False, threads=2)))
+    two = Sampling((0.0,), density=args.density, threads=2)
+    ours_2 = best(lambda: trace_light(canopy, LightRequest(sun, two, classes=False)))
     # maizeviz's whole call includes its own scene build; compare the tracing part it reports
     res = [trace_light(canopy, req) for _ in range(3)]
     t1 = min(r.seconds["trace"] for r in res)
-    res2 = [trace_light(canopy, LightRequest(sun, (0.0,), density=args.density, classes=False,
-                                             threads=2)) for _ in range(3)]
+    res2 = [trace_light(canopy, LightRequest(sun, two, classes=False)) for _ in range(3)]
     t2 = min(r.seconds["trace"] for r in res2)
     t6 = min(trace_light(canopy, req6, scene=scene).seconds["trace"] for _ in range(3))
 

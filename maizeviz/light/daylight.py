@@ -300,6 +300,8 @@ def _prepare(canopy: Canopy, sampling: Sampling | LightRequest, with_stalks: boo
              scene: RayScene | None, bin_cm: float) -> tuple[Sampler, list[str], float, _Bins]:
     from maizeviz.light.rays import ray_grid
 
+    if isinstance(sampling, LightRequest):
+        sampling = sampling.sampling
     rect, warnings = check_sampling(canopy, sampling)
     xe, ye = bin_edges(rect, bin_cm)
     xy = ray_grid(rect, sampling.density)[0]

@@ -154,7 +154,7 @@ class LightEngine:
                 sun = sun_at(date, time, lat, lon, tz, solar_noon, altitude)
         smp = self._sampling(sampling or self.sampling, fields_)
         scene, build_s = self._scene_and_build(smp.periodic)
-        result = trace_light(self.canopy, _request(sun, smp, classes),
+        result = trace_light(self.canopy, LightRequest(sun, smp, classes),
                              progress, self.with_stalks, scene)
         result.seconds["build"] = build_s
         return result
@@ -260,8 +260,6 @@ class LightEngine:
     # ``self.scene(periodic)``, as sun, sky and day do.
 
 
-def _request(sun: Sun, s: Sampling, classes: bool) -> LightRequest:
-    return LightRequest(sun, s.heights_cm, s.density, s.rect, s.periodic, s.threads, classes)
 
 
 def _sky_key(sky: Sky, s: Sampling, bin_cm: float) -> tuple:

@@ -49,31 +49,39 @@ class Sampling:
 
 @dataclass(frozen=True)
 class LightRequest:
-    """All inputs of one light computation.
+    """All inputs of one light computation: one sun, sampled as ``sampling`` says.
 
     Attributes
     ----------
     sun : Sun
-    heights_cm : (H,) heights of the sample planes, cm, >= 0
-    density : rays per cm2 of the sample rectangle
-    rect : (x0, y0, x1, y1) cm, or None for the central tile's footprint
-    periodic : rays leaving the plot sideways re-enter on the opposite side (infinite field)
-    threads : tracing threads
+    sampling : Sampling (heights, density, rectangle, periodic field, threads); its fields
+        read through the request too (``req.heights_cm``, ``req.density``, ...)
     classes : also trace second hits and per-triangle counts (the paper's hit classes)
     """
 
     sun: Sun
-    heights_cm: tuple[float, ...] = (0.0, 50.0, 100.0, 150.0, 200.0, 225.0)
-    density: float = 4.0
-    rect: Rect | None = None
-    periodic: bool = False
-    threads: int = 1
+    sampling: Sampling = Sampling()
     classes: bool = True
 
     @property
-    def sampling(self) -> Sampling:
-        """The sun-independent part of the request."""
-        return Sampling(self.heights_cm, self.density, self.rect, self.periodic, self.threads)
+    def heights_cm(self) -> tuple[float, ...]:
+        return self.sampling.heights_cm
+
+    @property
+    def density(self) -> float:
+        return self.sampling.density
+
+    @property
+    def rect(self) -> Rect | None:
+        return self.sampling.rect
+
+    @property
+    def periodic(self) -> bool:
+        return self.sampling.periodic
+
+    @property
+    def threads(self) -> int:
+        return self.sampling.threads
 
 
 def canopy_top(canopy: Canopy, with_stalks: bool = False) -> float:
@@ -128,7 +136,7 @@ def check_request(canopy: Canopy, req: LightRequest) -> tuple[Rect, list[str]]:
     return rect, warnings
 
 
-def check_sampling(canopy: Canopy, req: Sampling | LightRequest) -> tuple[Rect, list[str]]:
+def check_sampling(canopy: Canopy, req: Sampling) -> tuple[Rect, list[str]]:
     """Validate the sun-independent part of a request; returns the sample rectangle (cm) and
     warnings (heights above the canopy).
 

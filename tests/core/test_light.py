@@ -17,7 +17,7 @@ from maizeviz.light.beer_lambert import beer_lambert
 from maizeviz.light.heatmap import transmission_map
 from maizeviz.light.leaf_light import leaf_light
 from maizeviz.light.rays import ray_grid
-from maizeviz.light.request import LightRequest
+from maizeviz.light.request import LightRequest, Sampling
 from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import trace_light
 
@@ -48,8 +48,9 @@ def canopy_of(specs, layout=None):
 
 def test_vertical_sun_shades_exactly_the_overlap():
     c = canopy_of([(30, 40, 20, 80)])                      # 20 x 20 cm leaf at 80 cm
-    req = LightRequest(Sun(0, 0), heights_cm=(0, 50, 79.9, 80.1, 100), density=4,
-                       rect=(20, 20, 60, 60))              # overlap: x 30..50, y 40..60 = 400
+    # overlap: x 30..50, y 40..60 = 400
+    req = LightRequest(Sun(0, 0),
+                       Sampling(heights_cm=(0, 50, 79.9, 80.1, 100), density=4, rect=(20, 20, 60, 60)))
     r = trace_light(c, req)
     expect = 1 - 400 / 1600
     assert r.transmission[0] == pytest.approx(expect, abs=1e-12)
@@ -63,19 +64,20 @@ def test_vertical_sun_shades_exactly_the_overlap():
 def test_45_degree_sun_shifts_the_shadow():
     # sun from the east (azimuth 90) at 45 deg: the shadow of a leaf at 30 cm falls 30 cm west
     c = canopy_of([(60, 40, 20, 30)])
-    r = trace_light(c, LightRequest(Sun(45, 90), heights_cm=(0,), density=16,
-                                    rect=(20, 30, 60, 70)))
+    r = trace_light(c, LightRequest(Sun(45, 90),
+                                    Sampling(heights_cm=(0,), density=16, rect=(20, 30, 60, 70))))
     # shadow x 30..50, y 40..60, fully inside the 40 x 40 rectangle
     assert r.transmission[0] == pytest.approx(1 - 400 / 1600, abs=2e-3)
     # a rectangle east of the shadow sees full sun
-    r2 = trace_light(c, LightRequest(Sun(45, 90), heights_cm=(0,), density=16,
-                                     rect=(52, 30, 90, 70)))
+    r2 = trace_light(c, LightRequest(Sun(45, 90),
+                                     Sampling(heights_cm=(0,), density=16, rect=(52, 30, 90, 70))))
     assert r2.transmission[0] == 1.0
 
 
 def test_stacked_leaves_direct_and_second_class_areas():
     c = canopy_of([(20, 20, 40, 100), (30, 30, 40, 60), (10, 10, 10, 20)])
-    r = trace_light(c, LightRequest(Sun(0, 0), heights_cm=(0,), density=4, rect=(0, 0, 100, 100)))
+    r = trace_light(c, LightRequest(Sun(0, 0),
+                                    Sampling(heights_cm=(0,), density=4, rect=(0, 0, 100, 100))))
     rows = {row["leaf"]: row for row in leaf_light(c, r)}
     assert rows[1]["sunlit_area_cm2"] == pytest.approx(1600, rel=1e-9)        # top: all direct
     assert rows[1]["second_class_area_cm2"] == 0
@@ -92,8 +94,8 @@ def test_tilted_leaf_sunlit_area_is_its_surface_area():
     v = np.array([[40, 40, 50], [60, 40, 50], [60, 40 + 20 * math.cos(t), 50 + 20 * math.sin(t)],
                   [40, 40 + 20 * math.cos(t), 50 + 20 * math.sin(t)]])
     c = Canopy.from_triangles(v, np.array([[0, 1, 2], [0, 2, 3]]), plot(), np.array([1, 1]))
-    r = trace_light(c, LightRequest(Sun(0, 0), heights_cm=(0,), density=25,
-                                    rect=(30, 30, 70, 70)))
+    r = trace_light(c, LightRequest(Sun(0, 0),
+                                    Sampling(heights_cm=(0,), density=25, rect=(30, 30, 70, 70))))
     row = leaf_light(c, r)[0]
     assert row["sunlit_area_cm2"] == pytest.approx(400, rel=0.02)
     assert row["sunlit_intercepted_cm2"] == pytest.approx(200, rel=0.02)   # its shadow
@@ -108,8 +110,8 @@ def test_random_horizontal_leaves_transmit_exp_minus_lai(lai):
     xy = rng.uniform(-a, side, (n, 2))
     z = rng.uniform(10, 200, n)
     c = canopy_of([(x, y, a, h) for (x, y), h in zip(xy, z)], plot(0, 0, side, side))
-    r = trace_light(c, LightRequest(Sun(0, 0), heights_cm=(0, 105), density=1,
-                                    rect=(0, 0, side, side)))
+    r = trace_light(c, LightRequest(Sun(0, 0),
+                                    Sampling(heights_cm=(0, 105), density=1, rect=(0, 0, side, side))))
     assert r.transmission[0] == pytest.approx(math.exp(-lai), abs=0.02)
     # half the leaves lie above 105 cm: T(105) ~ exp(-lai * 95 / 190)
     assert r.transmission[1] == pytest.approx(math.exp(-lai * 95 / 190), abs=0.03)
@@ -125,7 +127,8 @@ def test_single_leaf_sensor_planes_are_exact_at_every_height():
                               np.array([1, 1]))
     heights = tuple(float(h) for h in range(0, 100, 5)) + (100.5, 130.0)
     for density in (1.0, 4.0):
-        r = trace_light(c, LightRequest(Sun(45, 90), heights, density, rect=(0, 20, 100, 80)))
+        r = trace_light(c, LightRequest(Sun(45, 90),
+                                        Sampling(heights, density, rect=(0, 20, 100, 80))))
         expect = [1 - (min(h + 50, 100) - max(h - 50, 0)) / 100 if h < 100 else 1.0
                   for h in heights]
         assert r.transmission == pytest.approx(expect, abs=1e-12), density
@@ -154,8 +157,8 @@ def test_vertical_sun_transmission_never_increases_downward(seed, x0, y0, x1, y1
     """Under a vertical sun each sensor's path contains the path of the sensor above it: on any
     rectangle T is monotone exactly, and 1 above the canopy."""
     heights = tuple(np.sort(np.random.default_rng(seed).uniform(0, 200, 10)))
-    r = trace_light(_random_squares(seed), LightRequest(Sun(0, 0), heights, density,
-                                                        (x0, y0, x1, y1), periodic,
+    r = trace_light(_random_squares(seed), LightRequest(Sun(0, 0),
+                                                        Sampling(heights, density, (x0, y0, x1, y1), periodic),
                                                         classes=False))
     t = r.transmission
     assert np.all((0 <= t) & (t <= 1))
@@ -170,8 +173,9 @@ def test_periodic_field_transmission_never_increases_downward(zenith, azimuth, s
     """In a periodic field sampled over its whole period every height's grid lies on the sun
     paths of the others (sensor_offsets), so T is monotone as in the continuum, at any sun."""
     heights = tuple(np.sort(np.random.default_rng(seed).uniform(0, 200, 10)))
-    r = trace_light(_random_squares(seed), LightRequest(Sun(zenith, azimuth), heights, density,
-                                                        (0, 0, 100, 100), True, classes=False))
+    r = trace_light(_random_squares(seed), LightRequest(Sun(zenith, azimuth),
+                                                        Sampling(heights, density, (0, 0, 100, 100), True),
+                                                        classes=False))
     t = r.transmission
     assert np.all((0 <= t) & (t <= 1))
     assert np.all(np.diff(t) >= 0), "transmission increased going down"
@@ -184,7 +188,7 @@ def test_sensor_planes_outside_a_periodic_period_can_rise_downward():
     v = np.array([[50, -20, 100], [150, -20, 100], [150, 120, 100], [50, 120, 100]], float)
     c = Canopy.from_triangles(v, np.array([[0, 1, 2], [0, 2, 3]]), plot(-200, -50, 300, 150),
                               np.array([1, 1]))
-    r = trace_light(c, LightRequest(Sun(45, 90), (0, 50), 1, rect=(0, 20, 100, 80)))
+    r = trace_light(c, LightRequest(Sun(45, 90), Sampling((0, 50), 1, rect=(0, 20, 100, 80))))
     assert r.transmission[0] > r.transmission[1]
 
 
@@ -195,8 +199,8 @@ def test_periodic_field_stops_rays_that_leave_the_plot():
                                              rng.uniform(5, 150, n))]
     c = canopy_of(specs)
     low = Sun(65, 180)
-    open_ = trace_light(c, LightRequest(low, (0,), 1, (30, 30, 70, 70), periodic=False))
-    wrapped = trace_light(c, LightRequest(low, (0,), 1, (30, 30, 70, 70), periodic=True))
+    open_ = trace_light(c, LightRequest(low, Sampling((0,), 1, (30, 30, 70, 70), periodic=False)))
+    wrapped = trace_light(c, LightRequest(low, Sampling((0,), 1, (30, 30, 70, 70), periodic=True)))
     assert any("overestimated" in w for w in open_.warnings)
     assert not wrapped.warnings
     assert wrapped.transmission[0] < 0.5 * open_.transmission[0]
@@ -211,7 +215,8 @@ def test_periodic_rays_wrap_in_every_direction(azimuth):
     if not along_x:
         v = v[:, [1, 0, 2]]
     c = Canopy.from_triangles(v, np.array([[0, 1, 2], [0, 2, 3]]), plot(), np.array([1, 1]))
-    r = trace_light(c, LightRequest(Sun(80, azimuth), (0,), 1, (0, 0, 100, 100), periodic=True))
+    r = trace_light(c, LightRequest(Sun(80, azimuth),
+                                    Sampling((0,), 1, (0, 0, 100, 100), periodic=True)))
     assert r.transmission[0] == pytest.approx(0.5, abs=0.011)
 
 
@@ -257,15 +262,15 @@ def test_bad_suns(make, match):
 ])
 def test_bad_requests(req, match):
     c = canopy_of([(30, 40, 20, 80)])
-    base = dict(sun=Sun(10, 0), heights_cm=(0,), density=1, rect=(10, 10, 90, 90))
+    base = dict(heights_cm=(0,), density=1, rect=(10, 10, 90, 90))
     base.update(req)
     with pytest.raises(MaizevizError, match=match):
-        trace_light(c, LightRequest(**base))
+        trace_light(c, LightRequest(Sun(10, 0), Sampling(**base)))
 
 
 def test_heights_above_canopy_fine_and_empty_canopy_refused():
     c = canopy_of([(30, 40, 20, 80)])
-    r = trace_light(c, LightRequest(Sun(10, 0), (0, 500), 1, (10, 10, 90, 90)))
+    r = trace_light(c, LightRequest(Sun(10, 0), Sampling((0, 500), 1, (10, 10, 90, 90))))
     assert r.transmission[1] == 1.0 and any("above the canopy top" in w for w in r.warnings)
     empty = Canopy.from_triangles(np.zeros((0, 3)), np.zeros((0, 3), int), plot(), np.zeros(0))
     with pytest.raises(MaizevizError, match="empty"):
@@ -278,14 +283,14 @@ def test_threads_give_the_same_answer_and_cancel_works(monkeypatch):
     rng = np.random.default_rng(1)
     c = canopy_of([(x, y, 10, h) for x, y, h in zip(rng.uniform(0, 90, 80), rng.uniform(0, 90, 80),
                                                     rng.uniform(5, 150, 80))])
-    req = dict(sun=Sun(30, 200), heights_cm=(0, 50, 100), density=4, rect=(0, 0, 100, 100))
-    one = trace_light(c, LightRequest(**req, threads=1))
-    two = trace_light(c, LightRequest(**req, threads=2))
+    req = dict(heights_cm=(0, 50, 100), density=4, rect=(0, 0, 100, 100))
+    one = trace_light(c, LightRequest(Sun(30, 200), Sampling(**req, threads=1)))
+    two = trace_light(c, LightRequest(Sun(30, 200), Sampling(**req, threads=2)))
     assert np.array_equal(one.transmission, two.transmission)
     assert np.array_equal(one.first_hits, two.first_hits)
     seen = []
     with pytest.raises(InterruptedError):
-        trace_light(c, LightRequest(**req), progress=lambda d, t: seen.append(d) or d < 3)
+        trace_light(c, LightRequest(Sun(30, 200), Sampling(**req)), progress=lambda d, t: seen.append(d) or d < 3)
     assert seen[-1] == 3
 
 
@@ -379,7 +384,7 @@ def test_sensor_planes_by_occlusion_and_by_the_ray_family_agree(monkeypatch, per
     c = _random_squares(9, n=150)
     heights = (0.0, 20.0, 55.5, 100.0, 140.0, 400.0)
     for zenith, azimuth in ((0, 0), (25, 160), (55, 300), (78, 45)):
-        req = LightRequest(Sun(zenith, azimuth), heights, 2.0, (10, 5, 90, 95), periodic)
+        req = LightRequest(Sun(zenith, azimuth), Sampling(heights, 2.0, (10, 5, 90, 95), periodic))
         results = []
         for cost in (1e-9, 1e9):                    # never / always the ray family
             monkeypatch.setattr(tr, "OCCLUSION_COST", cost)
@@ -397,7 +402,7 @@ def test_a_leaf_overhanging_a_periodic_plot_shades_the_opposite_edge():
     from maizeviz.light.transmission import light_scene
 
     c = canopy_of([(90, 40, 30, 50)])                       # x 90..120 over the edge at 100
-    req = LightRequest(Sun(0, 0), (0, 60), 4, (0, 0, 100, 100), periodic=True)
+    req = LightRequest(Sun(0, 0), Sampling((0, 60), 4, (0, 0, 100, 100), periodic=True))
     r = trace_light(c, req)
     assert r.transmission[0] == pytest.approx(1 - 900 / 10000, abs=1e-12)
     m = transmission_map(r, 0.0, 10.0)
@@ -406,10 +411,11 @@ def test_a_leaf_overhanging_a_periodic_plot_shades_the_opposite_edge():
     rows = leaf_light(c, r)
     assert rows[0]["sunlit_area_cm2"] == pytest.approx(900, rel=1e-9)
     # an open field has no such copy; a scene built for one is said to miss the overhang
-    assert trace_light(c, LightRequest(Sun(0, 0), (0,), 4, (0, 0, 100, 100))).transmission[0] \
+    assert trace_light(c, LightRequest(Sun(0, 0),
+                                       Sampling((0,), 4, (0, 0, 100, 100)))).transmission[0] \
         == pytest.approx(1 - 300 / 10000, abs=1e-12)
     plain = trace_light(c, req, scene=light_scene(c))
     assert any("overhanging" in w for w in plain.warnings)
     with pytest.raises(MaizevizError, match="cannot trace an open field"):
-        trace_light(c, LightRequest(Sun(0, 0), (0,), 4, (0, 0, 100, 100)),
+        trace_light(c, LightRequest(Sun(0, 0), Sampling((0,), 4, (0, 0, 100, 100))),
                     scene=light_scene(c, periodic=True))

@@ -51,7 +51,7 @@ def test_the_period_is_the_sum_of_its_steps_and_each_step_is_the_sun_alone(canop
     # each step: the direct part is the sun traced alone, the diffuse part the sky traced once
     for j in (0, 3, 6):
         sun = Sun(period.zenith_deg[j], period.azimuth_deg[j])
-        one = trace_light(canopy, LightRequest(sun, HEIGHTS, 0.5, (0, 0, 100, 100), True),
+        one = trace_light(canopy, LightRequest(sun, Sampling(HEIGHTS, 0.5, (0, 0, 100, 100), True)),
                           scene=scene)
         assert np.array_equal(pl.step_transmission[j], one.transmission)
         assert pl.step_intercepted_fraction[j] == pytest.approx(

@@ -92,8 +92,9 @@ def test_spherical_leaves_direct_and_uniform_sky_match_the_turbid_medium(lai):
     c = random_leaves(lai, 2.0, seed=0, spherical=True)
     scene = light_scene(c, periodic=True)
     for zenith in (0.0, 30.0, 60.0):
-        r = trace_light(c, LightRequest(Sun(zenith, 37.0), (0.0,), 0.25, (0, 0, SIDE, SIDE),
-                                        True, 2, classes=False), scene=scene)
+        r = trace_light(c, LightRequest(Sun(zenith, 37.0),
+                                        Sampling((0.0,), 0.25, (0, 0, SIDE, SIDE), True, 2),
+                                        classes=False), scene=scene)
         expect = math.exp(-0.5 * lai / math.cos(math.radians(zenith)))
         assert r.transmission[0] == pytest.approx(expect, rel=0.06), zenith
     sky = trace_sky(c, make_sky("uoc", 46), whole_plot(), scene=scene)
@@ -121,7 +122,7 @@ def test_sky_result_is_the_weighted_sum_of_its_directions():
     # each direction is traced exactly like the sun
     d = 5
     one = trace_light(c, LightRequest(Sun(sky.zenith_deg[d], sky.azimuth_deg[d]),
-                                      (0.0, 80.0, 200.0), 0.5, (0, 0, 100, 100), True))
+                                      Sampling((0.0, 80.0, 200.0), 0.5, (0, 0, 100, 100), True)))
     assert np.array_equal(one.transmission, res.per_direction[d])
     m = res.transmission_map(80.0)
     assert m.x_edges[0] == 0 and m.x_edges[-1] == 100 and m.rays.sum() == res.rays

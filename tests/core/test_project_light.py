@@ -64,7 +64,7 @@ def day(canopy, sampling, sky):
 
 @pytest.fixture(scope="module")
 def sun(canopy):
-    return trace_light(canopy, LightRequest(Sun(30.0, 150.0), HEIGHTS, 0.3, None, True))
+    return trace_light(canopy, LightRequest(Sun(30.0, 150.0), Sampling(HEIGHTS, 0.3, None, True)))
 
 
 @pytest.fixture(scope="module")

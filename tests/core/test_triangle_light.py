@@ -7,7 +7,7 @@ from maizeviz.canopy.layout import layout_for, layout_from_dict
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.leaf_light import NOT_TRACED, triangle_light
-from maizeviz.light.request import LightRequest
+from maizeviz.light.request import LightRequest, Sampling
 from maizeviz.light.sun import Sun
 from maizeviz.light.transmission import trace_light
 from maizeviz.mesh.levels import Level
@@ -30,7 +30,7 @@ def squares(specs, field=(0, 0, 100, 100)):
 def test_stacked_leaves_direct_second_and_untraced():
     # two stacked squares above the sample rectangle, one square far outside it
     c = squares([(20, 20, 20, 80), (20, 20, 20, 40), (70, 70, 10, 50)])
-    r = trace_light(c, LightRequest(Sun(0, 0), (0,), 4, (10, 10, 50, 50)))
+    r = trace_light(c, LightRequest(Sun(0, 0), Sampling((0,), 4, (10, 10, 50, 50))))
     classes = triangle_light(c, r)
     assert list(classes) == [2, 2, 1, 1, NOT_TRACED, NOT_TRACED]
 
@@ -42,7 +42,7 @@ def tiled():
 
 
 def test_every_copy_of_a_plant_is_classified_like_the_others_in_a_periodic_tiling(tiled):
-    r = trace_light(tiled, LightRequest(Sun(22.3, 167), (0,), 1, None, periodic=True))
+    r = trace_light(tiled, LightRequest(Sun(22.3, 167), Sampling((0,), 1, None, periodic=True)))
     classes = triangle_light(tiled, r)
     assert (classes >= 0).all(), "a tile-periodic field is classified everywhere"
     inst = tiled.face_instance
@@ -55,7 +55,7 @@ def test_every_copy_of_a_plant_is_classified_like_the_others_in_a_periodic_tilin
 
 
 def test_an_open_field_marks_what_no_ray_reached(tiled):
-    r = trace_light(tiled, LightRequest(Sun(22.3, 167), (0,), 1, None, periodic=False))
+    r = trace_light(tiled, LightRequest(Sun(22.3, 167), Sampling((0,), 1, None, periodic=False)))
     classes = triangle_light(tiled, r)
     centre = np.array([pl.tile == (0, 0) for pl in tiled.layout.placements])[tiled.face_instance]
     unreached = classes == NOT_TRACED

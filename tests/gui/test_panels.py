@@ -112,12 +112,12 @@ def test_plots_switch_heights(qtbot):
 
 
 def test_figures_are_the_core_heatmap_and_a_level_comparison(small_canopy):
-    from maizeviz.light.request import LightRequest
+    from maizeviz.light.request import LightRequest, Sampling
     from maizeviz.light.sun import Sun
     from maizeviz.light.transmission import trace_light
     from maizeviz_app.plots import Curve, heatmap_images, rgba, transmission_figure
 
-    result = trace_light(small_canopy, LightRequest(Sun(22.3, 167.0), (0.0, 100.0), 0.5,
+    result = trace_light(small_canopy, LightRequest(Sun(22.3, 167.0), Sampling((0.0, 100.0), 0.5),
                                                     classes=True))
     maps = heatmap_images(result, all_heights=True)
     assert heatmap_images(result, first=1)[0][1] is None      # drawn when asked for
