@@ -18,6 +18,7 @@ from maizeviz.canopy.measures import CanopyMeasures, measure_canopy
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.light.engine import LightEngine
+from maizeviz.light.irradiance import DEFAULT_PAR_UMOL_PER_J
 from maizeviz.light.request import LightRequest
 from maizeviz.light.transmission import LightResult
 from maizeviz.mesh.levels import parse_level
@@ -135,7 +136,7 @@ class DaySpec:
     start: str | None = None
     end: str | None = None
     linke: float = 3.0
-    par_factor: float = 2.1936
+    par_factor: float = DEFAULT_PAR_UMOL_PER_J
     weather: str | None = None
 
     def period(self):

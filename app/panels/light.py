@@ -28,6 +28,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QButtonGroup, QCheckBox, QComb
                                QStackedWidget, QTableWidget, QTableWidgetItem, QVBoxLayout,
                                QWidget)
 
+from maizeviz.light.irradiance import DEFAULT_PAR_UMOL_PER_J, PAR_FRACTION, PAR_UMOL_PER_J_PAR
 from maizeviz.mesh.levels import COMPLEXITY_STOPS, parse_level
 
 DEFAULT_PLACE = "2005-08-01 12:00 39.9 116.4 Asia/Shanghai"
@@ -46,7 +47,7 @@ SKY_SPLITS = {16: "16 directions (turtle)", 46: "46 directions (turtle, as Carib
               145: "145 directions (Tregenza)", None: "equal-area split of n directions"}
 DEFAULT_DAY = {"date": "2005-08-01", "lat": 39.9, "lon": 116.4, "tz": "Asia/Shanghai",
                "step_min": 30.0, "from": "", "to": "", "source": "clear", "linke": 3.0,
-               "weather": "", "par_factor": 2.1936}
+               "weather": "", "par_factor": DEFAULT_PAR_UMOL_PER_J}
 
 
 class InputProblem(ValueError):
@@ -512,7 +513,8 @@ class LightPanel(QWidget):
                                          value=DEFAULT_DAY["par_factor"], singleStep=0.01,
                                          suffix=" µmol/J")
         self.par_factor.setToolTip("µmol of PAR photons per joule of shortwave (default "
-                                   "0.48 × 4.57 = 2.1936)")
+                                   f"{PAR_FRACTION:g} × {PAR_UMOL_PER_J_PAR:g} = "
+                                   f"{DEFAULT_PAR_UMOL_PER_J:g})")
         form.addRow("PAR factor", self.par_factor)
         for b in (self.source_clear, self.source_weather):
             b.toggled.connect(lambda _c: self._on_source())
@@ -635,10 +637,9 @@ class LightPanel(QWidget):
         from maizeviz.light.request import LightRequest
         from maizeviz.light.sun import Sun
 
-        heights = parse_heights(self.heights.text())
+        sampling = self.sampling()
         sun = Sun(self.zenith.value(), self.azimuth.value())
-        return LightRequest(sun, heights, self.density.value(), None,
-                            self.periodic.isChecked(), 2, classes=True)
+        return LightRequest(sun, sampling, classes=True)
 
     def sampling(self):
         """Heights, density and field of a sky or a day (a ``Sampling``; 2 tracing threads)."""
