@@ -667,7 +667,7 @@ class MainWindow(QMainWindow):
     def _light_costs(self, mode: str, args: tuple, heights) -> list:
         """What a light run of ``mode`` on the canopy shown will cost (``maizeviz.cost``): its
         rays (times the directions: the sun, the sky's, a day's steps) and its heatmaps."""
-        from maizeviz.cost import heatmap_cost, light_cost
+        from maizeviz.cost import light_costs
 
         from maizeviz_app.plots import HEATMAP_BIN_CM
 
@@ -677,9 +677,8 @@ class MainWindow(QMainWindow):
             directions = max(args[1].directions, 1)
             if mode == "day":
                 directions += args[2].steps_bound()
-        return [light_cost(rect, args[0].density, len(heights), directions,
-                           self.built.measures.triangles),
-                heatmap_cost(rect, HEATMAP_BIN_CM, len(heights))]
+        return light_costs(rect, args[0].density, len(heights), directions, 1, HEATMAP_BIN_CM,
+                           self.built.measures.triangles)
 
     def affordable(self, stages, doing: str) -> bool:
         """Whether to start work estimated as ``stages`` (lists of ``maizeviz.cost.Cost``): no,

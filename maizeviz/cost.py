@@ -149,6 +149,28 @@ def light_cost(rect: Rect, density: float, heights: int, directions: int = 1,
                 work / RAYS_PER_S)
 
 
+def light_costs(rect: Rect, density: float, heights: int, directions: int = 1,
+                maps: int = 0, bin_cm: float = 5.0, triangles: int = 0) -> list[Cost]:
+    """A light run as the command line and the app estimate it: its rays and its maps.
+
+    Parameters
+    ----------
+    rect : (x0, y0, x1, y1) cm, the sample rectangle; density : rays per cm2
+    heights : sensor planes; directions : beams traced (the sun, sky directions, time steps;
+        at least 1 is counted)
+    maps : results mapped (a transmission map per height each; 0: none); bin_cm : map bin, cm
+    triangles : the canopy's, for the scene's memory (0: not counted)
+
+    Returns
+    -------
+    list of Cost: the tracing, then the maps if any
+    """
+    costs = [light_cost(rect, density, heights, max(directions, 1), triangles)]
+    if maps:
+        costs.append(heatmap_cost(rect, bin_cm, heights * maps))
+    return costs
+
+
 def cover_cost(layout: CanopyLayout, resolution_cm: float) -> Cost:
     """Measuring the ground cover of ``layout``'s plot with one vertical ray per
     ``resolution_cm`` pixel (:func:`maizeviz.canopy.measures.ground_cover`)."""

@@ -31,7 +31,7 @@ from maizeviz.cli.common import (
     say,
     suffixed,
 )
-from maizeviz.cost import heatmap_cost, light_cost
+from maizeviz.cost import light_costs
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import file_tag, make_folder, refuse_overwriting_inputs, write_rows
 from maizeviz.light.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping
@@ -251,10 +251,9 @@ def run(args: argparse.Namespace) -> int:
     sampled = rect or layout.centre_bounds
     directions = (sun is not None) + (sky.n if sky is not None else 0) + \
         (period.n_steps if period is not None else 0)
-    work = [light_cost(sampled, args.density, len(heights), max(directions, 1))]  # type: ignore[arg-type]
-    if args.heatmaps:
-        maps = (sun is not None) + (sky is not None) + (period is not None)
-        work.append(heatmap_cost(sampled, args.heatmap_bin, len(heights) * maps))  # type: ignore[arg-type]
+    maps = (sun is not None) + (sky is not None) + (period is not None) if args.heatmaps else 0
+    work = light_costs(sampled, args.density, len(heights), directions, maps,  # type: ignore[arg-type]
+                       args.heatmap_bin)
     check_canopy_costs(leaves, layout, levels, args.force, work)
     want_rows = bool(args.leaf_light or args.plant_light)
     records: list[dict[str, Any]] = []
