@@ -20,7 +20,9 @@ import numpy as np
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import write_text
 from maizeviz.io.inputs import read_input
+from maizeviz.io.points import MAX_ID as MAX_PLANT_ID  # plant ids as in points files
 from maizeviz.leaf.fit import Leaf
+from maizeviz.leaf.grid import stalk_base
 
 LAYOUT_SCHEMA = 1
 #: Plants a layout may hold (a hectare at 60 x 30 cm is about 55,000).
@@ -37,8 +39,6 @@ MAX_JITTER_CM = 100.0
 MAX_ANGLE_DEG = 360.0
 #: Seeds of the jitter's random generator: whole numbers 0 .. 2^32 - 1.
 MAX_SEED = 2**32 - 1
-#: Largest plant id (absolute value), as in points files.
-MAX_PLANT_ID = 1_000_000_000
 #: Largest layout file read (bytes).
 MAX_LAYOUT_BYTES = 20_000_000
 
@@ -182,12 +182,10 @@ def parse_shape(text: str, quantity: str = "tile") -> tuple[int, int]:
 def plant_bases(leaves: list[Leaf]) -> dict[int, tuple[float, float]]:
     """Stalk base (x, y) in cm of each digitized plant: the median of its leaves' collar
     midrib points (the insertions) seen from above."""
-    collars: dict[int, list[np.ndarray]] = defaultdict(list)
+    grids: dict[int, list] = defaultdict(list)
     for lf in leaves:
-        pts = lf.grid.points
-        collars[lf.grid.plant].append(pts[0, pts.shape[1] // 2, :2])
-    return {p: (float(np.median([c[0] for c in v])), float(np.median([c[1] for c in v])))
-            for p, v in collars.items()}
+        grids[lf.grid.plant].append(lf.grid)
+    return {p: stalk_base(g) for p, g in grids.items()}
 
 
 def _clusters(values: np.ndarray, spacing: float) -> np.ndarray:

@@ -26,8 +26,7 @@ def plant_tops(leaves: list[Leaf]) -> dict[int, float]:
     """Height (cm) of the highest leaf insertion of each plant: where the stalk mesh ends."""
     tops: dict[int, float] = defaultdict(float)
     for lf in leaves:
-        pts = lf.grid.points
-        tops[lf.grid.plant] = max(tops[lf.grid.plant], float(pts[0, pts.shape[1] // 2, 2]))
+        tops[lf.grid.plant] = max(tops[lf.grid.plant], float(lf.grid.collar[2]))
     return dict(tops)
 
 

@@ -62,6 +62,19 @@ class LeafGrid:
     def key(self) -> tuple[int, int]:
         return self.plant, self.leaf
 
+    @property
+    def collar(self) -> np.ndarray:
+        """(3,) cm: the midrib point of the collar cross-section, where the leaf is inserted
+        on the stalk."""
+        return self.points[0, self.points.shape[1] // 2]
+
+
+def stalk_base(grids) -> tuple[float, float]:
+    """(x, y) cm of a plant's stalk base: the median of its leaves' collar points seen from
+    above (``grids``: the plant's LeafGrids, at least one)."""
+    collars = np.array([g.collar[:2] for g in grids])
+    return float(np.median(collars[:, 0])), float(np.median(collars[:, 1]))
+
 
 def _polyline_resample(points: np.ndarray, fractions: np.ndarray) -> np.ndarray:
     """Resample a polyline (k, 3) at normalised arc-length ``fractions`` (n,) -> (n, 3)."""

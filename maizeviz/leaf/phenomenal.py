@@ -16,7 +16,7 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.io.phenomenal import LEAF_LABELS
-from maizeviz.leaf.grid import LeafGrid
+from maizeviz.leaf.grid import LeafGrid, stalk_base
 
 
 def _arc(points):
@@ -119,5 +119,5 @@ def move_plant(grids: list[LeafGrid], x: float, y: float) -> list[LeafGrid]:
     if not (np.isfinite(x) and np.isfinite(y)) or max(abs(x), abs(y)) > 1e5:
         raise MaizevizError(f"the stalk position must be finite cm within 1 km, got {x}, {y}",
                             quantity="at")
-    base = np.median([g.points[0, g.points.shape[1] // 2, :2] for g in grids], axis=0)
+    base = stalk_base(grids)
     return [replace(g, points=g.points + [x - base[0], y - base[1], 0.0]) for g in grids]
