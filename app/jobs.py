@@ -66,8 +66,14 @@ def load_points(path: str, tile: tuple[int, int] = (3, 3), row_spacing: float = 
 
 @dataclass(frozen=True)
 class Built:
-    """A canopy at one level with its Table 2 measures (``mesh``: what the viewport draws,
-    prepared off the GUI thread)."""
+    """A canopy at one level with its Table 2 measures.
+
+    Attributes
+    ----------
+    polydata : what the viewport draws, prepared off the GUI thread
+    columns, row : Table 2's column names and this canopy's row
+    serial : the points loaded when the canopy was asked for (a newer load makes it stale)
+    """
 
     level: str
     label: str
@@ -75,7 +81,10 @@ class Built:
     measures: CanopyMeasures
     build_s: float
     measure_s: float
-    mesh: Any = None
+    polydata: Any = None
+    columns: tuple[str, ...] = ()
+    row: Any = None
+    serial: int = -1
 
 
 def build(loaded: Loaded, level_text: str, preserve_area: bool,

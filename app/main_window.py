@@ -525,8 +525,8 @@ class MainWindow(QMainWindow):
 
             mesh = canopy_polydata(canopy)
             row = table2_row(m, build_s, label)
-            return jobs.Built(level, label, canopy, m, build_s, measure_s,
-                              (mesh, list(TABLE2_COLUMNS), row, serial))
+            return jobs.Built(level, label, canopy, m, build_s, measure_s, mesh,
+                              tuple(TABLE2_COLUMNS), row, serial)
 
         from maizeviz.cost import cover_cost, layout_cost
         from maizeviz.mesh.levels import parse_level
@@ -534,7 +534,7 @@ class MainWindow(QMainWindow):
         stage = [layout_cost(loaded.leaves, loaded.layout, parse_level(level)),
                  cover_cost(loaded.layout, jobs.APP_COVER_RESOLUTION_CM)]
         if not self.affordable([stage], "build"):
-            shown = self.built is not None and self.built.mesh[3] == serial
+            shown = self.built is not None and self.built.serial == serial
             if shown:
                 self.canopy_panel.set_level(self.built.level)
             self.canopy_panel.set_pending("" if shown else
@@ -548,8 +548,8 @@ class MainWindow(QMainWindow):
         """A canopy built: the level label, Table 2 and the view change together; while the
         digitizer records, the view keeps the plant being digitized and the canopy waits
         (``canopy_shown`` is emitted either way: the canopy is the window's)."""
-        mesh, columns, row, serial = built.mesh
-        if serial != self._serial or self.viewport is None:
+        mesh, columns, row = built.polydata, list(built.columns), built.row
+        if built.serial != self._serial or self.viewport is None:
             return
         self.canopy = built.canopy
         self.built = built
