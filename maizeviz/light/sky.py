@@ -556,6 +556,18 @@ def make_sky(kind: str = "soc", directions: int = 46, split: str = "auto") -> Sk
     split : "auto" (turtle for 6, 16, 46; Tregenza for 145; equal otherwise), "turtle",
         "tregenza" or "equal"
 
+    Returns
+    -------
+    Sky
+        ``zenith_deg``, ``azimuth_deg`` (n,) deg, ``solid_angle_sr`` (n,) sr, ``weights``
+        (n,) summing to 1 (each direction's share of the horizontal diffuse irradiance).
+
+    References
+    ----------
+    Moon, P. & Spencer, D.E. (1942). Illumination from a non-uniform sky. Illuminating
+    Engineering 37, 707-726. den Dulk, J.A. (1989), the turtle; Tregenza, P.R. (1987),
+    Lighting Research and Technology 19, 13-14 (see the module's references).
+
     Raises
     ------
     MaizevizError

@@ -52,6 +52,26 @@ def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None =
         its own offset, "12:00+08:00"), read by :func:`maizeviz.light.clock.local_time`
     lat, lon : degrees (north, east positive); tz : IANA zone such as "Asia/Shanghai" (UTC
         when neither the time nor ``tz`` says)
+    solar_noon : bool, the day's true solar noon (sun transit) instead of ``time``
+    altitude : float, m above sea level
+
+    Returns
+    -------
+    Sun
+        ``zenith_deg`` (apparent, refraction-corrected), ``azimuth_deg`` (clockwise from
+        north), ``when`` (ISO 8601 with its UTC offset).
+
+    Raises
+    ------
+    MaizevizError
+        A bad date, clock time, zone or place, or the sun below the horizon (``quantity``
+        names it).
+
+    References
+    ----------
+    Reda, I. & Andreas, A. (2004). Solar position algorithm for solar radiation
+    applications. Solar Energy 76(5), 577-589 (pvlib's ``get_solarposition`` and
+    ``sun_rise_set_transit_spa``).
     """
     import pandas as pd
     import pvlib
