@@ -93,18 +93,18 @@ class LightEngine:
         """The Embree scene for an open (``periodic`` False) or periodic field, built on
         first use and kept (``periodic`` None: the engine's sampling says)."""
         key = self.sampling.periodic if periodic is None else bool(periodic)
-        with self._lock:
-            if key not in self._scenes:
-                t0 = time.perf_counter()
-                self._scenes[key] = light_scene(self.canopy, self.with_stalks, key)
-                self.build_seconds[key] = time.perf_counter() - t0
-            return self._scenes[key]
+        return self._scene_and_build(key)[0]
 
     def _scene_and_build(self, periodic: bool) -> tuple[RayScene, float]:
-        """The scene, and the seconds spent building it in this call (0 when kept)."""
-        built = periodic in self._scenes
-        scene = self.scene(periodic)
-        return scene, 0.0 if built else self.build_seconds[periodic]
+        """The scene, and the seconds spent building it in this call (0 when kept, also for
+        a thread that waited while another built it)."""
+        with self._lock:
+            if periodic in self._scenes:
+                return self._scenes[periodic], 0.0
+            t0 = time.perf_counter()
+            self._scenes[periodic] = light_scene(self.canopy, self.with_stalks, periodic)
+            self.build_seconds[periodic] = time.perf_counter() - t0
+            return self._scenes[periodic], self.build_seconds[periodic]
 
     # ------------------------------------------------------------------ light
     def sun(self, sun: Sun | None = None, *, date: str | None = None, time: str | None = None,

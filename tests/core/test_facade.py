@@ -73,3 +73,14 @@ def test_per_plant_tables_sum_the_per_leaf_tables(small):
         light.table("leaf")
     with pytest.raises(mv.MaizevizError, match="height, leaf, plant"):
         light.table("tile", small)
+
+
+def test_threads_sharing_an_engine_build_its_scene_once(small):
+    from concurrent.futures import ThreadPoolExecutor
+
+    engine = LightEngine(small, density=0.25, heights_cm=(0,))
+    with ThreadPoolExecutor(4) as pool:
+        results = list(pool.map(lambda z: engine.sun(zenith=z, azimuth=90.0, classes=False),
+                                [10.0, 20.0, 30.0, 40.0]))
+    builds = [r.seconds["build"] for r in results]
+    assert sum(b > 0 for b in builds) == 1 and max(builds) == engine.build_seconds[False]
