@@ -3,9 +3,9 @@
 This is what the app saves and opens, and what the command line, sweeps and notebooks read::
 
     opened = open_project("study.maizeviz")           # checked; the points file to read
-    found = read_leaves(opened.points_path)
-    layout = restore_layout(opened, {lf.plant for lf in found.leaves})   # None: the tiling
-    results, notes = results_on(opened, layout or the tiling of ``opened.canopy``)
+    leaves = read_leaves(opened.points_path).leaves
+    layout = project_layout(opened, leaves)            # stored, or the settings' tiling
+    results, notes = results_on(opened, layout)        # those traced on these stands
 
 Opening uses the original points file when it is still there with the same content (hashed
 by streaming, never read whole), and the project's own copy otherwise: unpacked to a cache
@@ -148,6 +148,22 @@ def restore_layout(opened: Opened, plants: set[int]) -> CanopyLayout | None:
     if p.layout is None:
         return None
     return layout_from_parts(p.layout, p.arrays, plants, opened.path)
+
+
+def project_layout(opened: Opened, leaves: Sequence[Leaf]) -> CanopyLayout:
+    """The layout a project opens with: the one it stored (:func:`restore_layout`), else the
+    digitized block of ``leaves`` tiled as its canopy settings say (``tile``, default 3)."""
+    from maizeviz.canopy.layout import check_tile, layout_for
+
+    stored = restore_layout(opened, {lf.plant for lf in leaves})
+    if stored is not None:
+        return stored
+    tile = get(opened.canopy, "tile", int, 3, opened.path)
+    try:
+        shape = check_tile((tile, tile), len({lf.plant for lf in leaves}))
+    except MaizevizError as exc:
+        raise ProjectError(f"{opened.path}: {exc}", quantity="tile") from None
+    return layout_for(list(leaves), shape)
 
 
 def results_on(opened: Opened, layout: CanopyLayout) -> tuple[list[StoredResult], list[str]]:

@@ -252,3 +252,21 @@ def test_an_array_claiming_a_huge_shape_is_refused_unread(points, tmp_path):
         load_project(path)
     doc = json.loads(parts["project.json"])
     assert doc["arrays"] == ["cells"]
+
+
+def test_project_layout_is_the_stored_one_or_the_settings_tiling(points, leaves, tmp_path):
+    path = tmp_path / "tiled.maizeviz"
+    save_project(path, Project(points.read_bytes(), str(points), None,
+                               {"canopy": {"tile": 2}}))
+    opened = study.open_project(path, tmp_path)
+    assert study.project_layout(opened, leaves).placements == \
+        layout_for(leaves, (2, 2)).placements
+    layout = edited(leaves, (2, 3), 11, 2, 2)
+    save_project(path, study.make_project(str(points), points.read_bytes(), layout, layout,
+                                          {"tile": 2}, {}, []))
+    back = study.project_layout(study.open_project(path, tmp_path), leaves)
+    assert [stand_key(p) for p in back.placements] == [stand_key(p) for p in layout.placements]
+    save_project(path, Project(points.read_bytes(), str(points), None,
+                               {"canopy": {"tile": 200}}))
+    with pytest.raises(ProjectError, match="tiles of a block of 4 plants"):
+        study.project_layout(study.open_project(path, tmp_path), leaves)
