@@ -464,7 +464,8 @@ def sun_from_record(rec: Record, where: str) -> tuple[str, Any]:
             ray_area_cm2=_number(m, "ray_area_cm2", where, what),
             first_z=first_z.astype(np.float32), direction=np.array(direction),
             seconds={str(k): float(v) for k, v in get(m, "seconds", dict, {}, at).items()
-                     if isinstance(v, (int, float)) and not isinstance(v, bool)},
+                     if isinstance(v, (int, float)) and not isinstance(v, bool)
+                     and math.isfinite(v)},
             warnings=tuple(str(w) for w in get(m, "warnings", list, [], at)),
             level=str(get(m, "level", str, "", at)),
             density=_number(m, "density", where, what), **hits, **planes)
