@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 from pathlib import Path
+from typing import BinaryIO
 
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import atomic_open, cannot_write
@@ -18,6 +19,15 @@ from maizeviz.io.inputs import open_input
 
 #: Bytes read at a time while hashing.
 CHUNK = 1 << 20
+
+
+def sha256_stream(fh: BinaryIO) -> str:
+    """Hex SHA-256 of what is left to read in ``fh``, read in :data:`CHUNK` pieces; OSError
+    when it cannot be read."""
+    digest = hashlib.sha256()
+    while chunk := fh.read(CHUNK):
+        digest.update(chunk)
+    return digest.hexdigest()
 
 
 def sha256_file(path: str | Path, what: str = "file",
@@ -31,14 +41,11 @@ def sha256_file(path: str | Path, what: str = "file",
         :func:`maizeviz.io.inputs.open_input`).
     """
     fh, _ = open_input(path, what, error)
-    digest = hashlib.sha256()
     with fh:
         try:
-            while chunk := fh.read(CHUNK):
-                digest.update(chunk)
+            return sha256_stream(fh)
         except OSError as exc:
             raise error(f"{path}: cannot be read ({exc.strerror or exc})") from None
-    return digest.hexdigest()
 
 
 def same_content(path: str | Path, sha256: str) -> bool:
