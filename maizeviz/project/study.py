@@ -23,6 +23,7 @@ from typing import Any
 from maizeviz.canopy.layout import CanopyLayout
 from maizeviz.cost import check, layout_cost
 from maizeviz.errors import MaizevizError
+from maizeviz.io.atomic import remove_leftovers
 from maizeviz.io.hashing import checked_copy, same_content
 from maizeviz.io.project import Project, ProjectError, get
 from maizeviz.leaf.fit import Leaf
@@ -121,6 +122,7 @@ def open_project(path: str | Path, cache: str | Path | None = None) -> Opened:
 
     where = str(path)
     project = load_project(path)
+    remove_leftovers(path)             # temporary files of saves that were killed
     notes: list[str] = []
     points_path = _points_file(project, where, cache, notes)
     canopy = get(project.settings, CANOPY, dict, {}, where)

@@ -3,6 +3,7 @@ save and open, stale results are dropped with a note, the points copy is checked
 and what a project may hold is bounded before anything is built."""
 
 import hashlib
+import os
 import io
 import json
 import random
@@ -291,3 +292,19 @@ def test_project_layout_is_the_stored_one_or_the_settings_tiling(points, leaves,
                                {"canopy": {"tile": 200}}))
     with pytest.raises(ProjectError, match="tiles of a block of 4 plants"):
         study.project_layout(study.open_project(path, tmp_path), leaves)
+
+
+def test_opening_a_project_removes_the_part_files_of_killed_saves(points, tmp_path):
+    import subprocess
+    import sys
+
+    path = tmp_path / "p.maizeviz"
+    save_project(path, Project(points.read_bytes(), str(points)))
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    dead = tmp_path / f".p.maizeviz.{int(gone.stdout)}.k3j9.part.maizeviz"   # its writer died
+    dead.write_bytes(b"PK" * 1000)
+    mine = tmp_path / f".p.maizeviz.{os.getpid()}.a8b2.part.maizeviz"       # a live writer's
+    mine.write_bytes(b"PK")
+    study.open_project(path, tmp_path)
+    assert not dead.exists() and mine.exists()
