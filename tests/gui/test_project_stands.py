@@ -55,3 +55,32 @@ def test_an_edited_layouts_sky_light_stays_on_its_plants(window, qtbot, small_po
     assert after.keys() == before.keys()
     for stand, values in before.items():    # the same light on the same plant, to rounding
         np.testing.assert_allclose(after[stand], values, rtol=1e-5, err_msg=str(stand))
+
+
+def test_results_of_other_stands_are_left_out_with_one_line(window, qtbot, small_points,
+                                                            tmp_path):
+    from maizeviz.canopy.layout import layout_for
+    from maizeviz.canopy.scene import build_canopy
+    from maizeviz.io.project import save_project
+    from maizeviz.leaf.fit import read_leaves
+    from maizeviz.light.daylight import trace_sky
+    from maizeviz.light.request import Sampling
+    from maizeviz.light.sky import make_sky
+    from maizeviz.mesh.levels import parse_level
+    from maizeviz.project.study import make_project
+
+    leaves = read_leaves(small_points).leaves
+    level = parse_level("36")
+    other = layout_for(leaves, (3, 3))               # traced on a 3 x 3 tiling...
+    sky = trace_sky(build_canopy(leaves, other, level), make_sky("soc", 16),
+                    Sampling((0.0, 100.0), 0.3, None, True, 1))
+    path = tmp_path / "stale.maizeviz"                # ...saved with the 1 x 1 tiling
+    save_project(path, make_project(str(small_points), small_points.read_bytes(), None, other,
+                                    {"tile": 1, "level": "36", "preserve_area": True}, {},
+                                    [(level.label, sky)]))
+    w = window(path)
+    qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait()
+    text = w.messages.toPlainText()
+    assert f"note: the sky result on {level.label} was traced on other stands (18 plants) " \
+           "than the project's layout (2); left out (compute it again)" in text
+    assert not w.runs.runs and w.viewport.colouring != "light"
