@@ -889,22 +889,23 @@ class MainWindow(QMainWindow):
         if self.loaded is None:
             self.say("error: nothing to save yet: open a points file first", error=True)
             return
-        from maizeviz_app import project, project_light
+        from maizeviz_app import project
 
         loaded, data, origin = self.loaded, self._points_bytes, self._points_origin
         layout = loaded.layout if self._layout_edited else None   # else: the tiling, exactly
         canopy = {"tile": self.tile_n, "level": self.level,
                   "preserve_area": self.canopy_panel.preserve.isChecked()}
         light = self.light_panel.settings()
-        runs = [(r.label, r.result, project_light.settings_doc(r.kind,
-                                                               self.runs.settings.get(r.kind)))
+        runs = [(r.label, r.result, project.settings_doc(r.kind, self.runs.settings.get(r.kind)))
                 for r in self.runs.in_order()]
         path = str(path)
 
         def work(job):
             from maizeviz.io.project import save_project
+            from maizeviz.project.study import make_project
 
-            proj = project.make_project(origin, data, layout, canopy, light, runs)
+            # the runs were all traced on the layout shown (a layout edit clears them)
+            proj = make_project(origin, data, layout, loaded.layout, canopy, light, runs)
             save_project(path, proj)
             return path
 
@@ -928,17 +929,21 @@ class MainWindow(QMainWindow):
         cache = self._cache_folder()
 
         def work(job):
-            opened = project.open_project(path, cache)
+            from maizeviz.mesh.levels import parse_level
+            from maizeviz.project import study
+
+            opened = study.open_project(path, cache)
             tile, level, preserve = project.canopy_settings(opened)
             light = project.light_settings(opened)
             found = jobs.load_points(opened.points_path, (tile, tile),
                                      shown_name=opened.shown_name)
-            layout = found.layout
-            if opened.project.layout is not None:
-                layout = project.layout_from_parts(opened.project.layout,
-                                                   opened.project.arrays, found.plants, path)
+            layout = study.restore_layout(opened, found.plants) or found.layout
+            study.check_canopy_fits(found.leaves, layout, parse_level(level), path)
+            results, dropped = study.results_on(opened, layout)
+            opened.notes.extend(dropped)
+            runs = [project.stored_run(r, path) for r in results]
             loaded = replace(found, layout=layout)
-            return opened, loaded, (tile, level, preserve), light
+            return opened, loaded, (tile, level, preserve), light, runs
 
         self.runner.run("load", f"opening {Path(path).name}", work, on_done=self._on_project,
                         on_error=lambda e: self._fail(e, "open project"))
@@ -950,7 +955,7 @@ class MainWindow(QMainWindow):
         return str(Path(base or Path.home() / ".cache" / "maizeviz") / "projects")
 
     def _on_project(self, out) -> None:
-        opened, loaded, (tile, level, preserve), light = out
+        opened, loaded, (tile, level, preserve), light, runs = out
         for note in opened.notes:
             self.say(f"note: {note}")
         self._tile = tile
@@ -962,7 +967,7 @@ class MainWindow(QMainWindow):
         self._project_layout = opened.project.layout is not None
         self._on_loaded(loaded, opened.project.points_csv, opened.path,
                         opened.project.points_path)
-        self._pending_runs = list(opened.runs)
+        self._pending_runs = list(runs)
 
     def _adopt_pending_runs(self) -> None:
         """Light results of an opened project (sun, sky and day) join the comparison once its

@@ -303,6 +303,11 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
                         a * b * union_area(np.array(centre)))
 
 
+#: Above this many overlapping pairs of cells, the warning gives their count only (the area
+#: counted twice would need every pair in memory).
+MAX_OVERLAP_PAIRS = 2_000_000
+
+
 def _overlaps(cells: np.ndarray) -> str:
     """How much ground equal-sized cells (k, 4) count twice, in words ('' when none).
 
@@ -319,7 +324,13 @@ def _overlaps(cells: np.ndarray) -> str:
     h = cells[0, 3] - cells[0, 1]
     centres = np.column_stack([(cells[:, 0] + cells[:, 2]) / (2 * w),
                                (cells[:, 1] + cells[:, 3]) / (2 * h)])
-    pairs = cKDTree(centres).query_pairs(0.9, p=np.inf, output_type="ndarray")
+    tree = cKDTree(centres)
+    # count first (no pairs held): plants packed far closer than the spacing (100,000 plants
+    # 1 cm apart with a 30 cm spacing) make ~10^8 pairs, gigabytes if listed
+    n_pairs = (int(tree.count_neighbors(tree, 0.9, p=np.inf)) - len(centres)) // 2
+    if n_pairs > MAX_OVERLAP_PAIRS:
+        return f"({n_pairs:,} overlapping pairs)"
+    pairs = tree.query_pairs(0.9, p=np.inf, output_type="ndarray")
     if not len(pairs):
         return ""
     d = np.abs(centres[pairs[:, 0]] - centres[pairs[:, 1]])

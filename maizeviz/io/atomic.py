@@ -4,6 +4,11 @@ Every file maizeviz writes goes to a temporary file in the same folder, is flush
 (fsync) and renamed over the target (``os.replace`` is atomic within a file system); the folder
 is fsynced so the rename itself survives a power cut. A failure removes the temporary file and
 raises :class:`~maizeviz.errors.MaizevizError` naming the path.
+
+A process killed outright (kill -9, power cut) cannot remove its temporary file, so its name
+carries the writer's process id, ``.<name>.<pid>.<random>.part<suffix>``: the next write of the
+same target removes the leftovers of writers that are no longer running (a live writer's file
+is never touched, so two processes may write the same target at once).
 """
 
 from __future__ import annotations
@@ -71,6 +76,55 @@ def check_output(path: str | Path) -> Path:
     return path
 
 
+def _temp_prefix(path: Path) -> str:
+    return f".{path.name}."
+
+
+def temp_leftovers(path: str | Path) -> list[Path]:
+    """Temporary files of ``path`` left by writers that are no longer running."""
+    path = Path(path)
+    prefix = _temp_prefix(path)
+    out = []
+    try:
+        entries = list(os.scandir(path.parent))
+    except OSError:
+        return []
+    for entry in entries:
+        name = entry.name
+        if not name.startswith(prefix) or not name.endswith(f".part{path.suffix}"):
+            continue
+        pid_text = name[len(prefix):].split(".", 1)[0]
+        if not pid_text.isdigit() or _running(int(pid_text)):
+            continue
+        out.append(Path(entry.path))
+    return out
+
+
+def _running(pid: int) -> bool:
+    """Whether process ``pid`` exists (ours always does)."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, OSError):
+        return True          # another user's process, or a number we cannot check: keep it
+    return True
+
+
+def remove_leftovers(path: str | Path) -> int:
+    """Remove the temporary files of ``path`` left by killed writers; returns how many."""
+    n = 0
+    for tmp in temp_leftovers(path):
+        try:
+            tmp.unlink()
+            n += 1
+        except OSError:        # gone meanwhile, or not ours to remove: harmless
+            pass
+    return n
+
+
 @contextlib.contextmanager
 def atomic_path(path: str | Path) -> Iterator[Path]:
     """A temporary path beside ``path`` (same suffix, for writers that pick a format by it);
@@ -83,9 +137,10 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     """
     path = check_output(path)
     folder = path.parent
+    remove_leftovers(path)
     try:
-        fd, tmp_name = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=f".part{path.suffix}",
-                                        dir=folder)
+        fd, tmp_name = tempfile.mkstemp(prefix=f"{_temp_prefix(path)}{os.getpid()}.",
+                                        suffix=f".part{path.suffix}", dir=folder)
     except OSError as exc:
         raise cannot_write(path, exc) from None
     os.close(fd)

@@ -35,7 +35,7 @@ import zipfile
 import zlib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import IO, Any
 
 import numpy as np
 
@@ -232,7 +232,11 @@ def _expect(value: Any, kind: type | tuple[type, ...], what: str, where: str) ->
         shown = json.dumps(value)[:40] if _jsonable(value) else "something else"
         raise _refuse(where, f"{what} must be {names.get(kind, 'something else')}, got {shown}")
     if isinstance(value, float) and not math.isfinite(value):
-        raise _refuse(where, f"{what} must be a finite number, got {value}")
+        shown = "a number too large" if value in (math.inf, -math.inf) else str(value)
+        raise _refuse(where, f"{what} must be a finite number, got {shown}")
+    if isinstance(value, str) and "\x00" in value:
+        raise _refuse(where, f"{what} holds a NUL character; the project is damaged or was "
+                             "tampered with")
     return value
 
 
@@ -244,12 +248,24 @@ def _jsonable(v: Any) -> bool:
         return False
 
 
+#: Longest integer (digits) a project may hold; longer ones read as infinite, so the field that
+#: holds one is refused by name (no setting, id or count needs more).
+MAX_DIGITS = 30
+
+
+def _bounded_int(text: str) -> int | float:
+    digits = text.lstrip("-")
+    if len(digits) > MAX_DIGITS:
+        return -math.inf if text.startswith("-") else math.inf
+    return int(text)
+
+
 def _parse_json(raw: bytes, where: str) -> dict[str, Any]:
     try:
-        doc = json.loads(raw.decode("utf-8"))
+        doc = json.loads(raw.decode("utf-8"), parse_int=_bounded_int)
     except UnicodeDecodeError:
         raise _refuse(where, "project.json is not UTF-8 text; the project is damaged") from None
-    except (json.JSONDecodeError, RecursionError) as exc:
+    except (ValueError, RecursionError) as exc:
         raise _refuse(where, f"project.json is not valid JSON ({str(exc)[:60]}); the project "
                              "is damaged") from None
     if not isinstance(doc, dict):
@@ -266,9 +282,8 @@ def _parse_json(raw: bytes, where: str) -> dict[str, Any]:
     return doc
 
 
-def _read_npy(raw: bytes, name: str, where: str) -> np.ndarray:
-    """One .npy member, its header checked against its data before anything is allocated."""
-    fh = io.BytesIO(raw)
+def _npy_header(fh: IO[bytes], name: str, where: str) -> tuple[tuple[int, ...], bool, np.dtype]:
+    """Shape, Fortran order and type from the header of a .npy stream (its data unread)."""
     try:
         major, minor = np.lib.format.read_magic(fh)
         if (major, minor) == (1, 0):
@@ -277,16 +292,40 @@ def _read_npy(raw: bytes, name: str, where: str) -> np.ndarray:
             shape, fortran, dtype = np.lib.format.read_array_header_2_0(fh)
         else:
             raise ValueError(f"npy version {major}.{minor}")
-    except (ValueError, EOFError, SyntaxError, struct.error, OverflowError) as exc:
+    except (ValueError, EOFError, SyntaxError, struct.error, OverflowError, TypeError,
+            zlib.error, zipfile.BadZipFile) as exc:
         raise _refuse(where, f"array '{name}' is damaged ({str(exc)[:60]})") from None
     if dtype.hasobject or dtype.kind not in ARRAY_KINDS:
         raise _refuse(where, f"array '{name}' has type {dtype}, which projects never hold; "
                              "not opened")
-    count = math.prod(shape)
-    data = raw[fh.tell():]
-    if count * dtype.itemsize != len(data):
-        raise _refuse(where, f"array '{name}' says {shape} {dtype} but holds {len(data)} "
-                             "bytes; the project is damaged")
+    return shape, fortran, dtype
+
+
+def _read_npy(zf: zipfile.ZipFile, info: zipfile.ZipInfo, name: str, where: str,
+              budget: int) -> np.ndarray:
+    """One .npy member of arrays.npz: its header is read first and the size it declares is
+    checked against the member's size, :data:`MAX_ARRAY_BYTES` and ``budget`` (bytes left
+    for the project's arrays) before the data are read, so an array claiming a huge shape is
+    refused without allocating it."""
+    with zf.open(info) as fh:
+        shape, fortran, dtype = _npy_header(fh, name, where)
+        count = math.prod(shape)
+        size = count * dtype.itemsize
+        if fh.tell() + size != info.file_size:
+            raise _refuse(where, f"array '{name}' says {shape} {dtype} but holds "
+                                 f"{info.file_size - fh.tell()} bytes; the project is damaged")
+        if size > MAX_ARRAY_BYTES or size > budget:
+            raise _refuse(where, f"array '{name}' says {shape} {dtype} "
+                                 f"({size / 2**20:.0f} MiB), more than a project holds; not "
+                                 "opened")
+        try:
+            data = fh.read(size)
+            extra = fh.read(1)
+        except (zlib.error, zipfile.BadZipFile, EOFError, OSError) as exc:
+            raise _refuse(where, f"array '{name}' is damaged ({str(exc)[:60]})") from None
+    if len(data) != size or extra:
+        raise _refuse(where, f"array '{name}' holds more or less data than its header says; "
+                             "the project is damaged")
     a = np.frombuffer(data, dtype=dtype, count=count)
     return a.reshape(shape, order="F" if fortran else "C")
 
@@ -300,18 +339,20 @@ def _read_arrays(raw: bytes, where: str) -> dict[str, np.ndarray]:
     if len(infos) > 10_000:
         raise _refuse(where, f"arrays.npz holds {len(infos)} arrays; not a maizeviz project")
     out: dict[str, np.ndarray] = {}
-    total = 0
+    budget = MAX_MEMBER_BYTES["arrays.npz"]
     with inner:
         for info in infos:
             stem = info.filename[:-4] if info.filename.endswith(".npy") else ""
             if not _NAME.fullmatch(stem) or stem in out:
                 raise _refuse(where, f"arrays.npz holds an unexpected entry "
                                      f"'{info.filename[:60]}'; not opened")
-            data = _read_member(inner, info, MAX_ARRAY_BYTES + 4096, where, text=False)
-            total += len(data)
-            if total > MAX_MEMBER_BYTES["arrays.npz"]:
-                raise _refuse(where, "the arrays are larger than a project holds; not opened")
-            out[stem] = _read_npy(data, stem, where)
+            if info.flag_bits & 0x1:
+                raise _refuse(where, f"array '{stem}' is encrypted; maizeviz projects are not")
+            if info.file_size > MAX_ARRAY_BYTES + 4096:
+                raise _refuse(where, f"array '{stem}' is {info.file_size / 2**20:.0f} MiB "
+                                     "unpacked, more than a project holds; not opened")
+            out[stem] = _read_npy(inner, info, stem, where, budget)
+            budget -= out[stem].nbytes
     return out
 
 

@@ -23,7 +23,6 @@ module imports only its errors.
 
 from __future__ import annotations
 
-import hashlib
 import threading
 import time
 from collections import OrderedDict
@@ -36,6 +35,7 @@ from maizeviz.canopy.measures import measure_canopy
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.cost import Cost, cover_cost, layout_cost, light_cost
 from maizeviz.errors import MaizevizError
+from maizeviz.io.hashing import sha256_stream
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.engine import LightEngine
 from maizeviz.light.request import Sampling
@@ -136,11 +136,8 @@ def clear_caches() -> None:
 
 def file_sha256(path) -> str:
     """sha256 (hex) of a file's bytes; OSError when it cannot be read."""
-    h = hashlib.sha256()
     with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
+        return sha256_stream(fh)
 
 
 def _leaves(path: str, sha256: str):

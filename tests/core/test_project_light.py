@@ -10,8 +10,7 @@ import zipfile
 import numpy as np
 import pytest
 from maizeviz_app.jobs import DaySpec, SkySpec
-from maizeviz_app.project import make_project, open_project, run_from_record, run_record
-from maizeviz_app.project_light import DAY_KIND, SKY_KIND, settings_doc
+from maizeviz_app.project import settings_doc, stored_run
 
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
@@ -27,6 +26,8 @@ from maizeviz.light.sky import make_sky
 from maizeviz.light.sun import Sun
 from maizeviz.light.transmission import trace_light
 from maizeviz.mesh.levels import parse_level
+from maizeviz.project import study
+from maizeviz.project.records import DAY_KIND, SKY_KIND, run_from_record, run_record
 
 HEIGHTS = (0.0, 60.0, 150.0)
 SKY_SPEC = SkySpec("soc", 16, "auto")
@@ -41,9 +42,32 @@ def points(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def canopy(points):
-    found = read_leaves(points)
-    return build_canopy(found.leaves, layout_for(found.leaves, (1, 1)), parse_level("16"))
+def layout(points):
+    return layout_for(read_leaves(points).leaves, (1, 1))
+
+
+@pytest.fixture(scope="module")
+def canopy(points, layout):
+    return build_canopy(read_leaves(points).leaves, layout, parse_level("16"))
+
+
+class Reopened:
+    """A project read back as the window reads it: the core's results, the panel's settings."""
+
+    def __init__(self, path, layout):
+        opened = study.open_project(path)
+        results, dropped = study.results_on(opened, layout)
+        self.notes = opened.notes + dropped
+        self.runs = [stored_run(r, str(path)) for r in results]
+
+
+def window_read(rec, where):
+    """A record read as the window reads it (the core's result, the panel's settings)."""
+    return stored_run(study.StoredResult(*run_from_record(rec, where)), where)
+
+
+def make_project(points, data, layout, runs):
+    return study.make_project(points, data, None, layout, {}, {}, runs)
 
 
 @pytest.fixture(scope="module")
@@ -68,13 +92,13 @@ def sun(canopy):
 
 
 @pytest.fixture(scope="module")
-def reopened(points, sun, sky, day, tmp_path_factory):
+def reopened(points, layout, sun, sky, day, tmp_path_factory):
     """The three results saved in one project file and read back."""
     path = tmp_path_factory.mktemp("projlight") / "study.maizeviz"
     runs = [("16", sun), ("16", sky, settings_doc("sky", SKY_SPEC)),
             ("16", day, settings_doc("day", (DAY_SPEC, SKY_SPEC)))]
-    save_project(path, make_project(str(points), points.read_bytes(), None, {}, {}, runs))
-    return path, open_project(path)
+    save_project(path, make_project(str(points), points.read_bytes(), layout, runs))
+    return path, Reopened(path, layout)
 
 
 def same_map(a, b, height):
@@ -160,13 +184,13 @@ def test_a_day_comes_back_with_every_output_and_its_settings(reopened, day, cano
     assert (tmp_path / "a.csv").read_text() == (tmp_path / "b.csv").read_text()
 
 
-def test_sun_results_open_as_before_and_unknown_kinds_are_a_note(points, sun, tmp_path):
+def test_sun_results_open_as_before_and_unknown_kinds_are_a_note(points, layout, sun, tmp_path):
     path = tmp_path / "old.maizeviz"
-    proj = make_project(str(points), points.read_bytes(), None, {}, {}, [("16", sun)])
+    proj = make_project(str(points), points.read_bytes(), layout, [("16", sun)])
     moon = Record("light_moon", {"label": "16"}, {"x": np.zeros(2)})
     save_project(path, type(proj)(proj.points_csv, proj.points_path, None, {}, {},
                                   proj.results + (moon,)))
-    opened = open_project(path)
+    opened = Reopened(path, layout)
     assert len(opened.runs) == 1
     label, back, kind, settings = opened.runs[0]
     assert (label, kind, settings) == ("16", "sun", None)
@@ -177,9 +201,9 @@ def test_sun_results_open_as_before_and_unknown_kinds_are_a_note(points, sun, tm
 
 
 def test_a_record_without_settings_takes_the_skys_own(sky, day):
-    back = run_from_record(run_record("36", sky), "p")
+    back = window_read(run_record("36", sky), "p")
     assert back.settings == SkySpec("soc", 16, "auto")
-    assert run_from_record(run_record("36", day), "p").settings is None
+    assert window_read(run_record("36", day), "p").settings is None
 
 
 # --------------------------------------------------------------------------- damaged records
@@ -226,7 +250,7 @@ SKY_DAMAGE = [
 def test_damaged_sky_records_are_refused_with_what_is_wrong(sky, change, message):
     rec = damaged(run_record("16", sky, settings_doc("sky", SKY_SPEC)), change)
     with pytest.raises(ProjectError) as err:
-        run_from_record(rec, "study.maizeviz")
+        window_read(rec, "study.maizeviz")
     assert message in str(err.value) and str(err.value).startswith("study.maizeviz: ")
     assert "\n" not in str(err.value)
 
@@ -269,24 +293,24 @@ DAY_DAMAGE = [
 def test_damaged_day_records_are_refused_with_what_is_wrong(day, change, message):
     rec = damaged(run_record("16", day, settings_doc("day", (DAY_SPEC, SKY_SPEC))), change)
     with pytest.raises(ProjectError) as err:
-        run_from_record(rec, "study.maizeviz")
+        window_read(rec, "study.maizeviz")
     assert message in str(err.value) and str(err.value).startswith("study.maizeviz")
     assert "\n" not in str(err.value)
 
 
-def test_a_damaged_record_in_a_file_refuses_the_project(points, day, tmp_path):
+def test_a_damaged_record_in_a_file_refuses_the_project(points, layout, day, tmp_path):
     path = tmp_path / "bad.maizeviz"
     rec = damaged(run_record("16", day), lambda m, a: _times(m, 2, "noon"))
-    save_project(path, make_project(str(points), points.read_bytes(), None, {}, {}, []))
+    save_project(path, make_project(str(points), points.read_bytes(), layout, []))
     proj = load_project(path)
     save_project(path, type(proj)(proj.points_csv, proj.points_path, None, {}, {}, (rec,)))
     with pytest.raises(ProjectError, match="time step 3 must be an ISO 8601 time"):
-        open_project(path)
+        study.open_project(path)
 
 
 def test_a_fixed_offset_zone_and_utc_come_back(day):
     for zone in ("UTC", "UTC+08:00"):
         rec = damaged(run_record("16", day), lambda m, a, z=zone: _set(m["period"], "tz", z))
-        back = run_from_record(rec, "p").result
+        back = window_read(rec, "p").result
         assert (back.period.times == day.period.times).all()          # the same instants
         assert str(back.period.times.tz) == str(back.period.start.tz) == zone

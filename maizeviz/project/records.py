@@ -1,6 +1,7 @@
-"""Sky and day light results to and from project records (:mod:`maizeviz.io.project`); no Qt.
+"""Light results to and from project records (:mod:`maizeviz.io.project`).
 
-A sky result (:class:`~maizeviz.light.daylight.SkyLight`) is stored as a ``light_sky`` record,
+A sun result (:class:`~maizeviz.light.transmission.LightResult`) is stored as a ``light``
+record (the only kind of maizeviz 0.2's projects), a sky result (:class:`~maizeviz.light.daylight.SkyLight`) is stored as a ``light_sky`` record,
 a day (:class:`~maizeviz.light.daylight.PeriodLight`, its :class:`~maizeviz.light.irradiance.
 Period` and the sky light of its diffuse part) as a ``light_day`` record: JSON metadata
 (numbers, text, times as ISO 8601 with their UTC offset, the time zone's name) and numeric
@@ -8,8 +9,13 @@ arrays; no pickle. Reading checks every size, type and value before the objects 
 through their constructors (so :class:`~maizeviz.light.sky.Sky` and ``Period`` validate
 themselves too); anything wrong is a :class:`~maizeviz.io.project.ProjectError` naming it.
 
-Each record may also hold the app's settings of that light (``settings``: the sky chosen, the
-day's date and place), so a reopened comparison goes on as if the runs had just been made.
+Each record may also hold the settings of that light as JSON (``settings``: the sky chosen, the
+day's date and place), so a reopened comparison goes on as if the runs had just been made, and
+the identity of the stands it was traced on (``stands``, :mod:`maizeviz.project.stands`), so
+per-plant and per-leaf values are never shown on other plants.
+
+The command line, sweeps and notebooks read these records as the app does:
+:func:`run_from_record` turns any record into (label, result, kind, settings).
 """
 
 from __future__ import annotations
@@ -25,8 +31,10 @@ import numpy as np
 from maizeviz.errors import MaizevizError
 from maizeviz.io.project import ProjectError, Record, get, get_numbers
 
-#: Record kinds of a sky and a day result (a sun result is ``"light"``).
-SKY_KIND, DAY_KIND = "light_sky", "light_day"
+#: Record kinds of a sun, a sky and a day result (a sun's is the only kind of maizeviz 0.2).
+SUN_KIND, SKY_KIND, DAY_KIND = "light", "light_sky", "light_day"
+#: The light of each record kind, as results are named in tables and the app.
+KINDS = {SUN_KIND: "sun", SKY_KIND: "sky", DAY_KIND: "day"}
 #: Arrays of a Sky, under the record's prefix.
 _SKY_ARRAYS = ("zenith_deg", "azimuth_deg", "solid_angle_sr", "weights")
 #: Arrays of a Period (each (n,) float64), stored as ``period_<name>``.
@@ -142,15 +150,48 @@ def day_record(label: str, light, settings: dict | None = None) -> Record:
     return Record(DAY_KIND, meta, arrays)
 
 
-def record_of(label: str, result, settings: dict | None = None) -> Record | None:
-    """The record of a SkyLight or a PeriodLight; None for any other result."""
+def sun_record(label: str, result) -> Record:
+    """A sun result (a ``LightResult`` traced on the canopy labelled ``label``)."""
+    meta = {"label": label, "level": result.level,
+            "sun": {"zenith_deg": float(result.sun.zenith_deg),
+                    "azimuth_deg": float(result.sun.azimuth_deg), "when": result.sun.when},
+            "heights_cm": _floats(result.heights_cm),
+            "transmission": _floats(result.transmission),
+            "rays": int(result.rays), "rect": _floats(result.rect),
+            "ray_area_cm2": float(result.ray_area_cm2), "density": float(result.density),
+            "direction": _floats(result.direction),
+            "seconds": {k: float(v) for k, v in result.seconds.items()},
+            "warnings": [str(w) for w in result.warnings],
+            "periodic": bool(getattr(result, "periodic", False))}
+    arrays = {"first_z": np.asarray(result.first_z, np.float32)}
+    for name, dtype in (("sensor_lit", np.uint8), ("sensor_offset_cm", np.float64)):
+        a = getattr(result, name, None)
+        if a is not None:
+            arrays[name] = np.asarray(a, dtype)
+    for name in ("first_hits", "second_hits"):
+        a = getattr(result, name)
+        if a is not None:
+            arrays[name] = np.asarray(a, np.int32 if a.max(initial=0) < 2**31 else np.int64)
+    return Record(SUN_KIND, meta, arrays)
+
+
+def run_record(label: str, result, settings: dict | None = None,
+               stands: dict | None = None) -> Record:
+    """The record of any light result: a sun's ``LightResult``, a ``SkyLight`` or a
+    ``PeriodLight``; ``settings``: the settings of a sky or day run as JSON (kept for
+    reopening); ``stands``: the identity of the stands it was traced on
+    (:func:`maizeviz.project.stands.stands_identity`)."""
     from maizeviz.light.daylight import PeriodLight, SkyLight
 
     if isinstance(result, SkyLight):
-        return sky_record(label, result, settings)
-    if isinstance(result, PeriodLight):
-        return day_record(label, result, settings)
-    return None
+        rec = sky_record(label, result, settings)
+    elif isinstance(result, PeriodLight):
+        rec = day_record(label, result, settings)
+    else:
+        rec = sun_record(label, result)
+    if stands is not None:
+        rec.meta["stands"] = dict(stands)
+    return rec
 
 
 # ------------------------------------------------------------------------------ reading
@@ -378,57 +419,77 @@ def day_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None]:
             get(m, "settings", dict, None, where))
 
 
-# ------------------------------------------------------------------------ the app's settings
-def settings_doc(kind: str, settings: Any) -> dict | None:
-    """The window's settings of a sky run (a ``SkySpec``) or a day run (``(DaySpec,
-    SkySpec)``) as JSON, or None when they are not those."""
-    from dataclasses import asdict, is_dataclass
+def sun_from_record(rec: Record, where: str) -> tuple[str, Any]:
+    """(label, LightResult) from a ``light`` record; refused with ProjectError if malformed."""
+    from maizeviz.light.sun import Sun
+    from maizeviz.light.transmission import LightResult
 
-    if kind == "sky" and is_dataclass(settings) and not isinstance(settings, type):
-        return {"sky": asdict(settings)}
-    if kind == "day" and isinstance(settings, tuple) and len(settings) == 2 and \
-            all(is_dataclass(s) and not isinstance(s, type) for s in settings):
-        return {"day": asdict(settings[0]), "sky": asdict(settings[1])}
-    return None
+    m = rec.meta
+    what = "a sun result"
+    at = f"{where}: {what}"
+    sun = get(m, "sun", dict, where=at)
+    heights = get_numbers(m, "heights_cm", where=at)
+    transmission = get_numbers(m, "transmission", where=at)
+    rect = get_numbers(m, "rect", where=at)
+    direction = get_numbers(m, "direction", where=at)
+    rays = get(m, "rays", int, where=at)
+    if len(heights) != len(transmission) or len(rect) != 4 or len(direction) != 3 or rays < 0:
+        raise ProjectError(f"{at} has inconsistent sizes; the project is damaged")
+    first_z = rec.arrays.get("first_z")      # -inf where a ray hits nothing
+    if first_z is None or first_z.dtype.kind != "f" or first_z.shape != (rays,) or \
+            np.isnan(first_z).any() or (first_z == np.inf).any():
+        raise ProjectError(f"{at}: its rays are missing or do not match; the project is "
+                           "damaged")
+    hits: dict[str, Any] = {}
+    for name in ("first_hits", "second_hits"):
+        hits[name] = None if name not in rec.arrays else \
+            _array(rec, name, where, what, (None,), counts=True, lo=0)
+    planes: dict[str, Any] = {}
+    if "sensor_lit" in rec.arrays:
+        lit = rec.arrays["sensor_lit"]
+        if lit.dtype != np.uint8 or lit.shape != (len(heights), -(-rays // 8)):
+            raise ProjectError(f"{at}: its sensor planes do not match its heights and rays; "
+                               "the project is damaged")
+        planes = {"sensor_lit": np.array(lit),
+                  "sensor_offset_cm": _array(rec, "sensor_offset_cm", where, what,
+                                             (len(heights), 2)),
+                  "periodic": bool(get(m, "periodic", bool, False, at))}
+    try:
+        result = LightResult(
+            sun=Sun(_number(sun, "zenith_deg", where, what), _number(sun, "azimuth_deg", where,
+                                                                      what),
+                    str(get(sun, "when", str, "", at))),
+            heights_cm=np.array(heights), transmission=np.array(transmission), rays=rays,
+            rect=(rect[0], rect[1], rect[2], rect[3]),
+            ray_area_cm2=_number(m, "ray_area_cm2", where, what),
+            first_z=first_z.astype(np.float32), direction=np.array(direction),
+            seconds={str(k): float(v) for k, v in get(m, "seconds", dict, {}, at).items()
+                     if isinstance(v, (int, float)) and not isinstance(v, bool)
+                     and math.isfinite(v)},
+            warnings=tuple(str(w) for w in get(m, "warnings", list, [], at)),
+            level=str(get(m, "level", str, "", at)),
+            density=_number(m, "density", where, what), **hits, **planes)
+    except (ValueError, MaizevizError) as exc:     # e.g. a sun below the horizon
+        raise ProjectError(f"{at} cannot be used ({exc})") from None
+    return str(get(m, "label", str, result.level, at)), result
 
 
-def _sky_spec(doc: dict, where: str):
-    from maizeviz_app.jobs import SkySpec
+def run_from_record(rec: Record, where: str) -> tuple[str, Any, str, dict | None] | None:
+    """(label, result, light kind ``"sun"``/``"sky"``/``"day"``, stored settings or None) of
+    a record, or None for a kind this maizeviz does not know.
 
-    at = f"{where}: the sky settings of a light result"
-    return SkySpec(get(doc, "kind", str, where=at), get(doc, "directions", int, where=at),
-                   get(doc, "split", str, where=at))
-
-
-def _day_spec(doc: dict, where: str):
-    from maizeviz_app.jobs import DaySpec
-
-    at = f"{where}: the day settings of a light result"
-
-    def text_or_none(key: str):
-        value = doc.get(key)
-        return None if value is None else get(doc, key, str, where=at)
-
-    return DaySpec(get(doc, "date", str, where=at), float(get(doc, "lat", (int, float), where=at)),
-                   float(get(doc, "lon", (int, float), where=at)), get(doc, "tz", str, where=at),
-                   float(get(doc, "step_min", (int, float), where=at)), text_or_none("start"),
-                   text_or_none("end"), float(get(doc, "linke", (int, float), where=at)),
-                   float(get(doc, "par_factor", (int, float), where=at)),
-                   text_or_none("weather"))
-
-
-def run_settings(kind: str, result, stored: dict | None, where: str) -> Any:
-    """The settings a sky or day run is compared with in the window (what the light panel
-    gives for the same choice): from the stored ``settings``, else (an older record) the
-    sky's from the result and None for a day. Bad stored settings: ProjectError."""
-    from maizeviz_app.jobs import SkySpec
-
-    if stored is not None:
-        sky = _sky_spec(get(stored, "sky", dict, where=where), where)
-        if kind == "sky":
-            return sky
-        return (_day_spec(get(stored, "day", dict, where=where), where), sky)
-    if kind == "sky":
-        s = result.sky
-        return SkySpec(s.kind, s.n, "equal" if s.split == "equal" else "auto")
+    Raises
+    ------
+    ProjectError
+        A malformed record (one line naming what is wrong).
+    """
+    if rec.kind == SUN_KIND:
+        label, result = sun_from_record(rec, where)
+        return label, result, "sun", None
+    if rec.kind == SKY_KIND:
+        label, result, stored = sky_from_record(rec, where)
+        return label, result, "sky", stored
+    if rec.kind == DAY_KIND:
+        label, result, stored = day_from_record(rec, where)
+        return label, result, "day", stored
     return None

@@ -1,0 +1,207 @@
+"""A study to and from a ``.maizeviz`` project: points, layout, settings and light results.
+
+This is what the app saves and opens, and what the command line, sweeps and notebooks read::
+
+    opened = open_project("study.maizeviz")           # checked; the points file to read
+    leaves = read_leaves(opened.points_path).leaves
+    layout = project_layout(opened, leaves)            # stored, or the settings' tiling
+    results, notes = results_on(opened, layout)        # those traced on these stands
+
+Opening uses the original points file when it is still there with the same content (hashed
+by streaming, never read whole), and the project's own copy otherwise: unpacked to a cache
+folder, written atomically and checked against its hash every time it is used.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from maizeviz.canopy.layout import CanopyLayout
+from maizeviz.cost import check, layout_cost
+from maizeviz.errors import MaizevizError
+from maizeviz.io.atomic import remove_leftovers
+from maizeviz.io.hashing import checked_copy, same_content
+from maizeviz.io.project import Project, ProjectError, get
+from maizeviz.leaf.fit import Leaf
+from maizeviz.mesh.levels import Level
+from maizeviz.project.records import run_from_record, run_record
+from maizeviz.project.stands import layout_from_parts, layout_parts, stands_identity
+
+#: Settings groups of a project.
+CANOPY, LIGHT = "canopy", "light"
+
+
+@dataclass(frozen=True)
+class StoredResult:
+    """A light result read from a project.
+
+    Attributes
+    ----------
+    label : the canopy (level) it was traced on, as in Table 2
+    result : a ``LightResult`` (sun), ``SkyLight`` (sky) or ``PeriodLight`` (day)
+    kind : ``"sun"``, ``"sky"`` or ``"day"``
+    settings : the settings of a sky or day run as stored (JSON), or None
+    stands : ``{"n", "sha256"}`` of the stands it was traced on
+        (:func:`~maizeviz.project.stands.stands_identity`), None in older projects
+    """
+
+    label: str
+    result: Any
+    kind: str
+    settings: dict | None = None
+    stands: dict | None = None
+
+
+@dataclass
+class Opened:
+    """A project read and checked: the points file to load (the original or the project's
+    checked copy), notes for the user, settings and results."""
+
+    path: str
+    project: Project
+    points_path: str
+    shown_name: str
+    notes: list[str] = field(default_factory=list)
+    canopy: dict = field(default_factory=dict)
+    light: dict = field(default_factory=dict)
+    results: list[StoredResult] = field(default_factory=list)
+
+
+def make_project(points_path: str, points_bytes: bytes, layout: CanopyLayout | None,
+                 stands: CanopyLayout, canopy: dict, light: dict,
+                 runs: Sequence[tuple]) -> Project:
+    """The project of a study.
+
+    Parameters
+    ----------
+    points_path, points_bytes : the points file and its content (embedded in the project)
+    layout : the layout to store, or None when it is the tiling given by ``canopy["tile"]``
+    stands : the layout the ``runs`` were traced on (the one shown): each result is tagged
+        with its stands' identity
+    canopy, light : settings (JSON objects)
+    runs : (label, result) or (label, result, settings) tuples, results of any light
+    """
+    doc, arrays = layout_parts(layout) if layout is not None else (None, {})
+    identity = stands_identity(stands)
+    records = tuple(run_record(run[0], run[1], run[2] if len(run) > 2 else None,
+                               stands=identity) for run in runs)
+    return Project(points_bytes, str(points_path), doc, {CANOPY: canopy, LIGHT: light}, arrays,
+                   records)
+
+
+def _points_file(project: Project, where: str, cache: str | Path | None,
+                 notes: list[str]) -> str:
+    original = Path(project.points_path)
+    digest = project.points_sha256
+    if same_content(original, digest):
+        return str(original)
+    folder = Path(cache) if cache else Path(tempfile.gettempdir()) / "maizeviz-projects"
+    copy = checked_copy(folder, original.name or "points.csv", project.points_csv, digest,
+                        ProjectError)
+    why = "has changed" if original.is_file() else "is not there"
+    notes.append(f"the points file {original} {why}; using the copy saved in the project")
+    return str(copy)
+
+
+def open_project(path: str | Path, cache: str | Path | None = None) -> Opened:
+    """Read a project, decide which points file to load and read its light results.
+
+    ``cache``: the folder for the project's copy of its points (default: a folder in the
+    system's temporary folder).
+
+    Raises
+    ------
+    ProjectError
+        The project cannot be used (one line).
+    """
+    from maizeviz.io.project import load_project
+
+    where = str(path)
+    project = load_project(path)
+    remove_leftovers(path)             # temporary files of saves that were killed
+    notes: list[str] = []
+    points_path = _points_file(project, where, cache, notes)
+    canopy = get(project.settings, CANOPY, dict, {}, where)
+    light = get(project.settings, LIGHT, dict, {}, where)
+    results = []
+    for i, rec in enumerate(project.results):
+        run = run_from_record(rec, where)
+        if run is None:
+            notes.append(f"result {i + 1} is of a kind this maizeviz does not know "
+                         f"('{rec.kind}'); left out")
+            continue
+        stands = get(rec.meta, "stands", dict, None, f"{where}: result {i + 1}")
+        if stands is not None:
+            get(stands, "n", int, where=f"{where}: result {i + 1} stands")
+            get(stands, "sha256", str, where=f"{where}: result {i + 1} stands")
+        results.append(StoredResult(*run, stands=stands))
+    shown = f"{Path(project.points_path).name} (project {Path(path).name})"
+    return Opened(where, project, points_path, shown, notes, canopy, light, results)
+
+
+def restore_layout(opened: Opened, plants: set[int]) -> CanopyLayout | None:
+    """The layout the project stored (stands in their saved order), checked against the
+    plants read from its points; None when the project uses the tiling of its settings."""
+    p = opened.project
+    if p.layout is None:
+        return None
+    return layout_from_parts(p.layout, p.arrays, plants, opened.path)
+
+
+def project_layout(opened: Opened, leaves: Sequence[Leaf]) -> CanopyLayout:
+    """The layout a project opens with: the one it stored (:func:`restore_layout`), else the
+    digitized block of ``leaves`` tiled as its canopy settings say (``tile``, default 3)."""
+    from maizeviz.canopy.layout import check_tile, layout_for
+
+    stored = restore_layout(opened, {lf.plant for lf in leaves})
+    if stored is not None:
+        return stored
+    tile = get(opened.canopy, "tile", int, 3, opened.path)
+    try:
+        shape = check_tile((tile, tile), len({lf.plant for lf in leaves}))
+    except MaizevizError as exc:
+        raise ProjectError(f"{opened.path}: {exc}", quantity="tile") from None
+    return layout_for(list(leaves), shape)
+
+
+def results_on(opened: Opened, layout: CanopyLayout) -> tuple[list[StoredResult], list[str]]:
+    """The results of ``opened`` traced on the stands of ``layout`` (the layout the project
+    opens with), and one note per result left out because it was traced on other stands:
+    its per-plant light would be shown on other plants."""
+    here = stands_identity(layout)
+    kept, notes = [], []
+    edited = opened.project.layout is not None
+    legacy_order = edited and "layout_placements" not in opened.project.arrays
+    for r in opened.results:
+        name = f"the {r.kind} result on {r.label}"
+        if r.stands is None and not legacy_order:
+            kept.append(r)                 # an older project on its settings' tiling: same order
+        elif r.stands is None:
+            notes.append(f"{name} was saved by an older maizeviz with an edited layout whose "
+                         "plant order cannot be restored; left out (compute it again)")
+        elif r.stands != here:
+            notes.append(f"{name} was traced on other stands ({r.stands.get('n')} plants) than "
+                         f"the project's layout ({here['n']}); left out (compute it again)")
+        else:
+            kept.append(r)
+    return kept, notes
+
+
+def check_canopy_fits(leaves: Sequence[Leaf], layout: CanopyLayout, level: Level,
+                      where: str) -> None:
+    """Refuse, before anything is built, a project whose canopy would not fit in memory
+    (:func:`maizeviz.cost.check`, as the command line does).
+
+    Raises
+    ------
+    ProjectError
+        Naming the project, the estimate and the memory available.
+    """
+    try:
+        check([[layout_cost(leaves, layout, level)]], force=True)
+    except MaizevizError as exc:
+        raise ProjectError(f"{where}: {exc}", quantity=exc.quantity) from None

@@ -1,0 +1,310 @@
+"""Projects read by the core (maizeviz.project.study): results stay on their plants across
+save and open, stale results are dropped with a note, the points copy is checked before use,
+and what a project may hold is bounded before anything is built."""
+
+import hashlib
+import os
+import io
+import json
+import random
+import zipfile
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings, strategies as st
+
+from maizeviz.canopy.layout import CanopyLayout, Placement, layout_for, layout_to_dict
+from maizeviz.canopy.scene import build_canopy
+from maizeviz.io.hashing import sha256_file
+from maizeviz.io.points import write_points
+from maizeviz.io.project import Project, ProjectError, load_project, save_project
+from maizeviz.leaf.fit import read_leaves
+from maizeviz.leaf.synth import block_grids
+from maizeviz.light.daylight import trace_sky
+from maizeviz.light.request import Sampling
+from maizeviz.light.sky import make_sky
+from maizeviz.mesh.levels import parse_level
+from maizeviz.project import study
+
+LEVEL = parse_level("16")
+SAMPLING = Sampling((0.0, 100.0), 0.2, None, True, 1)
+
+
+@pytest.fixture(scope="module")
+def points(tmp_path_factory):
+    path = tmp_path_factory.mktemp("study") / "four.csv"
+    write_points(path, block_grids(2, 2, seed=5))
+    return path
+
+
+@pytest.fixture(scope="module")
+def leaves(points):
+    return read_leaves(points).leaves
+
+
+def stand_key(p: Placement) -> tuple:
+    return p.plant, round(p.x, 6), round(p.y, 6), round(p.azimuth_deg, 6), p.tile
+
+
+def per_stand(canopy, per_triangle: np.ndarray) -> dict:
+    """Stand identity -> the values of its triangles, in the canopy's order (the oracle)."""
+    return {stand_key(p): per_triangle[canopy.face_instance == i]
+            for i, p in enumerate(canopy.layout.placements)}
+
+
+def edited(leaves, tile: tuple[int, int], seed: int, drop: int, turn: int) -> CanopyLayout:
+    """A tiling edited as in the layout panel: stands dropped, turned and reordered."""
+    layout = layout_for(leaves, tile)
+    rng = random.Random(seed)
+    stands = list(layout.placements)
+    rng.shuffle(stands)
+    stands = stands[:max(1, len(stands) - drop)]
+    stands = [replace(p, azimuth_deg=float(rng.randrange(-180, 180))) if i < turn else p
+              for i, p in enumerate(stands)]
+    return replace(layout, placements=tuple(stands))
+
+
+def reopen(path, plants, cache):
+    opened = study.open_project(path, cache)
+    layout = study.restore_layout(opened, plants)
+    return opened, layout
+
+
+@settings(max_examples=12, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(tile=st.tuples(st.integers(1, 3), st.integers(1, 3)), seed=st.integers(0, 10**6),
+       drop=st.integers(0, 5), turn=st.integers(0, 4))
+def test_per_plant_light_is_on_the_same_plant_after_save_and_open(points, leaves, tmp_path,
+                                                                   tile, seed, drop, turn):
+    layout = edited(leaves, tile, seed, drop, turn)
+    canopy = build_canopy(leaves, layout, LEVEL)
+    sky = trace_sky(canopy, make_sky("soc", 16), SAMPLING)
+    path = tmp_path / "edited.maizeviz"
+    save_project(path, study.make_project(str(points), points.read_bytes(), layout, layout,
+                                          {"tile": 3}, {}, [(LEVEL.label, sky)]))
+    opened, back = reopen(path, {lf.plant for lf in leaves}, tmp_path / "cache")
+    assert back is not None
+    assert [stand_key(p) for p in back.placements] == [stand_key(p) for p in layout.placements]
+    results, dropped = study.results_on(opened, back)
+    assert dropped == [] and len(results) == 1
+    canopy_back = build_canopy(leaves, back, LEVEL)
+    want = per_stand(canopy, sky.triangle_share)
+    got = per_stand(canopy_back, results[0].result.triangle_share)
+    assert got.keys() == want.keys()
+    for stand, values in want.items():
+        np.testing.assert_array_equal(got[stand], values)
+
+
+def test_results_traced_on_other_stands_are_dropped_with_a_note(points, leaves, tmp_path):
+    shown = layout_for(leaves, (2, 2))
+    other = layout_for(leaves, (3, 3))
+    sky = trace_sky(build_canopy(leaves, other, LEVEL), make_sky("soc", 16), SAMPLING)
+    path = tmp_path / "stale.maizeviz"
+    # a result of the 3 x 3 tiling saved with a project laid out 2 x 2
+    save_project(path, study.make_project(str(points), points.read_bytes(), shown, other,
+                                          {}, {}, [(LEVEL.label, sky)]))
+    opened, back = reopen(path, {lf.plant for lf in leaves}, tmp_path)
+    results, notes = study.results_on(opened, back)
+    assert results == []
+    assert notes == [f"the sky result on {LEVEL.label} was traced on other stands (36 plants) "
+                     "than the project's layout (16); left out (compute it again)"]
+
+
+def test_an_older_project_with_an_edited_layout_drops_its_per_plant_results(points, leaves,
+                                                                           tmp_path):
+    layout = edited(leaves, (3, 3), 7, 1, 1)
+    sky = trace_sky(build_canopy(leaves, layout, LEVEL), make_sky("soc", 16), SAMPLING)
+    proj = study.make_project(str(points), points.read_bytes(), layout, layout, {}, {},
+                              [(LEVEL.label, sky)])
+    # as maizeviz 0.3 wrote it: no stands in order, no identity on the result
+    arrays = {k: v for k, v in proj.arrays.items() if k != "layout_placements"}
+    rec = proj.results[0]
+    old = replace(proj, arrays=arrays,
+                  results=(replace(rec, meta={k: v for k, v in rec.meta.items()
+                                              if k != "stands"}),))
+    path = tmp_path / "old.maizeviz"
+    save_project(path, old)
+    opened, back = reopen(path, {lf.plant for lf in leaves}, tmp_path)
+    results, notes = study.results_on(opened, back)
+    assert results == [] and "older maizeviz" in notes[0] and len(notes) == 1
+    # the same older project on its settings' tiling keeps its results (same order as then)
+    tiled = layout_for(leaves, (3, 3))
+    sky = trace_sky(build_canopy(leaves, tiled, LEVEL), make_sky("soc", 16), SAMPLING)
+    proj = study.make_project(str(points), points.read_bytes(), None, tiled, {}, {},
+                              [(LEVEL.label, sky)])
+    rec = proj.results[0]
+    save_project(path, replace(proj, results=(replace(rec, meta={
+        k: v for k, v in rec.meta.items() if k != "stands"}),)))
+    opened, _ = reopen(path, {lf.plant for lf in leaves}, tmp_path)
+    results, notes = study.results_on(opened, tiled)
+    assert len(results) == 1 and notes == []
+
+
+# ------------------------------------------------------------------------ the points copy
+def test_a_truncated_points_copy_is_never_used(points, leaves, tmp_path):
+    data = points.read_bytes()
+    moved = tmp_path / "gone" / "four.csv"                 # the original is not there
+    path = tmp_path / "p.maizeviz"
+    save_project(path, Project(data, str(moved)))
+    cache = tmp_path / "cache"
+    sha = hashlib.sha256(data).hexdigest()
+    cache.mkdir()
+    copy = cache / f"{sha[:16]}-four.csv"
+    copy.write_bytes(data[:len(data) // 2])               # what a full disk left
+    opened = study.open_project(path, cache)
+    assert opened.points_path == str(copy)
+    assert copy.read_bytes() == data and sha256_file(copy) == sha
+    assert len(read_leaves(opened.points_path).leaves) == len(leaves)
+    assert "is not there; using the copy saved in the project" in opened.notes[0]
+    assert [p for p in cache.iterdir() if ".part" in p.name] == []
+    copy.write_bytes(data.replace(b"1", b"2", 1))         # altered since: rewritten again
+    study.open_project(path, cache)
+    assert copy.read_bytes() == data
+
+
+def test_the_points_file_is_hashed_in_pieces(tmp_path):
+    import tracemalloc
+
+    from maizeviz.io import hashing
+
+    big = tmp_path / "big.csv"
+    with open(big, "wb") as fh:
+        for _ in range(32):
+            fh.write(b"1,2,3\n" * (2**20 // 6))
+    want = hashlib.sha256(big.read_bytes()).hexdigest()
+    tracemalloc.start()
+    try:
+        got = sha256_file(big)
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert got == want
+    assert peak < 4 * hashing.CHUNK            # a few pieces, not the 32 MiB file
+
+
+# ------------------------------------------------------------------- what a project holds
+def _with_json(path, change):
+    with zipfile.ZipFile(path) as zf:
+        parts = {i.filename: zf.read(i) for i in zf.infolist()}
+    parts["project.json"] = change(parts["project.json"].decode())
+    with zipfile.ZipFile(path, "w") as zf:
+        for name, data in parts.items():
+            zf.writestr(name, data)
+
+
+@pytest.mark.parametrize("change, field", [
+    (lambda t: t.replace('"path": "', '"path": "\\u0000', 1), "'points.path'"),
+    (lambda t: t.replace('"tile": 3', '"tile": ' + "9" * 5000), "'tile'"),
+    (lambda t: t.replace('"tile": 3', '"tile": -' + "9" * 5000), "'tile'"),
+])
+def test_a_nul_or_a_5000_digit_number_is_one_line_naming_the_field(points, tmp_path, change,
+                                                                   field):
+    path = tmp_path / "bad.maizeviz"
+    save_project(path, Project(points.read_bytes(), str(points), None,
+                               {"canopy": {"tile": 3}}))
+    _with_json(path, change)
+    with pytest.raises(ProjectError) as err:
+        opened = study.open_project(path, tmp_path)
+        from maizeviz.io.project import get
+        get(opened.canopy, "tile", int, where=opened.path)   # as the window reads it
+    text = str(err.value)
+    assert field in text and "\n" not in text and text.startswith(str(path))
+
+
+OPEN_HUGE = """
+import resource, sys
+resource.setrlimit(resource.RLIMIT_AS, (2 * 2**30, 2 * 2**30))   # listing the pairs needs more
+from maizeviz.io.project import ProjectError
+from maizeviz.leaf.fit import read_leaves
+from maizeviz.mesh.levels import parse_level
+from maizeviz.project import study
+opened = study.open_project(sys.argv[1], sys.argv[2])
+leaves = read_leaves(opened.points_path).leaves
+layout = study.project_layout(opened, leaves)
+print(len(layout.placements), layout.warnings[-1])
+try:
+    study.check_canopy_fits(leaves, layout, parse_level("36"), opened.path)
+except ProjectError as exc:
+    print(exc.quantity, exc)
+"""
+
+
+def test_a_100000_plant_layout_1_cm_apart_is_refused_before_building(points, leaves,
+                                                                     tmp_path):
+    import subprocess
+    import sys
+
+    side = 316                      # 99,856 plants 1 cm apart, on cells of 60 x 30 cm
+    stands = tuple(Placement(leaves[0].plant, float(i % side), float(i // side))
+                   for i in range(side * side))
+    layout = CanopyLayout(stands, np.array([[0.0, 0.0, side, side]]), 60.0, 30.0)
+    path = tmp_path / "huge.maizeviz"
+    save_project(path, Project(points.read_bytes(), str(points), layout_to_dict(layout)))
+    out = subprocess.run([sys.executable, "-c", OPEN_HUGE, str(path), str(tmp_path)],
+                         capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-2000:]
+    lines = out.stdout.splitlines()
+    assert lines[0].startswith("99856 ") and "overlapping pairs" in lines[0]
+    assert lines[1].startswith(f"tile {path}: the canopy of 99,856 plants")
+    assert "memory" in lines[1]
+
+
+def test_an_array_claiming_a_huge_shape_is_refused_unread(points, tmp_path):
+    path = tmp_path / "p.maizeviz"
+    save_project(path, Project(points.read_bytes(), str(points), None, {},
+                               {"cells": np.zeros((2, 4))}))
+    with zipfile.ZipFile(path) as zf:
+        parts = {i.filename: zf.read(i) for i in zf.infolist()}
+    header = io.BytesIO()
+    np.lib.format.write_array_header_1_0(header, {"descr": "<f8", "fortran_order": False,
+                                                  "shape": (2**40,)})
+    # a member whose zip header agrees with the npy header: nothing catches it but the size
+    claimed = header.getvalue()
+    inner = io.BytesIO()
+    with zipfile.ZipFile(inner, "w") as zf:
+        info = zipfile.ZipInfo("project.cells.npy")
+        zf.writestr(info, claimed + b"\0" * 64)
+    raw = bytearray(inner.getvalue())
+    parts["arrays.npz"] = bytes(raw)
+    with zipfile.ZipFile(path, "w") as zf:
+        for name, data in parts.items():
+            zf.writestr(name, data)
+    with pytest.raises(ProjectError, match="project.cells"):
+        load_project(path)
+    doc = json.loads(parts["project.json"])
+    assert doc["arrays"] == ["cells"]
+
+
+def test_project_layout_is_the_stored_one_or_the_settings_tiling(points, leaves, tmp_path):
+    path = tmp_path / "tiled.maizeviz"
+    save_project(path, Project(points.read_bytes(), str(points), None,
+                               {"canopy": {"tile": 2}}))
+    opened = study.open_project(path, tmp_path)
+    assert study.project_layout(opened, leaves).placements == \
+        layout_for(leaves, (2, 2)).placements
+    layout = edited(leaves, (2, 3), 11, 2, 2)
+    save_project(path, study.make_project(str(points), points.read_bytes(), layout, layout,
+                                          {"tile": 2}, {}, []))
+    back = study.project_layout(study.open_project(path, tmp_path), leaves)
+    assert [stand_key(p) for p in back.placements] == [stand_key(p) for p in layout.placements]
+    save_project(path, Project(points.read_bytes(), str(points), None,
+                               {"canopy": {"tile": 200}}))
+    with pytest.raises(ProjectError, match="tiles of a block of 4 plants"):
+        study.project_layout(study.open_project(path, tmp_path), leaves)
+
+
+def test_opening_a_project_removes_the_part_files_of_killed_saves(points, tmp_path):
+    import subprocess
+    import sys
+
+    path = tmp_path / "p.maizeviz"
+    save_project(path, Project(points.read_bytes(), str(points)))
+    gone = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)
+    dead = tmp_path / f".p.maizeviz.{int(gone.stdout)}.k3j9.part.maizeviz"   # its writer died
+    dead.write_bytes(b"PK" * 1000)
+    mine = tmp_path / f".p.maizeviz.{os.getpid()}.a8b2.part.maizeviz"       # a live writer's
+    mine.write_bytes(b"PK")
+    study.open_project(path, tmp_path)
+    assert not dead.exists() and mine.exists()
