@@ -46,8 +46,10 @@ def zone(tz) -> _dt.tzinfo:
 
     try:
         return zoneinfo.ZoneInfo(str(tz))
-    except (zoneinfo.ZoneInfoNotFoundError, ValueError, TypeError):
-        raise MaizevizError(f"unknown time zone '{tz}' (give an IANA name such as "
+    except (zoneinfo.ZoneInfoNotFoundError, ValueError, TypeError, OSError):
+        # OSError: a name that is a folder of the zone database ("Asia") or too long for a
+        # file name reaches the file system before zoneinfo can say it is not a zone
+        raise MaizevizError(f"unknown time zone '{str(tz)[:40]}' (give an IANA name such as "
                             f"Asia/Shanghai, or UTC)", quantity="tz") from None
 
 

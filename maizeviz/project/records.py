@@ -30,6 +30,7 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.io.project import ProjectError, Record, get, get_numbers
+from maizeviz.light.clock import zone as iana_zone
 
 #: Record kinds of a sun, a sky and a day result (a sun's is the only kind of maizeviz 0.2).
 SUN_KIND, SKY_KIND, DAY_KIND = "light", "light_sky", "light_day"
@@ -315,11 +316,9 @@ def sky_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None]:
 
 
 def _zone(name: str, where: str):
-    import zoneinfo
-
     try:
-        return zoneinfo.ZoneInfo(name)
-    except (zoneinfo.ZoneInfoNotFoundError, ValueError, TypeError, OSError):
+        return iana_zone(name)
+    except MaizevizError:
         pass
     fixed = _FIXED_ZONE.fullmatch(name)
     if fixed:

@@ -5,7 +5,7 @@ import datetime as dt
 import pytest
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.clock import local_time, parse_clock
+from maizeviz.light.clock import local_time, parse_clock, zone
 from maizeviz.light.irradiance import sun_track
 from maizeviz.light.sun import sun_at
 
@@ -50,3 +50,13 @@ def test_an_offset_other_than_the_zones_is_refused_by_both(call):
     with pytest.raises(MaizevizError, match=r"carries UTC offset \+0500 but the zone "
                                             "Asia/Shanghai is at \\+0800"):
         call()
+
+
+@pytest.mark.parametrize("name", ["Asia", "Europe", "x" * 5000, "", "Nowhere/Town"])
+def test_a_name_that_is_not_a_zone_is_one_line_naming_tz(name):
+    # "Asia" is a folder of the zone database and 5000 characters are too long for a file
+    # name: both reached the file system and escaped as OSError before
+    with pytest.raises(MaizevizError, match="unknown time zone") as err:
+        zone(name)
+    assert err.value.quantity == "tz" and "\n" not in str(err.value)
+    assert len(str(err.value)) < 200

@@ -267,6 +267,7 @@ DAY_DAMAGE = [
     (lambda m, a: _times(m, 0, "1600-01-01T00:00:00+00:00"), "years 1678 to 2261"),
     (lambda m, a: m["period"]["times"].reverse(), "not in increasing order"),
     (lambda m, a: _set(m["period"], "tz", "Mars/Olympus"), "time zone 'Mars/Olympus'"),
+    (lambda m, a: _set(m["period"], "tz", "Asia"), "time zone 'Asia'"),   # a folder of the database
     (lambda m, a: _set(m["period"], "end", m["period"]["start"]), "ends before it starts"),
     (lambda m, a: m["period"].pop("source"), "'source' is missing"),
     (lambda m, a: _set(m["period"], "par_umol_per_j", 50.0), "PAR conversion factor"),
