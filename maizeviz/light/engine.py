@@ -260,8 +260,6 @@ class LightEngine:
     # ``self.scene(periodic)``, as sun, sky and day do.
 
 
-
-
 def _sky_key(sky: Sky, s: Sampling, bin_cm: float) -> tuple:
     """What makes a traced sky light reusable: the sky's directions and weights and the
     sampling (threads aside)."""

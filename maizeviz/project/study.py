@@ -25,7 +25,7 @@ from maizeviz.cost import check, layout_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import remove_leftovers
 from maizeviz.io.hashing import checked_copy, same_content
-from maizeviz.io.project import Project, ProjectError, get
+from maizeviz.io.project import Project, ProjectError, get, load_project
 from maizeviz.leaf.fit import Leaf
 from maizeviz.mesh.levels import Level
 from maizeviz.project.records import run_from_record, run_record
@@ -93,8 +93,7 @@ def make_project(points_path: str, points_bytes: bytes, layout: CanopyLayout | N
                    records)
 
 
-def _points_file(project: Project, where: str, cache: str | Path | None,
-                 notes: list[str]) -> str:
+def _points_file(project: Project, cache: str | Path | None, notes: list[str]) -> str:
     original = Path(project.points_path)
     digest = project.points_sha256
     if same_content(original, digest):
@@ -118,13 +117,11 @@ def open_project(path: str | Path, cache: str | Path | None = None) -> Opened:
     ProjectError
         The project cannot be used (one line).
     """
-    from maizeviz.io.project import load_project
-
     where = str(path)
     project = load_project(path)
     remove_leftovers(path)             # temporary files of saves that were killed
     notes: list[str] = []
-    points_path = _points_file(project, where, cache, notes)
+    points_path = _points_file(project, cache, notes)
     canopy = get(project.settings, CANOPY, dict, {}, where)
     light = get(project.settings, LIGHT, dict, {}, where)
     results = []
