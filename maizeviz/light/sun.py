@@ -45,7 +45,8 @@ class Sun:
 def _zone(tz: str) -> _dt.tzinfo:
     try:
         return zoneinfo.ZoneInfo(tz)
-    except (zoneinfo.ZoneInfoNotFoundError, ValueError, TypeError):
+    except (zoneinfo.ZoneInfoNotFoundError, ValueError, TypeError, OSError):  # OSError: a name
+        # too long for a file name (ZoneInfo looks it up as a path)
         raise MaizevizError(f"unknown time zone '{tz}': use an IANA name such as "
                             "Asia/Shanghai or Europe/Paris", quantity="tz") from None
 
