@@ -138,9 +138,6 @@ def light_cost(rect: Rect, density: float, heights: int, directions: int = 1,
                triangles: int = 0) -> Cost:
     """Tracing ``directions`` parallel beams (the sun, sky directions, time steps) of rays at
     ``density`` per cm2 over ``rect`` (cm), measured at ``heights`` planes."""
-    if not (math.isfinite(density) and density > 0):
-        raise MaizevizError(f"the ray density must be > 0 rays per cm2, got {density}",
-                            quantity="density")
     rays = ray_count(rect, density)                         # arithmetic only: no grid built
     work = rays * directions * (1 + max(heights, 1) / 2)
     what = "direct light" if directions == 1 else f"light from {directions:,} directions"
