@@ -15,8 +15,8 @@ from maizeviz.cli.common import (
     load_leaves,
     say,
 )
-from maizeviz.io.atomic import refuse_overwriting_inputs
 from maizeviz.io.meshfile import write_mesh
+from maizeviz.io.outputs import check_run_paths
 from maizeviz.mesh.levels import (
     DEFAULT_LEVELS,
     LeafMeasures,
@@ -60,7 +60,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     levels = levels_from(args)
     check_export(args.export, levels)
-    refuse_overwriting_inputs([("the mesh export", args.export)], [args.points])
+    check_run_paths([("the mesh export", args.export)], [("the points file", args.points)])
     leaves, skipped = load_leaves(args.points, args.strict, args.degree, args.params,
                                   progress=_bar("gathering leaves"))
     reference_areas(leaves)           # every leaf's, once, for all levels (kept in leaf.cache)

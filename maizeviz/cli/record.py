@@ -12,6 +12,7 @@ from maizeviz.digitizer.port import FastrakPort
 from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import DEFAULT_COLS, Session
 from maizeviz.errors import MaizevizError, check_range
+from maizeviz.io.outputs import check_run_paths
 
 #: The subcommand.
 NAME = "record"
@@ -41,6 +42,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     check_range(args.answer_timeout, "the answer timeout", 0.01, 600, "answer_timeout", unit="s")
     check_range(args.baud, "the baud rate", 300, 4_000_000, "baud", whole=True)
+    check_run_paths([], [("the serial port", args.port)], appended=[("the recording", args.out)])
     session = Session(args.out, args.cols, args.resume, args.reference_station)
     for message in session.messages:
         say(f"note: {message}")

@@ -95,7 +95,8 @@ def phenomenal_grids(data: dict, plant: int = 1, cols: int = 5) -> tuple[list[Le
         The structure is wrong (see :func:`maizeviz.io.phenomenal.leaf_organs`), or no leaf
         could be imported.
     """
-    grids, warnings = [], []
+    grids: list[LeafGrid] = []
+    warnings: list[str] = []
     for organ in leaf_organs(data):
         longest = max(organ.polylines, key=len, default=np.empty((0, 3)))
         if organ.rank is None or not len(longest):

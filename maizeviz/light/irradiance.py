@@ -702,8 +702,8 @@ def _parse_times(texts: list, lines: list, path: Path, tz):
     zone = tz if tz is not None else parse_one(0).tz
     times = pd.DatetimeIndex(utc).tz_localize("UTC").tz_convert(zone)
     years = np.asarray(times.year)
-    for k in np.flatnonzero((years < FIRST_YEAR) | (years > LAST_YEAR)):
-        check_year(int(years[k]), f"{path}, line {lines[k]}, column time", texts[k],
+    for row in np.flatnonzero((years < FIRST_YEAR) | (years > LAST_YEAR)).tolist():
+        check_year(int(years[row]), f"{path}, line {lines[row]}, column time", texts[row],
                    WeatherFileError, "weather")
     return times
 

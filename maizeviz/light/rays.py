@@ -54,7 +54,7 @@ def check_rect(rect: Rect) -> Rect:
             or vals[2] <= vals[0] or vals[3] <= vals[1]:
         raise MaizevizError(f"the sample rectangle must be x0,y0,x1,y1 with x1 > x0 and y1 > y0, "
                             f"within {MAX_COORD_CM:g} cm, got {rect}", quantity="rect")
-    return vals  # type: ignore[return-value]
+    return vals[0], vals[1], vals[2], vals[3]
 
 
 def grid_shape(rect: Rect, density: float) -> tuple[int, int]:
