@@ -39,6 +39,9 @@ MAX_ANGLE_DEG = 360.0
 MAX_SEED = 2**32 - 1
 #: Largest plant id (absolute value), as in points files.
 MAX_PLANT_ID = 1_000_000_000
+#: Overlapping pairs of cells per plant beyond which their area is not measured (the pairs
+#: are only counted): a plant's cell overlaps at most 8 neighbours in a lattice.
+MAX_OVERLAP_PAIRS_PER_PLANT = 8
 #: Largest layout file read (bytes).
 MAX_LAYOUT_BYTES = 20_000_000
 
@@ -86,6 +89,9 @@ class CanopyLayout:
     centre_cells : (j, 4) float64, cm
         Cells of the central tile (or of the whole field), the default light sample area.
     warnings : tuple[str, ...]
+    ground_area : float, cm2, or None: the union of the cells
+    quantity : the input that set the plants (see :data:`maizeviz.errors.QUANTITIES`):
+        "tile" for a tiling, "layout" for a layout document; costs name it
     """
 
     placements: tuple[Placement, ...]
@@ -96,6 +102,7 @@ class CanopyLayout:
     centre_cells: np.ndarray = field(default_factory=lambda: np.empty((0, 4)))
     warnings: tuple[str, ...] = ()
     ground_area: float | None = None
+    quantity: str = "tile"
 
     @property
     def ground_area_cm2(self) -> float:
@@ -321,7 +328,14 @@ def _overlaps(cells: np.ndarray) -> str:
     h = cells[0, 3] - cells[0, 1]
     centres = np.column_stack([(cells[:, 0] + cells[:, 2]) / (2 * w),
                                (cells[:, 1] + cells[:, 3]) / (2 * h)])
-    pairs = cKDTree(centres).query_pairs(0.9, p=np.inf, output_type="ndarray")
+    tree = cKDTree(centres)
+    # counted first, without listing them: 100,000 plants 1 cm apart in 60 x 30 cm cells make
+    # 500 million pairs, 12 GB as a list
+    count = (int(tree.count_neighbors(tree, 0.9, p=np.inf)) - len(centres)) // 2
+    if count > MAX_OVERLAP_PAIRS_PER_PLANT * len(centres):
+        return (f"({count:,} overlapping pairs: the plants stand much closer than the "
+                "spacing)")
+    pairs = tree.query_pairs(0.9, p=np.inf, output_type="ndarray")
     if not len(pairs):
         return ""
     d = np.abs(centres[pairs[:, 0]] - centres[pairs[:, 1]])
@@ -496,7 +510,8 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
     if overlap:
         warnings.append(f"{source}: some positions are closer than the spacing {overlap}")
     field_rect = np.array([[x0, y0, x1, y1]])
-    return CanopyLayout(tuple(placements), field_rect, rs, ps, north, field_rect, tuple(warnings))
+    return CanopyLayout(tuple(placements), field_rect, rs, ps, north, field_rect, tuple(warnings),
+                        quantity="layout")
 
 
 def _seed(data: dict, source: str) -> int:

@@ -24,6 +24,7 @@ FLAGS = {
     "density": "--density", "heights": "--heights", "rect": "--rect", "threads": "--threads",
     "heatmap_bin": "--heatmap-bin", "cover_resolution": "--cover-resolution",
     "row_spacing": "--row-spacing", "plant_spacing": "--plant-spacing", "tile": "--tile",
+    "layout": "--layout",
     "block": "--block", "level": "--levels", "interp": "--interp", "triangles": "--triangles",
     "degree": "--degree", "params": "--params", "sun": "--sun-zenith/--sun-azimuth",
     "date": "--date", "time": "--time", "place": "--lat/--lon", "tz": "--tz", "cols": "--cols",
