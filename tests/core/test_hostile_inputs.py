@@ -52,3 +52,42 @@ def test_a_symlink_loop_is_one_line(capsys, tmp_path, role):
     assert main(argv) == EXIT_FAIL
     assert "loop.csv" in _one_error(capsys)
     assert os.readlink(loop) == str(loop)
+
+
+# ------------------------------------------------------------------ what the app passes on
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from maizeviz.errors import MaizevizError  # noqa: E402
+from maizeviz.light.irradiance import clear_sky_period, read_weather  # noqa: E402
+from maizeviz.light.sun import sun_at  # noqa: E402
+
+TEXT = st.one_of(st.text(max_size=30), st.sampled_from(
+    ["A" * 5000, "Asia/" + "x" * 300, "../../etc/passwd", "UTC\x00", "9999-12-31", "0000-01-01",
+     "24:00", "25:61", "12:00+99:00", "nan", "-1"]))
+NUMBER = st.one_of(st.floats(allow_nan=True, allow_infinity=True),
+                   st.integers(-10**30, 10**30))
+
+
+@settings(max_examples=300, deadline=None)
+@given(date=TEXT, clock=TEXT, tz=TEXT, lat=NUMBER, lon=NUMBER, step=NUMBER)
+def test_the_apps_day_and_sun_fields_give_only_maizeviz_errors(date, clock, tz, lat, lon, step):
+    """Whatever is typed in the light panel's date, time, zone and place fields, the core
+    answers with a result or a MaizevizError (the user's), never another exception."""
+    for make in (lambda: sun_at(date, clock, lat, lon, tz),
+                 lambda: clear_sky_period(date, lat, lon, tz, step, clock or None, None)):
+        try:
+            make()
+        except MaizevizError as exc:
+            assert "\n" not in str(exc)
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(time=TEXT, ghi=TEXT, tz=st.one_of(st.none(), TEXT))
+def test_weather_file_cells_give_only_maizeviz_errors(tmp_path, time, ghi, tz):
+    path = tmp_path / "w.csv"
+    path.write_text(f"time,ghi\n{time},{ghi}\n2005-08-01T12:00+08:00,5\n", errors="replace")
+    try:
+        read_weather(path, tz=tz)
+    except MaizevizError as exc:
+        assert "\n" not in str(exc)
