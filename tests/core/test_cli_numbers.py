@@ -68,3 +68,46 @@ def test_hostile_numbers_are_one_line_or_run(capsys, monkeypatch, tiny, name, fl
     assert "internal error" not in err and "Traceback" not in err, err[-500:]
     errors = [ln for ln in err.splitlines() if ln.startswith("error")]
     assert code in (0, 3) or (code == 1 and len(errors) == 1), (code, err[-500:])
+
+
+#: Options whose text holds numbers, dates or names, with hostile texts.
+TEXTS = ("nan", "inf,-inf", "1e308,1e308,1e308,1e308", "", ",,,", "abc", "9" * 5000,
+         "A" * 5000, "0x0", "-1x-1", "1e9x1e9", "\x00")
+TEXT_OPTIONS = {
+    "leaf": ["--levels"],
+    "canopy": ["--tile", "--block", "--levels"],
+    "light": ["--heights", "--rect", "--tile", "--block", "--levels", "--tz"],
+    "synth": ["--plants"],
+    "import-phenomenal": ["--at"],
+}
+DAY_TEXT_OPTIONS = ["--date", "--from", "--to", "--tz"]
+
+
+def _text_cases():
+    for name, flags in TEXT_OPTIONS.items():
+        for flag in flags:
+            for value in TEXTS:
+                yield pytest.param(name, flag, value, id=f"{name}{flag}={value[:12]!r}")
+    for flag in DAY_TEXT_OPTIONS:
+        for value in TEXTS:
+            yield pytest.param("day", flag, value, id=f"day{flag}={value[:12]!r}")
+
+
+@pytest.mark.parametrize("name, flag, value", list(_text_cases()))
+def test_hostile_texts_are_one_line_or_run(capsys, monkeypatch, tiny, name, flag, value):
+    from maizeviz.resources import example_phenomenal
+
+    monkeypatch.chdir(tiny)
+    argv = list(PERIOD) if name == "day" else list(BASE[name])
+    argv = [str(example_phenomenal()) if a == "PHENO" else a for a in argv]
+    if flag in argv:
+        k = argv.index(flag)
+        del argv[k:k + 2]
+    if name == "day" and flag in ("--from", "--to"):
+        argv += ["--step", "240"]
+    argv.append(f"{flag}={value}")
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert "internal error" not in err and "Traceback" not in err, err[-500:]
+    errors = [ln for ln in err.splitlines() if ln.startswith("error")]
+    assert code in (0, 3) or (code == 1 and len(errors) == 1), (code, err[-500:])
