@@ -410,7 +410,8 @@ def _check_paths(args: argparse.Namespace, labels: list[str], sun: bool,
     """Refuse, before any work, outputs (every per-level file and every file of the heatmap
     and plot folders) that would overwrite an input or each other."""
     period = _period_asked(args)
-    tables = [("the leaf light table", args.leaf_light), ("the plant light table", args.plant_light),
+    tables = [("the leaf light table", args.leaf_light),
+              ("the plant light table", args.plant_light),
               ("the time-step table", args.steps if period else None)]
     kinds = [kind for kind, asked in (("sun", sun), ("sky", args.sky is not None or period),
                                       ("period", period)) if asked]

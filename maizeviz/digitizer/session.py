@@ -296,7 +296,8 @@ class Session:
             raise SessionError(f"points per cross-section must be a whole number from 1 to "
                                f"10000, got {cols}", quantity="cols")
         self.path = Path(path)
-        self.cols: int = DEFAULT_COLS if cols is None and not resume else cols  # type: ignore[assignment]
+        # None while resuming: the recording's own, known once it is replayed (_width)
+        self.cols: int = DEFAULT_COLS if cols is None and not resume else cols  # type: ignore
         self.reference_station = reference_station
         self.pos = start or Position()
         self.count = Counters()

@@ -111,7 +111,8 @@ def check_paths(spec, out) -> None:
         if s.arrangement.layout_path:
             inputs.append(("the layout file", s.arrangement.layout_path))
     files = ("results.parquet", "results.csv", "summary.csv", "sweep.json")
-    check_run_paths([], list(dict.fromkeys(inputs)), [OutputFolder("the results folder", out, files)])
+    check_run_paths([], list(dict.fromkeys(inputs)),
+                    [OutputFolder("the results folder", out, files)])
 
 
 def _run(spec, args) -> int:

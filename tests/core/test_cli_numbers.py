@@ -30,7 +30,7 @@ SKY = ["light", "tiny.csv", "--sky", "soc", "--density", "0.05", "--heights", "0
 def _cases():
     parser = build_parser()
     sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-    for name, argv in BASE.items():
+    for name in BASE:
         for action in sub.choices[name]._actions:
             if action.type not in (int, float) or not action.option_strings:
                 continue

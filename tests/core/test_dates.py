@@ -29,7 +29,8 @@ def _iso(t: dt.datetime, offset_min: int | None) -> str:
     return f"{text}{sign}{abs(offset_min) // 60:02d}:{abs(offset_min) % 60:02d}"
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=150, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(t0=WHEN, offset=OFFSET_MIN, step=st.integers(1, 180))
 def test_weather_times_read_as_written_in_every_year(tmp_path, t0, offset, step):
     t1 = t0 + dt.timedelta(minutes=step)
@@ -44,7 +45,8 @@ def test_weather_times_read_as_written_in_every_year(tmp_path, t0, offset, step)
     assert list(w.step_s) == [step * 60.0, step * 60.0]
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=60, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(t0=WHEN, tz=ZONES)
 def test_weather_local_times_with_a_zone_read_as_written(tmp_path, t0, tz):
     path = tmp_path / "w.csv"
@@ -63,7 +65,8 @@ def test_weather_local_times_with_a_zone_read_as_written(tmp_path, t0, tz):
 @pytest.mark.parametrize("year", [1600, 1676, 2263, 2300, 9999, 1])
 def test_weather_file_outside_the_nanosecond_range_is_not_wrapped(tmp_path, year):
     path = tmp_path / "w.csv"
-    path.write_text(f"time,ghi\n{year:04d}-06-01T12:00+00:00,500\n{year:04d}-06-01T13:00+00:00,500\n")
+    path.write_text(f"time,ghi\n{year:04d}-06-01T12:00+00:00,500\n"
+                    f"{year:04d}-06-01T13:00+00:00,500\n")
     w = read_weather(path, label="start")
     assert w.start.year == year and w.end.year == year
     assert str(w.start).startswith(f"{year:04d}-06-01 12:00")

@@ -4,9 +4,14 @@ an "internal error", and nothing written."""
 import os
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from maizeviz.resources import example_points
 
 from maizeviz.cli import EXIT_FAIL, main
-from maizeviz.resources import example_points
+from maizeviz.errors import MaizevizError
+from maizeviz.light.irradiance import clear_sky_period, read_weather
+from maizeviz.light.sun import sun_at
 
 B = str(example_points())
 SUN = ["--sun-zenith", "10", "--sun-azimuth", "0"]
@@ -55,12 +60,6 @@ def test_a_symlink_loop_is_one_line(capsys, tmp_path, role):
 
 
 # ------------------------------------------------------------------ what the app passes on
-from hypothesis import HealthCheck, given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
-
-from maizeviz.errors import MaizevizError  # noqa: E402
-from maizeviz.light.irradiance import clear_sky_period, read_weather  # noqa: E402
-from maizeviz.light.sun import sun_at  # noqa: E402
 
 TEXT = st.one_of(st.text(max_size=30), st.sampled_from(
     ["A" * 5000, "Asia/" + "x" * 300, "../../etc/passwd", "UTC\x00", "9999-12-31", "0000-01-01",
@@ -82,7 +81,8 @@ def test_the_apps_day_and_sun_fields_give_only_maizeviz_errors(date, clock, tz, 
             assert "\n" not in str(exc)
 
 
-@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=100, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(time=TEXT, ghi=TEXT, tz=st.one_of(st.none(), TEXT))
 def test_weather_file_cells_give_only_maizeviz_errors(tmp_path, time, ghi, tz):
     path = tmp_path / "w.csv"

@@ -6,8 +6,9 @@ as is, ``./``, ``sub/..``, absolute, through a symbolic link to the file or to i
 through a hard link. The data are the oracle: no byte of any file already there changes, no
 file appears, and the refusal is one ``error:`` line with exit code 1 (docs/cli.md)."""
 
-import gzip
+import contextlib
 import hashlib
+import io
 import os
 import shutil
 import tempfile
@@ -16,9 +17,9 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from maizeviz.resources import example_phenomenal
 
 from maizeviz.cli import EXIT_FAIL, main
-from maizeviz.resources import example_phenomenal
 
 L = ["light", "pts.csv", "--sun-zenith", "10", "--sun-azimuth", "0", "--density", "0.05",
      "--heights", "0"]
@@ -126,8 +127,6 @@ def test_an_output_never_overwrites_an_input_or_another_output(tiny, case, how):
         old = os.getcwd()
         os.chdir(work)
         try:
-            import contextlib
-            import io
             err = io.StringIO()
             with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
                 code = main([spelled if a == "A" else a for a in argv])

@@ -7,14 +7,13 @@ import gzip
 import json
 import math
 
-import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from maizeviz.resources import example_phenomenal
 
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.io.points import read_points
-from maizeviz.resources import example_phenomenal
 
 #: What a value may be replaced by: every JSON kind, empty containers, non-finite and huge
 #: numbers, ragged rows, nesting.
@@ -85,7 +84,7 @@ def _import(tmp_path, text, name="p.json"):
 def _leaves(out):
     table = read_points(out)
     leaves = {}
-    for (plant, leaf, row, col), xyz in zip(table.ids.tolist(), table.xyz.tolist()):
+    for (_plant, leaf, row, col), xyz in zip(table.ids.tolist(), table.xyz.tolist()):
         leaves.setdefault(leaf, {})[(row, col)] = xyz
     return leaves
 
