@@ -3,6 +3,7 @@ tiling, a density of 24,000 rays per cm2) is refused in a second instead of eati
 machine's memory for minutes.
 
 The command line, the app and sweeps call the same functions: :func:`canopy_cost`,
+:func:`leaves_cost`,
 :func:`light_cost` and :func:`heatmap_cost` give :class:`Cost` estimates; :func:`check` refuses
 what would not fit in the memory available (always) or what would take longer than
 :data:`SLOW_SECONDS` (unless forced: the app asks, the command line takes ``--force``). The
@@ -14,7 +15,7 @@ from __future__ import annotations
 import math
 import os
 from collections import Counter
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 from maizeviz.canopy.layout import CanopyLayout
@@ -27,6 +28,11 @@ from maizeviz.mesh.levels import Level
 #: Peak bytes per canopy triangle: the canopy arrays, its Embree scene, the ground-cover scene
 #: and the transients of building them (measured: 345 B at K = 4 on the bundled example).
 BYTES_PER_TRIANGLE = 400
+#: Peak bytes per leaf triangle meshed and measured by ``maizeviz leaf`` (measured on the
+#: bundled example: 272 B from K = 4 to K = 16, 3.2 million more triangles).
+BYTES_PER_LEAF_TRIANGLE = 300
+#: Leaf triangles meshed and measured per second (measured there: about 1 million).
+LEAF_TRIANGLES_PER_S = 1_000_000
 #: Bytes per traced ray: origins, hits, heights, ground positions (measured: 48-55 B).
 BYTES_PER_RAY = 64
 #: Bytes per heatmap cell: histograms, the drawn mesh and the CSV line.
@@ -115,9 +121,11 @@ def leaf_triangles(rows: int, cols: int, tip_collapsed: bool, level: Level) -> i
     return full if level.triangles is None else min(level.triangles, full)
 
 
-def canopy_cost(leaves: Iterable[Leaf], placements: Mapping[int, int], level: Level) -> Cost:
+def canopy_cost(leaves: Iterable[Leaf], placements: Mapping[int, int], level: Level,
+                quantity: str = "tile") -> Cost:
     """The canopy of ``leaves`` at ``level`` with ``placements[plant]`` copies of each
-    digitized plant standing in the field."""
+    digitized plant standing in the field (set by the input ``quantity``: a tiling or a
+    layout)."""
     per_plant: dict[int, int] = {}
     for lf in leaves:
         m, n = lf.grid.shape
@@ -125,22 +133,32 @@ def canopy_cost(leaves: Iterable[Leaf], placements: Mapping[int, int], level: Le
             m, n, lf.grid.tip_collapsed, level)
     tris = sum(per_plant.get(p, 0) * count for p, count in placements.items())
     plants = sum(placements.values())
-    return Cost(f"the canopy of {plants:,} plants at {level}", "tile", tris, "triangles",
+    return Cost(f"the canopy of {plants:,} plants at {level}", quantity, tris, "triangles",
                 tris * BYTES_PER_TRIANGLE, tris / TRIANGLES_PER_S)
+
+
+def leaves_cost(leaves: Sequence[Leaf], level: Level, quantity: str, batch: int,
+                keep: bool = False) -> Cost:
+    """Meshing and measuring ``leaves`` one at a time at ``level`` (``maizeviz leaf``): the
+    meshes of ``batch`` leaves are held at once (of all of them when ``keep``, for an export).
+    ``quantity`` is the input that chose the level ("interp", "triangles" or "level")."""
+    tris = [leaf_triangles(*lf.grid.shape, lf.grid.tip_collapsed, level) for lf in leaves]
+    held = sum(tris) if keep else max((sum(tris[s:s + batch])
+                                       for s in range(0, len(tris), batch)), default=0)
+    return Cost(f"meshing {len(tris):,} leaves at {level}", quantity, sum(tris), "triangles",
+                held * BYTES_PER_LEAF_TRIANGLE, sum(tris) / LEAF_TRIANGLES_PER_S)
 
 
 def layout_cost(leaves: Iterable[Leaf], layout: CanopyLayout, level: Level) -> Cost:
     """The canopy of ``leaves`` standing as ``layout`` places them, at ``level``."""
-    return canopy_cost(leaves, dict(Counter(p.plant for p in layout.placements)), level)
+    return canopy_cost(leaves, dict(Counter(p.plant for p in layout.placements)), level,
+                       layout.quantity)
 
 
 def light_cost(rect: Rect, density: float, heights: int, directions: int = 1,
                triangles: int = 0) -> Cost:
     """Tracing ``directions`` parallel beams (the sun, sky directions, time steps) of rays at
     ``density`` per cm2 over ``rect`` (cm), measured at ``heights`` planes."""
-    if not (math.isfinite(density) and density > 0):
-        raise MaizevizError(f"the ray density must be > 0 rays per cm2, got {density}",
-                            quantity="density")
     rays = ray_count(rect, density)                         # arithmetic only: no grid built
     work = rays * directions * (1 + max(heights, 1) / 2)
     what = "direct light" if directions == 1 else f"light from {directions:,} directions"

@@ -82,6 +82,7 @@ QUANTITIES = {
     "row_spacing": "distance between rows, cm",
     "plant_spacing": "distance between plants of a row, cm",
     "tile": "tiles across and along the rows",
+    "layout": "layout file of plant positions",
     "block": "rows x plants per row of the digitized block",
     "level": "mesh level",
     "interp": "points interpolated between data points",

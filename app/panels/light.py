@@ -28,6 +28,7 @@ from PySide6.QtWidgets import (QAbstractItemView, QButtonGroup, QCheckBox, QComb
                                QStackedWidget, QTableWidget, QTableWidgetItem, QVBoxLayout,
                                QWidget)
 
+from maizeviz.errors import MaizevizError
 from maizeviz.light.irradiance import DEFAULT_PAR_UMOL_PER_J, PAR_FRACTION, PAR_UMOL_PER_J_PAR
 from maizeviz.mesh.levels import COMPLEXITY_STOPS, parse_level
 
@@ -50,12 +51,12 @@ DEFAULT_DAY = {"date": "2005-08-01", "lat": 39.9, "lon": 116.4, "tz": "Asia/Shan
                "weather": "", "par_factor": DEFAULT_PAR_UMOL_PER_J}
 
 
-class InputProblem(ValueError):
-    """A light setting the user typed that cannot be used; ``quantity`` names the field."""
+class InputProblem(MaizevizError):
+    """A light setting the user typed that cannot be used; ``quantity`` names the field. A
+    MaizevizError: the user's to correct, told in one line, never an internal error."""
 
     def __init__(self, message: str, quantity: str):
-        super().__init__(message)
-        self.quantity = quantity
+        super().__init__(message, quantity=quantity)
 
 
 def parse_heights(text: str) -> tuple[float, ...]:
@@ -71,7 +72,8 @@ def parse_heights(text: str) -> tuple[float, ...]:
             raise InputProblem(f"heights: '{part}' is not a number of centimetres; write them "
                                "separated by commas, e.g. 0, 50, 100", "heights") from None
         if not math.isfinite(h) or h < 0:
-            raise InputProblem(f"heights must be 0 cm or more, got {part}", "heights")
+            raise InputProblem(f"heights must be finite numbers of 0 cm or more, got {part}",
+                               "heights")
         out.append(h)
     if not out:
         raise InputProblem("give at least one height in cm, e.g. 0, 50, 100", "heights")

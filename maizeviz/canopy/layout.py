@@ -86,6 +86,9 @@ class CanopyLayout:
     centre_cells : (j, 4) float64, cm
         Cells of the central tile (or of the whole field), the default light sample area.
     warnings : tuple[str, ...]
+    ground_area : float, cm2, or None: the union of the cells
+    quantity : the input that set the plants (see :data:`maizeviz.errors.QUANTITIES`):
+        "tile" for a tiling, "layout" for a layout document; costs name it
     """
 
     placements: tuple[Placement, ...]
@@ -96,6 +99,7 @@ class CanopyLayout:
     centre_cells: np.ndarray = field(default_factory=lambda: np.empty((0, 4)))
     warnings: tuple[str, ...] = ()
     ground_area: float | None = None
+    quantity: str = "tile"
 
     @property
     def ground_area_cm2(self) -> float:
@@ -505,7 +509,8 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
     if overlap:
         warnings.append(f"{source}: some positions are closer than the spacing {overlap}")
     field_rect = np.array([[x0, y0, x1, y1]])
-    return CanopyLayout(tuple(placements), field_rect, rs, ps, north, field_rect, tuple(warnings))
+    return CanopyLayout(tuple(placements), field_rect, rs, ps, north, field_rect, tuple(warnings),
+                        quantity="layout")
 
 
 def _seed(data: dict, source: str) -> int:

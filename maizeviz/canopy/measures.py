@@ -7,7 +7,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.errors import MaizevizError
+from maizeviz.errors import check_range
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.mesh.tessellate import triangle_areas_normals
 
@@ -53,11 +53,15 @@ def table2_row(m: CanopyMeasures, build_s: float, label: str | None = None) -> d
             "build_s": f"{build_s:.2f}"}
 
 
+#: The ground-cover pixel side, cm, is refused outside these bounds: below, the vertical rays
+#: outnumber any memory; above, a pixel is wider than any plot.
+COVER_RESOLUTION_RANGE_CM = (1e-3, 1e4)
+
+
 def check_cover_resolution(resolution: float) -> None:
-    """Refuse a ground-cover pixel side (cm) that is not > 0."""
-    if not resolution > 0:
-        raise MaizevizError(f"the ground-cover pixel must be > 0 cm, got {resolution}",
-                            quantity="cover_resolution")
+    """Refuse a ground-cover pixel side (cm) outside :data:`COVER_RESOLUTION_RANGE_CM`."""
+    check_range(resolution, "the ground-cover pixel", *COVER_RESOLUTION_RANGE_CM,
+                "cover_resolution", unit="cm")
 
 
 def ground_cover(canopy: Canopy, resolution: float = COVER_RESOLUTION_CM,

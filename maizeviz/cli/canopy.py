@@ -22,14 +22,13 @@ from maizeviz.cli.common import (
     canopy_setup,
     check_canopy_costs,
     check_export,
-    check_outputs,
     fmt_table,
     leaves_summary,
     levels_from,
     say,
 )
 from maizeviz.cost import cover_cost
-from maizeviz.io.atomic import refuse_overwriting_inputs
+from maizeviz.io.outputs import check_run_paths
 from maizeviz.mesh.levels import CANOPY_LEVELS
 
 #: The subcommand.
@@ -58,9 +57,8 @@ def run(args: argparse.Namespace) -> int:
     levels = levels_from(args)
     check_export(args.export, levels)
     check_cover_resolution(args.cover_resolution)            # before the file is read
-    check_outputs(args.save_layout)
-    refuse_overwriting_inputs([("the mesh export", args.export),
-                               ("the saved layout", args.save_layout)], [args.points, args.layout])
+    check_run_paths([("the mesh export", args.export), ("the saved layout", args.save_layout)],
+                    [("the points file", args.points), ("the layout file", args.layout)])
     leaves, skipped, layout = canopy_setup(args)
     check_canopy_costs(leaves, layout, levels, args.force,
                        [cover_cost(layout, args.cover_resolution)])

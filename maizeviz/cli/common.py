@@ -10,7 +10,7 @@ from pathlib import Path
 from maizeviz.canopy.layout import CanopyLayout, check_tile, layout_for, parse_shape
 from maizeviz.cost import Cost, check, layout_cost
 from maizeviz.errors import LeafError, MaizevizError
-from maizeviz.io.atomic import check_output, file_tag
+from maizeviz.io.atomic import file_tag
 from maizeviz.io.meshfile import check_mesh_path
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.mesh.levels import Level, parse_levels
@@ -24,6 +24,7 @@ FLAGS = {
     "density": "--density", "heights": "--heights", "rect": "--rect", "threads": "--threads",
     "heatmap_bin": "--heatmap-bin", "cover_resolution": "--cover-resolution",
     "row_spacing": "--row-spacing", "plant_spacing": "--plant-spacing", "tile": "--tile",
+    "layout": "--layout",
     "block": "--block", "level": "--levels", "interp": "--interp", "triangles": "--triangles",
     "degree": "--degree", "params": "--params", "sun": "--sun-zenith/--sun-azimuth",
     "date": "--date", "time": "--time", "place": "--lat/--lon", "tz": "--tz", "cols": "--cols",
@@ -92,13 +93,6 @@ def add_level_options(p: argparse.ArgumentParser, default_levels: str) -> None:
     p.add_argument("--no-preserve-area", dest="preserve_area", action="store_false",
                    help="below the standard mesh, do not widen cross-sections to keep the "
                         "smooth surface's area")
-
-
-def check_outputs(*paths: str | None) -> None:
-    """Refuse, before any work, output files whose folder is missing or that are folders."""
-    for path in paths:
-        if path is not None:
-            check_output(path)
 
 
 def check_export(path: str | None, levels: list[Level]) -> None:
@@ -188,6 +182,12 @@ def suffixed(path: str | Path, label: str) -> Path:
     """``light.csv`` + ``"K=4"`` -> ``light_K_4.csv`` (one file per level)."""
     p = Path(path)
     return p.with_name(f"{p.stem}_{file_tag(label)}{p.suffix}")
+
+
+def level_path(path: str | Path, label: str, n_levels: int) -> Path:
+    """The file an output of one level goes to: ``path`` itself for a single level, else
+    :func:`suffixed` by the level's label."""
+    return Path(path) if n_levels == 1 else suffixed(path, label)
 
 
 def leaves_summary(done: int, skipped: list[LeafError]) -> int:

@@ -15,8 +15,9 @@ from maizeviz.cli.common import (
     load_leaves,
     say,
 )
-from maizeviz.io.atomic import refuse_overwriting_inputs
+from maizeviz.cost import check, leaves_cost
 from maizeviz.io.meshfile import write_mesh
+from maizeviz.io.outputs import check_run_paths
 from maizeviz.mesh.levels import (
     DEFAULT_LEVELS,
     LeafMeasures,
@@ -54,15 +55,22 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="data parameters (default chord length)")
     p.add_argument("--strict", action="store_true",
                    help="stop at the first bad leaf instead of skipping it")
+    p.add_argument("--force", action="store_true",
+                   help="run work estimated to take longer than 15 min (what would not fit in "
+                        "memory is refused anyway)")
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     levels = levels_from(args)
     check_export(args.export, levels)
-    refuse_overwriting_inputs([("the mesh export", args.export)], [args.points])
+    check_run_paths([("the mesh export", args.export)], [("the points file", args.points)])
     leaves, skipped = load_leaves(args.points, args.strict, args.degree, args.params,
                                   progress=_bar("gathering leaves"))
+    quantity = "level" if args.levels is not None else \
+        "triangles" if args.triangles is not None else "interp"
+    check([[leaves_cost(leaves, level, quantity, LEAF_BATCH, keep=bool(args.export))]
+           for level in levels], args.force)                 # before any mesh is made
     reference_areas(leaves)           # every leaf's, once, for all levels (kept in leaf.cache)
     per_level = []
     n = len(leaves)

@@ -23,21 +23,21 @@ from maizeviz.cli.common import (
     add_level_options,
     canopy_setup,
     check_canopy_costs,
-    check_outputs,
     floats,
     fmt_table,
     leaves_summary,
     levels_from,
     say,
-    suffixed,
+    level_path,
 )
 from maizeviz.cost import light_costs
 from maizeviz.errors import MaizevizError
-from maizeviz.io.atomic import file_tag, make_folder, refuse_overwriting_inputs, write_rows
+from maizeviz.io.atomic import file_tag, make_folder, write_rows
+from maizeviz.io.outputs import OutputFolder, check_run_paths
 from maizeviz.light.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping
 from maizeviz.light.daylight import PeriodLight, SkyLight
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.heatmap import save_figure, write_heatmaps
+from maizeviz.light.heatmap import map_stems, save_figure, write_heatmaps
 from maizeviz.light.irradiance import (
     DEFAULT_LINKE_TURBIDITY,
     DEFAULT_PAR_UMOL_PER_J,
@@ -230,11 +230,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.heatmap_bin > 0:
         raise MaizevizError(f"the heatmap bin must be > 0 cm, got {args.heatmap_bin}",
                             quantity="heatmap_bin")
-    check_outputs(args.leaf_light, args.plant_light, args.steps)
-    refuse_overwriting_inputs([("the leaf light table", args.leaf_light),
-                               ("the plant light table", args.plant_light),
-                               ("the time-step table", args.steps)],
-                              [args.points, args.layout, args.weather])
+    _check_paths(args, [level.label for level in levels], sun is not None, heights)
     period = period_from(args)
     sky = sky_from(args, period)
     if sun is not None:
@@ -401,6 +397,33 @@ def _jsonable(obj: Any) -> Any:
 
 
 # ------------------------------------------------------------------------------ files
+def _plot_name(label: str) -> str:
+    """The file of a period's plot at the mesh level labelled ``label``."""
+    return f"day_{file_tag(label) or 'level'}.png"
+
+
+def _check_paths(args: argparse.Namespace, labels: list[str], sun: bool,
+                 heights: tuple[float, ...]) -> None:
+    """Refuse, before any work, outputs (every per-level file and every file of the heatmap
+    and plot folders) that would overwrite an input or each other."""
+    period = _period_asked(args)
+    tables = [("the leaf light table", args.leaf_light),
+              ("the plant light table", args.plant_light),
+              ("the time-step table", args.steps if period else None)]
+    kinds = [kind for kind, asked in (("sun", sun), ("sky", args.sky is not None or period),
+                                      ("period", period)) if asked]
+    maps = [f"{stem}.{ext}" for label in labels for kind in kinds
+            for stem in map_stems(kind, label, heights) for ext in ("png", "csv")]
+    check_run_paths(
+        [(what, level_path(path, label, len(labels))) for what, path in tables if path
+         for label in labels],
+        [("the points file", args.points), ("the layout file", args.layout),
+         ("the weather file", args.weather)],
+        [OutputFolder("the heatmap folder", args.heatmaps, maps),
+         OutputFolder("the plot folder", args.plots if period else None,
+                      [_plot_name(label) for label in labels])])
+
+
 def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_levels: int,
                    res: LightResult | None, sky: SkyLight | None, pl: PeriodLight | None,
                    tables: list[list[dict]]) -> None:
@@ -415,8 +438,7 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
             n += len(write_heatmaps(folder, pl, kind="period")) // 2
         say(f"wrote {n} transmission maps (PNG + CSV) to {folder}")
     if pl is not None and args.steps:
-        path = args.steps if n_levels == 1 else suffixed(args.steps, label)
-        write_steps(path, pl)
+        write_steps(level_path(args.steps, label, n_levels), pl)
     if pl is not None and args.plots:
         from maizeviz.light.plots import day_figure
 
@@ -424,7 +446,7 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
         p = pl.period
         title = (f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M} ({p.start.tz}); "
                  f"{p.source}; level {label}")
-        path = folder / f"day_{file_tag(label) or 'level'}.png"
+        path = folder / _plot_name(label)
         save_figure(day_figure(pl, title), path)
         say(f"wrote {path}")
     if tables:
@@ -432,10 +454,9 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
         for r in rows:
             r["level"] = label
         if args.leaf_light:
-            write_rows(args.leaf_light if n_levels == 1 else suffixed(args.leaf_light, label), rows)
+            write_rows(level_path(args.leaf_light, label, n_levels), rows)
         if args.plant_light:
-            write_rows(args.plant_light if n_levels == 1 else suffixed(args.plant_light, label),
-                       plant_light(rows))
+            write_rows(level_path(args.plant_light, label, n_levels), plant_light(rows))
 
 
 # ------------------------------------------------------------------------------ tables

@@ -6,7 +6,7 @@ import argparse
 
 from maizeviz.cli.common import EXIT_OK, floats, say
 from maizeviz.errors import check_range
-from maizeviz.io.atomic import check_output, refuse_overwriting_inputs
+from maizeviz.io.outputs import check_run_paths
 from maizeviz.io.phenomenal import load_phenomenal
 from maizeviz.io.points import write_points
 from maizeviz.leaf.phenomenal import move_plant, phenomenal_grids
@@ -30,8 +30,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     check_range(args.plant, "the plant id", 0, 2**31 - 1, "plant", whole=True)
-    check_output(args.out)
-    refuse_overwriting_inputs([("the points file", args.out)], [args.file])
+    check_run_paths([("the points file", args.out)], [("the Phenomenal plant", args.file)])
     grids, warnings = phenomenal_grids(load_phenomenal(args.file), args.plant)
     for w in warnings:
         say(f"warning: {w}")

@@ -10,8 +10,9 @@ import threading
 from maizeviz.cli.common import EXIT_OK, say
 from maizeviz.digitizer.port import FastrakPort
 from maizeviz.digitizer.recorder import Recorder
-from maizeviz.digitizer.session import Session
+from maizeviz.digitizer.session import DEFAULT_COLS, Session
 from maizeviz.errors import MaizevizError, check_range
+from maizeviz.io.outputs import check_run_paths
 
 #: The subcommand.
 NAME = "record"
@@ -26,8 +27,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                     "r end the row early (tip), u undo the last point, q finish.")
     p.add_argument("--port", required=True, help="serial port, e.g. /dev/ttyUSB0")
     p.add_argument("--out", required=True, help="points CSV to append to")
-    p.add_argument("--cols", type=int, default=5,
-                   help="points per cross-section, margin to margin (default 5)")
+    p.add_argument("--cols", type=int, default=None,
+                   help=f"points per cross-section, margin to margin (default {DEFAULT_COLS}; "
+                        "with --resume, the recording's own: a different value is refused)")
     p.add_argument("--resume", action="store_true", help="continue --out where it stopped")
     p.add_argument("--baud", type=int, default=115200, help="baud rate (default 115200)")
     p.add_argument("--reference-station", type=int, choices=(2, 3, 4), metavar="N",
@@ -40,13 +42,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     check_range(args.answer_timeout, "the answer timeout", 0.01, 600, "answer_timeout", unit="s")
     check_range(args.baud, "the baud rate", 300, 4_000_000, "baud", whole=True)
+    check_run_paths([], [("the serial port", args.port)], appended=[("the recording", args.out)])
     session = Session(args.out, args.cols, args.resume, args.reference_station)
     for message in session.messages:
         say(f"note: {message}")
     if args.resume:
         q0 = session.pos
-        say(f"resuming {args.out}: {session.count.points} points on disk; next point is plant "
-            f"{q0.plant} leaf {q0.leaf} row {q0.row} col {q0.col}")
+        say(f"resuming {args.out}: {session.count.points} points on disk, {session.cols} points "
+            f"per cross-section; next point is plant {q0.plant} leaf {q0.leaf} row {q0.row} col "
+            f"{q0.col}")
     port = FastrakPort(args.port, args.baud, args.answer_timeout)
     stations = (1,) if args.reference_station is None else (1, args.reference_station)
     try:

@@ -6,7 +6,7 @@ import argparse
 
 from maizeviz.canopy.layout import parse_shape
 from maizeviz.cli.common import EXIT_OK, say
-from maizeviz.io.atomic import check_output
+from maizeviz.io.outputs import check_run_paths
 from maizeviz.io.points import write_points
 from maizeviz.leaf.synth import block_grids
 
@@ -35,7 +35,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     rows, per_row = parse_shape(args.plants, "plants")
-    check_output(args.out)
+    check_run_paths([("the points file", args.out)])
     grids = block_grids(rows, per_row, args.row_spacing, args.plant_spacing, args.seed,
                         grid_rows=args.sections, grid_cols=args.points_across)
     write_points(args.out, grids)

@@ -51,6 +51,8 @@ from maizeviz.io.points import (
 
 COLUMNS = JOURNAL_COLUMNS
 CONTROLS = {"n": "next_leaf", "p": "next_plant", "r": "end_row", "u": "undo", "q": "quit"}
+#: Points per cross-section of a new recording unless told.
+DEFAULT_COLS = 5
 #: Free space (bytes) a session needs before it starts.
 MIN_FREE_BYTES = 1 << 20
 #: The header line the recorder writes (csv's CR LF line end).
@@ -181,16 +183,30 @@ class JournalReplay(LineParser):
     Attributes
     ----------
     history : list of (Position, (x, y, z) cm), points recorded and not undone, in order
-    pos : Position, where the next point goes
+    pos : Position, where the next point goes (with ``cols`` None, after a point: its next col;
+        :meth:`pos_after` gives it for a width)
     problems : lines that were skipped, with the reason (the points reader says the same)
+    width : points per cross-section the recording shows, or None: the last row that ended
+        by itself (a point at col 0 right after the previous row's last point, no control or
+        undo in between) had ``width`` points
+    least_width : points per cross-section the recording needs at least (largest col + 1)
+    last_point : Position of the last line when it was a point (the next position depends on
+        the width), else None
     """
 
-    def __init__(self, source: str, cols: int):
+    def __init__(self, source: str, cols: int | None):
         super().__init__(source, max_points=MAX_JOURNAL_LINES, max_lines=MAX_JOURNAL_LINES)
         self.cols = cols
         self.history: list[tuple] = []
         self.pos = Position()
         self.controls = 0
+        self.width: int | None = None
+        self.least_width = 0
+        self.last_point: Position | None = None
+
+    def pos_after(self, cols: int) -> Position:
+        """Where the next point goes in a recording of ``cols`` points per cross-section."""
+        return self.pos if self.last_point is None else _after(self.last_point, cols)
 
     def _discard(self, lineno: int) -> None:
         """A torn line marked when an earlier session resumed: skipped without a word."""
@@ -198,11 +214,17 @@ class JournalReplay(LineParser):
 
     def commit(self, outcome) -> None:
         kind, payload, _ = outcome
+        last, self.last_point = self.last_point, None
         if kind == "point":
             plant, leaf, row, col, coords, _ = payload
             p = Position(plant, leaf, row, col)
+            if last is not None and col == 0 and (last.plant, last.leaf, last.row + 1) == \
+                    (plant, leaf, row):
+                self.width = last.col + 1                 # the row ended by itself
+            self.least_width = max(self.least_width, col + 1)
             self.history.append((p, tuple(coords)))
-            self.pos = _after(p, self.cols)
+            self.last_point = p
+            self.pos = _after(p, self.cols) if self.cols else Position(plant, leaf, row, col + 1)
         elif kind == "undo":
             if self.history:
                 last, _ = self.history.pop()
@@ -253,7 +275,9 @@ class Session:
     Parameters
     ----------
     path : output CSV
-    cols : points per cross-section; after ``cols`` presses the next row starts
+    cols : points per cross-section; after ``cols`` presses the next row starts. None: when
+        resuming, the recording's own (refused when no row of it has ended yet), else
+        :data:`DEFAULT_COLS`; given when resuming, it must agree with the recording
     resume : continue an existing recording where it stopped (else the file must not exist,
         be empty, or hold no point yet, as after a start that failed)
     reference_station : re-express stylus points in this receiver's frame (motion compensation)
@@ -265,13 +289,15 @@ class Session:
         last line found and marked not recorded, lines skipped in the replay.
     """
 
-    def __init__(self, path, cols: int, resume: bool = False,
+    def __init__(self, path, cols: int | None = None, resume: bool = False,
                  reference_station: int | None = None, start: Position | None = None):
-        if isinstance(cols, bool) or not isinstance(cols, int) or not 1 <= cols <= 10_000:
+        if cols is not None and (isinstance(cols, bool) or not isinstance(cols, int)
+                                 or not 1 <= cols <= 10_000):
             raise SessionError(f"points per cross-section must be a whole number from 1 to "
                                f"10000, got {cols}", quantity="cols")
         self.path = Path(path)
-        self.cols = cols
+        # None while resuming: the recording's own, known once it is replayed (_width)
+        self.cols: int = DEFAULT_COLS if cols is None and not resume else cols  # type: ignore
         self.reference_station = reference_station
         self.pos = start or Position()
         self.count = Counters()
@@ -376,8 +402,9 @@ class Session:
         """Take over the position and points of a replayed recording (when resuming) and
         what it says about the file."""
         if resume:
+            self.cols = self._width(replay)
             self.history = replay.history
-            self.pos = replay.pos
+            self.pos = replay.pos_after(self.cols)
             self.count.points = len(self.history)
             for q, _ in self.history:
                 self.count.leaves.add((q.plant, q.leaf))
@@ -386,6 +413,33 @@ class Session:
         if replay.torn is not None:
             self._tail = replay.torn[1]
             self._torn_line = replay.torn
+
+    def _width(self, replay: JournalReplay) -> int:
+        """The points per cross-section of a resumed recording: the one it shows, or the one
+        given if it agrees.
+
+        Raises
+        ------
+        SessionError
+            The width given contradicts the recording's; or none is given and no row of the
+            recording has ended yet, so its width is not known.
+        """
+        shown_width, least = replay.width, replay.least_width
+        if self.cols is None:
+            if shown_width is not None:
+                return shown_width
+            if not replay.history:
+                return DEFAULT_COLS
+            raise SessionError(f"{self.path}: no cross-section of the recording is finished yet, "
+                               f"so its points per cross-section are not known (at least "
+                               f"{least}): give the points per cross-section to resume it",
+                               quantity="cols")
+        if shown_width is not None and shown_width != self.cols or self.cols < least:
+            was = shown_width if shown_width is not None else f"at least {least}"
+            raise SessionError(f"{self.path} was recorded with {was} points per cross-section, "
+                               f"not {self.cols}; resume it without giving them (or with "
+                               f"{was})", quantity="cols")
+        return self.cols
 
     def _replay(self, resume: bool) -> JournalReplay:
         """Read the whole recording with the points reader's rules; refuse anything else."""

@@ -17,7 +17,7 @@ import contextlib
 import csv
 import os
 import tempfile
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import IO, Any
 
@@ -193,40 +193,3 @@ def write_rows(path: str | Path, rows: Sequence[Mapping[str, Any]]) -> None:
         w = csv.DictWriter(fh, fieldnames=fields)
         w.writeheader()
         w.writerows(rows)
-
-
-def refuse_overwriting_inputs(outputs: Iterable[tuple[str, str | Path | None]],
-                              inputs: Iterable[str | Path | None]) -> None:
-    """Refuse an output that is one of the inputs (a points file, a layout...).
-
-    Parameters
-    ----------
-    outputs : (what, path) pairs, e.g. ``("the leaf light table", "b.csv")``; None paths skipped
-    inputs : paths read by the same run; None skipped
-
-    Raises
-    ------
-    MaizevizError
-        Naming the output and the input it would overwrite.
-    """
-    ins = []
-    for p in inputs:
-        if p is None:
-            continue
-        try:
-            ins.append((Path(p), Path(p).resolve()))
-        except OSError:
-            continue
-    for what, out in outputs:
-        if out is None:
-            continue
-        target = Path(out)
-        for src, resolved in ins:
-            same = False
-            try:
-                same = target.exists() and os.path.samefile(target, src)
-            except OSError:
-                same = False
-            if same or target.resolve() == resolved:
-                raise MaizevizError(f"{out}: {what} would overwrite the input file {src}; "
-                                    "choose another name")

@@ -15,7 +15,7 @@ from dataclasses import replace
 import numpy as np
 
 from maizeviz.errors import MaizevizError
-from maizeviz.io.phenomenal import LEAF_LABELS
+from maizeviz.io.phenomenal import leaf_organs
 from maizeviz.leaf.grid import LeafGrid, stalk_base
 
 
@@ -87,27 +87,34 @@ def blade_grid(polyline: np.ndarray, voxels: np.ndarray, insertion: np.ndarray |
 
 
 def phenomenal_grids(data: dict, plant: int = 1, cols: int = 5) -> tuple[list[LeafGrid], list[str]]:
-    """Leaf grids of every ranked leaf of a Phenomenal plant, plus warnings for skipped organs."""
-    grids, warnings = [], []
-    for organ in data["voxel_organs"]:
-        if not isinstance(organ, dict) or organ.get("label") not in LEAF_LABELS:
+    """Leaf grids of every ranked leaf of a Phenomenal plant, plus warnings for skipped organs.
+
+    Raises
+    ------
+    MaizevizError
+        The structure is wrong (see :func:`maizeviz.io.phenomenal.leaf_organs`), or no leaf
+        could be imported.
+    """
+    grids: list[LeafGrid] = []
+    warnings: list[str] = []
+    for organ in leaf_organs(data):
+        longest = max(organ.polylines, key=len, default=np.empty((0, 3)))
+        if organ.rank is None or not len(longest):
+            warnings.append(f"a {organ.label} without rank or midrib skipped ({organ.where})")
             continue
-        info = organ.get("info") or {}
-        rank = info.get("pm_leaf_number")
-        segs = organ.get("voxel_segments") or []
-        if rank is None or not segs:
-            warnings.append(f"a {organ.get('label')} without rank or midrib skipped")
+        with np.errstate(all="ignore"):           # a degenerate blade is refused just below
+            try:
+                pts = blade_grid(longest, organ.voxels, organ.insertion, cols)
+            except ValueError as exc:
+                warnings.append(f"leaf {organ.rank}: skipped ({exc})")
+                continue
+        if not np.all(np.isfinite(pts)):
+            warnings.append(f"leaf {organ.rank}: skipped (its midrib or voxels are degenerate)")
             continue
-        seg = max(segs, key=lambda sg: len(sg.get("polyline") or []))
-        voxels = np.concatenate([np.asarray(sg.get("voxels_position") or np.empty((0, 3)),
-                                            dtype=np.float64).reshape(-1, 3) for sg in segs])
-        try:
-            pts = blade_grid(np.asarray(seg["polyline"], dtype=np.float64), voxels,
-                             np.asarray(info.get("pm_position_base", [np.nan] * 3), float), cols)
-        except (ValueError, KeyError, TypeError) as exc:
-            warnings.append(f"leaf {rank}: skipped ({exc})")
+        if any(g.leaf == organ.rank for g in grids):
+            warnings.append(f"leaf {organ.rank}: skipped (a leaf of that rank came first)")
             continue
-        grids.append(LeafGrid(plant, int(rank), pts, True, tuple(range(len(pts))), ()))
+        grids.append(LeafGrid(plant, organ.rank, pts, True, tuple(range(len(pts))), ()))
     if not grids:
         raise MaizevizError("no leaf could be imported from this Phenomenal plant")
     return sorted(grids, key=lambda g: g.leaf), warnings

@@ -23,6 +23,7 @@ from __future__ import annotations
 import datetime as _dt
 
 from maizeviz.errors import MaizevizError
+from maizeviz.light.dates import TIME_UNIT
 
 
 def zone(tz) -> _dt.tzinfo:
@@ -127,7 +128,9 @@ def local_time(day: _dt.date, clock, tz=None, what: str = "clock", quantity: str
     import pandas as pd
 
     since, offset = parse_clock(clock, what, quantity)
-    naive = pd.Timestamp(_dt.datetime.combine(day, _dt.time()) + since)
+    # added in pandas, whose microsecond Timestamps pass 9999-12-31 24:00 (datetime's do not)
+    naive = pd.Timestamp(_dt.datetime.combine(day, _dt.time())).as_unit(TIME_UNIT) + \
+        pd.Timedelta(since)
     where = None if tz is None else (tz if isinstance(tz, _dt.tzinfo) else zone(tz))
     zoned = None
     if where is not None:

@@ -10,7 +10,6 @@ from typing import TYPE_CHECKING, TypeAlias, cast
 
 import numpy as np
 
-from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import atomic_open, atomic_path, file_tag, make_folder
 from maizeviz.light.bins import TransmissionMap, bin_edges, binned
 from maizeviz.light.sky import SKY_KINDS
@@ -142,12 +141,19 @@ def result_figure(result: AnyLight, height: float, kind: str = "sun", bin_cm: fl
 
 
 def heatmap_stems(result: AnyLight, kind: str = "sun") -> list[str]:
-    """Distinct file stems, one per height: ``transmission_<level>_h<height>cm`` (a sun's
-    maps), ``diffuse_...`` (a sky's) or ``period_...`` (a period's)."""
+    """Distinct file stems of a result's maps, one per height (see :func:`map_stems`)."""
+    return map_stems(kind, result.level, result.heights_cm)
+
+
+def map_stems(kind: str, level: str, heights_cm) -> list[str]:
+    """Distinct file stems, one per height of ``heights_cm`` (cm) at the mesh level labelled
+    ``level``: ``transmission_<level>_h<height>cm`` (a sun's maps), ``diffuse_...`` (a sky's)
+    or ``period_...`` (a period's). Known before anything is traced, so output names can be
+    checked first."""
     _check_kind(kind)
-    level = file_tag(result.level) or "level"
+    level = file_tag(level) or "level"
     stems: list[str] = []
-    for h in result.heights_cm:
+    for h in heights_cm:
         stem = f"{MAP_PREFIXES[kind]}_{level}_h{h:g}cm".replace(".", "p")
         while stem in stems:                         # heights equal to %g precision
             stem += "_"

@@ -61,6 +61,7 @@ from maizeviz.io.inputs import read_input
 from maizeviz.light.clock import check_place as _check_place
 from maizeviz.light.clock import local_time
 from maizeviz.light.clock import zone as _time_zone
+from maizeviz.light.dates import FIRST_YEAR, LAST_YEAR, TIME_UNIT, check_year
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -599,7 +600,8 @@ def _header(line: int, fields: list, path: Path) -> dict:
 
 
 def _parse_times(texts: list, lines: list, path: Path, tz):
-    """Time texts -> tz-aware DatetimeIndex (in ``tz``, or the first row's offset)."""
+    """Time texts -> tz-aware DatetimeIndex in microseconds (in ``tz``, or the first row's
+    offset); every local date in the years :func:`~maizeviz.light.dates.check_year` allows."""
     import pandas as pd
 
     zoned = np.array([bool(_ZONE_SUFFIX.search(t)) for t in texts])
@@ -611,25 +613,29 @@ def _parse_times(texts: list, lines: list, path: Path, tz):
 
     def parse_one(k):
         try:
-            return pd.Timestamp(texts[k])
-        except (ValueError, TypeError):
+            stamp = pd.Timestamp(texts[k])
+        except (ValueError, TypeError, OverflowError):
             raise WeatherFileError(f"{path}, line {lines[k]}, column time: cannot read "
                                    f"'{texts[k]}' as an ISO 8601 time") from None
+        check_year(stamp.year, f"{path}, line {lines[k]}, column time", texts[k],
+                   WeatherFileError, "weather")
+        return stamp.as_unit(TIME_UNIT)
 
     def parse_all(idx, **kw):
         sub = [texts[k] for k in idx]
         try:
-            return pd.to_datetime(sub, format="ISO8601", **kw)
+            found = pd.to_datetime(sub, format="ISO8601", **kw)
         except (ValueError, TypeError, OverflowError):
-            for k in idx:
-                parse_one(k)
-            raise WeatherFileError(f"{path}, column time: cannot read the times as ISO "
-                                   f"8601") from None
+            # pandas refuses a mix it cannot hold in one resolution (nanosecond digits and a
+            # year out of the nanosecond range): row by row, naming the first bad one
+            found = pd.DatetimeIndex([parse_one(k) for k in idx])
+            found = found.tz_convert("UTC") if kw.get("utc") else found
+        return found.as_unit(TIME_UNIT)
 
-    utc = np.empty(len(texts), dtype="datetime64[ns]")
+    utc = np.empty(len(texts), dtype=f"datetime64[{TIME_UNIT}]")
     with_zone = np.flatnonzero(zoned)
     if len(with_zone):
-        utc[with_zone] = parse_all(with_zone, utc=True).tz_localize(None).to_numpy("datetime64[ns]")
+        utc[with_zone] = parse_all(with_zone, utc=True).tz_localize(None).to_numpy()
     naive = np.flatnonzero(~zoned)
     if len(naive):
         local = parse_all(naive)
@@ -645,9 +651,14 @@ def _parse_times(texts: list, lines: list, path: Path, tz):
                         f"occurs twice in {tz} (a daylight-saving change); write it with an "
                         f"offset") from None
             raise
-        utc[naive] = aware.tz_convert("UTC").tz_localize(None).to_numpy("datetime64[ns]")
+        utc[naive] = aware.tz_convert("UTC").tz_localize(None).to_numpy()
     zone = tz if tz is not None else parse_one(0).tz
-    return pd.DatetimeIndex(utc).tz_localize("UTC").tz_convert(zone)
+    times = pd.DatetimeIndex(utc).tz_localize("UTC").tz_convert(zone)
+    years = np.asarray(times.year)
+    for row in np.flatnonzero((years < FIRST_YEAR) | (years > LAST_YEAR)).tolist():
+        check_year(int(years[row]), f"{path}, line {lines[row]}, column time", texts[row],
+                   WeatherFileError, "weather")
+    return times
 
 
 def _value_problem(text: str) -> str | None:
@@ -687,9 +698,10 @@ def _parse_values(texts: list, lines: list, times: list, column: str, path: Path
     return values
 
 
-def _check_order(utc_ns: np.ndarray, lines: list, texts: list, path: Path) -> np.ndarray:
-    """Seconds between consecutive rows; refuses unsorted, repeated times and gaps."""
-    steps = np.diff(utc_ns).astype(np.float64) / 1e9
+def _check_order(utc_us: np.ndarray, lines: list, texts: list, path: Path) -> np.ndarray:
+    """Seconds between consecutive rows (times ``utc_us`` in int64 microseconds); refuses
+    unsorted, repeated times and gaps."""
+    steps = np.diff(utc_us).astype(np.float64) / 1e6
     for k in np.flatnonzero(steps <= 0):
         what = "repeats the time of" if steps[k] == 0 else "is earlier than"
         raise WeatherFileError(f"{path}, line {lines[k + 1]}, column time: '{texts[k + 1]}' "
@@ -705,14 +717,17 @@ def _check_order(utc_ns: np.ndarray, lines: list, texts: list, path: Path) -> np
     return steps
 
 
-def _intervals(utc_s: np.ndarray, steps: np.ndarray, label: str) -> np.ndarray:
-    """Interval edges (n + 1,) in s for rows whose times sit at ``label`` of their interval."""
+def _intervals(utc_us: np.ndarray, label: str) -> np.ndarray:
+    """Interval edges (n + 1,) int64 microseconds for rows at times ``utc_us`` (n,) int64
+    microseconds sitting at ``label`` of their interval. Integers, not float seconds: a float
+    holds a year-0001 time only to about 8 microseconds."""
+    steps = np.diff(utc_us)
     if label == "start":
-        return np.append(utc_s, utc_s[-1] + steps[-1])
+        return np.append(utc_us, utc_us[-1] + steps[-1])
     if label == "end":
-        return np.concatenate([[utc_s[0] - steps[0]], utc_s])
-    mids = (utc_s[:-1] + utc_s[1:]) / 2.0
-    return np.concatenate([[utc_s[0] - steps[0] / 2.0], mids, [utc_s[-1] + steps[-1] / 2.0]])
+        return np.concatenate([[utc_us[0] - steps[0]], utc_us])
+    mids = utc_us[:-1] + steps // 2
+    return np.concatenate([[utc_us[0] - steps[0] // 2], mids, [utc_us[-1] + steps[-1] // 2]])
 
 
 def read_weather(path, tz: str | None = None, label: str = "center",
@@ -774,18 +789,19 @@ def read_weather(path, tz: str | None = None, label: str = "center",
     times = _parse_times(texts, lines, path, zone)
     values = {c: _parse_values([row[columns[c]] for row in data], lines, texts, c, path)
               for c in ("ghi", *WEATHER_OPTIONAL) if c in columns}
-    utc_ns = times.tz_convert("UTC").tz_localize(None).to_numpy("datetime64[ns]").astype(np.int64)
-    steps = _check_order(utc_ns, lines, texts, path)
-    edges = _intervals(utc_ns / 1e9, steps, key)
-    mids = (edges[:-1] + edges[1:]) / 2.0
+    utc_us = times.tz_convert("UTC").tz_localize(None).to_numpy(
+        f"datetime64[{TIME_UNIT}]").astype(np.int64)
+    _check_order(utc_us, lines, texts, path)
+    edges = _intervals(utc_us, key)
+    mids = edges[:-1] + np.diff(edges) // 2
     import pandas as pd
 
-    def stamp(seconds):
-        return pd.to_datetime(np.round(np.asarray(seconds) * 1e6).astype(np.int64), unit="us",
-                              utc=True).tz_convert(times.tz)
+    def stamp(micros):
+        return pd.DatetimeIndex(np.asarray(micros).astype(f"datetime64[{TIME_UNIT}]")
+                                ).tz_localize("UTC").tz_convert(times.tz)
 
     bounds = stamp(edges[[0, -1]])
-    return Weather(path=str(path), times=stamp(mids), step_s=_frozen(np.diff(edges)),
+    return Weather(path=str(path), times=stamp(mids), step_s=_frozen(np.diff(edges) / 1e6),
                    ghi=_frozen(values["ghi"]), dni=values.get("dni"), dhi=values.get("dhi"),
                    line=_frozen(lines, np.int64), label=key, start=bounds[0], end=bounds[1])
 

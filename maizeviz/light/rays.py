@@ -26,10 +26,42 @@ from maizeviz.mesh.raytrace import RayScene
 Rect = tuple[float, float, float, float]
 
 
+#: The largest ray density, rays per cm2: a ray every micrometre (a leaf blade is a few
+#: hundred thick); larger numbers only overflow the arithmetic of the grid.
+MAX_DENSITY = 1e8
+#: The largest coordinate of a sample rectangle, cm (100 km).
+MAX_COORD_CM = 1e7
+
+
+def check_density(density: float) -> float:
+    """Refuse a ray density (rays per cm2) that is not a number in (0, MAX_DENSITY]."""
+    ok = isinstance(density, (int, float)) and not isinstance(density, bool) and \
+        0 < density <= MAX_DENSITY
+    if not ok:
+        raise MaizevizError(f"the ray density must be > 0 and at most {MAX_DENSITY:g} rays per "
+                            f"cm2, got {density}", quantity="density")
+    return float(density)
+
+
+def check_rect(rect: Rect) -> Rect:
+    """Refuse a sample rectangle (x0, y0, x1, y1) cm that is not four finite numbers of at
+    most MAX_COORD_CM with x1 > x0 and y1 > y0; returns it as floats."""
+    try:
+        vals = tuple(float(v) for v in rect)
+    except (TypeError, ValueError):
+        vals = ()
+    if len(vals) != 4 or not all(abs(v) <= MAX_COORD_CM for v in vals) \
+            or vals[2] <= vals[0] or vals[3] <= vals[1]:
+        raise MaizevizError(f"the sample rectangle must be x0,y0,x1,y1 with x1 > x0 and y1 > y0, "
+                            f"within {MAX_COORD_CM:g} cm, got {rect}", quantity="rect")
+    return vals[0], vals[1], vals[2], vals[3]
+
+
 def grid_shape(rect: Rect, density: float) -> tuple[int, int]:
-    """Rays across x and along y of a regular grid of ``density`` rays per cm2 over ``rect``."""
-    x0, y0, x1, y1 = rect
-    step = 1.0 / math.sqrt(density)
+    """Rays across x and along y of a regular grid of ``density`` rays per cm2 over ``rect``
+    (both checked: every grid is sized here)."""
+    x0, y0, x1, y1 = check_rect(rect)
+    step = 1.0 / math.sqrt(check_density(density))
     return max(1, int(round((x1 - x0) / step))), max(1, int(round((y1 - y0) / step)))
 
 

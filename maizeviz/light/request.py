@@ -14,9 +14,11 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError, check_range
-from maizeviz.light.rays import Rect, ray_count
+from maizeviz.light.rays import Rect, check_density, check_rect, ray_count
 from maizeviz.light.sun import Sun
 
+#: Highest sensor plane, cm (100 m: far above any crop; float32 tracing stays exact).
+MAX_HEIGHT_CM = 10_000.0
 #: More rays than this are refused (minutes of tracing and GiB of results).
 MAX_RAYS = 400_000_000
 #: More tracing threads than this are refused (Embree gains nothing past the cores).
@@ -151,18 +153,14 @@ def check_sampling(canopy: Canopy, req: Sampling) -> tuple[Rect, list[str]]:
     if not req.heights_cm:
         raise MaizevizError("give at least one height", quantity="heights")
     for h in req.heights_cm:
-        if not math.isfinite(h) or h < 0:
-            raise MaizevizError(f"heights must be >= 0 cm, got {h}", quantity="heights")
-    if not (math.isfinite(req.density) and req.density > 0):
-        raise MaizevizError(f"the ray density must be > 0 rays per cm2, got {req.density}",
-                            quantity="density")
+        if not math.isfinite(h) or not 0 <= h <= MAX_HEIGHT_CM:
+            raise MaizevizError(f"heights must be from 0 to {MAX_HEIGHT_CM:,.0f} cm, got {h:g}",
+                                quantity="heights")
+    check_density(req.density)
     check_range(req.threads, "tracing threads", 1, MAX_THREADS, "threads", whole=True)
     px0, py0, px1, py1 = canopy.layout.bounds
-    rect: Rect = tuple(float(v) for v in (req.rect or canopy.layout.centre_bounds))  # type: ignore[assignment]
+    rect = check_rect(req.rect or canopy.layout.centre_bounds)
     x0, y0, x1, y1 = rect
-    if not all(math.isfinite(v) for v in rect) or x1 <= x0 or y1 <= y0:
-        raise MaizevizError(f"the sample rectangle must be x0,y0,x1,y1 with x1 > x0 and y1 > y0, "
-                            f"got {rect}", quantity="rect")
     if x0 < px0 - 1e-6 or y0 < py0 - 1e-6 or x1 > px1 + 1e-6 or y1 > py1 + 1e-6:
         raise MaizevizError(f"the sample rectangle {rect} cm is not inside the plot "
                             f"({px0:.0f}, {py0:.0f}, {px1:.0f}, {py1:.0f}) cm", quantity="rect")

@@ -91,12 +91,28 @@ def run_sweep(args) -> int:
         spec = load_spec(args.spec, yes=args.yes)
         if args.dry_run:
             return _dry_run(spec, args)
+        check_paths(spec, args.out)
         if not args.scheduler:                       # a cluster's workers have their own memory
             check_memory(spec)
         return _run(spec, args)
     except MaizevizError as exc:
         _say(f"error: {exc}")
         return EXIT_FAIL
+
+
+def check_paths(spec, out) -> None:
+    """Refuse, before any work, a results folder whose files would overwrite the sweep file,
+    a points file or a layout file of the sweep."""
+    from maizeviz.io.outputs import OutputFolder, check_run_paths
+
+    inputs = [("the sweep file", spec.source)]
+    for s in spec.scenarios:
+        inputs.append(("the points file", s.points.path))
+        if s.arrangement.layout_path:
+            inputs.append(("the layout file", s.arrangement.layout_path))
+    files = ("results.parquet", "results.csv", "summary.csv", "sweep.json")
+    check_run_paths([], list(dict.fromkeys(inputs)),
+                    [OutputFolder("the results folder", out, files)])
 
 
 def _run(spec, args) -> int:

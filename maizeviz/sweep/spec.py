@@ -415,6 +415,9 @@ def read_toml(path) -> tuple[dict, str]:
         return tomllib.loads(text), text
     except tomllib.TOMLDecodeError as exc:
         raise SweepSpecError(f"{path}: not valid TOML: {' '.join(str(exc).split())}") from None
+    except RecursionError:                # tomllib recurses once per nested array or table
+        raise SweepSpecError(f"{path}: not a sweep file: arrays or tables nested too deeply") \
+            from None
 
 
 def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> SweepSpec:

@@ -29,9 +29,10 @@ class Recorder:
     """``maizeviz record`` in a subprocess, with its stdout lines in a queue."""
 
     def __init__(self, port, out, *extra, cols=3):
+        width = [] if cols is None else ["--cols", str(cols)]
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "maizeviz", "record", "--port", port, "--out", str(out),
-             "--cols", str(cols), "--answer-timeout", "0.5", *map(str, extra)],
+             *width, "--answer-timeout", "0.5", *map(str, extra)],
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
             bufsize=1)
         self.lines = queue.Queue()
@@ -389,3 +390,72 @@ def test_reconnect_reopens_and_reconfigures():
         sim.press([7, 8, 9])
         assert q.get(timeout=5).position == pytest.approx([7, 8, 9], abs=0.02)
         port.close()
+
+
+# ------------------------------------------------------------------ the shape of a resumed session
+def _record_then_kill(sim, out, presses, cols):
+    rec = Recorder(sim.path, out, cols=cols)
+    rec.expect("ready")
+    for k in range(presses):
+        press(sim, [k, 0, 0])
+        rec.expect("recorded")
+    os.kill(rec.proc.pid, signal.SIGKILL)
+    rec.proc.wait(timeout=10)
+
+
+def test_resume_without_cols_keeps_the_sessions_width(sim, tmp_path):
+    out = tmp_path / "rec.csv"
+    _record_then_kill(sim, out, 4, cols=3)           # row 0 whole, row 1 col 0
+    rec = Recorder(sim.path, out, "--resume", cols=None)
+    rec.expect("ready")
+    for k in range(4, 7):
+        press(sim, [k, 0, 0])
+        rec.expect("recorded")
+    code, err = rec.finish()
+    assert code == 0, err
+    assert "3 points per cross-section" in err
+    table = read_points(out)
+    rows_cols = [tuple(ids[2:]) for ids in table.ids.tolist()]
+    # the data are the oracle: presses 4, 5, 6 finish row 1 and start row 2 of a 3-wide leaf
+    assert rows_cols == [(0, 0), (0, 1), (0, 2), (1, 0), (1, 1), (1, 2), (2, 0)]
+    assert table.xyz[:, 0].round().tolist() == list(range(7))
+
+
+def test_resume_with_contradicting_cols_is_one_line_and_writes_nothing(sim, tmp_path):
+    out = tmp_path / "rec.csv"
+    _record_then_kill(sim, out, 4, cols=3)
+    before = out.read_bytes()
+    rec = Recorder(sim.path, out, "--resume", cols=5)
+    code = rec.proc.wait(timeout=20)
+    err = rec.proc.stderr.read()
+    errors = [ln for ln in err.splitlines() if ln.startswith(("error", "internal"))]
+    assert code == 1 and len(errors) == 1, err
+    assert "3 points per cross-section" in errors[0] and errors[0].endswith("(--cols)")
+    assert out.read_bytes() == before
+
+
+def test_resume_of_a_session_without_a_finished_row_needs_cols(sim, tmp_path):
+    out = tmp_path / "rec.csv"
+    _record_then_kill(sim, out, 2, cols=3)
+    before = out.read_bytes()
+    with pytest.raises(SessionError, match="give the points per cross-section") as err:
+        Session(out, None, resume=True)
+    assert err.value.quantity == "cols" and "\n" not in str(err.value)
+    assert out.read_bytes() == before
+    s = Session(out, 3, resume=True)                 # said once, it continues
+    assert (s.pos.row, s.pos.col) == (0, 2)
+    s.close()
+
+
+def test_session_width_from_the_journal_after_undo_and_end_row(tmp_path):
+    out = tmp_path / "rec.csv"
+    s = Session(out, 4)
+    for k in range(6):                               # row 0 whole, row 1 cols 0-1
+        s.on_event(Record(1, " ", (float(k), 0.0, 0.0), (0, 0, 0), 1))
+    s.control("u")
+    s.control("r")                                   # row 1 ended early: one col
+    s.on_event(Record(1, " ", (9.0, 0.0, 0.0), (0, 0, 0), 1))
+    s.close()
+    again = Session(out, None, resume=True)
+    assert again.cols == 4 and (again.pos.row, again.pos.col) == (2, 1)
+    again.close()

@@ -257,7 +257,8 @@ def test_bad_suns(make, match):
     (dict(rect=(50, 50, 40, 60)), "x1 > x0"),
     (dict(density=0), "density must be > 0"),
     (dict(density=1e7), "rays.*limit"),
-    (dict(heights_cm=(-5,)), "heights must be >= 0"),
+    (dict(heights_cm=(-5,)), "heights must be from 0 to"),
+    (dict(heights_cm=(1e308,)), "heights must be from 0 to 10,000 cm"),
     (dict(heights_cm=()), "at least one height"),
 ])
 def test_bad_requests(req, match):

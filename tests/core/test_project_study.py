@@ -246,7 +246,7 @@ def test_a_100000_plant_layout_1_cm_apart_is_refused_before_building(points, lea
     assert out.returncode == 0, out.stderr[-2000:]
     lines = out.stdout.splitlines()
     assert lines[0].startswith("99856 ") and "overlapping pairs" in lines[0]
-    assert lines[1].startswith(f"tile {path}: the canopy of 99,856 plants")
+    assert lines[1].startswith(f"layout {path}: the canopy of 99,856 plants")
     assert "memory" in lines[1]
 
 

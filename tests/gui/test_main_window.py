@@ -1,7 +1,6 @@
 """The desktop app as a person uses it: open, slide the complexity, compute light."""
 
 import numpy as np
-import pytest
 from maizeviz_app.main_window import LEVELS
 
 TIMEOUT = 120_000

@@ -1,0 +1,88 @@
+"""Work that would not fit in memory is refused before anything is allocated, naming the
+option that drives it: ``leaf --interp 50`` like ``canopy`` and ``light``, and a layout of
+100,000 plants 1 cm apart (a layout file or a tiling)."""
+
+import json
+import resource
+import subprocess
+import sys
+
+import pytest
+from maizeviz.resources import example_points
+
+from maizeviz.cli import EXIT_FAIL, main
+from maizeviz.cost import BYTES_PER_LEAF_TRIANGLE, check, leaves_cost
+from maizeviz.errors import MaizevizError
+from maizeviz.leaf.fit import read_leaves
+from maizeviz.mesh.levels import Level
+
+B = str(example_points())
+#: Address space a refused run may use: the interpreter and its libraries, no more.
+LIMIT_BYTES = 3 * 2**30
+
+
+def _limited():
+    resource.setrlimit(resource.RLIMIT_AS, (LIMIT_BYTES, LIMIT_BYTES))
+
+
+def _run_limited(*argv):
+    """``maizeviz argv`` in a child that cannot map more than LIMIT_BYTES."""
+    proc = subprocess.run([sys.executable, "-m", "maizeviz", *argv], capture_output=True,
+                          text=True, timeout=300, preexec_fn=_limited)
+    errors = [ln for ln in proc.stderr.splitlines() if ln.startswith(("error", "internal"))]
+    return proc.returncode, errors, proc.stderr
+
+
+def test_leaf_cost_counts_the_triangles_the_command_makes(capsys):
+    found = read_leaves(B)
+    cost = leaves_cost(found.leaves, Level(interp=16), "interp", batch=4096)
+    assert main(["leaf", B, "--interp", "16"]) == 0
+    total = int(capsys.readouterr().out.split("leaves, ")[1].split(" triangles")[0])
+    assert cost.count == total                     # the estimate is the data, not a guess
+    assert cost.bytes == total * BYTES_PER_LEAF_TRIANGLE
+    kept = leaves_cost(found.leaves, Level(interp=16), "interp", batch=10, keep=True)
+    assert kept.bytes == cost.bytes                # one batch of 140 or all kept: the same
+    small = leaves_cost(found.leaves, Level(interp=16), "interp", batch=10)
+    assert small.bytes < cost.bytes / 10
+
+
+def test_leaf_interp_50_refused_against_the_memory_available():
+    found = read_leaves(B)
+    stage = [leaves_cost(found.leaves, Level(interp=50), "interp", batch=4096)]
+    with pytest.raises(MaizevizError) as err:
+        check([stage], available=4 * 2**30)
+    assert err.value.quantity == "interp" and "31,2" in str(err.value)
+
+
+def test_leaf_interp_50_refused_before_any_mesh(monkeypatch, capsys):
+    monkeypatch.setattr("maizeviz.cost.memory_available", lambda: 2 * 2**30)
+    assert main(["leaf", B, "--interp", "50"]) == EXIT_FAIL
+    err = capsys.readouterr().err
+    line = [ln for ln in err.splitlines() if ln.startswith(("error", "internal"))]
+    assert len(line) == 1 and line[0].startswith("error: meshing 140 leaves at K=50")
+    assert line[0].endswith("(--interp)")
+
+
+def _grid_layout(path, spacing_rows, spacing_plants, n=316):
+    rows = [{"x": float(i), "plants": [{"y": float(j), "plant": 1 + (i + j) % 9}
+                                       for j in range(n)]} for i in range(n)]
+    path.write_text(json.dumps({"maizeviz_layout": 1, "row_spacing": spacing_rows,
+                                "plant_spacing": spacing_plants,
+                                "field": {"x0": -1, "y0": -1, "x1": n + 1, "y1": n + 1},
+                                "rows": rows}))
+    return path
+
+
+@pytest.mark.parametrize("spacing", [(1, 1), (60, 30)])
+def test_a_layout_of_100000_plants_1_cm_apart_is_refused_naming_the_layout(tmp_path, spacing):
+    layout = _grid_layout(tmp_path / "dense.json", *spacing)
+    code, errors, err = _run_limited("canopy", B, "--layout", str(layout))
+    assert code == EXIT_FAIL and len(errors) == 1, err[-800:]
+    assert "99,856 plants" in errors[0] and errors[0].endswith("(--layout)"), errors
+
+
+def test_a_tiling_of_100000_plants_1_cm_apart_is_refused_naming_the_tiling():
+    code, errors, err = _run_limited("canopy", B, "--tile", "105x105", "--row-spacing", "1",
+                                     "--plant-spacing", "1")
+    assert code == EXIT_FAIL and len(errors) == 1, err[-800:]
+    assert errors[0].endswith("(--tile)")
