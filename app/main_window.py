@@ -939,7 +939,7 @@ class MainWindow(QMainWindow):
                                      shown_name=opened.shown_name)
             layout = study.restore_layout(opened, found.plants) or found.layout
             study.check_canopy_fits(found.leaves, layout, parse_level(level), path)
-            results, dropped = study.results_on(opened, layout)
+            results, dropped = study.results_on(opened, layout, found.leaves)
             opened.notes.extend(dropped)
             runs = [project.stored_run(r, path) for r in results]
             loaded = replace(found, layout=layout)

@@ -20,6 +20,8 @@ from maizeviz.progress import ProgressCallback, report, scaled
 
 STALK_RADIUS_CM = 1.2
 STALK_SIDES = 8
+#: Triangles of one plant's stalk (:func:`stalk_mesh`: two per side).
+STALK_TRIANGLES = 2 * STALK_SIDES
 
 
 def plant_tops(leaves: list[Leaf]) -> dict[int, float]:

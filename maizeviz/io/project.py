@@ -25,14 +25,17 @@ caller turns them back into objects and validates them as it would any other inp
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import io
 import json
 import math
+import os
 import re
 import struct
 import zipfile
 import zlib
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, Any
@@ -79,7 +82,7 @@ class Record:
 
     kind: str
     meta: dict[str, Any]
-    arrays: dict[str, np.ndarray] = field(default_factory=dict)
+    arrays: Mapping[str, np.ndarray | StoredArray] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -101,7 +104,7 @@ class Project:
     points_path: str
     layout: dict[str, Any] | None = None
     settings: dict[str, Any] = field(default_factory=dict)
-    arrays: dict[str, np.ndarray] = field(default_factory=dict)
+    arrays: Mapping[str, np.ndarray | StoredArray] = field(default_factory=dict)
     results: tuple[Record, ...] = ()
 
     @property
@@ -110,8 +113,99 @@ class Project:
         return hashlib.sha256(self.points_csv).hexdigest()
 
 
+
+class StoredArray:
+    """An array of a project, read from the file only when its values are needed.
+
+    Opening a project reads each array's header (shape and type, checked against the
+    project's limits) but none of its data, so a reader can compare the declared size with
+    the canopy the array belongs to before any memory is spent on it
+    (:func:`maizeviz.project.study.results_on`). ``np.asarray(a)`` (or any numpy function)
+    reads the data once; the file must be unchanged since it was opened.
+
+    Attributes
+    ----------
+    name : str, the array's name in arrays.npz
+    shape : tuple of int; dtype : numpy.dtype; ndim, nbytes, size : as numpy's
+    """
+
+    def __init__(self, source: _ArraySource, name: str, info: zipfile.ZipInfo,
+                 shape: tuple[int, ...], dtype: np.dtype):
+        self.name, self.shape, self.dtype = name, tuple(shape), dtype
+        self._source, self._info = source, info
+        self._data: np.ndarray | None = None
+
+    ndim = property(lambda self: len(self.shape))
+    size = property(lambda self: math.prod(self.shape))
+    nbytes = property(lambda self: self.size * self.dtype.itemsize)
+
+    def __len__(self) -> int:
+        if not self.shape:
+            raise TypeError("len() of a 0-d array")
+        return self.shape[0]
+
+    def __repr__(self) -> str:
+        return f"StoredArray({self.name!r}, shape={self.shape}, dtype={self.dtype})"
+
+    def load(self) -> np.ndarray:
+        """The values (read-only), read on first use."""
+        if self._data is None:
+            with self._source.inner() as inner:
+                self._data = _read_npy(inner, self._info, self.name, self._source.where,
+                                       MAX_ARRAY_BYTES)
+            self._data.flags.writeable = False
+        return self._data
+
+    def __array__(self, dtype=None, copy=None):
+        a = self.load()
+        if dtype is not None and np.dtype(dtype) != a.dtype:
+            return a.astype(dtype)
+        return a.copy() if copy else a
+
+    def astype(self, dtype, **kwargs) -> np.ndarray:
+        return self.load().astype(dtype, **kwargs)
+
+    def __getitem__(self, key):
+        return self.load()[key]
+
+
+class _ArraySource:
+    """Where a project's arrays.npz is: the bytes read at open (a compressed member), or the
+    project file itself, reopened for each array and refused if it changed since."""
+
+    def __init__(self, where: str, raw: bytes | None, stamp: tuple | None):
+        self.where, self._raw, self._stamp = where, raw, stamp
+        self._file = os.path.abspath(where)     # the same file if the working folder changes
+
+    @contextlib.contextmanager
+    def inner(self) -> Iterator[zipfile.ZipFile]:
+        if self._raw is not None:
+            with zipfile.ZipFile(io.BytesIO(self._raw)) as inner:
+                yield inner
+            return
+        changed = _refuse(self.where, "the project file changed after it was opened; open it "
+                                      "again")
+        try:
+            with open(self._file, "rb") as fh:
+                if _stamp(fh) != self._stamp:
+                    raise changed
+                with zipfile.ZipFile(fh) as zf, zf.open("arrays.npz") as member, \
+                        zipfile.ZipFile(member) as inner:
+                    yield inner
+        except (zipfile.BadZipFile, KeyError, zlib.error, EOFError, ValueError) as exc:
+            raise _refuse(self.where, f"arrays.npz is damaged ({str(exc)[:60]})") from None
+        except OSError as exc:
+            raise _refuse(self.where, f"cannot be read ({exc.strerror or exc})") from None
+
+
+def _stamp(fh) -> tuple:
+    """What tells that an open file is the one read before: device, inode, size, mtime."""
+    st = os.fstat(fh.fileno())
+    return (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+
+
 # ---------------------------------------------------------------------------------- writing
-def _check_array(name: str, a: np.ndarray) -> np.ndarray:
+def _check_array(name: str, a: np.ndarray | StoredArray) -> np.ndarray:
     a = np.asarray(a)
     if a.dtype.kind not in ARRAY_KINDS or a.dtype.hasobject:
         raise ProjectError(f"array '{name}' of type {a.dtype} cannot be stored in a project "
@@ -301,23 +395,28 @@ def _npy_header(fh: IO[bytes], name: str, where: str) -> tuple[tuple[int, ...], 
     return shape, fortran, dtype
 
 
+def _declared_size(fh: IO[bytes], info: zipfile.ZipInfo, name: str, shape: tuple,
+                   dtype: np.dtype, where: str, budget: int) -> int:
+    """Bytes the header of array ``name`` declares (``fh`` just past the header), refused
+    unless they fill the member exactly and fit :data:`MAX_ARRAY_BYTES` and ``budget``."""
+    size = math.prod(shape) * dtype.itemsize
+    if fh.tell() + size != info.file_size:
+        raise _refuse(where, f"array '{name}' says {shape} {dtype} but holds "
+                             f"{info.file_size - fh.tell()} bytes; the project is damaged")
+    if size > MAX_ARRAY_BYTES or size > budget:
+        raise _refuse(where, f"array '{name}' says {shape} {dtype} ({size / 2**20:.0f} MiB), "
+                             "more than a project holds; not opened")
+    return size
+
+
 def _read_npy(zf: zipfile.ZipFile, info: zipfile.ZipInfo, name: str, where: str,
               budget: int) -> np.ndarray:
     """One .npy member of arrays.npz: its header is read first and the size it declares is
-    checked against the member's size, :data:`MAX_ARRAY_BYTES` and ``budget`` (bytes left
-    for the project's arrays) before the data are read, so an array claiming a huge shape is
-    refused without allocating it."""
+    checked (:func:`_declared_size`) before the data are read, so an array claiming a huge
+    shape is refused without allocating it."""
     with zf.open(info) as fh:
         shape, fortran, dtype = _npy_header(fh, name, where)
-        count = math.prod(shape)
-        size = count * dtype.itemsize
-        if fh.tell() + size != info.file_size:
-            raise _refuse(where, f"array '{name}' says {shape} {dtype} but holds "
-                                 f"{info.file_size - fh.tell()} bytes; the project is damaged")
-        if size > MAX_ARRAY_BYTES or size > budget:
-            raise _refuse(where, f"array '{name}' says {shape} {dtype} "
-                                 f"({size / 2**20:.0f} MiB), more than a project holds; not "
-                                 "opened")
+        size = _declared_size(fh, info, name, shape, dtype, where, budget)
         try:
             data = fh.read(size)
             extra = fh.read(1)
@@ -326,33 +425,42 @@ def _read_npy(zf: zipfile.ZipFile, info: zipfile.ZipInfo, name: str, where: str,
     if len(data) != size or extra:
         raise _refuse(where, f"array '{name}' holds more or less data than its header says; "
                              "the project is damaged")
-    a = np.frombuffer(data, dtype=dtype, count=count)
+    a = np.frombuffer(data, dtype=dtype, count=math.prod(shape))
     return a.reshape(shape, order="F" if fortran else "C")
 
 
-def _read_arrays(raw: bytes, where: str) -> dict[str, np.ndarray]:
+def _array_headers(source: _ArraySource) -> dict[str, StoredArray]:
+    """Every array of arrays.npz, by name, with its header read and checked (shape, type,
+    size against the member's bytes, :data:`MAX_ARRAY_BYTES` and, all together, the
+    arrays.npz limit); no data read."""
+    where = source.where
     try:
-        inner = zipfile.ZipFile(io.BytesIO(raw))
-        infos = inner.infolist()
-    except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError) as exc:
+        with source.inner() as inner:
+            infos = inner.infolist()
+            if len(infos) > 10_000:
+                raise _refuse(where, f"arrays.npz holds {len(infos)} arrays; not a maizeviz "
+                                     "project")
+            out: dict[str, StoredArray] = {}
+            budget = MAX_MEMBER_BYTES["arrays.npz"]
+            for info in infos:
+                stem = info.filename[:-4] if info.filename.endswith(".npy") else ""
+                if not _NAME.fullmatch(stem) or stem in out:
+                    raise _refuse(where, f"arrays.npz holds an unexpected entry "
+                                         f"'{info.filename[:60]}'; not opened")
+                if info.flag_bits & 0x1:
+                    raise _refuse(where, f"array '{stem}' is encrypted; maizeviz projects are "
+                                         "not")
+                if info.file_size > MAX_ARRAY_BYTES + 4096:
+                    raise _refuse(where, f"array '{stem}' is {info.file_size / 2**20:.0f} MiB "
+                                         "unpacked, more than a project holds; not opened")
+                with inner.open(info) as fh:
+                    shape, _, dtype = _npy_header(fh, stem, where)
+                    size = _declared_size(fh, info, stem, shape, dtype, where, budget)
+                out[stem] = StoredArray(source, stem, info, shape, dtype)
+                budget -= size
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError, NotImplementedError,
+            zlib.error) as exc:
         raise _refuse(where, f"arrays.npz is damaged ({str(exc)[:60]})") from None
-    if len(infos) > 10_000:
-        raise _refuse(where, f"arrays.npz holds {len(infos)} arrays; not a maizeviz project")
-    out: dict[str, np.ndarray] = {}
-    budget = MAX_MEMBER_BYTES["arrays.npz"]
-    with inner:
-        for info in infos:
-            stem = info.filename[:-4] if info.filename.endswith(".npy") else ""
-            if not _NAME.fullmatch(stem) or stem in out:
-                raise _refuse(where, f"arrays.npz holds an unexpected entry "
-                                     f"'{info.filename[:60]}'; not opened")
-            if info.flag_bits & 0x1:
-                raise _refuse(where, f"array '{stem}' is encrypted; maizeviz projects are not")
-            if info.file_size > MAX_ARRAY_BYTES + 4096:
-                raise _refuse(where, f"array '{stem}' is {info.file_size / 2**20:.0f} MiB "
-                                     "unpacked, more than a project holds; not opened")
-            out[stem] = _read_npy(inner, info, stem, where, budget)
-            budget -= out[stem].nbytes
     return out
 
 
@@ -369,9 +477,19 @@ def load_project(path: str | Path) -> Project:
     try:
         with fh, zipfile.ZipFile(fh) as zf:
             found = _members(zf, where)
+            packed = found["arrays.npz"]
+            # maizeviz stores arrays.npz unpacked: its arrays are read from the file when
+            # used; a packed one (another writer) is read now, within the same limit
+            lazy = packed.compress_type == zipfile.ZIP_STORED and Path(where).is_file()
             raw = {name: _read_member(zf, info, MAX_MEMBER_BYTES[name], where,
                                       text=name != "arrays.npz")
-                   for name, info in found.items()}
+                   for name, info in found.items() if not (lazy and info is packed)}
+            if packed.file_size > MAX_MEMBER_BYTES["arrays.npz"]:
+                raise _refuse(where, f"'arrays.npz' is {packed.file_size / 2**20:.0f} MiB, "
+                                     "more than a project holds; not opened")
+            source = _ArraySource(where, None if lazy else raw.pop("arrays.npz"),
+                                  _stamp(fh) if lazy else None)
+            arrays = _array_headers(source)
     except zipfile.BadZipFile as exc:
         text = str(exc)
         what = ("a file in it is damaged (checksum mismatch)" if "CRC" in text or "Bad" in text
@@ -382,10 +500,11 @@ def load_project(path: str | Path) -> Project:
         raise _refuse(where, f"the archive is damaged ({str(exc)[:60]})") from None
     except OSError as exc:
         raise _refuse(where, f"cannot be read ({exc.strerror or exc})") from None
-    return _project_from(raw, where)
+    return _project_from(raw, arrays, where)
 
 
-def _project_from(raw: dict[str, bytes], where: str) -> Project:
+def _project_from(raw: dict[str, bytes], arrays: dict[str, StoredArray],
+                  where: str) -> Project:
     doc = _parse_json(raw["project.json"], where)
     points = _expect(doc.get("points"), dict, "'points'", where)
     points_path = _expect(points.get("path"), str, "'points.path'", where)
@@ -400,9 +519,8 @@ def _project_from(raw: dict[str, bytes], where: str) -> Project:
     settings = _expect(doc.get("settings", {}), dict, "'settings'", where)
     array_names = _expect(doc.get("arrays", []), list, "'arrays'", where)
     results_doc = _expect(doc.get("results", []), list, "'results'", where)
-    arrays = _read_arrays(raw["arrays.npz"], where)
 
-    def take(key: str, what: str) -> np.ndarray:
+    def take(key: str, what: str) -> StoredArray:
         if key not in arrays:
             raise _refuse(where, f"{what} is listed but missing from arrays.npz; the project "
                                  "is damaged")

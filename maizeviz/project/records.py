@@ -31,6 +31,7 @@ import numpy as np
 from maizeviz.errors import MaizevizError
 from maizeviz.io.project import ProjectError, Record, get, get_numbers
 from maizeviz.light.clock import zone as iana_zone
+from maizeviz.light.request import MAX_RAYS
 
 #: Record kinds of a sun, a sky and a day result (a sun's is the only kind of maizeviz 0.2).
 SUN_KIND, SKY_KIND, DAY_KIND = "light", "light_sky", "light_day"
@@ -434,9 +435,13 @@ def sun_from_record(rec: Record, where: str) -> tuple[str, Any]:
     rays = get(m, "rays", int, where=at)
     if len(heights) != len(transmission) or len(rect) != 4 or len(direction) != 3 or rays < 0:
         raise ProjectError(f"{at} has inconsistent sizes; the project is damaged")
-    first_z = rec.arrays.get("first_z")      # -inf where a ray hits nothing
-    if first_z is None or first_z.dtype.kind != "f" or first_z.shape != (rays,) or \
-            np.isnan(first_z).any() or (first_z == np.inf).any():
+    stored_z = rec.arrays.get("first_z")     # -inf where a ray hits nothing
+    if stored_z is None or stored_z.dtype.kind != "f" or stored_z.shape != (rays,) or \
+            rays > MAX_RAYS:
+        raise ProjectError(f"{at}: its rays are missing or do not match; the project is "
+                           "damaged")
+    first_z = np.asarray(stored_z)           # read only now that its size is known right
+    if np.isnan(first_z).any() or (first_z == np.inf).any():
         raise ProjectError(f"{at}: its rays are missing or do not match; the project is "
                            "damaged")
     hits: dict[str, Any] = {}
@@ -492,3 +497,15 @@ def run_from_record(rec: Record, where: str) -> tuple[str, Any, str, dict | None
         label, result, stored = day_from_record(rec, where)
         return label, result, "day", stored
     return None
+
+
+#: Arrays of a record that hold one value per canopy triangle (stalks included).
+PER_TRIANGLE = ("first_hits", "second_hits", "triangle_share", "triangle_direct_mol",
+                "triangle_diffuse_mol")
+
+
+def per_triangle(rec: Record) -> int:
+    """The most triangles any per-triangle array of ``rec`` declares (0 without one), from
+    the arrays' headers: nothing is read."""
+    return max((int(a.shape[0]) if a.ndim else 0 for name, a in rec.arrays.items()
+                if name.endswith(PER_TRIANGLE)), default=0)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import hashlib
 from collections import Counter
+from collections.abc import Mapping
 from dataclasses import replace
 from typing import Any
 
@@ -77,7 +78,7 @@ def _in_order(layout: CanopyLayout, stands: np.ndarray, where: str) -> CanopyLay
     return replace(layout, placements=placements)
 
 
-def layout_from_parts(doc: dict, arrays: dict[str, np.ndarray], plants: set[int],
+def layout_from_parts(doc: dict, arrays: Mapping[str, Any], plants: set[int],
                       where: str) -> CanopyLayout:
     """The layout a project stored, validated like a layout file against the plants read, its
     stands in the order they were saved (projects without ``layout_placements``, from

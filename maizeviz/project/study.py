@@ -21,14 +21,15 @@ from pathlib import Path
 from typing import Any
 
 from maizeviz.canopy.layout import CanopyLayout
+from maizeviz.canopy.scene import STALK_TRIANGLES
 from maizeviz.cost import check, layout_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import remove_leftovers
 from maizeviz.io.hashing import checked_copy, same_content
-from maizeviz.io.project import Project, ProjectError, get, load_project
+from maizeviz.io.project import Project, ProjectError, Record, get, load_project
 from maizeviz.leaf.fit import Leaf
-from maizeviz.mesh.levels import Level
-from maizeviz.project.records import run_from_record, run_record
+from maizeviz.mesh.levels import Level, parse_level
+from maizeviz.project.records import KINDS, per_triangle, run_from_record, run_record
 from maizeviz.project.stands import layout_from_parts, layout_parts, stands_identity
 
 #: Settings groups of a project.
@@ -59,7 +60,8 @@ class StoredResult:
 @dataclass
 class Opened:
     """A project read and checked: the points file to load (the original or the project's
-    checked copy), notes for the user, settings and results."""
+    checked copy), notes for the user, settings and the records of its light results (read
+    into results by :func:`results_on`, once the canopy they belong to is known)."""
 
     path: str
     project: Project
@@ -68,7 +70,7 @@ class Opened:
     notes: list[str] = field(default_factory=list)
     canopy: dict = field(default_factory=dict)
     light: dict = field(default_factory=dict)
-    results: list[StoredResult] = field(default_factory=list)
+    records: list[Record] = field(default_factory=list)
 
 
 def make_project(points_path: str, points_bytes: bytes, layout: CanopyLayout | None,
@@ -124,10 +126,9 @@ def open_project(path: str | Path, cache: str | Path | None = None) -> Opened:
     points_path = _points_file(project, cache, notes)
     canopy = get(project.settings, CANOPY, dict, {}, where)
     light = get(project.settings, LIGHT, dict, {}, where)
-    results = []
+    records = []
     for i, rec in enumerate(project.results):
-        run = run_from_record(rec, where)
-        if run is None:
+        if rec.kind not in KINDS:
             notes.append(f"result {i + 1} is of a kind this maizeviz does not know "
                          f"('{rec.kind}'); left out")
             continue
@@ -135,9 +136,9 @@ def open_project(path: str | Path, cache: str | Path | None = None) -> Opened:
         if stands is not None:
             get(stands, "n", int, where=f"{where}: result {i + 1} stands")
             get(stands, "sha256", str, where=f"{where}: result {i + 1} stands")
-        results.append(StoredResult(*run, stands=stands))
+        records.append(rec)
     shown = f"{Path(project.points_path).name} (project {Path(path).name})"
-    return Opened(where, project, points_path, shown, notes, canopy, light, results)
+    return Opened(where, project, points_path, shown, notes, canopy, light, records)
 
 
 def restore_layout(opened: Opened, plants: set[int]) -> CanopyLayout | None:
@@ -165,27 +166,77 @@ def project_layout(opened: Opened, leaves: Sequence[Leaf]) -> CanopyLayout:
     return layout_for(list(leaves), shape)
 
 
-def results_on(opened: Opened, layout: CanopyLayout) -> tuple[list[StoredResult], list[str]]:
-    """The results of ``opened`` traced on the stands of ``layout`` (the layout the project
-    opens with), and one note per result left out because it was traced on other stands:
-    its per-plant light would be shown on other plants."""
+def results_on(opened: Opened, layout: CanopyLayout, leaves: Sequence[Leaf] | None = None
+               ) -> tuple[list[StoredResult], list[str]]:
+    """The light results of ``opened`` that belong to the canopy about to be shown, read.
+
+    A result is left out, with one note each, when it was traced on other stands than those
+    of ``layout`` (its per-plant light would be shown on other plants), or when it holds
+    light for more triangles than the canopy of ``leaves`` on ``layout`` has at the result's
+    mesh level (:func:`scene_triangles`): both are decided from the stored metadata and the
+    arrays' headers, before any of its arrays is read.
+
+    Parameters
+    ----------
+    opened : from :func:`open_project`
+    layout : the layout the project opens with (:func:`project_layout`)
+    leaves : the leaves of the project's points; None: per-triangle sizes not checked
+
+    Returns
+    -------
+    results : list of StoredResult, oldest first
+    notes : list of str, one per result left out
+
+    Raises
+    ------
+    ProjectError
+        A kept result whose stored data are malformed (one line).
+    """
     here = stands_identity(layout)
     kept, notes = [], []
     edited = opened.project.layout is not None
     legacy_order = edited and "layout_placements" not in opened.project.arrays
-    for r in opened.results:
-        name = f"the {r.kind} result on {r.label}"
-        if r.stands is None and not legacy_order:
-            kept.append(r)                 # an older project on its settings' tiling: same order
-        elif r.stands is None:
+    bounds: dict[str, int | None] = {}
+    for rec in opened.records:
+        stands = rec.meta.get("stands")
+        label = str(rec.meta.get("level", ""))
+        name = f"the {KINDS[rec.kind]} result on {rec.meta.get('label', label)}"
+        if stands is None and legacy_order:
             notes.append(f"{name} was saved by an older maizeviz with an edited layout whose "
                          "plant order cannot be restored; left out (compute it again)")
-        elif r.stands != here:
-            notes.append(f"{name} was traced on other stands ({r.stands.get('n')} plants) than "
+            continue
+        if stands is not None and stands != here:
+            notes.append(f"{name} was traced on other stands ({stands.get('n')} plants) than "
                          f"the project's layout ({here['n']}); left out (compute it again)")
-        else:
-            kept.append(r)
+            continue
+        if leaves is not None:
+            if label not in bounds:
+                bounds[label] = scene_triangles(leaves, layout, label)
+            held, most = per_triangle(rec), bounds[label]
+            if most is None:
+                notes.append(f"{name}: its mesh level '{label[:40]}' is not one this maizeviz "
+                             "knows; left out")
+                continue
+            if held > most:
+                notes.append(f"{name} holds light for {held:,} triangles, but its canopy has "
+                             f"at most {most:,}; left out (compute it again)")
+                continue
+        run = run_from_record(rec, opened.path)
+        if run is not None:
+            kept.append(StoredResult(*run, stands=stands))
     return kept, notes
+
+
+def scene_triangles(leaves: Sequence[Leaf], layout: CanopyLayout, label: str) -> int | None:
+    """At most how many triangles the scene of ``leaves`` on ``layout`` has at the mesh level
+    labelled ``label`` (as results store it, "36 triangles, widths unscaled" included):
+    leaves (:func:`maizeviz.cost.layout_cost`, an upper bound) and stalks. None for a label
+    that is not a mesh level."""
+    try:
+        level = parse_level(label.split(",")[0])
+    except MaizevizError:
+        return None
+    return layout_cost(leaves, layout, level).count + STALK_TRIANGLES * len(layout.placements)
 
 
 def check_canopy_fits(leaves: Sequence[Leaf], layout: CanopyLayout, level: Level,

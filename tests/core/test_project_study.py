@@ -308,3 +308,105 @@ def test_opening_a_project_removes_the_part_files_of_killed_saves(points, tmp_pa
     mine.write_bytes(b"PK")
     study.open_project(path, tmp_path)
     assert not dead.exists() and mine.exists()
+
+
+# ------------------------------------------------- arrays sized against the canopy first
+def _sky_project(points, leaves, tmp_path, share=None):
+    """A 2 x 2 project with one sky result; ``share`` replaces its per-triangle array."""
+    layout = layout_for(leaves, (2, 2))
+    canopy = build_canopy(leaves, layout, LEVEL)
+    sky = trace_sky(canopy, make_sky("soc", 16), SAMPLING)
+    proj = study.make_project(str(points), points.read_bytes(), None, layout, {"tile": 2}, {},
+                              [(LEVEL.label, sky)])
+    if share is not None:
+        rec = proj.results[0]
+        proj = replace(proj, results=(replace(rec, arrays={**rec.arrays,
+                                                           "triangle_share": share}),))
+    path = tmp_path / "sized.maizeviz"
+    save_project(path, proj)
+    return path, layout, canopy, sky
+
+
+def test_per_triangle_light_larger_than_the_canopy_is_left_out_unread(points, leaves,
+                                                                      tmp_path):
+    import tracemalloc
+
+    big = np.zeros(25_000_000)                      # 200 MB declared, a few hundred kB packed
+    path, layout, canopy, _ = _sky_project(points, leaves, tmp_path, big)
+    del big
+    assert path.stat().st_size < 5_000_000
+    tracemalloc.start()
+    try:
+        opened = study.open_project(path, tmp_path / "cache")
+        results, notes = study.results_on(opened, layout, leaves)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    most = study.scene_triangles(leaves, layout, LEVEL.label)
+    # the estimate bounds the scene (leaves and stalks) from above
+    assert canopy.n_triangles + 16 * len(layout.placements) <= most < 2 * canopy.n_triangles
+    assert results == []
+    assert notes == [f"the sky result on {LEVEL.label} holds light for 25,000,000 triangles, "
+                     f"but its canopy has at most {most:,}; left out (compute it again)"]
+    assert peak < 20 * 2**20, f"{peak / 2**20:.0f} MiB allocated: the array was read"
+
+
+def test_stored_arrays_are_read_when_used_and_equal_what_was_saved(points, leaves, tmp_path):
+    path, layout, canopy, sky = _sky_project(points, leaves, tmp_path)
+    opened = study.open_project(path, tmp_path / "cache")
+    share = opened.records[0].arrays["triangle_share"]
+    assert share.shape == sky.triangle_share.shape and share._data is None   # header only
+    results, notes = study.results_on(opened, layout, leaves)
+    assert notes == [] and len(results) == 1
+    np.testing.assert_array_equal(results[0].result.triangle_share, sky.triangle_share)
+    np.testing.assert_array_equal(results[0].result.maps, sky.maps)
+
+
+def test_a_project_changed_after_it_was_opened_is_refused_when_its_arrays_are_read(
+        points, leaves, tmp_path):
+    path, layout, _, _ = _sky_project(points, leaves, tmp_path)
+    opened = study.open_project(path, tmp_path / "cache")
+    (tmp_path / "other").mkdir()
+    other, *_ = _sky_project(points, leaves, tmp_path / "other")
+    os.replace(other, path)                          # saved again by another window
+    with pytest.raises(ProjectError) as err:
+        study.results_on(opened, layout)
+    assert str(err.value) == (f"{path}: the project file changed after it was opened; open "
+                              "it again")
+
+
+def test_a_project_whose_arrays_are_packed_by_another_writer_opens(points, leaves, tmp_path):
+    path, layout, _, sky = _sky_project(points, leaves, tmp_path)
+    repacked = tmp_path / "repacked.maizeviz"
+    with zipfile.ZipFile(path) as src, zipfile.ZipFile(repacked, "w",
+                                                       zipfile.ZIP_DEFLATED) as dst:
+        for info in src.infolist():
+            dst.writestr(info.filename, src.read(info))   # arrays.npz deflated too
+    with zipfile.ZipFile(repacked) as zf:
+        assert zf.getinfo("arrays.npz").compress_type == zipfile.ZIP_DEFLATED
+    opened = study.open_project(repacked, tmp_path / "cache")
+    results, notes = study.results_on(opened, layout)
+    assert notes == []
+    np.testing.assert_array_equal(results[0].result.triangle_share, sky.triangle_share)
+
+
+def test_results_at_other_levels_are_sized_against_their_own_level(points, leaves, tmp_path):
+    layout = layout_for(leaves, (2, 2))
+    fine, coarse = parse_level("36"), LEVEL
+    runs = [(lv.label, trace_sky(build_canopy(leaves, layout, lv), make_sky("soc", 16),
+                                 SAMPLING)) for lv in (fine, coarse)]
+    path = tmp_path / "levels.maizeviz"
+    save_project(path, study.make_project(str(points), points.read_bytes(), None, layout,
+                                          {"tile": 2, "level": coarse.label}, {}, runs))
+    results, notes = study.results_on(study.open_project(path, tmp_path), layout, leaves)
+    assert notes == [] and [r.label for r in results] == [fine.label, coarse.label]
+    assert len(results[0].result.triangle_share) > study.scene_triangles(leaves, layout,
+                                                                         coarse.label)
+    # a level this maizeviz does not know is left out, unread
+    proj = load_project(path)
+    rec = proj.results[0]
+    odd = replace(rec, meta={**rec.meta, "level": "K=999999"},
+                  arrays={k: np.asarray(v) for k, v in rec.arrays.items()})
+    save_project(path, replace(proj, results=(odd,)))
+    results, notes = study.results_on(study.open_project(path, tmp_path), layout, leaves)
+    assert results == [] and "its mesh level 'K=999999' is not one this maizeviz knows" in notes[0]
