@@ -27,6 +27,8 @@ _EXPORTS = {
     "lay_out": "maizeviz.api",
     "build_canopy": "maizeviz.api",
     "measure_canopy": "maizeviz.api",
+    "read_study": "maizeviz.project.study",
+    "save_study": "maizeviz.project.study",
     # light
     "LightEngine": "maizeviz.light.engine",
     "Sampling": "maizeviz.light.request",

@@ -12,6 +12,7 @@ from maizeviz.cost import Cost, check, layout_cost
 from maizeviz.errors import LeafError, MaizevizError
 from maizeviz.io.atomic import file_tag
 from maizeviz.io.meshfile import check_mesh_path
+from maizeviz.io.project import SUFFIX as PROJECT_SUFFIX
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.mesh.levels import Level, parse_levels
 from maizeviz.progress import ProgressCallback
@@ -114,10 +115,11 @@ def levels_from(args: argparse.Namespace, default_k: int = 4) -> list[Level]:
 
 
 def add_canopy_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("points", help="points CSV of the digitized plants (field coordinates, cm)")
-    p.add_argument("--tile", default="1x1", metavar="AxB",
+    p.add_argument("points", help="points CSV of the digitized plants (field coordinates, cm), "
+                                  "or a .maizeviz project (its points and its layout)")
+    p.add_argument("--tile", metavar="AxB",
                    help="repeat the digitized block A times across rows (x) and B times along "
-                        "them (y); the paper uses 3x3 (default 1x1)")
+                        "them (y); the paper uses 3x3 (default 1x1; a project's own layout)")
     p.add_argument("--block", metavar="RxP",
                    help="rows x plants per row of the digitized block (default: inferred from "
                         "the stalk positions)")
@@ -152,10 +154,17 @@ def load_leaves(path: str, strict: bool = False, degree: int = 3, method: str = 
 
 
 def canopy_setup(args: argparse.Namespace) -> tuple[list[Leaf], list[LeafError], CanopyLayout]:
-    """Leaves and layout from the canopy options; warnings on stderr."""
-    tile = check_tile(parse_shape(args.tile, "tile"))      # refused before reading anything
+    """Leaves and layout from the canopy options, or from a ``.maizeviz`` project given as
+    the points (its points and the layout it opens with; ``--layout`` replaces that layout,
+    ``--tile`` and ``--block`` retile its block); warnings on stderr."""
+    tile = check_tile(parse_shape(args.tile or "1x1", "tile"))   # refused before reading
     block = parse_shape(args.block, "block") if args.block else None
-    leaves, skipped = load_leaves(args.points, args.strict)
+    if is_project(args.points):
+        leaves, skipped, layout = _project_setup(args)
+        if args.layout is None and args.tile is None and args.block is None:
+            return leaves, skipped, layout
+    else:
+        leaves, skipped = load_leaves(args.points, args.strict)
     if not leaves:
         for e in skipped:
             say(f"skipped: {e}")
@@ -164,6 +173,25 @@ def canopy_setup(args: argparse.Namespace) -> tuple[list[Leaf], list[LeafError],
     for w in layout.warnings:
         say(f"note: {w}")
     return leaves, skipped, layout
+
+
+def is_project(path: str | Path) -> bool:
+    """Whether ``path`` names a ``.maizeviz`` project (by its name, as the app's File menu)."""
+    return Path(path).suffix.lower() == PROJECT_SUFFIX
+
+
+def _project_setup(args: argparse.Namespace) -> tuple[list[Leaf], list[LeafError], CanopyLayout]:
+    from maizeviz.project.study import read_study
+
+    study = read_study(args.points)
+    for note in study.notes:
+        say(f"note: {note}")
+    say(f"{args.points}: {len(study.plants.leaves)} leaves, {len(study.layout.placements)} "
+        f"plants as the project lays them out; {len(study.results)} stored light results "
+        "(not used by this command)")
+    if args.strict and study.plants.skipped:
+        raise MaizevizError(f"{args.points}: {study.plants.skipped[0]}", quantity="strict")
+    return list(study.plants.leaves), list(study.plants.skipped), study.layout
 
 
 def floats(text: str, what: str, quantity: str, count: int | None = None) -> list[float]:

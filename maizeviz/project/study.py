@@ -253,3 +253,101 @@ def check_canopy_fits(leaves: Sequence[Leaf], layout: CanopyLayout, level: Level
         check([[layout_cost(leaves, layout, level)]], force=True)
     except MaizevizError as exc:
         raise ProjectError(f"{where}: {exc}", quantity=exc.quantity) from None
+
+
+@dataclass
+class Study:
+    """A project read whole, as the command line and notebooks use it (:func:`read_study`).
+
+    Attributes
+    ----------
+    path : the project file
+    plants : LeavesFromFile, the leaves fitted from the project's points (``.leaves``,
+        ``.skipped``, ``.notes``)
+    layout : CanopyLayout, the stands the project opens with
+    level : str, the mesh level of its canopy settings ("36 triangles", "K=4")
+    preserve_area : bool, the area-preserving variant of triangle budgets
+    results : list of StoredResult, its light results on these stands (``.result.table()``)
+    notes : list of str, what the user should know (a moved points file, results left out)
+    """
+
+    path: str
+    plants: Any
+    layout: CanopyLayout
+    level: str
+    preserve_area: bool
+    results: list[StoredResult]
+    notes: list[str]
+
+
+def read_study(path: str | Path, cache: str | Path | None = None,
+               progress: Any = None) -> Study:
+    """Read a ``.maizeviz`` project: its points fitted, its layout, its canopy settings and
+    the light results that belong to them.
+
+    Parameters
+    ----------
+    path : the project file
+    cache : folder for the project's checked copy of its points when the original file moved
+        or changed (default: the system's temporary folder)
+    progress : ``progress(done, total)`` over the leaves; returning False cancels
+
+    Returns
+    -------
+    Study
+
+    Raises
+    ------
+    ProjectError
+        The project cannot be used, or its canopy would not fit in memory (one line).
+    """
+    from maizeviz.leaf.fit import read_leaves
+
+    opened = open_project(path, cache)
+    plants = read_leaves(opened.points_path, progress=progress)
+    if not plants.leaves:
+        raise ProjectError(f"{opened.path}: no leaf of its points could be reconstructed")
+    layout = project_layout(opened, plants.leaves)
+    text = get(opened.canopy, "level", str, "36", opened.path)
+    try:
+        level = parse_level(text)
+    except MaizevizError as exc:
+        raise ProjectError(f"{opened.path}: its canopy level: {exc}", quantity="level") from None
+    check_canopy_fits(plants.leaves, layout, level, opened.path)
+    results, dropped = results_on(opened, layout, plants.leaves)
+    return Study(opened.path, plants, layout, level.label,
+                 get(opened.canopy, "preserve_area", bool, True, opened.path), results,
+                 [*opened.notes, *plants.notes, *dropped])
+
+
+def save_study(path: str | Path, points: str | Path, layout: CanopyLayout,
+               results: Sequence[Any] = (), level: str = "36",
+               preserve_area: bool = True) -> Path:
+    """Write a ``.maizeviz`` project that the app and :func:`read_study` open.
+
+    Parameters
+    ----------
+    path : the project file to write (atomically: an existing one stays whole on failure)
+    points : the points file the plants were read from (its bytes go into the project)
+    layout : the stands of the canopy, stored with the project
+    results : light results traced on ``layout`` (``LightResult``, ``SkyLight`` or
+        ``PeriodLight``), each stored under its own mesh level
+    level : mesh level the project opens at; preserve_area : area-preserving triangle budgets
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    from maizeviz.io.inputs import read_input
+    from maizeviz.io.project import save_project
+
+    from maizeviz.io.project import MAX_MEMBER_BYTES
+
+    chosen = parse_level(str(level))
+    data = read_input(points, "points file", MAX_MEMBER_BYTES["points.csv"], ProjectError)
+    stop = (str(chosen.triangles) if chosen.triangles is not None else
+            "standard" if chosen.interp == 0 else f"K{chosen.interp}")   # as the app's slider
+    canopy = {"tile": 1, "level": stop, "preserve_area": bool(preserve_area)}
+    project = make_project(str(Path(points).resolve()), data, layout, layout, canopy, {},
+                           [(str(r.level), r) for r in results])
+    return save_project(path, project)
