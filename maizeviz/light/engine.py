@@ -27,12 +27,20 @@ from dataclasses import fields, replace
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
 from maizeviz.light.irradiance import DEFAULT_LINKE_TURBIDITY, DEFAULT_PAR_UMOL_PER_J, Period
+from maizeviz.light.optics import SHORTWAVE_SHARE, Optics, optics_for
 from maizeviz.light.request import LightRequest, Sampling
+from maizeviz.light.scatter import (
+    DEFAULT_DEPTH,
+    DEFAULT_THRESHOLD,
+    AbsorbedLight,
+    Balance,
+    scatter_beam,
+)
 from maizeviz.light.sky import Sky, make_sky
 from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import LightResult, light_scene, trace_light
 from maizeviz.mesh.raytrace import RayScene
-from maizeviz.progress import ProgressCallback
+from maizeviz.progress import ProgressCallback, report
 
 
 class LightEngine:
@@ -255,9 +263,112 @@ class LightEngine:
         return None
 
     # ------------------------------------------------------------------ scattering
-    # Light scattered by the leaves (the physics issue) is traced here too, on the same
-    # scenes: ``def scatter(self, ...)`` calling the scattering module with
-    # ``self.scene(periodic)``, as sun, sky and day do.
+    def absorbed(self, sun: Sun | None = None, *, band: str = "par",
+                 optics: Optics | None = None, direct_w_m2: float | None = None,
+                 diffuse_w_m2: float = 0.0, sky: Sky | str = "soc", directions: int = 46,
+                 depth: int = DEFAULT_DEPTH, threshold: float = DEFAULT_THRESHOLD,
+                 seed: int = 0, sampling: Sampling | None = None,
+                 progress: ProgressCallback | None = None, zenith: float | None = None,
+                 azimuth: float | None = None, date: str | None = None,
+                 time: str | None = None, lat: float | None = None, lon: float | None = None,
+                 tz: str | None = None, **fields_) -> AbsorbedLight:
+        """Light absorbed by leaves and ground in one band, with scattering
+        (:mod:`maizeviz.light.scatter`): the sun's direct beam and, when ``diffuse_w_m2`` > 0,
+        the diffuse light of a sky.
+
+        Parameters
+        ----------
+        sun, zenith, azimuth, date, time, lat, lon, tz : the sun, as :meth:`sun`
+        band : "par" or "nir"; optics : the band's Optics (default
+            :data:`maizeviz.light.optics.DEFAULT_OPTICS`)
+        direct_w_m2 : the band's direct irradiance on a horizontal plane above the canopy,
+            W/m2 (default: the band's share of 1000 W/m2 of shortwave, 480 in PAR)
+        diffuse_w_m2 : the band's diffuse irradiance on a horizontal plane, W/m2, spread over
+            ``sky`` (kind or Sky) split into ``directions`` directions
+        depth, threshold, seed : scatterings followed, share of the incident power left
+            travelling where tracing stops, random seed
+        sampling, progress, **fields_ : as :meth:`sun` (``progress`` after each beam)
+
+        Returns
+        -------
+        AbsorbedLight
+            ``balance`` (W/m2 of ground), absorbed W per triangle, ``table("plant", canopy)``.
+
+        References
+        ----------
+        Bailey, B. N. (2018). Ecological Modelling 368, 233-245 (Helios' radiation model).
+        """
+        import numpy as np
+
+        from maizeviz.errors import check_range
+        from maizeviz.light.request import check_sampling
+        from maizeviz.light.transmission import sampler
+
+        opt = optics if optics is not None else optics_for(band)
+        if sun is None:
+            if zenith is not None:
+                sun = Sun(float(zenith), float(azimuth if azimuth is not None else 180.0))
+            elif date is not None and lat is not None and lon is not None:
+                sun = sun_at(date, time, lat, lon, tz)
+        direct = 1000.0 * SHORTWAVE_SHARE[opt.band] if direct_w_m2 is None else direct_w_m2
+        check_range(direct, "the direct irradiance (W/m2)", 0, 5000, "irradiance")
+        check_range(diffuse_w_m2, "the diffuse irradiance (W/m2)", 0, 5000, "irradiance")
+        check_range(depth, "the scattering depth", 0, 10_000, "depth", whole=True)
+        check_range(threshold, "the scattering threshold", 0, 1, "threshold")
+        if sun is None and (direct > 0 or diffuse_w_m2 == 0):
+            raise TypeError("give a Sun, zenith and azimuth, or date, time, lat and lon; or "
+                            "direct_w_m2=0 with a diffuse irradiance")
+        smp_req = self._sampling(sampling or self.sampling, fields_)
+        rect, _ = check_sampling(self.canopy, smp_req)
+        scene, build_s = self._scene_and_build(smp_req.periodic)
+        smp = sampler(self.canopy, scene, rect, smp_req.density, smp_req.heights_cm,
+                      smp_req.periodic, self.with_stalks)
+        normals = self._normals()
+        beams: list[tuple[np.ndarray, float]] = []
+        if sun is not None and direct > 0:
+            beams.append((sun.direction(self.canopy.layout.north_deg), direct))
+        if diffuse_w_m2 > 0:
+            sky_obj = sky if isinstance(sky, Sky) else make_sky(sky, directions)
+            for toward, weight in zip(sky_obj.directions, sky_obj.weights):
+                beams.append((np.asarray(toward, np.float64), diffuse_w_m2 * float(weight)))
+        area_m2 = smp.ray_area_cm2 * 1e-4 * smp.n
+        nf = len(normals)
+        absorbed, sunlit = np.zeros(nf), np.zeros(nf)
+        parts = dict.fromkeys(("ground", "top", "sides", "unresolved"), 0.0)
+        events, seconds = 0, {"build": build_s, "trace": 0.0, "scatter": 0.0}
+        for k, (toward, irradiance) in enumerate(beams):
+            tally, secs = scatter_beam(smp, toward, opt, normals, depth, threshold,
+                                       seed + 7919 * k, smp_req.threads)
+            per_ray = irradiance * smp.ray_area_cm2 * 1e-4       # W carried by one ray
+            absorbed += tally.triangles * per_ray
+            if k == 0 and sun is not None and direct > 0:
+                sunlit = tally.sunlit
+            for name in parts:
+                parts[name] += getattr(tally, name) * per_ray
+            events += tally.events
+            seconds["trace"] += secs["trace"]
+            seconds["scatter"] += secs["scatter"]
+            report(progress, k + 1, len(beams), "absorbed light")
+        incident = direct * (sun is not None) + diffuse_w_m2
+        balance = Balance(float(incident), float(absorbed.sum()) / area_m2,
+                          *(float(parts[k]) / area_m2 for k in ("ground", "top", "sides",
+                                                                 "unresolved")))
+        return AbsorbedLight(opt.band, opt, incident, balance, absorbed, sunlit, rect, smp.n,
+                             len(beams), depth, threshold, seed, events, smp_req.periodic,
+                             self.canopy.level, seconds)
+
+    def _normals(self):
+        """Unit normals (F, 3) of the scene's leaf triangles, then its stalks' if traced."""
+        import numpy as np
+
+        from maizeviz.mesh.tessellate import triangle_areas_normals
+
+        c = self.canopy
+        normals = triangle_areas_normals(c.vertices, c.faces)[1]
+        if self.with_stalks:
+            normals = np.vstack([normals, triangle_areas_normals(c.stalk_vertices,
+                                                                 c.stalk_faces)[1]])
+        return normals
 
 
 def _sky_key(sky: Sky, s: Sampling, bin_cm: float) -> tuple:

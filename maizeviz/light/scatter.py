@@ -1,0 +1,394 @@
+"""Absorbed light with scattering: Monte Carlo ray tracing of a parallel beam (the sun, or one
+direction of a sky) through the canopy, leaves and ground reflecting and transmitting as
+:class:`~maizeviz.light.optics.Optics` say.
+
+The beam's rays are the ground rays of the direct-light computation
+(:func:`~maizeviz.light.transmission.trace_direction`): a regular grid over the sample
+rectangle, each ray carrying the beam's power over its footprint. Each ray is followed:
+
+- at a leaf it deposits the share ``1 - reflectance - transmittance`` of what it carries on
+  that triangle; it goes on, with probability ``reflectance + transmittance`` (Russian
+  roulette: its expected power is what the leaf scatters), reflected (to the side it came
+  from) or transmitted (to the other side) in proportion, in a cosine-distributed direction
+  about the leaf's normal;
+- on the ground (z = 0) it deposits ``1 - ground_reflectance`` of it and goes on upward with
+  probability ``ground_reflectance``;
+- above the canopy top going up, it is reflected out of the canopy; in an open field, leaving
+  the plot sideways, it escapes; in a periodic field it re-enters on the opposite side;
+- after ``depth`` scatterings, or once the power still travelling is below ``threshold`` of
+  the incident power, what remains is reported as unresolved.
+
+Deposits are exact expectations; only the choice to go on is random, so with every optical
+value 0 nothing goes on and the leaves absorb exactly what the direct-light computation
+intercepts, ray for ray. The energy balance (incident = absorbed by leaves + absorbed by the
+ground + reflected out of the top + escaped sideways + unresolved) holds in expectation; its
+closure is within Monte Carlo noise (about ``sqrt(k)/N`` of the incident for ``k`` scattering
+events and ``N`` rays).
+
+References
+----------
+Dutre, P., Bekaert, P. & Bala, K. (2006). Advanced Global Illumination, 2nd ed., A K Peters
+(Russian roulette, cosine-weighted sampling of a Lambertian surface).
+Chelle, M. & Andrieu, B. (1998). The nested radiosity model for the distribution of light
+within plant canopies. Ecological Modelling 111, 75-91 (Caribu: Lambertian leaves, periodic
+canopy).
+Bailey, B. N. (2018). A reverse ray-tracing method for modelling the net radiative flux in
+leaf-resolving plant canopy simulations. Ecological Modelling 368, 233-245 (Helios).
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from maizeviz.light.optics import Optics
+from maizeviz.light.rays import ray_grid
+from maizeviz.light.transmission import Sampler, trace_direction
+from maizeviz.progress import ProgressCallback, ordered_map, report
+
+#: Default largest number of scatterings followed per ray.
+DEFAULT_DEPTH = 20
+#: Default share of the incident power still travelling below which tracing stops.
+DEFAULT_THRESHOLD = 1e-4
+#: Distance (cm) a scattered ray starts off its surface (Embree starts at t = 0).
+EPS_CM = 1e-3
+#: Primary rays followed together (bounded memory: a few arrays of this length).
+CHUNK_RAYS = 1 << 19
+
+
+@dataclass
+class Tally:
+    """What one beam's rays deposited, in units of one primary ray's power.
+
+    Attributes
+    ----------
+    triangles : (F,) float64, absorbed by each triangle (leaves, then stalks)
+    sunlit : (F,) float64 cm2, leaf area each triangle has in the beam (first hits)
+    ground, top, sides, unresolved : float, absorbed by the ground, reflected out of the
+        canopy top, escaped sideways (open field), still travelling when tracing stopped
+    rays : primary rays; events : scatterings followed
+    """
+
+    triangles: np.ndarray
+    sunlit: np.ndarray
+    ground: float = 0.0
+    top: float = 0.0
+    sides: float = 0.0
+    unresolved: float = 0.0
+    rays: int = 0
+    events: int = 0
+
+    def add(self, other: Tally) -> None:
+        self.triangles += other.triangles
+        self.sunlit += other.sunlit
+        for name in ("ground", "top", "sides", "unresolved", "rays", "events"):
+            setattr(self, name, getattr(self, name) + getattr(other, name))
+
+
+def lambertian(normals: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Directions (M, 3) drawn with a cosine distribution about unit ``normals`` (M, 3)."""
+    m = len(normals)
+    u1, u2 = rng.random(m), rng.random(m)
+    r, phi = np.sqrt(u1), 2.0 * np.pi * u2
+    helper = np.where(np.abs(normals[:, :1]) > 0.9, [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])
+    t1 = np.cross(normals, helper)
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    t2 = np.cross(normals, t1)
+    return (r * np.cos(phi))[:, None] * t1 + (r * np.sin(phi))[:, None] * t2 + \
+        np.sqrt(1.0 - u1)[:, None] * normals
+
+
+@dataclass
+class _Rays:
+    """Rays travelling: origins (k, 3) cm, unit directions (k, 3)."""
+
+    org: np.ndarray
+    dirs: np.ndarray
+
+
+LEAF, GROUND, TOP, SIDES, LOST = range(5)
+
+
+def follow(smp: Sampler, rays: _Rays, max_crossings: int = 1000
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where each ray ends: what it met (LEAF, GROUND, TOP, SIDES, LOST), the triangle (leaf
+    and stalk ids, -1 unless LEAF) and the end point (k, 3) cm, wrapping rays across the plot
+    in a periodic field (:class:`~maizeviz.light.rays.Tracer` does it for one direction)."""
+    k = len(rays.org)
+    kind = np.full(k, LOST, dtype=np.int8)
+    prim = np.full(k, -1, dtype=np.int64)
+    end = rays.org.astype(np.float64).copy()
+    todo = np.arange(k)
+    pos = end.copy()
+    dirs = rays.dirs.astype(np.float64)
+    x0, y0, x1, y1 = smp.bounds
+    lo, hi, size = np.array([x0, y0]), np.array([x1, y1]), np.array([x1 - x0, y1 - y0])
+    source = getattr(smp.scene, "source", None)
+    if smp.periodic:              # a start outside the plot (a primary hit seen from the
+        pos[:, :2] = lo + np.mod(pos[:, :2] - lo, size)    # sample rectangle) is its copy in it
+    for _ in range(max_crossings):
+        if not len(todo):
+            break
+        o, d = pos[todo], dirs[todo]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t_vert = np.where(d[:, 2] < 0, -o[:, 2] / d[:, 2],
+                              np.where(d[:, 2] > 0, (smp.top - o[:, 2]) / d[:, 2], np.inf))
+            t_side = np.full(len(todo), np.inf)
+            for a in (0, 1):
+                edge = np.where(d[:, a] > 0, hi[a], lo[a])
+                ta = np.where(d[:, a] != 0, (edge - o[:, a]) / d[:, a], np.inf)
+                t_side = np.minimum(t_side, ta)
+        t_vert = np.maximum(t_vert, 0.0)
+        t_side = np.maximum(t_side, 0.0)
+        seg = np.minimum(t_vert, t_side)
+        ids, t = smp.scene.first_hit(o, d, seg)
+        hit = ids >= 0
+        where = todo[hit]
+        kind[where] = LEAF
+        prim[where] = ids[hit] if source is None else source[ids[hit]]
+        end[where] = o[hit] + t[hit, None] * d[hit]
+        vertical = ~hit & (t_vert <= t_side)
+        where = todo[vertical]
+        kind[where] = np.where(d[vertical, 2] < 0, GROUND, TOP)
+        end[where] = o[vertical] + t_vert[vertical, None] * d[vertical]
+        side = ~hit & ~vertical
+        if not smp.periodic:
+            where = todo[side]
+            kind[where] = SIDES
+            end[where] = o[side] + t_side[side, None] * d[side]
+            break
+        moved = o[side] + t_side[side, None] * d[side]
+        ds = d[side]
+        for a in (0, 1):
+            tol = 1e-7 * size[a]
+            out_hi = (ds[:, a] > 0) & (moved[:, a] >= hi[a] - tol)
+            out_lo = (ds[:, a] < 0) & (moved[:, a] <= lo[a] + tol)
+            moved[out_hi, a] -= size[a]
+            moved[out_lo, a] += size[a]
+        todo = todo[side]
+        pos[todo] = moved
+    return kind, prim, end
+
+
+def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng,
+            kind: np.ndarray, prim: np.ndarray, end: np.ndarray, dirs: np.ndarray) -> _Rays:
+    """Deposit what rays ending at leaves and the ground absorb, count those leaving, and draw
+    the rays that go on (Russian roulette on the scattering coefficient)."""
+    nf = len(tally.triangles)
+    leaf = kind == LEAF
+    sc = optics.scattering
+    tally.triangles += np.bincount(prim[leaf], minlength=nf) * (1.0 - sc)
+    ground = kind == GROUND
+    tally.ground += np.count_nonzero(ground) * (1.0 - optics.ground_reflectance)
+    tally.top += np.count_nonzero(kind == TOP)
+    tally.sides += np.count_nonzero(kind == SIDES)
+    tally.unresolved += np.count_nonzero(kind == LOST)
+    parts_o, parts_d = [], []
+    go = np.flatnonzero(leaf)
+    go = go[rng.random(len(go)) < sc] if sc > 0 else go[:0]
+    if len(go):
+        n = normals[prim[go]]
+        facing = np.einsum("ij,ij->i", n, dirs[go])             # < 0: hit the front side
+        back = np.where(facing < 0, 1.0, -1.0)[:, None] * n     # the side the ray came from
+        reflect = rng.random(len(go)) < optics.reflectance / sc
+        side = np.where(reflect[:, None], back, -back)
+        parts_o.append(end[go] + EPS_CM * side)
+        parts_d.append(lambertian(side, rng))
+    up = np.flatnonzero(ground)
+    rg = optics.ground_reflectance
+    up = up[rng.random(len(up)) < rg] if rg > 0 else up[:0]
+    if len(up):
+        zplus = np.tile([0.0, 0.0, 1.0], (len(up), 1))
+        o = end[up].copy()
+        o[:, 2] = EPS_CM
+        parts_o.append(o)
+        parts_d.append(lambertian(zplus, rng))
+    if not parts_o:
+        return _Rays(np.empty((0, 3)), np.empty((0, 3)))
+    return _Rays(np.vstack(parts_o), np.vstack(parts_d))
+
+
+def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.ndarray,
+                 depth: int = DEFAULT_DEPTH, threshold: float = DEFAULT_THRESHOLD,
+                 seed: int = 0, threads: int = 1, progress: ProgressCallback | None = None,
+                 stop: threading.Event | None = None) -> tuple[Tally, dict[str, float]]:
+    """Follow one parallel beam through the canopy (see the module docstring).
+
+    Parameters
+    ----------
+    smp : Sampler of the canopy (scene, sample rectangle and density, plot, periodic field)
+    toward : (3,) unit vector toward the light, z > 0
+    optics : Optics of the band
+    normals : (F, 3) unit normals of the scene's leaf and stalk triangles (their ids)
+    depth : most scatterings followed per ray; threshold : share of the incident power still
+        travelling below which tracing stops (the rest is unresolved)
+    seed : of the random generator (one stream per chunk of rays: the same numbers whatever
+        ``threads``)
+
+    Returns
+    -------
+    Tally in units of one primary ray's power, and seconds spent ("trace": the primary beam,
+    "scatter": the rest).
+    """
+    t0 = time.perf_counter()
+    s = np.asarray(toward, dtype=np.float64)
+    primary = trace_direction(smp, s, ids=True, threads=threads, stop=stop)
+    t1 = time.perf_counter()
+    n = smp.n
+    nf = len(normals)
+    area_factor = smp.ray_area_cm2 * s[2] / np.maximum(np.abs(normals @ s), 1e-6)
+    chunks = [(a, min(a + CHUNK_RAYS, n)) for a in range(0, n, CHUNK_RAYS)]
+    first_prim = primary.first_prim
+    assert first_prim is not None
+
+    def chunk(k_ab: tuple[int, tuple[int, int]]) -> Tally:
+        k, (a, b) = k_ab
+        rng = np.random.default_rng([seed, k])
+        tally = Tally(np.zeros(nf), np.zeros(nf), rays=b - a)
+        prim = first_prim[a:b].astype(np.int64)
+        z = primary.first_z[a:b].astype(np.float64)
+        g = ray_grid(smp.rect, smp.density, a, b)[0]
+        hit = prim >= 0
+        kind = np.where(hit, LEAF, GROUND).astype(np.int8)
+        end = np.empty((b - a, 3))
+        height = np.where(hit, z, 0.0)
+        end[:, :2] = g + s[:2] * (height / s[2])[:, None]
+        end[:, 2] = height
+        tally.sunlit += np.bincount(prim[hit], minlength=nf) * area_factor
+        dirs = np.tile(-s, (b - a, 1))
+        rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, dirs)
+        for _ in range(depth):
+            if len(rays.org) <= threshold * (b - a):
+                break
+            tally.events += len(rays.org)
+            kind, prim, end = follow(smp, rays)
+            rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, rays.dirs)
+        tally.unresolved += len(rays.org)
+        return tally
+
+    total = Tally(np.zeros(nf), np.zeros(nf))
+
+    def done(k: int) -> None:
+        report(progress, k, len(chunks), "scattering")
+
+    for part in ordered_map(chunk, list(enumerate(chunks)), threads, done, stop):
+        total.add(part)
+    return total, {"trace": t1 - t0, "scatter": time.perf_counter() - t1}
+
+
+@dataclass(frozen=True)
+class Balance:
+    """Where the incident light went, W/m2 of sample ground (or, for a period, MJ/m2 or mol/m2
+    as the result says).
+
+    incident = absorbed_leaves + absorbed_ground + reflected_top + escaped_sides + unresolved,
+    within Monte Carlo noise (``closure``).
+    """
+
+    incident: float
+    absorbed_leaves: float
+    absorbed_ground: float
+    reflected_top: float
+    escaped_sides: float = 0.0
+    unresolved: float = 0.0
+
+    @property
+    def closure(self) -> float:
+        """(sum of the parts) / incident - 1: 0 up to Monte Carlo noise."""
+        parts = (self.absorbed_leaves + self.absorbed_ground + self.reflected_top
+                 + self.escaped_sides + self.unresolved)
+        return parts / self.incident - 1.0 if self.incident else 0.0
+
+    def as_dict(self) -> dict[str, float]:
+        return {"incident": self.incident, "absorbed_leaves": self.absorbed_leaves,
+                "absorbed_ground": self.absorbed_ground, "reflected_top": self.reflected_top,
+                "escaped_sides": self.escaped_sides, "unresolved": self.unresolved,
+                "closure": self.closure}
+
+
+@dataclass(frozen=True)
+class AbsorbedLight:
+    """Light absorbed by the leaves (and the ground) in one band, with scattering.
+
+    Attributes
+    ----------
+    band : "par" or "nir"; optics : Optics
+    irradiance_w_m2 : float, the band's irradiance on a horizontal plane above the canopy
+        (direct plus diffuse as traced), W/m2
+    balance : Balance, W/m2 of sample ground
+    triangle_absorbed_w : (F,) float64 W absorbed by each triangle of the scene (leaves, then
+        stalks), from the light falling on the sample rectangle
+    triangle_sunlit_cm2 : (F,) float64 cm2 of each triangle in the direct beam (0 for a sky)
+    rect : (x0, y0, x1, y1) cm; rays : primary rays per direction; directions : beams traced
+    depth, threshold, seed : as traced; events : scatterings followed; periodic : bool
+    level : the canopy's mesh level; seconds : "trace" (primary beams), "scatter", "build"
+    """
+
+    band: str
+    optics: Optics
+    irradiance_w_m2: float
+    balance: Balance
+    triangle_absorbed_w: np.ndarray
+    triangle_sunlit_cm2: np.ndarray
+    rect: tuple[float, float, float, float]
+    rays: int
+    directions: int
+    depth: int
+    threshold: float
+    seed: int
+    events: int
+    periodic: bool
+    level: str = ""
+    seconds: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def fraction_absorbed(self) -> float:
+        """Share of the incident light the leaves absorb."""
+        b = self.balance
+        return b.absorbed_leaves / b.incident if b.incident else 0.0
+
+    def table(self, by: str = "plant", canopy=None):
+        """Absorbed light per leaf or per plant as a pandas DataFrame.
+
+        Columns: ``absorbed_w`` (W), ``absorbed_w_m2_leaf`` (W per m2 of one-sided leaf area),
+        ``sunlit_area_cm2`` and ``shaded_area_cm2`` (leaf area in and out of the direct beam),
+        and for PAR ``absorbed_umol_s`` (umol/s: 4.57 umol per J of PAR). ``by="balance"``:
+        the energy balance (W/m2 of ground) as one row.
+        """
+        import pandas as pd
+
+        if by == "balance":
+            return pd.DataFrame([{"band": self.band, **self.balance.as_dict()}])
+        if by not in ("leaf", "plant"):
+            from maizeviz.errors import MaizevizError
+
+            raise MaizevizError(f"absorbed light is tabled by 'leaf', 'plant' or 'balance', not "
+                                f"'{by}'", quantity="table")
+        if canopy is None:
+            from maizeviz.errors import MaizevizError
+
+            raise MaizevizError("give the canopy the light was traced on to table it by "
+                                f"{by}", quantity="table")
+        from maizeviz.light.irradiance import PAR_UMOL_PER_J_PAR
+        from maizeviz.light.leaf_light import leaf_sums
+
+        rows = leaf_sums(canopy, {"absorbed_w": self.triangle_absorbed_w,
+                                  "sunlit_area_cm2": self.triangle_sunlit_cm2},
+                         self.rect, self.periodic)
+        frame = pd.DataFrame(rows)
+        if frame.empty:
+            return frame
+        frame["sunlit_area_cm2"] = np.minimum(frame["sunlit_area_cm2"], frame["leaf_area_cm2"])
+        if by == "plant":
+            frame = frame.groupby("instance", as_index=False).agg(
+                plant=("plant", "first"), x_cm=("x_cm", "first"), y_cm=("y_cm", "first"),
+                leaves=("leaf", "size"), leaf_area_cm2=("leaf_area_cm2", "sum"),
+                absorbed_w=("absorbed_w", "sum"), sunlit_area_cm2=("sunlit_area_cm2", "sum"))
+        frame["shaded_area_cm2"] = frame["leaf_area_cm2"] - frame["sunlit_area_cm2"]
+        frame["absorbed_w_m2_leaf"] = frame["absorbed_w"] / (frame["leaf_area_cm2"] * 1e-4)
+        if self.band == "par":
+            frame["absorbed_umol_s"] = frame["absorbed_w"] * PAR_UMOL_PER_J_PAR
+        return frame

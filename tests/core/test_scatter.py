@@ -1,0 +1,192 @@
+"""Absorbed light with scattering (maizeviz.light.scatter), through real Embree, against
+references we did not write: exact interception with black leaves, the Beer-Lambert law of a
+random spherical canopy (the values Helios' homogeneous-canopy test uses), a leaf's
+transmittance, two parallel plates in closed form, de Pury & Farquhar's scattered-beam
+formula, and the energy balance."""
+
+import math
+
+import numpy as np
+import pytest
+
+from maizeviz.canopy.layout import layout_from_dict
+from maizeviz.canopy.scene import Canopy
+from maizeviz.errors import MaizevizError
+from maizeviz.light.engine import LightEngine
+from maizeviz.light.optics import DEFAULT_OPTICS, Optics, optics_for
+
+
+def plot(x0=0.0, y0=0.0, x1=100.0, y1=100.0):
+    return layout_from_dict({"maizeviz_layout": 1, "row_spacing": 60, "plant_spacing": 30,
+                             "field": {"x0": x0, "y0": y0, "x1": x1, "y1": y1},
+                             "rows": [{"x": (x0 + x1) / 2, "plants": [{"y": (y0 + y1) / 2,
+                                                                        "plant": 1}]}]})
+
+
+def plates(heights, size=100.0):
+    """Horizontal squares covering the whole 100 x 100 cm plot, one leaf each."""
+    v, f = [], []
+    for k, z in enumerate(heights):
+        v += [[0, 0, z], [size, 0, z], [size, size, z], [0, size, z]]
+        f += [[4 * k, 4 * k + 1, 4 * k + 2], [4 * k, 4 * k + 2, 4 * k + 3]]
+    leaf = np.repeat(np.arange(1, len(heights) + 1), 2)
+    return Canopy.from_triangles(np.array(v, float), np.array(f), plot(), leaf)
+
+
+def patches(lai, width, height=(20.0, 120.0), side=2.0, seed=1):
+    """A homogeneous canopy of square patches (``side`` cm) with normals uniform on the
+    sphere (a spherical leaf angle distribution), leaf area index ``lai`` over a square plot of
+    ``width`` cm, in a slab between the two heights (cm)."""
+    rng = np.random.default_rng(seed)
+    n = int(round(lai * width * width / side**2))
+    centre = np.column_stack([rng.uniform(0, width, n), rng.uniform(0, width, n),
+                              rng.uniform(*height, n)])
+    normal = rng.normal(size=(n, 3))
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    helper = np.where(np.abs(normal[:, :1]) > 0.9, [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])
+    t1 = np.cross(normal, helper)
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    t2 = np.cross(normal, t1)
+    h = side / 2
+    corners = np.stack([centre - h * t1 - h * t2, centre + h * t1 - h * t2,
+                        centre + h * t1 + h * t2, centre - h * t1 + h * t2], axis=1)
+    v = corners.reshape(-1, 3)
+    base = 4 * np.arange(n)[:, None]
+    f = np.vstack([np.hstack([base, base + 1, base + 2]), np.hstack([base, base + 2, base + 3])])
+    return Canopy.from_triangles(v, f, plot(0, 0, width, width), np.ones(len(f), np.int32))
+
+
+@pytest.fixture(scope="module")
+def homogeneous():
+    return patches(2.0, 100.0)
+
+
+# ----------------------------------------------------------------------------- black leaves
+def test_black_leaves_absorb_exactly_what_the_direct_light_intercepts(homogeneous):
+    eng = LightEngine(homogeneous, periodic=True, density=4.0, heights_cm=(0.0,))
+    sun = eng.sun(zenith=36, azimuth=120, classes=True)
+    got = eng.absorbed(zenith=36, azimuth=120, optics=Optics(0, 0, 0), direct_w_m2=500.0)
+    b = got.balance
+    assert b.absorbed_leaves / b.incident == 1.0 - sun.transmission[0]        # exactly
+    assert b.absorbed_ground / b.incident == sun.transmission[0]
+    assert b.reflected_top == b.unresolved == b.escaped_sides == 0.0 and got.events == 0
+    per_ray = 500.0 * sun.ray_area_cm2 * 1e-4
+    np.testing.assert_array_equal(got.triangle_absorbed_w, sun.first_hits * per_ray)
+
+
+@pytest.mark.parametrize("periodic, width, rect", [(True, 100.0, None),
+                                                    (False, 400.0, (150, 150, 250, 250))])
+def test_a_spherical_canopy_of_lai_2_intercepts_helios_direct_value(periodic, width, rect):
+    """Helios' homogeneous canopy: LAI 2, zenith 36 deg: 1 - exp(-0.5 / cos(36) * 2) = 0.7095
+    of the direct beam intercepted (tolerance 0.01)."""
+    canopy = patches(2.0, width, seed=4)
+    eng = LightEngine(canopy, periodic=periodic, density=4.0, heights_cm=(0.0,), rect=rect)
+    got = eng.absorbed(zenith=36, azimuth=30, optics=Optics(0, 0, 0))
+    expect = 1 - math.exp(-0.5 / math.cos(math.radians(36)) * 2.0)
+    assert expect == pytest.approx(0.7095, abs=5e-5)
+    assert got.fraction_absorbed == pytest.approx(expect, abs=0.01)
+
+
+def test_a_spherical_canopy_of_lai_2_intercepts_helios_uniform_sky_value(homogeneous):
+    """The same canopy under a uniform overcast sky: 0.7806 of the diffuse light
+    intercepted (Helios' value; tolerance 0.01), traced from 145 sky directions."""
+    eng = LightEngine(homogeneous, periodic=True, density=1.0, heights_cm=(0.0,))
+    got = eng.absorbed(optics=Optics(0, 0, 0), direct_w_m2=0.0, diffuse_w_m2=100.0,
+                       sky="uoc", directions=145)
+    assert got.directions == 145
+    assert got.fraction_absorbed == pytest.approx(0.7806, abs=0.01)
+
+
+# ------------------------------------------------------------------------- analytic scenes
+def test_leaves_that_scatter_everything_absorb_nothing(homogeneous):
+    eng = LightEngine(homogeneous, periodic=True, density=1.0, heights_cm=(0.0,))
+    got = eng.absorbed(zenith=36, azimuth=30, optics=Optics(0.5, 0.5, 0.0))
+    assert got.balance.absorbed_leaves == 0.0 and not got.triangle_absorbed_w.any()
+    b = got.balance
+    assert b.absorbed_ground + b.reflected_top + b.unresolved == pytest.approx(b.incident,
+                                                                               rel=0.02)
+
+
+def test_one_horizontal_leaf_over_black_ground_transmits_tau_of_the_beam():
+    eng = LightEngine(plates([50.0]), periodic=True, density=16.0, heights_cm=(0.0,))
+    n = eng.absorbed(zenith=30, azimuth=200, optics=Optics(0.10, 0.05, 0.0),
+                     direct_w_m2=1.0)
+    b = n.balance
+    sigma = math.sqrt(0.05 * 0.95 / n.rays)
+    assert b.absorbed_ground == pytest.approx(0.05, abs=4 * sigma)
+    assert b.reflected_top == pytest.approx(0.10, abs=4 * math.sqrt(0.1 * 0.9 / n.rays))
+    assert b.absorbed_leaves == pytest.approx(0.85, abs=1e-12)       # deposited, not drawn
+
+
+def test_two_parallel_gray_plates_match_the_closed_form():
+    """Infinite parallel plates (view factor 1) over black ground: with D the light going
+    down between them and U up, D = tau + rho U and U = rho D."""
+    rho, tau = 0.3, 0.2
+    eng = LightEngine(plates([40.0, 80.0]), periodic=True, density=16.0, heights_cm=(0.0,))
+    got = eng.absorbed(zenith=20, azimuth=10, optics=Optics(rho, tau, 0.0), direct_w_m2=1.0)
+    down = tau / (1 - rho**2)
+    up = rho * down
+    a = 1 - rho - tau
+    per_ray = got.balance.incident / got.rays
+    lower = got.triangle_absorbed_w[:2].sum() / (per_ray * got.rays)
+    upper = got.triangle_absorbed_w[2:].sum() / (per_ray * got.rays)
+    tol = 2 / math.sqrt(got.rays)            # about 10 standard errors
+    assert upper == pytest.approx(a * (1 + up), abs=tol)
+    assert lower == pytest.approx(a * down, abs=tol)
+    assert got.balance.absorbed_ground == pytest.approx(tau * down, abs=tol)
+    assert got.balance.reflected_top == pytest.approx(rho + tau * up, abs=tol)
+
+
+def test_a_spherical_canopy_absorbs_what_de_pury_and_farquhar_give():
+    """Direct beam absorbed with scattering by a deep spherical canopy over black soil:
+    (1 - rho_cb) (1 - exp(-k'_b L)), k'_b = k_b sqrt(1 - sigma) (de Pury & Farquhar 1997,
+    after Goudriaan 1977), within 3%."""
+    lai, zenith, sigma = 3.0, 36.0, 0.15
+    canopy = patches(lai, 100.0, seed=7)
+    eng = LightEngine(canopy, periodic=True, density=4.0, heights_cm=(0.0,))
+    got = eng.absorbed(zenith=zenith, azimuth=60, optics=Optics(sigma / 2, sigma / 2, 0.0))
+    kb = 0.5 / math.cos(math.radians(zenith))
+    rho_h = (1 - math.sqrt(1 - sigma)) / (1 + math.sqrt(1 - sigma))
+    rho_cb = 1 - math.exp(-2 * rho_h * kb / (1 + kb))
+    expect = (1 - rho_cb) * (1 - math.exp(-kb * math.sqrt(1 - sigma) * lai))
+    assert got.fraction_absorbed == pytest.approx(expect, rel=0.02)
+    assert got.balance.reflected_top / got.balance.incident == pytest.approx(rho_cb, abs=0.005)
+
+
+def test_the_energy_balance_closes_with_optics_on(homogeneous):
+    eng = LightEngine(homogeneous, periodic=True, density=2.0, heights_cm=(0.0,))
+    for band in ("par", "nir"):
+        got = eng.absorbed(zenith=40, azimuth=100, band=band, diffuse_w_m2=50.0,
+                           directions=16)
+        b = got.balance
+        assert b.incident == pytest.approx(1000 * (0.48 if band == "par" else 0.52) + 50.0)
+        assert abs(b.closure) < 5 / math.sqrt(got.rays)
+        assert b.unresolved < 1e-3 * b.incident
+        assert b.escaped_sides == 0.0                                     # periodic
+
+
+def test_an_open_field_loses_light_through_its_sides():
+    eng = LightEngine(patches(2.0, 100.0, seed=2), periodic=False, density=2.0,
+                      heights_cm=(0.0,), rect=(30, 30, 70, 70))
+    got = eng.absorbed(zenith=50, azimuth=90, band="nir")
+    assert got.balance.escaped_sides > 0 and abs(got.balance.closure) < 0.05
+
+
+# ----------------------------------------------------------------------------- the inputs
+@pytest.mark.parametrize("kw, quantity", [
+    (dict(reflectance=-0.1, transmittance=0.1, ground_reflectance=0.1), "reflectance"),
+    (dict(reflectance=0.7, transmittance=0.4, ground_reflectance=0.1), "transmittance"),
+    (dict(reflectance=0.1, transmittance=math.nan, ground_reflectance=0.1), "transmittance"),
+    (dict(reflectance=0.1, transmittance=0.1, ground_reflectance=2.0), "ground_reflectance"),
+])
+def test_impossible_optics_are_one_line(kw, quantity):
+    with pytest.raises(MaizevizError) as err:
+        Optics(**kw)
+    assert err.value.quantity == quantity and "\n" not in str(err.value)
+
+
+def test_band_defaults_and_overrides():
+    assert optics_for("nir") == DEFAULT_OPTICS["nir"]
+    assert optics_for("par", reflectance=0.2).reflectance == 0.2
+    with pytest.raises(MaizevizError, match="unknown band 'uv'"):
+        optics_for("uv")
