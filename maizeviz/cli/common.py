@@ -35,7 +35,9 @@ FLAGS = {
     "altitude": "--altitude", "weather": "--weather",
     "baud": "--baud", "points_across": "--points-across", "seed": "--seed", "plant": "--plant",
     "pace": "--pace", "noise": "--noise", "answer_timeout": "--answer-timeout",
-    "resume": "--resume",
+    "resume": "--resume", "band": "--band", "reflectance": "--reflectance",
+    "transmittance": "--transmittance", "ground_reflectance": "--ground-reflectance",
+    "irradiance": "--irradiance/--diffuse", "depth": "--depth",
 }
 
 

@@ -26,12 +26,12 @@ from maizeviz.cli.common import (
     floats,
     fmt_table,
     leaves_summary,
+    level_path,
     levels_from,
     say,
-    level_path,
 )
 from maizeviz.cost import light_costs
-from maizeviz.errors import MaizevizError
+from maizeviz.errors import MaizevizError, check_range
 from maizeviz.io.atomic import file_tag, make_folder, write_rows
 from maizeviz.io.outputs import OutputFolder, check_run_paths
 from maizeviz.light.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping
@@ -41,14 +41,17 @@ from maizeviz.light.heatmap import map_stems, save_figure, write_heatmaps
 from maizeviz.light.irradiance import (
     DEFAULT_LINKE_TURBIDITY,
     DEFAULT_PAR_UMOL_PER_J,
+    PAR_UMOL_PER_J_PAR,
     Period,
     clear_sky_period,
     read_weather,
     weather_period,
 )
 from maizeviz.light.leaf_light import leaf_light, merge_rows, plant_light
+from maizeviz.light.optics import BANDS, optics_for
 from maizeviz.light.reports import period_leaf_rows, sky_leaf_rows, write_steps
 from maizeviz.light.request import Sampling
+from maizeviz.light.scatter import DEFAULT_DEPTH, AbsorbedLight, absorbed_leaf_rows
 from maizeviz.light.sky import SKY_KINDS, Sky, make_sky
 from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import LightResult
@@ -127,7 +130,32 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--leaf-light", metavar="CSV",
                    help="write the light intercepted by every lit leaf")
     p.add_argument("--plant-light", metavar="CSV", help="the same summed per plant")
+    ab = p.add_argument_group(
+        "absorbed light with scattering (any of these turns it on; needs a sun)")
+    ab.add_argument("--band", choices=BANDS, default=None,
+                    help="waveband: par (default) or nir, with its default optics")
+    ab.add_argument("--reflectance", type=float, default=None, metavar="R",
+                    help="leaf reflectance in the band (PAR default 0.10, NIR 0.45)")
+    ab.add_argument("--transmittance", type=float, default=None, metavar="T",
+                    help="leaf transmittance in the band (PAR default 0.05, NIR 0.40)")
+    ab.add_argument("--ground-reflectance", type=float, default=None, metavar="G",
+                    help="soil reflectance in the band (PAR default 0.10, NIR 0.25)")
+    ab.add_argument("--irradiance", type=float, default=None, metavar="W_M2",
+                    help="the band's direct irradiance on a horizontal plane, W/m2 (default "
+                         "its share of 1000 W/m2: PAR 480, NIR 520)")
+    ab.add_argument("--diffuse", type=float, default=0.0, metavar="W_M2",
+                    help="the band's diffuse irradiance on a horizontal plane, W/m2, spread "
+                         "over --sky (default soc) (default 0)")
+    ab.add_argument("--depth", type=int, default=DEFAULT_DEPTH, metavar="N",
+                    help=f"most scatterings followed per ray (default {DEFAULT_DEPTH})")
+    ab.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.set_defaults(run=run)
+
+
+def _absorbed_asked(args: argparse.Namespace) -> bool:
+    return any(v is not None for v in (args.band, args.reflectance, args.transmittance,
+                                        args.ground_reflectance, args.irradiance)) or \
+        bool(args.diffuse)
 
 
 # ------------------------------------------------------------------------------ what is asked
@@ -226,6 +254,18 @@ def run(args: argparse.Namespace) -> int:
     levels = levels_from(args)
     sun = sun_from(args)
     heights = tuple(floats(args.heights, "heights", "heights"))
+    absorbed_optics = None
+    if _absorbed_asked(args):
+        if sun is None:
+            raise MaizevizError("absorbed light with scattering needs a sun: give "
+                                "--sun-zenith/--sun-azimuth or --date, --time, --lat, --lon",
+                                quantity="band")
+        absorbed_optics = optics_for(args.band or "par", args.reflectance, args.transmittance,
+                                     args.ground_reflectance)
+        if args.irradiance is not None:
+            check_range(args.irradiance, "the direct irradiance (W/m2)", 0, 5000, "irradiance")
+        check_range(args.diffuse, "the diffuse irradiance (W/m2)", 0, 5000, "irradiance")
+        check_range(args.depth, "the scattering depth", 0, 10_000, "depth", whole=True)
     rect = tuple(floats(args.rect, "the sample rectangle", "rect", 4)) if args.rect else None
     if not args.heatmap_bin > 0:
         raise MaizevizError(f"the heatmap bin must be > 0 cm, got {args.heatmap_bin}",
@@ -305,6 +345,16 @@ def run(args: argparse.Namespace) -> int:
                 said.add(w)
                 say(f"{'note' if w in (period.notes if period else ()) else 'warning'}: {w}")
         rec["warnings"] = list(dict.fromkeys(warnings))
+        if absorbed_optics is not None:
+            ab = engine.absorbed(sun, optics=absorbed_optics, direct_w_m2=args.irradiance,
+                                 diffuse_w_m2=args.diffuse, sky=args.sky or "soc",
+                                 directions=args.sky_directions or 46, depth=args.depth,
+                                 seed=args.seed)
+            rec["balance"] = ab.balance.as_dict()
+            rec["absorbed"] = _absorbed_record(ab, canopy)
+            rec["seconds"]["scatter"] = ab.seconds["trace"] + ab.seconds["scatter"]
+            if want_rows:
+                tables.append(absorbed_leaf_rows(canopy, ab))
         if sun is None:
             rays = per_res.rays if per_res else sky_res.rays if sky_res else 0
             x0, y0, x1, y1 = per_res.rect if per_res else sky_res.rect if sky_res else (0, 0, 1, 1)
@@ -322,6 +372,28 @@ def run(args: argparse.Namespace) -> int:
 
 
 # ------------------------------------------------------------------------------ records
+def _absorbed_record(ab: AbsorbedLight, canopy: Canopy) -> dict[str, Any]:
+    """The absorbed light of a level for the JSON output (balance in W/m2 of ground)."""
+    o = ab.optics
+    out: dict[str, Any] = {
+        "band": ab.band, "units": "W/m2 of ground",
+        "optics": {"reflectance": o.reflectance, "transmittance": o.transmittance,
+                   "ground_reflectance": o.ground_reflectance},
+        "fraction_absorbed": ab.fraction_absorbed,
+        "sunlit_lai": _sunlit_m2(ab, canopy),
+        "rays": ab.rays, "directions": ab.directions, "depth": ab.depth, "seed": ab.seed,
+        "scatterings": ab.events}
+    if ab.band == "par":
+        out["absorbed_leaves_umol_m2_s"] = ab.balance.absorbed_leaves * PAR_UMOL_PER_J_PAR
+    return out
+
+
+def _sunlit_m2(ab: AbsorbedLight, canopy: Canopy) -> float:
+    """Sunlit leaf area (m2) per m2 of sample ground: the sunlit leaf area index."""
+    x0, y0, x1, y1 = ab.rect
+    return float(ab.triangle_sunlit_cm2[:canopy.n_triangles].sum()) / ((x1 - x0) * (y1 - y0))
+
+
 def _sun_record(res: LightResult, sun: Sun, canopy: Canopy, args: argparse.Namespace,
                 heights: tuple[float, ...]) -> dict[str, Any]:
     rec: dict[str, Any] = {
@@ -470,6 +542,8 @@ def _print_tables(records: list[dict], sun: Sun | None, heights: tuple[float, ..
     if "period" in r0:
         for r in records:
             _print_period(r, len(records) > 1)
+    if "balance" in r0:
+        _print_balance(records)
     print()
     t_ref = _cost(r0)
     cols = ["level", "triangles", "canopy s", "scene s"]
@@ -577,3 +651,21 @@ def _print_period(r: dict, label: bool) -> None:
                      for i, (h, v, f) in enumerate(zip(tb["heights_cm"], tb["par_mol_m2"],
                                                        tb["fraction"]))]))
     print()
+
+
+def _print_balance(records: list[dict]) -> None:
+    """Absorbed light with scattering: the energy balance per level, W/m2 of ground."""
+    ab = records[0]["absorbed"]
+    o = ab["optics"]
+    print(f"\nabsorbed {ab['band'].upper()} with scattering (leaf reflectance "
+          f"{o['reflectance']:g}, transmittance {o['transmittance']:g}, ground "
+          f"{o['ground_reflectance']:g}), W/m2 of ground:")
+    rows = []
+    for r in records:
+        b = r["balance"]
+        rows.append([r["level"], f"{b['incident']:.1f}", f"{b['absorbed_leaves']:.1f}",
+                     f"{b['absorbed_ground']:.1f}", f"{b['reflected_top']:.1f}",
+                     f"{b['escaped_sides'] + b['unresolved']:.2f}", f"{b['closure']:+.4f}",
+                     f"{r['absorbed']['sunlit_lai']:.2f}"])
+    print(fmt_table(["level", "incident", "leaves", "ground", "reflected", "other",
+                     "closure", "sunlit LAI"], rows))

@@ -84,6 +84,7 @@ class LightEngine:
         self._scenes: dict[bool, RayScene] = {}
         self._lock = threading.Lock()
         self._sky: tuple[tuple, SkyLight] | None = None
+        self._normals_kept = None
 
     @staticmethod
     def _sampling(base: Sampling, changes: dict) -> Sampling:
@@ -340,9 +341,16 @@ class LightEngine:
             tally, secs = scatter_beam(smp, toward, opt, normals, depth, threshold,
                                        seed + 7919 * k, smp_req.threads)
             per_ray = irradiance * smp.ray_area_cm2 * 1e-4       # W carried by one ray
-            absorbed += tally.triangles * per_ray
+            absorbed += tally.per_triangle(nf, (1.0 - opt.scattering) * per_ray)
             if k == 0 and sun is not None and direct > 0:
-                sunlit = tally.sunlit
+                # cm2 of leaf a ray's beam covers: its footprint across the beam over the
+                # cosine of the leaf's tilt to it
+                first = np.concatenate(tally.first_hits) if tally.first_hits else []
+                lit = np.unique(first)
+                factor = np.zeros(nf)
+                factor[lit] = smp.ray_area_cm2 * toward[2] / np.maximum(
+                    np.abs(normals[lit] @ toward), 1e-6)
+                sunlit = tally.sunlit(nf, factor)
             for name in parts:
                 parts[name] += getattr(tally, name) * per_ray
             events += tally.events
@@ -358,16 +366,20 @@ class LightEngine:
                              self.canopy.level, seconds)
 
     def _normals(self):
-        """Unit normals (F, 3) of the scene's leaf triangles, then its stalks' if traced."""
+        """Unit normals (F, 3) of the scene's leaf triangles, then its stalks' if traced
+        (computed once)."""
         import numpy as np
 
         from maizeviz.mesh.tessellate import triangle_areas_normals
 
+        if self._normals_kept is not None:
+            return self._normals_kept
         c = self.canopy
         normals = triangle_areas_normals(c.vertices, c.faces)[1]
         if self.with_stalks:
             normals = np.vstack([normals, triangle_areas_normals(c.stalk_vertices,
                                                                  c.stalk_faces)[1]])
+        self._normals_kept = normals
         return normals
 
 

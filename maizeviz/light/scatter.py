@@ -65,15 +65,16 @@ class Tally:
 
     Attributes
     ----------
-    triangles : (F,) float64, absorbed by each triangle (leaves, then stalks)
-    sunlit : (F,) float64 cm2, leaf area each triangle has in the beam (first hits)
+    leaf_hits : list of int64 arrays, the triangle of every ray's arrival at a leaf (each
+        deposits ``1 - scattering`` there)
+    first_hits : list of int64 arrays, the triangles the primary rays hit (sunlit area)
     ground, top, sides, unresolved : float, absorbed by the ground, reflected out of the
         canopy top, escaped sideways (open field), still travelling when tracing stopped
     rays : primary rays; events : scatterings followed
     """
 
-    triangles: np.ndarray
-    sunlit: np.ndarray
+    leaf_hits: list = field(default_factory=list)
+    first_hits: list = field(default_factory=list)
     ground: float = 0.0
     top: float = 0.0
     sides: float = 0.0
@@ -82,10 +83,21 @@ class Tally:
     events: int = 0
 
     def add(self, other: Tally) -> None:
-        self.triangles += other.triangles
-        self.sunlit += other.sunlit
+        self.leaf_hits += other.leaf_hits
+        self.first_hits += other.first_hits
         for name in ("ground", "top", "sides", "unresolved", "rays", "events"):
             setattr(self, name, getattr(self, name) + getattr(other, name))
+
+    def per_triangle(self, n_triangles: int, absorbed_share: float) -> np.ndarray:
+        """(F,) float64: what each triangle absorbed (``absorbed_share`` of each arrival)."""
+        ids = np.concatenate(self.leaf_hits) if self.leaf_hits else np.empty(0, np.int64)
+        return np.bincount(ids, minlength=n_triangles) * absorbed_share
+
+    def sunlit(self, n_triangles: int, area_factor: np.ndarray) -> np.ndarray:
+        """(F,) float64 cm2 in the direct beam: primary hits times each triangle's
+        ``area_factor`` (cm2 of leaf per ray)."""
+        ids = np.concatenate(self.first_hits) if self.first_hits else np.empty(0, np.int64)
+        return np.bincount(ids, minlength=n_triangles) * area_factor
 
 
 def lambertian(normals: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -177,10 +189,10 @@ def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng
             kind: np.ndarray, prim: np.ndarray, end: np.ndarray, dirs: np.ndarray) -> _Rays:
     """Deposit what rays ending at leaves and the ground absorb, count those leaving, and draw
     the rays that go on (Russian roulette on the scattering coefficient)."""
-    nf = len(tally.triangles)
     leaf = kind == LEAF
     sc = optics.scattering
-    tally.triangles += np.bincount(prim[leaf], minlength=nf) * (1.0 - sc)
+    if sc < 1.0:
+        tally.leaf_hits.append(prim[leaf])
     ground = kind == GROUND
     tally.ground += np.count_nonzero(ground) * (1.0 - optics.ground_reflectance)
     tally.top += np.count_nonzero(kind == TOP)
@@ -238,8 +250,6 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
     primary = trace_direction(smp, s, ids=True, threads=threads, stop=stop)
     t1 = time.perf_counter()
     n = smp.n
-    nf = len(normals)
-    area_factor = smp.ray_area_cm2 * s[2] / np.maximum(np.abs(normals @ s), 1e-6)
     chunks = [(a, min(a + CHUNK_RAYS, n)) for a in range(0, n, CHUNK_RAYS)]
     first_prim = primary.first_prim
     assert first_prim is not None
@@ -247,7 +257,7 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
     def chunk(k_ab: tuple[int, tuple[int, int]]) -> Tally:
         k, (a, b) = k_ab
         rng = np.random.default_rng([seed, k])
-        tally = Tally(np.zeros(nf), np.zeros(nf), rays=b - a)
+        tally = Tally(rays=b - a)
         prim = first_prim[a:b].astype(np.int64)
         z = primary.first_z[a:b].astype(np.float64)
         g = ray_grid(smp.rect, smp.density, a, b)[0]
@@ -257,8 +267,8 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
         height = np.where(hit, z, 0.0)
         end[:, :2] = g + s[:2] * (height / s[2])[:, None]
         end[:, 2] = height
-        tally.sunlit += np.bincount(prim[hit], minlength=nf) * area_factor
-        dirs = np.tile(-s, (b - a, 1))
+        tally.first_hits.append(prim[hit])
+        dirs = np.broadcast_to(-s, (b - a, 3))
         rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, dirs)
         for _ in range(depth):
             if len(rays.org) <= threshold * (b - a):
@@ -269,7 +279,7 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
         tally.unresolved += len(rays.org)
         return tally
 
-    total = Tally(np.zeros(nf), np.zeros(nf))
+    total = Tally()
 
     def done(k: int) -> None:
         report(progress, k, len(chunks), "scattering")
@@ -392,3 +402,16 @@ class AbsorbedLight:
         if self.band == "par":
             frame["absorbed_umol_s"] = frame["absorbed_w"] * PAR_UMOL_PER_J_PAR
         return frame
+
+
+def absorbed_leaf_rows(canopy, light: AbsorbedLight) -> list[dict]:
+    """Per lit leaf: ``absorbed_w`` (W), ``absorbed_w_m2_leaf`` and ``sunlit_area_cm2``, as
+    the light tables of the command line (:func:`maizeviz.light.leaf_light.leaf_sums`)."""
+    from maizeviz.light.leaf_light import leaf_sums
+
+    rows = leaf_sums(canopy, {"absorbed_w": light.triangle_absorbed_w,
+                              "absorbed_sunlit_area_cm2": light.triangle_sunlit_cm2},
+                     light.rect, light.periodic)
+    for r in rows:
+        r["absorbed_w_m2_leaf"] = float(r["absorbed_w"]) / (float(r["leaf_area_cm2"]) * 1e-4)
+    return rows

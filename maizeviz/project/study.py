@@ -339,9 +339,7 @@ def save_study(path: str | Path, points: str | Path, layout: CanopyLayout,
     pathlib.Path
     """
     from maizeviz.io.inputs import read_input
-    from maizeviz.io.project import save_project
-
-    from maizeviz.io.project import MAX_MEMBER_BYTES
+    from maizeviz.io.project import MAX_MEMBER_BYTES, save_project
 
     chosen = parse_level(str(level))
     data = read_input(points, "points file", MAX_MEMBER_BYTES["points.csv"], ProjectError)

@@ -190,3 +190,76 @@ def test_band_defaults_and_overrides():
     assert optics_for("par", reflectance=0.2).reflectance == 0.2
     with pytest.raises(MaizevizError, match="unknown band 'uv'"):
         optics_for("uv")
+
+
+# ------------------------------------------------------------------------- the command line
+def run_cli(capsys, *argv):
+    from maizeviz.cli import main
+
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+BASE = ["light", None, "--tile", "3x3", "--levels", "36", "--sun-zenith", "30",
+        "--sun-azimuth", "150", "--periodic", "--density", "1", "--json"]
+
+
+def cli_args(**extra):
+    from maizeviz.resources import example_points
+
+    args = [str(example_points()) if a is None else a for a in BASE]
+    for k, v in extra.items():
+        args += [f"--{k.replace('_', '-')}", str(v)]
+    return args
+
+
+def test_the_cli_with_all_optics_0_gives_todays_interception_exactly(capsys):
+    import json
+
+    code, out, err = run_cli(capsys, *cli_args(reflectance=0, transmittance=0,
+                                               ground_reflectance=0, irradiance=480))
+    assert code == 0, err
+    doc = json.loads(out)
+    b = doc["balance"]
+    assert set(b) >= {"incident", "absorbed_leaves", "absorbed_ground", "reflected_top"}
+    assert b["absorbed_leaves"] / b["incident"] == doc["sunlit_intercepted_fraction"]
+    assert b["incident"] == 480.0 and b["reflected_top"] == 0.0
+    assert doc["absorbed"]["absorbed_leaves_umol_m2_s"] == pytest.approx(
+        b["absorbed_leaves"] * 4.57)
+
+
+def test_the_cli_nir_balance_closes_and_leaf_rows_carry_absorbed_light(capsys, tmp_path):
+    import csv
+    import json
+
+    leaves = tmp_path / "leaves.csv"
+    code, out, err = run_cli(capsys, *cli_args(band="nir", leaf_light=leaves))
+    assert code == 0, err
+    b = json.loads(out)["balance"]
+    assert b["incident"] == pytest.approx(520.0)
+    assert abs(b["closure"]) < 0.02 and b["reflected_top"] > 0.2 * b["incident"]
+    rows = list(csv.DictReader(leaves.open()))
+    assert rows and all(float(r["absorbed_w"]) >= 0 for r in rows)
+    per_leaf = [float(r["absorbed_w_m2_leaf"]) for r in rows]
+    assert 0 < np.median(per_leaf) < 520
+
+
+@pytest.mark.parametrize("extra, message", [
+    (dict(reflectance=1.2), "the reflectance must be a number from 0 to 1, got 1.2"),
+    (dict(reflectance=0.7, transmittance=0.5), "cannot reflect and transmit more"),
+    (dict(ground_reflectance="nan"), "the ground reflectance must be a number from 0 to 1"),
+    (dict(irradiance=-5), "irradiance"),
+])
+def test_the_cli_refuses_impossible_optics_in_one_line(capsys, extra, message):
+    code, out, err = run_cli(capsys, *cli_args(**extra))
+    assert code != 0 and out == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], err
+
+
+def test_the_cli_asks_for_a_sun_for_absorbed_light(capsys):
+    from maizeviz.resources import example_points
+
+    code, out, err = run_cli(capsys, "light", example_points(), "--sky", "soc", "--band", "nir")
+    assert code != 0 and "absorbed light with scattering needs a sun" in err

@@ -1,0 +1,85 @@
+"""Absorbed PAR with scattering against the black-leaf run, in the same run.
+
+On the bundled 3 x 3 block tiled 3 x 3 (81 plants) at ``--level`` (default K = 4, 2.68 M
+triangles), periodic field, a noon-like sun (zenith 30 deg), ``--density`` rays per cm2 over
+the central tile, on the engine's kept scene (its build is not counted on either side):
+
+- sun_s: today's black-leaf run, the direct light of the same sun (``LightEngine.sun``,
+  no hit classes): the anchor
+- black_s: absorbed light with black leaves and ground (every optical value 0: the primary
+  beam only, equal to the interception of direct light)
+- scatter_s: the same with the maize PAR optics, scattering followed to ``--depth``
+  (default 3)
+- cost_ratio: scatter_s / sun_s (target <= 3); black_ratio: black_s / sun_s
+- rays_per_s: primary and scattered rays traced per second with scattering
+- closure: the energy balance's closure (0 up to Monte Carlo noise)
+
+    python benchmarks/bench_scatter.py [--json] [--level K4] [--density 4] [--depth 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+
+from maizeviz.resources import example_points
+
+from maizeviz.canopy.layout import layout_for
+from maizeviz.canopy.scene import build_canopy
+from maizeviz.leaf.fit import read_leaves
+from maizeviz.light.engine import LightEngine
+from maizeviz.light.optics import DEFAULT_OPTICS, Optics
+from maizeviz.mesh.levels import parse_level
+
+
+def best(fn, repeat: int):
+    out = None
+    times = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return min(times), out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--json", action="store_true")
+    ap.add_argument("--level", default="K4")
+    ap.add_argument("--density", type=float, default=4.0)
+    ap.add_argument("--depth", type=int, default=3)
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--repeat", type=int, default=3)
+    args = ap.parse_args()
+
+    leaves = read_leaves(example_points()).leaves
+    canopy = build_canopy(leaves, layout_for(leaves, (3, 3)), parse_level(args.level))
+    eng = LightEngine(canopy, periodic=True, density=args.density, heights_cm=(0.0,),
+                      threads=args.threads)
+    eng.scene()
+    eng.absorbed(zenith=30, azimuth=150, optics=Optics(0, 0, 0))   # normals, warm caches
+    sun_s, _ = best(lambda: eng.sun(zenith=30, azimuth=150, classes=False), args.repeat)
+    black_s, black = best(lambda: eng.absorbed(zenith=30, azimuth=150,
+                                               optics=Optics(0, 0, 0)), args.repeat)
+    scatter_s, lit = best(lambda: eng.absorbed(zenith=30, azimuth=150,
+                                               optics=DEFAULT_OPTICS["par"],
+                                               depth=args.depth), args.repeat)
+    out = {"triangles": canopy.n_triangles, "rays": lit.rays, "depth": args.depth,
+           "sun_s": round(sun_s, 3), "black_s": round(black_s, 3),
+           "scatter_s": round(scatter_s, 3), "cost_ratio": round(scatter_s / sun_s, 2),
+           "black_ratio": round(black_s / sun_s, 2),
+           "rays_per_s": round((lit.rays + lit.events) / scatter_s),
+           "black_fraction_absorbed": round(black.fraction_absorbed, 4),
+           "fraction_absorbed": round(lit.fraction_absorbed, 4),
+           "reflected_top": round(lit.balance.reflected_top / lit.balance.incident, 4),
+           "closure": round(lit.balance.closure, 5)}
+    if args.json:
+        print(json.dumps(out, indent=1))
+    else:
+        for k, v in out.items():
+            print(f"{k:>24}: {v}")
+
+
+if __name__ == "__main__":
+    main()
