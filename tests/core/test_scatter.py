@@ -263,3 +263,17 @@ def test_the_cli_asks_for_a_sun_for_absorbed_light(capsys):
 
     code, out, err = run_cli(capsys, "light", example_points(), "--sky", "soc", "--band", "nir")
     assert code != 0 and "absorbed light with scattering needs a sun" in err
+
+
+def test_per_plant_tables_add_up_to_the_balance(homogeneous):
+    eng = LightEngine(homogeneous, periodic=True, density=1.0)
+    got = eng.absorbed(zenith=30, azimuth=150, band="nir")
+    x0, y0, x1, y1 = got.rect
+    area_m2 = (x1 - x0) * (y1 - y0) * 1e-4
+    table = got.table("plant", homogeneous)
+    assert table["absorbed_w"].sum() == pytest.approx(got.balance.absorbed_leaves * area_m2)
+    assert (table["sunlit_area_cm2"] <= table["leaf_area_cm2"] + 1e-9).all()
+    assert "absorbed_umol_s" not in table                         # NIR: no photon count
+    assert list(got.table("balance").columns[:2]) == ["band", "incident"]
+    with pytest.raises(MaizevizError, match="give the canopy"):
+        got.table("leaf")
