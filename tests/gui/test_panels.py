@@ -2,12 +2,18 @@
 
 import numpy as np
 import pytest
-
-from maizeviz.errors import LeafError, MaizevizError, PointsFileError
 from maizeviz_app.messages import user_message
 from maizeviz_app.panels.canopy import CanopyPanel
-from maizeviz_app.panels.light import (InputProblem, LightPanel, LightPlots, LightRuns, Run,
-                                       parse_heights)
+from maizeviz_app.panels.light import (
+    InputProblem,
+    LightPanel,
+    LightPlots,
+    LightRuns,
+    Run,
+    parse_heights,
+)
+
+from maizeviz.errors import LeafError, MaizevizError, PointsFileError
 
 
 def test_slider_asks_once_and_the_label_follows_the_view(qtbot):
@@ -112,10 +118,11 @@ def test_plots_switch_heights(qtbot):
 
 
 def test_figures_are_the_core_heatmap_and_a_level_comparison(small_canopy):
+    from maizeviz_app.plots import Curve, heatmap_images, rgba, transmission_figure
+
     from maizeviz.light.request import LightRequest, Sampling
     from maizeviz.light.sun import Sun
     from maizeviz.light.transmission import trace_light
-    from maizeviz_app.plots import Curve, heatmap_images, rgba, transmission_figure
 
     result = trace_light(small_canopy, LightRequest(Sun(22.3, 167.0), Sampling((0.0, 100.0), 0.5),
                                                     classes=True))

@@ -95,4 +95,5 @@ def test_a_sky_at_another_level_gets_its_plants_when_that_level_is_shown(
         w2._export_diffuse("leaves", str(tmp_path / "x.csv"))
     with qtbot.waitSignal(w2.canopy_shown, timeout=TIMEOUT):
         w2.slider.setValue(w2.slider.value() - 1)          # back to 36: computed against it
-    assert run.extra is not None and w2.light_panel.plants.rowCount() == 2
+    qtbot.waitUntil(lambda: run.extra is not None, timeout=TIMEOUT)    # in a worker
+    assert w2.light_panel.plants.rowCount() == 2

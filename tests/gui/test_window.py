@@ -24,7 +24,7 @@ def test_close_right_after_start(window, qtbot, capfd):
         qtbot.wait(delay)
         w.close()
         started = []
-        w.runner.changed.connect(lambda: started.append(w.runner.running()))
+        w.runner.changed.connect(lambda w=w, started=started: started.append(w.runner.running()))
         qtbot.wait(1500)
         assert not w.runner.running() and not started
         assert QThreadPool.globalInstance().waitForDone(10_000)
@@ -175,8 +175,9 @@ def test_exports(window, qtbot, small_points, tmp_path):
 
 
 def test_menus_show_shortcuts_and_about_names_the_paper(window, qtbot):
-    from maizeviz import __version__
     from maizeviz_app.main_window import about_text
+
+    from maizeviz import __version__
 
     w = window(wait_ready=False)
     texts = {name: a.shortcut().toString() for name, a in w.actions.items()}

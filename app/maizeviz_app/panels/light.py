@@ -15,34 +15,47 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from PySide6.QtCore import QDate, QSize, Qt, Signal
 from PySide6.QtGui import QImage, QPixmap
-from PySide6.QtWidgets import (QAbstractItemView, QButtonGroup, QCheckBox, QComboBox,
-                               QCompleter, QDateEdit, QDoubleSpinBox, QFileDialog, QFormLayout,
-                               QGroupBox, QHBoxLayout, QHeaderView, QLabel, QLineEdit,
-                               QPushButton, QRadioButton, QSizePolicy, QSpinBox,
-                               QStackedWidget, QTableWidget, QTableWidgetItem, QVBoxLayout,
-                               QWidget)
+from PySide6.QtWidgets import (
+    QAbstractItemView,
+    QButtonGroup,
+    QCheckBox,
+    QComboBox,
+    QCompleter,
+    QDateEdit,
+    QDoubleSpinBox,
+    QFileDialog,
+    QFormLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QLineEdit,
+    QPushButton,
+    QRadioButton,
+    QSizePolicy,
+    QSpinBox,
+    QStackedWidget,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
 
 from maizeviz.errors import MaizevizError
 from maizeviz.light.irradiance import DEFAULT_PAR_UMOL_PER_J, PAR_FRACTION, PAR_UMOL_PER_J_PAR
-from maizeviz.mesh.levels import COMPLEXITY_STOPS, parse_level
+from maizeviz_app.runs import MODES, SKIES, LightRuns, Run, level_order  # noqa: F401 - re-exported
 
 DEFAULT_PLACE = "2005-08-01 12:00 39.9 116.4 Asia/Shanghai"
 DEFAULT_HEIGHTS = "0, 50, 100, 150, 200, 225"
 PROBLEM_STYLE = "border: 2px solid #d0342c; border-radius: 3px;"
-#: The lights the panel computes, in the order of the buttons, the table and the plot.
-MODES = ("sun", "sky", "day")
 MODE_BUTTONS = {"sun": "Sun", "sky": "Sky", "day": "Day"}
 COMPUTE_TEXT = {"sun": "Compute direct light", "sky": "Compute diffuse light",
                 "day": "Compute the day's light"}
-#: Skies: kind -> (what the combo says, how a result is named in the table and plot).
-SKIES = {"soc": ("standard overcast (SOC): brightness (1 + 2 cos θ)/3", "overcast sky"),
-         "uoc": ("uniform overcast (UOC)", "uniform sky")}
 #: Sky splits offered: directions (None: an equal-area split of n) -> what the combo says.
 SKY_SPLITS = {16: "16 directions (turtle)", 46: "46 directions (turtle, as Caribu)",
               145: "145 directions (Tregenza)", None: "equal-area split of n directions"}
@@ -80,145 +93,9 @@ def parse_heights(text: str) -> tuple[float, ...]:
     return tuple(out)
 
 
-def level_order(label: str) -> int:
-    """Fine-to-coarse rank of a level label (``K=4`` ... ``4 triangles``), for sorting."""
-    for k, stop in enumerate(COMPLEXITY_STOPS):
-        if parse_level(stop).label == label.split(",")[0]:
-            return k
-    return len(COMPLEXITY_STOPS)
-
-
-@dataclass
-class Run:
-    """One light result: the level it was traced on (``label``), the canopy it belongs to
-    (``signature``), the light (``kind``: sun, sky or day) and, for a sun, each leaf
-    triangle's light class (F,) int8 (None until computed); for a sky or a day ``extra``
-    holds what the light process made of it (per-leaf and per-plant rows, per-triangle
-    values: :class:`maizeviz_app.jobs.Diffuse`)."""
-
-    label: str
-    signature: tuple
-    result: Any
-    classes: np.ndarray | None = None
-    kind: str = "sun"
-    extra: Any = None
-
-    @property
-    def name(self) -> str:
-        """The run's column in the table and curve in the plot."""
-        if self.kind == "sky":
-            return f"{self.label}, {SKIES.get(self.result.sky.kind, ('', 'sky'))[1]}"
-        if self.kind == "day":
-            return f"{self.label}, day: PAR transmitted"
-        return self.label
-
-    @property
-    def transmission(self) -> np.ndarray:
-        """(H,) the fraction of the light reaching each height (for a day: of its PAR)."""
-        if self.kind == "day":
-            return np.asarray(self.result.transmission_by_height)
-        return np.asarray(self.result.transmission)
-
-
-class LightRuns:
-    """The last light result per mesh level and light, sampled the same way."""
-
-    def __init__(self) -> None:
-        self.runs: dict[str, Run] = {}
-        self.settings: dict[str, Any] = {}          # each light's own settings
-        self.sampling: Any = None                   # heights, density, periodic field
-        self.last: Run | None = None
-        self._order: dict[int, int] = {}            # id(run) -> when it was added
-        self._added = 0
-
-    def add(self, run: Run, settings: Any, sampling: Any = None) -> bool:
-        """Keep ``run``; True if it replaced results traced with other settings (another
-        ``sampling``: every result; other ``settings`` of the run's light: that light's)."""
-        dropped = False
-        if self.runs and sampling != self.sampling:
-            self.runs.clear()
-            self.settings.clear()
-            dropped = True
-        elif run.kind in self.settings and settings != self.settings[run.kind]:
-            kept = {k: r for k, r in self.runs.items() if r.kind != run.kind}
-            dropped = len(kept) != len(self.runs)
-            self.runs = kept
-        self.sampling = sampling
-        self.settings[run.kind] = settings
-        self.runs[run.name] = run
-        self.runs = dict(sorted(self.runs.items(),
-                                key=lambda kv: (MODES.index(kv[1].kind),
-                                                level_order(kv[1].label))))
-        self._added += 1
-        self._order[id(run)] = self._added
-        self._order = {id(r): self._order.get(id(r), 0) for r in self.runs.values()}
-        self.last = run
-        return dropped
-
-    def copy(self) -> LightRuns:
-        """A shallow copy (the runs are shared), to preview a result in a worker."""
-        other = LightRuns()
-        other.runs, other.settings = dict(self.runs), dict(self.settings)
-        other.sampling, other.last = self.sampling, self.last
-        other._order, other._added = dict(self._order), self._added
-        return other
-
-    def clear(self) -> None:
-        self.runs.clear()
-        self.settings.clear()
-        self.sampling = None
-        self.last = None
-        self._order.clear()
-
-    def for_signature(self, signature: tuple, kind: str = "sun") -> Run | None:
-        """The ``kind`` result of a canopy."""
-        for run in self.runs.values():
-            if run.signature == signature and run.kind == kind:
-                return run
-        return None
-
-    def latest(self, signature: tuple | None = None, kinds: Sequence[str] = MODES) -> Run | None:
-        """The result added last (of a canopy, of the ``kinds`` given)."""
-        runs = [r for r in self.runs.values() if r.kind in kinds and
-                (signature is None or r.signature == signature)]
-        return max(runs, key=lambda r: self._order.get(id(r), 0)) if runs else None
-
-    def in_order(self) -> list[Run]:
-        """The runs in the order they were added (the last one is :attr:`last`)."""
-        return sorted(self.runs.values(), key=lambda r: self._order.get(id(r), 0))
-
-    def of_kind(self, kind: str) -> Run | None:
-        return self.latest(None, (kind,))
-
-    def heights(self) -> tuple[float, ...]:
-        if self.last is None:
-            return ()
-        return tuple(float(h) for h in self.last.result.heights_cm)
-
-    def curves(self):
-        from maizeviz_app.plots import Curve
-
-        return [Curve(r.name, tuple(map(float, r.result.heights_cm)),
-                      tuple(map(float, r.transmission)), r.kind, r.label)
-                for r in self.runs.values()]
-
-    def table(self) -> tuple[list[str], list[list[str]]]:
-        """Header and rows (one per height) of the results table."""
-        names = list(self.runs)
-        header = ["height cm"] + names
-        rows = []
-        for i, h in enumerate(self.heights()):
-            row = [f"{h:g}"]
-            for name in names:
-                t = self.runs[name].transmission
-                row.append(f"{t[i]:.3f}" if i < len(t) and np.isfinite(t[i]) else "")
-            rows.append(row)
-        return header, rows
-
-
 def _form() -> QFormLayout:
     form = QFormLayout()
-    form.setFieldGrowthPolicy(QFormLayout.AllNonFixedFieldsGrow)
+    form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
     return form
 
 
@@ -232,7 +109,10 @@ def _time_zones() -> list[str]:
 
 
 class LightPanel(QWidget):
-    """Signals: ``compute_requested()``, ``cancel_requested()``, ``place_requested(text)``,
+    """The light settings and the results table of the study in ``study`` (a
+    :class:`~maizeviz_app.model.StudyModel`, followed: its runs fill the table).
+
+    Signals: ``compute_requested()``, ``cancel_requested()``, ``place_requested(text)``,
     ``export_requested(what)`` with what in ``table``, ``heatmap``, ``plot``, ``canopy``,
     ``steps``, ``leaves``, ``plants``, ``day``; ``mode_changed(mode)``."""
 
@@ -242,8 +122,9 @@ class LightPanel(QWidget):
     export_requested = Signal(str)
     mode_changed = Signal(str)
 
-    def __init__(self, parent=None):
+    def __init__(self, study=None, parent=None):
         super().__init__(parent)
+        self.study = study
         lay = QVBoxLayout(self)
         # ---- which light
         modes = QHBoxLayout()
@@ -313,17 +194,17 @@ class LightPanel(QWidget):
         self.table = QTableWidget(0, 1)
         self.table.setHorizontalHeaderLabels(["height cm"])
         self.table.verticalHeader().setVisible(False)
-        self.table.setEditTriggers(QAbstractItemView.NoEditTriggers)
-        self.table.setVerticalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
-        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeToContents)
-        self.table.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Fixed)
+        self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+        self.table.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        self.table.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
         lay.addWidget(self.table)
         self.info = QLabel("")
         self.info.setWordWrap(True)
         lay.addWidget(self.info)
         self.summary = QLabel("")
         self.summary.setWordWrap(True)
-        self.summary.setTextInteractionFlags(Qt.TextSelectableByMouse)
+        self.summary.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         self.summary.setStyleSheet("background: #fff8e1; padding: 4px;")
         self.summary.hide()
         lay.addWidget(self.summary)
@@ -333,9 +214,9 @@ class LightPanel(QWidget):
         lay.addWidget(self.plants_title)
         self.plants = QTableWidget(0, 0)
         self.plants.verticalHeader().setVisible(False)
-        self.plants.setEditTriggers(QAbstractItemView.NoEditTriggers)
-        self.plants.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeToContents)
-        self.plants.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Fixed)
+        self.plants.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+        self.plants.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        self.plants.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
         self.plants.hide()
         lay.addWidget(self.plants)
         # ---- exports
@@ -385,6 +266,8 @@ class LightPanel(QWidget):
         self.day_date.dateChanged.connect(lambda _d: self.clear_problem(self.day_date))
         self.set_mode("sun")
         self._fit_table()
+        if study is not None:
+            study.runs_changed.connect(self.show_runs)
 
     # ------------------------------------------------------------------ pages
     def _sun_page(self) -> QWidget:
@@ -462,8 +345,8 @@ class LightPanel(QWidget):
         self.tz.setToolTip("time zone of the clock times (IANA name such as Asia/Shanghai, "
                            "Europe/Paris or UTC)")
         completer = QCompleter(_time_zones(), self.tz)
-        completer.setCaseSensitivity(Qt.CaseInsensitive)
-        completer.setFilterMode(Qt.MatchContains)
+        completer.setCaseSensitivity(Qt.CaseSensitivity.CaseInsensitive)
+        completer.setFilterMode(Qt.MatchFlag.MatchContains)
         self.tz.setCompleter(completer)
         form.addRow("time zone", self.tz)
         self.source_clear = QRadioButton("clear sky (Ineichen-Perez, pvlib), Linke turbidity")
@@ -569,7 +452,7 @@ class LightPanel(QWidget):
         for k in range(self.pages.count()):
             # only the page shown takes room: the sun page is short, the day page tall
             self.pages.widget(k).setSizePolicy(
-                QSizePolicy.Preferred, QSizePolicy.Preferred if k == page else QSizePolicy.Ignored)
+                QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Preferred if k == page else QSizePolicy.Policy.Ignored)
         self.pages.setCurrentIndex(page)
         self.pages.setVisible(mode != "sky")
         self.sky_box.setVisible(mode != "sun")
@@ -734,7 +617,7 @@ class LightPanel(QWidget):
         for r, vals in enumerate(rows):
             for c, v in enumerate(vals):
                 item = QTableWidgetItem(v)
-                item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter)
+                item.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
                 self.table.setItem(r, c, item)
         self._fit_table()
         self.info.setText(info)
@@ -790,7 +673,7 @@ class LightPanel(QWidget):
                 vals.append(fmt.format(v if day else v / area))
             for c, v in enumerate(vals):
                 item = QTableWidgetItem(v)
-                item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter)
+                item.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
                 t.setItem(r, c, item)
         t.resizeRowsToContents()
         shown = min(len(rows), 9)
@@ -820,9 +703,9 @@ class ImageView(QLabel):
         super().__init__(placeholder, parent)
         self._placeholder = placeholder
         self._image: QImage | None = None
-        self.setAlignment(Qt.AlignCenter)
+        self.setAlignment(Qt.AlignmentFlag.AlignCenter)
         self.setMinimumSize(160, 120)
-        self.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Ignored)
+        self.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Ignored)
         self.setStyleSheet("background: white; color: #666;")
 
     def set_rgba(self, rgba: np.ndarray | None) -> None:
@@ -833,7 +716,7 @@ class ImageView(QLabel):
             return
         h, w = rgba.shape[:2]
         self._image = QImage(np.ascontiguousarray(rgba).data, w, h, 4 * w,
-                             QImage.Format_RGBA8888).copy()
+                             QImage.Format.Format_RGBA8888).copy()
         self._rescale()
 
     def image(self) -> QImage | None:
@@ -847,7 +730,7 @@ class ImageView(QLabel):
         if self._image is None:
             return
         self.setPixmap(QPixmap.fromImage(self._image).scaled(
-            self.size(), Qt.KeepAspectRatio, Qt.SmoothTransformation))
+            self.size(), Qt.AspectRatioMode.KeepAspectRatio, Qt.TransformationMode.SmoothTransformation))
 
     def sizeHint(self) -> QSize:  # noqa: N802
         return QSize(360, 200)
@@ -874,7 +757,7 @@ class LightPlots(QWidget):
         self.source = QComboBox()
         self.source.setToolTip("which light's map: the direct sun, the diffuse sky or the "
                                "day's PAR")
-        self.source.setSizeAdjustPolicy(QComboBox.AdjustToContents)
+        self.source.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToContents)
         self.source.currentIndexChanged.connect(lambda _i: self._show_height(
             self.height.currentIndex()))
         top.addWidget(self.source)
