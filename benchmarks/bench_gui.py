@@ -55,7 +55,7 @@ class GilProbe:
             self.worst = max(self.worst, now - last)
             last = now
 
-    def __enter__(self) -> "GilProbe":
+    def __enter__(self) -> GilProbe:
         self._thread.start()
         return self
 

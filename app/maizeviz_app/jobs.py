@@ -10,6 +10,7 @@ child's ``state`` (the canopy it holds, and the light engine keeping its Embree 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -82,7 +83,7 @@ class Built:
     build_s: float
     measure_s: float
     polydata: Any = None
-    columns: tuple[str, ...] = ()
+    columns: tuple[tuple[str, str], ...] = ()
     row: Any = None
     serial: int = -1
 
@@ -270,5 +271,5 @@ def op_ping(state: dict, progress: ProgressCallback) -> str:
     return "pong"
 
 
-OPS = {"measure": op_measure, "light": op_light, "sky": op_sky, "period": op_period,
-       "ping": op_ping}
+OPS: dict[str, Callable[..., Any]] = {"measure": op_measure, "light": op_light, "sky": op_sky,
+                                      "period": op_period, "ping": op_ping}

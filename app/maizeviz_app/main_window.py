@@ -28,9 +28,10 @@ import threading
 import time
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from PySide6.QtCore import QSettings, Qt, QTimer, Signal
+from PySide6.QtCore import QByteArray, QSettings, Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QApplication,
     QDockWidget,
@@ -63,6 +64,11 @@ from maizeviz_app.panels.light import (
     Run,
 )
 from maizeviz_app.workers import JobRunner, describe_internal
+
+if TYPE_CHECKING:
+    from maizeviz_app.panels.digitizer import DigitizerPanel
+    from maizeviz_app.panels.layout import LayoutPanel
+    from maizeviz_app.viewport import Viewport
 
 #: Version of the saved dock layout; bump when docks change so an old layout is not applied.
 STATE_VERSION = 3
@@ -123,8 +129,8 @@ class MainWindow(QMainWindow):
         self.model.modified_changed.connect(lambda on: self.setWindowModified(on))
         self.model.project_changed.connect(lambda _p: self.setWindowTitle(self.model.title))
         self.model.points_changed.connect(lambda _l: self.setWindowTitle(self.model.title))
-        self.viewport = None
-        self._view_pending = None         # (canopy, mesh) built while the digitizer records
+        self.viewport: Viewport | None = None
+        self._view_pending: tuple | None = None   # (canopy, mesh) built while digitizing
         self._pending_runs: list = []     # light results of a project, waiting for a canopy
         self._after_save = None           # what to do once the project is saved (close, open)
         self._progress_shown = 0.0
@@ -143,8 +149,8 @@ class MainWindow(QMainWindow):
         self._build_status()
         from maizeviz_app.menus import build_menus
 
-        self.actions = build_menus(self)
-        self._default_state = None             # taken at the first show, docks sized
+        self.menu_actions = build_menus(self)
+        self._default_state: QByteArray | None = None   # taken at the first show, docks sized
         self._state_restored = self._restore_window()
         self._to_open = str(points) if points is not None else self._last_opened()
         self._view_ready = threading.Event()  # the build job waits for it before meshing
@@ -156,8 +162,9 @@ class MainWindow(QMainWindow):
         dock = QDockWidget(title, self)
         dock.setObjectName(name)
         dock.setWidget(_scrolled(widget) if scroll else widget)
-        dock.setFeatures(QDockWidget.DockWidgetFeature.DockWidgetMovable | QDockWidget.DockWidgetFeature.DockWidgetFloatable |
-                         QDockWidget.DockWidgetFeature.DockWidgetClosable)
+        feature = QDockWidget.DockWidgetFeature
+        dock.setFeatures(feature.DockWidgetMovable | feature.DockWidgetFloatable
+                         | feature.DockWidgetClosable)
         self.addDockWidget(area, dock)
         self.docks[name] = dock
         return dock
@@ -165,7 +172,8 @@ class MainWindow(QMainWindow):
     def _build_panels(self) -> None:
         self.setCorner(Qt.Corner.BottomRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
         self.setCorner(Qt.Corner.TopRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
-        self.setDockOptions(QMainWindow.DockOption.AnimatedDocks | QMainWindow.DockOption.AllowTabbedDocks)
+        self.setDockOptions(QMainWindow.DockOption.AnimatedDocks
+                            | QMainWindow.DockOption.AllowTabbedDocks)
         self.canopy_panel = CanopyPanel(self.model)
         self.canopy_panel.open_requested.connect(self.choose_points)
         self.canopy_panel.level_requested.connect(lambda _lv: self.rebuild())
@@ -178,8 +186,8 @@ class MainWindow(QMainWindow):
         self.light_panel.mode_changed.connect(lambda _m: self.light_panel.clear_problem())
         # the layout editor and the digitizer import much of the core: they are made once the
         # window is on screen (see _make_late_panels)
-        self.layout_panel = None
-        self.digitizer = None
+        self.layout_panel: LayoutPanel | None = None
+        self.digitizer: DigitizerPanel | None = None
         self.plots = LightPlots()
         self.plots.heatmap_needed.connect(self._draw_heatmap)
         self.messages = QPlainTextEdit(readOnly=True)
@@ -193,10 +201,9 @@ class MainWindow(QMainWindow):
         for d in (light, layout, digitizer):
             self.tabifyDockWidget(canopy, d)
         canopy.raise_()
-        results = self._dock("results", "Light results", self.plots, Qt.DockWidgetArea.BottomDockWidgetArea,
-                             scroll=False)
-        messages = self._dock("messages", "Messages", self.messages, Qt.DockWidgetArea.BottomDockWidgetArea,
-                              scroll=False)
+        bottom = Qt.DockWidgetArea.BottomDockWidgetArea
+        results = self._dock("results", "Light results", self.plots, bottom, scroll=False)
+        messages = self._dock("messages", "Messages", self.messages, bottom, scroll=False)
         self.tabifyDockWidget(results, messages)
         results.raise_()
 
@@ -219,7 +226,7 @@ class MainWindow(QMainWindow):
         lay.addWidget(self.cancel_button)
         self.statusBar().addPermanentWidget(box)
 
-    def _restore_window(self) -> None:
+    def _restore_window(self) -> bool:
         geometry = self._settings.value("geometry")
         restored = bool(geometry) and self.restoreGeometry(geometry)
         if not restored:
@@ -644,6 +651,8 @@ class MainWindow(QMainWindow):
         panel = self.light_panel
         panel.clear_problem()
         mode = panel.mode
+        settings: object
+        args: tuple
         try:
             if mode == "sun":
                 request = panel.request()
@@ -673,7 +682,7 @@ class MainWindow(QMainWindow):
         runs = self.runs.copy()
         key = self._canopy_id
         runner = self.runner
-        shown_height = max(self.plots.height.currentIndex(), 0)
+        shown_height = max(self.plots.height_box.currentIndex(), 0)
 
         def work(job):
             out = runner.light_process.call(op, key, canopy, args, job)
@@ -735,7 +744,8 @@ class MainWindow(QMainWindow):
         box = QMessageBox(QMessageBox.Icon.Question, "Start a long computation?",
                           f"{estimate}.\n\nIt runs in the background and can be cancelled; "
                           "a coarser level, a lower density or fewer directions or steps make "
-                          "it shorter.", QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.Cancel, self)
+                          "it shorter.",
+                          QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.Cancel, self)
         box.button(QMessageBox.StandardButton.Yes).setText("Start")
         box.setDefaultButton(QMessageBox.StandardButton.Cancel)
         return box.exec() == QMessageBox.StandardButton.Yes
@@ -846,7 +856,7 @@ class MainWindow(QMainWindow):
         if self.viewport is None:
             return
         for name in ("plant", "leaf", "light"):
-            act = self.actions.get(f"colour_{name}")
+            act = self.menu_actions.get(f"colour_{name}")
             if act is not None:
                 act.setChecked(self.viewport.colouring == name)
 
@@ -1120,7 +1130,7 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ recent files
     def recent_files(self) -> list[str]:
-        value = self._settings.value("recent", [])
+        value: Any = self._settings.value("recent", [])
         if isinstance(value, str):
             value = [value]
         return [str(p) for p in (value or []) if Path(str(p)).exists()]
@@ -1209,7 +1219,7 @@ class MainWindow(QMainWindow):
         if self.runs.last is None:
             raise MaizevizError("no light result to export yet: compute light first")
         if what == "table":
-            header, rows = self.runs.table()
+            header, table_rows = self.runs.table()
 
             def work(job):
                 from maizeviz.io.atomic import atomic_open
@@ -1217,7 +1227,7 @@ class MainWindow(QMainWindow):
                 with atomic_open(path, "w", newline="") as fh:
                     w = csv.writer(fh)
                     w.writerow(["height_cm"] + [f"transmission {h}" for h in header[1:]])
-                    w.writerows(rows)
+                    w.writerows(table_rows)
                 return path
             return work, ()
         if what == "heatmap":
@@ -1284,13 +1294,13 @@ class MainWindow(QMainWindow):
                                 f"against its canopy: show level {label} first")
         rows = [dict(r, level=label) for r in extra.leaf_rows]
 
-        def work(job):
+        def write_table(job):
             from maizeviz.io.atomic import write_rows
             from maizeviz.light.leaf_light import plant_light
 
             write_rows(path, rows if what == "leaves" else plant_light(rows))
             return path
-        return work, ()
+        return write_table, ()
 
     # ------------------------------------------------------------------ help
     def about(self) -> None:

@@ -35,7 +35,8 @@ def build_menus(w) -> dict[str, QAction]:
     w.recent_menu = f.addMenu("Open &recent")
     w.recent_menu.aboutToShow.connect(lambda: fill_recent(w))
     f.addSeparator()
-    acts["save"] = _action(w, f, "&Save project", w.save_project_here, QKeySequence.StandardKey.Save,
+    acts["save"] = _action(w, f, "&Save project", w.save_project_here,
+                           QKeySequence.StandardKey.Save,
                            "save points, layout, settings and light results in one file")
     acts["save_as"] = _action(w, f, "Save project &as…", w.choose_project_target,
                               QKeySequence.StandardKey.SaveAs)

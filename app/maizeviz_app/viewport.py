@@ -29,6 +29,10 @@ from pyvistaqt import QtInteractor
 
 from maizeviz_app.options import CAMERAS, COLOURINGS, LIGHT_CLASSES, NOT_TRACED, STALK
 
+#: Text alignments of the painted axes and legends.
+CENTRE = Qt.AlignmentFlag.AlignCenter
+LEFT = Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter
+
 _PLANT_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
                   "#7f7f7f", "#bcbd22", "#17becf")
 
@@ -446,14 +450,12 @@ def ground_image(field: tuple[float, float, float, float], margin: float, xs: np
     box = margin * scale * 0.6
     for x in xs[::step_x]:
         c = px(x, y0 - margin * 0.27)
-        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), Qt.AlignmentFlag.AlignCenter,
-                   f"{x:.0f}")
+        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), CENTRE, f"{x:.0f}")
     for y in ys[::step_y]:
         c = px(x0 - margin * 0.27, y)
-        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), Qt.AlignmentFlag.AlignCenter,
-                   f"{y:.0f}")
+        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), CENTRE, f"{y:.0f}")
     c = px((x0 + x1) / 2, y0 - margin * 0.72)
-    p.drawText(QRectF(c.x() - 20 * box, c.y() - box / 2, 40 * box, box), Qt.AlignmentFlag.AlignCenter,
+    p.drawText(QRectF(c.x() - 20 * box, c.y() - box / 2, 40 * box, box), CENTRE,
                "x (cm, across the rows)")
     c = px(x0 - margin * 0.72, (y0 + y1) / 2)
     p.translate(c)
@@ -514,8 +516,7 @@ class Legend(QWidget):
         line = fm.height() + 4
         p.setPen(QColor("#222222"))
         y = 6
-        p.drawText(QRectF(8, y, self.width() - 16, line), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter,
-                   self._title)
+        p.drawText(QRectF(8, y, self.width() - 16, line), LEFT, self._title)
         y += line
         if self._gradient is not None:
             colours, lo, hi = self._gradient
@@ -529,7 +530,6 @@ class Legend(QWidget):
             y += line
         for label, colour in self._items:
             p.fillRect(QRectF(8, y + 3, 16, line - 6), QColor(colour))
-            p.drawText(QRectF(30, y, self.width() - 38, line), Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter,
-                       label)
+            p.drawText(QRectF(30, y, self.width() - 38, line), LEFT, label)
             y += line
         p.end()

@@ -43,7 +43,7 @@ class Job:
     id: int
     kind: str
     label: str
-    runner: "JobRunner"
+    runner: JobRunner
     cancel: threading.Event = field(default_factory=threading.Event)
     started: float = field(default_factory=time.perf_counter)
 
@@ -124,6 +124,7 @@ class JobRunner(QObject):
         delivered = self._delivered
 
         def guarded() -> None:
+            exc: BaseException | None
             try:
                 result, exc = func(job, *args), None
             except InterruptedError:                  # superseded, cancelled or closing

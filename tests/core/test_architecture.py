@@ -47,11 +47,22 @@ def test_layers_only_point_down():
     assert "0 broken" in proc.stdout
 
 
-def test_core_type_checks():
+def test_core_and_app_type_check():
+    """mypy over the core and the app (pyproject's [tool.mypy] files)."""
     from mypy import api
 
     out, err, status = api.run(["--config-file", str(ROOT / "pyproject.toml")])
     assert status == 0, out[-5000:] + err[-2000:]
+    assert "app/maizeviz_app" in (ROOT / "pyproject.toml").read_text()
+
+
+def test_lint_is_clean():
+    """ruff (pyproject's [tool.ruff]: pyflakes, pycodestyle, isort, bugbear, pyupgrade) over
+    the core, the app, the tests and the benchmarks."""
+    ruff = Path(sys.executable).with_name("ruff")
+    proc = subprocess.run([str(ruff), "check", "--no-cache", "maizeviz", "app", "tests",
+                           "benchmarks"], capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-5000:] + proc.stderr[-2000:]
 
 
 def test_no_reference_to_documents_outside_the_repository():

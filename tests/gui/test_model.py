@@ -7,11 +7,10 @@ import subprocess
 import sys
 
 import pytest
-from test_light_modes import TIMEOUT, compute, shown, small_light
-
 from maizeviz_app.jobs import load_points
 from maizeviz_app.model import StudyModel
 from maizeviz_app.runs import Run
+from test_light_modes import TIMEOUT, compute, shown, small_light
 
 
 class _Result:

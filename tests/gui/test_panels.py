@@ -109,9 +109,9 @@ def test_plots_switch_heights(qtbot):
     qtbot.addWidget(plots)
     images = [(h, np.full((40, 60, 4), v, np.uint8)) for h, v in ((0.0, 10), (50.0, 200))]
     plots.set_heatmaps(images)
-    assert plots.height.count() == 2 and plots.shown_height == 0.0
+    assert plots.height_box.count() == 2 and plots.shown_height == 0.0
     assert plots.heatmap.image().pixel(5, 5) & 0xFF == 10
-    plots.height.setCurrentIndex(1)
+    plots.height_box.setCurrentIndex(1)
     assert plots.shown_height == 50.0 and plots.heatmap.image().pixel(5, 5) & 0xFF == 200
     plots.set_transmission(np.zeros((30, 30, 4), np.uint8))
     assert plots.transmission.image() is not None

@@ -65,7 +65,7 @@ def test_sky_and_day_results_come_back_with_a_project(window, qtbot, small_point
         w2.viewport.canopy_mesh.cell_data["light_value"][:w2.canopy.n_triangles], values)
     # the sky's map on demand, and the exports of a day
     w2.plots.source.setCurrentIndex(sources.index("diffuse sky"))
-    assert w2.plots.kind == "sky" and w2.plots.height.count() == 3
+    assert w2.plots.kind == "sky" and w2.plots.height_box.count() == 3
     for what in ("steps", "leaves", "plants"):
         with qtbot.waitSignal(w2.saved, timeout=TIMEOUT):
             w2.export(what, tmp_path / f"{what}.csv")

@@ -169,8 +169,9 @@ class CanopyPanel(QWidget):
         for r, vals in enumerate(self.rows.values()):
             for c, v in enumerate(vals):
                 item = QTableWidgetItem(v)
-                item.setTextAlignment((Qt.AlignmentFlag.AlignLeft if c == 0 else Qt.AlignmentFlag.AlignRight)
-                                      | Qt.AlignmentFlag.AlignVCenter)
+                align = Qt.AlignmentFlag
+                item.setTextAlignment((align.AlignLeft if c == 0 else align.AlignRight)
+                                      | align.AlignVCenter)
                 self.table.setItem(r, c, item)
         shown = list(self.rows).index(values[0])
         self.table.selectRow(shown)

@@ -149,12 +149,12 @@ class DigitizerPanel(QWidget):
 
         outer = QVBoxLayout(self)
         outer.setContentsMargins(0, 0, 0, 0)
-        self.scroll = QScrollArea()
-        self.scroll.setWidgetResizable(True)
-        self.scroll.setFrameShape(QFrame.Shape.NoFrame)
-        outer.addWidget(self.scroll)
+        self.scroll_area = QScrollArea()
+        self.scroll_area.setWidgetResizable(True)
+        self.scroll_area.setFrameShape(QFrame.Shape.NoFrame)
+        outer.addWidget(self.scroll_area)
         body = QWidget()
-        self.scroll.setWidget(body)
+        self.scroll_area.setWidget(body)
         lay = QVBoxLayout(body)
 
         self.band = StatusBand()
@@ -210,7 +210,8 @@ class DigitizerPanel(QWidget):
         self.log = QListWidget()
         self.log.setUniformItemSizes(True)          # scrolling 400 lines stays instant
         self.log.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
-        self.log.setTextElideMode(Qt.TextElideMode.ElideMiddle)   # the band shows the whole last line
+        # the band shows the whole last line
+        self.log.setTextElideMode(Qt.TextElideMode.ElideMiddle)
         self.log.setMinimumHeight(90)
         lay.addWidget(self.log, 1)
 
@@ -278,7 +279,9 @@ class DigitizerPanel(QWidget):
             sc.setContext(Qt.ShortcutContext.ApplicationShortcut)
             sc.activated.connect(lambda c=key: self.control(c))
             self._shortcuts.append(sc)
-        QApplication.instance().installEventFilter(self._keys)
+        app = QApplication.instance()
+        if app is not None:
+            app.installEventFilter(self._keys)
 
     def _release_keys(self) -> None:
         app = QApplication.instance()
@@ -309,7 +312,10 @@ class DigitizerPanel(QWidget):
         return self.recorder is not None
 
     def _where(self) -> str:
-        p = self.session.pos
+        session = self.session
+        if session is None:
+            return "not recording"
+        p = session.pos
         return f"plant {p.plant} · leaf {p.leaf} · row {p.row} · col {p.col}"
 
     def _show_counts(self) -> None:
@@ -363,7 +369,7 @@ class DigitizerPanel(QWidget):
         if demo:
             self._start_replay(session.reference_station is not None)
 
-    def _not_connected(self, port: FastrakPort, session: Session, exc: Exception) -> None:
+    def _not_connected(self, port: FastrakPort, session: Session, exc: BaseException) -> None:
         if self._connecting is None or self._connecting[0] is not port:
             return
         self._connecting = None

@@ -44,7 +44,7 @@ def _pen(color, width: float = 1.0, style=Qt.PenStyle.SolidLine) -> QPen:
 class _Knob(QGraphicsEllipseItem):
     """The tip of a plant's arrow: drag it round to turn the plant."""
 
-    def __init__(self, plant: "PlantItem", radius: float):
+    def __init__(self, plant: PlantItem, radius: float):
         super().__init__(-radius, -radius, 2 * radius, 2 * radius, plant.arrow)
         self.plant = plant
         self.setBrush(QBrush(QColor("white")))
@@ -70,7 +70,7 @@ class _Knob(QGraphicsEllipseItem):
 class PlantItem(QGraphicsEllipseItem):
     """One placement: a disc at (x, y), its digitized plant's id, an azimuth arrow."""
 
-    def __init__(self, view: "FieldView", index: int, placement, radius: float, reach: float):
+    def __init__(self, view: FieldView, index: int, placement, radius: float, reach: float):
         super().__init__(-radius, -radius, 2 * radius, 2 * radius)
         self.view, self.index = view, index
         # movable but not selectable: the picked plant is shown by its colour (FieldView.select).
@@ -155,16 +155,17 @@ class FieldView(QGraphicsView):
         many = 0 < len(centre) < len(layout.cells)      # a central tile among others
         for cell in layout.cells.tolist():
             x0, y0, x1, y1 = cell
-            item = QGraphicsRectItem(QRectF(x0, y0, x1 - x0, y1 - y0))
-            item.setPen(_pen("#c8c0a8", 0.8))
+            box = QGraphicsRectItem(QRectF(x0, y0, x1 - x0, y1 - y0))
+            box.setPen(_pen("#c8c0a8", 0.8))
             if many and tuple(cell) in centre:
-                item.setBrush(QBrush(QColor("#fff3c4")))
-            scene.addItem(item)
+                box.setBrush(QBrush(QColor("#fff3c4")))
+            scene.addItem(box)
         x0, y0, x1, y1 = layout.bounds
         field = scene.addRect(QRectF(x0, y0, x1 - x0, y1 - y0), _pen("#5d4037", 2))
         field.setZValue(1)
         for row in rows_of(placements):
-            line = scene.addLine(row["x"], y0, row["x"], y1, _pen("#8d9e6b", 1, Qt.PenStyle.DashLine))
+            line = scene.addLine(row["x"], y0, row["x"], y1,
+                                 _pen("#8d9e6b", 1, Qt.PenStyle.DashLine))
             line.setZValue(0.5)
         self._labels = []
         for text, x, y, above in ((f"{fmt(x0, 0)}, {fmt(y0, 0)} cm", x0, y0, False),

@@ -123,7 +123,8 @@ class LayoutPanel(QWidget):
         self.table.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
         self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Stretch)
         self.table.verticalHeader().setDefaultSectionSize(22)
-        self.table.verticalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Fixed)   # 700 rows stay fast
+        # fixed rows: 700 rows stay fast
+        self.table.verticalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Fixed)
         self.table.selectionModel().currentRowChanged.connect(
             lambda cur, _prev: self.view.select(cur.row()))
         self.splitter.addWidget(self.view)
@@ -300,7 +301,8 @@ class LayoutPanel(QWidget):
 
     def _confirm(self, text: str) -> bool:
         box = QMessageBox(QMessageBox.Icon.Warning, "Replace the edited layout?", text,
-                          QMessageBox.StandardButton.Discard | QMessageBox.StandardButton.Cancel, self)
+                          QMessageBox.StandardButton.Discard
+                          | QMessageBox.StandardButton.Cancel, self)
         box.button(QMessageBox.StandardButton.Discard).setText("Replace")
         box.setDefaultButton(QMessageBox.StandardButton.Cancel)
         return box.exec() == QMessageBox.StandardButton.Discard

@@ -14,7 +14,13 @@ from dataclasses import dataclass, replace
 from PySide6.QtCore import QAbstractTableModel, QModelIndex, QObject, Qt, Signal
 from PySide6.QtGui import QUndoCommand
 
-from maizeviz.canopy.layout import CanopyLayout, Placement, layout_from_dict, layout_to_dict
+from maizeviz.canopy.layout import (
+    CanopyLayout,
+    LayoutError,
+    Placement,
+    layout_from_dict,
+    layout_to_dict,
+)
 
 COLUMNS = ("x cm", "y cm", "plant", "azimuth °")
 
@@ -66,6 +72,8 @@ class EditedLayout(QObject):
 
     def document(self) -> dict:
         """The layout document (schema of the README) of the edited placements."""
+        if self.base is None:
+            raise LayoutError("no layout to edit yet: open a points file first")
         return layout_to_dict(self.base, self.placements)
 
     def layout(self) -> CanopyLayout:
@@ -76,6 +84,7 @@ class EditedLayout(QObject):
         layout it was.
         """
         checked = layout_from_dict(self.document(), self.plants, "layout")
+        assert self.base is not None                    # document() refused otherwise
         return replace(self.base, placements=tuple(self.placements), warnings=checked.warnings)
 
 

@@ -59,9 +59,10 @@ COMPUTE_TEXT = {"sun": "Compute direct light", "sky": "Compute diffuse light",
 #: Sky splits offered: directions (None: an equal-area split of n) -> what the combo says.
 SKY_SPLITS = {16: "16 directions (turtle)", 46: "46 directions (turtle, as Caribu)",
               145: "145 directions (Tregenza)", None: "equal-area split of n directions"}
-DEFAULT_DAY = {"date": "2005-08-01", "lat": 39.9, "lon": 116.4, "tz": "Asia/Shanghai",
-               "step_min": 30.0, "from": "", "to": "", "source": "clear", "linke": 3.0,
-               "weather": "", "par_factor": DEFAULT_PAR_UMOL_PER_J}
+DEFAULT_DAY: dict[str, Any] = {
+    "date": "2005-08-01", "lat": 39.9, "lon": 116.4, "tz": "Asia/Shanghai", "step_min": 30.0,
+    "from": "", "to": "", "source": "clear", "linke": 3.0, "weather": "",
+    "par_factor": DEFAULT_PAR_UMOL_PER_J}
 
 
 class InputProblem(MaizevizError):
@@ -248,7 +249,7 @@ class LightPanel(QWidget):
         self.fields: dict[str, Any] = {"heights": self.heights, "density": self.density,
                                        "periodic": self.periodic, "rect": self.heights,
                                        "threads": self.density}
-        self.mode_fields = {
+        self.mode_fields: dict[str, dict[str, Any]] = {
             "sun": {"sun": self.zenith, "place": self.place, "date": self.place,
                     "time": self.place, "tz": self.place},
             "sky": {"sky": self.sky_kind, "sky_directions": self.sky_n},
@@ -257,11 +258,12 @@ class LightPanel(QWidget):
                     "step": self.step, "period": [self.day_from, self.day_to],
                     "par_factor": self.par_factor, "linke_turbidity": self.linke,
                     "weather": self.weather, "altitude": self.lat, "time": self.day_from}}
-        for w in (self.heights, self.place, self.tz, self.day_from, self.day_to, self.weather):
-            w.textEdited.connect(lambda _t, w=w: self.clear_problem(w))
-        for w in (self.zenith, self.azimuth, self.density, self.lat, self.lon, self.step,
-                  self.par_factor, self.linke, self.sky_n):
-            w.valueChanged.connect(lambda _v, w=w: self.clear_problem(w))
+        for edit in (self.heights, self.place, self.tz, self.day_from, self.day_to,
+                     self.weather):
+            edit.textEdited.connect(lambda _t, w=edit: self.clear_problem(w))
+        for box in (self.zenith, self.azimuth, self.density, self.lat, self.lon, self.step,
+                    self.par_factor, self.linke, self.sky_n):
+            box.valueChanged.connect(lambda _v, w=box: self.clear_problem(w))
         self.sky_kind.currentIndexChanged.connect(lambda _i: self.clear_problem(self.sky_kind))
         self.day_date.dateChanged.connect(lambda _d: self.clear_problem(self.day_date))
         self.set_mode("sun")
@@ -341,7 +343,7 @@ class LightPanel(QWidget):
         where.addWidget(self.lat, 1)
         where.addWidget(self.lon, 1)
         form.addRow("latitude, longitude", where)
-        self.tz = QLineEdit(DEFAULT_DAY["tz"])
+        self.tz = QLineEdit(str(DEFAULT_DAY["tz"]))
         self.tz.setToolTip("time zone of the clock times (IANA name such as Asia/Shanghai, "
                            "Europe/Paris or UTC)")
         completer = QCompleter(_time_zones(), self.tz)
@@ -395,7 +397,8 @@ class LightPanel(QWidget):
         span.addWidget(self.day_to, 1)
         form.addRow("hours (optional)", span)
         self.par_factor = QDoubleSpinBox(decimals=4, minimum=0.0001, maximum=10.0,
-                                         value=DEFAULT_DAY["par_factor"], singleStep=0.01,
+                                         value=float(DEFAULT_DAY["par_factor"]),
+                                         singleStep=0.01,
                                          suffix=" µmol/J")
         self.par_factor.setToolTip("µmol of PAR photons per joule of shortwave (default "
                                    f"{PAR_FRACTION:g} × {PAR_UMOL_PER_J_PAR:g} = "
@@ -451,8 +454,10 @@ class LightPanel(QWidget):
         page = {"sun": 0, "day": 1, "sky": 2}[mode]
         for k in range(self.pages.count()):
             # only the page shown takes room: the sun page is short, the day page tall
-            self.pages.widget(k).setSizePolicy(
-                QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Preferred if k == page else QSizePolicy.Policy.Ignored)
+            policy = QSizePolicy.Policy.Preferred if k == page else QSizePolicy.Policy.Ignored
+            widget = self.pages.widget(k)
+            if widget is not None:
+                widget.setSizePolicy(QSizePolicy.Policy.Preferred, policy)
         self.pages.setCurrentIndex(page)
         self.pages.setVisible(mode != "sky")
         self.sky_box.setVisible(mode != "sun")
@@ -615,8 +620,8 @@ class LightPanel(QWidget):
         self.table.setHorizontalHeaderLabels([h.replace(", ", ",\n") for h in header])
         self.table.setRowCount(len(rows))
         for r, vals in enumerate(rows):
-            for c, v in enumerate(vals):
-                item = QTableWidgetItem(v)
+            for c, text in enumerate(vals):
+                item = QTableWidgetItem(text)
                 item.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
                 self.table.setItem(r, c, item)
         self._fit_table()
@@ -643,11 +648,12 @@ class LightPanel(QWidget):
         """What each plant intercepted in a sky or day ``run`` (None: hide the table)."""
         rows = run.extra.plant_rows if run is not None and run.extra is not None else []
         t = self.plants
-        if not rows:
+        if run is None or not rows:
             self.plants_title.hide()
             t.hide()
             return
         day = run.kind == "day"
+        keys: tuple[str, ...]
         if day:
             header = ["stand", "plant", "x, y cm", "PAR mol", "direct mol", "diffuse mol"]
             keys = ("par_intercepted_mol", "direct_par_intercepted_mol",
@@ -671,8 +677,8 @@ class LightPanel(QWidget):
             for k in keys:
                 v = float(row.get(k, 0.0))
                 vals.append(fmt.format(v if day else v / area))
-            for c, v in enumerate(vals):
-                item = QTableWidgetItem(v)
+            for c, text in enumerate(vals):
+                item = QTableWidgetItem(text)
                 item.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
                 t.setItem(r, c, item)
         t.resizeRowsToContents()
@@ -730,7 +736,8 @@ class ImageView(QLabel):
         if self._image is None:
             return
         self.setPixmap(QPixmap.fromImage(self._image).scaled(
-            self.size(), Qt.AspectRatioMode.KeepAspectRatio, Qt.TransformationMode.SmoothTransformation))
+            self.size(), Qt.AspectRatioMode.KeepAspectRatio,
+            Qt.TransformationMode.SmoothTransformation))
 
     def sizeHint(self) -> QSize:  # noqa: N802
         return QSize(360, 200)
@@ -758,14 +765,14 @@ class LightPlots(QWidget):
         self.source.setToolTip("which light's map: the direct sun, the diffuse sky or the "
                                "day's PAR")
         self.source.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToContents)
-        self.source.currentIndexChanged.connect(lambda _i: self._show_height(
-            self.height.currentIndex()))
         top.addWidget(self.source)
         top.addWidget(QLabel("at"))
-        self.height = QComboBox()
-        self.height.setToolTip("height of the sample plane shown (PgUp / PgDown)")
-        self.height.currentIndexChanged.connect(self._show_height)
-        top.addWidget(self.height)
+        self.height_box = QComboBox()
+        self.source.currentIndexChanged.connect(lambda _i: self._show_height(
+            self.height_box.currentIndex()))
+        self.height_box.setToolTip("height of the sample plane shown (PgUp / PgDown)")
+        self.height_box.currentIndexChanged.connect(self._show_height)
+        top.addWidget(self.height_box)
         top.addStretch(1)
         left.addLayout(top)
         self.heatmap = ImageView("compute light to see where it reaches each height")
@@ -795,7 +802,7 @@ class LightPlots(QWidget):
         self._fill_sources(kind if maps else None)
 
     def _fill_sources(self, show: str | None) -> None:
-        keep_height = self.height.currentIndex()
+        keep_height = self.height_box.currentIndex()
         current = show or self.kind
         self.source.blockSignals(True)
         self.source.clear()
@@ -805,14 +812,14 @@ class LightPlots(QWidget):
         k = self.source.findData(current)
         self.source.setCurrentIndex(k if k >= 0 else 0)
         self.source.blockSignals(False)
-        maps = self._maps.get(self.kind, [])
-        self.height.blockSignals(True)
-        self.height.clear()
-        self.height.addItems([f"{h:g} cm" for h, _ in maps])
-        self.height.blockSignals(False)
+        maps = self._maps.get(self.kind or "", [])
+        self.height_box.blockSignals(True)
+        self.height_box.clear()
+        self.height_box.addItems([f"{h:g} cm" for h, _ in maps])
+        self.height_box.blockSignals(False)
         if maps:
-            self.height.setCurrentIndex(keep_height if 0 <= keep_height < len(maps) else 0)
-        self._show_height(self.height.currentIndex())
+            self.height_box.setCurrentIndex(keep_height if 0 <= keep_height < len(maps) else 0)
+        self._show_height(self.height_box.currentIndex())
 
     def keep_only(self, kinds) -> None:
         """Forget the maps of the lights not in ``kinds`` (a new comparison started)."""
@@ -827,13 +834,13 @@ class LightPlots(QWidget):
         maps = self._maps.get(kind)
         if maps is not None and 0 <= index < len(maps):
             maps[index] = (maps[index][0], rgba)
-            if kind == self.kind and index == self.height.currentIndex():
+            if kind == self.kind and index == self.height_box.currentIndex():
                 self.heatmap.set_rgba(rgba)
 
     def _show_height(self, index: int) -> None:
         kind = self.kind
         maps = self._maps.get(kind, []) if kind is not None else []
-        if len(maps) != self.height.count():          # another light chosen: its heights
+        if len(maps) != self.height_box.count():          # another light chosen: its heights
             self._fill_sources(kind)
             return
         if 0 <= index < len(maps):
@@ -847,8 +854,8 @@ class LightPlots(QWidget):
 
     @property
     def shown_height(self) -> float | None:
-        i = self.height.currentIndex()
-        maps = self._maps.get(self.kind, []) if self.kind is not None else []
+        i = self.height_box.currentIndex()
+        maps = self._maps.get(self.kind or "", []) if self.kind is not None else []
         return maps[i][0] if 0 <= i < len(maps) else None
 
     def set_transmission(self, rgba: np.ndarray | None) -> None:
