@@ -35,6 +35,8 @@ _EXPORTS = {
     "Sun": "maizeviz.light.sun",
     "sun_at": "maizeviz.light.sun",
     "make_sky": "maizeviz.light.sky",
+    "SkySpec": "maizeviz.light.specs",
+    "DaySpec": "maizeviz.light.specs",
     "clear_sky_period": "maizeviz.light.irradiance",
     "read_weather": "maizeviz.light.irradiance",
     "weather_period": "maizeviz.light.irradiance",
