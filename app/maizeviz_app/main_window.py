@@ -22,7 +22,6 @@ an error about one light setting also marks that field.
 
 from __future__ import annotations
 
-import csv
 import sys
 import threading
 import time
@@ -30,7 +29,6 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
 from PySide6.QtCore import QByteArray, QSettings, Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QApplication,
@@ -51,6 +49,7 @@ from maizeviz import __version__
 from maizeviz.errors import MaizevizError
 from maizeviz.mesh.levels import COMPLEXITY_STOPS as LEVELS  # noqa: F401 - the slider's stops
 from maizeviz.resources import example_points
+from maizeviz_app.exports import export_job
 from maizeviz_app.messages import user_message
 from maizeviz_app.model import StudyModel
 from maizeviz_app.panels.canopy import CanopyPanel
@@ -63,6 +62,7 @@ from maizeviz_app.panels.light import (
     LightRuns,
     Run,
 )
+from maizeviz_app.runs import day_summary, plot_title, run_info, value_legend
 from maizeviz_app.workers import JobRunner, describe_internal
 
 if TYPE_CHECKING:
@@ -629,7 +629,7 @@ class MainWindow(QMainWindow):
         if run is not None and run.kind == "sun" and run.classes is not None:
             self.viewport.set_light(run.classes)
         elif run is not None and run.extra is not None:
-            title, unit = _value_legend(run)
+            title, unit = value_legend(run)
             self.viewport.set_light_values(run.extra.leaf_value, title, unit)
         if colour and run is not None:
             self.colour_by("light")
@@ -696,7 +696,7 @@ class MainWindow(QMainWindow):
             maps = plots.heatmap_images(run.result, first=shown_height, check=job.check,
                                         kind=mode)
             runs.add(run, settings, sampling_key)
-            plot = plots.rgba(plots.transmission_figure(runs.curves(), _plot_title(runs)))
+            plot = plots.rgba(plots.transmission_figure(runs.curves(), plot_title(runs)))
             return run, settings, sampling_key, maps, plot
 
         panel.set_running(True)
@@ -762,7 +762,7 @@ class MainWindow(QMainWindow):
         panel.set_running(False)
         if run.signature[0] != self.model.serial:
             return
-        if self.model.add_run(run, settings, sampling_key, _run_info(run)):
+        if self.model.add_run(run, settings, sampling_key, run_info(run)):
             self.say("note: the light settings changed; the comparison starts again")
         r = run.result
         if run.kind == "day":
@@ -1057,7 +1057,7 @@ class MainWindow(QMainWindow):
         latest = self.runs.latest(here) or self.runs.last
         order = sorted(shown, key=lambda k: latest is not None and k == latest.kind)
         curves = self.runs.curves()
-        title = _plot_title(self.runs)
+        title = plot_title(self.runs)
         self._heatmaps_for = dict(shown)
         results = [(k, shown[k].result) for k in order]
 
@@ -1170,7 +1170,8 @@ class MainWindow(QMainWindow):
         for a sky or a day) to ``path`` in a worker, atomically."""
         path = str(path)
         try:
-            work, args = self._export_work(what, path)
+            heatmap = (self.plots.kind, dict(self._heatmaps_for), self.plots.shown_height)
+            work, args = export_job(what, path, self.model, heatmap)
         except MaizevizError as exc:
             self._fail(exc, "export")
             return
@@ -1181,126 +1182,6 @@ class MainWindow(QMainWindow):
 
         self.runner.run("export", f"exporting {Path(path).name}", work, *args, on_done=done,
                         on_error=lambda e: self._fail(e, "export"), supersede=False)
-
-    def _export_work(self, what: str, path: str):
-        if what == "canopy":
-            if self.canopy is None:
-                raise MaizevizError("no canopy to export yet")
-            canopy = self.canopy
-            signature = self.signature(self.built.label)
-            cells = {}
-            run = self.runs.for_signature(signature)
-            if run is not None and run.classes is not None:
-                cells["light"] = run.classes.astype("int32")
-            for kind, name in (("sky", "diffuse_per_m2_leaf"), ("day", "par_mol_per_m2_leaf")):
-                run = self.runs.for_signature(signature, kind)
-                if run is not None and run.extra is not None:
-                    cells[name] = run.extra.leaf_value.astype("float32")
-
-            def work(job):
-                from maizeviz.canopy.export import export_canopy
-
-                export_canopy(path, canopy, cell_data=cells)
-                return path
-            return work, ()
-        if what == "measures":
-            if not self.measures_rows:
-                raise MaizevizError("no canopy measures to export yet")
-            rows = list(self.measures_rows.values())
-
-            def work(job):
-                from maizeviz.io.atomic import write_rows
-
-                write_rows(path, [{k: v.replace(",", "") for k, v in r.items()} for r in rows])
-                return path
-            return work, ()
-        if what in ("steps", "leaves", "plants", "day"):
-            return self._export_diffuse(what, path)
-        if self.runs.last is None:
-            raise MaizevizError("no light result to export yet: compute light first")
-        if what == "table":
-            header, table_rows = self.runs.table()
-
-            def work(job):
-                from maizeviz.io.atomic import atomic_open
-
-                with atomic_open(path, "w", newline="") as fh:
-                    w = csv.writer(fh)
-                    w.writerow(["height_cm"] + [f"transmission {h}" for h in header[1:]])
-                    w.writerows(table_rows)
-                return path
-            return work, ()
-        if what == "heatmap":
-            kind = self.plots.kind or self.runs.last.kind
-            run = self._heatmaps_for.get(kind) or self.runs.last
-            kind = run.kind
-            height = self.plots.shown_height
-            if height is None:
-                height = float(run.result.heights_cm[0])
-            result = run.result
-
-            def work(job):
-                from maizeviz.light.heatmap import save_figure
-                from maizeviz_app.plots import heatmap_figure_of
-
-                save_figure(heatmap_figure_of(result, height, kind), path)
-                return path
-            return work, ()
-        if what == "plot":
-            from maizeviz_app import plots
-
-            curves = self.runs.curves()
-            title = _plot_title(self.runs)
-
-            def work(job):
-                from maizeviz.light.heatmap import save_figure
-
-                save_figure(plots.transmission_figure(curves, title, width_in=7, dpi=110), path)
-                return path
-            return work, ()
-        raise MaizevizError(f"unknown export '{what}'")
-
-    def _export_diffuse(self, what: str, path: str):
-        """The day's steps CSV and figure, the per-leaf and per-plant CSV of the last sky or
-        day (the day when both)."""
-        day = self.runs.of_kind("day")
-        run = day if day is not None else self.runs.of_kind("sky")
-        if what in ("steps", "day") and day is None:
-            raise MaizevizError("no day computed yet: choose Day in the light panel and "
-                                "compute the day's light first")
-        if run is None:
-            raise MaizevizError("no sky or day computed yet: choose Sky or Day in the light "
-                                "panel and compute first")
-        light, extra, label = run.result, run.extra, run.label
-        if what == "steps":
-            def work(job):
-                from maizeviz.light.reports import write_steps
-
-                write_steps(path, light)
-                return path
-            return work, ()
-        if what == "day":
-            title = _day_title(light, label)
-
-            def work(job):
-                from maizeviz.light.heatmap import save_figure
-                from maizeviz.light.plots import day_figure
-
-                save_figure(day_figure(light, title), path)
-                return path
-            return work, ()
-        if extra is None:
-            raise MaizevizError(f"the light per leaf of the {run.kind} on {label} is computed "
-                                f"against its canopy: show level {label} first")
-        rows = [dict(r, level=label) for r in extra.leaf_rows]
-
-        def write_table(job):
-            from maizeviz.io.atomic import write_rows
-            from maizeviz.light.leaf_light import plant_light
-
-            write_rows(path, rows if what == "leaves" else plant_light(rows))
-            return path
-        return write_table, ()
 
     # ------------------------------------------------------------------ help
     def about(self) -> None:
@@ -1327,86 +1208,6 @@ class MainWindow(QMainWindow):
         if self.viewport is not None:
             self.viewport.close()
         super().closeEvent(event)
-
-
-def _plot_title(runs: LightRuns) -> str:
-    """What the transmission plot compares: the sun, the sky, the day; rays per cm²."""
-    parts = []
-    sun, sky, day = (runs.of_kind(k) for k in ("sun", "sky", "day"))
-    if sun is not None:
-        r = sun.result
-        parts.append(f"sun zenith {r.sun.zenith_deg:.1f}°, azimuth {r.sun.azimuth_deg:.1f}°")
-    diffuse = sky.result.sky if sky is not None else \
-        (day.result.sky.sky if day is not None and day.result.sky is not None else None)
-    if diffuse is not None:
-        parts.append(f"sky {diffuse.kind.upper()}, {diffuse.n} directions")
-    if day is not None:
-        p = day.result.period
-        parts.append(f"day {p.start:%Y-%m-%d}, {p.n_steps} steps")
-    density = runs.sampling[1] if runs.sampling else None
-    if density is None and runs.last is not None:
-        density = getattr(runs.last.result, "density", None)
-    if density is not None:
-        parts.append(f"{density:g} rays/cm²")
-    return "; ".join(parts)
-
-
-def _value_legend(run: Run) -> tuple[str, str]:
-    """Colour-bar title and unit of a sky's or day's light per leaf."""
-    if run.kind == "day":
-        return "PAR intercepted per leaf over the day", "mol/m² leaf"
-    return "diffuse light per leaf area (1: the sky's on open ground)", ""
-
-
-def _run_info(run: Run) -> str:
-    """What was traced and how long it took, for the light panel."""
-    r = run.result
-    secs = r.seconds
-    build_s = run.extra.build_s if run.extra is not None else secs.get("build", 0)
-    build = f"{build_s:.2f} s" if build_s > 0 else "kept from the last run"
-    if run.kind == "sun":
-        info = (f"{r.rays:,} rays on the central tile at {r.density_per_cm2:.2f} per cm²; "
-                f"level {run.label}; Embree scene {build}, tracing "
-                f"{secs.get('trace', 0) + secs.get('second', 0):.2f} s")
-        share = r.sunlit_intercepted_fraction
-        if share is not None:
-            info += f"; leaves take {share:.1%} of the direct light"
-    elif run.kind == "sky":
-        info = (f"{r.sky.description}; {r.rays:,} rays per direction; level {run.label}; "
-                f"Embree scene {build}, tracing {secs.get('trace', 0):.2f} s; leaves "
-                f"take {r.intercepted_fraction:.1%} of the diffuse light")
-    else:
-        sky = r.sky.sky.description if r.sky is not None else "no sky"
-        info = (f"{r.n_steps} time steps and the sky ({sky}); {r.rays:,} rays per "
-                f"direction; level {run.label}; Embree scene {build}, tracing "
-                f"{secs.get('trace', 0):.2f} s")
-    return info + "".join(f"\n⚠ {w}" for w in r.warnings if "sun never rises" not in w)
-
-
-def day_summary(light) -> str:
-    """The day in two lines: PAR incident, intercepted (fraction), transmitted to the lowest
-    height, mol/m² of ground; and where the irradiance came from."""
-    p = light.period
-    frac = light.fraction_intercepted
-    h = light.heights_cm
-    low = int(np.argmin(h))
-    where = "the ground" if h[low] == 0 else f"{h[low]:g} cm"
-    t_low = float(light.par_transmitted_mol_m2[low])
-    share = f" ({light.transmission_by_height[low]:.1%})" if frac is not None else ""
-    span = (f"{p.start:%Y-%m-%d}" if (p.end - p.start).total_seconds() == 86400 and
-            p.start.hour == 0 and p.start.minute == 0 else
-            f"{p.start:%Y-%m-%d %H:%M} to {p.end:%H:%M}")
-    return (f"{span}: PAR incident {light.par_incident_mol_m2:.1f} mol/m² (direct "
-            f"{light.par_direct_mol_m2:.1f}, diffuse {light.par_diffuse_mol_m2:.1f}); "
-            f"intercepted {light.par_intercepted_mol_m2:.1f} mol/m²"
-            + (f" ({frac:.1%})" if frac is not None else "")
-            + f"; transmitted to {where} {t_low:.2f} mol/m²{share}\n{p.source}")
-
-
-def _day_title(light, label: str) -> str:
-    p = light.period
-    return (f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M} ({p.start.tz}); {p.source}; "
-            f"level {label}")
 
 
 def about_text() -> str:

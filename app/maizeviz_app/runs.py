@@ -152,3 +152,83 @@ class LightRuns:
                 row.append(f"{t[i]:.3f}" if i < len(t) and np.isfinite(t[i]) else "")
             rows.append(row)
         return header, rows
+
+
+def plot_title(runs: LightRuns) -> str:
+    """What the transmission plot compares: the sun, the sky, the day; rays per cm²."""
+    parts = []
+    sun, sky, day = (runs.of_kind(k) for k in ("sun", "sky", "day"))
+    if sun is not None:
+        r = sun.result
+        parts.append(f"sun zenith {r.sun.zenith_deg:.1f}°, azimuth {r.sun.azimuth_deg:.1f}°")
+    diffuse = sky.result.sky if sky is not None else \
+        (day.result.sky.sky if day is not None and day.result.sky is not None else None)
+    if diffuse is not None:
+        parts.append(f"sky {diffuse.kind.upper()}, {diffuse.n} directions")
+    if day is not None:
+        p = day.result.period
+        parts.append(f"day {p.start:%Y-%m-%d}, {p.n_steps} steps")
+    density = runs.sampling[1] if runs.sampling else None
+    if density is None and runs.last is not None:
+        density = getattr(runs.last.result, "density", None)
+    if density is not None:
+        parts.append(f"{density:g} rays/cm²")
+    return "; ".join(parts)
+
+
+def value_legend(run: Run) -> tuple[str, str]:
+    """Colour-bar title and unit of a sky's or day's light per leaf."""
+    if run.kind == "day":
+        return "PAR intercepted per leaf over the day", "mol/m² leaf"
+    return "diffuse light per leaf area (1: the sky's on open ground)", ""
+
+
+def run_info(run: Run) -> str:
+    """What was traced and how long it took, for the light panel."""
+    r = run.result
+    secs = r.seconds
+    build_s = run.extra.build_s if run.extra is not None else secs.get("build", 0)
+    build = f"{build_s:.2f} s" if build_s > 0 else "kept from the last run"
+    if run.kind == "sun":
+        info = (f"{r.rays:,} rays on the central tile at {r.density_per_cm2:.2f} per cm²; "
+                f"level {run.label}; Embree scene {build}, tracing "
+                f"{secs.get('trace', 0) + secs.get('second', 0):.2f} s")
+        share = r.sunlit_intercepted_fraction
+        if share is not None:
+            info += f"; leaves take {share:.1%} of the direct light"
+    elif run.kind == "sky":
+        info = (f"{r.sky.description}; {r.rays:,} rays per direction; level {run.label}; "
+                f"Embree scene {build}, tracing {secs.get('trace', 0):.2f} s; leaves "
+                f"take {r.intercepted_fraction:.1%} of the diffuse light")
+    else:
+        sky = r.sky.sky.description if r.sky is not None else "no sky"
+        info = (f"{r.n_steps} time steps and the sky ({sky}); {r.rays:,} rays per "
+                f"direction; level {run.label}; Embree scene {build}, tracing "
+                f"{secs.get('trace', 0):.2f} s")
+    return info + "".join(f"\n⚠ {w}" for w in r.warnings if "sun never rises" not in w)
+
+
+def day_summary(light) -> str:
+    """The day in two lines: PAR incident, intercepted (fraction), transmitted to the lowest
+    height, mol/m² of ground; and where the irradiance came from."""
+    p = light.period
+    frac = light.fraction_intercepted
+    h = light.heights_cm
+    low = int(np.argmin(h))
+    where = "the ground" if h[low] == 0 else f"{h[low]:g} cm"
+    t_low = float(light.par_transmitted_mol_m2[low])
+    share = f" ({light.transmission_by_height[low]:.1%})" if frac is not None else ""
+    span = (f"{p.start:%Y-%m-%d}" if (p.end - p.start).total_seconds() == 86400 and
+            p.start.hour == 0 and p.start.minute == 0 else
+            f"{p.start:%Y-%m-%d %H:%M} to {p.end:%H:%M}")
+    return (f"{span}: PAR incident {light.par_incident_mol_m2:.1f} mol/m² (direct "
+            f"{light.par_direct_mol_m2:.1f}, diffuse {light.par_diffuse_mol_m2:.1f}); "
+            f"intercepted {light.par_intercepted_mol_m2:.1f} mol/m²"
+            + (f" ({frac:.1%})" if frac is not None else "")
+            + f"; transmitted to {where} {t_low:.2f} mol/m²{share}\n{p.source}")
+
+
+def day_title(light, label: str) -> str:
+    p = light.period
+    return (f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M} ({p.start.tz}); {p.source}; "
+            f"level {label}")
