@@ -37,6 +37,7 @@ _EXPORTS = {
     "make_sky": "maizeviz.light.sky",
     "SkySpec": "maizeviz.light.specs",
     "DaySpec": "maizeviz.light.specs",
+    "OpticsSpec": "maizeviz.light.specs",
     "clear_sky_period": "maizeviz.light.irradiance",
     "read_weather": "maizeviz.light.irradiance",
     "weather_period": "maizeviz.light.irradiance",

@@ -14,15 +14,18 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from maizeviz.canopy.layout import CanopyLayout, layout_for
 from maizeviz.canopy.measures import CanopyMeasures, measure_canopy
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.light.engine import LightEngine
 from maizeviz.light.request import LightRequest
-from maizeviz.light.specs import DaySpec, SkySpec  # noqa: F401 - the app's names for them
+from maizeviz.light.specs import DaySpec, OpticsSpec, SkySpec  # noqa: F401 - the app's names
 from maizeviz.light.transmission import LightResult
 from maizeviz.mesh.levels import parse_level
+from maizeviz.mesh.tessellate import triangle_areas_normals
 from maizeviz.progress import ProgressCallback
 
 #: Pixel edge (cm) of the ground-cover grid in the app (the CLI's default is 0.5 cm).
@@ -118,6 +121,32 @@ def op_light(state: dict, progress: ProgressCallback, request: LightRequest) -> 
                               progress=progress)
 
 
+def op_absorbed(state: dict, progress: ProgressCallback, request: LightRequest,
+                spec: OpticsSpec) -> Absorbed:
+    """Light absorbed with scattering for the request's sun, on the engine's scene, with what
+    the window shows of it: each leaf triangle's absorbed W per m2 of leaf and the plants'
+    rows."""
+    canopy = state["canopy"]
+    light = spec.absorbed(_engine(state), request.sun, request.sampling, progress)
+    nf = canopy.n_triangles
+    areas_m2 = triangle_areas_normals(canopy.vertices, canopy.faces)[0] * 1e-4
+    per_m2 = np.where(areas_m2 > 0, light.triangle_absorbed_w[:nf] / np.maximum(areas_m2, 1e-12),
+                      0.0).astype(np.float32)
+    plants = light.table("plant", canopy).to_dict("records")
+    return Absorbed(light, per_m2, plants)
+
+
+@dataclass(frozen=True)
+class Absorbed:
+    """Absorbed light (:class:`maizeviz.light.scatter.AbsorbedLight`) with what the window
+    shows of it: ``leaf_value`` (F,) float32 W absorbed per m2 of each leaf triangle, and
+    ``plant_rows`` (the result's ``table("plant")`` as records)."""
+
+    light: Any
+    leaf_value: np.ndarray
+    plant_rows: list
+
+
 @dataclass(frozen=True)
 class Diffuse:
     """A sky or period result with what the window shows of it, made in the child: per-leaf
@@ -198,4 +227,5 @@ def op_ping(state: dict, progress: ProgressCallback) -> str:
 
 
 OPS: dict[str, Callable[..., Any]] = {"measure": op_measure, "light": op_light, "sky": op_sky,
-                                      "period": op_period, "ping": op_ping}
+                                      "period": op_period, "absorbed": op_absorbed,
+                                      "ping": op_ping}

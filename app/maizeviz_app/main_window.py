@@ -626,7 +626,8 @@ class MainWindow(QMainWindow):
                 self._view_pending is not None:
             return
         run = self.runs.latest(self.signature(self.built.label))
-        if run is not None and run.kind == "sun" and run.classes is not None:
+        if run is not None and run.kind == "sun" and run.classes is not None and \
+                run.extra is None:
             self.viewport.set_light(run.classes)
         elif run is not None and run.extra is not None:
             title, unit = value_legend(run)
@@ -654,10 +655,13 @@ class MainWindow(QMainWindow):
         settings: object
         args: tuple
         try:
+            optics = None
             if mode == "sun":
                 request = panel.request()
                 heights = request.heights_cm
-                settings = (round(request.sun.zenith_deg, 6), round(request.sun.azimuth_deg, 6))
+                optics = panel.optics_spec()
+                settings = (round(request.sun.zenith_deg, 6), round(request.sun.azimuth_deg, 6),
+                            optics)
                 op, args = "light", (request,)
             else:
                 sampling = panel.sampling()
@@ -671,7 +675,7 @@ class MainWindow(QMainWindow):
         except (InputProblem, MaizevizError) as exc:
             self._fail(exc, "light", mode)
             return
-        if not self.affordable([self._light_costs(mode, args, heights)], "light"):
+        if not self.affordable([self._light_costs(mode, args, heights, optics)], "light"):
             return
         from maizeviz_app import plots
 
@@ -690,7 +694,12 @@ class MainWindow(QMainWindow):
             if mode == "sun":
                 from maizeviz.light.leaf_light import triangle_light
 
-                run = Run(label, signature, out, triangle_light(canopy, out))
+                absorbed = None
+                if optics is not None:              # leaves with optics: absorbed light too
+                    absorbed = runner.light_process.call("absorbed", key, canopy,
+                                                         (args[0], optics), job)
+                    job.check()
+                run = Run(label, signature, out, triangle_light(canopy, out), extra=absorbed)
             else:
                 run = Run(label, signature, out.light, None, mode, out)
             maps = plots.heatmap_images(run.result, first=shown_height, check=job.check,
@@ -705,14 +714,17 @@ class MainWindow(QMainWindow):
         self.runner.run("light", f"{mode} light on {label}", work, on_done=self._on_lit,
                         on_error=lambda e: self._light_failed(e, mode))
 
-    def _light_costs(self, mode: str, args: tuple, heights) -> list:
+    def _light_costs(self, mode: str, args: tuple, heights, optics=None) -> list:
         """What a light run of ``mode`` on the canopy shown will cost (``maizeviz.cost``): its
-        rays (times the directions: the sun, the sky's, a day's steps) and its heatmaps."""
+        rays (times the directions: the sun, the sky's, a day's steps; with leaf optics, the
+        absorbed light's beams and their scattering) and its heatmaps."""
         from maizeviz.cost import light_costs
         from maizeviz_app.plots import HEATMAP_BIN_CM
 
         rect = args[0].rect or self.canopy.layout.centre_bounds
         directions = 1
+        if optics is not None:                          # the beams, each scattered ~3 times
+            directions += 3 * (1 + (46 if optics.diffuse_w_m2 > 0 else 0))
         if mode != "sun":
             directions = max(args[1].directions, 1)
             if mode == "day":
@@ -770,7 +782,7 @@ class MainWindow(QMainWindow):
             panel.show_summary(summary)
         elif self.runs.of_kind("day") is None:
             panel.show_summary("")
-        if run.kind != "sun":
+        if run.kind != "sun" or run.extra is not None:
             panel.show_plants(run)
         elif self.runs.of_kind("sky") is None and self.runs.of_kind("day") is None:
             panel.show_plants(None)

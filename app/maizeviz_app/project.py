@@ -65,10 +65,14 @@ LIGHT_SETTINGS = (("zenith_deg", (int, float)), ("azimuth_deg", (int, float)), (
                   ("longitude", (int, float)), ("tz", str), ("step_min", (int, float)),
                   ("from", str), ("to", str), ("source", str),
                   ("linke_turbidity", (int, float)), ("weather", str),
-                  ("par_factor", (int, float)))
+                  ("par_factor", (int, float)), ("optics", bool), ("band", str),
+                  ("reflectance", (int, float)), ("transmittance", (int, float)),
+                  ("ground_reflectance", (int, float)), ("direct_w_m2", (int, float)),
+                  ("diffuse_w_m2", (int, float)), ("depth", int))
 #: Allowed values of the light settings that name a choice.
 LIGHT_CHOICES = {"mode": ("sun", "sky", "day"), "sky_kind": ("soc", "uoc"),
-                 "sky_split": ("auto", "equal"), "source": ("clear", "weather")}
+                 "sky_split": ("auto", "equal"), "source": ("clear", "weather"),
+                 "band": ("par", "nir")}
 
 
 def light_settings(opened: Opened) -> dict:

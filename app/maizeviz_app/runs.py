@@ -13,6 +13,13 @@ from maizeviz.mesh.levels import COMPLEXITY_STOPS, parse_level
 
 #: The lights the app computes, in the order of the buttons, the table and the plot.
 MODES = ("sun", "sky", "day")
+#: Rows of the results table for the energy balance of a sun traced with leaf optics:
+#: Balance field -> the row's label.
+BALANCE_ROWS = (("incident", "{band} incident W/m²"),
+                ("absorbed_leaves", "absorbed by leaves W/m²"),
+                ("absorbed_ground", "absorbed by the ground W/m²"),
+                ("reflected_top", "reflected out of the top W/m²"),
+                ("escaped_sides", "out of the sides W/m²"))
 #: Skies: kind -> (what the light panel's combo says, how a result is named in the table).
 SKIES = {"soc": ("standard overcast (SOC): brightness (1 + 2 cos θ)/3", "overcast sky"),
          "uoc": ("uniform overcast (UOC)", "uniform sky")}
@@ -32,7 +39,8 @@ class Run:
     (``signature``), the light (``kind``: sun, sky or day) and, for a sun, each leaf
     triangle's light class (F,) int8 (None until computed); for a sky or a day ``extra``
     holds what the light process made of it (per-leaf and per-plant rows, per-triangle
-    values: :class:`maizeviz_app.jobs.Diffuse`)."""
+    values: :class:`maizeviz_app.jobs.Diffuse`); for a sun traced with leaf optics, the light
+    absorbed with scattering (:class:`maizeviz_app.jobs.Absorbed`)."""
 
     label: str
     signature: tuple
@@ -49,6 +57,13 @@ class Run:
         if self.kind == "day":
             return f"{self.label}, day: PAR transmitted"
         return self.label
+
+    @property
+    def balance(self) -> Any:
+        """The energy balance (:class:`maizeviz.light.scatter.Balance`, W/m2 of ground) of a
+        sun traced with leaf optics, else None."""
+        light = getattr(self.extra, "light", None) if self.kind == "sun" else None
+        return getattr(light, "balance", None)
 
     @property
     def transmission(self) -> np.ndarray:
@@ -141,7 +156,8 @@ class LightRuns:
                 for r in self.runs.values()]
 
     def table(self) -> tuple[list[str], list[list[str]]]:
-        """Header and rows (one per height) of the results table."""
+        """Header and rows (one per height) of the results table; then, when a sun was traced
+        with leaf optics, its energy balance (W/m2 of ground) in rows of their own."""
         names = list(self.runs)
         header = ["height cm"] + names
         rows = []
@@ -151,6 +167,16 @@ class LightRuns:
                 t = self.runs[name].transmission
                 row.append(f"{t[i]:.3f}" if i < len(t) and np.isfinite(t[i]) else "")
             rows.append(row)
+        balances = {name: r.balance for name, r in self.runs.items() if r.balance is not None}
+        if balances:
+            band = next(r.extra.light.band for r in self.runs.values()
+                        if r.balance is not None).upper()
+            for field, what in BALANCE_ROWS:
+                row = [what.format(band=band)]
+                for name in names:
+                    b = balances.get(name)
+                    row.append(f"{getattr(b, field):.1f}" if b is not None else "")
+                rows.append(row)
         return header, rows
 
 
@@ -177,7 +203,10 @@ def plot_title(runs: LightRuns) -> str:
 
 
 def value_legend(run: Run) -> tuple[str, str]:
-    """Colour-bar title and unit of a sky's or day's light per leaf."""
+    """Colour-bar title and unit of a sky's or day's light per leaf, or a sun's absorbed
+    light per leaf triangle."""
+    if run.kind == "sun":
+        return f"{run.extra.light.band.upper()} absorbed per leaf area", "W/m² leaf"
     if run.kind == "day":
         return "PAR intercepted per leaf over the day", "mol/m² leaf"
     return "diffuse light per leaf area (1: the sky's on open ground)", ""
@@ -187,7 +216,8 @@ def run_info(run: Run) -> str:
     """What was traced and how long it took, for the light panel."""
     r = run.result
     secs = r.seconds
-    build_s = run.extra.build_s if run.extra is not None else secs.get("build", 0)
+    build_s = run.extra.build_s if run.kind != "sun" and run.extra is not None \
+        else secs.get("build", 0)
     build = f"{build_s:.2f} s" if build_s > 0 else "kept from the last run"
     if run.kind == "sun":
         info = (f"{r.rays:,} rays on the central tile at {r.density_per_cm2:.2f} per cm²; "
@@ -196,6 +226,15 @@ def run_info(run: Run) -> str:
         share = r.sunlit_intercepted_fraction
         if share is not None:
             info += f"; leaves take {share:.1%} of the direct light"
+        if run.balance is not None:
+            a = run.extra.light
+            b = run.balance
+            info += (f"; with leaf optics (ρ {a.optics.reflectance:g}, τ "
+                     f"{a.optics.transmittance:g}, soil {a.optics.ground_reflectance:g}) the "
+                     f"leaves absorb {a.fraction_absorbed:.1%} of the {a.band.upper()}, "
+                     f"{b.reflected_top / b.incident if b.incident else 0:.1%} is reflected "
+                     f"(balance closes within {abs(b.closure):.2%}; scattering "
+                     f"{a.seconds.get('scatter', 0):.2f} s)")
     elif run.kind == "sky":
         info = (f"{r.sky.description}; {r.rays:,} rays per direction; level {run.label}; "
                 f"Embree scene {build}, tracing {secs.get('trace', 0):.2f} s; leaves "

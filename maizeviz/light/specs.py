@@ -110,3 +110,53 @@ class DaySpec:
         except MaizevizError:
             minutes = 24 * 60.0                          # refused when the period is made
         return max(math.ceil(minutes / max(self.step_min, 1.0)), 1)
+
+
+@dataclass(frozen=True)
+class OpticsSpec:
+    """Absorbed light with scattering as a user chooses it: the band, the leaf and soil
+    optics, the irradiance and how far scattering is followed (see
+    :meth:`maizeviz.light.engine.LightEngine.absorbed`, which :meth:`absorbed` calls).
+
+    Attributes
+    ----------
+    band : str
+        ``"par"`` or ``"nir"``.
+    reflectance, transmittance, ground_reflectance : float or None
+        Leaf and soil fractions in [0, 1] (None: the band's default,
+        :data:`maizeviz.light.optics.DEFAULT_OPTICS`).
+    direct_w_m2 : float or None
+        The band's direct irradiance on a horizontal plane above the canopy, W/m2 (None: the
+        band's share of 1000 W/m2 of shortwave).
+    diffuse_w_m2 : float
+        The band's diffuse irradiance on a horizontal plane, W/m2, from a standard overcast
+        sky of 46 directions (0: the direct beam only).
+    depth : int
+        Scatterings followed (0: first hits only).
+    seed : int
+        Random seed of the Monte Carlo scattering (the same seed gives the same result).
+    """
+
+    band: str = "par"
+    reflectance: float | None = None
+    transmittance: float | None = None
+    ground_reflectance: float | None = None
+    direct_w_m2: float | None = None
+    diffuse_w_m2: float = 0.0
+    depth: int = 3
+    seed: int = 0
+
+    def optics(self):
+        """The :class:`~maizeviz.light.optics.Optics` of the band (checked: MaizevizError
+        naming the value out of range)."""
+        from maizeviz.light.optics import optics_for
+
+        return optics_for(self.band, self.reflectance, self.transmittance,
+                          self.ground_reflectance)
+
+    def absorbed(self, engine, sun, sampling=None, progress=None):
+        """Trace it: ``engine.absorbed`` for ``sun`` (an AbsorbedLight)."""
+        return engine.absorbed(sun, band=self.band, optics=self.optics(),
+                               direct_w_m2=self.direct_w_m2, diffuse_w_m2=self.diffuse_w_m2,
+                               depth=self.depth, seed=self.seed, sampling=sampling,
+                               progress=progress)

@@ -250,7 +250,10 @@ class LightPanel(QWidget):
                                        "periodic": self.periodic, "rect": self.heights,
                                        "threads": self.density}
         self.mode_fields: dict[str, dict[str, Any]] = {
-            "sun": {"sun": self.zenith, "place": self.place, "date": self.place,
+            "sun": {"band": self.band, "reflectance": self.reflectance,
+                    "transmittance": self.transmittance,
+                    "ground_reflectance": self.ground_reflectance,
+                    "sun": self.zenith, "place": self.place, "date": self.place,
                     "time": self.place, "tz": self.place},
             "sky": {"sky": self.sky_kind, "sky_directions": self.sky_n},
             "day": {"sky": self.sky_kind, "sky_directions": self.sky_n,
@@ -294,7 +297,83 @@ class LightPanel(QWidget):
         place_row.addWidget(self.place, 1)
         place_row.addWidget(self.place_button)
         form.addRow("date time lat lon tz", place_row)
+        form.addRow(self._optics_group())
         return page
+
+    def _optics_group(self) -> QGroupBox:
+        """Leaf optics: absorbed light with scattering (off: black leaves, interception)."""
+        from maizeviz.light.optics import DEFAULT_OPTICS, SHORTWAVE_SHARE
+
+        box = QGroupBox("leaf optics: absorbed light with scattering")
+        box.setCheckable(True)
+        box.setChecked(False)
+        box.setToolTip("off: leaves are black (light intercepted at first hits); on: leaves "
+                       "reflect and transmit, light is followed through the canopy and each "
+                       "leaf's absorbed light painted on the plants, with the energy balance")
+        form = _form()
+        box.setLayout(form)
+        self.optics_box = box
+        self.band = QComboBox()
+        self.band.addItem("PAR (400-700 nm)", "par")
+        self.band.addItem("NIR (700-3000 nm)", "nir")
+        self.band.setToolTip("the waveband traced; its leaf and soil optics and irradiance "
+                             "follow the band's defaults (maize: see docs/method.md)")
+        form.addRow("band", self.band)
+
+        def fraction(tip: str) -> QDoubleSpinBox:
+            w = QDoubleSpinBox(decimals=3, minimum=0.0, maximum=1.0, singleStep=0.01)
+            w.setToolTip(tip)
+            return w
+
+        self.reflectance = fraction("share of the light a leaf reflects (Lambertian)")
+        self.transmittance = fraction("share of the light a leaf transmits (Lambertian)")
+        self.ground_reflectance = fraction("share of the light the soil reflects")
+        leaf = QHBoxLayout()
+        leaf.addWidget(QLabel("ρ"))
+        leaf.addWidget(self.reflectance, 1)
+        leaf.addWidget(QLabel("τ"))
+        leaf.addWidget(self.transmittance, 1)
+        form.addRow("leaf", leaf)
+        form.addRow("soil ρ", self.ground_reflectance)
+        self.direct_w = QDoubleSpinBox(decimals=1, minimum=0.0, maximum=2000.0,
+                                       suffix=" W/m²")
+        self.direct_w.setToolTip("the band's direct irradiance on a horizontal plane above the "
+                                 "canopy")
+        self.diffuse_w = QDoubleSpinBox(decimals=1, minimum=0.0, maximum=2000.0, value=0.0,
+                                        suffix=" W/m²")
+        self.diffuse_w.setToolTip("the band's diffuse irradiance on a horizontal plane, from a "
+                                  "standard overcast sky of 46 directions (0: direct only)")
+        form.addRow("direct", self.direct_w)
+        form.addRow("diffuse", self.diffuse_w)
+        self.scatter_depth = QSpinBox(minimum=0, maximum=20, value=3)
+        self.scatter_depth.setToolTip("scatterings followed (0: first hits only; 3 keeps > 99% of PAR "
+                              "and most of NIR)")
+        form.addRow("scattering depth", self.scatter_depth)
+
+        def band_defaults(_i: int = 0) -> None:
+            band = str(self.band.currentData())
+            d = DEFAULT_OPTICS[band]
+            self.reflectance.setValue(d.reflectance)
+            self.transmittance.setValue(d.transmittance)
+            self.ground_reflectance.setValue(d.ground_reflectance)
+            self.direct_w.setValue(round(1000.0 * SHORTWAVE_SHARE[band], 1))
+
+        self.band.currentIndexChanged.connect(band_defaults)
+        band_defaults()
+        return box
+
+    def optics_spec(self):
+        """Absorbed light as chosen (:class:`maizeviz.light.specs.OpticsSpec`), None when leaf
+        optics are off; leaf scattering above 1 refused naming the field."""
+        from maizeviz.light.specs import OpticsSpec
+
+        if not self.optics_box.isChecked():
+            return None
+        spec = OpticsSpec(str(self.band.currentData()), self.reflectance.value(),
+                          self.transmittance.value(), self.ground_reflectance.value(),
+                          self.direct_w.value(), self.diffuse_w.value(), self.scatter_depth.value())
+        spec.optics()                                   # checked now, named by the core
+        return spec
 
     def _sky_group(self) -> QGroupBox:
         box = QGroupBox("diffuse sky")
@@ -482,9 +561,26 @@ class LightPanel(QWidget):
                 "from": self.day_from.text(), "to": self.day_to.text(),
                 "source": "weather" if self.source_weather.isChecked() else "clear",
                 "linke_turbidity": self.linke.value(), "weather": self.weather.text(),
-                "par_factor": self.par_factor.value()}
+                "par_factor": self.par_factor.value(),
+                "optics": self.optics_box.isChecked(), "band": self.band.currentData(),
+                "reflectance": self.reflectance.value(),
+                "transmittance": self.transmittance.value(),
+                "ground_reflectance": self.ground_reflectance.value(),
+                "direct_w_m2": self.direct_w.value(), "diffuse_w_m2": self.diffuse_w.value(),
+                "depth": self.scatter_depth.value()}
 
     def apply_settings(self, s: dict) -> None:
+        if s.get("band") in ("par", "nir"):
+            self.band.setCurrentIndex(self.band.findData(s["band"]))
+        for key, w in (("reflectance", self.reflectance),
+                       ("transmittance", self.transmittance),
+                       ("ground_reflectance", self.ground_reflectance),
+                       ("direct_w_m2", self.direct_w), ("diffuse_w_m2", self.diffuse_w)):
+            if key in s:
+                w.setValue(float(s[key]))
+        if "depth" in s:
+            self.scatter_depth.setValue(int(s["depth"]))
+        self.optics_box.setChecked(bool(s.get("optics", False)))
         self.zenith.setValue(float(s.get("zenith_deg", self.zenith.value())))
         self.azimuth.setValue(float(s.get("azimuth_deg", self.azimuth.value())))
         self.place.setText(str(s.get("place", self.place.text())))
@@ -645,7 +741,8 @@ class LightPanel(QWidget):
         self.summary.setVisible(bool(text))
 
     def show_plants(self, run: Run | None) -> None:
-        """What each plant intercepted in a sky or day ``run`` (None: hide the table)."""
+        """What each plant intercepted in a sky or day ``run``, or absorbed in a sun traced
+        with leaf optics (None: hide the table)."""
         rows = run.extra.plant_rows if run is not None and run.extra is not None else []
         t = self.plants
         if run is None or not rows:
@@ -654,7 +751,16 @@ class LightPanel(QWidget):
             return
         day = run.kind == "day"
         keys: tuple[str, ...]
-        if day:
+        scale = 1.0
+        if run.kind == "sun":
+            band = run.extra.light.band.upper()
+            header = ["stand", "plant", "x, y cm", f"{band} absorbed W", "W/m² leaf",
+                      "sunlit m² leaf"]
+            keys = ("absorbed_w", "absorbed_w_m2_leaf", "sunlit_area_cm2")
+            fmt = "{:.2f}"
+            self.plants_title.setText(f"{band} each plant absorbs, with scattering "
+                                      f"({run.label})")
+        elif day:
             header = ["stand", "plant", "x, y cm", "PAR mol", "direct mol", "diffuse mol"]
             keys = ("par_intercepted_mol", "direct_par_intercepted_mol",
                     "diffuse_par_intercepted_mol")
@@ -662,7 +768,7 @@ class LightPanel(QWidget):
             self.plants_title.setText(f"PAR intercepted by each plant over the day, mol "
                                       f"({run.label})")
         else:
-            area = run.result.rect_area_cm2
+            scale = 1.0 / run.result.rect_area_cm2
             header = ["stand", "plant", "x, y cm", "share of the sky light"]
             keys = ("diffuse_intercepted_cm2",)
             fmt = "{:.1%}"
@@ -675,8 +781,9 @@ class LightPanel(QWidget):
             vals = [str(row["instance"]), str(row["plant"]),
                     f"{float(row['x_cm']):.0f}, {float(row['y_cm']):.0f}"]
             for k in keys:
-                v = float(row.get(k, 0.0))
-                vals.append(fmt.format(v if day else v / area))
+                v = float(row.get(k, 0.0)) * (1e-4 if run.kind == "sun" and k.endswith("_cm2")
+                                              else scale)
+                vals.append(fmt.format(v))
             for c, text in enumerate(vals):
                 item = QTableWidgetItem(text)
                 item.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
