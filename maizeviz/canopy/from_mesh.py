@@ -70,9 +70,10 @@ def _field_coordinates(mesh: MeshData, unit: str | None, up: str, src: str) -> n
     if up not in UP_AXES:
         raise MaizevizError(f"the up axis must be z or y, got '{up}'", quantity="up")
     v = mesh.vertices
-    used = np.unique(mesh.faces)
+    used = np.zeros(len(v), bool)
+    used[mesh.faces.ravel()] = True
     height_axis = 2 if up == "z" else 1
-    h = float(np.ptp(v[used, height_axis])) if len(used) else 0.0
+    h = float(np.ptp(v[used, height_axis])) if used.any() else 0.0
     if unit is None:
         if h < GUESS_MIN_HEIGHT:
             raise MaizevizError(
@@ -91,13 +92,23 @@ def _field_coordinates(mesh: MeshData, unit: str | None, up: str, src: str) -> n
         out = v.copy() if scale != 1.0 else v
     if scale != 1.0:
         out = out * scale
-    big = np.flatnonzero(np.abs(out).max(axis=1) > MAX_COORD_CM) if len(out) else []
+    big = np.flatnonzero(np.abs(out).max(axis=1) > MAX_COORD_CM) if len(out) else \
+        np.zeros(0, np.int64)
     if len(big):
         i = int(big[0])
         raise MaizevizError(f"{src}: {mesh.where_vertex(i)} lies {np.abs(out[i]).max():.4g} cm "
                             f"from the origin, beyond {MAX_COORD_CM / 100:g} m: not a field plot "
                             "(is the unit right?)", quantity="mesh_unit")
     return out
+
+
+def _distinct(a: np.ndarray) -> np.ndarray:
+    """Sorted distinct values of ``a``, fast where equal values come in runs (a file's faces
+    come leaf by leaf)."""
+    if not len(a):
+        return a
+    starts = np.flatnonzero(np.concatenate([[True], a[1:] != a[:-1]]))
+    return np.unique(a[starts])
 
 
 def _split(vertices: np.ndarray, faces: np.ndarray, is_leaf: np.ndarray
@@ -123,11 +134,12 @@ def _split(vertices: np.ndarray, faces: np.ndarray, is_leaf: np.ndarray
     return vertices[keep_leaf], new_leaf[leaf_f].astype(np.int64), *stalk
 
 
-def _positions(plants: np.ndarray, leaf_v: np.ndarray, leaf_f: np.ndarray, leaf_inst: np.ndarray,
-               stalk_v: np.ndarray, stalk_f: np.ndarray, stalk_inst: np.ndarray) -> np.ndarray:
-    """(P, 2) cm: the mean of each plant's stalk vertices, or its leaves' area-weighted centre."""
+def _positions(plants: np.ndarray, leaf_v: np.ndarray, leaf_f: np.ndarray, area: np.ndarray,
+               leaf_inst: np.ndarray, stalk_v: np.ndarray, stalk_f: np.ndarray,
+               stalk_inst: np.ndarray) -> np.ndarray:
+    """(P, 2) cm: the mean of each plant's stalk vertices, or its leaves' area-weighted centre
+    (``area``: of each leaf triangle)."""
     n = len(plants)
-    area, _ = triangle_areas_normals(leaf_v, leaf_f)
     centre = leaf_v[leaf_f].mean(axis=1)[:, :2]
     weight = np.bincount(leaf_inst, area, n)
     count = np.bincount(leaf_inst, minlength=n).astype(np.float64)
@@ -187,13 +199,13 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
         t = int(np.flatnonzero(is_leaf)[int(np.flatnonzero(area == 0)[0])])
         notes.append(f"{source}: {flat:,} of the {n_leaf:,} leaf triangles have no area (first: "
                      f"{mesh.where_triangle(t)}); kept, they receive no light")
-    plants = np.unique(mesh.plant)
+    plants = _distinct(mesh.plant)
     inst = np.searchsorted(plants, mesh.plant).astype(np.int32)
     leaf_inst, stalk_inst = inst[is_leaf], inst[~is_leaf]
     leaf_ids = mesh.leaf[is_leaf].astype(np.int32)
-    pairs = np.unique(leaf_inst.astype(np.int64) * (MAX_LEAF_ID + 1) + leaf_ids)
+    pairs = _distinct(leaf_inst.astype(np.int64) * (MAX_LEAF_ID + 1) + leaf_ids)
     leaves_per = np.bincount(pairs // (MAX_LEAF_ID + 1), minlength=len(plants)).astype(np.int32)
-    xy = _positions(plants, leaf_v, leaf_f, leaf_inst, stalk_v, stalk_f, stalk_inst)
+    xy = _positions(plants, leaf_v, leaf_f, area, leaf_inst, stalk_v, stalk_f, stalk_inst)
     placements = tuple(Placement(int(p), float(x), float(y)) for p, (x, y) in zip(plants, xy))
     if field is None:
         every = np.vstack([leaf_v, stalk_v])

@@ -731,6 +731,7 @@ _IGNORED = {"vt", "vn", "vp", "s", "usemtl", "mtllib", "l", "p", "mg", "lod", "s
             "trace_obj", "bevel", "c_interp", "d_interp", "maplib", "usemap"}
 _FREE_FORM = {"cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm", "trim", "hole",
               "scrv", "sp", "end", "con", "ctech", "stech"}
+_F_LINE = re.compile(r"f(?:[ \t]+-?\d+(?:/-?\d*(?:/-?\d+)?)?)+")
 _SEP = r"[\s_./:|\-]*"
 _PLANT_NAME = re.compile(r"^(?:plant|p)[\s_\-]*(\d+)(?:" + _SEP + r"(.*))?$", re.I | re.S)
 _LEAF_NAME = re.compile(r"^(?:leaf|l)[\s_\-]*(\d+)$", re.I)
@@ -741,12 +742,12 @@ def _read_obj(data: bytes, src: str) -> MeshData:
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        line = data.count(b"\n", 0, exc.start) + 1
-        raise MeshFileError(f"{src}: line {line}: not UTF-8 text (byte 0x{data[exc.start]:02x}); "
+        bad_line = data.count(b"\n", 0, exc.start) + 1
+        raise MeshFileError(f"{src}: line {bad_line}: not UTF-8 text (byte 0x{data[exc.start]:02x}); "
                             "an OBJ file is text") from None
     if text.startswith("\ufeff"):
         text = text[1:]
-    verts: list[list[float]] = []
+    coords: list[float] = []
     vlines: list[int] = []
     flat: list[int] = []
     lengths: list[int] = []
@@ -759,53 +760,54 @@ def _read_obj(data: bytes, src: str) -> MeshData:
     current = -1
     ignored = 0
     pending = ""
-    for no, raw in enumerate(text.split("\n"), 1):
-        line = pending + raw.rstrip("\r")
-        if line.endswith("\\"):
-            pending = line[:-1] + " "
-            continue
-        pending = ""
-        hash_at = line.find("#")
-        if hash_at >= 0:
-            line = line[:hash_at]
+    for no, line in enumerate(text.split("\n"), 1):
+        if pending or line.endswith(("\\", "\\\r")) or "#" in line:
+            line = pending + line.rstrip("\r")
+            if line.endswith("\\"):
+                pending = line[:-1] + " "
+                continue
+            pending = ""
+            line = line.split("#", 1)[0]
         words = line.split()
         if not words:
             continue
         key = words[0]
         if key == "v":
-            if len(words) < 4:
-                raise MeshFileError(f"{src}: line {no}: a vertex needs x, y and z")
             try:
-                xyz = [float(w) for w in words[1:4]]
+                if len(words) < 4:
+                    raise ValueError
+                coords.extend(map(float, words[1:4]))
             except ValueError:
-                bad = next(w for w in words[1:4] if not _is_float(w))
-                raise MeshFileError(f"{src}: line {no}: '{bad[:30]}' is not a number") from None
-            verts.append(xyz)
+                raise MeshFileError(f"{src}: line {no}: a vertex needs x, y and z numbers, got "
+                                    f"'{line.strip()[:60]}'") from None
             vlines.append(no)
         elif key == "f":
-            if len(words) < 4:
-                raise MeshFileError(f"{src}: line {no}: a face has {len(words) - 1} vertices; "
-                                    "a face needs at least 3")
-            nv = len(verts)
-            for w in words[1:]:
-                parts = w.split("/")
-                try:
-                    if len(parts) > 3 or any(p and int(p) == 0 for p in parts) or not parts[0]:
+            nv = len(vlines)
+            try:
+                if "/" in line:
+                    if not _F_LINE.fullmatch(line.strip()):
                         raise ValueError
-                    idx = int(parts[0])
-                except ValueError:
-                    raise MeshFileError(f"{src}: line {no}: '{w[:30]}' is not a face vertex "
-                                        "(v, v/vt, v//vn or v/vt/vn, whole numbers, not 0)"
-                                        ) from None
-                if idx < 0:
-                    if -idx > nv:
-                        raise MeshFileError(f"{src}: line {no}: vertex index {idx} reaches "
-                                            f"before the first vertex ({nv:,} defined so far)")
-                    idx = nv + idx
+                    idx = [int(w.partition("/")[0]) for w in words[1:]]
                 else:
-                    idx -= 1
-                flat.append(idx)
-            lengths.append(len(words) - 1)
+                    idx = list(map(int, words[1:]))
+                if 0 in idx:
+                    raise ValueError
+            except ValueError:
+                raise MeshFileError(f"{src}: line {no}: '{line.strip()[:60]}' is not a face: "
+                                    "f then vertices v, v/vt, v//vn or v/vt/vn (whole numbers, "
+                                    "not 0)") from None
+            if len(idx) < 3:
+                raise MeshFileError(f"{src}: line {no}: a face has {len(idx)} vertices; a face "
+                                    "needs at least 3")
+            if min(idx) < 0:
+                if min(idx) < -nv:
+                    raise MeshFileError(f"{src}: line {no}: vertex index {min(idx)} reaches "
+                                        f"before the first vertex ({nv:,} defined so far)")
+                idx = [i + nv if i < 0 else i - 1 for i in idx]
+                flat.extend(idx)
+            else:
+                flat.extend(i - 1 for i in idx)
+            lengths.append(len(idx))
             flines.append(no)
             if current < 0 and (obj_name is not None or grp_name is not None):
                 current = _group(groups, group_line, obj_name, grp_name, no)
@@ -826,7 +828,8 @@ def _read_obj(data: bytes, src: str) -> MeshData:
             raise MeshFileError(f"{src}: line {no}: '{key[:30]}' is not an OBJ statement")
     if not lengths:
         raise MeshFileError(f"{src}: the file has no faces (no 'f' line): no surface to trace")
-    vertices = np.array(verts, np.float64).reshape(-1, 3)
+    vertices = np.array(coords, np.float64).reshape(-1, 3)
+    del coords
     vline_arr = np.array(vlines, np.int64)
     _check_finite(vertices, src, vline_arr)
     face_lines = np.array(flines, np.int64)
