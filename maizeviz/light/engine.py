@@ -23,6 +23,7 @@ from __future__ import annotations
 import threading
 import time
 from dataclasses import fields, replace
+from typing import Any
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
@@ -84,7 +85,7 @@ class LightEngine:
         self._scenes: dict[bool, RayScene] = {}
         self._lock = threading.Lock()
         self._sky: tuple[tuple, SkyLight] | None = None
-        self._normals_kept = None
+        self._normals_kept: Any = None          # (F, 3) numpy array once computed
 
     @staticmethod
     def _sampling(base: Sampling, changes: dict) -> Sampling:
@@ -345,7 +346,7 @@ class LightEngine:
             if k == 0 and sun is not None and direct > 0:
                 # cm2 of leaf a ray's beam covers: its footprint across the beam over the
                 # cosine of the leaf's tilt to it
-                first = np.concatenate(tally.first_hits) if tally.first_hits else []
+                first: Any = np.concatenate(tally.first_hits) if tally.first_hits else []
                 lit = np.unique(first)
                 factor = np.zeros(nf)
                 factor[lit] = smp.ray_area_cm2 * toward[2] / np.maximum(

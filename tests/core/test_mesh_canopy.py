@@ -620,3 +620,26 @@ def test_light_and_canopy_on_a_small_mesh(tmp_path, capsys):
     assert m["ground_area_m2"] == pytest.approx(500 / 1e4)
     text = (tmp_path / "o.obj").read_text()
     assert "g plant1_leaf2" in text and "g plant2_leaf5" in text and "g plant2_leaf0" in text
+
+
+def test_degenerate_triangles_are_kept_and_said(tmp_path):
+    faces = F + [[0, 0, 1], [0, 1, 1]]
+    p = write_ply(tmp_path / "d.ply", V, faces, {"plant": PLANT + [3, 3], "leaf": LEAF + [2, 2]})
+    canopy, mesh, notes = read_mesh_canopy(p)
+    assert canopy.n_triangles == 6 and mesh.n_triangles == 7
+    assert any("2 of the 6 leaf triangles have no area (first: face 5" in n for n in notes)
+
+
+def test_stalks_intercept_only_when_asked(tmp_path, capsys):
+    """Leaf 0 is the stalk: out of the leaves, in the light only with --with-stalks."""
+    verts = np.vstack([V[:8], [[20, 0, 0], [30, 0, 0], [30, 10, 0.5], [20, 10, 0.5]]])
+    faces = F[:4] + [[8, 9, 10], [8, 10, 11]]
+    p = write_ply(tmp_path / "s.ply", verts, faces,
+                  {"plant": [3, 3, 7, 7, 7, 7], "leaf": [2, 2, 5, 5, 0, 0]})
+    runs = []
+    for extra in ([], ["--with-stalks"]):
+        assert main(["light", str(p), "--mesh-unit", "cm", "--sun-zenith", "0",
+                     "--sun-azimuth", "0", "--heights", "0", "--density", "4", "--json",
+                     *extra]) == EXIT_OK
+        runs.append(json.loads(capsys.readouterr().out)["transmission"][0])
+    assert runs[0] == pytest.approx(0.6, abs=0.01) and runs[1] == pytest.approx(0.4, abs=0.01)
