@@ -747,6 +747,17 @@ def _read_obj(data: bytes, src: str) -> MeshData:
                             "an OBJ file is text") from None
     if text.startswith("\ufeff"):
         text = text[1:]
+    lines = text.split("\n")
+    del text
+    return _obj_mesh(*_obj_statements(lines, src), src)
+
+
+def _obj_statements(lines: list[str], src: str) -> tuple[
+        np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+        dict[str, int], dict[str, int], int]:
+    """The OBJ statements line by line: vertices and their lines, face vertex indices (from
+    0), face lengths and lines, each face's group, the groups by name and the line of their
+    first face, and how many line and point statements were passed over."""
     coords: list[float] = []
     vlines: list[int] = []
     flat: list[int] = []
@@ -760,7 +771,7 @@ def _read_obj(data: bytes, src: str) -> MeshData:
     current = -1
     ignored = 0
     pending = ""
-    for no, line in enumerate(text.split("\n"), 1):
+    for no, line in enumerate(lines, 1):
         if pending or line.endswith(("\\", "\\\r")) or "#" in line:
             line = pending + line.rstrip("\r")
             if line.endswith("\\"):
@@ -826,27 +837,30 @@ def _read_obj(data: bytes, src: str) -> MeshData:
                                 "export triangles or polygons")
         else:
             raise MeshFileError(f"{src}: line {no}: '{key[:30]}' is not an OBJ statement")
-    if not lengths:
+    return (np.array(coords, np.float64).reshape(-1, 3), np.array(vlines, np.int64),
+            np.array(flat, np.int64), np.array(lengths, np.int64), np.array(flines, np.int64),
+            np.array(fgroup, np.int64), groups, group_line, ignored)
+
+
+def _obj_mesh(vertices: np.ndarray, vline_arr: np.ndarray, flat: np.ndarray,
+              length: np.ndarray, face_lines: np.ndarray, fg: np.ndarray,
+              groups: dict[str, int], group_line: dict[str, int], ignored: int,
+              src: str) -> MeshData:
+    if not len(length):
         raise MeshFileError(f"{src}: the file has no faces (no 'f' line): no surface to trace")
-    vertices = np.array(coords, np.float64).reshape(-1, 3)
-    del coords
-    vline_arr = np.array(vlines, np.int64)
     _check_finite(vertices, src, vline_arr)
-    face_lines = np.array(flines, np.int64)
-    length = np.array(lengths, np.int64)
 
     def at(i: int) -> str:
         return f"face {i} (counting from 0, line {int(face_lines[i])})"
 
-    faces, tri_face, polygons = _fan(length, np.array(flat, np.int64), len(vertices), at, src)
-    fg = np.array(fgroup, np.int64)
+    faces, tri_face, polygons = _fan(length, flat, len(vertices), at, src)
     if not groups:
         raise MeshFileError(f"{src}: the faces carry no plant or leaf id (no o or g names): "
                             "name each leaf's faces with a 'g' line (g plant1_leaf3)",
                             quantity="mesh_ids")
     if (fg < 0).any():
         i = int(np.flatnonzero(fg < 0)[0])
-        raise MeshFileError(f"{src}: line {flines[i]}: a face before any o or g name while "
+        raise MeshFileError(f"{src}: line {face_lines[i]}: a face before any o or g name while "
                             "other faces are named: its plant and leaf are unknown",
                             quantity="mesh_ids")
     gp, gl, notes = _group_ids(groups, group_line, src)
