@@ -75,6 +75,8 @@ MAX_LEAF_ID = 9999
 MAX_PLANT_ID = MAX_ID
 #: Most vertices of one polygon face.
 MAX_POLYGON = 100_000
+#: Longest value in an ascii PLY (characters): a double needs 24.
+MAX_VALUE_CHARS = 100
 
 _PLY_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2",
               "int16": "i2", "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4",
@@ -342,7 +344,7 @@ def _check_counts(elements: list[_Element], remaining: int, binary: bool, src: s
         else:                                 # a value is at least a character and a space
             per = 2 * sum(1 + _min_entries(el, p) if p.is_list else 1 for p in el.props)
         need += el.count * per
-        if need > remaining:
+        if need > remaining + (0 if binary else 1):      # the last value needs no space
             raise MeshFileError(
                 f"{src}: the header declares {el.count:,} {el.name} items, which take at least "
                 f"{need:,} bytes with those before them, but only {remaining:,} bytes follow "
@@ -483,6 +485,12 @@ def _ply_ascii(body: bytes, elements: list[_Element], header_lines: int,
 
 def _numbers(tokens: list[bytes], counts: np.ndarray, line_no: np.ndarray, src: str) -> np.ndarray:
     """Tokens as float64; the first one that is not a number is named with its line."""
+    longest = max(map(len, tokens), default=0)
+    if longest > MAX_VALUE_CHARS:
+        k = next(i for i, t in enumerate(tokens) if len(t) == longest)
+        line = int(line_no[int(np.searchsorted(np.cumsum(counts), k, "right"))])
+        raise MeshFileError(f"{src}: line {line}: a value of {longest:,} characters; a number "
+                            f"has at most {MAX_VALUE_CHARS}")
     try:
         return np.array(tokens, dtype=bytes).astype(np.float64) if tokens else np.zeros(0)
     except (ValueError, OverflowError):
@@ -856,13 +864,11 @@ def _obj_mesh(vertices: np.ndarray, vline_arr: np.ndarray, flat: np.ndarray,
     faces, tri_face, polygons = _fan(length, flat, len(vertices), at, src)
     if not groups:
         raise MeshFileError(f"{src}: the faces carry no plant or leaf id (no o or g names): "
-                            "name each leaf's faces with a 'g' line (g plant1_leaf3)",
-                            quantity="mesh_ids")
+                            "name each leaf's faces with a 'g' line (g plant1_leaf3)")
     if (fg < 0).any():
         i = int(np.flatnonzero(fg < 0)[0])
         raise MeshFileError(f"{src}: line {face_lines[i]}: a face before any o or g name while "
-                            "other faces are named: its plant and leaf are unknown",
-                            quantity="mesh_ids")
+                            "other faces are named: its plant and leaf are unknown")
     gp, gl, notes = _group_ids(groups, group_line, src)
     notes = ([f"{src}: {ignored:,} line and point statements (no surface) ignored"]
              if ignored else []) + notes

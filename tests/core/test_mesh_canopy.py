@@ -212,6 +212,14 @@ def test_one_id_missing_takes_the_documented_default(tmp_path):
     assert mesh.leaf.tolist() == [1] * 5 and "each plant is one leaf" in mesh.notes[0]
 
 
+def test_an_ascii_ply_without_a_last_line_end(tmp_path):
+    p = tmp_path / "n.ply"
+    p.write_bytes(b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y"
+                  b"\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices"
+                  b"\nproperty uchar leaf\nend_header\n0 0 9\n1 0 9\n0 1 9\n3 0 1 2 1")
+    assert read_mesh(p).faces.tolist() == [[0, 1, 2]]
+
+
 def test_extra_elements_and_properties_are_read_past(tmp_path):
     head = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
             "property float z\nproperty uchar red\nelement material 2\nproperty list uchar int "
@@ -264,7 +272,8 @@ def test_meshio_files_without_ids_are_refused_with_a_hint(tmp_path):
         mesh.write(p)
         with pytest.raises(MeshFileError, match="carry no plant or leaf id") as exc:
             read_mesh(p)
-        assert exc.value.quantity == "mesh_ids"
+        # a PLY's ids may be named (--mesh-plant/--mesh-leaf); an OBJ's come from its names
+        assert exc.value.quantity == ("mesh_ids" if ext == "ply" else None)
 
 
 # ------------------------------------------------------------------------------ properties
@@ -396,6 +405,8 @@ def _hostile(tmp_path):
         "two_vertices.ply": (asc.replace(b"3 8 9 10 7 0", b"2 8 9 7 0"), "needs at least 3"),
         "leaf_id.ply": (asc.replace(b"3 8 9 10 7 0", b"3 8 9 10 7 12000"), "leaf id"),
         "float_index.ply": (asc.replace(b"3 8 9 10 7 0", b"3 8 9.5 10 7 0"), "whole number"),
+        "long_value.ply": (asc.replace(b"45.0 5.0 0.0", b"45.0 5.0 " + b"1" * 10_000_000),
+                           "a value of 10,000,000 characters"),
         "junk.ply": (bytes(range(256)) * 20, "not a PLY file"),
         "junk_header.ply": (b"ply\nformat ascii 1.0\n\xff\xfe\nend_header\n", "not ASCII"),
         "no_end.ply": (b"ply\nformat ascii 1.0\nelement vertex 3\n", "end_header"),
@@ -435,7 +446,7 @@ def _hostile(tmp_path):
     "empty.ply", "empty.obj", "truncated.ply", "truncated_vertices.ply", "more_data.ply",
     "ascii_more_lines.ply", "ascii_fewer_lines.ply", "huge_count.ply", "huge_vertices.ply",
     "index.ply", "negative_index.ply", "nan.ply", "inf.ply", "text.ply", "two_vertices.ply",
-    "leaf_id.ply", "float_index.ply", "junk.ply", "junk_header.ply", "no_end.ply",
+    "leaf_id.ply", "float_index.ply", "long_value.ply", "junk.ply", "junk_header.ply", "no_end.ply",
     "format.ply", "no_face.ply", "no_faces.ply", "no_ids.ply", "junk.obj", "csv.obj",
     "index.obj", "zero.obj", "negative.obj", "nan.obj", "short.obj", "nofaces.obj",
     "nogroups.obj", "ungrouped.obj", "surface.obj", "degenerate.obj", "stalks_only.obj",
