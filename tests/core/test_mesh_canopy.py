@@ -563,8 +563,8 @@ def test_light_of_the_exported_canopy_is_the_same(tmp_path, capsys, periodic):
                  "--save-layout", str(lay), "--json"]) == EXIT_OK
     f = json.loads(lay.read_text())["field"]
     field = ",".join(repr(f[k]) for k in ("x0", "y0", "x1", "y1"))
-    common = [*SUN, "--density", "1", "--json", "--sky", "soc", "--sky-directions", "16"] + \
-        (["--periodic"] if periodic else [])
+    common = [*SUN, "--density", "1", "--json", "--sky", "soc", "--sky-directions", "16",
+              "--band", "par", "--depth", "2"] + (["--periodic"] if periodic else [])
     capsys.readouterr()
     assert main(["light", B, "--tile", "3x3", "--interp", "0", *common,
                  "--leaf-light", str(tmp_path / "o.csv")]) == EXIT_OK
@@ -577,9 +577,10 @@ def test_light_of_the_exported_canopy_is_the_same(tmp_path, capsys, periodic):
     assert back["transmission"] == orig["transmission"]
     assert back["diffuse"]["transmission"] == orig["diffuse"]["transmission"]
     assert back["diffuse"]["intercepted_fraction"] == orig["diffuse"]["intercepted_fraction"]
+    assert back["balance"] == orig["balance"]                  # absorbed, with scattering
     o_rows, m_rows = _rows(tmp_path / "o.csv"), _rows(tmp_path / "m.csv")
     cols = ["sunlit_area_cm2", "second_class_area_cm2", "sunlit_intercepted_cm2",
-            "second_class_intercepted_cm2", "diffuse_intercepted_cm2"]
+            "second_class_intercepted_cm2", "diffuse_intercepted_cm2", "absorbed_w"]
     if not periodic:
         # leaf by leaf: the same leaves, the same light; the plant column is the file's id
         assert [(r["instance"], r["leaf"]) for r in m_rows] == \
