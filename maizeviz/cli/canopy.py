@@ -25,6 +25,7 @@ from maizeviz.cli.common import (
     check_export,
     check_input_options,
     fmt_table,
+    input_name,
     is_mesh,
     leaves_summary,
     levels_from,
@@ -63,7 +64,7 @@ def run(args: argparse.Namespace) -> int:
     check_export(args.export, levels)
     check_cover_resolution(args.cover_resolution)            # before the file is read
     check_run_paths([("the mesh export", args.export), ("the saved layout", args.save_layout)],
-                    [("the points file", args.points), ("the layout file", args.layout)])
+                    [(input_name(args.points), args.points), ("the layout file", args.layout)])
     if is_mesh(args.points):
         return _run_mesh(args)
     leaves, skipped, layout = canopy_setup(args)

@@ -205,6 +205,12 @@ def is_mesh(path: str | Path) -> bool:
     return is_mesh_path(path)
 
 
+def input_name(path: str | Path) -> str:
+    """What the canopy input is, in words: "the mesh file", "the project", "the points file"."""
+    return "the mesh file" if is_mesh(path) else "the project" if is_project(path) \
+        else "the points file"
+
+
 #: Options that shape a canopy of digitized plants, refused with a mesh file (flag, what
 #: makes it given).
 _DIGITIZED_ONLY = (("--tile", "tile"), ("--block", "block"), ("--layout", "layout"),

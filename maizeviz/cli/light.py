@@ -27,6 +27,7 @@ from maizeviz.cli.common import (
     check_input_options,
     floats,
     fmt_table,
+    input_name,
     is_mesh,
     leaves_summary,
     level_path,
@@ -512,7 +513,7 @@ def _check_paths(args: argparse.Namespace, labels: list[str], sun: bool,
     check_run_paths(
         [(what, level_path(path, label, len(labels))) for what, path in tables if path
          for label in labels],
-        [("the points file", args.points), ("the layout file", args.layout),
+        [(input_name(args.points), args.points), ("the layout file", args.layout),
          ("the weather file", args.weather)],
         [OutputFolder("the heatmap folder", args.heatmaps, maps),
          OutputFolder("the plot folder", args.plots if period else None,
