@@ -52,7 +52,7 @@ from maizeviz.resources import example_points
 from maizeviz_app.exports import export_job
 from maizeviz_app.messages import user_message
 from maizeviz_app.model import StudyModel
-from maizeviz_app.panels.canopy import CanopyPanel
+from maizeviz_app.panels.canopy import MESH_LEVEL, CanopyPanel
 from maizeviz_app.panels.light import (
     COMPUTE_TEXT,
     MODES,
@@ -74,6 +74,10 @@ if TYPE_CHECKING:
 STATE_VERSION = 3
 PROJECT_FILTER = "maizeviz project (*.maizeviz)"
 POINTS_FILTER = "Points CSV (*.csv);;All files (*)"
+CANOPY_MESH_FILTER = "Canopy mesh with plant and leaf ids (*.ply *.obj);;All files (*)"
+#: Units and up axis a mesh file may be written in (what the open dialog offers).
+MESH_FRAMES = {"cm, z up": ("cm", "z"), "m, z up": ("m", "z"), "mm, z up": ("mm", "z"),
+               "cm, y up": ("cm", "y"), "m, y up": ("m", "y"), "mm, y up": ("mm", "y")}
 MESH_FILTER = ("PLY (*.ply);;VTK legacy (*.vtk);;VTK XML unstructured (*.vtu);;"
                "VTK XML polydata (*.vtp);;Wavefront OBJ (*.obj);;STL (*.stl)")
 PAPER = ("Xinyu Guo, Chunjiang Zhao, Boxiang Xiao, Shenglian Lu, Changfeng Li. <i>Study on "
@@ -395,9 +399,13 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ opening
     def open_any(self, path: str | Path) -> None:
-        """A project (``.maizeviz``) or a points CSV."""
+        """A project (``.maizeviz``), a canopy mesh (``.ply``, ``.obj``) or a points CSV."""
+        from maizeviz.io.mesh_canopy import is_mesh_path
+
         if str(path).endswith(".maizeviz"):
             self.open_project(path)
+        elif is_mesh_path(path):
+            self.open_mesh(path)
         else:
             self.open_points(path)
 
@@ -406,6 +414,72 @@ class MainWindow(QMainWindow):
                                               POINTS_FILTER)
         if path:
             self.open_points(path)
+
+    def choose_mesh(self) -> None:
+        """Open a canopy from elsewhere (OpenAlea, Helios, a scan): a PLY or OBJ with a plant
+        and a leaf id per face, after asking its units and up axis."""
+        from PySide6.QtWidgets import QInputDialog
+
+        path, _ = QFileDialog.getOpenFileName(self, "Open a canopy mesh", self._folder(),
+                                              CANOPY_MESH_FILTER)
+        if not path:
+            return
+        frame, ok = QInputDialog.getItem(
+            self, "Units of the mesh", "The file's coordinates are in (OpenAlea and Helios "
+            "write z up, many scanners y up):", list(MESH_FRAMES), 0, False)
+        if ok:
+            self.open_mesh(path, *MESH_FRAMES[frame])
+
+    def open_mesh(self, path: str | Path, unit: str | None = None, up: str = "z") -> None:
+        """Read a canopy mesh in a worker (:func:`maizeviz.canopy.from_mesh.read_mesh_canopy`:
+        ``unit`` cm, m or mm, None: cm, refused when the size says otherwise); it replaces the
+        points: light, tables and exports work on it, the slider and layout do not apply."""
+        if not self.keep_unsaved(lambda: self.open_mesh(path, unit, up)):
+            return
+        from maizeviz_app import jobs
+
+        path = str(path)
+        self.say(f"reading the canopy mesh {path}")
+        runner, view_ready = self.runner, self._view_ready
+
+        def work(job):
+            from maizeviz.canopy.from_mesh import read_mesh_canopy
+            from maizeviz.canopy.measures import TABLE2_COLUMNS, table2_row
+
+            t0 = time.perf_counter()
+            canopy, _mesh, notes = read_mesh_canopy(path, unit, up)
+            read_s = time.perf_counter() - t0
+            job.check()
+            t0 = time.perf_counter()
+            m = runner.cover_process.call("measure", object(), canopy,
+                                          (jobs.APP_COVER_RESOLUTION_CM,), job)
+            measure_s = time.perf_counter() - t0
+            while not view_ready.wait(0.05):
+                job.check()
+            from maizeviz_app.viewport import canopy_polydata
+
+            row = table2_row(m, read_s, MESH_LEVEL)
+            return notes, (canopy, m, read_s, measure_s, canopy_polydata(canopy),
+                           tuple(TABLE2_COLUMNS), row)
+
+        self.runner.run("load", f"reading {Path(path).name}", work,
+                        on_done=lambda out: self._on_mesh(path, *out),
+                        on_error=lambda e: self._fail(e, "open mesh"))
+
+    def _on_mesh(self, path: str, notes: list, parts: tuple) -> None:
+        from maizeviz_app import jobs
+
+        self._heatmaps_for.clear()
+        self.plots.clear()
+        self.plots.set_transmission(None)
+        self.model.open_mesh(path)
+        self._settings.setValue("last_folder", str(Path(path).parent))
+        self._remember(path)
+        for note in notes:
+            self.say(f"note: {note}")
+        canopy, m, read_s, measure_s, mesh, columns, row = parts
+        self._on_built(jobs.Built(MESH_LEVEL, MESH_LEVEL, canopy, m, read_s, measure_s, mesh,
+                                  columns, row, self.model.serial))
 
     def choose_project(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self, "Open project", self._folder(),
@@ -938,6 +1012,10 @@ class MainWindow(QMainWindow):
 
     def save_project(self, path: str | Path) -> None:
         """Write the project (points, layout, settings, light results) in a worker."""
+        if self.model.mesh_path is not None:
+            self.say("error: a canopy read from a mesh file is not saved in a project (a "
+                     "project keeps digitized points); export its light instead", error=True)
+            return
         if self.loaded is None:
             self.say("error: nothing to save yet: open a points file first", error=True)
             return
