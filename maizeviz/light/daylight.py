@@ -474,9 +474,10 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
     """
     from maizeviz.light.sky import make_sky
 
-    if diffuse is not None and diffuse.n_steps != period.n_steps:
-        raise MaizevizError(f"the diffuse split has {diffuse.n_steps} time steps but the period "
-                            f"{period.n_steps}", quantity="sky")
+    if diffuse is not None and (diffuse.n_steps != period.n_steps or not np.allclose(
+            diffuse.dhi_w_m2, period.dhi, rtol=1e-9, atol=1e-9)):
+        raise MaizevizError("the diffuse split is not this period's: its steps or its diffuse "
+                            "irradiance differ (split the period itself)", quantity="sky")
     smp, warnings, build_s, bins = _prepare(canopy, sampling, with_stalks, scene, bin_cm)
     edges = bins.edges
     warnings += list(period.notes)

@@ -79,6 +79,9 @@ PEREZ_MODELS = {
     "perez-driesse": "Perez-Driesse continuous form of the Perez 1990 sky (Driesse et al. "
                      "2024, pvlib)",
 }
+#: The arrays of a :class:`DiffuseSplit`, in its constructor's order after ``model``.
+SPLIT_ARRAYS = ("isotropic_w_m2", "circumsolar_w_m2", "horizon_w_m2", "horizon_vertical_w_m2",
+                "f1", "f2", "clearness", "brightness")
 #: Below this solar elevation (deg) Perez's horizontal parts add to less than dhi.
 LOW_SUN_ELEVATION_DEG = 5.0
 
@@ -102,7 +105,8 @@ class DiffuseSplit:
     horizon_vertical_w_m2 : (n,) float64 W/m2: what the horizon band gives a vertical plane,
         F2 dhi (negative: horizon darkening); not traced
     f1, f2 : (n,) float64: Perez's circumsolar and horizon coefficients of each step
-    clearness : (n,) float64: Perez's sky clearness epsilon (1: overcast; above 6.2: clear)
+    clearness : (n,) float64: Perez's sky clearness epsilon (1: overcast; above 6.2: clear;
+        NaN where dhi is 0)
     brightness : (n,) float64: Perez's sky brightness delta = dhi m / I0
 
     For every step ``isotropic + circumsolar + horizon == dhi`` (to rounding) and each part is
@@ -124,8 +128,7 @@ class DiffuseSplit:
             raise MaizevizError(f"unknown diffuse model '{self.model}' (known: "
                                 f"{', '.join(PEREZ_MODELS)})", quantity="sky")
         n = len(self.isotropic_w_m2)
-        for name in ("isotropic_w_m2", "circumsolar_w_m2", "horizon_w_m2",
-                     "horizon_vertical_w_m2", "f1", "f2", "clearness", "brightness"):
+        for name in SPLIT_ARRAYS:
             arr = _frozen(getattr(self, name))
             if arr.shape != (n,):
                 raise MaizevizError(f"diffuse split {name} must hold {n} numbers, got shape "
@@ -214,7 +217,7 @@ def perez_split(period: Period, model: str = "perez") -> DiffuseSplit:
     zr = np.radians(zen)
     with np.errstate(invalid="ignore", divide="ignore"):
         eps = np.where(lit, ((dhi + dni) / np.where(lit, dhi, 1.0) + kappa * zr ** 3)
-                       / (1.0 + kappa * zr ** 3), np.inf)
+                       / (1.0 + kappa * zr ** 3), np.nan)
     delta = dhi * airmass / extra
     return DiffuseSplit(key, iso, circ, np.zeros(n), f2 * dhi, f1, f2, eps, delta)
 

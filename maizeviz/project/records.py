@@ -44,6 +44,8 @@ _PERIOD_ARRAYS = ("step_s", "zenith_deg", "azimuth_deg", "ghi", "dni", "dhi",
                   "direct_horizontal")
 #: Prefix of the arrays of a day's sky light.
 _DIFFUSE = "diffuse_"
+#: Prefix of the arrays of a day's diffuse split by Perez's model.
+_PEREZ = "perez_"
 _OFFSET = re.compile(r"(Z|[+-]\d\d:?\d\d(:?\d\d(\.\d+)?)?)$")
 _FIXED_ZONE = re.compile(r"UTC([+-])(\d\d):(\d\d)")
 #: Fractions may exceed 1 by rounding (weighted sums): the bound checked on reading.
@@ -125,6 +127,8 @@ def sky_record(label: str, light, settings: dict | None = None) -> Record:
 def day_record(label: str, light, settings: dict | None = None) -> Record:
     """A day result (``PeriodLight`` traced on the canopy labelled ``label``); ``settings``
     as :func:`sky_record`."""
+    from maizeviz.light.perez import SPLIT_ARRAYS
+
     p = light.period
     meta = _common_meta(label, light)
     meta["period"] = {"times": [t.isoformat() for t in p.times],
@@ -141,6 +145,10 @@ def day_record(label: str, light, settings: dict | None = None) -> Record:
                    "triangle_direct_mol": np.asarray(light.triangle_direct_mol, np.float64),
                    "triangle_diffuse_mol": np.asarray(light.triangle_diffuse_mol, np.float64)})
     arrays.update(_map_arrays(light))
+    if light.diffuse is not None:                   # each step's diffuse light split by Perez
+        meta["diffuse_model"] = str(light.diffuse.model)
+        arrays.update({f"{_PEREZ}{name}": np.asarray(getattr(light.diffuse, name), np.float64)
+                       for name in SPLIT_ARRAYS})
     if light.sky is not None:
         sky_meta, sky_arrays = _sky_parts(light.sky, _DIFFUSE)
         meta["sky"] = sky_meta
@@ -390,6 +398,7 @@ def day_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None]:
     """(label, PeriodLight, stored settings or None) from a ``light_day`` record; refused with
     ProjectError if malformed."""
     from maizeviz.light.daylight import PeriodLight
+    from maizeviz.light.perez import SPLIT_ARRAYS, DiffuseSplit
 
     m = rec.meta
     what = "a day result"
@@ -412,9 +421,20 @@ def day_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None]:
     elif n:
         raise ProjectError(f"{where}: a day result with time steps has no sky light; the "
                            "project is damaged")
+    split = None
+    model = get(m, "diffuse_model", str, None, f"{where}: {what}")
+    if model is not None:
+        parts = {name: _array(rec, f"{_PEREZ}{name}", where, what, (n,),
+                              nan=name == "clearness") for name in SPLIT_ARRAYS}
+        try:
+            split = DiffuseSplit(model, **parts)
+        except MaizevizError as exc:
+            raise ProjectError(f"{where}: {what}: its diffuse split cannot be used ({exc}); "
+                               "the project is damaged") from None
     light = PeriodLight(period=period, sky=sky, step_transmission=step_t,
                         step_intercepted_fraction=step_f, triangle_direct_mol=direct,
-                        triangle_diffuse_mol=diffuse, **_maps(rec, "", n_h, where, what), **c)
+                        triangle_diffuse_mol=diffuse, diffuse=split,
+                        **_maps(rec, "", n_h, where, what), **c)
     return (str(get(m, "label", str, light.level, where)), light,
             get(m, "settings", dict, None, where))
 
