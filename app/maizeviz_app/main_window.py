@@ -701,9 +701,10 @@ class MainWindow(QMainWindow):
             return
         run = self.runs.latest(self.signature(self.built.label))
         if run is not None and run.kind == "sun" and run.classes is not None and \
-                run.extra is None:
+                (run.extra is None or run.extra.leaf_value is None):
             self.viewport.set_light(run.classes)
-        elif run is not None and run.extra is not None:
+        elif run is not None and run.extra is not None and \
+                getattr(run.extra, "leaf_value", None) is not None:
             title, unit = value_legend(run)
             self.viewport.set_light_values(run.extra.leaf_value, title, unit)
         if colour and run is not None:
@@ -1027,8 +1028,16 @@ class MainWindow(QMainWindow):
         canopy = {"tile": self.tile_n, "level": self.level,
                   "preserve_area": self.canopy_panel.preserve.isChecked()}
         light = self.light_panel.settings()
-        runs = [(r.label, r.result, project.settings_doc(r.kind, self.runs.settings.get(r.kind)))
-                for r in self.runs.in_order()]
+        runs = []
+        sun_settings = self.runs.settings.get("sun")
+        optics = sun_settings[2] if isinstance(sun_settings, tuple) and \
+            len(sun_settings) == 3 else None
+        for r in self.runs.in_order():
+            runs.append((r.label, r.result,
+                         project.settings_doc(r.kind, self.runs.settings.get(r.kind))))
+            if r.balance is not None:              # the sun's absorbed light beside it
+                runs.append((r.label, r.extra.light, project.settings_doc("absorbed",
+                                                                           optics)))
         path = str(path)
 
         def work(job):
@@ -1115,13 +1124,20 @@ class MainWindow(QMainWindow):
         shown are computed against it, the others' when their level is shown)."""
         if not self._pending_runs or self.built is None:
             return
-        from maizeviz_app import plots
+        from maizeviz_app import jobs, plots
 
         pending, self._pending_runs = self._pending_runs, []
+        absorbed = {s.label: s for s in pending if s.kind == "absorbed"}
+        pending = [s for s in pending if s.kind != "absorbed"]
         for stored in pending:
             label, result, kind, settings = stored
+            extra = None
             if kind == "sun":
-                settings = (round(result.sun.zenith_deg, 6), round(result.sun.azimuth_deg, 6))
+                kept = absorbed.get(label)
+                settings = (round(result.sun.zenith_deg, 6), round(result.sun.azimuth_deg, 6),
+                            kept.settings if kept is not None else None)
+                if kept is not None:                # computed against the canopy later
+                    extra = jobs.Absorbed(kept.result, None, None)
                 density = result.density
             elif kind == "sky":
                 density = result.density
@@ -1130,9 +1146,9 @@ class MainWindow(QMainWindow):
                     self.light_panel.density.value()
             sampling = (tuple(float(h) for h in result.heights_cm), density,
                         bool(getattr(result, "periodic", self.light_panel.periodic.isChecked())))
-            self.model.add_run(Run(label, self.signature(label), result, None, kind), settings,
-                               sampling, f"{len(pending)} light result(s) from the project",
-                               saved=True)
+            self.model.add_run(Run(label, self.signature(label), result, None, kind, extra),
+                               settings, sampling,
+                               f"{len(pending)} light result(s) from the project", saved=True)
         here = self.signature(self.built.label)
         shown = {}
         for kind in MODES:
@@ -1143,7 +1159,7 @@ class MainWindow(QMainWindow):
             return
         day = shown.get("day")
         self.light_panel.show_summary(day_summary(day.result) if day is not None else "")
-        self.light_panel.show_plants(self.runs.latest(None, ("sky", "day")))
+        self.light_panel.show_plants(self._plants_run())
         latest = self.runs.latest(here) or self.runs.last
         order = sorted(shown, key=lambda k: latest is not None and k == latest.kind)
         curves = self.runs.curves()
@@ -1168,6 +1184,13 @@ class MainWindow(QMainWindow):
                         on_error=lambda e: self._fail(e, "light"))
         self._light_to_view(colour=True)
 
+    def _plants_run(self) -> Run | None:
+        """The latest result with light per plant to show: a sky's, a day's or a sun's
+        absorbed light (once computed against its canopy)."""
+        runs = [r for r in self.runs.runs.values()
+                if r.kind != "sun" or getattr(r.extra, "plant_rows", None) is not None]
+        return max(runs, key=lambda r: self.runs.in_order().index(r), default=None)
+
     def _complete_runs(self) -> None:
         """Results read from a project that were traced on the canopy shown get what the
         window shows of them, computed against it in a worker: a sun's light class per
@@ -1182,7 +1205,8 @@ class MainWindow(QMainWindow):
             if run.signature != here:
                 continue
             r = run.result
-            if run.kind == "sun" and run.classes is None:
+            if run.kind == "sun" and (run.classes is None or run.extra is not None
+                                      and run.extra.leaf_value is None):
                 if r.first_hits is not None and len(r.first_hits) >= n:
                     todo.append(run)
             elif run.kind != "sun" and run.extra is None:
@@ -1196,21 +1220,27 @@ class MainWindow(QMainWindow):
             from maizeviz.light.leaf_light import triangle_light
             from maizeviz_app import jobs
 
-            done = []
+            done: list[Any] = []
             for run in todo:
                 job.check()
-                done.append(triangle_light(canopy, run.result) if run.kind == "sun"
-                            else jobs.diffuse_of(canopy, run.result, run.kind))
+                if run.kind == "sun":
+                    absorbed = None if run.extra is None else \
+                        jobs.absorbed_of(canopy, run.extra.light)
+                    done.append((triangle_light(canopy, run.result), absorbed))
+                else:
+                    done.append(jobs.diffuse_of(canopy, run.result, run.kind))
             return done
 
         def adopt(done):
             for run, value in zip(todo, done):
                 if run.kind == "sun":
-                    run.classes = value
+                    run.classes, absorbed = value
+                    if absorbed is not None:
+                        run.extra = absorbed
                 else:
                     run.extra = value
             if self.built is not None and self.signature(self.built.label) == here:
-                self.light_panel.show_plants(self.runs.latest(None, ("sky", "day")))
+                self.light_panel.show_plants(self._plants_run())
                 self._light_to_view(colour=True)
                 if self.runner.current("figures") is None:     # else: when they are drawn
                     self.light_shown.emit()
