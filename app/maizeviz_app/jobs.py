@@ -216,7 +216,8 @@ def op_period(state: dict, progress, sampling, sky: SkySpec, day: DaySpec) -> Di
 
     period = day.period()
     engine = _engine(state)
-    sky_obj = sky.sky()
+    perez = day.diffuse == "perez"             # the sky's directions, as a uniform sky
+    sky_obj = SkySpec("uoc", sky.directions, sky.split).sky() if perez else sky.sky()
     n_sky = 0 if engine.kept_sky(sky_obj, sampling) is not None else sky_obj.n
 
     def steps(done: int, total: int):
@@ -224,7 +225,8 @@ def op_period(state: dict, progress, sampling, sky: SkySpec, day: DaySpec) -> Di
             return progress(done, total, f"sky direction {done} of {n_sky}")
         return progress(done, total, f"time step {done - n_sky} of {total - n_sky}")
 
-    light = engine.day(period, sky=sky_obj, sampling=sampling, progress=steps)
+    light = engine.day(period, sky="perez" if perez else sky_obj, directions=sky_obj.n,
+                       sampling=sampling, progress=steps)
     return _diffuse(state, light, period_leaf_rows(state["canopy"], light),
                     "par_intercepted_mol", light.seconds["build"])
 

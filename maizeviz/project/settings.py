@@ -47,7 +47,14 @@ def _day_spec(doc: dict, where: str) -> DaySpec:
                    float(get(doc, "step_min", (int, float), where=at)), text_or_none("start"),
                    text_or_none("end"), float(get(doc, "linke", (int, float), where=at)),
                    float(get(doc, "par_factor", (int, float), where=at)),
-                   text_or_none("weather"))
+                   text_or_none("weather"), _choice(doc, "diffuse", ("sky", "perez"), at))
+
+
+def _choice(doc: dict, key: str, allowed: tuple[str, ...], at: str) -> str:
+    value = get(doc, key, str, allowed[0], at)
+    if value not in allowed:
+        raise ProjectError(f"{at}: '{key}' is '{value[:40]}', not one of {', '.join(allowed)}")
+    return value
 
 
 def run_settings(kind: str, result, stored: dict | None, where: str) -> Any:

@@ -96,3 +96,25 @@ def test_optics_out_of_range_is_one_line_on_the_field(window, qtbot, small_point
         p.compute_button.click()
     assert "1" in sig.args[0] and "internal" not in sig.args[0]
     assert "border" in p.transmittance.styleSheet() or "border" in p.reflectance.styleSheet()
+
+
+def test_a_day_with_perez_diffuse_light(window, qtbot, small_points, tmp_path):
+    """Day mode with Perez's anisotropic diffuse light: the same directions traced, the
+    circumsolar share said, the choice saved in the project."""
+    w = shown(qtbot, window(small_points, tile=1))
+    p = w.light_panel
+    small_light(p, "day")
+    p.day_diffuse.setCurrentIndex(p.day_diffuse.findData("perez"))
+    compute(qtbot, w)
+    day = w.runs.last.result
+    assert day.diffuse is not None and day.diffuse.model == "perez"
+    assert "Perez anisotropic" in p.info.text() and "circumsolar" in p.info.text()
+    total = day.par_diffuse_mol_m2
+    assert abs(float(day.step_diffuse_mol_m2.sum()) - total) < 1e-9 * max(total, 1)
+    path = tmp_path / "perez.maizeviz"
+    with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
+        w.save_project(path)
+    w2 = window(path)
+    qtbot.waitUntil(lambda: w2.runs.last is not None, timeout=TIMEOUT)
+    assert w2.light_panel.day_diffuse.currentData() == "perez"
+    assert w2.runs.last.result.diffuse is not None
