@@ -12,6 +12,7 @@ import json
 import math
 import os
 import time
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -54,7 +55,7 @@ from maizeviz.light.irradiance import (
     weather_period,
 )
 from maizeviz.light.leaf_light import leaf_light, merge_rows, plant_light
-from maizeviz.light.optics import BANDS, optics_for
+from maizeviz.light.optics import BANDS, optics_for, read_optics_table
 from maizeviz.light.perez import PEREZ_MODELS, split_summary
 from maizeviz.light.reports import period_leaf_rows, sky_leaf_rows, write_steps
 from maizeviz.light.request import Sampling
@@ -152,6 +153,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                     help="leaf transmittance in the band (PAR default 0.05, NIR 0.40)")
     ab.add_argument("--ground-reflectance", type=float, default=None, metavar="G",
                     help="soil reflectance in the band (PAR default 0.10, NIR 0.25)")
+    ab.add_argument("--optics-table", metavar="CSV",
+                    help="leaf optics per leaf rank: a CSV with rank,reflectance,transmittance "
+                         "(and optionally band); ranks it does not name take --reflectance and "
+                         "--transmittance (or the band's defaults)")
     ab.add_argument("--irradiance", type=float, default=None, metavar="W_M2",
                     help="the band's direct irradiance on a horizontal plane, W/m2 (default "
                          "its share of 1000 W/m2: PAR 480, NIR 520)")
@@ -166,8 +171,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 def _absorbed_asked(args: argparse.Namespace) -> bool:
     return any(v is not None for v in (args.band, args.reflectance, args.transmittance,
-                                        args.ground_reflectance, args.irradiance)) or \
-        bool(args.diffuse)
+                                        args.ground_reflectance, args.irradiance,
+                                        args.optics_table)) or bool(args.diffuse)
 
 
 # ------------------------------------------------------------------------------ what is asked
@@ -281,6 +286,9 @@ def run(args: argparse.Namespace) -> int:
                                 quantity="band")
         absorbed_optics = optics_for(args.band or "par", args.reflectance, args.transmittance,
                                      args.ground_reflectance)
+        if args.optics_table:
+            absorbed_optics = replace(absorbed_optics, ranks=read_optics_table(
+                args.optics_table, absorbed_optics.band))
         if args.irradiance is not None:
             check_range(args.irradiance, "the direct irradiance (W/m2)", 0, 5000, "irradiance")
         check_range(args.diffuse, "the diffuse irradiance (W/m2)", 0, 5000, "irradiance")
@@ -542,7 +550,7 @@ def _check_paths(args: argparse.Namespace, labels: list[str], sun: bool,
         [(what, level_path(path, label, len(labels))) for what, path in tables if path
          for label in labels],
         [(input_name(args.points), args.points), ("the layout file", args.layout),
-         ("the weather file", args.weather)],
+         ("the weather file", args.weather), ("the optics table", args.optics_table)],
         [OutputFolder("the heatmap folder", args.heatmaps, maps),
          OutputFolder("the plot folder", args.plots if period else None,
                       [_plot_name(label) for label in labels])])

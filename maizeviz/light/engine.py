@@ -345,14 +345,21 @@ class LightEngine:
                 beams.append((np.asarray(toward, np.float64), diffuse_w_m2 * float(weight)))
         area_m2 = smp.ray_area_cm2 * 1e-4 * smp.n
         nf = len(normals)
+        leaf_optics, kept = None, 1.0 - opt.scattering
+        if opt.ranks:                                # leaves differ by rank (stalks: 0)
+            rank = np.zeros(nf, np.int64)
+            rank[:self.canopy.n_triangles] = self.canopy.face_leaf
+            leaf_optics = opt.per_triangle(rank)
+            kept = 1.0 - (leaf_optics[0] + leaf_optics[1])
         absorbed, sunlit = np.zeros(nf), np.zeros(nf)
         parts = dict.fromkeys(("ground", "top", "sides", "unresolved"), 0.0)
         events, seconds = 0, {"build": build_s, "trace": 0.0, "scatter": 0.0}
         for k, (toward, irradiance) in enumerate(beams):
             tally, secs = scatter_beam(smp, toward, opt, normals, depth, threshold,
-                                       seed + 7919 * k, smp_req.threads)
+                                       seed + 7919 * k, smp_req.threads,
+                                       leaf_optics=leaf_optics)
             per_ray = irradiance * smp.ray_area_cm2 * 1e-4       # W carried by one ray
-            absorbed += tally.per_triangle(nf, (1.0 - opt.scattering) * per_ray)
+            absorbed += tally.per_triangle(nf, kept * per_ray)
             if k == 0 and sun is not None and direct > 0:
                 # cm2 of leaf a ray's beam covers: its footprint across the beam over the
                 # cosine of the leaf's tilt to it

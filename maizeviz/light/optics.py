@@ -51,12 +51,16 @@ class Optics:
     reflectance, transmittance : leaf, fractions in [0, 1] with a sum <= 1
     ground_reflectance : soil, fraction in [0, 1]
     band : ``"par"`` or ``"nir"`` (names the results' units)
+    ranks : ((rank, reflectance, transmittance), ...): leaves of these ranks (1: the lowest
+        leaf of a plant) take their own values (older, lower leaves are often paler); the
+        others take ``reflectance`` and ``transmittance``; stalks too
     """
 
     reflectance: float
     transmittance: float
     ground_reflectance: float
     band: str = "par"
+    ranks: tuple[tuple[int, float, float], ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("reflectance", "transmittance", "ground_reflectance"):
@@ -73,6 +77,36 @@ class Optics:
         if self.band not in BANDS:
             raise MaizevizError(f"unknown band '{self.band}' (known: {', '.join(BANDS)})",
                                 quantity="band")
+        ranks = []
+        for row in self.ranks:
+            if not isinstance(row, (tuple, list)) or len(row) != 3:
+                raise MaizevizError(f"a row of the optics table must be (rank, reflectance, "
+                                    f"transmittance), got {str(row)[:60]}",
+                                    quantity="optics_table")
+            rank, rho, tau = row
+            if isinstance(rank, bool) or not isinstance(rank, int) or not 1 <= rank <= 10_000:
+                raise MaizevizError(f"a leaf rank must be a whole number from 1 to 10000, got "
+                                    f"{rank!r}", quantity="optics_table")
+            leaf = Optics(rho, tau, self.ground_reflectance, self.band)    # checked alike
+            ranks.append((rank, leaf.reflectance, leaf.transmittance))
+        if len({r for r, _, _ in ranks}) != len(ranks):
+            raise MaizevizError("a leaf rank appears twice in the optics table",
+                                quantity="optics_table")
+        object.__setattr__(self, "ranks", tuple(sorted(ranks)))
+
+    def per_triangle(self, leaf_rank) -> tuple:
+        """(reflectance, transmittance) of every triangle, (F,) float64 each, from its leaf's
+        rank ``leaf_rank`` (F,) int (1: the lowest leaf; 0: a stalk): the ranks' table where
+        it names the rank, else this optics' leaf values."""
+        import numpy as np
+
+        ranks = np.asarray(leaf_rank, dtype=np.int64)
+        rho = np.full(len(ranks), self.reflectance)
+        tau = np.full(len(ranks), self.transmittance)
+        for rank, r, t in self.ranks:
+            at = ranks == rank
+            rho[at], tau[at] = r, t
+        return rho, tau
 
     @property
     def scattering(self) -> float:
@@ -82,7 +116,8 @@ class Optics:
     @property
     def black(self) -> bool:
         """Nothing is scattered: leaves and ground absorb all they intercept."""
-        return self.scattering == 0.0 and self.ground_reflectance == 0.0
+        return self.scattering == 0.0 and self.ground_reflectance == 0.0 and \
+            all(r + t == 0.0 for _, r, t in self.ranks)
 
 
 #: Maize defaults per band (module docstring).
@@ -108,3 +143,51 @@ def optics_for(band: str = "par", reflectance: float | None = None,
                   d.transmittance if transmittance is None else transmittance,
                   d.ground_reflectance if ground_reflectance is None else ground_reflectance,
                   band)
+
+
+def read_optics_table(path, band: str) -> tuple[tuple[int, float, float], ...]:
+    """Leaf optics per rank from a CSV with a header ``rank,reflectance,transmittance`` (and
+    optionally ``band``: rows of other bands are left out), one row per leaf rank.
+
+    Raises
+    ------
+    MaizevizError
+        The file cannot be read, a column is missing, a value is not a number (naming the
+        line), a rank appears twice; values are checked by :class:`Optics`.
+    """
+    import csv
+
+    from maizeviz.io.inputs import read_input
+
+    text = read_input(path, "optics table", max_bytes=4 * 2**20).decode("utf-8", "replace")
+    rows = list(csv.reader(text.splitlines()))
+    if not rows:
+        raise MaizevizError(f"{path}: the optics table is empty", quantity="optics_table")
+    head = [h.strip().lower() for h in rows[0]]
+    for need in ("rank", "reflectance", "transmittance"):
+        if need not in head:
+            raise MaizevizError(f"{path}: the optics table has no '{need}' column (header: "
+                                "rank,reflectance,transmittance[,band])",
+                                quantity="optics_table")
+    col = {h: i for i, h in enumerate(head)}
+    out = []
+    for line, row in enumerate(rows[1:], start=2):
+        if not any(c.strip() for c in row):
+            continue
+        if len(row) != len(head):
+            raise MaizevizError(f"{path}, line {line}: {len(row)} values for {len(head)} "
+                                "columns", quantity="optics_table")
+        if "band" in col and row[col["band"]].strip().lower() != band:
+            continue
+        try:
+            rank = int(row[col["rank"]])
+            rho, tau = float(row[col["reflectance"]]), float(row[col["transmittance"]])
+        except ValueError:
+            raise MaizevizError(f"{path}, line {line}: rank, reflectance and transmittance "
+                                f"must be numbers, got {', '.join(c[:20] for c in row)}",
+                                quantity="optics_table") from None
+        out.append((rank, rho, tau))
+    if not out:
+        raise MaizevizError(f"{path}: the optics table has no row for the {band.upper()} band",
+                            quantity="optics_table")
+    return tuple(out)

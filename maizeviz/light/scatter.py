@@ -186,12 +186,16 @@ def follow(smp: Sampler, rays: _Rays, max_crossings: int = 1000
 
 
 def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng,
-            kind: np.ndarray, prim: np.ndarray, end: np.ndarray, dirs: np.ndarray) -> _Rays:
+            kind: np.ndarray, prim: np.ndarray, end: np.ndarray, dirs: np.ndarray,
+            leaf_optics: tuple | None = None) -> _Rays:
     """Deposit what rays ending at leaves and the ground absorb, count those leaving, and draw
-    the rays that go on (Russian roulette on the scattering coefficient)."""
+    the rays that go on (Russian roulette on the scattering coefficient); ``leaf_optics``:
+    (reflectance, transmittance) per triangle (F,) when leaves differ by rank."""
     leaf = kind == LEAF
     sc = optics.scattering
-    if sc < 1.0:
+    if leaf_optics is not None:
+        tally.leaf_hits.append(prim[leaf])
+    elif sc < 1.0:
         tally.leaf_hits.append(prim[leaf])
     ground = kind == GROUND
     tally.ground += np.count_nonzero(ground) * (1.0 - optics.ground_reflectance)
@@ -200,12 +204,19 @@ def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng
     tally.unresolved += np.count_nonzero(kind == LOST)
     parts_o, parts_d = [], []
     go = np.flatnonzero(leaf)
-    go = go[rng.random(len(go)) < sc] if sc > 0 else go[:0]
+    if leaf_optics is not None:
+        rho_t, tau_t = leaf_optics[0][prim[go]], leaf_optics[1][prim[go]]
+        sc_t = rho_t + tau_t
+        keep = rng.random(len(go)) < sc_t
+        go, rho_go = go[keep], rho_t[keep] / np.where(sc_t[keep] > 0, sc_t[keep], 1.0)
+    else:
+        go = go[rng.random(len(go)) < sc] if sc > 0 else go[:0]
+        rho_go = optics.reflectance / sc if sc > 0 else 0.0
     if len(go):
         n = normals[prim[go]]
         facing = np.einsum("ij,ij->i", n, dirs[go])             # < 0: hit the front side
         back = np.where(facing < 0, 1.0, -1.0)[:, None] * n     # the side the ray came from
-        reflect = rng.random(len(go)) < optics.reflectance / sc
+        reflect = rng.random(len(go)) < rho_go
         side = np.where(reflect[:, None], back, -back)
         parts_o.append(end[go] + EPS_CM * side)
         parts_d.append(lambertian(side, rng))
@@ -226,7 +237,8 @@ def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng
 def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.ndarray,
                  depth: int = DEFAULT_DEPTH, threshold: float = DEFAULT_THRESHOLD,
                  seed: int = 0, threads: int = 1, progress: ProgressCallback | None = None,
-                 stop: threading.Event | None = None) -> tuple[Tally, dict[str, float]]:
+                 stop: threading.Event | None = None,
+                 leaf_optics: tuple | None = None) -> tuple[Tally, dict[str, float]]:
     """Follow one parallel beam through the canopy (see the module docstring).
 
     Parameters
@@ -239,6 +251,8 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
         travelling below which tracing stops (the rest is unresolved)
     seed : of the random generator (one stream per chunk of rays: the same numbers whatever
         ``threads``)
+    leaf_optics : (reflectance, transmittance) of every triangle, (F,) each, when leaves
+        differ by rank (:meth:`~maizeviz.light.optics.Optics.per_triangle`); None: ``optics``
 
     Returns
     -------
@@ -269,13 +283,14 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
         end[:, 2] = height
         tally.first_hits.append(prim[hit])
         dirs = np.broadcast_to(-s, (b - a, 3))
-        rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, dirs)
+        rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, dirs, leaf_optics)
         for _ in range(depth):
             if len(rays.org) <= threshold * (b - a):
                 break
             tally.events += len(rays.org)
             kind, prim, end = follow(smp, rays)
-            rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, rays.dirs)
+            rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, rays.dirs,
+                           leaf_optics)
         tally.unresolved += len(rays.org)
         return tally
 

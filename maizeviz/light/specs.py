@@ -141,6 +141,8 @@ class OpticsSpec:
         Scatterings followed (0: first hits only).
     seed : int
         Random seed of the Monte Carlo scattering (the same seed gives the same result).
+    ranks : tuple of (rank, reflectance, transmittance)
+        Leaf optics of the ranks that differ (see :class:`maizeviz.light.optics.Optics`).
     """
 
     band: str = "par"
@@ -151,14 +153,18 @@ class OpticsSpec:
     diffuse_w_m2: float = 0.0
     depth: int = 3
     seed: int = 0
+    ranks: tuple = ()
 
     def optics(self):
         """The :class:`~maizeviz.light.optics.Optics` of the band (checked: MaizevizError
         naming the value out of range)."""
+        from dataclasses import replace
+
         from maizeviz.light.optics import optics_for
 
-        return optics_for(self.band, self.reflectance, self.transmittance,
+        base = optics_for(self.band, self.reflectance, self.transmittance,
                           self.ground_reflectance)
+        return replace(base, ranks=tuple(tuple(r) for r in self.ranks)) if self.ranks else base
 
     def absorbed(self, engine, sun, sampling=None, progress=None):
         """Trace it: ``engine.absorbed`` for ``sun`` (an AbsorbedLight)."""

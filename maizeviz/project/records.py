@@ -197,7 +197,8 @@ def absorbed_record(label: str, light, settings: dict | None = None) -> Record:
     meta = {"label": label, "level": light.level, "band": light.band,
             "optics": {"reflectance": float(o.reflectance),
                        "transmittance": float(o.transmittance),
-                       "ground_reflectance": float(o.ground_reflectance)},
+                       "ground_reflectance": float(o.ground_reflectance),
+                       "ranks": [[int(r), float(a), float(b)] for r, a, b in o.ranks]},
             "irradiance_w_m2": float(light.irradiance_w_m2),
             "balance": {k: float(getattr(light.balance, k)) for k in _BALANCE},
             "rect": _floats(light.rect), "rays": int(light.rays),
@@ -552,7 +553,8 @@ def absorbed_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None
         light = AbsorbedLight(
             band, Optics(_number(optics, "reflectance", where, what, 0, 1),
                          _number(optics, "transmittance", where, what, 0, 1),
-                         _number(optics, "ground_reflectance", where, what, 0, 1), band),
+                         _number(optics, "ground_reflectance", where, what, 0, 1), band,
+                         _ranks(optics, at)),
             _number(m, "irradiance_w_m2", where, what, 0),
             Balance(*(_number(balance, k, where, what) for k in _BALANCE)),
             absorbed, sunlit, (rect[0], rect[1], rect[2], rect[3]),
@@ -565,6 +567,15 @@ def absorbed_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None
     except (ValueError, TypeError, MaizevizError) as exc:
         raise ProjectError(f"{at} cannot be used ({exc})") from None
     return str(get(m, "label", str, light.level, at)), light, settings
+
+
+def _ranks(optics: dict, at: str) -> tuple:
+    """Leaf optics per rank of a record: ((rank, reflectance, transmittance), ...)."""
+    rows = get(optics, "ranks", list, [], at)
+    if len(rows) > 10_000 or not all(isinstance(r, list) and len(r) == 3 for r in rows):
+        raise ProjectError(f"{at}: its optics per leaf rank are malformed; the project is "
+                           "damaged")
+    return tuple((r[0], r[1], r[2]) for r in rows)
 
 
 def run_from_record(rec: Record, where: str) -> tuple[str, Any, str, dict | None] | None:

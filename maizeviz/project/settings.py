@@ -91,9 +91,11 @@ def _optics_spec(stored: dict | None, light, where: str) -> OpticsSpec:
                       number_or_none("transmittance"), number_or_none("ground_reflectance"),
                       number_or_none("direct_w_m2"),
                       float(get(doc, "diffuse_w_m2", (int, float), 0.0, at)),
-                      get(doc, "depth", int, 3, at), get(doc, "seed", int, 0, at))
+                      get(doc, "depth", int, 3, at), get(doc, "seed", int, 0, at),
+                      tuple(tuple(r) for r in get(doc, "ranks", list, [], at)
+                            if isinstance(r, list)))
     try:
         spec.optics()
-    except MaizevizError as exc:
+    except (MaizevizError, TypeError, ValueError) as exc:
         raise ProjectError(f"{at}: {exc}") from None
     return spec

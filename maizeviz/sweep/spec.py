@@ -26,7 +26,8 @@ Defaults are those of ``maizeviz canopy`` and ``maizeviz light``::
     optics = ["black",             # leaf optics: "black" (interception only, the default) or
               {band = "par"},      # a table: absorbed light with scattering, each key optional:
               {band = "nir", reflectance = 0.45, transmittance = 0.40, ground_reflectance = 0.25,
-               direct_w_m2 = 520, diffuse_w_m2 = 0, depth = 3, seed = 0}]
+               direct_w_m2 = 520, diffuse_w_m2 = 0, depth = 3, seed = 0,
+               ranks = [[1, 0.5, 0.35], [2, 0.48, 0.38]]}]   # [rank, rho, tau] per leaf rank
 
     [[exclude]]                    # partial scenarios to drop (or, before [canopy]:
     level = "K4"                   # exclude = [{level = "K4", density = 16}])
@@ -84,7 +85,7 @@ AXES = ("points", "tile", "row_spacing", "plant_spacing", "layout", "level", "pr
 #: Keys of an optics table (:class:`maizeviz.light.specs.OpticsSpec`); "black" (or false) is
 #: the black leaves of interception.
 OPTICS_KEYS = ("band", "reflectance", "transmittance", "ground_reflectance", "direct_w_m2",
-               "diffuse_w_m2", "depth", "seed")
+               "diffuse_w_m2", "depth", "seed", "ranks")
 #: Most scatterings a sweep follows.
 MAX_DEPTH = 50
 SUN_ANGLE_KEYS = ("zenith", "azimuth")
@@ -414,6 +415,13 @@ class _Checker:
                                               f"{MAX_DEPTH if k == 'depth' else 2**31 - 1}, "
                                               f"got {x!r}")
                 t[k] = x
+        if "ranks" in v:
+            rows = v["ranks"]
+            if not isinstance(rows, list) or not all(
+                    isinstance(r, list) and len(r) == 3 for r in rows):
+                self.fail(f"{where}.ranks", "must be a list of [rank, reflectance, "
+                                            "transmittance], such as [[1, 0.12, 0.06]]")
+            t["ranks"] = tuple(tuple(r) for r in rows)
         spec = OpticsSpec(**t)
         try:
             spec.optics()

@@ -108,3 +108,22 @@ def test_absorbed_light_declaring_more_triangles_than_its_canopy_is_left_out(tra
     results, notes = study.results_on(study.open_project(target), layout, leaves)
     assert not results and len(notes) == 1 and "absorbed result" in notes[0]
     assert load_project(target).results[0].kind == "light_absorbed"
+
+
+def test_optics_per_rank_travel_with_the_absorbed_light(traced, tmp_path):
+    path, leaves, layout, canopy, _ = traced
+    spec = OpticsSpec("par", ranks=((1, 0.2, 0.1), (2, 0.18, 0.08)))
+    engine = LightEngine(canopy, density=0.3, heights_cm=(0.0,), periodic=True, threads=1)
+    light = spec.absorbed(engine, engine.sun(zenith=40, azimuth=120).sun)
+    assert light.optics.ranks == ((1, 0.2, 0.1), (2, 0.18, 0.08))
+    proj = study.make_project(str(path), path.read_bytes(), None, layout,
+                              {"tile": 1, "level": "16"}, {},
+                              [("16 triangles", light, settings_doc("absorbed", spec))])
+    target = tmp_path / "r.maizeviz"
+    save_project(target, proj)
+    got = study.results_on(study.open_project(target), layout, leaves)[0][0]
+    assert got.result.optics == light.optics and got.specs().optics() == light.optics
+    rec = run_record("16 triangles", light)
+    rec.meta["optics"] = dict(rec.meta["optics"], ranks=[[1, 0.2]])
+    with pytest.raises(ProjectError, match="cannot be used"):
+        run_from_record(rec, "p.maizeviz")
