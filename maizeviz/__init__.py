@@ -48,6 +48,8 @@ _EXPORTS = {
     "LightResult": "maizeviz.light.transmission",
     "SkyLight": "maizeviz.light.daylight",
     "PeriodLight": "maizeviz.light.daylight",
+    "AbsorbedLight": "maizeviz.light.scatter",
+    "AbsorbedPeriod": "maizeviz.light.scatter",
     "MaizevizError": "maizeviz.errors",
 }
 

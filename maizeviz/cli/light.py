@@ -280,10 +280,14 @@ def run(args: argparse.Namespace) -> int:
     heights = tuple(floats(args.heights, "heights", "heights"))
     absorbed_optics = None
     if _absorbed_asked(args):
-        if sun is None:
-            raise MaizevizError("absorbed light with scattering needs a sun: give "
-                                "--sun-zenith/--sun-azimuth or --date, --time, --lat, --lon",
-                                quantity="band")
+        if sun is None and not _period_asked(args):
+            raise MaizevizError("absorbed light with scattering needs a sun or a period: "
+                                "give --sun-zenith/--sun-azimuth, --date, --time, --lat, "
+                                "--lon, or --day", quantity="band")
+        if sun is None and (args.irradiance is not None or args.diffuse):
+            raise MaizevizError("over a period the irradiance is the period's (clear sky or "
+                                "weather file): --irradiance and --diffuse are for one sun",
+                                quantity="irradiance")
         absorbed_optics = optics_for(args.band or "par", args.reflectance, args.transmittance,
                                      args.ground_reflectance)
         if args.optics_table:
@@ -394,7 +398,18 @@ def run(args: argparse.Namespace) -> int:
                 said.add(w)
                 say(f"{'note' if w in (period.notes if period else ()) else 'warning'}: {w}")
         rec["warnings"] = list(dict.fromkeys(warnings))
-        if absorbed_optics is not None:
+        if absorbed_optics is not None and sun is None and period is not None:
+            abd = engine.absorbed_day(period, optics=absorbed_optics,
+                                      sky="soc" if args.sky in (None, PEREZ) else args.sky,
+                                      directions=args.sky_directions or 46, depth=args.depth,
+                                      seed=args.seed,
+                                      progress=Progress(f"absorbed light over the period, "
+                                                        f"{label}"))
+            rec["balance"] = dict(abd.balance.as_dict(), units="MJ/m2 of ground")
+            rec["absorbed"] = _absorbed_period_record(abd)
+            rec["seconds"]["scatter"] = abd.seconds.get("trace", 0.0) + \
+                abd.seconds.get("scatter", 0.0)
+        elif absorbed_optics is not None:
             ab = engine.absorbed(sun, optics=absorbed_optics, direct_w_m2=args.irradiance,
                                  diffuse_w_m2=args.diffuse, sky=args.sky or "soc",
                                  directions=args.sky_directions or 46, depth=args.depth,
@@ -434,6 +449,22 @@ def _absorbed_record(ab: AbsorbedLight, canopy: Canopy) -> dict[str, Any]:
         "scatterings": ab.events}
     if ab.band == "par":
         out["absorbed_leaves_umol_m2_s"] = ab.balance.absorbed_leaves * PAR_UMOL_PER_J_PAR
+    return out
+
+
+def _absorbed_period_record(ab) -> dict[str, Any]:
+    """Absorbed light over a period for the JSON output (balance in MJ/m2 of ground)."""
+    o = ab.optics
+    out: dict[str, Any] = {
+        "band": ab.band, "units": "MJ/m2 of ground",
+        "optics": {"reflectance": o.reflectance, "transmittance": o.transmittance,
+                   "ground_reflectance": o.ground_reflectance},
+        "fraction_absorbed": ab.fraction_absorbed, "rays": ab.rays, "depth": ab.depth,
+        "seed": ab.seed,
+        "step_absorbed_leaves_w_m2": [float(w) for w in ab.step_absorbed_leaves_w_m2],
+        "step_incident_w_m2": [float(w) for w in ab.step_incident_w_m2]}
+    if ab.band == "par":
+        out["absorbed_leaves_mol_m2"] = ab.absorbed_leaves_mol_m2
     return out
 
 
@@ -725,18 +756,22 @@ def _print_period(r: dict, label: bool) -> None:
 
 
 def _print_balance(records: list[dict]) -> None:
-    """Absorbed light with scattering: the energy balance per level, W/m2 of ground."""
+    """Absorbed light with scattering: the energy balance per level, W/m2 of ground (MJ/m2
+    over a period, with the PAR the leaves absorbed in mol/m2)."""
     ab = records[0]["absorbed"]
     o = ab["optics"]
+    period = ab["units"].startswith("MJ")
     print(f"\nabsorbed {ab['band'].upper()} with scattering (leaf reflectance "
           f"{o['reflectance']:g}, transmittance {o['transmittance']:g}, ground "
-          f"{o['ground_reflectance']:g}), W/m2 of ground:")
+          f"{o['ground_reflectance']:g}), {ab['units']}:")
     rows = []
     for r in records:
         b = r["balance"]
-        rows.append([r["level"], f"{b['incident']:.1f}", f"{b['absorbed_leaves']:.1f}",
-                     f"{b['absorbed_ground']:.1f}", f"{b['reflected_top']:.1f}",
+        last = f"{r['absorbed'].get('absorbed_leaves_mol_m2') or 0:.2f}" if period else \
+            f"{r['absorbed']['sunlit_lai']:.2f}"
+        rows.append([r["level"], f"{b['incident']:.2f}", f"{b['absorbed_leaves']:.2f}",
+                     f"{b['absorbed_ground']:.2f}", f"{b['reflected_top']:.2f}",
                      f"{b['escaped_sides'] + b['unresolved']:.2f}", f"{b['closure']:+.4f}",
-                     f"{r['absorbed']['sunlit_lai']:.2f}"])
+                     last])
     print(fmt_table(["level", "incident", "leaves", "ground", "reflected", "other",
-                     "closure", "sunlit LAI"], rows))
+                     "closure", "PAR mol/m2" if period else "sunlit LAI"], rows))

@@ -36,6 +36,7 @@ from maizeviz.light.scatter import (
     DEFAULT_DEPTH,
     DEFAULT_THRESHOLD,
     AbsorbedLight,
+    AbsorbedPeriod,
     Balance,
     scatter_beam,
 )
@@ -383,6 +384,79 @@ class LightEngine:
         return AbsorbedLight(opt.band, opt, incident, balance, absorbed, sunlit, rect, smp.n,
                              len(beams), depth, threshold, seed, events, smp_req.periodic,
                              self.canopy.level, seconds)
+
+    def absorbed_day(self, period: Period | None = None, *, band: str = "par",
+                     optics: Optics | None = None, sky: Sky | str = "soc",
+                     directions: int = 46, depth: int = DEFAULT_DEPTH,
+                     threshold: float = DEFAULT_THRESHOLD, seed: int = 0,
+                     sampling: Sampling | None = None,
+                     progress: ProgressCallback | None = None, date: str | None = None,
+                     lat: float | None = None, lon: float | None = None, tz: str = "UTC",
+                     step_min: float = 30.0, start: str | None = None,
+                     end: str | None = None, linke: float = DEFAULT_LINKE_TURBIDITY,
+                     **fields_) -> AbsorbedPeriod:
+        """Light absorbed with scattering over a period (a day), in one band: each step's
+        sun with the band's share of its direct irradiance, and the diffuse part spread over
+        ``sky``, traced once per W/m2 and scaled by each step's diffuse irradiance (the
+        transport is linear in the light put in).
+
+        Parameters
+        ----------
+        period, date, lat, lon, tz, step_min, start, end, linke : the period, as :meth:`day`
+        band, optics, depth, threshold, seed, sampling, **fields_ : as :meth:`absorbed`
+        sky, directions : the diffuse light's sky (default: standard overcast, 46)
+        progress : after the sky and after each step
+
+        Returns
+        -------
+        AbsorbedPeriod
+            ``balance`` in MJ/m2 of ground, J per triangle, ``absorbed_leaves_mol_m2`` (PAR),
+            ``table("plant", canopy)``.
+        """
+        from maizeviz.light.irradiance import clear_sky_period
+
+        if period is None:
+            if date is None or lat is None or lon is None:
+                raise TypeError("give a Period, or date, lat and lon")
+            period = clear_sky_period(date, lat, lon, tz, step_min, start, end, 0.0, linke)
+        opt = optics if optics is not None else optics_for(band)
+        share = SHORTWAVE_SHARE[opt.band]
+        common = dict(band=opt.band, optics=opt, depth=depth, threshold=threshold, seed=seed,
+                      sampling=sampling, **fields_)
+        steps = len(period.step_s)
+        unit = self.absorbed(direct_w_m2=0.0, diffuse_w_m2=1.0, sky=sky,
+                             directions=directions, **common)
+        report(progress, 1, steps + 1, "absorbed light: the sky")
+        diffuse_w = np.asarray(period.dhi, np.float64) * share
+        step_s = np.asarray(period.step_s, np.float64)
+        joules = unit.triangle_absorbed_w * float(np.sum(diffuse_w * step_s))
+        ub = unit.balance
+        parts = {k: getattr(ub, k) * float(np.sum(diffuse_w * step_s))
+                 for k in ("absorbed_leaves", "absorbed_ground", "reflected_top",
+                           "escaped_sides", "unresolved")}
+        leaves_w = ub.absorbed_leaves * diffuse_w
+        seconds = dict(unit.seconds)
+        direct_w = np.asarray(period.direct_horizontal, np.float64) * share
+        for k in range(steps):
+            z = float(period.zenith_deg[k])
+            if direct_w[k] > 0 and z < 90.0:
+                light = self.absorbed(Sun(z, float(period.azimuth_deg[k])),
+                                      direct_w_m2=float(direct_w[k]), **common)
+                joules += light.triangle_absorbed_w * step_s[k]
+                for name in parts:
+                    parts[name] += getattr(light.balance, name) * step_s[k]
+                leaves_w[k] += light.balance.absorbed_leaves
+                for name in ("trace", "scatter"):
+                    seconds[name] = seconds.get(name, 0.0) + light.seconds.get(name, 0.0)
+            report(progress, k + 2, steps + 1, f"absorbed light: time step {k + 1} of {steps}")
+        incident_w = diffuse_w + direct_w
+        balance = Balance(float(np.sum(incident_w * step_s)) * 1e-6,
+                          *(float(parts[k]) * 1e-6 for k in ("absorbed_leaves", "absorbed_ground",
+                                                       "reflected_top", "escaped_sides",
+                                                       "unresolved")))
+        return AbsorbedPeriod(opt.band, opt, period, balance, joules, leaves_w, incident_w,
+                              unit.rect, unit.rays, depth, seed, unit.periodic,
+                              self.canopy.level, seconds)
 
     def _normals(self):
         """Unit normals (F, 3) of the scene's leaf triangles, then its stalks' if traced

@@ -41,6 +41,7 @@ from __future__ import annotations
 import threading
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -430,3 +431,84 @@ def absorbed_leaf_rows(canopy, light: AbsorbedLight) -> list[dict]:
     for r in rows:
         r["absorbed_w_m2_leaf"] = float(r["absorbed_w"]) / (float(r["leaf_area_cm2"]) * 1e-4)
     return rows
+
+
+@dataclass(frozen=True)
+class AbsorbedPeriod:
+    """Light absorbed by the leaves (and the ground) in one band over a period (a day), with
+    scattering: each time step's sun traced with its direct irradiance, the diffuse part
+    traced once per unit of diffuse irradiance and scaled by each step's (it is linear).
+
+    Attributes
+    ----------
+    band : "par" or "nir"; optics : Optics
+    period : Period (:mod:`maizeviz.light.irradiance`): its steps, sun and irradiance
+    balance : Balance in MJ/m2 of sample ground over the period
+    triangle_absorbed_j : (F,) float64 J absorbed by each scene triangle over the period
+    step_absorbed_leaves_w_m2 : (n,) float64 W/m2 of ground the leaves absorb at each step
+    step_incident_w_m2 : (n,) float64 the band's irradiance on a horizontal plane at each step
+    rect, rays, depth, seed, periodic, level : as traced; seconds : "trace", "scatter",
+        "build"
+    """
+
+    band: str
+    optics: Optics
+    period: Any
+    balance: Balance
+    triangle_absorbed_j: np.ndarray
+    step_absorbed_leaves_w_m2: np.ndarray
+    step_incident_w_m2: np.ndarray
+    rect: tuple[float, float, float, float]
+    rays: int
+    depth: int
+    seed: int
+    periodic: bool
+    level: str = ""
+    seconds: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def fraction_absorbed(self) -> float:
+        """Share of the period's incident light the leaves absorb."""
+        b = self.balance
+        return b.absorbed_leaves / b.incident if b.incident else 0.0
+
+    @property
+    def absorbed_leaves_mol_m2(self) -> float | None:
+        """PAR the leaves absorbed over the period, mol per m2 of ground (None for NIR)."""
+        from maizeviz.light.irradiance import PAR_UMOL_PER_J_PAR
+
+        return self.balance.absorbed_leaves * PAR_UMOL_PER_J_PAR if self.band == "par" \
+            else None                           # MJ x umol/J = mol
+
+    def table(self, by: str = "plant", canopy=None):
+        """Absorbed light per leaf or per plant over the period as a pandas DataFrame:
+        ``absorbed_mj`` (MJ), ``absorbed_mj_m2_leaf``, and for PAR ``absorbed_mol``;
+        ``by="balance"``: the balance (MJ/m2 of ground) as one row."""
+        import pandas as pd
+
+        from maizeviz.errors import MaizevizError
+
+        if by == "balance":
+            return pd.DataFrame([{"band": self.band, "unit": "MJ/m2",
+                                  **self.balance.as_dict()}])
+        if by not in ("leaf", "plant") or canopy is None:
+            raise MaizevizError("absorbed light over a period is tabled by 'leaf' or 'plant' "
+                                "(with the canopy it was traced on) or 'balance'",
+                                quantity="table")
+        from maizeviz.light.irradiance import PAR_UMOL_PER_J_PAR
+        from maizeviz.light.leaf_light import leaf_sums
+
+        rows = leaf_sums(canopy, {"absorbed_mj": self.triangle_absorbed_j * 1e-6}, self.rect,
+                         self.periodic)
+        frame = pd.DataFrame(rows)
+        if frame.empty:
+            return frame
+        if by == "plant":
+            frame = frame.groupby("instance", as_index=False).agg(
+                plant=("plant", "first"), x_cm=("x_cm", "first"), y_cm=("y_cm", "first"),
+                leaves=("leaf", "size"), leaf_area_cm2=("leaf_area_cm2", "sum"),
+                absorbed_mj=("absorbed_mj", "sum"))
+        frame["absorbed_mj_m2_leaf"] = frame["absorbed_mj"] / (frame["leaf_area_cm2"] * 1e-4)
+        if self.band == "par":
+            frame["absorbed_mol"] = frame["absorbed_mj"] * PAR_UMOL_PER_J_PAR
+        return frame

@@ -1,0 +1,60 @@
+"""Absorbed light over a period (a day), with scattering: black leaves absorb exactly the
+PAR the day intercepts, the balance closes, and the command line reports MJ/m2 and mol/m2."""
+
+import json
+
+import pytest
+
+import maizeviz as mv
+from maizeviz.cli import main as cli_main
+from maizeviz.light.optics import Optics
+
+DAY = dict(date="2005-08-01", lat=39.9, lon=116.4, tz="Asia/Shanghai", step_min=60)
+
+
+@pytest.fixture(scope="module")
+def engine():
+    plants = mv.read_points(mv.example_points())
+    canopy = mv.build_canopy(plants, tile=(1, 1), level="16")
+    return mv.LightEngine(canopy, density=0.3, heights_cm=(0.0, 100.0), periodic=True)
+
+
+def test_black_leaves_absorb_the_par_the_day_intercepts(engine):
+    day = engine.day(**DAY)
+    black = engine.absorbed_day(optics=Optics(0, 0, 0), **DAY)
+    assert black.absorbed_leaves_mol_m2 == pytest.approx(day.par_intercepted_mol_m2, rel=1e-12)
+    assert black.balance.incident * 4.57 == pytest.approx(day.par_incident_mol_m2, rel=1e-12)
+    assert black.balance.reflected_top == 0.0 and black.balance.closure == pytest.approx(0.0)
+
+
+def test_the_days_balance_closes_and_tables_add_up(engine):
+    got = engine.absorbed_day(**DAY)
+    b = got.balance
+    assert abs(b.closure) < 0.01 and 0 < b.absorbed_leaves < b.incident
+    assert got.absorbed_leaves_mol_m2 == pytest.approx(b.absorbed_leaves * 4.57)
+    assert len(got.step_absorbed_leaves_w_m2) == len(got.period.step_s)
+    # the steps' absorbed power integrates to the day's absorbed energy
+    energy = float((got.step_absorbed_leaves_w_m2 * got.period.step_s).sum()) * 1e-6
+    assert energy == pytest.approx(b.absorbed_leaves, rel=1e-9)
+    plants = got.table("plant", engine.canopy)
+    x0, y0, x1, y1 = got.rect
+    area_m2 = (x1 - x0) * (y1 - y0) * 1e-4
+    assert plants["absorbed_mj"].sum() == pytest.approx(b.absorbed_leaves * area_m2, rel=1e-6)
+    assert got.table("balance")["unit"][0] == "MJ/m2"
+    nir = engine.absorbed_day(band="nir", **DAY)
+    assert nir.absorbed_leaves_mol_m2 is None and nir.fraction_absorbed < got.fraction_absorbed
+
+
+def test_the_cli_reports_a_days_absorbed_par(capsys):
+    args = ["light", str(mv.example_points()), "--triangles", "16", "--periodic", "--density",
+            "0.3", "--day", "--date", "2005-08-01", "--lat", "39.9", "--lon", "116.4", "--tz",
+            "Asia/Shanghai", "--step", "60", "--band", "par", "--json"]
+    assert cli_main(args) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["balance"]["units"] == "MJ/m2 of ground"
+    a = out["absorbed"]
+    assert a["absorbed_leaves_mol_m2"] == pytest.approx(out["balance"]["absorbed_leaves"] * 4.57)
+    assert a["absorbed_leaves_mol_m2"] < out["period"]["par_intercepted_mol_m2"]
+    assert cli_main(args[:-1] + ["--irradiance", "400"]) != 0
+    err = capsys.readouterr().err
+    assert "over a period the irradiance is the period's" in err and "Traceback" not in err
