@@ -38,10 +38,12 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.hits import SunRays, first_hits, hit_counts, lattice_first_hits, second_hits
+from maizeviz.light.periodic import Wrap, overhang_copies, snap
 from maizeviz.light.rays import Rect, Tracer, ray_grid, sensor_offsets
 from maizeviz.light.request import LightRequest, canopy_top, check_request
 from maizeviz.light.result import TracedLight
 from maizeviz.light.sun import Sun
+from maizeviz.light.tiling import BlockTiling, block_mesh, block_tiling, tile_triangles
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, ordered_map, report
 
@@ -133,49 +135,60 @@ class CanopyScene(RayScene):
 
     In a periodic field a ray that leaves the plot re-enters on the opposite side, so a leaf
     part hanging over the edge (3.7 % of the leaf area of the bundled block tiled 3 x 3) must
-    also stand just inside the opposite edge, where the next tile's plants would put it.
+    also stand just inside the opposite edge, where the next tile's plants would put it. A
+    periodic scene's x, y are on the field's grid (:mod:`maizeviz.light.periodic`).
 
     Attributes
     ----------
     n_original : int, leaf + stalk triangles (the ids hits are reported in)
     source : (F_scene,) int64, the original triangle of each scene triangle (None: identity)
     wrapped : (x0, y0, x1, y1) cm, the plot whose overhangs were copied, or None
+    wrap : Wrap of the periodic field this scene repeats in (the plot), or None
     """
 
     def __init__(self, vertices: np.ndarray, faces: np.ndarray, n_original: int | None = None,
-                 source: np.ndarray | None = None, wrapped: Rect | None = None):
+                 source: np.ndarray | None = None, wrapped: Rect | None = None,
+                 wrap: Wrap | None = None):
         super().__init__(vertices, faces)
         self.n_original = len(faces) if n_original is None else n_original
         self.source = source
         self.wrapped = wrapped
+        self.wrap = wrap
+
+    def resolve(self, prim: np.ndarray, cell: np.ndarray | None) -> np.ndarray:
+        """Canopy triangle ids (k,) of scene triangles ``prim`` (k,) hit in field cells
+        ``cell`` (k, 2) (unused here: every cell holds the same canopy)."""
+        return prim if self.source is None else self.source[prim]
 
 
-def _overhang_copies(verts: np.ndarray, faces: np.ndarray,
-                     bounds: Rect) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Copies of the triangles that reach over the plot edges, moved by the plot's width and
-    height into it: vertices (3k, 3), faces (k, 3) numbered from 0, source ids (k,)."""
-    x0, y0, x1, y1 = bounds
-    w, h = x1 - x0, y1 - y0
-    tri = verts[faces]
-    lo, hi = tri.min(axis=1), tri.max(axis=1)
-    out_v, out_src = [], []
-    for dx in (-w, 0.0, w):
-        for dy in (-h, 0.0, h):
-            if dx == 0.0 and dy == 0.0:
-                continue
-            keep = np.flatnonzero((hi[:, 0] + dx > x0) & (lo[:, 0] + dx < x1) &
-                                  (hi[:, 1] + dy > y0) & (lo[:, 1] + dy < y1))
-            if len(keep):
-                out_v.append((tri[keep] + np.array([dx, dy, 0.0])).reshape(-1, 3))
-                out_src.append(keep)
-    if not out_v:
-        return np.empty((0, 3)), np.empty((0, 3), np.int64), np.empty(0, np.int64)
-    v = np.vstack(out_v)
-    return v, np.arange(len(v)).reshape(-1, 3), np.concatenate(out_src).astype(np.int64)
+class BlockScene(CanopyScene):
+    """The scene of one block of a tiled canopy in a periodic field
+    (:mod:`maizeviz.light.tiling`): the block's triangles and copies of its neighbours'
+    overhangs; hits are reported as the tiled canopy's triangles (``n_original`` of them).
+
+    Attributes
+    ----------
+    tiling : BlockTiling; plus those of :class:`CanopyScene` (``wrap``: the block's field)
+    """
+
+    def __init__(self, canopy: Canopy, tiling: BlockTiling, with_stalks: bool):
+        verts, faces, self._local, self._cell = block_mesh(canopy, tiling, with_stalks)
+        n = canopy.n_triangles + (len(canopy.stalk_faces) if with_stalks else 0)
+        super().__init__(verts, faces, n, None, canopy.layout.bounds, tiling.wrap)
+        self.tiling = tiling
+        self._n_leaf = canopy.n_triangles
+
+    def resolve(self, prim: np.ndarray, cell: np.ndarray | None) -> np.ndarray:
+        """Canopy triangle ids (k,) of block triangles ``prim`` (k,) hit in the block copies
+        of field cells ``cell`` (k, 2)."""
+        if cell is None:  # pragma: no cover - a block scene traces periodic fields only
+            raise ValueError("a block scene's hits need their field cells")
+        return tile_triangles(self.tiling, self._n_leaf, self._local[prim],
+                              cell + self._cell[prim])
 
 
-def light_scene(canopy: Canopy, with_stalks: bool = False,
-                periodic: bool = False) -> CanopyScene:
+def light_scene(canopy: Canopy, with_stalks: bool = False, periodic: bool = False,
+                block: bool = True) -> CanopyScene:
     """The Embree scene of a canopy's leaves (and stalks): build it once, trace many suns.
 
     Parameters
@@ -183,6 +196,9 @@ def light_scene(canopy: Canopy, with_stalks: bool = False,
     with_stalks : stalks intercept light too
     periodic : for a periodic field (``--periodic``): leaf parts overhanging the plot edges are
         copied to the opposite side; such a scene traces periodic requests only
+    block : for a periodic field, the scene of the canopy's block alone when the canopy tiles
+        it exactly (:mod:`maizeviz.light.tiling`: the same hits, A x B times fewer triangles);
+        False: always the whole canopy
     """
     verts, faces = canopy.vertices, canopy.faces
     if with_stalks:
@@ -191,10 +207,16 @@ def light_scene(canopy: Canopy, with_stalks: bool = False,
     n = len(faces)
     if not periodic:
         return CanopyScene(verts, faces)
+    if block:
+        tiling = block_tiling(canopy)
+        if tiling is not None:
+            return BlockScene(canopy, tiling, with_stalks)
     bounds = canopy.layout.bounds
-    cv, cf, src = _overhang_copies(verts, faces, bounds)
+    wrap = Wrap.of(bounds)
+    verts = snap(verts, wrap.q)
+    cv, cf, src, _ = overhang_copies(verts, faces, wrap)
     return CanopyScene(np.vstack([verts, cv]), np.vstack([faces, cf + len(verts)]), n,
-                       np.concatenate([np.arange(n, dtype=np.int64), src]), bounds)
+                       np.concatenate([np.arange(n, dtype=np.int64), src]), bounds, wrap)
 
 
 def scene_for(canopy: Canopy, periodic: bool, scene: RayScene | None,
@@ -437,7 +459,8 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
                     org = np.empty((b - a, 3))
                     org[:, :2] = ground + offsets[k]
                     org[:, 2] = h
-                    lit = ~up.occluded(org, np.full(b - a, (smp.top - h) / s[2]))
+                    lit = ~up.occluded(org, np.full(b - a, (smp.top - h) / s[2]),
+                                       row=rays.shape[1])
                 counts[k] = np.count_nonzero(lit)
                 packed[k, a // 8:(b + 7) // 8] = np.packbits(lit)
             return counts
@@ -448,12 +471,13 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
         fz = np.empty(len(family.cells), dtype=np.float32)
         fp = np.empty(len(family.cells), dtype=np.int32) if keep_ids else None
         bh = family.index.shape[1]
+        whole = len(family.cells) == family.index.size     # the box without holes: a grid
 
         def fchunk(a: int, b: int) -> None:
             check()
             i, j = np.divmod(family.cells[a:b], bh)
             prim, z = lattice_first_hits(down, rays, i + family.lo[0], j + family.lo[1],
-                                         ids=keep_ids)
+                                         ids=keep_ids, row=bh if whole else 0)
             fz[a:b] = z
             if fp is not None and prim is not None:
                 fp[a:b] = prim
