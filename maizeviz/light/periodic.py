@@ -50,7 +50,7 @@ def quantum_cm(plot: Rect) -> float:
     cm: every coordinate a periodic query uses (the plot, one period, a re-anchored ray's
     travel) is below 2^24 q, so its multiples of q are exact in float32."""
     x0, y0, x1, y1 = plot
-    reach = max(abs(x0), abs(y0), abs(x1), abs(y1)) + 2 * max(x1 - x0, y1 - y0) + ANCHOR_CM
+    reach = max(abs(x0), abs(y0), abs(x1), abs(y1)) + max(x1 - x0, y1 - y0) + ANCHOR_CM
     return 2.0 ** (math.ceil(math.log2(reach)) - 23)
 
 
