@@ -147,7 +147,7 @@ def _exit_times(org: np.ndarray, dirs: np.ndarray, cell: np.ndarray, wrap: Wrap
 
 
 def trace_wrapped(scene, wrap: Wrap, org: np.ndarray, dirs: np.ndarray, length: np.ndarray,
-                  any_hit: bool = False, ids: bool = True, row: int = 0):
+                  any_hit: bool = False, ids: bool = True, row: int = 0, native: bool = True):
     """Rays through the periodic field ``wrap`` of ``scene`` (see the module docstring).
 
     Parameters
@@ -158,6 +158,8 @@ def trace_wrapped(scene, wrap: Wrap, org: np.ndarray, dirs: np.ndarray, length: 
     any_hit : only whether anything is hit (occlusion queries)
     ids : keep the triangle ids (nearest hits)
     row : rays per row when the rays form a grid laid out row by row (coherent packets)
+    native : through the C kernel where the scene has it (:func:`maizeviz.mesh.packets.wrapped`,
+        the same steps); False: here, in numpy
 
     Returns
     -------
@@ -165,6 +167,15 @@ def trace_wrapped(scene, wrap: Wrap, org: np.ndarray, dirs: np.ndarray, length: 
     ``ids``), the cell (N, 2) int64 whose copy of the scene holds the hit, and the hit distance
     (N,) float64 cm (inf where none).
     """
+    kernel = getattr(scene, "_kernel", None) if native else None
+    if kernel is not None:                       # the same algorithm, in C
+        from maizeviz.mesh.packets import wrapped
+
+        got = wrapped(kernel, scene._handle, org, np.asarray(dirs).reshape(-1, 3), length,
+                      (wrap.x0, wrap.y0, wrap.w, wrap.h, wrap.q, ANCHOR_CM), any_hit, row=row)
+        if any_hit:
+            return got
+        return (got[0] if ids else None), got[1], got[2]
     n = len(org)
     q = wrap.q
     o = snap(org, q)
@@ -208,16 +219,14 @@ def trace_wrapped(scene, wrap: Wrap, org: np.ndarray, dirs: np.ndarray, length: 
             blocked[todo[hit]] = True
             done = hit | (end >= length[todo])
         else:
-            p, t = (scene.first_hit(qo, qd, reach, row=r) if ids else
-                    (None, scene.distance(qo, qd, reach, row=r)))
-            found = (p >= 0) if p is not None else (t < reach)
+            p, t = scene.first_hit(qo, qd, reach, row=r)
+            found = p >= 0
             dist = t_anchor + t.astype(np.float64)
             better = found & (dist < best[todo])
             sel = todo[better]
             best[sel] = dist[better]
             where[sel] = cell[todo][better]
-            if p is not None:
-                prim[sel] = p[better]
+            prim[sel] = p[better]
             done = (best[todo] <= end) | (end >= length[todo])
         crossed = ~done & (t_exit <= end)
         cell[todo[crossed]] += step[crossed]

@@ -102,6 +102,15 @@ def test_rays_in_any_direction_from_anywhere(tiled):
     _same(da, db)
     _same(oa, ob)
     _same(oa, ia >= 0)                                   # occlusion sees what hits see
+    # the C kernel's wrapping (packets) and numpy's (single queries) are the same steps
+    for scene in (whole, block):
+        if scene.packets:
+            c_way = trace_wrapped(scene, scene.wrap, org, d, length)
+            np_way = trace_wrapped(scene, scene.wrap, org, d, length, native=False)
+            for x, y in zip(c_way, np_way):
+                _same(x, y)
+            _same(trace_wrapped(scene, scene.wrap, org, d, length, any_hit=True),
+                  trace_wrapped(scene, scene.wrap, org, d, length, any_hit=True, native=False))
 
 
 def test_sky_and_day_through_the_block(tiled):
