@@ -6,7 +6,7 @@ peak resident memory, and each rebuild over an anchor measured in the same run (
 workload: 20 products of 400 x 400 matrices) so runs on busy machines stay comparable.
 Targets: under 1 s per rebuild, under 1 GiB peak.
 
-    python benchmarks/bench_canopy.py [--json] [--points resources/block3x3.csv]
+    python benchmarks/bench_canopy.py [--json] [--points maizeviz/resources/block3x3.csv]
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--json", action="store_true")
-    ap.add_argument("--points", default=str(ROOT / "resources" / "block3x3.csv"))
+    ap.add_argument("--points", default=str(ROOT / "maizeviz" / "resources" / "block3x3.csv"))
     args = ap.parse_args()
     grids, _ = build_grids(read_points(args.points))
     leaves, _ = fit_leaves(grids)

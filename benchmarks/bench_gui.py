@@ -55,7 +55,7 @@ class GilProbe:
             self.worst = max(self.worst, now - last)
             last = now
 
-    def __enter__(self) -> "GilProbe":
+    def __enter__(self) -> GilProbe:
         self._thread.start()
         return self
 
@@ -75,12 +75,13 @@ class Ticket:
 def gil_part() -> dict:
     """The app's build and light jobs at K = 4, no Qt: the longest stall of a Python thread."""
     sys.setswitchinterval(0.005)
+    from maizeviz_app import jobs
+    from maizeviz_app.process import CoreProcess
+
     from maizeviz.light.leaf_light import triangle_light
     from maizeviz.light.request import LightRequest, Sampling
     from maizeviz.light.sun import Sun
     from maizeviz.resources import example_points
-    from maizeviz_app import jobs
-    from maizeviz_app.process import CoreProcess
 
     cover, light = CoreProcess("cover"), CoreProcess("light")
     cover.start()
@@ -124,9 +125,8 @@ def gil_part() -> dict:
 # ---------------------------------------------------------------------------- GUI parts
 def _app():
     os.environ.setdefault("QT_API", "pyside6")
-    from PySide6.QtWidgets import QApplication
-
     from maizeviz_app.main import gl_format
+    from PySide6.QtWidgets import QApplication
 
     gl_format()
     return QApplication.instance() or QApplication([sys.argv[0]])
@@ -137,10 +137,10 @@ def startup_child() -> None:
     is on screen (the parent times from the launch)."""
     os.environ["XDG_CONFIG_HOME"] = os.environ.get("BENCH_CONFIG", "/tmp/maizeviz-bench-cfg")
     app = _app()  # noqa: F841  (keeps the QApplication alive)
+    from maizeviz_app.main_window import MainWindow
     from PySide6.QtCore import QTimer
 
     from maizeviz.resources import example_points
-    from maizeviz_app.main_window import MainWindow
 
     window = MainWindow(str(example_points()), 3)
     window.resize(1366, 740)
@@ -210,11 +210,11 @@ def gui_child(levels: list[str]) -> None:
     """In a display: idle renders, renders per canopy, slider latency and gaps per level."""
     os.environ["XDG_CONFIG_HOME"] = os.environ.get("BENCH_CONFIG", "/tmp/maizeviz-bench-cfg")
     app = _app()  # noqa: F841  (keeps the QApplication alive)
+    from maizeviz_app.main_window import MainWindow
     from PySide6.QtCore import QCoreApplication
 
     from maizeviz.mesh.levels import COMPLEXITY_STOPS
     from maizeviz.resources import example_points
-    from maizeviz_app.main_window import MainWindow
 
     def spin(seconds: float, until=None) -> bool:
         end = time.perf_counter() + seconds
@@ -250,9 +250,9 @@ def gui_child(levels: list[str]) -> None:
         gaps.start()
         t0 = time.perf_counter()
         window.slider.setValue(COMPLEXITY_STOPS.index(level))
-        assert spin(TIMEOUT_S, lambda: len(shown) > before), f"no canopy at {level}"
+        assert spin(TIMEOUT_S, lambda before=before: len(shown) > before), f"no canopy at {level}"
         framed = view.render_count
-        spin(TIMEOUT_S, lambda: view.render_count > framed)
+        spin(TIMEOUT_S, lambda framed=framed: view.render_count > framed)
         out["slider_to_view_s"][level] = time.perf_counter() - t0
         out["event_loop_max_gap_ms"][level] = gaps.stop()
         spin(1.0)

@@ -58,7 +58,7 @@ def main():
     ap.add_argument("--trimesh-rays", type=int, default=300)
     args = ap.parse_args()
 
-    grids, _ = build_grids(read_points(ROOT / "resources" / "block3x3.csv"))
+    grids, _ = build_grids(read_points(ROOT / "maizeviz" / "resources" / "block3x3.csv"))
     leaves, _ = fit_leaves(grids)
     layout = tiled_layout(plant_bases(leaves), (3, 3))
     canopy = build_canopy(leaves, layout, parse_level(args.level))

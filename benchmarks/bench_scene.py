@@ -23,13 +23,13 @@ import time
 import numpy as np
 from embreex.mesh_construction import TriangleMesh
 from embreex.rtcore_scene import EmbreeScene
-from maizeviz.resources import example_points
 
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.mesh.embree_fill import fill
 from maizeviz.mesh.levels import parse_level
+from maizeviz.resources import example_points
 
 
 def timed_build(vertices, faces, by_copy: bool) -> tuple[float, float]:

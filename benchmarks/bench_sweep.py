@@ -86,7 +86,7 @@ def on_cluster(client, spec, out: Path) -> tuple[float, float, list, dict]:
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--json", action="store_true")
-    ap.add_argument("--points", default=str(ROOT / "resources" / "block3x3.csv"))
+    ap.add_argument("--points", default=str(ROOT / "maizeviz" / "resources" / "block3x3.csv"))
     ap.add_argument("--tile", default="1x1", help="tiling of the block (default 1x1)")
     ap.add_argument("--density", type=float, default=32.0,
                     help="rays per cm2 (default 32: tracing about half the work)")

@@ -14,7 +14,7 @@ import numpy as np
 from maizeviz.io.phenomenal import leaf_traits, load_phenomenal
 from maizeviz.leaf.synth import PlantShape, plant_leaf_shapes
 
-DEFAULT = Path(__file__).resolve().parents[1] / "resources/phenotrack3d/1649057232.json.gz"
+DEFAULT = Path(__file__).resolve().parents[1] / "maizeviz/resources/phenotrack3d/1649057232.json.gz"
 
 
 def main():

@@ -70,7 +70,7 @@ class Canopy:
 
     @classmethod
     def from_triangles(cls, vertices: np.ndarray, faces: np.ndarray, layout: CanopyLayout,
-                       face_leaf: np.ndarray | None = None, level: str = "") -> "Canopy":
+                       face_leaf: np.ndarray | None = None, level: str = "") -> Canopy:
         """A canopy of given triangles (V, 3) cm / (F, 3), all belonging to the layout's first
         placement; for analytic test scenes and imported meshes."""
         n = len(faces)

@@ -157,7 +157,7 @@ class FastrakPort:
         return replace(rec, position=(x * CM_PER_INCH, y * CM_PER_INCH, z * CM_PER_INCH))
 
     # ------------------------------------------------------------------------- reader
-    def start_reader(self, callback=None) -> "queue.Queue | None":
+    def start_reader(self, callback=None) -> queue.Queue | None:
         """Start the reader thread; events go to ``callback(event)`` or to a returned queue.
 
         Events: :class:`~maizeviz.digitizer.protocol.Record` (position in cm),

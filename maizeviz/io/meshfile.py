@@ -75,7 +75,7 @@ def _vtp_array(name: str, a: np.ndarray) -> str:
 def _write_vtp(path: Path, pts: np.ndarray, faces: np.ndarray, cells: CellData) -> None:
     n = len(faces)
     conn = _b64(faces.astype("<i8").ravel())
-    offs = _b64((np.arange(1, n + 1, dtype="<i8") * 3))
+    offs = _b64(np.arange(1, n + 1, dtype="<i8") * 3)
     scalars = f' Scalars="{next(iter(cells))}"' if cells else ""
     arrays = "\n        ".join(_vtp_array(k, a) for k, a in cells.items())
     xml = f"""<?xml version="1.0"?>

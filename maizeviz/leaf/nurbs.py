@@ -159,7 +159,7 @@ class NurbsSurfaces:
     def __len__(self) -> int:
         return len(self.control)
 
-    def __getitem__(self, i) -> "NurbsSurfaces":
+    def __getitem__(self, i) -> NurbsSurfaces:
         i = np.atleast_1d(np.arange(len(self))[i])
         return NurbsSurfaces(self.degree_u, self.degree_v, self.knots_u[i], self.knots_v[i],
                              self.control[i], self.weights[i], self.params_u[i], self.params_v[i])

@@ -24,6 +24,8 @@ import threading
 import time
 from dataclasses import fields, replace
 
+import numpy as np
+
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
 from maizeviz.light.irradiance import DEFAULT_LINKE_TURBIDITY, DEFAULT_PAR_UMOL_PER_J, Period
@@ -84,7 +86,7 @@ class LightEngine:
         self._scenes: dict[bool, RayScene] = {}
         self._lock = threading.Lock()
         self._sky: tuple[tuple, SkyLight] | None = None
-        self._normals_kept = None
+        self._normals_kept: np.ndarray | None = None
 
     @staticmethod
     def _sampling(base: Sampling, changes: dict) -> Sampling:
@@ -345,7 +347,8 @@ class LightEngine:
             if k == 0 and sun is not None and direct > 0:
                 # cm2 of leaf a ray's beam covers: its footprint across the beam over the
                 # cosine of the leaf's tilt to it
-                first = np.concatenate(tally.first_hits) if tally.first_hits else []
+                first = (np.concatenate(tally.first_hits) if tally.first_hits
+                         else np.zeros(0, dtype=np.int64))
                 lit = np.unique(first)
                 factor = np.zeros(nf)
                 factor[lit] = smp.ray_area_cm2 * toward[2] / np.maximum(

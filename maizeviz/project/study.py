@@ -56,6 +56,16 @@ class StoredResult:
     settings: dict | None = None
     stands: dict | None = None
 
+    def specs(self, where: str = "project") -> Any:
+        """How a sky or day result was traced: a :class:`~maizeviz.light.specs.SkySpec`, or
+        ``(DaySpec, SkySpec)`` for a day (None for a sun, or a day of an older project);
+        stored settings that do not read: ProjectError naming ``where``."""
+        from maizeviz.project.settings import run_settings
+
+        if self.kind == "sun":
+            return None
+        return run_settings(self.kind, self.result, self.settings, where)
+
 
 @dataclass
 class Opened:

@@ -47,11 +47,22 @@ def test_layers_only_point_down():
     assert "0 broken" in proc.stdout
 
 
-def test_core_type_checks():
+def test_core_and_app_type_check():
+    """mypy over the core and the app (pyproject's [tool.mypy] files)."""
     from mypy import api
 
     out, err, status = api.run(["--config-file", str(ROOT / "pyproject.toml")])
     assert status == 0, out[-5000:] + err[-2000:]
+    assert "app/maizeviz_app" in (ROOT / "pyproject.toml").read_text()
+
+
+def test_lint_is_clean():
+    """ruff (pyproject's [tool.ruff]: pyflakes, pycodestyle, isort, bugbear, pyupgrade) over
+    the core, the app, the tests and the benchmarks."""
+    ruff = Path(sys.executable).with_name("ruff")
+    proc = subprocess.run([str(ruff), "check", "--no-cache", "maizeviz", "app", "tests",
+                           "benchmarks"], capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-5000:] + proc.stderr[-2000:]
 
 
 def test_no_reference_to_documents_outside_the_repository():
@@ -73,19 +84,24 @@ def test_no_reference_to_documents_outside_the_repository():
     assert not missing, "references to docs pages that do not exist: " + "; ".join(missing)
 
 
-def test_every_package_folder_is_installed():
-    """Each folder with an __init__.py is listed in pyproject's packages (else a wheel lacks it)."""
+def test_every_package_folder_is_a_package_of_its_own_name():
+    """Each folder with an __init__.py under maizeviz/ and app/maizeviz_app/ installs under its
+    own name (packages.find, no package-dir renames), and nothing else does."""
     import tomllib
+    from setuptools import find_namespace_packages
 
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
-    listed = set(config["packages"])
-    dirs = {"maizeviz": "maizeviz", "maizeviz_app": "app", "maizeviz.resources": "resources"}
+    assert "package-dir" not in config, "no package-dir renames: folders carry package names"
+    find = config["packages"]["find"]
     found = set()
-    for name, folder in dirs.items():
-        for init in (ROOT / folder).rglob("__init__.py"):
-            parts = init.parent.relative_to(ROOT / folder).parts
-            found.add(".".join((name, *parts)))
-    assert found == listed, f"not listed: {found - listed}; listed but absent: {listed - found}"
+    for where in find["where"]:
+        found |= set(find_namespace_packages(str(ROOT / where), include=find["include"]))
+    folders = {".".join(init.parent.relative_to(base).parts)
+               for base in (ROOT, ROOT / "app")
+               for top in ("maizeviz", "maizeviz_app") if (base / top).is_dir()
+               for init in (base / top).rglob("__init__.py")}
+    assert folders <= found, f"package folders not installed: {folders - found}"
+    assert (ROOT / "LICENSE").is_file() and config is not None
 
 
 @pytest.fixture(scope="module")

@@ -8,13 +8,13 @@ import subprocess
 import sys
 
 import pytest
-from maizeviz.resources import example_points
 
 from maizeviz.cli import EXIT_FAIL, main
 from maizeviz.cost import BYTES_PER_LEAF_TRIANGLE, check, leaves_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.mesh.levels import Level
+from maizeviz.resources import example_points
 
 B = str(example_points())
 #: Address space a refused run may use: the interpreter and its libraries, no more.

@@ -25,7 +25,7 @@ from maizeviz.leaf.grid import LeafGrid
 from maizeviz.leaf.synth import PlantShape, block_grids, plant_grids
 from maizeviz.mesh.levels import Level, measure, mesh_leaf
 
-PHENO = str(Path(__file__).resolve().parents[2] / "resources/phenotrack3d/1649057232.json.gz")
+PHENO = str(Path(__file__).resolve().parents[2] / "maizeviz/resources/phenotrack3d/1649057232.json.gz")
 
 
 def flat_leaf(plant, leaf, x0, y0, length, width, z, rows=4, cols=3, stalk=None):

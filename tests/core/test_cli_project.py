@@ -5,7 +5,6 @@ import json
 from dataclasses import replace
 
 import pytest
-from maizeviz.resources import example_points
 
 from maizeviz.canopy.layout import layout_for, layout_to_dict
 from maizeviz.canopy.scene import build_canopy
@@ -13,6 +12,7 @@ from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.mesh.levels import parse_level
 from maizeviz.project.study import read_study, save_study
+from maizeviz.resources import example_points
 
 SUN = ["--sun-zenith", "30", "--sun-azimuth", "140", "--density", "0.5", "--rect=10,10,170,170",
        "--json"]

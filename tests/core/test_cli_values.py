@@ -2,9 +2,9 @@
 "internal error", and nothing written."""
 
 import pytest
-from maizeviz.resources import example_points
 
 from maizeviz.cli import EXIT_FAIL, main
+from maizeviz.resources import example_points
 
 B = str(example_points())
 SUN = ["--sun-zenith", "10", "--sun-azimuth", "0"]

@@ -1,7 +1,6 @@
 """Cost estimates before any work: exact triangle counts, refusals that name the input."""
 
 import pytest
-from maizeviz.resources import example_points
 
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
@@ -10,6 +9,7 @@ from maizeviz.cost import Cost, canopy_cost, check, heatmap_cost, leaf_triangles
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.mesh.levels import Level, mesh_leaves
+from maizeviz.resources import example_points
 
 
 @pytest.fixture(scope="module")

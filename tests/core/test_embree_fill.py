@@ -4,7 +4,6 @@ same hits, triangle by triangle, on the bundled canopy (real Embree, no mock).""
 import numpy as np
 import pytest
 from embreex.rtcore_scene import EmbreeScene
-from maizeviz.resources import example_points
 
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
@@ -12,6 +11,7 @@ from maizeviz.leaf.fit import read_leaves
 from maizeviz.mesh.embree_fill import fill
 from maizeviz.mesh.levels import parse_level
 from maizeviz.mesh.raytrace import RayScene
+from maizeviz.resources import example_points
 
 
 @pytest.fixture(scope="module")

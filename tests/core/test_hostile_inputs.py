@@ -6,12 +6,12 @@ import os
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from maizeviz.resources import example_points
 
 from maizeviz.cli import EXIT_FAIL, main
 from maizeviz.errors import MaizevizError
 from maizeviz.light.irradiance import clear_sky_period, read_weather
 from maizeviz.light.sun import sun_at
+from maizeviz.resources import example_points
 
 B = str(example_points())
 SUN = ["--sun-zenith", "10", "--sun-azimuth", "0"]

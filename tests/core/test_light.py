@@ -21,7 +21,7 @@ from maizeviz.light.request import LightRequest, Sampling
 from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import trace_light
 
-BLOCK = str(Path(__file__).resolve().parents[2] / "resources/block3x3.csv")
+BLOCK = str(Path(__file__).resolve().parents[2] / "maizeviz/resources/block3x3.csv")
 
 
 def plot(x0=0, y0=0, x1=100, y1=100):

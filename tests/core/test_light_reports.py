@@ -8,13 +8,13 @@ import pytest
 
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
+from maizeviz.io.atomic import write_rows
 from maizeviz.io.points import write_points
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.leaf.synth import block_grids
 from maizeviz.light.daylight import trace_period
 from maizeviz.light.irradiance import WeatherFileError, clear_sky_period, read_weather
 from maizeviz.light.leaf_light import plant_light
-from maizeviz.io.atomic import write_rows
 from maizeviz.light.reports import leaf_values, period_leaf_rows, write_steps
 from maizeviz.light.request import Sampling
 from maizeviz.light.sky import make_sky

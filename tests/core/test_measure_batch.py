@@ -11,7 +11,6 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from maizeviz.resources import example_points
 
 from maizeviz.leaf.fit import Leaf, fit_leaves, read_leaves
 from maizeviz.leaf.grid import LeafGrid
@@ -29,6 +28,7 @@ from maizeviz.mesh.levels import (
     reference_areas,
 )
 from maizeviz.mesh.tessellate import grid_faces, mesh_grid, triangle_areas_normals
+from maizeviz.resources import example_points
 
 #: Every level of the paper's Table 1 plus a finer one.
 LEVELS = parse_levels("K4,K1,standard,36,8,4,3") + [Level(interp=2)]

@@ -17,9 +17,9 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from maizeviz.resources import example_phenomenal
 
 from maizeviz.cli import EXIT_FAIL, main
+from maizeviz.resources import example_phenomenal
 
 L = ["light", "pts.csv", "--sun-zenith", "10", "--sun-azimuth", "0", "--density", "0.05",
      "--heights", "0"]

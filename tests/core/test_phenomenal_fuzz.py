@@ -10,10 +10,10 @@ import math
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from maizeviz.resources import example_phenomenal
 
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.io.points import read_points
+from maizeviz.resources import example_phenomenal
 
 #: What a value may be replaced by: every JSON kind, empty containers, non-finite and huge
 #: numbers, ragged rows, nesting.

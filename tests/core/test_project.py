@@ -7,11 +7,20 @@ import zipfile
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from maizeviz.errors import MaizevizError
-from maizeviz.io.project import (PROJECT_FORMAT, Project, ProjectError, Record, get,
-                                 get_numbers, load_project, save_project)
+from maizeviz.io.project import (
+    PROJECT_FORMAT,
+    Project,
+    ProjectError,
+    Record,
+    get,
+    get_numbers,
+    load_project,
+    save_project,
+)
 
 CSV = b"plant,leaf,row,col,x,y,z\n1,1,0,0,0,0,10\n1,1,0,1,1,0,10\n"
 

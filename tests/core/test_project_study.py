@@ -3,16 +3,17 @@ save and open, stale results are dropped with a note, the points copy is checked
 and what a project may hold is bounded before anything is built."""
 
 import hashlib
-import os
 import io
 import json
+import os
 import random
 import zipfile
 from dataclasses import replace
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from maizeviz.canopy.layout import CanopyLayout, Placement, layout_for, layout_to_dict
 from maizeviz.canopy.scene import build_canopy

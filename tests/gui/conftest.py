@@ -38,14 +38,16 @@ def fresh_settings():
 def window(qtbot):
     """A main window (the bundled example by default), its 3D view made; closed (viewport
     and core processes included) after the test."""
-    from maizeviz.resources import example_points
     from maizeviz_app.main_window import MainWindow
+
+    from maizeviz.resources import example_points
 
     made = []
 
     def make(points=None, tile=3, wait_ready=True, size=(1366, 740)):
         points = example_points() if points is None else points
         w = MainWindow(points if points != "last" else None, tile)
+        w.confirm_unsaved = False          # tests close windows with results unsaved
         if size is not None:
             w.resize(*size)
         made.append(w)

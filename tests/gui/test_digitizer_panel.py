@@ -83,7 +83,7 @@ def test_buttons_are_big_and_the_panel_scrolls_on_a_laptop(make_panel):
     # every control fits in a small dock: the rest scrolls
     assert panel.minimumSizeHint().height() < 300
     panel.resize(380, 320)
-    assert panel.scroll.verticalScrollBar().maximum() > 0
+    assert panel.scroll_area.verticalScrollBar().maximum() > 0
 
 
 def test_shortcuts_act_wherever_the_focus_is(qtbot, make_panel, tmp_path):

@@ -58,8 +58,8 @@ def test_sky_mode_adds_a_diffuse_curve_maps_and_colours(window, qtbot, small_poi
     # the heatmap selector offers both lights' maps; the diffuse one is shown
     sources = [w.plots.source.itemText(i) for i in range(w.plots.source.count())]
     assert sources == ["direct sun", "diffuse sky"] and w.plots.kind == "sky"
-    assert w.plots.height.count() == 3 and w.plots.heatmap.image() is not None
-    w.plots.height.setCurrentIndex(2)                       # another height: drawn on demand
+    assert w.plots.height_box.count() == 3 and w.plots.heatmap.image() is not None
+    w.plots.height_box.setCurrentIndex(2)                       # another height: drawn on demand
     qtbot.waitUntil(lambda: w.plots.heatmap.image() is not None, timeout=TIMEOUT)
     assert w.plots.transmission.image() is not None
     # the leaves coloured by the diffuse light they take, with a colour bar
@@ -75,7 +75,7 @@ def test_sky_mode_adds_a_diffuse_curve_maps_and_colours(window, qtbot, small_poi
                                         abs=0.002)
     # back to the sun's colours and map
     w.plots.source.setCurrentIndex(0)
-    assert w.plots.kind == "sun" and w.plots.height.count() == 3
+    assert w.plots.kind == "sun" and w.plots.height_box.count() == 3
 
 
 def test_day_mode_summary_plants_and_exports(window, qtbot, small_points, tmp_path):

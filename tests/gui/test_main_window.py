@@ -69,11 +69,11 @@ def test_compute_light_colours_the_leaves(window, qtbot):
     assert w.viewport.actors["canopy"].mapper.GetArrayName() == "light"
     light = w.viewport.canopy_mesh.cell_data["light"][:w.canopy.n_triangles]
     assert set(np.unique(light)) == {0, 1, 2}
-    assert w.actions["colour_light"].isChecked()
+    assert w.menu_actions["colour_light"].isChecked()
     # a heatmap per height and the transmission plot
-    assert w.plots.height.count() == 6 and w.plots.heatmap.image() is not None
+    assert w.plots.height_box.count() == 6 and w.plots.heatmap.image() is not None
     assert w.plots.transmission.image() is not None
-    w.plots.height.setCurrentIndex(3)
+    w.plots.height_box.setCurrentIndex(3)
     assert w.plots.shown_height == 150.0
 
 

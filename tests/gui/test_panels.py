@@ -2,12 +2,18 @@
 
 import numpy as np
 import pytest
-
-from maizeviz.errors import LeafError, MaizevizError, PointsFileError
 from maizeviz_app.messages import user_message
 from maizeviz_app.panels.canopy import CanopyPanel
-from maizeviz_app.panels.light import (InputProblem, LightPanel, LightPlots, LightRuns, Run,
-                                       parse_heights)
+from maizeviz_app.panels.light import (
+    InputProblem,
+    LightPanel,
+    LightPlots,
+    LightRuns,
+    Run,
+    parse_heights,
+)
+
+from maizeviz.errors import LeafError, MaizevizError, PointsFileError
 
 
 def test_slider_asks_once_and_the_label_follows_the_view(qtbot):
@@ -103,19 +109,20 @@ def test_plots_switch_heights(qtbot):
     qtbot.addWidget(plots)
     images = [(h, np.full((40, 60, 4), v, np.uint8)) for h, v in ((0.0, 10), (50.0, 200))]
     plots.set_heatmaps(images)
-    assert plots.height.count() == 2 and plots.shown_height == 0.0
+    assert plots.height_box.count() == 2 and plots.shown_height == 0.0
     assert plots.heatmap.image().pixel(5, 5) & 0xFF == 10
-    plots.height.setCurrentIndex(1)
+    plots.height_box.setCurrentIndex(1)
     assert plots.shown_height == 50.0 and plots.heatmap.image().pixel(5, 5) & 0xFF == 200
     plots.set_transmission(np.zeros((30, 30, 4), np.uint8))
     assert plots.transmission.image() is not None
 
 
 def test_figures_are_the_core_heatmap_and_a_level_comparison(small_canopy):
+    from maizeviz_app.plots import Curve, heatmap_images, rgba, transmission_figure
+
     from maizeviz.light.request import LightRequest, Sampling
     from maizeviz.light.sun import Sun
     from maizeviz.light.transmission import trace_light
-    from maizeviz_app.plots import Curve, heatmap_images, rgba, transmission_figure
 
     result = trace_light(small_canopy, LightRequest(Sun(22.3, 167.0), Sampling((0.0, 100.0), 0.5),
                                                     classes=True))

@@ -7,6 +7,7 @@ import zipfile
 
 import numpy as np
 import pytest
+from maizeviz_app.exports import export_job
 from test_light_modes import compute, headers, shown, small_light
 
 TIMEOUT = 120_000
@@ -65,7 +66,7 @@ def test_sky_and_day_results_come_back_with_a_project(window, qtbot, small_point
         w2.viewport.canopy_mesh.cell_data["light_value"][:w2.canopy.n_triangles], values)
     # the sky's map on demand, and the exports of a day
     w2.plots.source.setCurrentIndex(sources.index("diffuse sky"))
-    assert w2.plots.kind == "sky" and w2.plots.height.count() == 3
+    assert w2.plots.kind == "sky" and w2.plots.height_box.count() == 3
     for what in ("steps", "leaves", "plants"):
         with qtbot.waitSignal(w2.saved, timeout=TIMEOUT):
             w2.export(what, tmp_path / f"{what}.csv")
@@ -92,7 +93,8 @@ def test_a_sky_at_another_level_gets_its_plants_when_that_level_is_shown(
     run = w2.runs.of_kind("sky")
     assert run.label == "36 triangles" and run.extra is None and w2.level == "16"
     with pytest.raises(Exception, match="show level 36 triangles first"):
-        w2._export_diffuse("leaves", str(tmp_path / "x.csv"))
+        export_job("leaves", str(tmp_path / "x.csv"), w2.model)
     with qtbot.waitSignal(w2.canopy_shown, timeout=TIMEOUT):
         w2.slider.setValue(w2.slider.value() - 1)          # back to 36: computed against it
-    assert run.extra is not None and w2.light_panel.plants.rowCount() == 2
+    qtbot.waitUntil(lambda: run.extra is not None, timeout=TIMEOUT)    # in a worker
+    assert w2.light_panel.plants.rowCount() == 2

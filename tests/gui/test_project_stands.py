@@ -2,7 +2,6 @@
 
 import numpy as np
 
-
 TIMEOUT = 120_000
 
 

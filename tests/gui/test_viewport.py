@@ -73,10 +73,10 @@ def test_light_colouring(qtbot, viewport, small_canopy):
 
 
 def test_digitizing_hides_and_restores_the_canopy(qtbot, viewport, small_canopy):
-    from maizeviz.mesh.levels import Level, mesh_leaves
     from maizeviz.leaf.fit import fit_leaves
-    from maizeviz.leaf.synth import example_leaf
     from maizeviz.leaf.grid import LeafGrid
+    from maizeviz.leaf.synth import example_leaf
+    from maizeviz.mesh.levels import Level, mesh_leaves
 
     viewport.show_canopy(small_canopy)
     viewport.hide_canopy()

@@ -24,7 +24,7 @@ def test_close_right_after_start(window, qtbot, capfd):
         qtbot.wait(delay)
         w.close()
         started = []
-        w.runner.changed.connect(lambda: started.append(w.runner.running()))
+        w.runner.changed.connect(lambda w=w, started=started: started.append(w.runner.running()))
         qtbot.wait(1500)
         assert not w.runner.running() and not started
         assert QThreadPool.globalInstance().waitForDone(10_000)
@@ -114,7 +114,7 @@ def test_project_round_trip(window, qtbot, small_points, tmp_path):
     assert w2.level == "36" and w2.light_panel.heights.text() == "0, 100, 200"
     assert "study.maizeviz" in w2.canopy_panel.file_label.text()
     assert [[w2.light_panel.table.item(r, c).text() for c in range(3)] for r in range(3)] == table
-    assert w2.viewport.colouring == "light" and w2.plots.height.count() == 3
+    assert w2.viewport.colouring == "light" and w2.plots.height_box.count() == 3
     np.testing.assert_array_equal(w2.loaded.layout.cells, w.loaded.layout.cells)
     assert w2.loaded.layout.placements == w.loaded.layout.placements
 
@@ -175,11 +175,12 @@ def test_exports(window, qtbot, small_points, tmp_path):
 
 
 def test_menus_show_shortcuts_and_about_names_the_paper(window, qtbot):
-    from maizeviz import __version__
     from maizeviz_app.main_window import about_text
 
+    from maizeviz import __version__
+
     w = window(wait_ready=False)
-    texts = {name: a.shortcut().toString() for name, a in w.actions.items()}
+    texts = {name: a.shortcut().toString() for name, a in w.menu_actions.items()}
     assert texts["open"] == "Ctrl+O" and texts["compute"] == "Ctrl+L"
     assert texts["save"] == "Ctrl+S" and texts["quit"] == "Ctrl+Q"
     assert texts["camera_top"] == "Ctrl+1" and texts["colour_light"] == "Ctrl+Shift+3"

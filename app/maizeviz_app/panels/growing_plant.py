@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 from PySide6.QtCore import QObject, QThreadPool, Signal
-from superqt.utils import create_worker
 
 from maizeviz.digitizer.recorder import plant_sections
 from maizeviz.errors import MaizevizError
+from maizeviz_app.workers import JobRunner
 
 #: Mesh of the live preview: the standard mesh refined twice (smooth enough, about 10 ms).
 PREVIEW_INTERP = 2
@@ -56,7 +56,7 @@ class GrowingPlant(QObject):
         self.viewport = viewport
         self.pool = QThreadPool(self)
         self.pool.setMaxThreadCount(1)
-        self._workers: set = set()
+        self.runner = JobRunner(self, pool=self.pool)
         self._generation = 0
         self._plant: int | None = None
         self._wanted: dict[int, bytes] = {}     # leaf -> key of the sections asked for
@@ -96,7 +96,7 @@ class GrowingPlant(QObject):
     def clear(self) -> None:
         """Forget the plant and drop pending work; results still in flight are ignored."""
         self._generation += 1
-        self.pool.clear()
+        self.runner.cancel()                            # their results are dropped
         self._plant, self._framed = None, None
         self._wanted.clear()
         self._shown.clear()
@@ -110,12 +110,11 @@ class GrowingPlant(QObject):
     # ------------------------------------------------------------------------ internals
     def _submit(self, plant: int, leaf: int, rows: dict, key: bytes) -> None:
         generation = self._generation
-        worker = create_worker(mesh_sections, plant, leaf, rows, _start_thread=False)
-        worker.returned.connect(
-            lambda result: self._on_meshed(generation, plant, leaf, key, result))
-        worker.finished.connect(lambda: self._workers.discard(worker))
-        self._workers.add(worker)
-        self.pool.start(worker)
+        # one job per leaf: a newer press on the same leaf supersedes its meshing
+        self.runner.run(f"leaf {plant}/{leaf}", f"meshing leaf {leaf}",
+                        lambda job: mesh_sections(plant, leaf, rows),
+                        on_done=lambda result: self._on_meshed(generation, plant, leaf, key,
+                                                               result))
 
     def _on_meshed(self, generation: int, plant: int, leaf: int, key: bytes, result) -> None:
         if generation != self._generation or plant != self._plant \

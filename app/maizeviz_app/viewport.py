@@ -29,6 +29,10 @@ from pyvistaqt import QtInteractor
 
 from maizeviz_app.options import CAMERAS, COLOURINGS, LIGHT_CLASSES, NOT_TRACED, STALK
 
+#: Text alignments of the painted axes and legends.
+CENTRE = Qt.AlignmentFlag.AlignCenter
+LEFT = Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter
+
 _PLANT_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
                   "#7f7f7f", "#bcbd22", "#17becf")
 
@@ -423,14 +427,14 @@ def ground_image(field: tuple[float, float, float, float], margin: float, xs: np
     width_cm, height_cm = x1 - x0 + 2 * margin, y1 - y0 + 2 * margin
     scale = min(4.0, max_px / max(width_cm, height_cm))
     w, h = int(round(width_cm * scale)), int(round(height_cm * scale))
-    img = QImage(w, h, QImage.Format_RGBA8888)
+    img = QImage(w, h, QImage.Format.Format_RGBA8888)
     img.fill(QColor("#ece3cc"))
 
     def px(x, y):
         return QPointF((x - x0 + margin) * scale, (y1 + margin - y) * scale)
 
     p = QPainter(img)
-    p.setRenderHint(QPainter.Antialiasing)
+    p.setRenderHint(QPainter.RenderHint.Antialiasing)
     p.fillRect(QRectF(px(x0, y1), px(x1, y0)), QColor("#cdb98f"))
     p.setPen(QPen(QColor("#8a7a55"), max(1.0, 0.35 * scale)))
     for x in xs:
@@ -446,19 +450,17 @@ def ground_image(field: tuple[float, float, float, float], margin: float, xs: np
     box = margin * scale * 0.6
     for x in xs[::step_x]:
         c = px(x, y0 - margin * 0.27)
-        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), Qt.AlignCenter,
-                   f"{x:.0f}")
+        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), CENTRE, f"{x:.0f}")
     for y in ys[::step_y]:
         c = px(x0 - margin * 0.27, y)
-        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), Qt.AlignCenter,
-                   f"{y:.0f}")
+        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), CENTRE, f"{y:.0f}")
     c = px((x0 + x1) / 2, y0 - margin * 0.72)
-    p.drawText(QRectF(c.x() - 20 * box, c.y() - box / 2, 40 * box, box), Qt.AlignCenter,
+    p.drawText(QRectF(c.x() - 20 * box, c.y() - box / 2, 40 * box, box), CENTRE,
                "x (cm, across the rows)")
     c = px(x0 - margin * 0.72, (y0 + y1) / 2)
     p.translate(c)
     p.rotate(-90)
-    p.drawText(QRectF(-20 * box, -box / 2, 40 * box, box), Qt.AlignCenter,
+    p.drawText(QRectF(-20 * box, -box / 2, 40 * box, box), Qt.AlignmentFlag.AlignCenter,
                "y (cm, along the rows)")
     p.end()
     arr = np.frombuffer(img.constBits(), np.uint8).reshape(h, img.bytesPerLine())[:, :4 * w]
@@ -471,7 +473,7 @@ class Legend(QWidget):
 
     def __init__(self, parent=None):
         super().__init__(parent)
-        self.setAttribute(Qt.WA_TransparentForMouseEvents)
+        self.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents)
         self._title = ""
         self._items: list[tuple[str, str]] = []
         self._gradient: tuple | None = None
@@ -506,16 +508,15 @@ class Legend(QWidget):
 
     def paintEvent(self, _event) -> None:  # noqa: N802 - Qt's name
         p = QPainter(self)
-        p.setRenderHint(QPainter.Antialiasing)
-        p.setPen(Qt.NoPen)
+        p.setRenderHint(QPainter.RenderHint.Antialiasing)
+        p.setPen(Qt.PenStyle.NoPen)
         p.setBrush(QColor(255, 255, 255, 215))
         p.drawRoundedRect(QRectF(self.rect()), 6, 6)
         fm = self.fontMetrics()
         line = fm.height() + 4
         p.setPen(QColor("#222222"))
         y = 6
-        p.drawText(QRectF(8, y, self.width() - 16, line), Qt.AlignLeft | Qt.AlignVCenter,
-                   self._title)
+        p.drawText(QRectF(8, y, self.width() - 16, line), LEFT, self._title)
         y += line
         if self._gradient is not None:
             colours, lo, hi = self._gradient
@@ -524,12 +525,11 @@ class Legend(QWidget):
                 grad.setColorAt(k / max(len(colours) - 1, 1), QColor(*[int(v) for v in c[:3]]))
             p.fillRect(QRectF(8, y + 2, self.width() - 16, line - 4), grad)
             y += line
-            p.drawText(QRectF(8, y, self.width() - 16, line), Qt.AlignLeft, str(lo))
-            p.drawText(QRectF(8, y, self.width() - 16, line), Qt.AlignRight, str(hi))
+            p.drawText(QRectF(8, y, self.width() - 16, line), Qt.AlignmentFlag.AlignLeft, str(lo))
+            p.drawText(QRectF(8, y, self.width() - 16, line), Qt.AlignmentFlag.AlignRight, str(hi))
             y += line
         for label, colour in self._items:
             p.fillRect(QRectF(8, y + 3, 16, line - 6), QColor(colour))
-            p.drawText(QRectF(30, y, self.width() - 38, line), Qt.AlignLeft | Qt.AlignVCenter,
-                       label)
+            p.drawText(QRectF(30, y, self.width() - 38, line), LEFT, label)
             y += line
         p.end()

@@ -1,6 +1,9 @@
-"""Jobs the window hands to threads (and, through them, to the core processes).
+"""Jobs the app hands to threads (and, through them, to the core processes): the one worker
+system of the app. The window's runner uses Qt's global pool; a panel that needs its own
+ordering (the digitizer's connection, the growing plant's one-leaf-at-a-time meshing) gives its
+runner a pool of its own.
 
-Jobs run on Qt's global thread pool as plain QRunnables started at once, and their results
+Jobs run on a Qt thread pool as plain QRunnables started at once, and their results
 come back through the runner's own queued signal. (superqt's ``create_worker`` starts a worker
 from a 1 ms timer when an event loop runs, so a job asked for just before the window closed
 could start after it; and its queued ``returned`` is lost when the worker object is deleted
@@ -40,7 +43,7 @@ class Job:
     id: int
     kind: str
     label: str
-    runner: "JobRunner"
+    runner: JobRunner
     cancel: threading.Event = field(default_factory=threading.Event)
     started: float = field(default_factory=time.perf_counter)
 
@@ -74,8 +77,9 @@ class JobRunner(QObject):
     _progress_signal = Signal(int, int, int, str)
     _delivered = Signal(int, object, object)
 
-    def __init__(self, parent=None):
+    def __init__(self, parent=None, pool: QThreadPool | None = None):
         super().__init__(parent)
+        self.pool = pool if pool is not None else QThreadPool.globalInstance()
         self._ids = itertools.count(1)
         self._current: dict[str, Job] = {}
         self._handlers: dict[int, tuple] = {}
@@ -120,6 +124,7 @@ class JobRunner(QObject):
         delivered = self._delivered
 
         def guarded() -> None:
+            exc: BaseException | None
             try:
                 result, exc = func(job, *args), None
             except InterruptedError:                  # superseded, cancelled or closing
@@ -133,7 +138,7 @@ class JobRunner(QObject):
 
         task = _Task(guarded)
         self._tasks[job.id] = task
-        QThreadPool.globalInstance().start(task)
+        self.pool.start(task)
         self.changed.emit()
         return job
 
@@ -196,7 +201,7 @@ class JobRunner(QObject):
             job.cancel.set()
         self.cover_process.close()
         self.light_process.close()
-        ok = QThreadPool.globalInstance().waitForDone(int(timeout_s * 1000))
+        ok = self.pool.waitForDone(int(timeout_s * 1000))
         if not ok:
             print("maizeviz: some work was still running when the window closed",
                   file=sys.stderr)

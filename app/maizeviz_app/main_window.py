@@ -22,28 +22,53 @@ an error about one light setting also marks that field.
 
 from __future__ import annotations
 
-import csv
 import sys
 import threading
 import time
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
-from PySide6.QtCore import QSettings, Qt, QTimer, Signal
-from PySide6.QtWidgets import (QApplication, QDockWidget, QFileDialog, QHBoxLayout, QLabel,
-                               QMainWindow, QMessageBox, QPlainTextEdit,
-                               QPushButton, QScrollArea, QStackedWidget, QWidget)
+from PySide6.QtCore import QByteArray, QSettings, Qt, QTimer, Signal
+from PySide6.QtWidgets import (
+    QApplication,
+    QDockWidget,
+    QFileDialog,
+    QHBoxLayout,
+    QLabel,
+    QMainWindow,
+    QMessageBox,
+    QPlainTextEdit,
+    QPushButton,
+    QScrollArea,
+    QStackedWidget,
+    QWidget,
+)
 
 from maizeviz import __version__
 from maizeviz.errors import MaizevizError
 from maizeviz.mesh.levels import COMPLEXITY_STOPS as LEVELS  # noqa: F401 - the slider's stops
 from maizeviz.resources import example_points
+from maizeviz_app.exports import export_job
 from maizeviz_app.messages import user_message
+from maizeviz_app.model import StudyModel
 from maizeviz_app.panels.canopy import CanopyPanel
-from maizeviz_app.panels.light import (COMPUTE_TEXT, MODES, InputProblem, LightPanel,
-                                       LightPlots, LightRuns, Run)
+from maizeviz_app.panels.light import (
+    COMPUTE_TEXT,
+    MODES,
+    InputProblem,
+    LightPanel,
+    LightPlots,
+    LightRuns,
+    Run,
+)
+from maizeviz_app.runs import day_summary, plot_title, run_info, value_legend
 from maizeviz_app.workers import JobRunner, describe_internal
+
+if TYPE_CHECKING:
+    from maizeviz_app.panels.digitizer import DigitizerPanel
+    from maizeviz_app.panels.layout import LayoutPanel
+    from maizeviz_app.viewport import Viewport
 
 #: Version of the saved dock layout; bump when docks change so an old layout is not applied.
 STATE_VERSION = 3
@@ -70,8 +95,8 @@ def _scrolled(widget: QWidget) -> QScrollArea:
     area = QScrollArea()
     area.setWidget(widget)
     area.setWidgetResizable(True)
-    area.setFrameShape(QScrollArea.NoFrame)
-    area.setHorizontalScrollBarPolicy(Qt.ScrollBarAsNeeded)
+    area.setFrameShape(QScrollArea.Shape.NoFrame)
+    area.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAsNeeded)
     return area
 
 
@@ -88,6 +113,9 @@ class MainWindow(QMainWindow):
     ready = Signal()                    # the 3D view and every panel exist
     saved = Signal(str)                 # a project or export written (its path)
     _warmed = Signal(str, object)       # from the warm-up thread: stage, None or the error
+    #: Ask Save / Discard / Cancel before unsaved work (an edited layout, light results) is
+    #: closed or replaced by another file.
+    confirm_unsaved = True
 
     def __init__(self, points: str | Path | None = None, tile: int = 3):
         super().__init__()
@@ -97,27 +125,21 @@ class MainWindow(QMainWindow):
         self.runner = JobRunner(self)
         self.runner.progressed.connect(self._on_progress)
         self.runner.changed.connect(self._on_jobs_changed)
-        self.viewport = None
-        self.loaded = None
-        self.canopy = None
-        self.built = None
-        self.measures_rows: dict[str, dict] = {}
-        self.runs = LightRuns()
-        self._tile = tile                 # tiling until a layout is on screen (then: its own)
-        self._view_pending = None         # (canopy, mesh) built while the digitizer records
-        self.project_path: str | None = None
-        self._serial = 0                  # changes whenever the points or layout change
+        self.model = StudyModel(tile)
+        self.model.modified_changed.connect(lambda on: self.setWindowModified(on))
+        self.model.project_changed.connect(lambda _p: self.setWindowTitle(self.model.title))
+        self.model.points_changed.connect(lambda _l: self.setWindowTitle(self.model.title))
+        self.viewport: Viewport | None = None
+        self._view_pending: tuple | None = None   # (canopy, mesh) built while digitizing
         self._pending_runs: list = []     # light results of a project, waiting for a canopy
+        self._after_save = None           # what to do once the project is saved (close, open)
         self._progress_shown = 0.0
         self._canopy_id = 0               # identifies the canopy shown (the light process
                                           # keeps the last one and its Embree scene)
-        self._points_bytes = b""
-        self._points_origin = ""          # where the points came from (a project's original)
-        self._layout_edited = False       # the layout is not the tiling of the settings
         self._project_layout = False
         self._heatmaps_for: dict[str, Run] = {}    # light -> the run whose maps are shown
 
-        placeholder = QLabel("starting the 3D view…", alignment=Qt.AlignCenter)
+        placeholder = QLabel("starting the 3D view…", alignment=Qt.AlignmentFlag.AlignCenter)
         self._centre = QStackedWidget()
         self._centre.setMinimumSize(320, 200)
         self._centre.addWidget(placeholder)
@@ -127,8 +149,8 @@ class MainWindow(QMainWindow):
         self._build_status()
         from maizeviz_app.menus import build_menus
 
-        self.actions = build_menus(self)
-        self._default_state = None             # taken at the first show, docks sized
+        self.menu_actions = build_menus(self)
+        self._default_state: QByteArray | None = None   # taken at the first show, docks sized
         self._state_restored = self._restore_window()
         self._to_open = str(points) if points is not None else self._last_opened()
         self._view_ready = threading.Event()  # the build job waits for it before meshing
@@ -140,21 +162,23 @@ class MainWindow(QMainWindow):
         dock = QDockWidget(title, self)
         dock.setObjectName(name)
         dock.setWidget(_scrolled(widget) if scroll else widget)
-        dock.setFeatures(QDockWidget.DockWidgetMovable | QDockWidget.DockWidgetFloatable |
-                         QDockWidget.DockWidgetClosable)
+        feature = QDockWidget.DockWidgetFeature
+        dock.setFeatures(feature.DockWidgetMovable | feature.DockWidgetFloatable
+                         | feature.DockWidgetClosable)
         self.addDockWidget(area, dock)
         self.docks[name] = dock
         return dock
 
     def _build_panels(self) -> None:
-        self.setCorner(Qt.BottomRightCorner, Qt.RightDockWidgetArea)
-        self.setCorner(Qt.TopRightCorner, Qt.RightDockWidgetArea)
-        self.setDockOptions(QMainWindow.AnimatedDocks | QMainWindow.AllowTabbedDocks)
-        self.canopy_panel = CanopyPanel()
+        self.setCorner(Qt.Corner.BottomRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
+        self.setCorner(Qt.Corner.TopRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
+        self.setDockOptions(QMainWindow.DockOption.AnimatedDocks
+                            | QMainWindow.DockOption.AllowTabbedDocks)
+        self.canopy_panel = CanopyPanel(self.model)
         self.canopy_panel.open_requested.connect(self.choose_points)
         self.canopy_panel.level_requested.connect(lambda _lv: self.rebuild())
         self.canopy_panel.preserve_changed.connect(lambda _b: self.rebuild())
-        self.light_panel = LightPanel()
+        self.light_panel = LightPanel(self.model)
         self.light_panel.compute_requested.connect(self.compute_light)
         self.light_panel.cancel_requested.connect(lambda: self.cancel_jobs("light"))
         self.light_panel.place_requested.connect(lambda _t: self.sun_from_place())
@@ -162,14 +186,14 @@ class MainWindow(QMainWindow):
         self.light_panel.mode_changed.connect(lambda _m: self.light_panel.clear_problem())
         # the layout editor and the digitizer import much of the core: they are made once the
         # window is on screen (see _make_late_panels)
-        self.layout_panel = None
-        self.digitizer = None
+        self.layout_panel: LayoutPanel | None = None
+        self.digitizer: DigitizerPanel | None = None
         self.plots = LightPlots()
         self.plots.heatmap_needed.connect(self._draw_heatmap)
         self.messages = QPlainTextEdit(readOnly=True)
         self.messages.setMaximumBlockCount(1000)
 
-        right = Qt.RightDockWidgetArea
+        right = Qt.DockWidgetArea.RightDockWidgetArea
         canopy = self._dock("canopy", "Canopy", self.canopy_panel, right)
         light = self._dock("light", "Light", self.light_panel, right)
         layout = self._dock("layout", "Layout", QLabel("starting…"), right)
@@ -177,10 +201,9 @@ class MainWindow(QMainWindow):
         for d in (light, layout, digitizer):
             self.tabifyDockWidget(canopy, d)
         canopy.raise_()
-        results = self._dock("results", "Light results", self.plots, Qt.BottomDockWidgetArea,
-                             scroll=False)
-        messages = self._dock("messages", "Messages", self.messages, Qt.BottomDockWidgetArea,
-                              scroll=False)
+        bottom = Qt.DockWidgetArea.BottomDockWidgetArea
+        results = self._dock("results", "Light results", self.plots, bottom, scroll=False)
+        messages = self._dock("messages", "Messages", self.messages, bottom, scroll=False)
         self.tabifyDockWidget(results, messages)
         results.raise_()
 
@@ -194,7 +217,7 @@ class MainWindow(QMainWindow):
         lay.setContentsMargins(0, 0, 0, 0)
         self.job_label = QLabel("")
         self.job_label.setFixedWidth(300)
-        self.job_label.setAlignment(Qt.AlignRight | Qt.AlignVCenter)
+        self.job_label.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
         self.cancel_button = QPushButton("Cancel")
         self.cancel_button.setToolTip("stop the work under way (Esc)")
         self.cancel_button.clicked.connect(lambda: self.cancel_jobs())
@@ -203,7 +226,7 @@ class MainWindow(QMainWindow):
         lay.addWidget(self.cancel_button)
         self.statusBar().addPermanentWidget(box)
 
-    def _restore_window(self) -> None:
+    def _restore_window(self) -> bool:
         geometry = self._settings.value("geometry")
         restored = bool(geometry) and self.restoreGeometry(geometry)
         if not restored:
@@ -241,9 +264,9 @@ class MainWindow(QMainWindow):
     def _apply_default_sizes(self) -> None:
         w, h = self.width(), self.height()
         self.resizeDocks([self.docks["canopy"]], [max(380, min(480, int(w * 0.33)))],
-                         Qt.Horizontal)
+                         Qt.Orientation.Horizontal)
         self.resizeDocks([self.docks["results"]], [max(200, min(380, int(h * 0.36)))],
-                         Qt.Vertical)
+                         Qt.Orientation.Vertical)
 
     def reset_layout(self) -> None:
         """Docks back to where they are on a first start."""
@@ -316,7 +339,7 @@ class MainWindow(QMainWindow):
         from maizeviz_app.panels.digitizer import DigitizerPanel
         from maizeviz_app.panels.layout import LayoutPanel
 
-        self.layout_panel = LayoutPanel()
+        self.layout_panel = LayoutPanel(self.model)
         self.layout_panel.applied.connect(self._on_layout)
         self.layout_panel.problem.connect(self.say)
         self.digitizer = DigitizerPanel(self.viewport)
@@ -324,8 +347,6 @@ class MainWindow(QMainWindow):
         self.digitizer.stopped.connect(self._digitizing_stopped)
         self.docks["layout"].setWidget(_scrolled(self.layout_panel))
         self.docks["digitizer"].setWidget(_scrolled(self.digitizer))
-        if self.loaded is not None:
-            self.layout_panel.show_layout(self.loaded.layout, self.loaded.plants)
 
     def _start_processes(self) -> None:
         for proc in (self.runner.cover_process, self.runner.light_process):
@@ -395,8 +416,33 @@ class MainWindow(QMainWindow):
     def _folder(self) -> str:
         return str(self._settings.value("last_folder", str(Path.home())))
 
+    def keep_unsaved(self, then) -> bool:
+        """True when the caller may go on: nothing is unsaved, or the user discards it. Save
+        saves the project (asking where, the first time) and calls ``then()`` once it is
+        written; Cancel (or a save that does not happen) stops."""
+        if not self.model.modified or not self.confirm_unsaved or self._closing:
+            return True
+        name = Path(self.project_path).name if self.project_path else "this study"
+        box = QMessageBox(QMessageBox.Icon.Warning, "Unsaved changes",
+                          f"{name} has changes that are not in a project: an edited layout or "
+                          "light results. Save them first?",
+                          QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
+                          | QMessageBox.StandardButton.Cancel, self)
+        box.setDefaultButton(QMessageBox.StandardButton.Save)
+        answer = box.exec()
+        if answer == QMessageBox.StandardButton.Discard:
+            return True
+        if answer == QMessageBox.StandardButton.Save:
+            self._after_save = then
+            self.save_project_here()
+            if self.runner.current("save") is None:   # the save dialog was cancelled
+                self._after_save = None
+        return False
+
     def open_points(self, path: str | Path, layout=None) -> None:
         """Read a points file in a worker; the current canopy stays until it has loaded."""
+        if not self.keep_unsaved(lambda: self.open_points(path, layout)):
+            return
         from maizeviz_app import jobs
 
         path = str(path)
@@ -413,65 +459,63 @@ class MainWindow(QMainWindow):
 
     @property
     def tile_n(self) -> int:
-        """Tiles along each side of the layout on screen, as the layout panel's presets set
-        it (the one place to choose a tiling); a points file opens with it. Before a layout
-        (or for a layout that is not a square tiling): the tiling the window started with."""
-        from maizeviz_app.options import tiling_of
+        """Tiles along each side of the layout on screen (see ``StudyModel.tile_n``)."""
+        return self.model.tile_n
 
-        tiles = tiling_of(self.loaded.layout) if self.loaded is not None else None
-        if tiles is not None and tiles[0] == tiles[1]:
-            return tiles[0]
-        return self._tile
+    # the model's state, under the names tests and scripts know
+    @property
+    def loaded(self):
+        return self.model.loaded
+
+    @property
+    def built(self):
+        return self.model.built
+
+    @property
+    def canopy(self):
+        return self.model.canopy
+
+    @property
+    def runs(self) -> LightRuns:
+        return self.model.runs
+
+    @property
+    def project_path(self) -> str | None:
+        return self.model.project_path
+
+    @property
+    def measures_rows(self) -> dict[str, dict]:
+        return self.model.measures_rows
 
     def _on_loaded(self, loaded, points_bytes: bytes, project: str | None,
                    origin: str) -> None:
-        self.loaded = loaded
-        self._points_bytes = points_bytes
-        self._points_origin = str(Path(origin).resolve())
-        self._serial += 1
-        self.runs.clear()
-        self.measures_rows.clear()
-        self.canopy_panel.clear_rows()
-        self.light_panel.show_runs(self.runs)
         self._heatmaps_for.clear()
         self.plots.clear()
         self.plots.set_transmission(None)
-        self.canopy_panel.set_file(Path(loaded.shown_name).name if project is None
-                                   else loaded.shown_name, loaded.path)
-        self.project_path = project
-        self._layout_edited = project is not None and self._project_layout
+        self.model.open_points(loaded, points_bytes, origin, project,
+                               project is not None and self._project_layout)
         opened = project or loaded.path
         if loaded.path != str(example_points()) or project:
             self._settings.setValue("last_opened", opened)
             self._remember(opened)
         self._settings.setValue("last_folder", str(Path(opened).parent))
-        self.setWindowTitle(f"maizeviz — {Path(opened).name}")
         for w in loaded.warnings:
             self.say(f"note: {w}")
         for e in loaded.skipped:
             self.say(f"skipped: {e}")
         self.say(f"{len(loaded.leaves)} leaves of {len(loaded.plants)} plants; "
                  f"{len(loaded.layout.placements)} plants in the canopy")
-        if self.layout_panel is not None:
-            self.layout_panel.show_layout(loaded.layout, loaded.plants)
         self.rebuild()
 
     def _on_layout(self, layout) -> None:
         if self.loaded is None:
             return
-        self.loaded = replace(self.loaded, layout=layout)
-        self._layout_edited = True
-        self._serial += 1
-        if self.runs.runs:
+        if self.model.edit_layout(layout):
             self.say("note: the layout changed; light results of the previous layout were "
                      "cleared")
-        self.runs.clear()
-        self.light_panel.show_runs(self.runs)
         self._heatmaps_for.clear()
         self.plots.clear()
         self.plots.set_transmission(None)
-        self.measures_rows.clear()
-        self.canopy_panel.clear_rows()
         self.say(f"layout applied: {len(layout.placements)} plants")
         self.rebuild()
 
@@ -495,7 +539,7 @@ class MainWindow(QMainWindow):
 
     def signature(self, label: str) -> tuple:
         """What identifies a canopy: the points and layout (serial) and the level variant."""
-        return (self._serial, label)
+        return self.model.signature(label)
 
     def rebuild(self) -> None:
         """Rebuild the canopy at the slider's level (a running rebuild is superseded)."""
@@ -505,7 +549,7 @@ class MainWindow(QMainWindow):
 
         loaded, level = self.loaded, self.level
         preserve = self.canopy_panel.preserve.isChecked()
-        serial = self._serial
+        serial = self.model.serial
         key = object()
         runner = self.runner
         view_ready = self._view_ready
@@ -548,14 +592,10 @@ class MainWindow(QMainWindow):
         """A canopy built: the level label, Table 2 and the view change together; while the
         digitizer records, the view keeps the plant being digitized and the canopy waits
         (``canopy_shown`` is emitted either way: the canopy is the window's)."""
-        mesh, columns, row = built.polydata, list(built.columns), built.row
-        if built.serial != self._serial or self.viewport is None:
+        mesh = built.polydata
+        if self.viewport is None or not self.model.show_built(built):
             return
-        self.canopy = built.canopy
-        self.built = built
         self._canopy_id += 1
-        self.canopy_panel.show_built(built.level, columns, row)
-        self.measures_rows[built.label] = row
         if self.digitizing:
             self._view_pending = (built.canopy, mesh)
             self.say(f"{built.label} is ready; it shows when the digitizing session stops",
@@ -563,9 +603,8 @@ class MainWindow(QMainWindow):
         else:
             self._view_pending = None
             self.viewport.show_canopy(built.canopy, mesh)
-        if self._complete_runs() and not self._pending_runs:
-            self.light_panel.show_plants(self.runs.latest(None, ("sky", "day")))
         self._adopt_pending_runs()
+        self._complete_runs()
         self._light_to_view()
         m = built.measures
         if not self.digitizing:
@@ -587,10 +626,11 @@ class MainWindow(QMainWindow):
                 self._view_pending is not None:
             return
         run = self.runs.latest(self.signature(self.built.label))
-        if run is not None and run.kind == "sun" and run.classes is not None:
+        if run is not None and run.kind == "sun" and run.classes is not None and \
+                run.extra is None:
             self.viewport.set_light(run.classes)
         elif run is not None and run.extra is not None:
-            title, unit = _value_legend(run)
+            title, unit = value_legend(run)
             self.viewport.set_light_values(run.extra.leaf_value, title, unit)
         if colour and run is not None:
             self.colour_by("light")
@@ -612,11 +652,16 @@ class MainWindow(QMainWindow):
         panel = self.light_panel
         panel.clear_problem()
         mode = panel.mode
+        settings: object
+        args: tuple
         try:
+            optics = None
             if mode == "sun":
                 request = panel.request()
                 heights = request.heights_cm
-                settings = (round(request.sun.zenith_deg, 6), round(request.sun.azimuth_deg, 6))
+                optics = panel.optics_spec()
+                settings = (round(request.sun.zenith_deg, 6), round(request.sun.azimuth_deg, 6),
+                            optics)
                 op, args = "light", (request,)
             else:
                 sampling = panel.sampling()
@@ -630,7 +675,7 @@ class MainWindow(QMainWindow):
         except (InputProblem, MaizevizError) as exc:
             self._fail(exc, "light", mode)
             return
-        if not self.affordable([self._light_costs(mode, args, heights)], "light"):
+        if not self.affordable([self._light_costs(mode, args, heights, optics)], "light"):
             return
         from maizeviz_app import plots
 
@@ -641,7 +686,7 @@ class MainWindow(QMainWindow):
         runs = self.runs.copy()
         key = self._canopy_id
         runner = self.runner
-        shown_height = max(self.plots.height.currentIndex(), 0)
+        shown_height = max(self.plots.height_box.currentIndex(), 0)
 
         def work(job):
             out = runner.light_process.call(op, key, canopy, args, job)
@@ -649,13 +694,18 @@ class MainWindow(QMainWindow):
             if mode == "sun":
                 from maizeviz.light.leaf_light import triangle_light
 
-                run = Run(label, signature, out, triangle_light(canopy, out))
+                absorbed = None
+                if optics is not None:              # leaves with optics: absorbed light too
+                    absorbed = runner.light_process.call("absorbed", key, canopy,
+                                                         (args[0], optics), job)
+                    job.check()
+                run = Run(label, signature, out, triangle_light(canopy, out), extra=absorbed)
             else:
                 run = Run(label, signature, out.light, None, mode, out)
             maps = plots.heatmap_images(run.result, first=shown_height, check=job.check,
                                         kind=mode)
             runs.add(run, settings, sampling_key)
-            plot = plots.rgba(plots.transmission_figure(runs.curves(), _plot_title(runs)))
+            plot = plots.rgba(plots.transmission_figure(runs.curves(), plot_title(runs)))
             return run, settings, sampling_key, maps, plot
 
         panel.set_running(True)
@@ -664,15 +714,17 @@ class MainWindow(QMainWindow):
         self.runner.run("light", f"{mode} light on {label}", work, on_done=self._on_lit,
                         on_error=lambda e: self._light_failed(e, mode))
 
-    def _light_costs(self, mode: str, args: tuple, heights) -> list:
+    def _light_costs(self, mode: str, args: tuple, heights, optics=None) -> list:
         """What a light run of ``mode`` on the canopy shown will cost (``maizeviz.cost``): its
-        rays (times the directions: the sun, the sky's, a day's steps) and its heatmaps."""
+        rays (times the directions: the sun, the sky's, a day's steps; with leaf optics, the
+        absorbed light's beams and their scattering) and its heatmaps."""
         from maizeviz.cost import light_costs
-
         from maizeviz_app.plots import HEATMAP_BIN_CM
 
         rect = args[0].rect or self.canopy.layout.centre_bounds
         directions = 1
+        if optics is not None:                          # the beams, each scattered ~3 times
+            directions += 3 * (1 + (46 if optics.diffuse_w_m2 > 0 else 0))
         if mode != "sun":
             directions = max(args[1].directions, 1)
             if mode == "day":
@@ -701,13 +753,14 @@ class MainWindow(QMainWindow):
     def confirm_slow(self, estimate: str) -> bool:
         """Ask before starting work estimated at ``estimate`` (more than a quarter of an
         hour); it runs in the background and can be cancelled."""
-        box = QMessageBox(QMessageBox.Question, "Start a long computation?",
+        box = QMessageBox(QMessageBox.Icon.Question, "Start a long computation?",
                           f"{estimate}.\n\nIt runs in the background and can be cancelled; "
                           "a coarser level, a lower density or fewer directions or steps make "
-                          "it shorter.", QMessageBox.Yes | QMessageBox.Cancel, self)
-        box.button(QMessageBox.Yes).setText("Start")
-        box.setDefaultButton(QMessageBox.Cancel)
-        return box.exec() == QMessageBox.Yes
+                          "it shorter.",
+                          QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.Cancel, self)
+        box.button(QMessageBox.StandardButton.Yes).setText("Start")
+        box.setDefaultButton(QMessageBox.StandardButton.Cancel)
+        return box.exec() == QMessageBox.StandardButton.Yes
 
     def _light_failed(self, exc: BaseException, mode: str = "sun") -> None:
         self.light_panel.set_running(False)
@@ -719,18 +772,17 @@ class MainWindow(QMainWindow):
         run, settings, sampling_key, maps, plot = out
         panel = self.light_panel
         panel.set_running(False)
-        if run.signature[0] != self._serial:
+        if run.signature[0] != self.model.serial:
             return
-        if self.runs.add(run, settings, sampling_key):
+        if self.model.add_run(run, settings, sampling_key, run_info(run)):
             self.say("note: the light settings changed; the comparison starts again")
         r = run.result
-        panel.show_runs(self.runs, _run_info(run))
         if run.kind == "day":
             summary = day_summary(r)
             panel.show_summary(summary)
         elif self.runs.of_kind("day") is None:
             panel.show_summary("")
-        if run.kind != "sun":
+        if run.kind != "sun" or run.extra is not None:
             panel.show_plants(run)
         elif self.runs.of_kind("sky") is None and self.runs.of_kind("day") is None:
             panel.show_plants(None)
@@ -816,7 +868,7 @@ class MainWindow(QMainWindow):
         if self.viewport is None:
             return
         for name in ("plant", "leaf", "light"):
-            act = self.actions.get(f"colour_{name}")
+            act = self.menu_actions.get(f"colour_{name}")
             if act is not None:
                 act.setChecked(self.viewport.colouring == name)
 
@@ -891,8 +943,9 @@ class MainWindow(QMainWindow):
             return
         from maizeviz_app import project
 
-        loaded, data, origin = self.loaded, self._points_bytes, self._points_origin
-        layout = loaded.layout if self._layout_edited else None   # else: the tiling, exactly
+        model = self.model
+        loaded, data, origin = model.loaded, model.points_bytes, model.points_origin
+        layout = loaded.layout if model.layout_edited else None   # else: the tiling, exactly
         canopy = {"tile": self.tile_n, "level": self.level,
                   "preserve_area": self.canopy_panel.preserve.isChecked()}
         light = self.light_panel.settings()
@@ -910,18 +963,26 @@ class MainWindow(QMainWindow):
             return path
 
         self.runner.run("save", f"saving {Path(path).name}", work, on_done=self._on_saved,
-                        on_error=lambda e: self._fail(e, "save project"), supersede=False)
+                        on_error=self._save_failed, supersede=False)
+
+    def _save_failed(self, exc: BaseException) -> None:
+        self._after_save = None                  # nothing closes or opens over unsaved work
+        self._fail(exc, "save project")
 
     def _on_saved(self, path: str) -> None:
-        self.project_path = path
+        self.model.saved(path)
         self._settings.setValue("last_opened", path)
         self._remember(path)
-        self.setWindowTitle(f"maizeviz — {Path(path).name}")
         self.say(f"saved the project {path}")
         self.saved.emit(path)
+        then, self._after_save = self._after_save, None
+        if then is not None:
+            then()
 
     def open_project(self, path: str | Path) -> None:
         """Read a project in a worker; the current canopy stays if it cannot be used."""
+        if not self.keep_unsaved(lambda: self.open_project(path)):
+            return
         from maizeviz_app import jobs, project
 
         path = str(path)
@@ -951,14 +1012,14 @@ class MainWindow(QMainWindow):
     def _cache_folder(self) -> str:
         from PySide6.QtCore import QStandardPaths
 
-        base = QStandardPaths.writableLocation(QStandardPaths.CacheLocation)
+        base = QStandardPaths.writableLocation(QStandardPaths.StandardLocation.CacheLocation)
         return str(Path(base or Path.home() / ".cache" / "maizeviz") / "projects")
 
     def _on_project(self, out) -> None:
         opened, loaded, (tile, level, preserve), light, runs = out
         for note in opened.notes:
             self.say(f"note: {note}")
-        self._tile = tile
+        self.model.tile = tile
         self.canopy_panel.set_level(level)
         self.canopy_panel.preserve.blockSignals(True)
         self.canopy_panel.preserve.setChecked(preserve)
@@ -991,11 +1052,9 @@ class MainWindow(QMainWindow):
                     self.light_panel.density.value()
             sampling = (tuple(float(h) for h in result.heights_cm), density,
                         bool(getattr(result, "periodic", self.light_panel.periodic.isChecked())))
-            self.runs.add(Run(label, self.signature(label), result, None, kind), settings,
-                          sampling)
-        self._complete_runs()
-        self.light_panel.show_runs(self.runs, f"{len(pending)} light result(s) from the "
-                                              "project")
+            self.model.add_run(Run(label, self.signature(label), result, None, kind), settings,
+                               sampling, f"{len(pending)} light result(s) from the project",
+                               saved=True)
         here = self.signature(self.built.label)
         shown = {}
         for kind in MODES:
@@ -1010,7 +1069,7 @@ class MainWindow(QMainWindow):
         latest = self.runs.latest(here) or self.runs.last
         order = sorted(shown, key=lambda k: latest is not None and k == latest.kind)
         curves = self.runs.curves()
-        title = _plot_title(self.runs)
+        title = plot_title(self.runs)
         self._heatmaps_for = dict(shown)
         results = [(k, shown[k].result) for k in order]
 
@@ -1024,41 +1083,66 @@ class MainWindow(QMainWindow):
                 if self._heatmaps_for.get(kind) is shown[kind]:
                     self.plots.set_heatmaps(maps, kind)
             self.plots.set_transmission(out[1])
-            self.light_shown.emit()
+            if self.runner.current("complete") is None:        # else: once it is done
+                self.light_shown.emit()
 
         self.runner.run("figures", "drawing the light figures", work, on_done=done,
                         on_error=lambda e: self._fail(e, "light"))
         self._light_to_view(colour=True)
 
-    def _complete_runs(self) -> bool:
+    def _complete_runs(self) -> None:
         """Results read from a project that were traced on the canopy shown get what the
-        window shows of them, computed against it: a sun's light class per triangle, a sky's
-        or day's light per leaf and plant. True if any did."""
+        window shows of them, computed against it in a worker: a sun's light class per
+        triangle, a sky's or day's light per leaf and plant; then the plants' light and the
+        canopy's colours follow."""
         if self.built is None or self.canopy is None:
-            return False
-        from maizeviz.light.leaf_light import triangle_light
-        from maizeviz_app import jobs
-
-        here, n = self.signature(self.built.label), self.canopy.n_triangles
-        done = False
+            return
+        here, canopy = self.signature(self.built.label), self.canopy
+        n = canopy.n_triangles
+        todo = []
         for run in self.runs.runs.values():
             if run.signature != here:
                 continue
             r = run.result
             if run.kind == "sun" and run.classes is None:
                 if r.first_hits is not None and len(r.first_hits) >= n:
-                    run.classes = triangle_light(self.canopy, r)
-                    done = True
+                    todo.append(run)
             elif run.kind != "sun" and run.extra is None:
                 per_triangle = r.triangle_share if run.kind == "sky" else r.triangle_direct_mol
                 if len(per_triangle) >= n:
-                    run.extra = jobs.diffuse_of(self.canopy, r, run.kind)
-                    done = True
-        return done
+                    todo.append(run)
+        if not todo:
+            return
+
+        def work(job):
+            from maizeviz.light.leaf_light import triangle_light
+            from maizeviz_app import jobs
+
+            done = []
+            for run in todo:
+                job.check()
+                done.append(triangle_light(canopy, run.result) if run.kind == "sun"
+                            else jobs.diffuse_of(canopy, run.result, run.kind))
+            return done
+
+        def adopt(done):
+            for run, value in zip(todo, done):
+                if run.kind == "sun":
+                    run.classes = value
+                else:
+                    run.extra = value
+            if self.built is not None and self.signature(self.built.label) == here:
+                self.light_panel.show_plants(self.runs.latest(None, ("sky", "day")))
+                self._light_to_view(colour=True)
+                if self.runner.current("figures") is None:     # else: when they are drawn
+                    self.light_shown.emit()
+
+        self.runner.run("complete", "light per leaf of the project's results", work,
+                        on_done=adopt, on_error=lambda e: self._fail(e, "light"))
 
     # ------------------------------------------------------------------ recent files
     def recent_files(self) -> list[str]:
-        value = self._settings.value("recent", [])
+        value: Any = self._settings.value("recent", [])
         if isinstance(value, str):
             value = [value]
         return [str(p) for p in (value or []) if Path(str(p)).exists()]
@@ -1098,7 +1182,8 @@ class MainWindow(QMainWindow):
         for a sky or a day) to ``path`` in a worker, atomically."""
         path = str(path)
         try:
-            work, args = self._export_work(what, path)
+            heatmap = (self.plots.kind, dict(self._heatmaps_for), self.plots.shown_height)
+            work, args = export_job(what, path, self.model, heatmap)
         except MaizevizError as exc:
             self._fail(exc, "export")
             return
@@ -1110,126 +1195,6 @@ class MainWindow(QMainWindow):
         self.runner.run("export", f"exporting {Path(path).name}", work, *args, on_done=done,
                         on_error=lambda e: self._fail(e, "export"), supersede=False)
 
-    def _export_work(self, what: str, path: str):
-        if what == "canopy":
-            if self.canopy is None:
-                raise MaizevizError("no canopy to export yet")
-            canopy = self.canopy
-            signature = self.signature(self.built.label)
-            cells = {}
-            run = self.runs.for_signature(signature)
-            if run is not None and run.classes is not None:
-                cells["light"] = run.classes.astype("int32")
-            for kind, name in (("sky", "diffuse_per_m2_leaf"), ("day", "par_mol_per_m2_leaf")):
-                run = self.runs.for_signature(signature, kind)
-                if run is not None and run.extra is not None:
-                    cells[name] = run.extra.leaf_value.astype("float32")
-
-            def work(job):
-                from maizeviz.canopy.export import export_canopy
-
-                export_canopy(path, canopy, cell_data=cells)
-                return path
-            return work, ()
-        if what == "measures":
-            if not self.measures_rows:
-                raise MaizevizError("no canopy measures to export yet")
-            rows = list(self.measures_rows.values())
-
-            def work(job):
-                from maizeviz.io.atomic import write_rows
-
-                write_rows(path, [{k: v.replace(",", "") for k, v in r.items()} for r in rows])
-                return path
-            return work, ()
-        if what in ("steps", "leaves", "plants", "day"):
-            return self._export_diffuse(what, path)
-        if self.runs.last is None:
-            raise MaizevizError("no light result to export yet: compute light first")
-        if what == "table":
-            header, rows = self.runs.table()
-
-            def work(job):
-                from maizeviz.io.atomic import atomic_open
-
-                with atomic_open(path, "w", newline="") as fh:
-                    w = csv.writer(fh)
-                    w.writerow(["height_cm"] + [f"transmission {h}" for h in header[1:]])
-                    w.writerows(rows)
-                return path
-            return work, ()
-        if what == "heatmap":
-            kind = self.plots.kind or self.runs.last.kind
-            run = self._heatmaps_for.get(kind) or self.runs.last
-            kind = run.kind
-            height = self.plots.shown_height
-            if height is None:
-                height = float(run.result.heights_cm[0])
-            result = run.result
-
-            def work(job):
-                from maizeviz.light.heatmap import save_figure
-                from maizeviz_app.plots import heatmap_figure_of
-
-                save_figure(heatmap_figure_of(result, height, kind), path)
-                return path
-            return work, ()
-        if what == "plot":
-            from maizeviz_app import plots
-
-            curves = self.runs.curves()
-            title = _plot_title(self.runs)
-
-            def work(job):
-                from maizeviz.light.heatmap import save_figure
-
-                save_figure(plots.transmission_figure(curves, title, width_in=7, dpi=110), path)
-                return path
-            return work, ()
-        raise MaizevizError(f"unknown export '{what}'")
-
-    def _export_diffuse(self, what: str, path: str):
-        """The day's steps CSV and figure, the per-leaf and per-plant CSV of the last sky or
-        day (the day when both)."""
-        day = self.runs.of_kind("day")
-        run = day if day is not None else self.runs.of_kind("sky")
-        if what in ("steps", "day") and day is None:
-            raise MaizevizError("no day computed yet: choose Day in the light panel and "
-                                "compute the day's light first")
-        if run is None:
-            raise MaizevizError("no sky or day computed yet: choose Sky or Day in the light "
-                                "panel and compute first")
-        light, extra, label = run.result, run.extra, run.label
-        if what == "steps":
-            def work(job):
-                from maizeviz.light.reports import write_steps
-
-                write_steps(path, light)
-                return path
-            return work, ()
-        if what == "day":
-            title = _day_title(light, label)
-
-            def work(job):
-                from maizeviz.light.heatmap import save_figure
-                from maizeviz.light.plots import day_figure
-
-                save_figure(day_figure(light, title), path)
-                return path
-            return work, ()
-        if extra is None:
-            raise MaizevizError(f"the light per leaf of the {run.kind} on {label} is computed "
-                                f"against its canopy: show level {label} first")
-        rows = [dict(r, level=label) for r in extra.leaf_rows]
-
-        def work(job):
-            from maizeviz.io.atomic import write_rows
-            from maizeviz.light.leaf_light import plant_light
-
-            write_rows(path, rows if what == "leaves" else plant_light(rows))
-            return path
-        return work, ()
-
     # ------------------------------------------------------------------ help
     def about(self) -> None:
         QMessageBox.about(self, "About maizeviz", about_text())
@@ -1237,7 +1202,11 @@ class MainWindow(QMainWindow):
     # ------------------------------------------------------------------ close
     def closeEvent(self, event) -> None:  # noqa: N802 - Qt's name
         """Stop the reader, cancel and wait for the jobs, kill the core processes, save the
-        window's geometry and docks, close the 3D view explicitly."""
+        window's geometry and docks, close the 3D view explicitly. Unsaved work is asked
+        about first (:meth:`keep_unsaved`)."""
+        if not self._closing and not self.keep_unsaved(self.close):
+            event.ignore()
+            return
         self._closing = True
         try:
             if self.digitizer is not None:
@@ -1251,86 +1220,6 @@ class MainWindow(QMainWindow):
         if self.viewport is not None:
             self.viewport.close()
         super().closeEvent(event)
-
-
-def _plot_title(runs: LightRuns) -> str:
-    """What the transmission plot compares: the sun, the sky, the day; rays per cm²."""
-    parts = []
-    sun, sky, day = (runs.of_kind(k) for k in ("sun", "sky", "day"))
-    if sun is not None:
-        r = sun.result
-        parts.append(f"sun zenith {r.sun.zenith_deg:.1f}°, azimuth {r.sun.azimuth_deg:.1f}°")
-    diffuse = sky.result.sky if sky is not None else \
-        (day.result.sky.sky if day is not None and day.result.sky is not None else None)
-    if diffuse is not None:
-        parts.append(f"sky {diffuse.kind.upper()}, {diffuse.n} directions")
-    if day is not None:
-        p = day.result.period
-        parts.append(f"day {p.start:%Y-%m-%d}, {p.n_steps} steps")
-    density = runs.sampling[1] if runs.sampling else None
-    if density is None and runs.last is not None:
-        density = getattr(runs.last.result, "density", None)
-    if density is not None:
-        parts.append(f"{density:g} rays/cm²")
-    return "; ".join(parts)
-
-
-def _value_legend(run: Run) -> tuple[str, str]:
-    """Colour-bar title and unit of a sky's or day's light per leaf."""
-    if run.kind == "day":
-        return "PAR intercepted per leaf over the day", "mol/m² leaf"
-    return "diffuse light per leaf area (1: the sky's on open ground)", ""
-
-
-def _run_info(run: Run) -> str:
-    """What was traced and how long it took, for the light panel."""
-    r = run.result
-    secs = r.seconds
-    build_s = run.extra.build_s if run.extra is not None else secs.get("build", 0)
-    build = f"{build_s:.2f} s" if build_s > 0 else "kept from the last run"
-    if run.kind == "sun":
-        info = (f"{r.rays:,} rays on the central tile at {r.density_per_cm2:.2f} per cm²; "
-                f"level {run.label}; Embree scene {build}, tracing "
-                f"{secs.get('trace', 0) + secs.get('second', 0):.2f} s")
-        share = r.sunlit_intercepted_fraction
-        if share is not None:
-            info += f"; leaves take {share:.1%} of the direct light"
-    elif run.kind == "sky":
-        info = (f"{r.sky.description}; {r.rays:,} rays per direction; level {run.label}; "
-                f"Embree scene {build}, tracing {secs.get('trace', 0):.2f} s; leaves "
-                f"take {r.intercepted_fraction:.1%} of the diffuse light")
-    else:
-        sky = r.sky.sky.description if r.sky is not None else "no sky"
-        info = (f"{r.n_steps} time steps and the sky ({sky}); {r.rays:,} rays per "
-                f"direction; level {run.label}; Embree scene {build}, tracing "
-                f"{secs.get('trace', 0):.2f} s")
-    return info + "".join(f"\n⚠ {w}" for w in r.warnings if "sun never rises" not in w)
-
-
-def day_summary(light) -> str:
-    """The day in two lines: PAR incident, intercepted (fraction), transmitted to the lowest
-    height, mol/m² of ground; and where the irradiance came from."""
-    p = light.period
-    frac = light.fraction_intercepted
-    h = light.heights_cm
-    low = int(np.argmin(h))
-    where = "the ground" if h[low] == 0 else f"{h[low]:g} cm"
-    t_low = float(light.par_transmitted_mol_m2[low])
-    share = f" ({light.transmission_by_height[low]:.1%})" if frac is not None else ""
-    span = (f"{p.start:%Y-%m-%d}" if (p.end - p.start).total_seconds() == 86400 and
-            p.start.hour == 0 and p.start.minute == 0 else
-            f"{p.start:%Y-%m-%d %H:%M} to {p.end:%H:%M}")
-    return (f"{span}: PAR incident {light.par_incident_mol_m2:.1f} mol/m² (direct "
-            f"{light.par_direct_mol_m2:.1f}, diffuse {light.par_diffuse_mol_m2:.1f}); "
-            f"intercepted {light.par_intercepted_mol_m2:.1f} mol/m²"
-            + (f" ({frac:.1%})" if frac is not None else "")
-            + f"; transmitted to {where} {t_low:.2f} mol/m²{share}\n{p.source}")
-
-
-def _day_title(light, label: str) -> str:
-    p = light.period
-    return (f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M} ({p.start.tz}); {p.source}; "
-            f"level {label}")
 
 
 def about_text() -> str:

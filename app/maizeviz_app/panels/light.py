@@ -15,40 +15,54 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from PySide6.QtCore import QDate, QSize, Qt, Signal
 from PySide6.QtGui import QImage, QPixmap
-from PySide6.QtWidgets import (QAbstractItemView, QButtonGroup, QCheckBox, QComboBox,
-                               QCompleter, QDateEdit, QDoubleSpinBox, QFileDialog, QFormLayout,
-                               QGroupBox, QHBoxLayout, QHeaderView, QLabel, QLineEdit,
-                               QPushButton, QRadioButton, QSizePolicy, QSpinBox,
-                               QStackedWidget, QTableWidget, QTableWidgetItem, QVBoxLayout,
-                               QWidget)
+from PySide6.QtWidgets import (
+    QAbstractItemView,
+    QButtonGroup,
+    QCheckBox,
+    QComboBox,
+    QCompleter,
+    QDateEdit,
+    QDoubleSpinBox,
+    QFileDialog,
+    QFormLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QLineEdit,
+    QPushButton,
+    QRadioButton,
+    QSizePolicy,
+    QSpinBox,
+    QStackedWidget,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
 
 from maizeviz.errors import MaizevizError
 from maizeviz.light.irradiance import DEFAULT_PAR_UMOL_PER_J, PAR_FRACTION, PAR_UMOL_PER_J_PAR
-from maizeviz.mesh.levels import COMPLEXITY_STOPS, parse_level
+from maizeviz_app.runs import MODES, SKIES, LightRuns, Run, level_order  # noqa: F401 - re-exported
 
 DEFAULT_PLACE = "2005-08-01 12:00 39.9 116.4 Asia/Shanghai"
 DEFAULT_HEIGHTS = "0, 50, 100, 150, 200, 225"
 PROBLEM_STYLE = "border: 2px solid #d0342c; border-radius: 3px;"
-#: The lights the panel computes, in the order of the buttons, the table and the plot.
-MODES = ("sun", "sky", "day")
 MODE_BUTTONS = {"sun": "Sun", "sky": "Sky", "day": "Day"}
 COMPUTE_TEXT = {"sun": "Compute direct light", "sky": "Compute diffuse light",
                 "day": "Compute the day's light"}
-#: Skies: kind -> (what the combo says, how a result is named in the table and plot).
-SKIES = {"soc": ("standard overcast (SOC): brightness (1 + 2 cos θ)/3", "overcast sky"),
-         "uoc": ("uniform overcast (UOC)", "uniform sky")}
 #: Sky splits offered: directions (None: an equal-area split of n) -> what the combo says.
 SKY_SPLITS = {16: "16 directions (turtle)", 46: "46 directions (turtle, as Caribu)",
               145: "145 directions (Tregenza)", None: "equal-area split of n directions"}
-DEFAULT_DAY = {"date": "2005-08-01", "lat": 39.9, "lon": 116.4, "tz": "Asia/Shanghai",
-               "step_min": 30.0, "from": "", "to": "", "source": "clear", "linke": 3.0,
-               "weather": "", "par_factor": DEFAULT_PAR_UMOL_PER_J}
+DEFAULT_DAY: dict[str, Any] = {
+    "date": "2005-08-01", "lat": 39.9, "lon": 116.4, "tz": "Asia/Shanghai", "step_min": 30.0,
+    "from": "", "to": "", "source": "clear", "linke": 3.0, "weather": "",
+    "par_factor": DEFAULT_PAR_UMOL_PER_J}
 
 
 class InputProblem(MaizevizError):
@@ -80,145 +94,9 @@ def parse_heights(text: str) -> tuple[float, ...]:
     return tuple(out)
 
 
-def level_order(label: str) -> int:
-    """Fine-to-coarse rank of a level label (``K=4`` ... ``4 triangles``), for sorting."""
-    for k, stop in enumerate(COMPLEXITY_STOPS):
-        if parse_level(stop).label == label.split(",")[0]:
-            return k
-    return len(COMPLEXITY_STOPS)
-
-
-@dataclass
-class Run:
-    """One light result: the level it was traced on (``label``), the canopy it belongs to
-    (``signature``), the light (``kind``: sun, sky or day) and, for a sun, each leaf
-    triangle's light class (F,) int8 (None until computed); for a sky or a day ``extra``
-    holds what the light process made of it (per-leaf and per-plant rows, per-triangle
-    values: :class:`maizeviz_app.jobs.Diffuse`)."""
-
-    label: str
-    signature: tuple
-    result: Any
-    classes: np.ndarray | None = None
-    kind: str = "sun"
-    extra: Any = None
-
-    @property
-    def name(self) -> str:
-        """The run's column in the table and curve in the plot."""
-        if self.kind == "sky":
-            return f"{self.label}, {SKIES.get(self.result.sky.kind, ('', 'sky'))[1]}"
-        if self.kind == "day":
-            return f"{self.label}, day: PAR transmitted"
-        return self.label
-
-    @property
-    def transmission(self) -> np.ndarray:
-        """(H,) the fraction of the light reaching each height (for a day: of its PAR)."""
-        if self.kind == "day":
-            return np.asarray(self.result.transmission_by_height)
-        return np.asarray(self.result.transmission)
-
-
-class LightRuns:
-    """The last light result per mesh level and light, sampled the same way."""
-
-    def __init__(self) -> None:
-        self.runs: dict[str, Run] = {}
-        self.settings: dict[str, Any] = {}          # each light's own settings
-        self.sampling: Any = None                   # heights, density, periodic field
-        self.last: Run | None = None
-        self._order: dict[int, int] = {}            # id(run) -> when it was added
-        self._added = 0
-
-    def add(self, run: Run, settings: Any, sampling: Any = None) -> bool:
-        """Keep ``run``; True if it replaced results traced with other settings (another
-        ``sampling``: every result; other ``settings`` of the run's light: that light's)."""
-        dropped = False
-        if self.runs and sampling != self.sampling:
-            self.runs.clear()
-            self.settings.clear()
-            dropped = True
-        elif run.kind in self.settings and settings != self.settings[run.kind]:
-            kept = {k: r for k, r in self.runs.items() if r.kind != run.kind}
-            dropped = len(kept) != len(self.runs)
-            self.runs = kept
-        self.sampling = sampling
-        self.settings[run.kind] = settings
-        self.runs[run.name] = run
-        self.runs = dict(sorted(self.runs.items(),
-                                key=lambda kv: (MODES.index(kv[1].kind),
-                                                level_order(kv[1].label))))
-        self._added += 1
-        self._order[id(run)] = self._added
-        self._order = {id(r): self._order.get(id(r), 0) for r in self.runs.values()}
-        self.last = run
-        return dropped
-
-    def copy(self) -> LightRuns:
-        """A shallow copy (the runs are shared), to preview a result in a worker."""
-        other = LightRuns()
-        other.runs, other.settings = dict(self.runs), dict(self.settings)
-        other.sampling, other.last = self.sampling, self.last
-        other._order, other._added = dict(self._order), self._added
-        return other
-
-    def clear(self) -> None:
-        self.runs.clear()
-        self.settings.clear()
-        self.sampling = None
-        self.last = None
-        self._order.clear()
-
-    def for_signature(self, signature: tuple, kind: str = "sun") -> Run | None:
-        """The ``kind`` result of a canopy."""
-        for run in self.runs.values():
-            if run.signature == signature and run.kind == kind:
-                return run
-        return None
-
-    def latest(self, signature: tuple | None = None, kinds: Sequence[str] = MODES) -> Run | None:
-        """The result added last (of a canopy, of the ``kinds`` given)."""
-        runs = [r for r in self.runs.values() if r.kind in kinds and
-                (signature is None or r.signature == signature)]
-        return max(runs, key=lambda r: self._order.get(id(r), 0)) if runs else None
-
-    def in_order(self) -> list[Run]:
-        """The runs in the order they were added (the last one is :attr:`last`)."""
-        return sorted(self.runs.values(), key=lambda r: self._order.get(id(r), 0))
-
-    def of_kind(self, kind: str) -> Run | None:
-        return self.latest(None, (kind,))
-
-    def heights(self) -> tuple[float, ...]:
-        if self.last is None:
-            return ()
-        return tuple(float(h) for h in self.last.result.heights_cm)
-
-    def curves(self):
-        from maizeviz_app.plots import Curve
-
-        return [Curve(r.name, tuple(map(float, r.result.heights_cm)),
-                      tuple(map(float, r.transmission)), r.kind, r.label)
-                for r in self.runs.values()]
-
-    def table(self) -> tuple[list[str], list[list[str]]]:
-        """Header and rows (one per height) of the results table."""
-        names = list(self.runs)
-        header = ["height cm"] + names
-        rows = []
-        for i, h in enumerate(self.heights()):
-            row = [f"{h:g}"]
-            for name in names:
-                t = self.runs[name].transmission
-                row.append(f"{t[i]:.3f}" if i < len(t) and np.isfinite(t[i]) else "")
-            rows.append(row)
-        return header, rows
-
-
 def _form() -> QFormLayout:
     form = QFormLayout()
-    form.setFieldGrowthPolicy(QFormLayout.AllNonFixedFieldsGrow)
+    form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
     return form
 
 
@@ -232,7 +110,10 @@ def _time_zones() -> list[str]:
 
 
 class LightPanel(QWidget):
-    """Signals: ``compute_requested()``, ``cancel_requested()``, ``place_requested(text)``,
+    """The light settings and the results table of the study in ``study`` (a
+    :class:`~maizeviz_app.model.StudyModel`, followed: its runs fill the table).
+
+    Signals: ``compute_requested()``, ``cancel_requested()``, ``place_requested(text)``,
     ``export_requested(what)`` with what in ``table``, ``heatmap``, ``plot``, ``canopy``,
     ``steps``, ``leaves``, ``plants``, ``day``; ``mode_changed(mode)``."""
 
@@ -242,8 +123,9 @@ class LightPanel(QWidget):
     export_requested = Signal(str)
     mode_changed = Signal(str)
 
-    def __init__(self, parent=None):
+    def __init__(self, study=None, parent=None):
         super().__init__(parent)
+        self.study = study
         lay = QVBoxLayout(self)
         # ---- which light
         modes = QHBoxLayout()
@@ -313,17 +195,17 @@ class LightPanel(QWidget):
         self.table = QTableWidget(0, 1)
         self.table.setHorizontalHeaderLabels(["height cm"])
         self.table.verticalHeader().setVisible(False)
-        self.table.setEditTriggers(QAbstractItemView.NoEditTriggers)
-        self.table.setVerticalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
-        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeToContents)
-        self.table.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Fixed)
+        self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+        self.table.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        self.table.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
         lay.addWidget(self.table)
         self.info = QLabel("")
         self.info.setWordWrap(True)
         lay.addWidget(self.info)
         self.summary = QLabel("")
         self.summary.setWordWrap(True)
-        self.summary.setTextInteractionFlags(Qt.TextSelectableByMouse)
+        self.summary.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         self.summary.setStyleSheet("background: #fff8e1; padding: 4px;")
         self.summary.hide()
         lay.addWidget(self.summary)
@@ -333,9 +215,9 @@ class LightPanel(QWidget):
         lay.addWidget(self.plants_title)
         self.plants = QTableWidget(0, 0)
         self.plants.verticalHeader().setVisible(False)
-        self.plants.setEditTriggers(QAbstractItemView.NoEditTriggers)
-        self.plants.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeToContents)
-        self.plants.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Fixed)
+        self.plants.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+        self.plants.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+        self.plants.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
         self.plants.hide()
         lay.addWidget(self.plants)
         # ---- exports
@@ -367,8 +249,11 @@ class LightPanel(QWidget):
         self.fields: dict[str, Any] = {"heights": self.heights, "density": self.density,
                                        "periodic": self.periodic, "rect": self.heights,
                                        "threads": self.density}
-        self.mode_fields = {
-            "sun": {"sun": self.zenith, "place": self.place, "date": self.place,
+        self.mode_fields: dict[str, dict[str, Any]] = {
+            "sun": {"band": self.band, "reflectance": self.reflectance,
+                    "transmittance": self.transmittance,
+                    "ground_reflectance": self.ground_reflectance,
+                    "sun": self.zenith, "place": self.place, "date": self.place,
                     "time": self.place, "tz": self.place},
             "sky": {"sky": self.sky_kind, "sky_directions": self.sky_n},
             "day": {"sky": self.sky_kind, "sky_directions": self.sky_n,
@@ -376,15 +261,18 @@ class LightPanel(QWidget):
                     "step": self.step, "period": [self.day_from, self.day_to],
                     "par_factor": self.par_factor, "linke_turbidity": self.linke,
                     "weather": self.weather, "altitude": self.lat, "time": self.day_from}}
-        for w in (self.heights, self.place, self.tz, self.day_from, self.day_to, self.weather):
-            w.textEdited.connect(lambda _t, w=w: self.clear_problem(w))
-        for w in (self.zenith, self.azimuth, self.density, self.lat, self.lon, self.step,
-                  self.par_factor, self.linke, self.sky_n):
-            w.valueChanged.connect(lambda _v, w=w: self.clear_problem(w))
+        for edit in (self.heights, self.place, self.tz, self.day_from, self.day_to,
+                     self.weather):
+            edit.textEdited.connect(lambda _t, w=edit: self.clear_problem(w))
+        for box in (self.zenith, self.azimuth, self.density, self.lat, self.lon, self.step,
+                    self.par_factor, self.linke, self.sky_n):
+            box.valueChanged.connect(lambda _v, w=box: self.clear_problem(w))
         self.sky_kind.currentIndexChanged.connect(lambda _i: self.clear_problem(self.sky_kind))
         self.day_date.dateChanged.connect(lambda _d: self.clear_problem(self.day_date))
         self.set_mode("sun")
         self._fit_table()
+        if study is not None:
+            study.runs_changed.connect(self.show_runs)
 
     # ------------------------------------------------------------------ pages
     def _sun_page(self) -> QWidget:
@@ -409,7 +297,83 @@ class LightPanel(QWidget):
         place_row.addWidget(self.place, 1)
         place_row.addWidget(self.place_button)
         form.addRow("date time lat lon tz", place_row)
+        form.addRow(self._optics_group())
         return page
+
+    def _optics_group(self) -> QGroupBox:
+        """Leaf optics: absorbed light with scattering (off: black leaves, interception)."""
+        from maizeviz.light.optics import DEFAULT_OPTICS, SHORTWAVE_SHARE
+
+        box = QGroupBox("leaf optics: absorbed light with scattering")
+        box.setCheckable(True)
+        box.setChecked(False)
+        box.setToolTip("off: leaves are black (light intercepted at first hits); on: leaves "
+                       "reflect and transmit, light is followed through the canopy and each "
+                       "leaf's absorbed light painted on the plants, with the energy balance")
+        form = _form()
+        box.setLayout(form)
+        self.optics_box = box
+        self.band = QComboBox()
+        self.band.addItem("PAR (400-700 nm)", "par")
+        self.band.addItem("NIR (700-3000 nm)", "nir")
+        self.band.setToolTip("the waveband traced; its leaf and soil optics and irradiance "
+                             "follow the band's defaults (maize: see docs/method.md)")
+        form.addRow("band", self.band)
+
+        def fraction(tip: str) -> QDoubleSpinBox:
+            w = QDoubleSpinBox(decimals=3, minimum=0.0, maximum=1.0, singleStep=0.01)
+            w.setToolTip(tip)
+            return w
+
+        self.reflectance = fraction("share of the light a leaf reflects (Lambertian)")
+        self.transmittance = fraction("share of the light a leaf transmits (Lambertian)")
+        self.ground_reflectance = fraction("share of the light the soil reflects")
+        leaf = QHBoxLayout()
+        leaf.addWidget(QLabel("ρ"))
+        leaf.addWidget(self.reflectance, 1)
+        leaf.addWidget(QLabel("τ"))
+        leaf.addWidget(self.transmittance, 1)
+        form.addRow("leaf", leaf)
+        form.addRow("soil ρ", self.ground_reflectance)
+        self.direct_w = QDoubleSpinBox(decimals=1, minimum=0.0, maximum=2000.0,
+                                       suffix=" W/m²")
+        self.direct_w.setToolTip("the band's direct irradiance on a horizontal plane above the "
+                                 "canopy")
+        self.diffuse_w = QDoubleSpinBox(decimals=1, minimum=0.0, maximum=2000.0, value=0.0,
+                                        suffix=" W/m²")
+        self.diffuse_w.setToolTip("the band's diffuse irradiance on a horizontal plane, from a "
+                                  "standard overcast sky of 46 directions (0: direct only)")
+        form.addRow("direct", self.direct_w)
+        form.addRow("diffuse", self.diffuse_w)
+        self.scatter_depth = QSpinBox(minimum=0, maximum=20, value=3)
+        self.scatter_depth.setToolTip("scatterings followed (0: first hits only; 3 keeps > 99% of PAR "
+                              "and most of NIR)")
+        form.addRow("scattering depth", self.scatter_depth)
+
+        def band_defaults(_i: int = 0) -> None:
+            band = str(self.band.currentData())
+            d = DEFAULT_OPTICS[band]
+            self.reflectance.setValue(d.reflectance)
+            self.transmittance.setValue(d.transmittance)
+            self.ground_reflectance.setValue(d.ground_reflectance)
+            self.direct_w.setValue(round(1000.0 * SHORTWAVE_SHARE[band], 1))
+
+        self.band.currentIndexChanged.connect(band_defaults)
+        band_defaults()
+        return box
+
+    def optics_spec(self):
+        """Absorbed light as chosen (:class:`maizeviz.light.specs.OpticsSpec`), None when leaf
+        optics are off; leaf scattering above 1 refused naming the field."""
+        from maizeviz.light.specs import OpticsSpec
+
+        if not self.optics_box.isChecked():
+            return None
+        spec = OpticsSpec(str(self.band.currentData()), self.reflectance.value(),
+                          self.transmittance.value(), self.ground_reflectance.value(),
+                          self.direct_w.value(), self.diffuse_w.value(), self.scatter_depth.value())
+        spec.optics()                                   # checked now, named by the core
+        return spec
 
     def _sky_group(self) -> QGroupBox:
         box = QGroupBox("diffuse sky")
@@ -458,12 +422,12 @@ class LightPanel(QWidget):
         where.addWidget(self.lat, 1)
         where.addWidget(self.lon, 1)
         form.addRow("latitude, longitude", where)
-        self.tz = QLineEdit(DEFAULT_DAY["tz"])
+        self.tz = QLineEdit(str(DEFAULT_DAY["tz"]))
         self.tz.setToolTip("time zone of the clock times (IANA name such as Asia/Shanghai, "
                            "Europe/Paris or UTC)")
         completer = QCompleter(_time_zones(), self.tz)
-        completer.setCaseSensitivity(Qt.CaseInsensitive)
-        completer.setFilterMode(Qt.MatchContains)
+        completer.setCaseSensitivity(Qt.CaseSensitivity.CaseInsensitive)
+        completer.setFilterMode(Qt.MatchFlag.MatchContains)
         self.tz.setCompleter(completer)
         form.addRow("time zone", self.tz)
         self.source_clear = QRadioButton("clear sky (Ineichen-Perez, pvlib), Linke turbidity")
@@ -512,7 +476,8 @@ class LightPanel(QWidget):
         span.addWidget(self.day_to, 1)
         form.addRow("hours (optional)", span)
         self.par_factor = QDoubleSpinBox(decimals=4, minimum=0.0001, maximum=10.0,
-                                         value=DEFAULT_DAY["par_factor"], singleStep=0.01,
+                                         value=float(DEFAULT_DAY["par_factor"]),
+                                         singleStep=0.01,
                                          suffix=" µmol/J")
         self.par_factor.setToolTip("µmol of PAR photons per joule of shortwave (default "
                                    f"{PAR_FRACTION:g} × {PAR_UMOL_PER_J_PAR:g} = "
@@ -568,8 +533,10 @@ class LightPanel(QWidget):
         page = {"sun": 0, "day": 1, "sky": 2}[mode]
         for k in range(self.pages.count()):
             # only the page shown takes room: the sun page is short, the day page tall
-            self.pages.widget(k).setSizePolicy(
-                QSizePolicy.Preferred, QSizePolicy.Preferred if k == page else QSizePolicy.Ignored)
+            policy = QSizePolicy.Policy.Preferred if k == page else QSizePolicy.Policy.Ignored
+            widget = self.pages.widget(k)
+            if widget is not None:
+                widget.setSizePolicy(QSizePolicy.Policy.Preferred, policy)
         self.pages.setCurrentIndex(page)
         self.pages.setVisible(mode != "sky")
         self.sky_box.setVisible(mode != "sun")
@@ -594,9 +561,26 @@ class LightPanel(QWidget):
                 "from": self.day_from.text(), "to": self.day_to.text(),
                 "source": "weather" if self.source_weather.isChecked() else "clear",
                 "linke_turbidity": self.linke.value(), "weather": self.weather.text(),
-                "par_factor": self.par_factor.value()}
+                "par_factor": self.par_factor.value(),
+                "optics": self.optics_box.isChecked(), "band": self.band.currentData(),
+                "reflectance": self.reflectance.value(),
+                "transmittance": self.transmittance.value(),
+                "ground_reflectance": self.ground_reflectance.value(),
+                "direct_w_m2": self.direct_w.value(), "diffuse_w_m2": self.diffuse_w.value(),
+                "depth": self.scatter_depth.value()}
 
     def apply_settings(self, s: dict) -> None:
+        if s.get("band") in ("par", "nir"):
+            self.band.setCurrentIndex(self.band.findData(s["band"]))
+        for key, w in (("reflectance", self.reflectance),
+                       ("transmittance", self.transmittance),
+                       ("ground_reflectance", self.ground_reflectance),
+                       ("direct_w_m2", self.direct_w), ("diffuse_w_m2", self.diffuse_w)):
+            if key in s:
+                w.setValue(float(s[key]))
+        if "depth" in s:
+            self.scatter_depth.setValue(int(s["depth"]))
+        self.optics_box.setChecked(bool(s.get("optics", False)))
         self.zenith.setValue(float(s.get("zenith_deg", self.zenith.value())))
         self.azimuth.setValue(float(s.get("azimuth_deg", self.azimuth.value())))
         self.place.setText(str(s.get("place", self.place.text())))
@@ -732,9 +716,9 @@ class LightPanel(QWidget):
         self.table.setHorizontalHeaderLabels([h.replace(", ", ",\n") for h in header])
         self.table.setRowCount(len(rows))
         for r, vals in enumerate(rows):
-            for c, v in enumerate(vals):
-                item = QTableWidgetItem(v)
-                item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter)
+            for c, text in enumerate(vals):
+                item = QTableWidgetItem(text)
+                item.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
                 self.table.setItem(r, c, item)
         self._fit_table()
         self.info.setText(info)
@@ -757,15 +741,26 @@ class LightPanel(QWidget):
         self.summary.setVisible(bool(text))
 
     def show_plants(self, run: Run | None) -> None:
-        """What each plant intercepted in a sky or day ``run`` (None: hide the table)."""
+        """What each plant intercepted in a sky or day ``run``, or absorbed in a sun traced
+        with leaf optics (None: hide the table)."""
         rows = run.extra.plant_rows if run is not None and run.extra is not None else []
         t = self.plants
-        if not rows:
+        if run is None or not rows:
             self.plants_title.hide()
             t.hide()
             return
         day = run.kind == "day"
-        if day:
+        keys: tuple[str, ...]
+        scale = 1.0
+        if run.kind == "sun":
+            band = run.extra.light.band.upper()
+            header = ["stand", "plant", "x, y cm", f"{band} absorbed W", "W/m² leaf",
+                      "sunlit m² leaf"]
+            keys = ("absorbed_w", "absorbed_w_m2_leaf", "sunlit_area_cm2")
+            fmt = "{:.2f}"
+            self.plants_title.setText(f"{band} each plant absorbs, with scattering "
+                                      f"({run.label})")
+        elif day:
             header = ["stand", "plant", "x, y cm", "PAR mol", "direct mol", "diffuse mol"]
             keys = ("par_intercepted_mol", "direct_par_intercepted_mol",
                     "diffuse_par_intercepted_mol")
@@ -773,7 +768,7 @@ class LightPanel(QWidget):
             self.plants_title.setText(f"PAR intercepted by each plant over the day, mol "
                                       f"({run.label})")
         else:
-            area = run.result.rect_area_cm2
+            scale = 1.0 / run.result.rect_area_cm2
             header = ["stand", "plant", "x, y cm", "share of the sky light"]
             keys = ("diffuse_intercepted_cm2",)
             fmt = "{:.1%}"
@@ -786,11 +781,12 @@ class LightPanel(QWidget):
             vals = [str(row["instance"]), str(row["plant"]),
                     f"{float(row['x_cm']):.0f}, {float(row['y_cm']):.0f}"]
             for k in keys:
-                v = float(row.get(k, 0.0))
-                vals.append(fmt.format(v if day else v / area))
-            for c, v in enumerate(vals):
-                item = QTableWidgetItem(v)
-                item.setTextAlignment(Qt.AlignRight | Qt.AlignVCenter)
+                v = float(row.get(k, 0.0)) * (1e-4 if run.kind == "sun" and k.endswith("_cm2")
+                                              else scale)
+                vals.append(fmt.format(v))
+            for c, text in enumerate(vals):
+                item = QTableWidgetItem(text)
+                item.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
                 t.setItem(r, c, item)
         t.resizeRowsToContents()
         shown = min(len(rows), 9)
@@ -820,9 +816,9 @@ class ImageView(QLabel):
         super().__init__(placeholder, parent)
         self._placeholder = placeholder
         self._image: QImage | None = None
-        self.setAlignment(Qt.AlignCenter)
+        self.setAlignment(Qt.AlignmentFlag.AlignCenter)
         self.setMinimumSize(160, 120)
-        self.setSizePolicy(QSizePolicy.Ignored, QSizePolicy.Ignored)
+        self.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Ignored)
         self.setStyleSheet("background: white; color: #666;")
 
     def set_rgba(self, rgba: np.ndarray | None) -> None:
@@ -833,7 +829,7 @@ class ImageView(QLabel):
             return
         h, w = rgba.shape[:2]
         self._image = QImage(np.ascontiguousarray(rgba).data, w, h, 4 * w,
-                             QImage.Format_RGBA8888).copy()
+                             QImage.Format.Format_RGBA8888).copy()
         self._rescale()
 
     def image(self) -> QImage | None:
@@ -847,7 +843,8 @@ class ImageView(QLabel):
         if self._image is None:
             return
         self.setPixmap(QPixmap.fromImage(self._image).scaled(
-            self.size(), Qt.KeepAspectRatio, Qt.SmoothTransformation))
+            self.size(), Qt.AspectRatioMode.KeepAspectRatio,
+            Qt.TransformationMode.SmoothTransformation))
 
     def sizeHint(self) -> QSize:  # noqa: N802
         return QSize(360, 200)
@@ -874,15 +871,15 @@ class LightPlots(QWidget):
         self.source = QComboBox()
         self.source.setToolTip("which light's map: the direct sun, the diffuse sky or the "
                                "day's PAR")
-        self.source.setSizeAdjustPolicy(QComboBox.AdjustToContents)
-        self.source.currentIndexChanged.connect(lambda _i: self._show_height(
-            self.height.currentIndex()))
+        self.source.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToContents)
         top.addWidget(self.source)
         top.addWidget(QLabel("at"))
-        self.height = QComboBox()
-        self.height.setToolTip("height of the sample plane shown (PgUp / PgDown)")
-        self.height.currentIndexChanged.connect(self._show_height)
-        top.addWidget(self.height)
+        self.height_box = QComboBox()
+        self.source.currentIndexChanged.connect(lambda _i: self._show_height(
+            self.height_box.currentIndex()))
+        self.height_box.setToolTip("height of the sample plane shown (PgUp / PgDown)")
+        self.height_box.currentIndexChanged.connect(self._show_height)
+        top.addWidget(self.height_box)
         top.addStretch(1)
         left.addLayout(top)
         self.heatmap = ImageView("compute light to see where it reaches each height")
@@ -912,7 +909,7 @@ class LightPlots(QWidget):
         self._fill_sources(kind if maps else None)
 
     def _fill_sources(self, show: str | None) -> None:
-        keep_height = self.height.currentIndex()
+        keep_height = self.height_box.currentIndex()
         current = show or self.kind
         self.source.blockSignals(True)
         self.source.clear()
@@ -922,14 +919,14 @@ class LightPlots(QWidget):
         k = self.source.findData(current)
         self.source.setCurrentIndex(k if k >= 0 else 0)
         self.source.blockSignals(False)
-        maps = self._maps.get(self.kind, [])
-        self.height.blockSignals(True)
-        self.height.clear()
-        self.height.addItems([f"{h:g} cm" for h, _ in maps])
-        self.height.blockSignals(False)
+        maps = self._maps.get(self.kind or "", [])
+        self.height_box.blockSignals(True)
+        self.height_box.clear()
+        self.height_box.addItems([f"{h:g} cm" for h, _ in maps])
+        self.height_box.blockSignals(False)
         if maps:
-            self.height.setCurrentIndex(keep_height if 0 <= keep_height < len(maps) else 0)
-        self._show_height(self.height.currentIndex())
+            self.height_box.setCurrentIndex(keep_height if 0 <= keep_height < len(maps) else 0)
+        self._show_height(self.height_box.currentIndex())
 
     def keep_only(self, kinds) -> None:
         """Forget the maps of the lights not in ``kinds`` (a new comparison started)."""
@@ -944,13 +941,13 @@ class LightPlots(QWidget):
         maps = self._maps.get(kind)
         if maps is not None and 0 <= index < len(maps):
             maps[index] = (maps[index][0], rgba)
-            if kind == self.kind and index == self.height.currentIndex():
+            if kind == self.kind and index == self.height_box.currentIndex():
                 self.heatmap.set_rgba(rgba)
 
     def _show_height(self, index: int) -> None:
         kind = self.kind
         maps = self._maps.get(kind, []) if kind is not None else []
-        if len(maps) != self.height.count():          # another light chosen: its heights
+        if len(maps) != self.height_box.count():          # another light chosen: its heights
             self._fill_sources(kind)
             return
         if 0 <= index < len(maps):
@@ -964,8 +961,8 @@ class LightPlots(QWidget):
 
     @property
     def shown_height(self) -> float | None:
-        i = self.height.currentIndex()
-        maps = self._maps.get(self.kind, []) if self.kind is not None else []
+        i = self.height_box.currentIndex()
+        maps = self._maps.get(self.kind or "", []) if self.kind is not None else []
         return maps[i][0] if 0 <= i < len(maps) else None
 
     def set_transmission(self, rgba: np.ndarray | None) -> None:

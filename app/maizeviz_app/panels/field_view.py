@@ -14,7 +14,6 @@ from __future__ import annotations
 import math
 from functools import lru_cache
 
-from maizeviz_app.panels.layout_model import fmt
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QBrush, QColor, QFont, QPainter, QPen, QTransform
 from PySide6.QtWidgets import (
@@ -28,6 +27,7 @@ from PySide6.QtWidgets import (
 )
 
 from maizeviz.canopy.layout import rows_of
+from maizeviz_app.panels.layout_model import fmt
 
 WHEEL_STEP_DEG = 5.0
 PLANT = QColor("#2e7d32")
@@ -35,7 +35,7 @@ PICKED = QColor("#ff8f00")
 
 
 @lru_cache(maxsize=32)
-def _pen(color, width: float = 1.0, style=Qt.SolidLine) -> QPen:
+def _pen(color, width: float = 1.0, style=Qt.PenStyle.SolidLine) -> QPen:
     pen = QPen(QColor(color), width, style)
     pen.setCosmetic(True)                       # pixels, whatever the zoom
     return pen
@@ -44,12 +44,12 @@ def _pen(color, width: float = 1.0, style=Qt.SolidLine) -> QPen:
 class _Knob(QGraphicsEllipseItem):
     """The tip of a plant's arrow: drag it round to turn the plant."""
 
-    def __init__(self, plant: "PlantItem", radius: float):
+    def __init__(self, plant: PlantItem, radius: float):
         super().__init__(-radius, -radius, 2 * radius, 2 * radius, plant.arrow)
         self.plant = plant
         self.setBrush(QBrush(QColor("white")))
         self.setPen(_pen("#1b5e20", 1.5))
-        self.setCursor(Qt.CrossCursor)
+        self.setCursor(Qt.CursorShape.CrossCursor)
         self.setToolTip("drag round to turn the plant")
 
     def mousePressEvent(self, event) -> None:  # noqa: N802 - Qt's name
@@ -57,7 +57,7 @@ class _Knob(QGraphicsEllipseItem):
 
     def _azimuth(self, event) -> float:
         d = event.scenePos() - self.plant.scenePos()
-        step = 1.0 if event.modifiers() & Qt.ShiftModifier else 5.0
+        step = 1.0 if event.modifiers() & Qt.KeyboardModifier.ShiftModifier else 5.0
         return (round(math.degrees(math.atan2(d.y(), d.x())) / step) * step) % 360.0
 
     def mouseMoveEvent(self, event) -> None:  # noqa: N802
@@ -70,23 +70,23 @@ class _Knob(QGraphicsEllipseItem):
 class PlantItem(QGraphicsEllipseItem):
     """One placement: a disc at (x, y), its digitized plant's id, an azimuth arrow."""
 
-    def __init__(self, view: "FieldView", index: int, placement, radius: float, reach: float):
+    def __init__(self, view: FieldView, index: int, placement, radius: float, reach: float):
         super().__init__(-radius, -radius, 2 * radius, 2 * radius)
         self.view, self.index = view, index
         # movable but not selectable: the picked plant is shown by its colour (FieldView.select).
         # No Python paint() or itemChange() here: PySide6 leaks a reference to None on every
         # such call, and a few thousand plants drain it until the interpreter aborts at exit.
-        self.setFlags(QGraphicsItem.ItemIsMovable)
+        self.setFlags(QGraphicsItem.GraphicsItemFlag.ItemIsMovable)
         self.setBrush(QBrush(PLANT))
         self.setPen(_pen("#1b5e20"))
-        self.setCursor(Qt.OpenHandCursor)
+        self.setCursor(Qt.CursorShape.OpenHandCursor)
         self.setZValue(2)
         self.arrow = QGraphicsLineItem(0, 0, reach, 0, self)
         self.arrow.setPen(_pen("#1b5e20", 2))
         self.knob = _Knob(self, 0.45 * radius)
         self.knob.setPos(reach, 0)
         self.label = QGraphicsSimpleTextItem("", self)
-        self.label.setFlag(QGraphicsItem.ItemIgnoresTransformations)
+        self.label.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIgnoresTransformations)
         font = QFont()
         font.setPointSize(8)
         self.label.setFont(font)
@@ -129,9 +129,9 @@ class FieldView(QGraphicsView):
     def __init__(self, parent=None):
         super().__init__(parent)
         self.setScene(QGraphicsScene(self))
-        self.setRenderHint(QPainter.Antialiasing)
-        self.setTransformationAnchor(QGraphicsView.AnchorUnderMouse)
-        self.setViewportUpdateMode(QGraphicsView.SmartViewportUpdate)
+        self.setRenderHint(QPainter.RenderHint.Antialiasing)
+        self.setTransformationAnchor(QGraphicsView.ViewportAnchor.AnchorUnderMouse)
+        self.setViewportUpdateMode(QGraphicsView.ViewportUpdateMode.SmartViewportUpdate)
         self.setBackgroundBrush(QBrush(QColor("#f4f1e8")))
         self.setMinimumSize(160, 120)
         self.items_: list[PlantItem] = []
@@ -155,22 +155,23 @@ class FieldView(QGraphicsView):
         many = 0 < len(centre) < len(layout.cells)      # a central tile among others
         for cell in layout.cells.tolist():
             x0, y0, x1, y1 = cell
-            item = QGraphicsRectItem(QRectF(x0, y0, x1 - x0, y1 - y0))
-            item.setPen(_pen("#c8c0a8", 0.8))
+            box = QGraphicsRectItem(QRectF(x0, y0, x1 - x0, y1 - y0))
+            box.setPen(_pen("#c8c0a8", 0.8))
             if many and tuple(cell) in centre:
-                item.setBrush(QBrush(QColor("#fff3c4")))
-            scene.addItem(item)
+                box.setBrush(QBrush(QColor("#fff3c4")))
+            scene.addItem(box)
         x0, y0, x1, y1 = layout.bounds
         field = scene.addRect(QRectF(x0, y0, x1 - x0, y1 - y0), _pen("#5d4037", 2))
         field.setZValue(1)
         for row in rows_of(placements):
-            line = scene.addLine(row["x"], y0, row["x"], y1, _pen("#8d9e6b", 1, Qt.DashLine))
+            line = scene.addLine(row["x"], y0, row["x"], y1,
+                                 _pen("#8d9e6b", 1, Qt.PenStyle.DashLine))
             line.setZValue(0.5)
         self._labels = []
         for text, x, y, above in ((f"{fmt(x0, 0)}, {fmt(y0, 0)} cm", x0, y0, False),
                                   (f"{fmt(x1, 0)}, {fmt(y1, 0)} cm", x1, y1, True)):
             label = scene.addSimpleText(text)
-            label.setFlag(QGraphicsItem.ItemIgnoresTransformations)
+            label.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIgnoresTransformations)
             label.setBrush(QBrush(QColor("#5d4037")))
             label.setPos(x, y)
             if above:                                   # the top-right corner: above, inside
@@ -210,7 +211,7 @@ class FieldView(QGraphicsView):
         if rect.isEmpty():
             return
         self.resetTransform()
-        self.fitInView(rect, Qt.KeepAspectRatio)
+        self.fitInView(rect, Qt.AspectRatioMode.KeepAspectRatio)
         self.scale(1, -1)
         self._level_of_detail()
 
@@ -244,7 +245,7 @@ class FieldView(QGraphicsView):
             return
         plant = self._plant_at(event.position().toPoint())
         if plant is not None:
-            step = 1.0 if event.modifiers() & Qt.ShiftModifier else WHEEL_STEP_DEG
+            step = 1.0 if event.modifiers() & Qt.KeyboardModifier.ShiftModifier else WHEEL_STEP_DEG
             az = (plant.placement.azimuth_deg + step * notches) % 360.0
             self.turned.emit(plant.index, az, True)
         else:

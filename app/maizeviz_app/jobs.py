@@ -10,18 +10,22 @@ child's ``state`` (the canopy it holds, and the light engine keeping its Embree 
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
+
+import numpy as np
 
 from maizeviz.canopy.layout import CanopyLayout, layout_for
 from maizeviz.canopy.measures import CanopyMeasures, measure_canopy
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.irradiance import DEFAULT_PAR_UMOL_PER_J
 from maizeviz.light.request import LightRequest
+from maizeviz.light.specs import DaySpec, OpticsSpec, SkySpec  # noqa: F401 - the app's names
 from maizeviz.light.transmission import LightResult
 from maizeviz.mesh.levels import parse_level
+from maizeviz.mesh.tessellate import triangle_areas_normals
 from maizeviz.progress import ProgressCallback
 
 #: Pixel edge (cm) of the ground-cover grid in the app (the CLI's default is 0.5 cm).
@@ -82,7 +86,7 @@ class Built:
     build_s: float
     measure_s: float
     polydata: Any = None
-    columns: tuple[str, ...] = ()
+    columns: tuple[tuple[str, str], ...] = ()
     row: Any = None
     serial: int = -1
 
@@ -117,78 +121,30 @@ def op_light(state: dict, progress: ProgressCallback, request: LightRequest) -> 
                               progress=progress)
 
 
+def op_absorbed(state: dict, progress: ProgressCallback, request: LightRequest,
+                spec: OpticsSpec) -> Absorbed:
+    """Light absorbed with scattering for the request's sun, on the engine's scene, with what
+    the window shows of it: each leaf triangle's absorbed W per m2 of leaf and the plants'
+    rows."""
+    canopy = state["canopy"]
+    light = spec.absorbed(_engine(state), request.sun, request.sampling, progress)
+    nf = canopy.n_triangles
+    areas_m2 = triangle_areas_normals(canopy.vertices, canopy.faces)[0] * 1e-4
+    per_m2 = np.where(areas_m2 > 0, light.triangle_absorbed_w[:nf] / np.maximum(areas_m2, 1e-12),
+                      0.0).astype(np.float32)
+    plants = light.table("plant", canopy).to_dict("records")
+    return Absorbed(light, per_m2, plants)
+
+
 @dataclass(frozen=True)
-class SkySpec:
-    """A discretised sky: ``kind`` "soc" or "uoc", ``directions`` (16, 46, 145 or any n for
-    an equal-area split), ``split`` "auto" or "equal" (see maizeviz.light.sky.make_sky)."""
+class Absorbed:
+    """Absorbed light (:class:`maizeviz.light.scatter.AbsorbedLight`) with what the window
+    shows of it: ``leaf_value`` (F,) float32 W absorbed per m2 of each leaf triangle, and
+    ``plant_rows`` (the result's ``table("plant")`` as records)."""
 
-    kind: str = "soc"
-    directions: int = 46
-    split: str = "auto"
-
-    def sky(self):
-        from maizeviz.light.sky import make_sky
-
-        return make_sky(self.kind, self.directions, self.split)
-
-
-@dataclass(frozen=True)
-class DaySpec:
-    """A day (or part of it) at a place: clear sky (Ineichen-Perez, ``linke`` turbidity) or a
-    weather file (``weather``: its path; it sets the period and its steps)."""
-
-    date: str = "2005-08-01"
-    lat: float = 39.9
-    lon: float = 116.4
-    tz: str = "Asia/Shanghai"
-    step_min: float = 30.0
-    start: str | None = None
-    end: str | None = None
-    linke: float = 3.0
-    par_factor: float = DEFAULT_PAR_UMOL_PER_J
-    weather: str | None = None
-
-    def period(self):
-        """The Period (maizeviz.light.irradiance) the spec describes; refused with a
-        MaizevizError naming the quantity (date, tz, step, period, weather...)."""
-        from maizeviz.errors import MaizevizError
-        from maizeviz.light import irradiance as irr
-
-        if self.weather:
-            weather = irr.read_weather(self.weather, tz=self.tz or None)
-            period = irr.weather_period(weather, self.lat, self.lon, 0.0, self.par_factor)
-        else:
-            period = irr.clear_sky_period(self.date, self.lat, self.lon, self.tz or "UTC",
-                                          self.step_min, self.start or None, self.end or None,
-                                          0.0, self.linke, self.par_factor)
-        if period.n_steps == 0:
-            note = period.notes[0] if period.notes else "the sun never rises in this period"
-            raise MaizevizError(f"{note}; choose another date or place",
-                                quantity="place" if self.weather else "date")
-        return period
-
-    def steps_bound(self) -> int:
-        """At most how many time steps :meth:`period` will have, known without computing it
-        (for the cost estimate): the span over the step for a clear sky, the rows a weather
-        file of its size can hold (24 bytes a row at the least)."""
-        import math
-        import os
-
-        from maizeviz.errors import MaizevizError
-        from maizeviz.light.clock import parse_clock
-
-        if self.weather:
-            try:
-                return max(os.path.getsize(self.weather) // 24, 1)
-            except OSError:
-                return 1                                 # refused later, naming the file
-        try:
-            span = (parse_clock(self.end or "24:00", "end")[0]
-                    - parse_clock(self.start or "00:00", "start")[0])
-            minutes = max(span.total_seconds() / 60, 1.0)
-        except MaizevizError:
-            minutes = 24 * 60.0                          # refused when the period is made
-        return max(math.ceil(minutes / max(self.step_min, 1.0)), 1)
+    light: Any
+    leaf_value: np.ndarray
+    plant_rows: list
 
 
 @dataclass(frozen=True)
@@ -270,5 +226,6 @@ def op_ping(state: dict, progress: ProgressCallback) -> str:
     return "pong"
 
 
-OPS = {"measure": op_measure, "light": op_light, "sky": op_sky, "period": op_period,
-       "ping": op_ping}
+OPS: dict[str, Callable[..., Any]] = {"measure": op_measure, "light": op_light, "sky": op_sky,
+                                      "period": op_period, "absorbed": op_absorbed,
+                                      "ping": op_ping}

@@ -8,12 +8,28 @@ show_built`), so the label never names a level the view does not show yet.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from PySide6.QtCore import Qt, QTimer, Signal
-from PySide6.QtWidgets import (QAbstractItemView, QCheckBox, QFormLayout, QGroupBox,
-                               QHBoxLayout, QHeaderView, QLabel, QPushButton, QSizePolicy,
-                               QSlider, QTableWidget, QTableWidgetItem, QVBoxLayout, QWidget)
+from PySide6.QtWidgets import (
+    QAbstractItemView,
+    QCheckBox,
+    QFormLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QPushButton,
+    QSizePolicy,
+    QSlider,
+    QTableWidget,
+    QTableWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
 
 from maizeviz.mesh.levels import COMPLEXITY_STOPS, parse_level
+
 
 def describe(level: str) -> str:
     """A slider stop in words."""
@@ -21,20 +37,25 @@ def describe(level: str) -> str:
 
 
 class CanopyPanel(QWidget):
-    """Signals: ``open_requested()``, ``level_requested(stop)`` (after the slider rests
-    250 ms), ``preserve_changed(bool)``."""
+    """The points file, the slider and Table 2 of the study in ``study`` (a
+    :class:`~maizeviz_app.model.StudyModel`, followed: new points clear the table, a built
+    canopy shows its level and row).
+
+    Signals: ``open_requested()``, ``level_requested(stop)`` (after the slider rests 250 ms),
+    ``preserve_changed(bool)``."""
 
     open_requested = Signal()
     level_requested = Signal(str)
     preserve_changed = Signal(bool)
 
-    def __init__(self, level: str = "36", parent=None):
+    def __init__(self, study=None, level: str = "36", parent=None):
         super().__init__(parent)
+        self.study = study
         lay = QVBoxLayout(self)
         row = QHBoxLayout()
         self.file_label = QLabel("no file")
         self.file_label.setWordWrap(True)
-        self.file_label.setTextInteractionFlags(Qt.TextSelectableByMouse)
+        self.file_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         self.open_button = QPushButton("Open points…")
         self.open_button.setToolTip("Open a digitized points CSV (Ctrl+O)")
         self.open_button.clicked.connect(self.open_requested)
@@ -52,11 +73,11 @@ class CanopyPanel(QWidget):
 
         group = QGroupBox("mesh complexity")
         g = QVBoxLayout(group)
-        self.slider = QSlider(Qt.Horizontal)
+        self.slider = QSlider(Qt.Orientation.Horizontal)
         self.slider.setRange(0, len(COMPLEXITY_STOPS) - 1)
         self.slider.setValue(COMPLEXITY_STOPS.index(level) if level in COMPLEXITY_STOPS
                              else COMPLEXITY_STOPS.index("36"))
-        self.slider.setTickPosition(QSlider.TicksBelow)
+        self.slider.setTickPosition(QSlider.TickPosition.TicksBelow)
         self.slider.setPageStep(1)
         self.slider.setToolTip("fine (K=4, the paper's reference mesh) to coarse (4 triangles "
                                "per leaf); the canopy is rebuilt when the slider rests")
@@ -77,16 +98,18 @@ class CanopyPanel(QWidget):
         lay.addWidget(QLabel("canopy measures per level (the paper's Table 2)"))
         self.table = QTableWidget(0, 0)
         self.table.verticalHeader().setVisible(False)
-        self.table.setEditTriggers(QAbstractItemView.NoEditTriggers)
-        self.table.setSelectionBehavior(QAbstractItemView.SelectRows)
-        self.table.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Expanding)
-        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeToContents)
+        self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+        self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
+        self.table.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
+        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         lay.addWidget(self.table, 1)
         self.rows: dict[str, list[str]] = {}
         self.columns: list[str] = []
         self._debounce = QTimer(self, singleShot=True, interval=250)
         self._debounce.timeout.connect(lambda: self.level_requested.emit(self.level))
         self.slider.valueChanged.connect(self._on_slider)
+        if study is not None:
+            self._follow(study)
 
     # ------------------------------------------------------------------ state
     @property
@@ -100,6 +123,17 @@ class CanopyPanel(QWidget):
             self.slider.blockSignals(True)
             self.slider.setValue(COMPLEXITY_STOPS.index(level))
             self.slider.blockSignals(False)
+
+    def _follow(self, study) -> None:
+        study.points_changed.connect(self._on_points)
+        study.canopy_changed.connect(
+            lambda built: self.show_built(built.level, list(built.columns), built.row))
+
+    def _on_points(self, loaded) -> None:
+        self.clear_rows()
+        from_project = self.study.project_path is not None
+        self.set_file(loaded.shown_name if from_project else Path(loaded.shown_name).name,
+                      loaded.path)
 
     def set_file(self, name: str, tooltip: str = "") -> None:
         self.file_label.setText(name)
@@ -135,8 +169,9 @@ class CanopyPanel(QWidget):
         for r, vals in enumerate(self.rows.values()):
             for c, v in enumerate(vals):
                 item = QTableWidgetItem(v)
-                item.setTextAlignment((Qt.AlignLeft if c == 0 else Qt.AlignRight)
-                                      | Qt.AlignVCenter)
+                align = Qt.AlignmentFlag
+                item.setTextAlignment((align.AlignLeft if c == 0 else align.AlignRight)
+                                      | align.AlignVCenter)
                 self.table.setItem(r, c, item)
         shown = list(self.rows).index(values[0])
         self.table.selectRow(shown)

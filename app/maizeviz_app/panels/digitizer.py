@@ -18,8 +18,6 @@ import threading
 import time
 from pathlib import Path
 
-from maizeviz.resources import example_points
-from maizeviz_app.panels.growing_plant import GrowingPlant
 from PySide6.QtCore import QEvent, QObject, QSettings, Qt, QThreadPool, QTimer, Signal
 from PySide6.QtGui import QKeySequence, QShortcut
 from PySide6.QtWidgets import (
@@ -41,12 +39,14 @@ from PySide6.QtWidgets import (
     QVBoxLayout,
     QWidget,
 )
-from superqt.utils import create_worker
 
 from maizeviz.digitizer.port import FastrakPort
 from maizeviz.digitizer.recorder import Recorder, Update
 from maizeviz.digitizer.session import Session
 from maizeviz.errors import MaizevizError
+from maizeviz.resources import example_points
+from maizeviz_app.panels.growing_plant import GrowingPlant
+from maizeviz_app.workers import JobRunner
 
 #: The technician's controls: key, button text.
 CONTROLS = (("n", "Next leaf"), ("p", "Next plant"), ("r", "End row"), ("u", "Undo"))
@@ -103,12 +103,12 @@ class _ControlKeys(QObject):
     N, P, R or U as a letter is not asked (its ShortcutOverride is swallowed unaccepted), so
     the application shortcut fires instead, wherever the focus is."""
 
-    KEYS = {Qt.Key_N, Qt.Key_P, Qt.Key_R, Qt.Key_U}
+    KEYS = {Qt.Key.Key_N, Qt.Key.Key_P, Qt.Key.Key_R, Qt.Key.Key_U}
 
     def eventFilter(self, obj, ev) -> bool:  # noqa: N802 - Qt's name
-        if ev.type() == QEvent.ShortcutOverride and ev.key() in self.KEYS:
-            mods = ev.modifiers() & ~Qt.KeypadModifier
-            return mods == Qt.NoModifier
+        if ev.type() == QEvent.Type.ShortcutOverride and ev.key() in self.KEYS:
+            mods = ev.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
+            return mods == Qt.KeyboardModifier.NoModifier
         return False
 
 
@@ -141,7 +141,7 @@ class DigitizerPanel(QWidget):
         self._connecting: tuple[FastrakPort, Session] | None = None
         self._connect_pool = QThreadPool(self)
         self._connect_pool.setMaxThreadCount(1)
-        self._workers: set = set()
+        self._runner = JobRunner(self, pool=self._connect_pool)
         self._shortcuts: list[QShortcut] = []
         self._keys = _ControlKeys(self)
         self._settings = QSettings("maizeviz", "maizeviz")
@@ -149,12 +149,12 @@ class DigitizerPanel(QWidget):
 
         outer = QVBoxLayout(self)
         outer.setContentsMargins(0, 0, 0, 0)
-        self.scroll = QScrollArea()
-        self.scroll.setWidgetResizable(True)
-        self.scroll.setFrameShape(QFrame.NoFrame)
-        outer.addWidget(self.scroll)
+        self.scroll_area = QScrollArea()
+        self.scroll_area.setWidgetResizable(True)
+        self.scroll_area.setFrameShape(QFrame.Shape.NoFrame)
+        outer.addWidget(self.scroll_area)
         body = QWidget()
-        self.scroll.setWidget(body)
+        self.scroll_area.setWidget(body)
         lay = QVBoxLayout(body)
 
         self.band = StatusBand()
@@ -209,8 +209,9 @@ class DigitizerPanel(QWidget):
         lay.addWidget(self.counts)
         self.log = QListWidget()
         self.log.setUniformItemSizes(True)          # scrolling 400 lines stays instant
-        self.log.setHorizontalScrollBarPolicy(Qt.ScrollBarAlwaysOff)
-        self.log.setTextElideMode(Qt.ElideMiddle)   # the band shows the whole last line
+        self.log.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        # the band shows the whole last line
+        self.log.setTextElideMode(Qt.TextElideMode.ElideMiddle)
         self.log.setMinimumHeight(90)
         lay.addWidget(self.log, 1)
 
@@ -220,7 +221,7 @@ class DigitizerPanel(QWidget):
     def _big_button(self, text: str) -> QPushButton:
         b = QPushButton(text)
         b.setMinimumHeight(BIG_BUTTON_PX)
-        b.setSizePolicy(QSizePolicy.Expanding, QSizePolicy.Fixed)
+        b.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
         font = b.font()
         font.setPointSize(max(font.pointSize(), 9) + 5)
         font.setBold(True)
@@ -275,10 +276,12 @@ class DigitizerPanel(QWidget):
         owner = self.window()
         for key, _ in CONTROLS:
             sc = QShortcut(QKeySequence(key.upper()), owner)
-            sc.setContext(Qt.ApplicationShortcut)
+            sc.setContext(Qt.ShortcutContext.ApplicationShortcut)
             sc.activated.connect(lambda c=key: self.control(c))
             self._shortcuts.append(sc)
-        QApplication.instance().installEventFilter(self._keys)
+        app = QApplication.instance()
+        if app is not None:
+            app.installEventFilter(self._keys)
 
     def _release_keys(self) -> None:
         app = QApplication.instance()
@@ -309,7 +312,10 @@ class DigitizerPanel(QWidget):
         return self.recorder is not None
 
     def _where(self) -> str:
-        p = self.session.pos
+        session = self.session
+        if session is None:
+            return "not recording"
+        p = session.pos
         return f"plant {p.plant} · leaf {p.leaf} · row {p.row} · col {p.col}"
 
     def _show_counts(self) -> None:
@@ -343,13 +349,10 @@ class DigitizerPanel(QWidget):
                             "connecting")
         self._lock(False, connecting=True)
         stations = (1,) if ref is None else (1, ref)
-        worker = create_worker(port.configure, stations, _start_thread=False,
-                               _ignore_errors=True)
-        worker.returned.connect(lambda cfg: self._connected(port, session, cfg, demo))
-        worker.errored.connect(lambda exc: self._not_connected(port, session, exc))
-        worker.finished.connect(lambda: self._workers.discard(worker))
-        self._workers.add(worker)
-        self._connect_pool.start(worker)
+        self._runner.run("connect", f"connecting to {port_name}",
+                         lambda job: port.configure(stations),
+                         on_done=lambda cfg: self._connected(port, session, cfg, demo),
+                         on_error=lambda exc: self._not_connected(port, session, exc))
 
     def _connected(self, port: FastrakPort, session: Session, cfg, demo: bool) -> None:
         if self._connecting is None or self._connecting[0] is not port:
@@ -366,7 +369,7 @@ class DigitizerPanel(QWidget):
         if demo:
             self._start_replay(session.reference_station is not None)
 
-    def _not_connected(self, port: FastrakPort, session: Session, exc: Exception) -> None:
+    def _not_connected(self, port: FastrakPort, session: Session, exc: BaseException) -> None:
         if self._connecting is None or self._connecting[0] is not port:
             return
         self._connecting = None

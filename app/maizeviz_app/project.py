@@ -2,9 +2,9 @@
 
 What a project holds and how it is read is the core's (:mod:`maizeviz.project.study`: points,
 layout with its stands in order, settings, and sun, sky and day results tagged with the stands
-they were traced on); this module adds only what belongs to the window: the light panel's
-settings of each run (``SkySpec``, ``DaySpec``) and the checks of the settings the window
-offers (tilings, slider stops, light choices).
+they were traced on); the sky and day specs of each result are the core's too
+(:mod:`maizeviz.project.settings`). This module adds only what belongs to the window: the
+checks of the settings the window offers (tilings, slider stops, light choices).
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import Any, NamedTuple
 
 from maizeviz.io.project import ProjectError, get
+from maizeviz.project.settings import run_settings, settings_doc  # noqa: F401 - re-exported
 from maizeviz.project.study import CANOPY, LIGHT, Opened, StoredResult
 
 __all__ = ["CANOPY", "LIGHT", "Opened", "StoredRun", "canopy_settings", "light_settings",
@@ -32,64 +33,7 @@ class StoredRun(NamedTuple):
 
 def stored_run(stored: StoredResult, where: str) -> StoredRun:
     """The window's run of a result read from a project (its settings as the panel's)."""
-    settings = None if stored.kind == "sun" else \
-        run_settings(stored.kind, stored.result, stored.settings, where)
-    return StoredRun(stored.label, stored.result, stored.kind, settings)
-
-
-def settings_doc(kind: str, settings: Any) -> dict | None:
-    """The window's settings of a sky run (a ``SkySpec``) or a day run (``(DaySpec,
-    SkySpec)``) as JSON, or None when they are not those."""
-    from dataclasses import asdict, is_dataclass
-
-    if kind == "sky" and is_dataclass(settings) and not isinstance(settings, type):
-        return {"sky": asdict(settings)}
-    if kind == "day" and isinstance(settings, tuple) and len(settings) == 2 and \
-            all(is_dataclass(s) and not isinstance(s, type) for s in settings):
-        return {"day": asdict(settings[0]), "sky": asdict(settings[1])}
-    return None
-
-
-def _sky_spec(doc: dict, where: str):
-    from maizeviz_app.jobs import SkySpec
-
-    at = f"{where}: the sky settings of a light result"
-    return SkySpec(get(doc, "kind", str, where=at), get(doc, "directions", int, where=at),
-                   get(doc, "split", str, where=at))
-
-
-def _day_spec(doc: dict, where: str):
-    from maizeviz_app.jobs import DaySpec
-
-    at = f"{where}: the day settings of a light result"
-
-    def text_or_none(key: str):
-        value = doc.get(key)
-        return None if value is None else get(doc, key, str, where=at)
-
-    return DaySpec(get(doc, "date", str, where=at), float(get(doc, "lat", (int, float), where=at)),
-                   float(get(doc, "lon", (int, float), where=at)), get(doc, "tz", str, where=at),
-                   float(get(doc, "step_min", (int, float), where=at)), text_or_none("start"),
-                   text_or_none("end"), float(get(doc, "linke", (int, float), where=at)),
-                   float(get(doc, "par_factor", (int, float), where=at)),
-                   text_or_none("weather"))
-
-
-def run_settings(kind: str, result, stored: dict | None, where: str) -> Any:
-    """The settings a sky or day run is compared with in the window (what the light panel
-    gives for the same choice): from the stored ``settings``, else (an older record) the
-    sky's from the result and None for a day. Bad stored settings: ProjectError."""
-    from maizeviz_app.jobs import SkySpec
-
-    if stored is not None:
-        sky = _sky_spec(get(stored, "sky", dict, where=where), where)
-        if kind == "sky":
-            return sky
-        return (_day_spec(get(stored, "day", dict, where=where), where), sky)
-    if kind == "sky":
-        s = result.sky
-        return SkySpec(s.kind, s.n, "equal" if s.split == "equal" else "auto")
-    return None
+    return StoredRun(stored.label, stored.result, stored.kind, stored.specs(where))
 
 
 def canopy_settings(opened: Opened) -> tuple[int, str, bool]:
@@ -121,10 +65,14 @@ LIGHT_SETTINGS = (("zenith_deg", (int, float)), ("azimuth_deg", (int, float)), (
                   ("longitude", (int, float)), ("tz", str), ("step_min", (int, float)),
                   ("from", str), ("to", str), ("source", str),
                   ("linke_turbidity", (int, float)), ("weather", str),
-                  ("par_factor", (int, float)))
+                  ("par_factor", (int, float)), ("optics", bool), ("band", str),
+                  ("reflectance", (int, float)), ("transmittance", (int, float)),
+                  ("ground_reflectance", (int, float)), ("direct_w_m2", (int, float)),
+                  ("diffuse_w_m2", (int, float)), ("depth", int))
 #: Allowed values of the light settings that name a choice.
 LIGHT_CHOICES = {"mode": ("sun", "sky", "day"), "sky_kind": ("soc", "uoc"),
-                 "sky_split": ("auto", "equal"), "source": ("clear", "weather")}
+                 "sky_split": ("auto", "equal"), "source": ("clear", "weather"),
+                 "band": ("par", "nir")}
 
 
 def light_settings(opened: Opened) -> dict:

@@ -14,7 +14,13 @@ from dataclasses import dataclass, replace
 from PySide6.QtCore import QAbstractTableModel, QModelIndex, QObject, Qt, Signal
 from PySide6.QtGui import QUndoCommand
 
-from maizeviz.canopy.layout import CanopyLayout, Placement, layout_from_dict, layout_to_dict
+from maizeviz.canopy.layout import (
+    CanopyLayout,
+    LayoutError,
+    Placement,
+    layout_from_dict,
+    layout_to_dict,
+)
 
 COLUMNS = ("x cm", "y cm", "plant", "azimuth °")
 
@@ -66,6 +72,8 @@ class EditedLayout(QObject):
 
     def document(self) -> dict:
         """The layout document (schema of the README) of the edited placements."""
+        if self.base is None:
+            raise LayoutError("no layout to edit yet: open a points file first")
         return layout_to_dict(self.base, self.placements)
 
     def layout(self) -> CanopyLayout:
@@ -76,6 +84,7 @@ class EditedLayout(QObject):
         layout it was.
         """
         checked = layout_from_dict(self.document(), self.plants, "layout")
+        assert self.base is not None                    # document() refused otherwise
         return replace(self.base, placements=tuple(self.placements), warnings=checked.warnings)
 
 
@@ -154,29 +163,29 @@ class PlacementTable(QAbstractTableModel):
     def columnCount(self, parent=QModelIndex()) -> int:  # noqa: N802, B008
         return 0 if parent.isValid() else len(COLUMNS)
 
-    def headerData(self, section, orientation, role=Qt.DisplayRole):  # noqa: N802
-        if role != Qt.DisplayRole:
+    def headerData(self, section, orientation, role=Qt.ItemDataRole.DisplayRole):  # noqa: N802
+        if role != Qt.ItemDataRole.DisplayRole:
             return None
-        return COLUMNS[section] if orientation == Qt.Horizontal else str(section + 1)
+        return COLUMNS[section] if orientation == Qt.Orientation.Horizontal else str(section + 1)
 
     def flags(self, index):
-        return Qt.ItemIsSelectable | Qt.ItemIsEnabled | Qt.ItemIsEditable
+        return Qt.ItemFlag.ItemIsSelectable | Qt.ItemFlag.ItemIsEnabled | Qt.ItemFlag.ItemIsEditable
 
-    def data(self, index, role=Qt.DisplayRole):
+    def data(self, index, role=Qt.ItemDataRole.DisplayRole):
         if not index.isValid():
             return None
         p = self.model.placements[index.row()]
         value = (p.x, p.y, p.plant, p.azimuth_deg)[index.column()]
-        if role == Qt.DisplayRole:
+        if role == Qt.ItemDataRole.DisplayRole:
             return str(value) if index.column() == 2 else fmt(value)
-        if role == Qt.EditRole:
+        if role == Qt.ItemDataRole.EditRole:
             return str(value) if index.column() == 2 else repr(float(value))
-        if role == Qt.TextAlignmentRole:
-            return int(Qt.AlignRight | Qt.AlignVCenter)
+        if role == Qt.ItemDataRole.TextAlignmentRole:
+            return int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
         return None
 
-    def setData(self, index, value, role=Qt.EditRole) -> bool:  # noqa: N802
-        if role != Qt.EditRole or not index.isValid():
+    def setData(self, index, value, role=Qt.ItemDataRole.EditRole) -> bool:  # noqa: N802
+        if role != Qt.ItemDataRole.EditRole or not index.isValid():
             return False
         row, col = index.row(), index.column()
         name = COLUMNS[col]

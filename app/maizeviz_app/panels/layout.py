@@ -15,15 +15,6 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-from maizeviz_app.options import TILINGS, tiling_of
-from maizeviz_app.panels.field_view import FieldView
-from maizeviz_app.panels.layout_model import (
-    EditedLayout,
-    EditPlacement,
-    PlacementTable,
-    ReplaceLayout,
-    fmt,
-)
 from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtGui import QKeySequence, QUndoStack
 from PySide6.QtWidgets import (
@@ -52,19 +43,31 @@ from maizeviz.canopy.layout import (
     tiled_layout,
 )
 from maizeviz.errors import MaizevizError
+from maizeviz_app.options import TILINGS, tiling_of
+from maizeviz_app.panels.field_view import FieldView
+from maizeviz_app.panels.layout_model import (
+    EditedLayout,
+    EditPlacement,
+    PlacementTable,
+    ReplaceLayout,
+    fmt,
+)
 
 FOLLOW_DELAY_MS = 400
 
 
 class LayoutPanel(QWidget):
     """Edit a :class:`~maizeviz.canopy.layout.CanopyLayout`; ``applied`` carries the new one,
-    ``problem`` a line for the technician (a refused edit, a note from the checks)."""
+    ``problem`` a line for the technician (a refused edit, a note from the checks). With a
+    ``study`` (:class:`~maizeviz_app.model.StudyModel`) it shows the layout of the points the
+    study opens."""
 
     applied = Signal(object)
     problem = Signal(str)
 
-    def __init__(self, parent=None):
+    def __init__(self, study=None, parent=None):
         super().__init__(parent)
+        self.study = study
         self.model = EditedLayout(self)
         self.model.changed.connect(self._on_changed)
         self.bases: dict[int, tuple[float, float]] = {}
@@ -86,21 +89,21 @@ class LayoutPanel(QWidget):
         self.tiling.setToolTip("repeat the digitized block; the paper tiles its 3 x 3 block "
                                "3 x 3 times (9 x 9 plants)")
         self.tiling.activated.connect(self._on_tiling_chosen)
-        self.tiling.setSizeAdjustPolicy(QComboBox.AdjustToMinimumContentsLengthWithIcon)
+        self.tiling.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
         self.tiling.setMinimumContentsLength(10)
         bar.addWidget(self.tiling, 1)
         self.undo_action = self.undo_stack.createUndoAction(self, "Undo")
-        self.undo_action.setShortcut(QKeySequence.Undo)
+        self.undo_action.setShortcut(QKeySequence.StandardKey.Undo)
         self.redo_action = self.undo_stack.createRedoAction(self, "Redo")
         self.redo_action.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")])
-        for action, icon in ((self.undo_action, QStyle.SP_ArrowBack),
-                             (self.redo_action, QStyle.SP_ArrowForward)):
-            action.setShortcutContext(Qt.WidgetWithChildrenShortcut)
+        for action, icon in ((self.undo_action, QStyle.StandardPixmap.SP_ArrowBack),
+                             (self.redo_action, QStyle.StandardPixmap.SP_ArrowForward)):
+            action.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
             action.setIcon(self.style().standardIcon(icon))
             self.addAction(action)
             button = QToolButton()
             button.setDefaultAction(action)
-            button.setToolButtonStyle(Qt.ToolButtonIconOnly)
+            button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonIconOnly)
             bar.addWidget(button)
         self.follow = QCheckBox("3D view follows")
         self.follow.setToolTip("rebuild the canopy after each edit")
@@ -108,7 +111,7 @@ class LayoutPanel(QWidget):
         bar.addWidget(self.follow)
         lay.addLayout(bar)
 
-        self.splitter = QSplitter(Qt.Horizontal)
+        self.splitter = QSplitter(Qt.Orientation.Horizontal)
         self.view = FieldView()
         self.view.moved.connect(self._on_moved)
         self.view.turned.connect(self._on_turned)
@@ -116,11 +119,12 @@ class LayoutPanel(QWidget):
         self.table = QTableView()
         self.rows = PlacementTable(self.model, self._push_edit, self.problem.emit, self)
         self.table.setModel(self.rows)
-        self.table.setSelectionBehavior(QAbstractItemView.SelectRows)
-        self.table.setSelectionMode(QAbstractItemView.SingleSelection)
-        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.Stretch)
+        self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
+        self.table.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
+        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Stretch)
         self.table.verticalHeader().setDefaultSectionSize(22)
-        self.table.verticalHeader().setSectionResizeMode(QHeaderView.Fixed)   # 700 rows stay fast
+        # fixed rows: 700 rows stay fast
+        self.table.verticalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Fixed)
         self.table.selectionModel().currentRowChanged.connect(
             lambda cur, _prev: self.view.select(cur.row()))
         self.splitter.addWidget(self.view)
@@ -146,6 +150,11 @@ class LayoutPanel(QWidget):
 
         self._follow_timer = QTimer(self, singleShot=True, interval=FOLLOW_DELAY_MS)
         self._follow_timer.timeout.connect(self.apply)
+        if study is not None:
+            study.points_changed.connect(lambda loaded: self.show_layout(loaded.layout,
+                                                                         loaded.plants))
+            if study.loaded is not None:
+                self.show_layout(study.loaded.layout, study.loaded.plants)
 
     # ------------------------------------------------------------------------ state
     @property
@@ -291,11 +300,12 @@ class LayoutPanel(QWidget):
             self.set_tiling(int(n))
 
     def _confirm(self, text: str) -> bool:
-        box = QMessageBox(QMessageBox.Warning, "Replace the edited layout?", text,
-                          QMessageBox.Discard | QMessageBox.Cancel, self)
-        box.button(QMessageBox.Discard).setText("Replace")
-        box.setDefaultButton(QMessageBox.Cancel)
-        return box.exec() == QMessageBox.Discard
+        box = QMessageBox(QMessageBox.Icon.Warning, "Replace the edited layout?", text,
+                          QMessageBox.StandardButton.Discard
+                          | QMessageBox.StandardButton.Cancel, self)
+        box.button(QMessageBox.StandardButton.Discard).setText("Replace")
+        box.setDefaultButton(QMessageBox.StandardButton.Cancel)
+        return box.exec() == QMessageBox.StandardButton.Discard
 
     # ------------------------------------------------------------------ apply, files
     def apply(self) -> None:
@@ -356,7 +366,7 @@ class LayoutPanel(QWidget):
         super().resizeEvent(event)
         # beside the table when there is room, above it in a narrow dock
         wide = self.width() > 1.1 * self.height() and self.width() > 560
-        orientation = Qt.Horizontal if wide else Qt.Vertical
+        orientation = Qt.Orientation.Horizontal if wide else Qt.Orientation.Vertical
         if orientation != self.splitter.orientation() or not self._split:
             self.splitter.setOrientation(orientation)
             length = self.width() if wide else self.height()

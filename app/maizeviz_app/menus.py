@@ -28,17 +28,18 @@ def build_menus(w) -> dict[str, QAction]:
     bar = w.menuBar()
     acts: dict[str, QAction] = {}
     f = bar.addMenu("&File")
-    acts["open"] = _action(w, f, "&Open points…", w.choose_points, QKeySequence.Open,
+    acts["open"] = _action(w, f, "&Open points…", w.choose_points, QKeySequence.StandardKey.Open,
                            "open a digitized points CSV")
     acts["open_project"] = _action(w, f, "Open &project…", w.choose_project, "Ctrl+Shift+O",
                                    "open a maizeviz project")
     w.recent_menu = f.addMenu("Open &recent")
     w.recent_menu.aboutToShow.connect(lambda: fill_recent(w))
     f.addSeparator()
-    acts["save"] = _action(w, f, "&Save project", w.save_project_here, QKeySequence.Save,
+    acts["save"] = _action(w, f, "&Save project", w.save_project_here,
+                           QKeySequence.StandardKey.Save,
                            "save points, layout, settings and light results in one file")
     acts["save_as"] = _action(w, f, "Save project &as…", w.choose_project_target,
-                              QKeySequence.SaveAs)
+                              QKeySequence.StandardKey.SaveAs)
     f.addSeparator()
     acts["export_mesh"] = _action(w, f, "&Export mesh…", lambda: w.choose_export("canopy"),
                                   "Ctrl+E", "the canopy with plant, leaf and light ids per "
@@ -64,7 +65,7 @@ def build_menus(w) -> dict[str, QAction]:
     acts["export_day"] = _action(w, results, "Day figure (PNG)…",
                                  lambda: w.choose_export("day"))
     f.addSeparator()
-    acts["quit"] = _action(w, f, "&Quit", w.close, QKeySequence.Quit)
+    acts["quit"] = _action(w, f, "&Quit", w.close, QKeySequence.StandardKey.Quit)
 
     v = bar.addMenu("&View")
     cam = v.addMenu("&Camera")
@@ -103,7 +104,7 @@ def build_menus(w) -> dict[str, QAction]:
     acts["sun_place"] = _action(w, r, "&Sun from place", w.sun_from_place, "Ctrl+Shift+L")
 
     h = bar.addMenu("&Help")
-    acts["about"] = _action(w, h, "&About maizeviz", w.about, QKeySequence.HelpContents)
+    acts["about"] = _action(w, h, "&About maizeviz", w.about, QKeySequence.StandardKey.HelpContents)
     return acts
 
 

@@ -1,0 +1,138 @@
+"""Exports of the study open in the window, as work for a worker thread (no Qt here): the
+canopy mesh with its light, the tables, the figures. Every file is written atomically."""
+
+from __future__ import annotations
+
+import csv
+
+from maizeviz.errors import MaizevizError
+from maizeviz_app.model import StudyModel
+from maizeviz_app.runs import day_title, plot_title
+
+
+def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, {}, None)):
+    """The work writing ``what`` of the study in ``model`` to ``path`` (atomically), to run
+    in a worker as ``work(job, *args)``: returns ``(work, args)``. ``heatmap``: the light
+    whose map is shown, the run shown for each light, the height shown (cm).
+
+    ``what``: canopy (mesh with each triangle's light), table (transmission by height),
+    measures (Table 2), heatmap, plot; steps, leaves, plants, day (of a sky or a day). Nothing
+    to export yet: MaizevizError saying what to do first."""
+    if what == "canopy":
+        if model.canopy is None:
+            raise MaizevizError("no canopy to export yet")
+        canopy = model.canopy
+        signature = model.signature(model.built.label)
+        cells = {}
+        run = model.runs.for_signature(signature)
+        if run is not None and run.classes is not None:
+            cells["light"] = run.classes.astype("int32")
+        for kind, name in (("sky", "diffuse_per_m2_leaf"), ("day", "par_mol_per_m2_leaf")):
+            run = model.runs.for_signature(signature, kind)
+            if run is not None and run.extra is not None:
+                cells[name] = run.extra.leaf_value.astype("float32")
+
+        def work(job):
+            from maizeviz.canopy.export import export_canopy
+
+            export_canopy(path, canopy, cell_data=cells)
+            return path
+        return work, ()
+    if what == "measures":
+        if not model.measures_rows:
+            raise MaizevizError("no canopy measures to export yet")
+        rows = list(model.measures_rows.values())
+
+        def work(job):
+            from maizeviz.io.atomic import write_rows
+
+            write_rows(path, [{k: v.replace(",", "") for k, v in r.items()} for r in rows])
+            return path
+        return work, ()
+    if what in ("steps", "leaves", "plants", "day"):
+        return _diffuse_job(what, path, model)
+    if model.runs.last is None:
+        raise MaizevizError("no light result to export yet: compute light first")
+    if what == "table":
+        header, table_rows = model.runs.table()
+
+        def work(job):
+            from maizeviz.io.atomic import atomic_open
+
+            with atomic_open(path, "w", newline="") as fh:
+                w = csv.writer(fh)
+                w.writerow(["height_cm"] + [f"transmission {h}" for h in header[1:]])
+                w.writerows(table_rows)
+            return path
+        return work, ()
+    if what == "heatmap":
+        shown_kind, shown_runs, height = heatmap
+        kind = shown_kind or model.runs.last.kind
+        run = shown_runs.get(kind) or model.runs.last
+        kind = run.kind
+        if height is None:
+            height = float(run.result.heights_cm[0])
+        result = run.result
+
+        def work(job):
+            from maizeviz.light.heatmap import save_figure
+            from maizeviz_app.plots import heatmap_figure_of
+
+            save_figure(heatmap_figure_of(result, height, kind), path)
+            return path
+        return work, ()
+    if what == "plot":
+        from maizeviz_app import plots
+
+        curves = model.runs.curves()
+        title = plot_title(model.runs)
+
+        def work(job):
+            from maizeviz.light.heatmap import save_figure
+
+            save_figure(plots.transmission_figure(curves, title, width_in=7, dpi=110), path)
+            return path
+        return work, ()
+    raise MaizevizError(f"unknown export '{what}'")
+
+def _diffuse_job(what: str, path: str, model: StudyModel):
+    """The day's steps CSV and figure, the per-leaf and per-plant CSV of the last sky or
+    day (the day when both)."""
+    day = model.runs.of_kind("day")
+    run = day if day is not None else model.runs.of_kind("sky")
+    if what in ("steps", "day") and day is None:
+        raise MaizevizError("no day computed yet: choose Day in the light panel and "
+                            "compute the day's light first")
+    if run is None:
+        raise MaizevizError("no sky or day computed yet: choose Sky or Day in the light "
+                            "panel and compute first")
+    light, extra, label = run.result, run.extra, run.label
+    if what == "steps":
+        def work(job):
+            from maizeviz.light.reports import write_steps
+
+            write_steps(path, light)
+            return path
+        return work, ()
+    if what == "day":
+        title = day_title(light, label)
+
+        def work(job):
+            from maizeviz.light.heatmap import save_figure
+            from maizeviz.light.plots import day_figure
+
+            save_figure(day_figure(light, title), path)
+            return path
+        return work, ()
+    if extra is None:
+        raise MaizevizError(f"the light per leaf of the {run.kind} on {label} is computed "
+                            f"against its canopy: show level {label} first")
+    rows = [dict(r, level=label) for r in extra.leaf_rows]
+
+    def write_table(job):
+        from maizeviz.io.atomic import write_rows
+        from maizeviz.light.leaf_light import plant_light
+
+        write_rows(path, rows if what == "leaves" else plant_light(rows))
+        return path
+    return write_table, ()

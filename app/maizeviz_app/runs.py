@@ -1,0 +1,273 @@
+"""Light results the window keeps: one per mesh level and light (sun, sky, day), compared in
+one table and one plot while they share their sampling. Qt-free (the model holds them)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from maizeviz.mesh.levels import COMPLEXITY_STOPS, parse_level
+
+#: The lights the app computes, in the order of the buttons, the table and the plot.
+MODES = ("sun", "sky", "day")
+#: Rows of the results table for the energy balance of a sun traced with leaf optics:
+#: Balance field -> the row's label.
+BALANCE_ROWS = (("incident", "{band} incident W/m²"),
+                ("absorbed_leaves", "absorbed by leaves W/m²"),
+                ("absorbed_ground", "absorbed by the ground W/m²"),
+                ("reflected_top", "reflected out of the top W/m²"),
+                ("escaped_sides", "out of the sides W/m²"))
+#: Skies: kind -> (what the light panel's combo says, how a result is named in the table).
+SKIES = {"soc": ("standard overcast (SOC): brightness (1 + 2 cos θ)/3", "overcast sky"),
+         "uoc": ("uniform overcast (UOC)", "uniform sky")}
+
+
+def level_order(label: str) -> int:
+    """Fine-to-coarse rank of a level label (``K=4`` ... ``4 triangles``), for sorting."""
+    for k, stop in enumerate(COMPLEXITY_STOPS):
+        if parse_level(stop).label == label.split(",")[0]:
+            return k
+    return len(COMPLEXITY_STOPS)
+
+
+@dataclass
+class Run:
+    """One light result: the level it was traced on (``label``), the canopy it belongs to
+    (``signature``), the light (``kind``: sun, sky or day) and, for a sun, each leaf
+    triangle's light class (F,) int8 (None until computed); for a sky or a day ``extra``
+    holds what the light process made of it (per-leaf and per-plant rows, per-triangle
+    values: :class:`maizeviz_app.jobs.Diffuse`); for a sun traced with leaf optics, the light
+    absorbed with scattering (:class:`maizeviz_app.jobs.Absorbed`)."""
+
+    label: str
+    signature: tuple
+    result: Any
+    classes: np.ndarray | None = None
+    kind: str = "sun"
+    extra: Any = None
+
+    @property
+    def name(self) -> str:
+        """The run's column in the table and curve in the plot."""
+        if self.kind == "sky":
+            return f"{self.label}, {SKIES.get(self.result.sky.kind, ('', 'sky'))[1]}"
+        if self.kind == "day":
+            return f"{self.label}, day: PAR transmitted"
+        return self.label
+
+    @property
+    def balance(self) -> Any:
+        """The energy balance (:class:`maizeviz.light.scatter.Balance`, W/m2 of ground) of a
+        sun traced with leaf optics, else None."""
+        light = getattr(self.extra, "light", None) if self.kind == "sun" else None
+        return getattr(light, "balance", None)
+
+    @property
+    def transmission(self) -> np.ndarray:
+        """(H,) the fraction of the light reaching each height (for a day: of its PAR)."""
+        if self.kind == "day":
+            return np.asarray(self.result.transmission_by_height)
+        return np.asarray(self.result.transmission)
+
+
+class LightRuns:
+    """The last light result per mesh level and light, sampled the same way."""
+
+    def __init__(self) -> None:
+        self.runs: dict[str, Run] = {}
+        self.settings: dict[str, Any] = {}          # each light's own settings
+        self.sampling: Any = None                   # heights, density, periodic field
+        self.last: Run | None = None
+        self._order: dict[int, int] = {}            # id(run) -> when it was added
+        self._added = 0
+
+    def add(self, run: Run, settings: Any, sampling: Any = None) -> bool:
+        """Keep ``run``; True if it replaced results traced with other settings (another
+        ``sampling``: every result; other ``settings`` of the run's light: that light's)."""
+        dropped = False
+        if self.runs and sampling != self.sampling:
+            self.runs.clear()
+            self.settings.clear()
+            dropped = True
+        elif run.kind in self.settings and settings != self.settings[run.kind]:
+            kept = {k: r for k, r in self.runs.items() if r.kind != run.kind}
+            dropped = len(kept) != len(self.runs)
+            self.runs = kept
+        self.sampling = sampling
+        self.settings[run.kind] = settings
+        self.runs[run.name] = run
+        self.runs = dict(sorted(self.runs.items(),
+                                key=lambda kv: (MODES.index(kv[1].kind),
+                                                level_order(kv[1].label))))
+        self._added += 1
+        self._order[id(run)] = self._added
+        self._order = {id(r): self._order.get(id(r), 0) for r in self.runs.values()}
+        self.last = run
+        return dropped
+
+    def copy(self) -> LightRuns:
+        """A shallow copy (the runs are shared), to preview a result in a worker."""
+        other = LightRuns()
+        other.runs, other.settings = dict(self.runs), dict(self.settings)
+        other.sampling, other.last = self.sampling, self.last
+        other._order, other._added = dict(self._order), self._added
+        return other
+
+    def clear(self) -> None:
+        self.runs.clear()
+        self.settings.clear()
+        self.sampling = None
+        self.last = None
+        self._order.clear()
+
+    def for_signature(self, signature: tuple, kind: str = "sun") -> Run | None:
+        """The ``kind`` result of a canopy."""
+        for run in self.runs.values():
+            if run.signature == signature and run.kind == kind:
+                return run
+        return None
+
+    def latest(self, signature: tuple | None = None, kinds: Sequence[str] = MODES) -> Run | None:
+        """The result added last (of a canopy, of the ``kinds`` given)."""
+        runs = [r for r in self.runs.values() if r.kind in kinds and
+                (signature is None or r.signature == signature)]
+        return max(runs, key=lambda r: self._order.get(id(r), 0)) if runs else None
+
+    def in_order(self) -> list[Run]:
+        """The runs in the order they were added (the last one is :attr:`last`)."""
+        return sorted(self.runs.values(), key=lambda r: self._order.get(id(r), 0))
+
+    def of_kind(self, kind: str) -> Run | None:
+        return self.latest(None, (kind,))
+
+    def heights(self) -> tuple[float, ...]:
+        if self.last is None:
+            return ()
+        return tuple(float(h) for h in self.last.result.heights_cm)
+
+    def curves(self):
+        from maizeviz_app.plots import Curve
+
+        return [Curve(r.name, tuple(map(float, r.result.heights_cm)),
+                      tuple(map(float, r.transmission)), r.kind, r.label)
+                for r in self.runs.values()]
+
+    def table(self) -> tuple[list[str], list[list[str]]]:
+        """Header and rows (one per height) of the results table; then, when a sun was traced
+        with leaf optics, its energy balance (W/m2 of ground) in rows of their own."""
+        names = list(self.runs)
+        header = ["height cm"] + names
+        rows = []
+        for i, h in enumerate(self.heights()):
+            row = [f"{h:g}"]
+            for name in names:
+                t = self.runs[name].transmission
+                row.append(f"{t[i]:.3f}" if i < len(t) and np.isfinite(t[i]) else "")
+            rows.append(row)
+        balances = {name: r.balance for name, r in self.runs.items() if r.balance is not None}
+        if balances:
+            band = next(r.extra.light.band for r in self.runs.values()
+                        if r.balance is not None).upper()
+            for field, what in BALANCE_ROWS:
+                row = [what.format(band=band)]
+                for name in names:
+                    b = balances.get(name)
+                    row.append(f"{getattr(b, field):.1f}" if b is not None else "")
+                rows.append(row)
+        return header, rows
+
+
+def plot_title(runs: LightRuns) -> str:
+    """What the transmission plot compares: the sun, the sky, the day; rays per cm²."""
+    parts = []
+    sun, sky, day = (runs.of_kind(k) for k in ("sun", "sky", "day"))
+    if sun is not None:
+        r = sun.result
+        parts.append(f"sun zenith {r.sun.zenith_deg:.1f}°, azimuth {r.sun.azimuth_deg:.1f}°")
+    diffuse = sky.result.sky if sky is not None else \
+        (day.result.sky.sky if day is not None and day.result.sky is not None else None)
+    if diffuse is not None:
+        parts.append(f"sky {diffuse.kind.upper()}, {diffuse.n} directions")
+    if day is not None:
+        p = day.result.period
+        parts.append(f"day {p.start:%Y-%m-%d}, {p.n_steps} steps")
+    density = runs.sampling[1] if runs.sampling else None
+    if density is None and runs.last is not None:
+        density = getattr(runs.last.result, "density", None)
+    if density is not None:
+        parts.append(f"{density:g} rays/cm²")
+    return "; ".join(parts)
+
+
+def value_legend(run: Run) -> tuple[str, str]:
+    """Colour-bar title and unit of a sky's or day's light per leaf, or a sun's absorbed
+    light per leaf triangle."""
+    if run.kind == "sun":
+        return f"{run.extra.light.band.upper()} absorbed per leaf area", "W/m² leaf"
+    if run.kind == "day":
+        return "PAR intercepted per leaf over the day", "mol/m² leaf"
+    return "diffuse light per leaf area (1: the sky's on open ground)", ""
+
+
+def run_info(run: Run) -> str:
+    """What was traced and how long it took, for the light panel."""
+    r = run.result
+    secs = r.seconds
+    build_s = run.extra.build_s if run.kind != "sun" and run.extra is not None \
+        else secs.get("build", 0)
+    build = f"{build_s:.2f} s" if build_s > 0 else "kept from the last run"
+    if run.kind == "sun":
+        info = (f"{r.rays:,} rays on the central tile at {r.density_per_cm2:.2f} per cm²; "
+                f"level {run.label}; Embree scene {build}, tracing "
+                f"{secs.get('trace', 0) + secs.get('second', 0):.2f} s")
+        share = r.sunlit_intercepted_fraction
+        if share is not None:
+            info += f"; leaves take {share:.1%} of the direct light"
+        if run.balance is not None:
+            a = run.extra.light
+            b = run.balance
+            info += (f"; with leaf optics (ρ {a.optics.reflectance:g}, τ "
+                     f"{a.optics.transmittance:g}, soil {a.optics.ground_reflectance:g}) the "
+                     f"leaves absorb {a.fraction_absorbed:.1%} of the {a.band.upper()}, "
+                     f"{b.reflected_top / b.incident if b.incident else 0:.1%} is reflected "
+                     f"(balance closes within {abs(b.closure):.2%}; scattering "
+                     f"{a.seconds.get('scatter', 0):.2f} s)")
+    elif run.kind == "sky":
+        info = (f"{r.sky.description}; {r.rays:,} rays per direction; level {run.label}; "
+                f"Embree scene {build}, tracing {secs.get('trace', 0):.2f} s; leaves "
+                f"take {r.intercepted_fraction:.1%} of the diffuse light")
+    else:
+        sky = r.sky.sky.description if r.sky is not None else "no sky"
+        info = (f"{r.n_steps} time steps and the sky ({sky}); {r.rays:,} rays per "
+                f"direction; level {run.label}; Embree scene {build}, tracing "
+                f"{secs.get('trace', 0):.2f} s")
+    return info + "".join(f"\n⚠ {w}" for w in r.warnings if "sun never rises" not in w)
+
+
+def day_summary(light) -> str:
+    """The day in two lines: PAR incident, intercepted (fraction), transmitted to the lowest
+    height, mol/m² of ground; and where the irradiance came from."""
+    p = light.period
+    frac = light.fraction_intercepted
+    h = light.heights_cm
+    low = int(np.argmin(h))
+    where = "the ground" if h[low] == 0 else f"{h[low]:g} cm"
+    t_low = float(light.par_transmitted_mol_m2[low])
+    share = f" ({light.transmission_by_height[low]:.1%})" if frac is not None else ""
+    span = (f"{p.start:%Y-%m-%d}" if (p.end - p.start).total_seconds() == 86400 and
+            p.start.hour == 0 and p.start.minute == 0 else
+            f"{p.start:%Y-%m-%d %H:%M} to {p.end:%H:%M}")
+    return (f"{span}: PAR incident {light.par_incident_mol_m2:.1f} mol/m² (direct "
+            f"{light.par_direct_mol_m2:.1f}, diffuse {light.par_diffuse_mol_m2:.1f}); "
+            f"intercepted {light.par_intercepted_mol_m2:.1f} mol/m²"
+            + (f" ({frac:.1%})" if frac is not None else "")
+            + f"; transmitted to {where} {t_low:.2f} mol/m²{share}\n{p.source}")
+
+
+def day_title(light, label: str) -> str:
+    p = light.period
+    return (f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M} ({p.start.tz}); {p.source}; "
+            f"level {label}")

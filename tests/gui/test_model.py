@@ -1,0 +1,153 @@
+"""The app's study model without a window (Qt-free), and the window's unsaved-changes marker
+and prompt built on it."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+from maizeviz_app.jobs import load_points
+from maizeviz_app.model import StudyModel
+from maizeviz_app.runs import Run
+from test_light_modes import TIMEOUT, compute, shown, small_light
+
+
+class _Result:
+    def __init__(self, heights=(0.0, 100.0), t=(0.4, 0.8)):
+        self.heights_cm, self.transmission = heights, t
+
+
+@pytest.fixture(scope="module")
+def loaded(small_points):
+    return load_points(str(small_points), (1, 1))
+
+
+def _record(model):
+    seen = []
+    for name in ("points_changed", "layout_changed", "canopy_changed", "runs_changed",
+                 "project_changed", "modified_changed"):
+        getattr(model, name).connect(lambda *a, name=name: seen.append((name, a)))
+    return seen
+
+
+def test_the_model_imports_without_qt():
+    code = ("import sys, maizeviz_app.model, maizeviz_app.runs; "
+            "bad = [m for m in sys.modules if m.split('.')[0] in ('PySide6', 'pyvista', 'vtk')]; "
+            "print(bad); sys.exit(1 if bad else 0)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def test_opening_points_starts_a_clean_study(loaded, small_points):
+    model = StudyModel(tile=3)
+    seen = _record(model)
+    assert model.title == "maizeviz" and not model.modified
+    model.open_points(loaded, b"abc", str(small_points))
+    assert model.loaded is loaded and model.points_bytes == b"abc" and model.serial == 1
+    assert [n for n, _ in seen] == ["runs_changed", "points_changed", "project_changed"]
+    assert not model.modified and model.title == f"maizeviz — {small_points.name}[*]"
+    assert model.tile_n == 1                        # the layout's own tiling, not the start's
+
+
+def test_light_results_are_unsaved_work_until_saved(loaded, small_points, tmp_path):
+    model = StudyModel()
+    model.open_points(loaded, b"", str(small_points))
+    seen = _record(model)
+    run = Run("36 triangles", model.signature("36 triangles"), _Result())
+    assert not model.add_run(run, ("sun",), ("h",), "traced")
+    assert model.modified and ("modified_changed", (True,)) in seen
+    assert ("runs_changed", (model.runs, "traced")) in seen
+    assert list(model.runs.runs) == ["36 triangles"]
+    # a result for older points is not kept
+    stale = Run("K=4", (model.serial - 1, "K=4"), _Result())
+    assert not model.add_run(stale, ("sun",), ("h",))
+    assert list(model.runs.runs) == ["36 triangles"]
+    target = str(tmp_path / "s.maizeviz")
+    model.saved(target)
+    assert not model.modified and model.project_path == target
+    assert model.title == "maizeviz — s.maizeviz[*]"
+    # results read back from a project are not new work
+    model.add_run(Run("4 triangles", model.signature("4 triangles"), _Result()), ("sun",),
+                  ("h",), saved=True)
+    assert not model.modified and len(model.runs.runs) == 2
+
+
+def test_a_layout_edit_drops_results_and_stales_canopies(loaded, small_points):
+    from dataclasses import replace
+
+    model = StudyModel()
+    model.open_points(loaded, b"", str(small_points))
+    old_serial = model.serial
+    model.add_run(Run("36 triangles", model.signature("36 triangles"), _Result()), (), ())
+    seen = _record(model)
+    moved = replace(loaded.layout)
+    assert model.edit_layout(moved) is True
+    assert model.loaded.layout is moved and model.layout_edited and model.modified
+    assert model.serial == old_serial + 1 and not model.runs.runs
+    assert ("layout_changed", (moved,)) in seen
+
+    class Built:
+        serial, label, row, level = old_serial, "36 triangles", {"a": "1"}, "36"
+        canopy = None
+    assert not model.show_built(Built())            # built for the layout before the edit
+    assert model.built is None
+    Built.serial = model.serial
+    assert model.show_built(Built()) and model.measures_rows == {"36 triangles": {"a": "1"}}
+
+
+def test_window_marks_unsaved_work_and_asks_before_closing(window, qtbot, small_points,
+                                                           tmp_path):
+    from PySide6.QtCore import QTimer
+    from PySide6.QtWidgets import QApplication, QMessageBox
+
+    w = shown(qtbot, window(small_points, tile=1))
+    assert not w.isWindowModified() and w.windowTitle().endswith("[*]")
+    small_light(w.light_panel, "sun")
+    compute(qtbot, w)
+    assert w.isWindowModified() and w.model.modified
+    w.confirm_unsaved = True
+    answers = []
+
+    def answer(button):
+        def click():
+            box = QApplication.activeModalWidget()
+            if isinstance(box, QMessageBox):
+                answers.append(box.text())
+                box.button(button).click()
+            else:
+                QTimer.singleShot(50, click)
+        QTimer.singleShot(50, click)
+
+    answer(QMessageBox.StandardButton.Cancel)
+    assert not w.close()                            # Cancel: the window stays, results kept
+    assert w.isVisible() and w.runs.runs and "not in a project" in answers[0]
+    # Save with a project already named: saved, then closed
+    w.model.project_path = str(tmp_path / "kept.maizeviz")
+    answer(QMessageBox.StandardButton.Save)
+    with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
+        assert not w.close()                        # closes once the project is written
+    qtbot.waitUntil(lambda: not w.isVisible(), timeout=TIMEOUT)
+    assert (tmp_path / "kept.maizeviz").stat().st_size > 0 and len(answers) == 2
+
+
+def test_discarding_lets_another_file_open(window, qtbot, small_points):
+    from PySide6.QtCore import QTimer
+    from PySide6.QtWidgets import QApplication, QMessageBox
+
+    w = shown(qtbot, window(small_points, tile=1))
+    small_light(w.light_panel, "sun")
+    compute(qtbot, w)
+    w.confirm_unsaved = True
+    serial = w.model.serial
+
+    def discard():
+        box = QApplication.activeModalWidget()
+        if isinstance(box, QMessageBox):
+            box.button(QMessageBox.StandardButton.Discard).click()
+        else:
+            QTimer.singleShot(50, discard)
+    QTimer.singleShot(50, discard)
+    with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
+        w.open_points(small_points)
+    assert w.model.serial == serial + 1 and not w.runs.runs and not w.isWindowModified()
