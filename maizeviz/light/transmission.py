@@ -38,12 +38,14 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.hits import SunRays, first_hits, hit_counts, lattice_first_hits, second_hits
-from maizeviz.light.periodic import Wrap, overhang_copies, snap
+from maizeviz.light.periodic import ANCHOR_CM, Wrap, overhang_copies, snap
 from maizeviz.light.rays import Rect, Tracer, ray_grid, sensor_offsets
 from maizeviz.light.request import LightRequest, canopy_top, check_request
 from maizeviz.light.result import TracedLight
 from maizeviz.light.sun import Sun
 from maizeviz.light.tiling import BlockTiling, block_mesh, block_tiling, tile_triangles
+from maizeviz.mesh import packets as _packets
+from maizeviz.mesh.instances import Instances
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, ordered_map, report
 
@@ -177,6 +179,36 @@ class BlockScene(CanopyScene):
         super().__init__(verts, faces, n, None, canopy.layout.bounds, tiling.wrap)
         self.tiling = tiling
         self._n_leaf = canopy.n_triangles
+        # with the packet kernel: the block placed at every tile of the plot (Embree
+        # instances), traced over the plot's period: the whole canopy's segments, the block's
+        # build (without: the block's own period, more segments, the same hits)
+        self.instanced: Instances | None = None
+        if self._kernel is not None:
+            a, b = tiling.shape
+            i0, j0 = tiling.first_key
+            keys = np.array([(i, j) for i in range(i0, i0 + a) for j in range(j0, j0 + b)])
+            try:
+                self.instanced = Instances(self, keys * tiling.wrap.period)
+                self._keys = keys
+            except (RuntimeError, ValueError):  # pragma: no cover - Embree refused
+                self.instanced = None
+
+    def wrapped_native(self, org: np.ndarray, dirs: np.ndarray, length: np.ndarray,
+                       any_hit: bool, row: int):
+        """:func:`~maizeviz.light.periodic.trace_wrapped` through the block's instances over
+        the plot (same results); None where there are no instances."""
+        if self.instanced is None or self._kernel is None:
+            return None
+        pw = self.tiling.plot_wrap
+        got = _packets.wrapped(self._kernel, self.instanced.handle, org, dirs, length,
+                               (pw.x0, pw.y0, pw.w, pw.h, pw.q, ANCHOR_CM), any_hit, row=row)
+        if any_hit:
+            return got
+        prim, cell, dist, inst = got
+        hit = prim >= 0
+        # the hit block's key: its instance's, plus the plot periods the ray had crossed
+        cell[hit] = self._keys[inst[hit]] + cell[hit] * np.array(self.tiling.shape)
+        return prim, cell, dist
 
     def resolve(self, prim: np.ndarray, cell: np.ndarray | None) -> np.ndarray:
         """Canopy triangle ids (k,) of block triangles ``prim`` (k,) hit in the block copies

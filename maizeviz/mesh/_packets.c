@@ -133,6 +133,7 @@ static int order_next(packet_order *o, int width, int64_t *idx) {
                 uint32_t p = rh.hit.prim_id[k];                                             \
                 if (prim_out) prim_out[idx[k]] = p == INVALID_ID ? -1 : (int32_t)p;         \
                 if (tfar_out) tfar_out[idx[k]] = rh.ray.tfar[k];                            \
+                if (inst_out) inst_out[idx[k]] = p == INVALID_ID ? -1 : (int32_t)rh.hit.inst_id[k]; \
             }                                                                               \
         }                                                                                   \
     }
@@ -140,12 +141,13 @@ static int order_next(packet_order *o, int width, int64_t *idx) {
 /* Nearest hits of n rays: origins org (n, 3), directions dir (n, 3) (dir_step 1) or one
  * direction (dir_step 0), ray lengths tfar (n,) or NULL (unbounded). Writes prim_out (n,)
  * int32 (-1: no hit) and tfar_out (n,) float32 (the hit distance, or the ray's tfar where
- * none); either may be NULL. coherent: Embree's coherent-rays flag. row: rays per row when
+ * none) and inst_out (n,) int32, the instance hit in a scene of instances (-1: none); any
+ * may be NULL. coherent: Embree's coherent-rays flag. row: rays per row when
  * the rays form a grid laid out row by row (packets then take tiles of it), else 0.
  * Returns 0, or -1 for an unknown packet width. */
 int mz_intersect(void *fn_addr, int width, void *scene, int64_t n, const float *org,
                  const float *dir, int dir_step, const float *tfar, int32_t *prim_out,
-                 float *tfar_out, int coherent, int64_t row) {
+                 float *tfar_out, int32_t *inst_out, int coherent, int64_t row) {
     query_args args;
     init_args(&args, coherent);
     switch (width) {
@@ -202,7 +204,7 @@ int mz_occluded(void *fn_addr, int width, void *scene, int64_t n, const float *o
 typedef struct {
     double o[3], d[3], len, at, k, best, start;
     int64_t cell[2], bcell[2];
-    int32_t prim;
+    int32_t prim, inst;
     int active;
 } lane;
 
@@ -228,6 +230,7 @@ static void lane_init(lane *L, const double *org, const double *dir, double len,
     L->best = INFINITY;
     L->start = 0.0;
     L->prim = -1;
+    L->inst = -1;
     L->bcell[0] = L->bcell[1] = 0;
     for (int a = 0; a < 2; ++a)
         L->cell[a] = (int64_t)floor((L->o[a] - wrap[a]) / wrap[2 + a]);
@@ -328,6 +331,7 @@ static void lane_advance(lane *L, const segment *S, int done) {
                         double dist = S->t_anchor + (double)rh.ray.tfar[k];                 \
                         if (dist < L->best) {                                               \
                             L->best = dist; L->prim = (int32_t)p;                           \
+                            L->inst = (int32_t)rh.hit.inst_id[k];                           \
                             L->bcell[0] = L->cell[0]; L->bcell[1] = L->cell[1];             \
                         }                                                                   \
                     }                                                                       \
@@ -347,13 +351,15 @@ WRAPPED_PASS(16)
 /* Rays through the periodic field `wrap` (see above): origins org (n, 3) and directions dir
  * (n, 3) or one (dir_step 0), float64 cm, lengths length (n,) cm. any_hit: blocked_out (n,)
  * uint8; else prim_out (n,) int32 (-1: none), cell_out (n, 2) int64 (the cell whose copy of
- * the scene holds the hit), dist_out (n,) float64 (inf: none). Rays are traced segment by
+ * the scene holds the hit), dist_out (n,) float64 (inf: none), inst_out (n,) int32 (the
+ * instance hit in a scene of instances; may be NULL). Rays are traced segment by
  * segment in passes, the rays still travelling packed together. Returns 0; -1 for an unknown
  * packet width, -2 for a ray that never ends, -3 when memory runs out. */
 int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene, int64_t n,
                const double *org, const double *dir, int dir_step, const double *length,
                const double *wrap, int any_hit, int32_t *prim_out, int64_t *cell_out,
-               double *dist_out, uint8_t *blocked_out, int coherent, int64_t row) {
+               double *dist_out, int32_t *inst_out, uint8_t *blocked_out, int coherent,
+               int64_t row) {
     if (width != 4 && width != 8 && width != 16) return -1;
     query_args args;
     init_args(&args, coherent);
@@ -384,6 +390,7 @@ int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene, in
         cell_out[2 * j] = st[j].bcell[0];
         cell_out[2 * j + 1] = st[j].bcell[1];
         dist_out[j] = st[j].best;
+        if (inst_out) inst_out[j] = st[j].prim >= 0 ? st[j].inst : -1;
     }
     free(st);
     free(act);

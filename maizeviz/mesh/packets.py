@@ -110,22 +110,24 @@ def kernel() -> Kernel | None:
         return None
     p, i64, i32 = ctypes.c_void_p, ctypes.c_int64, ctypes.c_int
     lib.mz_intersect.restype = i32
-    lib.mz_intersect.argtypes = [p, i32, p, i64, p, p, i32, p, p, p, i32, i64]
+    lib.mz_intersect.argtypes = [p, i32, p, i64, p, p, i32, p, p, p, p, i32, i64]
     lib.mz_occluded.restype = i32
     lib.mz_occluded.argtypes = [p, i32, p, i64, p, p, i32, p, p, i32, i64]
     lib.mz_wrapped.restype = i32
-    lib.mz_wrapped.argtypes = [p, p, i32, p, i64, p, p, i32, p, p, i32, p, p, p, p, i32, i64]
+    lib.mz_wrapped.argtypes = [p, p, i32, p, i64, p, p, i32, p, p, i32, p, p, p, p, p, i32, i64]
     lib.mz_layout_check.restype = i64
     if lib.mz_layout_check() != _LAYOUT:
         return None
-    inter, occl = {}, {}
+    inter: dict[int, int] = {}
+    occl: dict[int, int] = {}
     for w in (4, 8, 16):
         fi = getattr(embree, f"rtcIntersect{w}", None)
         fo = getattr(embree, f"rtcOccluded{w}", None)
-        if fi is None or fo is None:
+        ai = ctypes.cast(fi, ctypes.c_void_p).value if fi is not None else None
+        ao = ctypes.cast(fo, ctypes.c_void_p).value if fo is not None else None
+        if not ai or not ao:
             return None
-        inter[w] = ctypes.cast(fi, ctypes.c_void_p).value
-        occl[w] = ctypes.cast(fo, ctypes.c_void_p).value
+        inter[w], occl[w] = ai, ao
     width = DEFAULT_WIDTH if DEFAULT_WIDTH in inter else 8
     return Kernel(lib, inter, occl, width)
 
@@ -146,13 +148,15 @@ def _ptr(a: np.ndarray | None) -> int | None:
 
 def intersect(k: Kernel, scene_handle: int, origins: np.ndarray, directions: np.ndarray,
               tfar: np.ndarray | None, ids: bool = True, coherent: bool = True,
-              width: int | None = None, row: int = 0) -> tuple[np.ndarray | None, np.ndarray]:
+              width: int | None = None, row: int = 0, inst: np.ndarray | None = None
+              ) -> tuple[np.ndarray | None, np.ndarray]:
     """Nearest hits of rays from ``origins`` (N, 3) cm along ``directions`` (N, 3) or (1, 3)
     within ``tfar`` (N,) cm (None: unbounded). ``row``: rays per row when the rays are a
     regular grid laid out row by row (packets then take compact tiles of it), else 0.
 
     Returns triangle ids (N,) int32, -1 where none (None unless ``ids``), and distances (N,)
-    float32 cm: the hit's, or the ray's ``tfar`` (1e37 when unbounded) where none.
+    float32 cm: the hit's, or the ray's ``tfar`` (1e37 when unbounded) where none. ``inst``:
+    an (N,) int32 array to receive the instance hit in a scene of instances (-1: none).
     """
     o, d, step = _rays(origins, directions)
     n = len(o)
@@ -163,7 +167,8 @@ def intersect(k: Kernel, scene_handle: int, origins: np.ndarray, directions: np.
     w = width or k.width
     if n:
         rc = k.lib.mz_intersect(k.intersect[w], w, scene_handle, n, _ptr(o), _ptr(d), step,
-                                _ptr(t), _ptr(prim), _ptr(dist), int(coherent), int(row))
+                                _ptr(t), _ptr(prim), _ptr(dist), _ptr(inst), int(coherent),
+                                int(row))
         if rc != 0:  # pragma: no cover - widths are checked above
             raise ValueError(f"packet width {w} not supported")
     return prim, dist
@@ -201,8 +206,9 @@ def wrapped(k: Kernel, scene_handle: int, origins: np.ndarray, directions: np.nd
 
     Returns
     -------
-    any_hit: blocked (N,) bool; else triangle ids (N,) int32 (-1: none), cells (N, 2) int64 and
-    distances (N,) float64 cm (inf: none).
+    any_hit: blocked (N,) bool; else triangle ids (N,) int32 (-1: none), cells (N, 2) int64,
+    distances (N,) float64 cm (inf: none) and the instances hit (N,) int32 (-1: none; in a
+    scene of instances).
     """
     o = np.ascontiguousarray(origins, dtype=np.float64).reshape(-1, 3)
     d = np.ascontiguousarray(directions, dtype=np.float64).reshape(-1, 3)
@@ -216,14 +222,15 @@ def wrapped(k: Kernel, scene_handle: int, origins: np.ndarray, directions: np.nd
     prim = None if any_hit else np.empty(n, np.int32)
     cell = None if any_hit else np.empty((n, 2), np.int64)
     dist = None if any_hit else np.empty(n, np.float64)
+    inst = None if any_hit else np.empty(n, np.int32)
     if n:
         rc = k.lib.mz_wrapped(k.intersect[width], k.occluded[width], width, scene_handle, n,
                               _ptr(o), _ptr(d), int(len(d) == n and n > 1), _ptr(t), _ptr(w),
-                              int(any_hit), _ptr(prim), _ptr(cell), _ptr(dist), _ptr(blocked),
-                              int(coherent), int(row))
+                              int(any_hit), _ptr(prim), _ptr(cell), _ptr(dist), _ptr(inst),
+                              _ptr(blocked), int(coherent), int(row))
         if rc != 0:  # pragma: no cover - a segment always ends at an edge, anchor or the end
             raise RuntimeError(f"periodic tracing failed ({rc})")
     if any_hit:
         assert blocked is not None
         return blocked.view(bool)
-    return prim, cell, dist
+    return prim, cell, dist, inst

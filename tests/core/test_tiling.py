@@ -7,12 +7,12 @@ is traced whole."""
 import numpy as np
 import pytest
 
-from maizeviz.canopy.layout import layout_for, layout_to_dict, layout_from_dict
+from maizeviz.canopy.layout import layout_for, layout_from_dict, layout_to_dict
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
-from maizeviz.light.heatmap import transmission_map
 from maizeviz.light.daylight import trace_period, trace_sky
 from maizeviz.light.engine import LightEngine
+from maizeviz.light.heatmap import transmission_map
 from maizeviz.light.irradiance import clear_sky_period
 from maizeviz.light.leaf_light import leaf_light
 from maizeviz.light.periodic import Wrap, trace_wrapped
@@ -40,6 +40,8 @@ def tiled(leaves):
 def test_the_block_scene_is_chosen_for_a_tiled_periodic_canopy(tiled):
     c, whole, block = tiled
     assert isinstance(block, BlockScene) and type(whole) is CanopyScene
+    if block.packets:                          # the block at the 9 tiles, one BVH
+        assert block.instanced is not None and len(block.instanced.offsets) == 9
     assert block.tiling.shape == (3, 3)
     # the block and its neighbours' overhangs: 9 times fewer triangles, near enough
     assert block.n_triangles < whole.n_triangles / 7
@@ -102,15 +104,21 @@ def test_rays_in_any_direction_from_anywhere(tiled):
     _same(da, db)
     _same(oa, ob)
     _same(oa, ia >= 0)                                   # occlusion sees what hits see
-    # the C kernel's wrapping (packets) and numpy's (single queries) are the same steps
+    # the C kernel's wrapping (packets; the block's instances over the plot) and numpy's
+    # (single queries; the block's own period) find the same triangles at the same distances
     for scene in (whole, block):
         if scene.packets:
-            c_way = trace_wrapped(scene, scene.wrap, org, d, length)
-            np_way = trace_wrapped(scene, scene.wrap, org, d, length, native=False)
-            for x, y in zip(c_way, np_way):
+            got = []
+            for native in (True, False):
+                prim, cell, dist = trace_wrapped(scene, scene.wrap, org, d, length,
+                                                 native=native)
+                hit = prim >= 0
+                ids = np.full(n, -1, np.int64)
+                ids[hit] = scene.resolve(prim[hit], cell[hit])
+                got.append((ids, dist, trace_wrapped(scene, scene.wrap, org, d, length,
+                                                     any_hit=True, native=native)))
+            for x, y in zip(*got):
                 _same(x, y)
-            _same(trace_wrapped(scene, scene.wrap, org, d, length, any_hit=True),
-                  trace_wrapped(scene, scene.wrap, org, d, length, any_hit=True, native=False))
 
 
 def test_sky_and_day_through_the_block(tiled):
