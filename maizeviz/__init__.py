@@ -27,6 +27,8 @@ _EXPORTS = {
     "lay_out": "maizeviz.api",
     "build_canopy": "maizeviz.api",
     "measure_canopy": "maizeviz.api",
+    "export_canopy": "maizeviz.canopy.export",
+    "read_mesh_canopy": "maizeviz.canopy.from_mesh",
     "read_study": "maizeviz.project.study",
     "save_study": "maizeviz.project.study",
     # light

@@ -155,6 +155,12 @@ def layout_cost(leaves: Iterable[Leaf], layout: CanopyLayout, level: Level) -> C
                        layout.quantity)
 
 
+def mesh_cost(triangles: int) -> Cost:
+    """Tracing a canopy of ``triangles`` read from a mesh file (its scene and tables)."""
+    return Cost(f"the mesh canopy of {triangles:,} triangles", "mesh", triangles, "triangles",
+                triangles * BYTES_PER_TRIANGLE, triangles / TRIANGLES_PER_S)
+
+
 def light_cost(rect: Rect, density: float, heights: int, directions: int = 1,
                triangles: int = 0) -> Cost:
     """Tracing ``directions`` parallel beams (the sun, sky directions, time steps) of rays at

@@ -122,4 +122,9 @@ QUANTITIES = {
     "at": "stalk position x, y, cm",
     "params": "data parameterisation",
     "resume": "continue an existing recording",
+    "mesh": "mesh file of plants (PLY, OBJ) traced as it is",
+    "mesh_unit": "length unit of a mesh file (m, cm, mm)",
+    "up": "up axis of a mesh file (z, y)",
+    "field": "field rectangle of a mesh canopy x0, y0, x1, y1, cm",
+    "mesh_ids": "face properties holding a mesh's plant and leaf ids",
 }

@@ -25,7 +25,6 @@ from maizeviz.light.request import LightRequest
 from maizeviz.light.specs import DaySpec, OpticsSpec, SkySpec  # noqa: F401 - the app's names
 from maizeviz.light.transmission import LightResult
 from maizeviz.mesh.levels import parse_level
-from maizeviz.mesh.tessellate import triangle_areas_normals
 from maizeviz.progress import ProgressCallback
 
 #: Pixel edge (cm) of the ground-cover grid in the app (the CLI's default is 0.5 cm).
@@ -124,22 +123,25 @@ def op_light(state: dict, progress: ProgressCallback, request: LightRequest) -> 
 def op_absorbed(state: dict, progress: ProgressCallback, request: LightRequest,
                 spec: OpticsSpec) -> Absorbed:
     """Light absorbed with scattering for the request's sun, on the engine's scene, with what
-    the window shows of it: each leaf triangle's absorbed W per m2 of leaf and the plants'
-    rows."""
+    the window shows of it: each leaf's absorbed W per m2 of leaf on its triangles (copies
+    of a plant in a periodic field take their representative's; NaN on plants outside the
+    sample rectangle of an open field) and the plants' rows."""
+    from maizeviz.light.reports import leaf_values
+    from maizeviz.light.scatter import absorbed_leaf_rows
+
     canopy = state["canopy"]
     light = spec.absorbed(_engine(state), request.sun, request.sampling, progress)
-    nf = canopy.n_triangles
-    areas_m2 = triangle_areas_normals(canopy.vertices, canopy.faces)[0] * 1e-4
-    per_m2 = np.where(areas_m2 > 0, light.triangle_absorbed_w[:nf] / np.maximum(areas_m2, 1e-12),
-                      0.0).astype(np.float32)
+    values = leaf_values(canopy, absorbed_leaf_rows(canopy, light), "absorbed_w", light.rect,
+                         light.periodic)
     plants = light.table("plant", canopy).to_dict("records")
-    return Absorbed(light, per_m2, plants)
+    return Absorbed(light, values.astype(np.float32), plants)
 
 
 @dataclass(frozen=True)
 class Absorbed:
     """Absorbed light (:class:`maizeviz.light.scatter.AbsorbedLight`) with what the window
-    shows of it: ``leaf_value`` (F,) float32 W absorbed per m2 of each leaf triangle, and
+    shows of it: ``leaf_value`` (F,) float32 W absorbed per m2 of leaf on each leaf triangle
+    (its leaf's), and
     ``plant_rows`` (the result's ``table("plant")`` as records)."""
 
     light: Any

@@ -23,10 +23,13 @@ def canopy_cells(canopy: Canopy, cell_data: dict[str, np.ndarray] | None = None,
     cells.update({k: np.asarray(v) for k, v in (cell_data or {}).items()})
     if not with_stalks or not len(canopy.stalk_faces):
         return canopy.vertices, canopy.faces, cells
-    per_stalk = len(canopy.stalk_faces) // max(canopy.n_plants, 1)
     n_stalk = len(canopy.stalk_faces)
-    stalk = {"plant": np.repeat(np.arange(1, canopy.n_plants + 1, dtype=np.int32), per_stalk),
-             "leaf": np.zeros(n_stalk, np.int32)}
+    if canopy.stalk_instance is not None:
+        stalk_plant = (np.asarray(canopy.stalk_instance) + 1).astype(np.int32)
+    else:
+        per_stalk = n_stalk // max(canopy.n_plants, 1)
+        stalk_plant = np.repeat(np.arange(1, canopy.n_plants + 1, dtype=np.int32), per_stalk)
+    stalk = {"plant": stalk_plant, "leaf": np.zeros(n_stalk, np.int32)}
     for k, v in cells.items():
         if k not in stalk:
             fill = 0 if np.issubdtype(v.dtype, np.integer) else np.nan

@@ -51,6 +51,10 @@ class Canopy:
     stalk_vertices : (S, 3) float64, stalk_faces : (G, 3) int64
         Stalk cylinders for views; not leaves, not in the leaf measures.
     leaves_per_instance : (P,) int32
+    stalk_instance : (G,) int32, or None
+        The placement each stalk triangle belongs to, where plants' stalks differ in size (a
+        canopy read from a mesh file); None: each placement has an equal share of the stalk
+        triangles, in placement order.
     """
 
     vertices: np.ndarray
@@ -63,6 +67,7 @@ class Canopy:
     stalk_vertices: np.ndarray
     stalk_faces: np.ndarray
     leaves_per_instance: np.ndarray
+    stalk_instance: np.ndarray | None = None
 
     @property
     def n_triangles(self) -> int:

@@ -7,14 +7,15 @@ import json
 import time
 
 from maizeviz.canopy.export import export_canopy
-from maizeviz.canopy.layout import save_layout
+from maizeviz.canopy.layout import CanopyLayout, save_layout
 from maizeviz.canopy.measures import (
     TABLE2_COLUMNS,
+    CanopyMeasures,
     check_cover_resolution,
     measure_canopy,
     table2_row,
 )
-from maizeviz.canopy.scene import build_canopy
+from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.cli.common import (
     Progress,
     add_canopy_options,
@@ -22,12 +23,16 @@ from maizeviz.cli.common import (
     canopy_setup,
     check_canopy_costs,
     check_export,
+    check_input_options,
     fmt_table,
+    input_name,
+    is_mesh,
     leaves_summary,
     levels_from,
+    mesh_setup,
     say,
 )
-from maizeviz.cost import cover_cost
+from maizeviz.cost import check, cover_cost, mesh_cost
 from maizeviz.io.outputs import check_run_paths
 from maizeviz.mesh.levels import CANOPY_LEVELS
 
@@ -54,11 +59,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_input_options(args)
     levels = levels_from(args)
     check_export(args.export, levels)
     check_cover_resolution(args.cover_resolution)            # before the file is read
     check_run_paths([("the mesh export", args.export), ("the saved layout", args.save_layout)],
-                    [("the points file", args.points), ("the layout file", args.layout)])
+                    [(input_name(args.points), args.points), ("the layout file", args.layout)])
+    if is_mesh(args.points):
+        return _run_mesh(args)
     leaves, skipped, layout = canopy_setup(args)
     check_canopy_costs(leaves, layout, levels, args.force,
                        [cover_cost(layout, args.cover_resolution)])
@@ -72,15 +80,37 @@ def run(args: argparse.Namespace) -> int:
         for preserve in variants:
             t0 = time.perf_counter()
             canopy = build_canopy(leaves, layout, level, preserve, Progress(f"building {level}"))
-            t1 = time.perf_counter()
-            m = measure_canopy(canopy, args.cover_resolution, args.with_stalks)
-            runs.append((m, dict(m.as_dict(), level=level.variant_label(preserve),
-                                 build_s=t1 - t0, measure_s=time.perf_counter() - t1,
-                                 preserve_area=preserve)))
-            if args.export:
-                path = export_canopy(args.export, canopy)
-                say(f"wrote {canopy.n_triangles} leaf triangles of {canopy.n_plants} plants "
-                    f"(and their stalks) to {path}")
+            runs.append(_measured(args, canopy, level.variant_label(preserve), t0, preserve))
+    _report(args, runs, layout)
+    return leaves_summary(len(leaves), skipped)
+
+
+def _run_mesh(args: argparse.Namespace) -> int:
+    """A mesh file as the canopy: measured (and exported) as it is."""
+    t0 = time.perf_counter()
+    canopy = mesh_setup(args)
+    check([[mesh_cost(canopy.n_triangles), cover_cost(canopy.layout, args.cover_resolution)]],
+          args.force)
+    _report(args, [_measured(args, canopy, canopy.level, t0, True)], canopy.layout)
+    return leaves_summary(canopy.n_leaves, [])
+
+
+def _measured(args: argparse.Namespace, canopy: Canopy, label: str, t0: float,
+              preserve: bool) -> tuple[CanopyMeasures, dict]:
+    """Measures of a built canopy (exported if asked) and its JSON record."""
+    t1 = time.perf_counter()
+    m = measure_canopy(canopy, args.cover_resolution, args.with_stalks)
+    rec = dict(m.as_dict(), level=label, build_s=t1 - t0, measure_s=time.perf_counter() - t1,
+               preserve_area=preserve)
+    if args.export:
+        path = export_canopy(args.export, canopy)
+        say(f"wrote {canopy.n_triangles} leaf triangles of {canopy.n_plants} plants "
+            f"(and their stalks) to {path}")
+    return m, rec
+
+
+def _report(args: argparse.Namespace, runs: list[tuple[CanopyMeasures, dict]],
+            layout: CanopyLayout) -> None:
     if args.json:
         records = [d for _, d in runs]
         print(json.dumps(records[0] if len(records) == 1 else {"levels": records}, indent=1))
@@ -93,4 +123,3 @@ def run(args: argparse.Namespace) -> int:
         print(fmt_table([h for _, h in TABLE2_COLUMNS],
                         [[r[k] for k, _ in TABLE2_COLUMNS] for r in rows]))
         print(f"ground cover: vertical rays every {args.cover_resolution:g} cm inside the plot")
-    return leaves_summary(len(leaves), skipped)

@@ -7,10 +7,13 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from maizeviz.canopy.from_mesh import UNITS, UP_AXES, read_mesh_canopy
 from maizeviz.canopy.layout import CanopyLayout, check_tile, layout_for, parse_shape
+from maizeviz.canopy.scene import Canopy
 from maizeviz.cost import Cost, check, layout_cost
 from maizeviz.errors import LeafError, MaizevizError
 from maizeviz.io.atomic import file_tag
+from maizeviz.io.mesh_canopy import is_mesh_path
 from maizeviz.io.meshfile import check_mesh_path
 from maizeviz.io.project import SUFFIX as PROJECT_SUFFIX
 from maizeviz.leaf.fit import Leaf, read_leaves
@@ -38,6 +41,8 @@ FLAGS = {
     "resume": "--resume", "band": "--band", "reflectance": "--reflectance",
     "transmittance": "--transmittance", "ground_reflectance": "--ground-reflectance",
     "irradiance": "--irradiance/--diffuse", "depth": "--depth",
+    "mesh_unit": "--mesh-unit", "up": "--up", "field": "--field",
+    "mesh_ids": "--mesh-plant/--mesh-leaf",
 }
 
 
@@ -118,7 +123,8 @@ def levels_from(args: argparse.Namespace, default_k: int = 4) -> list[Level]:
 
 def add_canopy_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("points", help="points CSV of the digitized plants (field coordinates, cm), "
-                                  "or a .maizeviz project (its points and its layout)")
+                                  "a .maizeviz project (its points and its layout), or a mesh "
+                                  "file (.ply, .obj) with a plant and leaf id per face")
     p.add_argument("--tile", metavar="AxB",
                    help="repeat the digitized block A times across rows (x) and B times along "
                         "them (y); the paper uses 3x3 (default 1x1; a project's own layout)")
@@ -135,6 +141,23 @@ def add_canopy_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--force", action="store_true",
                    help="run work estimated to take longer than 15 min (what would not fit in "
                         "memory is refused anyway)")
+    m = p.add_argument_group("a mesh file as the canopy (.ply, .obj; see docs/cli.md)")
+    m.add_argument("--mesh-unit", choices=sorted(UNITS), default=None,
+                   help="length unit of the mesh file (default cm, refusing a mesh under 5 or "
+                        "over 1000 units tall, which is likely in m or mm)")
+    m.add_argument("--up", choices=UP_AXES, default=None,
+                   help="the mesh file's up axis: z (default; OpenAlea, Helios) or y (many "
+                        "scanners: field x, y, z = file x, -z, y)")
+    m.add_argument("--field", metavar="X0,Y0,X1,Y1",
+                   help="the ground of the mesh canopy, cm (default: the mesh's bounding box "
+                        "seen from above): LAI, ground cover, default sample rectangle and the "
+                        "tile of --periodic")
+    m.add_argument("--mesh-plant", metavar="NAME",
+                   help="PLY face property holding the plant id (default: plant, plant_id, "
+                        "plantid)")
+    m.add_argument("--mesh-leaf", metavar="NAME",
+                   help="PLY face property holding the leaf id (default: leaf, leaf_id, "
+                        "leafid, organ, organ_id, label, object_label)")
 
 
 def check_canopy_costs(leaves: list[Leaf], layout: CanopyLayout, levels: list[Level],
@@ -175,6 +198,63 @@ def canopy_setup(args: argparse.Namespace) -> tuple[list[Leaf], list[LeafError],
     for w in layout.warnings:
         say(f"note: {w}")
     return leaves, skipped, layout
+
+
+def is_mesh(path: str | Path) -> bool:
+    """Whether ``path`` names a mesh file (.ply, .obj) to trace as it is."""
+    return is_mesh_path(path)
+
+
+def input_name(path: str | Path) -> str:
+    """What the canopy input is, in words: "the mesh file", "the project", "the points file"."""
+    return "the mesh file" if is_mesh(path) else "the project" if is_project(path) \
+        else "the points file"
+
+
+#: Options that shape a canopy of digitized plants, refused with a mesh file (flag, what
+#: makes it given).
+_DIGITIZED_ONLY = (("--tile", "tile"), ("--block", "block"), ("--layout", "layout"),
+                   ("--interp", "interp"), ("--triangles", "triangles"), ("--levels", "levels"),
+                   ("--save-layout", "save_layout"))
+_MESH_ONLY = (("--mesh-unit", "mesh_unit"), ("--up", "up"), ("--field", "field"),
+              ("--mesh-plant", "mesh_plant"), ("--mesh-leaf", "mesh_leaf"))
+
+
+def check_input_options(args: argparse.Namespace) -> None:
+    """Refuse options that do not fit the input: tiling, layouts and mesh levels with a mesh
+    file (it is traced as it is), mesh options with digitized plants."""
+    if is_mesh(args.points):
+        given = [flag for flag, name in _DIGITIZED_ONLY if getattr(args, name, None) is not None]
+        if not getattr(args, "preserve_area", True):
+            given.append("--no-preserve-area")
+        if given:
+            raise MaizevizError(f"{', '.join(given)}: a mesh file is traced as it is, its plants "
+                                "where they stand (no tiling, layout or mesh levels)")
+        return
+    given = [flag for flag, name in _MESH_ONLY if getattr(args, name, None) is not None]
+    if given:
+        raise MaizevizError(f"{', '.join(given)}: for a mesh file (.ply, .obj) given in place of "
+                            "the points")
+
+
+def mesh_setup(args: argparse.Namespace) -> Canopy:
+    """The canopy of a mesh file given as the points, with the mesh options; what was read and
+    decided on stderr."""
+    field = tuple(floats(args.field, "the field X0,Y0,X1,Y1", "field", 4)) if args.field \
+        else None
+    canopy, mesh, notes = read_mesh_canopy(args.points, args.mesh_unit, args.up or "z", field,  # type: ignore[arg-type]
+                                           args.mesh_plant, args.mesh_leaf)
+    for note in notes:
+        say(f"note: {note}")
+    for w in canopy.layout.warnings:
+        say(f"note: {w}")
+    poly = f", {mesh.polygons:,} polygons cut into triangles" if mesh.polygons else ""
+    stalk = f" and {len(canopy.stalk_faces):,} stalk" if len(canopy.stalk_faces) else ""
+    say(f"{args.points}: {mesh.kind}, {mesh.file_faces:,} faces{poly}: "
+        f"{canopy.n_triangles:,} leaf{stalk} triangles, {canopy.n_leaves:,} leaves of "
+        f"{canopy.n_plants:,} plants (ids from {mesh.ids}); unit {args.mesh_unit or 'cm'}, "
+        f"{args.up or 'z'} up")
+    return canopy
 
 
 def is_project(path: str | Path) -> bool:

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from maizeviz.canopy.from_mesh import MESH_LEVEL
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.cli.common import (
     Progress,
@@ -23,17 +24,22 @@ from maizeviz.cli.common import (
     add_level_options,
     canopy_setup,
     check_canopy_costs,
+    check_input_options,
     floats,
     fmt_table,
+    input_name,
+    is_mesh,
     leaves_summary,
     level_path,
     levels_from,
+    mesh_setup,
     say,
 )
-from maizeviz.cost import light_costs
-from maizeviz.errors import MaizevizError, check_range
+from maizeviz.cost import check, light_costs, mesh_cost
+from maizeviz.errors import LeafError, MaizevizError, check_range
 from maizeviz.io.atomic import file_tag, make_folder, write_rows
 from maizeviz.io.outputs import OutputFolder, check_run_paths
+from maizeviz.leaf.fit import Leaf
 from maizeviz.light.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping
 from maizeviz.light.daylight import PeriodLight, SkyLight
 from maizeviz.light.engine import LightEngine
@@ -251,7 +257,10 @@ def sky_from(args: argparse.Namespace, period: Period | None) -> Sky | None:
 # ------------------------------------------------------------------------------ run
 def run(args: argparse.Namespace) -> int:
     _check_options(args)
+    check_input_options(args)
+    mesh = is_mesh(args.points)
     levels = levels_from(args)
+    labels = [MESH_LEVEL] if mesh else [level.label for level in levels]
     sun = sun_from(args)
     heights = tuple(floats(args.heights, "heights", "heights"))
     absorbed_optics = None
@@ -270,7 +279,7 @@ def run(args: argparse.Namespace) -> int:
     if not args.heatmap_bin > 0:
         raise MaizevizError(f"the heatmap bin must be > 0 cm, got {args.heatmap_bin}",
                             quantity="heatmap_bin")
-    _check_paths(args, [level.label for level in levels], sun is not None, heights)
+    _check_paths(args, labels, sun is not None, heights)
     period = period_from(args)
     sky = sky_from(args, period)
     if sun is not None:
@@ -283,27 +292,42 @@ def run(args: argparse.Namespace) -> int:
     if period is not None:
         say(f"period: {period.start.isoformat()} to {period.end.isoformat()}, "
             f"{period.n_steps} steps with the sun up; {period.source}")
-    leaves, skipped, layout = canopy_setup(args)
+    if mesh:
+        t0 = time.perf_counter()
+        mesh_canopy = mesh_setup(args)
+        read_s = time.perf_counter() - t0
+        leaves: list[Leaf] = []
+        skipped: list[LeafError] = []
+        layout = mesh_canopy.layout
+    else:
+        leaves, skipped, layout = canopy_setup(args)
     sampled = rect or layout.centre_bounds
     directions = (sun is not None) + (sky.n if sky is not None else 0) + \
         (period.n_steps if period is not None else 0)
     maps = (sun is not None) + (sky is not None) + (period is not None) if args.heatmaps else 0
     work = light_costs(sampled, args.density, len(heights), directions, maps,  # type: ignore[arg-type]
                        args.heatmap_bin)
-    check_canopy_costs(leaves, layout, levels, args.force, work)
+    if mesh:
+        check([[mesh_cost(mesh_canopy.n_triangles), *work]], args.force)
+    else:
+        check_canopy_costs(leaves, layout, levels, args.force, work)
     want_rows = bool(args.leaf_light or args.plant_light)
     records: list[dict[str, Any]] = []
     said: set[str] = set()
-    for level in levels:
+    for level in [None] if mesh else levels:
         t0 = time.perf_counter()
-        canopy = build_canopy(leaves, layout, level, args.preserve_area,
-                              Progress(f"building {level}"))
-        canopy_s = time.perf_counter() - t0
+        if level is None:
+            canopy, canopy_s = mesh_canopy, read_s
+        else:
+            canopy = build_canopy(leaves, layout, level, args.preserve_area,
+                                  Progress(f"building {level}"))
+            canopy_s = time.perf_counter() - t0
+        label = canopy.level
         sampling = Sampling(heights, args.density, rect, args.periodic, args.threads)  # type: ignore[arg-type]
         engine = LightEngine(canopy, sampling, with_stalks=args.with_stalks)
         engine.scene()
         scene_s = engine.build_seconds[args.periodic]
-        rec: dict[str, Any] = {"level": level.label, "triangles": canopy.n_triangles,
+        rec: dict[str, Any] = {"level": label, "triangles": canopy.n_triangles,
                                "heights_cm": [float(h) for h in heights],
                                "periodic": args.periodic, "threads": args.threads,
                                "seconds": {"canopy": canopy_s, "scene": scene_s}}
@@ -311,8 +335,8 @@ def run(args: argparse.Namespace) -> int:
         tables: list[list[dict]] = []
         res = sky_res = per_res = None
         if sun is not None:
-            res = engine.sun(sun, classes=want_rows or len(levels) == 1,
-                             progress=Progress(f"tracing {level}"))
+            res = engine.sun(sun, classes=want_rows or len(labels) == 1,
+                             progress=Progress(f"tracing {label}"))
             warnings += res.warnings
             rec.update(_sun_record(res, sun, canopy, args, heights))
             rec["seconds"].update(trace=res.seconds["trace"],
@@ -321,12 +345,12 @@ def run(args: argparse.Namespace) -> int:
                 tables.append(leaf_light(canopy, res))
         if period is not None:
             per_res = engine.day(period, sky=sky, bin_cm=args.heatmap_bin,
-                                 progress=Progress(f"tracing the period, {level}"))
+                                 progress=Progress(f"tracing the period, {label}"))
             sky_res = per_res.sky
             warnings += per_res.warnings
             rec["seconds"]["period"] = per_res.seconds["trace"]
         elif sky is not None:
-            sky_res = engine.sky(sky, progress=Progress(f"tracing the sky, {level}"),
+            sky_res = engine.sky(sky, progress=Progress(f"tracing the sky, {label}"),
                                  bin_cm=args.heatmap_bin)
             warnings += sky_res.warnings
             rec["seconds"]["sky"] = sky_res.seconds["trace"]
@@ -360,7 +384,7 @@ def run(args: argparse.Namespace) -> int:
             x0, y0, x1, y1 = per_res.rect if per_res else sky_res.rect if sky_res else (0, 0, 1, 1)
             rec.update(sun=None, transmission=None, rays=rays, rect_cm=[x0, y0, x1, y1],
                        density_per_cm2=rays / ((x1 - x0) * (y1 - y0)))
-        _write_outputs(args, canopy, level.label, len(levels), res, sky_res, per_res, tables)
+        _write_outputs(args, canopy, label, len(labels), res, sky_res, per_res, tables)
         records.append(rec)
 
     if args.json:
@@ -368,7 +392,7 @@ def run(args: argparse.Namespace) -> int:
                          indent=1))
     else:
         _print_tables(records, sun, heights, args)
-    return leaves_summary(len(leaves), skipped)
+    return leaves_summary(mesh_canopy.n_leaves if mesh else len(leaves), skipped)
 
 
 # ------------------------------------------------------------------------------ records
@@ -489,7 +513,7 @@ def _check_paths(args: argparse.Namespace, labels: list[str], sun: bool,
     check_run_paths(
         [(what, level_path(path, label, len(labels))) for what, path in tables if path
          for label in labels],
-        [("the points file", args.points), ("the layout file", args.layout),
+        [(input_name(args.points), args.points), ("the layout file", args.layout),
          ("the weather file", args.weather)],
         [OutputFolder("the heatmap folder", args.heatmaps, maps),
          OutputFolder("the plot folder", args.plots if period else None,

@@ -346,8 +346,8 @@ class LightPanel(QWidget):
         form.addRow("direct", self.direct_w)
         form.addRow("diffuse", self.diffuse_w)
         self.scatter_depth = QSpinBox(minimum=0, maximum=20, value=3)
-        self.scatter_depth.setToolTip("scatterings followed (0: first hits only; 3 keeps > 99% of PAR "
-                              "and most of NIR)")
+        self.scatter_depth.setToolTip("scatterings followed (0: first hits only; 3 keeps "
+                                      "> 99% of PAR and most of NIR)")
         form.addRow("scattering depth", self.scatter_depth)
 
         def band_defaults(_i: int = 0) -> None:

@@ -1,0 +1,250 @@
+"""A canopy from a mesh file made elsewhere (OpenAlea/PlantGL, Helios, 3D scans): one placement
+per plant of the file, its leaf ids kept, so every light computation and table works on it.
+
+What is taken from the file, and nothing else changed:
+
+- **units**: the file's lengths are cm unless told (m, cm, mm); told nothing, a mesh whose
+  height (extent along the up axis) is below :data:`GUESS_MIN_HEIGHT` or above
+  :data:`GUESS_MAX_HEIGHT` units is refused, since it is most likely in metres or millimetres
+  (a maize canopy in cm is 5 to 1000 units tall); saying the unit, even ``cm``, reads it as is;
+- **up axis**: z (OpenAlea, Helios and maizeviz write z up) or y (many scanners): field
+  (x, y, z) = file (x, -z, y), a rotation, so triangles keep their orientation;
+- **ground**: z = 0 in field coordinates, as for digitized plants (a note says when the
+  mesh's lowest point is far from it);
+- **stalks**: triangles of leaf id 0 are the stalk (or another organ that is not a leaf), as
+  maizeviz exports stalks: left out of the leaves, traced only with the stalks;
+- **plants**: one placement per plant id, in increasing id order; it stands at the mean x, y
+  of its stalk's vertices, or, without a stalk, at the area-weighted centre of its leaves
+  seen from above (only the tables' ``x_cm, y_cm`` and which plants a sample rectangle holds
+  depend on it);
+- **field** (the ground: LAI, ground cover, the periodic field's tile, the default sample
+  rectangle): a rectangle x0, y0, x1, y1 in cm if given, else the mesh's bounding box seen
+  from above.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from maizeviz.canopy.layout import MAX_COORD_CM, CanopyLayout, Placement
+from maizeviz.canopy.scene import Canopy
+from maizeviz.errors import MaizevizError
+from maizeviz.io.mesh_canopy import MAX_LEAF_ID, MeshData, read_mesh
+from maizeviz.mesh.tessellate import triangle_areas_normals
+
+#: cm per unit of a mesh file.
+UNITS = {"m": 100.0, "cm": 1.0, "mm": 0.1}
+#: Up axes a mesh file may have.
+UP_AXES = ("z", "y")
+#: Without a unit, a mesh of a height outside these (file units) is refused as most likely in
+#: metres (below) or millimetres (above).
+GUESS_MIN_HEIGHT = 5.0
+GUESS_MAX_HEIGHT = 1000.0
+#: The mesh's level label (a mesh file is traced as it is: it has no mesh levels).
+MESH_LEVEL = "mesh"
+
+
+def check_field(field: tuple[float, float, float, float] | list[float]) -> tuple[float, ...]:
+    """A field rectangle x0, y0, x1, y1 (cm): finite, within 1 km, x1 > x0 and y1 > y0."""
+    vals = tuple(float(v) for v in field)
+    if len(vals) != 4:
+        raise MaizevizError(f"the field needs 4 numbers x0, y0, x1, y1 (cm), got {len(vals)}",
+                            quantity="field")
+    if not all(math.isfinite(v) and abs(v) <= MAX_COORD_CM for v in vals):
+        raise MaizevizError(f"the field {vals} must be finite numbers of at most "
+                            f"{MAX_COORD_CM:g} cm in size", quantity="field")
+    x0, y0, x1, y1 = vals
+    if not (x1 > x0 and y1 > y0):
+        raise MaizevizError(f"the field x0, y0, x1, y1 = {x0:g}, {y0:g}, {x1:g}, {y1:g} cm needs "
+                            "x1 > x0 and y1 > y0", quantity="field")
+    return vals
+
+
+def _field_coordinates(mesh: MeshData, unit: str | None, up: str, src: str) -> np.ndarray:
+    if unit is not None and unit not in UNITS:
+        raise MaizevizError(f"the mesh unit must be one of {', '.join(UNITS)}, got '{unit}'",
+                            quantity="mesh_unit")
+    if up not in UP_AXES:
+        raise MaizevizError(f"the up axis must be z or y, got '{up}'", quantity="up")
+    v = mesh.vertices
+    used = np.zeros(len(v), bool)
+    used[mesh.faces.ravel()] = True
+    height_axis = 2 if up == "z" else 1
+    h = float(np.ptp(v[used, height_axis])) if used.any() else 0.0
+    if unit is None:
+        if h < GUESS_MIN_HEIGHT:
+            raise MaizevizError(
+                f"{src}: the mesh is {h:.4g} units tall: in cm that is not a maize canopy; if "
+                "its unit is the metre say so (m), or say cm to read it as it is",
+                quantity="mesh_unit")
+        if h > GUESS_MAX_HEIGHT:
+            raise MaizevizError(
+                f"{src}: the mesh is {h:.4g} units tall: in cm that is more than "
+                f"{GUESS_MAX_HEIGHT / 100:g} m; if its unit is the millimetre say so (mm), or "
+                "say cm to read it as it is", quantity="mesh_unit")
+    scale = UNITS[unit or "cm"]
+    if up == "y":
+        out = np.column_stack([v[:, 0], -v[:, 2], v[:, 1]])
+    else:
+        out = v.copy() if scale != 1.0 else v
+    if scale != 1.0:
+        out = out * scale
+    big = np.flatnonzero(np.abs(out).max(axis=1) > MAX_COORD_CM) if len(out) else \
+        np.zeros(0, np.int64)
+    if len(big):
+        i = int(big[0])
+        raise MaizevizError(f"{src}: {mesh.where_vertex(i)} lies {np.abs(out[i]).max():.4g} cm "
+                            f"from the origin, beyond {MAX_COORD_CM / 100:g} m: not a field plot "
+                            "(is the unit right?)", quantity="mesh_unit")
+    return out
+
+
+def _distinct(a: np.ndarray) -> np.ndarray:
+    """Sorted distinct values of ``a``, fast where equal values come in runs (a file's faces
+    come leaf by leaf)."""
+    if not len(a):
+        return a
+    starts = np.flatnonzero(np.concatenate([[True], a[1:] != a[:-1]]))
+    return np.unique(a[starts])
+
+
+def _split(vertices: np.ndarray, faces: np.ndarray, is_leaf: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Leaf vertices and faces, stalk vertices and faces, each renumbered, vertices in file
+    order. The stalk's vertices are those only stalk triangles use; the leaves keep every
+    other vertex (also those no face uses: the file's vertices come back as they were)."""
+    stalk_f = faces[~is_leaf]
+    leaf_f = faces[is_leaf]
+    used_by_leaf = np.zeros(len(vertices), bool)
+    used_by_leaf[leaf_f.ravel()] = True
+    in_stalk = np.zeros(len(vertices), bool)
+    in_stalk[stalk_f.ravel()] = True
+    stalk_only = in_stalk & ~used_by_leaf
+    keep_leaf = ~stalk_only
+    new_leaf = np.cumsum(keep_leaf) - 1
+    if len(stalk_f):
+        # a vertex both organs use is copied into the stalk's vertices
+        new_stalk = np.cumsum(in_stalk) - 1
+        stalk = (vertices[in_stalk], new_stalk[stalk_f].astype(np.int64))
+    else:
+        stalk = (np.empty((0, 3)), np.empty((0, 3), np.int64))
+    return vertices[keep_leaf], new_leaf[leaf_f].astype(np.int64), *stalk
+
+
+def _positions(plants: np.ndarray, leaf_v: np.ndarray, leaf_f: np.ndarray, area: np.ndarray,
+               leaf_inst: np.ndarray, stalk_v: np.ndarray, stalk_f: np.ndarray,
+               stalk_inst: np.ndarray) -> np.ndarray:
+    """(P, 2) cm: the mean of each plant's stalk vertices, or its leaves' area-weighted centre
+    (``area``: of each leaf triangle)."""
+    n = len(plants)
+    centre = leaf_v[leaf_f].mean(axis=1)[:, :2]
+    weight = np.bincount(leaf_inst, area, n)
+    count = np.bincount(leaf_inst, minlength=n).astype(np.float64)
+    out = np.zeros((n, 2))
+    for k in range(2):
+        wsum = np.bincount(leaf_inst, area * centre[:, k], n)
+        plain = np.bincount(leaf_inst, centre[:, k], n)
+        out[:, k] = np.where(weight > 0, wsum / np.where(weight > 0, weight, 1),
+                             plain / np.maximum(count, 1))
+    if len(stalk_f):
+        # each stalk vertex once per plant that uses it
+        vi = np.unique(stalk_inst.astype(np.int64)[:, None] * len(stalk_v) + stalk_f)
+        owner, vert = vi // len(stalk_v), vi % len(stalk_v)
+        has = np.bincount(owner, minlength=n) > 0
+        for k in range(2):
+            mean = np.bincount(owner, stalk_v[vert, k], n) / np.maximum(
+                np.bincount(owner, minlength=n), 1)
+            out[has, k] = mean[has]
+    return out
+
+
+def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
+                     field: tuple[float, float, float, float] | None = None,
+                     source: str = "mesh") -> tuple[Canopy, list[str]]:
+    """A canopy of the mesh's triangles, and notes on what was decided (one line each).
+
+    Parameters
+    ----------
+    mesh : as :func:`maizeviz.io.mesh_canopy.read_mesh` reads it
+    unit : "m", "cm" or "mm"; None: cm, refusing a height that suggests another unit
+    up : "z" or "y", the file's up axis
+    field : x0, y0, x1, y1 cm; None: the mesh's bounding box seen from above
+    source : the file, for messages
+
+    Raises
+    ------
+    MaizevizError
+        The unit or field is wrong (``quantity`` says which), no leaf triangle, or every leaf
+        triangle has no area.
+    """
+    notes = list(mesh.notes)
+    if field is not None:
+        field = check_field(field)                                    # type: ignore[assignment]
+    verts = _field_coordinates(mesh, unit, up, source)
+    is_leaf = mesh.leaf != 0
+    n_leaf = int(is_leaf.sum())
+    if n_leaf == 0:
+        raise MaizevizError(f"{source}: no leaf triangle: all {mesh.n_triangles:,} have leaf id "
+                            "0 (a stalk or another organ that is not a leaf)")
+    leaf_v, leaf_f, stalk_v, stalk_f = _split(verts, mesh.faces, is_leaf)
+    area, _ = triangle_areas_normals(leaf_v, leaf_f)
+    flat = int((area == 0).sum())
+    if flat == n_leaf:
+        raise MaizevizError(f"{source}: all {n_leaf:,} leaf triangles are degenerate (no area: "
+                            "repeated or aligned vertices): no surface to trace")
+    if flat:
+        t = int(np.flatnonzero(is_leaf)[int(np.flatnonzero(area == 0)[0])])
+        notes.append(f"{source}: {flat:,} of the {n_leaf:,} leaf triangles have no area (first: "
+                     f"{mesh.where_triangle(t)}); kept, they receive no light")
+    plants = _distinct(mesh.plant)
+    inst = np.searchsorted(plants, mesh.plant).astype(np.int32)
+    leaf_inst, stalk_inst = inst[is_leaf], inst[~is_leaf]
+    leaf_ids = mesh.leaf[is_leaf].astype(np.int32)
+    pairs = _distinct(leaf_inst.astype(np.int64) * (MAX_LEAF_ID + 1) + leaf_ids)
+    leaves_per = np.bincount(pairs // (MAX_LEAF_ID + 1), minlength=len(plants)).astype(np.int32)
+    xy = _positions(plants, leaf_v, leaf_f, area, leaf_inst, stalk_v, stalk_f, stalk_inst)
+    placements = tuple(Placement(int(p), float(x), float(y)) for p, (x, y) in zip(plants, xy))
+    if field is None:
+        every = np.vstack([leaf_v, stalk_v])
+        lo, hi = every[:, :2].min(axis=0), every[:, :2].max(axis=0)
+        if not (hi[0] > lo[0] and hi[1] > lo[1]):
+            raise MaizevizError(f"{source}: the mesh has no extent in "
+                                f"{'x' if not hi[0] > lo[0] else 'y'} seen from above: give "
+                                "the field rectangle (is the up axis right?)", quantity="field")
+        field = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+        fsrc = "the mesh's bounding box"
+    else:
+        fsrc = "given"
+        x0, y0, x1, y1 = field
+        outside = [p.plant for p in placements if not (x0 <= p.x <= x1 and y0 <= p.y <= y1)]
+        if outside:
+            shown = ", ".join(map(str, outside[:5])) + (", ..." if len(outside) > 5 else "")
+            notes.append(f"{source}: {len(outside):,} plant(s) stand outside the field: "
+                         f"{shown}")
+    zmin = float(min(leaf_v[:, 2].min(), stalk_v[:, 2].min() if len(stalk_v) else np.inf))
+    if zmin < -1.0 or zmin > 100.0:
+        notes.append(f"{source}: the mesh's lowest point is at z = {zmin:.1f} cm; the ground is "
+                     "z = 0 (sensor heights count from it)")
+    x0, y0, x1, y1 = field
+    cells = np.array([field], np.float64)
+    layout = CanopyLayout(placements, cells, x1 - x0, y1 - y0, 0.0, cells.copy(),
+                          (f"the field is {fsrc}: x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f} "
+                           "cm",), (x1 - x0) * (y1 - y0), "mesh")
+    canopy = Canopy(leaf_v, leaf_f, leaf_inst, mesh.plant[is_leaf].astype(np.int32), leaf_ids,
+                    layout, MESH_LEVEL, stalk_v, stalk_f, leaves_per,
+                    stalk_instance=stalk_inst)
+    return canopy, notes
+
+
+def read_mesh_canopy(path: str | Path, unit: str | None = None, up: str = "z",
+                     field: tuple[float, float, float, float] | None = None,
+                     plant_property: str | None = None,
+                     leaf_property: str | None = None) -> tuple[Canopy, MeshData, list[str]]:
+    """Read a mesh file (:func:`maizeviz.io.mesh_canopy.read_mesh`) as a canopy
+    (:func:`canopy_from_mesh`): the canopy, the file's mesh, and notes."""
+    mesh = read_mesh(path, plant_property, leaf_property)
+    canopy, notes = canopy_from_mesh(mesh, unit, up, field, str(path))
+    return canopy, mesh, notes
