@@ -89,7 +89,7 @@ def dask_rows(args, sky: Sky, cores: int) -> list[dict]:
             client.run(_worker_setup, args.level)
             parts = np.array_split(np.arange(sky.n), max(workers, sky.n // 2))
 
-            def run():
+            def run(parts=parts):
                 futures = [client.submit(_worker_trace, args.level,
                                          sky.zenith_deg[p].tolist(), sky.azimuth_deg[p].tolist(),
                                          sky.weights[p].tolist(), args.density, pure=False)
@@ -121,7 +121,7 @@ def main() -> None:
     t = 1
     while t <= args.max_threads:
         smp = Sampling(density=args.density, periodic=True, threads=t)
-        secs = best(lambda: trace_sky(canopy, sky, smp, scene=scene), args.repeat)
+        secs = best(lambda smp=smp: trace_sky(canopy, sky, smp, scene=scene), args.repeat)
         rows.append({"threads": t, "seconds": round(secs, 3),
                      **({"oversubscribed": True} if t > cores else {})})
         t *= 2
