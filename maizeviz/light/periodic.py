@@ -10,9 +10,10 @@ that reaches into its cell, the cell's own and copies of its neighbours' overhan
 Exact translations. Embree intersects in float32, from ``v0 - org`` (triangle vertex minus ray
 origin). Moving a ray by a period only gives the same float32 numbers as moving the scene
 when every coordinate involved is a multiple of one power of two, the *quantum* q
-(:func:`quantum_cm`, 2^-10 cm = 10 um for plots up to 80 m), small enough to stay exact in
-float32: the x, y of the scene's vertices, of the periods and of the ray origins are rounded to
-multiples of q (:func:`snap`, at most q / 2 = 5 um, a fortieth of a leaf's thickness). Then
+(:func:`quantum_cm`: 2^-12 cm = 2.4 um for the bundled 5.4 x 2.7 m plot, coarser for larger
+plots), large enough for every multiple of it in the field to be exact in float32: the x, y of
+the scene's vertices, of the periods and of the ray origins are rounded to multiples of q
+(:func:`snap`, by at most q / 2 = 1.2 um, a hundredth of a leaf's thickness). Then
 
 - a ray is never moved along itself (that would round): every query of a ray starts at its
   own origin moved by whole periods, with ``tfar`` the end of the cell's segment, so a hit
@@ -37,7 +38,7 @@ import numpy as np
 from maizeviz.errors import MaizevizError
 
 #: Horizontal travel (cm) after which a ray is re-anchored on the grid (a power of two).
-ANCHOR_CM = 4096.0
+ANCHOR_CM = 1024.0
 #: Distance (cm) beyond the cell within which neighbours' triangles are copied into it: more
 #: than a re-anchored ray's offset (q / 2) and than rounding at a cell edge.
 COPY_MARGIN_CM = 0.01

@@ -17,7 +17,7 @@ the same plants in the same order, every tile's triangles the block's moved by a
 of block periods once on the field's grid (:func:`maizeviz.light.periodic.snap`), exactly, and
 the plot exactly A x B periods. Then the block scene gives the same hits as the tiled scene,
 ray for ray (``tests/core/test_tiling.py``). Otherwise (a layout file, an edited layout, a
-spacing that is not a multiple of the grid step, 2^-10 cm) :func:`block_tiling` returns None
+spacing that is not a multiple of the grid step, 2^-12 cm here) :func:`block_tiling` returns None
 and the whole canopy is traced.
 """
 

@@ -177,13 +177,13 @@ def test_canopies_that_do_not_tile_their_block_are_traced_whole(leaves):
     # one tile alone is its own plot
     one = build_canopy(leaves, layout_for(leaves, (1, 1)), parse_level("4"))
     assert block_tiling(one) is None
-    # spacings whose block is not on the 2^-10 cm grid
+    # spacings whose block is not on the 2^-12 cm grid
     odd = build_canopy(leaves, layout_for(leaves, (3, 3), 60.3, 30.1), parse_level("4"))
     assert block_tiling(odd) is None
 
 
 def test_the_grid_is_exact_in_float32():
     w = Wrap.of((-0.42, -0.38, 179.58, 89.62), (-180.42, -90.38, 359.58, 179.62))
-    assert w.q == 2.0 ** -10 and w.w == 180.0 and w.h == 90.0
+    assert w.q == 2.0 ** -12 and w.w == 180.0 and w.h == 90.0
     big = Wrap.of((0, 0, 10_000, 10_000))
     assert big.q == 2.0 ** -8
