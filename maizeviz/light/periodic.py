@@ -168,9 +168,9 @@ def trace_wrapped(scene, wrap: Wrap, org: np.ndarray, dirs: np.ndarray, length: 
     ``ids``), the cell (N, 2) int64 whose copy of the scene holds the hit, and the hit distance
     (N,) float64 cm (inf where none).
     """
-    hook = getattr(scene, "wrapped_native", None) if native else None
-    got = hook(org, np.asarray(dirs).reshape(-1, 3), length, any_hit, row) if hook else None
-    if got is not None:                          # the scene's own way (a tiled block's)
+    field = getattr(scene, "trace_field", None)
+    if field is not None:                        # the scene's own way (a tiled block's)
+        got = field(org, np.asarray(dirs).reshape(-1, 3), length, any_hit, row, native)
         return got if any_hit else ((got[0] if ids else None), got[1], got[2])
     kernel = getattr(scene, "_kernel", None) if native else None
     if kernel is not None:                       # the same algorithm, in C

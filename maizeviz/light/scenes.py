@@ -8,10 +8,19 @@ scene triangle hit in a field cell to them (:mod:`maizeviz.light.periodic`).
 
 from __future__ import annotations
 
+import threading
+
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.light.periodic import ANCHOR_CM, Rect, Wrap, overhang_copies, snap
+from maizeviz.light.periodic import (
+    ANCHOR_CM,
+    COPY_MARGIN_CM,
+    Rect,
+    Wrap,
+    overhang_copies,
+    snap,
+)
 from maizeviz.light.tiling import BlockTiling, block_mesh, block_tiling, tile_triangles
 from maizeviz.mesh import packets as _packets
 from maizeviz.mesh.instances import Instances
@@ -52,58 +61,89 @@ class CanopyScene(RayScene):
 
 class BlockScene(CanopyScene):
     """The scene of one block of a tiled canopy in a periodic field
-    (:mod:`maizeviz.light.tiling`): the block's triangles and copies of its neighbours'
-    overhangs; hits are reported as the tiled canopy's triangles (``n_original`` of them).
+    (:mod:`maizeviz.light.tiling`); hits are reported as the tiled canopy's triangles
+    (``n_original`` of them).
+
+    With the packet kernel, the block's own triangles are placed at every tile of the plot and
+    one ring of tiles around it (Embree instances, one BVH: the block's), and rays are wrapped
+    over the plot as for the whole canopy. Without it (embreex's single rays, which do not
+    report instances), and for ``native=False``, the block with its neighbours' overhangs
+    copied in is traced over the block's own period: more segments, the same hits.
 
     Attributes
     ----------
-    tiling : BlockTiling; plus those of :class:`CanopyScene` (``wrap``: the block's field)
+    tiling : BlockTiling; instanced : Instances or None; plus those of :class:`CanopyScene`
+        (``wrap``: the block's field)
     """
 
     def __init__(self, canopy: Canopy, tiling: BlockTiling, with_stalks: bool):
         verts, faces, self._local, self._cell = block_mesh(canopy, tiling, with_stalks)
+        own = int(np.count_nonzero(np.all(self._cell == 0, axis=1) &
+                                   (self._local == np.arange(len(self._local)))))
+        n_verts = int(faces[:own].max()) + 1
         n = canopy.n_triangles + (len(canopy.stalk_faces) if with_stalks else 0)
-        super().__init__(verts, faces, n, None, canopy.layout.bounds, tiling.wrap)
+        super().__init__(verts[:n_verts], faces[:own], n, None, canopy.layout.bounds,
+                         tiling.wrap)
         self.tiling = tiling
         self._n_leaf = canopy.n_triangles
-        # with the packet kernel: the block placed at every tile of the plot (Embree
-        # instances), traced over the plot's period: the whole canopy's segments, the block's
-        # build (without: the block's own period, more segments, the same hits)
+        self._flat_mesh = (verts, faces)
+        self._flat: RayScene | None = None
+        self._lock = threading.Lock()
         self.instanced: Instances | None = None
         if self._kernel is not None:
-            a, b = tiling.shape
-            i0, j0 = tiling.first_key
-            keys = np.array([(i, j) for i in range(i0, i0 + a) for j in range(j0, j0 + b)])
+            # rings of tiles around the plot, enough for the block's farthest overhang
+            w = tiling.wrap
+            over = np.maximum(np.abs(verts[:n_verts, :2].min(axis=0) - w.corner),
+                              np.abs(verts[:n_verts, :2].max(axis=0) - (w.corner + w.period)))
+            rx, ry = (int(v) for v in np.ceil((over + COPY_MARGIN_CM) / w.period))
+            (a, b), (i0, j0) = tiling.shape, tiling.first_key
+            keys = np.array([(i, j) for i in range(i0 - rx, i0 + a + rx)
+                             for j in range(j0 - ry, j0 + b + ry)], dtype=np.int64)
             try:
-                self.instanced = Instances(self, keys * tiling.wrap.period)
+                self.instanced = Instances(self, keys * w.period)
                 self._keys = keys
             except (RuntimeError, ValueError):  # pragma: no cover - Embree refused
                 self.instanced = None
 
-    def wrapped_native(self, org: np.ndarray, dirs: np.ndarray, length: np.ndarray,
-                       any_hit: bool, row: int):
-        """:func:`~maizeviz.light.periodic.trace_wrapped` through the block's instances over
-        the plot (same results); None where there are no instances."""
-        if self.instanced is None or self._kernel is None:
-            return None
-        pw = self.tiling.plot_wrap
-        got = _packets.wrapped(self._kernel, self.instanced.handle, org, dirs, length,
-                               (pw.x0, pw.y0, pw.w, pw.h, pw.q, ANCHOR_CM), any_hit, row=row)
+    def flat(self) -> RayScene:
+        """The block with its neighbours' overhangs copied in (built on first use)."""
+        with self._lock:
+            if self._flat is None:
+                self._flat = RayScene(*self._flat_mesh)
+            return self._flat
+
+    def trace_field(self, org: np.ndarray, dirs: np.ndarray, length: np.ndarray,
+                    any_hit: bool, row: int, native: bool):
+        """:func:`~maizeviz.light.periodic.trace_wrapped` for this scene: blocked (N,) bool
+        (``any_hit``), else the block triangles hit (N,) int32 (-1: none; leaves, then
+        stalks), the tile keys (N, 2) int64 of the block copies hit and the distances (N,)
+        float64 cm (inf: none); :meth:`resolve` names the canopy's triangles."""
+        from maizeviz.light.periodic import trace_wrapped
+
+        if native and self.instanced is not None and self._kernel is not None:
+            pw = self.tiling.plot_wrap
+            got = _packets.wrapped(self._kernel, self.instanced.handle, org, dirs, length,
+                                   (pw.x0, pw.y0, pw.w, pw.h, pw.q, ANCHOR_CM), any_hit,
+                                   row=row, inst_cells=self._keys,
+                                   frame_cells=self.tiling.shape)
+            return got if any_hit else got[:3]
+        got = trace_wrapped(self.flat(), self.wrap, org, dirs, length, any_hit, row=row,
+                            native=native)
         if any_hit:
             return got
-        prim, cell, dist, inst = got
+        prim, cell, dist = got
+        assert prim is not None
         hit = prim >= 0
-        # the hit block's key: its instance's, plus the plot periods the ray had crossed
-        cell[hit] = self._keys[inst[hit]] + cell[hit] * np.array(self.tiling.shape)
+        cell[hit] += self._cell[prim[hit]]            # a copy stands for its neighbour's
+        prim[hit] = self._local[prim[hit]]
         return prim, cell, dist
 
     def resolve(self, prim: np.ndarray, cell: np.ndarray | None) -> np.ndarray:
-        """Canopy triangle ids (k,) of block triangles ``prim`` (k,) hit in the block copies
-        of field cells ``cell`` (k, 2)."""
+        """Canopy triangle ids (k,) of block triangles ``prim`` (k,) (leaves, then stalks)
+        hit in the block copies standing at tile keys ``cell`` (k, 2)."""
         if cell is None:  # pragma: no cover - a block scene traces periodic fields only
             raise ValueError("a block scene's hits need their field cells")
-        return tile_triangles(self.tiling, self._n_leaf, self._local[prim],
-                              cell + self._cell[prim])
+        return tile_triangles(self.tiling, self._n_leaf, prim, cell)
 
 
 def light_scene(canopy: Canopy, with_stalks: bool = False, periodic: bool = False,

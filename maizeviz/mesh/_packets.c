@@ -352,14 +352,16 @@ WRAPPED_PASS(16)
  * (n, 3) or one (dir_step 0), float64 cm, lengths length (n,) cm. any_hit: blocked_out (n,)
  * uint8; else prim_out (n,) int32 (-1: none), cell_out (n, 2) int64 (the cell whose copy of
  * the scene holds the hit), dist_out (n,) float64 (inf: none), inst_out (n,) int32 (the
- * instance hit in a scene of instances; may be NULL). Rays are traced segment by
+ * instance hit in a scene of instances; may be NULL). With inst_cells (k, 2) int64, the cell
+ * of each instance, cell_out is instead that of the instance hit, plus the frame's cell times
+ * frame_cells (2,) (instances tiling each frame). Rays are traced segment by
  * segment in passes, the rays still travelling packed together. Returns 0; -1 for an unknown
  * packet width, -2 for a ray that never ends, -3 when memory runs out. */
 int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene, int64_t n,
                const double *org, const double *dir, int dir_step, const double *length,
                const double *wrap, int any_hit, int32_t *prim_out, int64_t *cell_out,
                double *dist_out, int32_t *inst_out, uint8_t *blocked_out, int coherent,
-               int64_t row) {
+               int64_t row, const int64_t *inst_cells, const int64_t *frame_cells) {
     if (width != 4 && width != 8 && width != 16) return -1;
     query_args args;
     init_args(&args, coherent);
@@ -391,6 +393,11 @@ int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene, in
         cell_out[2 * j + 1] = st[j].bcell[1];
         dist_out[j] = st[j].best;
         if (inst_out) inst_out[j] = st[j].prim >= 0 ? st[j].inst : -1;
+        if (inst_cells && st[j].prim >= 0) {   /* the cell of the instance hit, in the field */
+            int64_t i = st[j].inst;
+            cell_out[2 * j] = inst_cells[2 * i] + st[j].bcell[0] * frame_cells[0];
+            cell_out[2 * j + 1] = inst_cells[2 * i + 1] + st[j].bcell[1] * frame_cells[1];
+        }
     }
     free(st);
     free(act);

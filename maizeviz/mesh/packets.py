@@ -114,7 +114,8 @@ def kernel() -> Kernel | None:
     lib.mz_occluded.restype = i32
     lib.mz_occluded.argtypes = [p, i32, p, i64, p, p, i32, p, p, i32, i64]
     lib.mz_wrapped.restype = i32
-    lib.mz_wrapped.argtypes = [p, p, i32, p, i64, p, p, i32, p, p, i32, p, p, p, p, p, i32, i64]
+    lib.mz_wrapped.argtypes = [p, p, i32, p, i64, p, p, i32, p, p, i32, p, p, p, p, p, i32, i64,
+                               p, p]
     lib.mz_layout_check.restype = i64
     if lib.mz_layout_check() != _LAYOUT:
         return None
@@ -193,7 +194,8 @@ def occluded(k: Kernel, scene_handle: int, origins: np.ndarray, directions: np.n
 def wrapped(k: Kernel, scene_handle: int, origins: np.ndarray, directions: np.ndarray,
             length: np.ndarray, wrap: tuple[float, float, float, float, float, float],
             any_hit: bool = False, coherent: bool = True, width: int | None = None,
-            row: int = 0):
+            row: int = 0, inst_cells: np.ndarray | None = None,
+            frame_cells: tuple[int, int] = (1, 1)):
     """Rays through a periodic field, in C: :func:`maizeviz.light.periodic.trace_wrapped`'s
     algorithm, the same float64 steps, the same queries.
 
@@ -203,6 +205,9 @@ def wrapped(k: Kernel, scene_handle: int, origins: np.ndarray, directions: np.nd
     wrap : (x0, y0, w, h, q, anchor_cm): cell (0, 0)'s corner and size, the grid step and the
         re-anchoring travel, cm
     any_hit, coherent, width, row : as :func:`intersect` / :func:`occluded`
+    inst_cells : (k, 2) int64, for a scene of k instances tiling each cell of ``wrap``: the
+        cells are then reported as the instance's cell plus the ``wrap`` cell's index times
+        ``frame_cells`` (the instances along x and y)
 
     Returns
     -------
@@ -223,11 +228,13 @@ def wrapped(k: Kernel, scene_handle: int, origins: np.ndarray, directions: np.nd
     cell = None if any_hit else np.empty((n, 2), np.int64)
     dist = None if any_hit else np.empty(n, np.float64)
     inst = None if any_hit else np.empty(n, np.int32)
+    ic = None if inst_cells is None else np.ascontiguousarray(inst_cells, dtype=np.int64)
+    fc = np.array(frame_cells, dtype=np.int64)
     if n:
         rc = k.lib.mz_wrapped(k.intersect[width], k.occluded[width], width, scene_handle, n,
                               _ptr(o), _ptr(d), int(len(d) == n and n > 1), _ptr(t), _ptr(w),
                               int(any_hit), _ptr(prim), _ptr(cell), _ptr(dist), _ptr(inst),
-                              _ptr(blocked), int(coherent), int(row))
+                              _ptr(blocked), int(coherent), int(row), _ptr(ic), _ptr(fc))
         if rc != 0:  # pragma: no cover - a segment always ends at an edge, anchor or the end
             raise RuntimeError(f"periodic tracing failed ({rc})")
     if any_hit:

@@ -40,8 +40,8 @@ def tiled(leaves):
 def test_the_block_scene_is_chosen_for_a_tiled_periodic_canopy(tiled):
     c, whole, block = tiled
     assert isinstance(block, BlockScene) and type(whole) is CanopyScene
-    if block.packets:                          # the block at the 9 tiles, one BVH
-        assert block.instanced is not None and len(block.instanced.offsets) == 9
+    if block.packets:                # the block at the 9 tiles and a ring around, one BVH
+        assert block.instanced is not None and len(block.instanced.offsets) >= 25
     assert block.tiling.shape == (3, 3)
     # the block and its neighbours' overhangs: 9 times fewer triangles, near enough
     assert block.n_triangles < whole.n_triangles / 7
