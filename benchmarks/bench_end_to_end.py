@@ -10,6 +10,8 @@ Fresh processes of the command line (``maizeviz light``, the bundled 3 x 3 block
 - cli_sun_angles_s: the same sun given as angles (no pvlib import)
 - cli_day_s: that day at 30-minute steps (29 steps with the sun up) plus the standard overcast
   sky in 46 directions (target: 5 s)
+- cli_day_36_s: the same day as benchmarks/bench_daylight.py traces it: 36 triangles a leaf,
+  1 ray per cm2, five planes
 - *_seconds: the JSON's own split (canopy, scene, trace, second hits)
 - cli_*_single_rays_s: the same with MAIZEVIZ_PACKETS=0 (embreex's single rays)
 
@@ -78,6 +80,9 @@ def main() -> None:
                          ("cli_sun_angles", ["--sun-zenith", "22.34", "--sun-azimuth", "166.95",
                                              *threads], None),
                          ("cli_day", [*PLACE, "--day", "--step", "30", *threads], None),
+                         ("cli_day_36", [*PLACE, "--day", "--step", "30", "--triangles", "36",
+                                         "--density", "1", "--heights", "0,50,100,150,200",
+                                         *threads], None),
                          ("cli_sun_single_rays", sun_args, {"MAIZEVIZ_PACKETS": "0"})):
         s, doc = best_cli(a, args.repeat, env)
         out[f"{name}_s"] = round(s, 2)

@@ -172,6 +172,13 @@ def trace_wrapped(scene, wrap: Wrap, org: np.ndarray, dirs: np.ndarray, length: 
     if field is not None:                        # the scene's own way (a tiled block's)
         got = field(org, np.asarray(dirs).reshape(-1, 3), length, any_hit, row, native)
         return got if any_hit else ((got[0] if ids else None), got[1], got[2])
+    return wrap_segments(scene, wrap, org, dirs, length, any_hit, ids, row, native)
+
+
+def wrap_segments(scene, wrap: Wrap, org: np.ndarray, dirs: np.ndarray, length: np.ndarray,
+                  any_hit: bool = False, ids: bool = True, row: int = 0, native: bool = True):
+    """:func:`trace_wrapped` through ``scene`` itself, whatever its own way: segment by segment
+    over the cells of ``wrap`` (in C where the scene has the packet kernel and ``native``)."""
     kernel = getattr(scene, "_kernel", None) if native else None
     if kernel is not None:                       # the same algorithm, in C
         from maizeviz.mesh.packets import wrapped
