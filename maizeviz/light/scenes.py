@@ -122,7 +122,7 @@ class BlockScene(CanopyScene):
                                    frame_cells=self.tiling.shape)
             got = got if any_hit else got[:3]
         else:
-            got = wrap_segments(self, self.wrap, org, dirs, length, any_hit, row=row,
+            got = wrap_segments(self, self.tiling.wrap, org, dirs, length, any_hit, row=row,
                                 native=native)
         if any_hit:
             return got
