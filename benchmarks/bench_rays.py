@@ -18,6 +18,11 @@ of them, in Mrays/s:
 - _1t / _2t: on 1 and 2 threads (chunks of 2^16 rays, ctypes and embreex release the GIL)
 - speedup_*: ratios in this run (target: packets_occluded_2t >= 20 Mrays/s and >= 3 x
   intersect1_occluded_2t on 2 cores)
+- sensor_answers_*: maizeviz's whole computation of one direction (``trace_direction``: the
+  ground rays and the six default planes, each sensor's path answered by an occlusion query
+  or, at this sun, by the first hit of the ray of the same family through it), in sensor
+  answers (rays x 7 planes, the ground included) per second: open field with packets and with
+  single rays, and the periodic field through the block
 
     python benchmarks/bench_rays.py [--json] [--level K4] [--density 16] [--repeat 5]
 """
@@ -37,7 +42,7 @@ from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.rays import Tracer, ray_grid
 from maizeviz.light.sun import sun_at
-from maizeviz.light.transmission import light_scene
+from maizeviz.light.transmission import light_scene, sampler, trace_direction
 from maizeviz.mesh.levels import parse_level
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.resources import example_points
@@ -127,6 +132,16 @@ def main() -> None:
         for threads in (1, 2):
             out[f"{name}_{threads}t"] = round(n / best(chunked(fn, n, threads), args.repeat)
                                               / 1e6, 2)
+    heights = (0.0, 50.0, 100.0, 150.0, 200.0, 225.0)
+    for name, sc, periodic in (("open_packets", packed, False), ("open_single_rays", single, False),
+                               ("periodic_block", block, True)):
+        smp = sampler(canopy, sc, rect, args.density, heights, periodic)
+        answers = smp.n * (len(heights) + 1)
+        for threads in (1, 2):
+            secs = best(lambda smp=smp, threads=threads: trace_direction(smp, s,
+                                                                           threads=threads),
+                        args.repeat)
+            out[f"sensor_answers_{name}_{threads}t"] = round(answers / secs / 1e6, 2)
     for q in ("occluded", "nearest"):
         for t in ("1t", "2t"):
             out[f"speedup_{q}_{t}"] = round(out[f"packets_{q}_{t}"]            # type: ignore
