@@ -60,8 +60,9 @@ def _worker_trace(level: str, zenith: list[float], azimuth: list[float], weights
                   density: float) -> float:
     """Trace some of the sky's directions on the worker's kept scene; seconds spent."""
     _worker_setup(level)
-    sky = Sky("soc", "auto", np.array(zenith), np.array(azimuth),
-              np.full(len(zenith), 1.0 / len(zenith)), np.array(weights))
+    w = np.array(weights)
+    sky = Sky("soc", "equal", np.array(zenith), np.array(azimuth),
+              np.full(len(zenith), 2 * np.pi / len(zenith)), w / w.sum())   # a part of it
     t0 = time.perf_counter()
     trace_sky(_WORKER["canopy"], sky, Sampling(density=density, periodic=True, threads=1),
               scene=_WORKER["scene"])
