@@ -143,6 +143,7 @@ def startup_child() -> None:
     from maizeviz.resources import example_points
 
     window = MainWindow(str(example_points()), 3)
+    window.confirm_unsaved = False          # the benchmark closes with results unsaved
     window.resize(1366, 740)
     window.show()
     said = {"window": False}
@@ -226,6 +227,7 @@ def gui_child(levels: list[str]) -> None:
         return until is None
 
     window = MainWindow(str(example_points()), 3)
+    window.confirm_unsaved = False          # the benchmark closes with results unsaved
     window.resize(1366, 740)
     window.show()
     shown: list[str] = []

@@ -126,11 +126,16 @@ def op_absorbed(state: dict, progress: ProgressCallback, request: LightRequest,
     the window shows of it: each leaf's absorbed W per m2 of leaf on its triangles (copies
     of a plant in a periodic field take their representative's; NaN on plants outside the
     sample rectangle of an open field) and the plants' rows."""
+    light = spec.absorbed(_engine(state), request.sun, request.sampling, progress)
+    return absorbed_of(state["canopy"], light)
+
+
+def absorbed_of(canopy, light) -> Absorbed:
+    """What the window shows of absorbed light (an ``AbsorbedLight``) on the canopy it was
+    traced on (also for a result read from a project)."""
     from maizeviz.light.reports import leaf_values
     from maizeviz.light.scatter import absorbed_leaf_rows
 
-    canopy = state["canopy"]
-    light = spec.absorbed(_engine(state), request.sun, request.sampling, progress)
     values = leaf_values(canopy, absorbed_leaf_rows(canopy, light), "absorbed_w", light.rect,
                          light.periodic)
     plants = light.table("plant", canopy).to_dict("records")
@@ -141,12 +146,12 @@ def op_absorbed(state: dict, progress: ProgressCallback, request: LightRequest,
 class Absorbed:
     """Absorbed light (:class:`maizeviz.light.scatter.AbsorbedLight`) with what the window
     shows of it: ``leaf_value`` (F,) float32 W absorbed per m2 of leaf on each leaf triangle
-    (its leaf's), and
-    ``plant_rows`` (the result's ``table("plant")`` as records)."""
+    (its leaf's), and ``plant_rows`` (the result's ``table("plant")`` as records); both None
+    for a result read from a project until computed against its canopy."""
 
     light: Any
-    leaf_value: np.ndarray
-    plant_rows: list
+    leaf_value: np.ndarray | None
+    plant_rows: list | None
 
 
 @dataclass(frozen=True)
@@ -211,7 +216,8 @@ def op_period(state: dict, progress, sampling, sky: SkySpec, day: DaySpec) -> Di
 
     period = day.period()
     engine = _engine(state)
-    sky_obj = sky.sky()
+    perez = day.diffuse == "perez"             # the sky's directions, as a uniform sky
+    sky_obj = SkySpec("uoc", sky.directions, sky.split).sky() if perez else sky.sky()
     n_sky = 0 if engine.kept_sky(sky_obj, sampling) is not None else sky_obj.n
 
     def steps(done: int, total: int):
@@ -219,7 +225,8 @@ def op_period(state: dict, progress, sampling, sky: SkySpec, day: DaySpec) -> Di
             return progress(done, total, f"sky direction {done} of {n_sky}")
         return progress(done, total, f"time step {done - n_sky} of {total - n_sky}")
 
-    light = engine.day(period, sky=sky_obj, sampling=sampling, progress=steps)
+    light = engine.day(period, sky="perez" if perez else sky_obj, directions=sky_obj.n,
+                       sampling=sampling, progress=steps)
     return _diffuse(state, light, period_leaf_rows(state["canopy"], light),
                     "par_intercepted_mol", light.seconds["build"])
 

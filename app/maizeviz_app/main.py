@@ -47,8 +47,9 @@ def gl_format() -> None:
 def run(argv: Sequence[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="maizeviz", description="The maizeviz desktop app.")
     ap.add_argument("points", nargs="?",
-                    help="points CSV or .maizeviz project (default: the last one opened, or "
-                         "the bundled 3x3 block)")
+                    help="points CSV, .maizeviz project or canopy mesh (.ply, .obj with plant "
+                         "and leaf ids, cm, z up) (default: the last one opened, or the "
+                         "bundled 3x3 block)")
     ap.add_argument("--tile", type=int, default=3, choices=(1, 3, 5, 7, 9),
                     help="tiling of the digitized block, N x N (default 3: the paper's 81 "
                          "plants)")

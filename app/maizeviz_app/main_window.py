@@ -52,7 +52,7 @@ from maizeviz.resources import example_points
 from maizeviz_app.exports import export_job
 from maizeviz_app.messages import user_message
 from maizeviz_app.model import StudyModel
-from maizeviz_app.panels.canopy import CanopyPanel
+from maizeviz_app.panels.canopy import MESH_LEVEL, CanopyPanel
 from maizeviz_app.panels.light import (
     COMPUTE_TEXT,
     MODES,
@@ -74,6 +74,10 @@ if TYPE_CHECKING:
 STATE_VERSION = 3
 PROJECT_FILTER = "maizeviz project (*.maizeviz)"
 POINTS_FILTER = "Points CSV (*.csv);;All files (*)"
+CANOPY_MESH_FILTER = "Canopy mesh with plant and leaf ids (*.ply *.obj);;All files (*)"
+#: Units and up axis a mesh file may be written in (what the open dialog offers).
+MESH_FRAMES = {"cm, z up": ("cm", "z"), "m, z up": ("m", "z"), "mm, z up": ("mm", "z"),
+               "cm, y up": ("cm", "y"), "m, y up": ("m", "y"), "mm, y up": ("mm", "y")}
 MESH_FILTER = ("PLY (*.ply);;VTK legacy (*.vtk);;VTK XML unstructured (*.vtu);;"
                "VTK XML polydata (*.vtp);;Wavefront OBJ (*.obj);;STL (*.stl)")
 PAPER = ("Xinyu Guo, Chunjiang Zhao, Boxiang Xiao, Shenglian Lu, Changfeng Li. <i>Study on "
@@ -395,9 +399,13 @@ class MainWindow(QMainWindow):
 
     # ------------------------------------------------------------------ opening
     def open_any(self, path: str | Path) -> None:
-        """A project (``.maizeviz``) or a points CSV."""
+        """A project (``.maizeviz``), a canopy mesh (``.ply``, ``.obj``) or a points CSV."""
+        from maizeviz.io.mesh_canopy import is_mesh_path
+
         if str(path).endswith(".maizeviz"):
             self.open_project(path)
+        elif is_mesh_path(path):
+            self.open_mesh(path)
         else:
             self.open_points(path)
 
@@ -406,6 +414,72 @@ class MainWindow(QMainWindow):
                                               POINTS_FILTER)
         if path:
             self.open_points(path)
+
+    def choose_mesh(self) -> None:
+        """Open a canopy from elsewhere (OpenAlea, Helios, a scan): a PLY or OBJ with a plant
+        and a leaf id per face, after asking its units and up axis."""
+        from PySide6.QtWidgets import QInputDialog
+
+        path, _ = QFileDialog.getOpenFileName(self, "Open a canopy mesh", self._folder(),
+                                              CANOPY_MESH_FILTER)
+        if not path:
+            return
+        frame, ok = QInputDialog.getItem(
+            self, "Units of the mesh", "The file's coordinates are in (OpenAlea and Helios "
+            "write z up, many scanners y up):", list(MESH_FRAMES), 0, False)
+        if ok:
+            self.open_mesh(path, *MESH_FRAMES[frame])
+
+    def open_mesh(self, path: str | Path, unit: str | None = None, up: str = "z") -> None:
+        """Read a canopy mesh in a worker (:func:`maizeviz.canopy.from_mesh.read_mesh_canopy`:
+        ``unit`` cm, m or mm, None: cm, refused when the size says otherwise); it replaces the
+        points: light, tables and exports work on it, the slider and layout do not apply."""
+        if not self.keep_unsaved(lambda: self.open_mesh(path, unit, up)):
+            return
+        from maizeviz_app import jobs
+
+        path = str(path)
+        self.say(f"reading the canopy mesh {path}")
+        runner, view_ready = self.runner, self._view_ready
+
+        def work(job):
+            from maizeviz.canopy.from_mesh import read_mesh_canopy
+            from maizeviz.canopy.measures import TABLE2_COLUMNS, table2_row
+
+            t0 = time.perf_counter()
+            canopy, _mesh, notes = read_mesh_canopy(path, unit, up)
+            read_s = time.perf_counter() - t0
+            job.check()
+            t0 = time.perf_counter()
+            m = runner.cover_process.call("measure", object(), canopy,
+                                          (jobs.APP_COVER_RESOLUTION_CM,), job)
+            measure_s = time.perf_counter() - t0
+            while not view_ready.wait(0.05):
+                job.check()
+            from maizeviz_app.viewport import canopy_polydata
+
+            row = table2_row(m, read_s, MESH_LEVEL)
+            return notes, (canopy, m, read_s, measure_s, canopy_polydata(canopy),
+                           tuple(TABLE2_COLUMNS), row)
+
+        self.runner.run("load", f"reading {Path(path).name}", work,
+                        on_done=lambda out: self._on_mesh(path, *out),
+                        on_error=lambda e: self._fail(e, "open mesh"))
+
+    def _on_mesh(self, path: str, notes: list, parts: tuple) -> None:
+        from maizeviz_app import jobs
+
+        self._heatmaps_for.clear()
+        self.plots.clear()
+        self.plots.set_transmission(None)
+        self.model.open_mesh(path)
+        self._settings.setValue("last_folder", str(Path(path).parent))
+        self._remember(path)
+        for note in notes:
+            self.say(f"note: {note}")
+        canopy, m, read_s, measure_s, mesh, columns, row = parts
+        self._on_built(jobs.Built(MESH_LEVEL, MESH_LEVEL, canopy, m, read_s, measure_s, mesh,
+                                  columns, row, self.model.serial))
 
     def choose_project(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self, "Open project", self._folder(),
@@ -627,9 +701,10 @@ class MainWindow(QMainWindow):
             return
         run = self.runs.latest(self.signature(self.built.label))
         if run is not None and run.kind == "sun" and run.classes is not None and \
-                run.extra is None:
+                (run.extra is None or run.extra.leaf_value is None):
             self.viewport.set_light(run.classes)
-        elif run is not None and run.extra is not None:
+        elif run is not None and run.extra is not None and \
+                getattr(run.extra, "leaf_value", None) is not None:
             title, unit = value_legend(run)
             self.viewport.set_light_values(run.extra.leaf_value, title, unit)
         if colour and run is not None:
@@ -938,6 +1013,10 @@ class MainWindow(QMainWindow):
 
     def save_project(self, path: str | Path) -> None:
         """Write the project (points, layout, settings, light results) in a worker."""
+        if self.model.mesh_path is not None:
+            self.say("error: a canopy read from a mesh file is not saved in a project (a "
+                     "project keeps digitized points); export its light instead", error=True)
+            return
         if self.loaded is None:
             self.say("error: nothing to save yet: open a points file first", error=True)
             return
@@ -949,8 +1028,16 @@ class MainWindow(QMainWindow):
         canopy = {"tile": self.tile_n, "level": self.level,
                   "preserve_area": self.canopy_panel.preserve.isChecked()}
         light = self.light_panel.settings()
-        runs = [(r.label, r.result, project.settings_doc(r.kind, self.runs.settings.get(r.kind)))
-                for r in self.runs.in_order()]
+        runs = []
+        sun_settings = self.runs.settings.get("sun")
+        optics = sun_settings[2] if isinstance(sun_settings, tuple) and \
+            len(sun_settings) == 3 else None
+        for r in self.runs.in_order():
+            runs.append((r.label, r.result,
+                         project.settings_doc(r.kind, self.runs.settings.get(r.kind))))
+            if r.balance is not None:              # the sun's absorbed light beside it
+                runs.append((r.label, r.extra.light, project.settings_doc("absorbed",
+                                                                           optics)))
         path = str(path)
 
         def work(job):
@@ -1037,13 +1124,20 @@ class MainWindow(QMainWindow):
         shown are computed against it, the others' when their level is shown)."""
         if not self._pending_runs or self.built is None:
             return
-        from maizeviz_app import plots
+        from maizeviz_app import jobs, plots
 
         pending, self._pending_runs = self._pending_runs, []
+        absorbed = {s.label: s for s in pending if s.kind == "absorbed"}
+        pending = [s for s in pending if s.kind != "absorbed"]
         for stored in pending:
             label, result, kind, settings = stored
+            extra = None
             if kind == "sun":
-                settings = (round(result.sun.zenith_deg, 6), round(result.sun.azimuth_deg, 6))
+                kept = absorbed.get(label)
+                settings = (round(result.sun.zenith_deg, 6), round(result.sun.azimuth_deg, 6),
+                            kept.settings if kept is not None else None)
+                if kept is not None:                # computed against the canopy later
+                    extra = jobs.Absorbed(kept.result, None, None)
                 density = result.density
             elif kind == "sky":
                 density = result.density
@@ -1052,9 +1146,9 @@ class MainWindow(QMainWindow):
                     self.light_panel.density.value()
             sampling = (tuple(float(h) for h in result.heights_cm), density,
                         bool(getattr(result, "periodic", self.light_panel.periodic.isChecked())))
-            self.model.add_run(Run(label, self.signature(label), result, None, kind), settings,
-                               sampling, f"{len(pending)} light result(s) from the project",
-                               saved=True)
+            self.model.add_run(Run(label, self.signature(label), result, None, kind, extra),
+                               settings, sampling,
+                               f"{len(pending)} light result(s) from the project", saved=True)
         here = self.signature(self.built.label)
         shown = {}
         for kind in MODES:
@@ -1065,7 +1159,7 @@ class MainWindow(QMainWindow):
             return
         day = shown.get("day")
         self.light_panel.show_summary(day_summary(day.result) if day is not None else "")
-        self.light_panel.show_plants(self.runs.latest(None, ("sky", "day")))
+        self.light_panel.show_plants(self._plants_run())
         latest = self.runs.latest(here) or self.runs.last
         order = sorted(shown, key=lambda k: latest is not None and k == latest.kind)
         curves = self.runs.curves()
@@ -1090,6 +1184,13 @@ class MainWindow(QMainWindow):
                         on_error=lambda e: self._fail(e, "light"))
         self._light_to_view(colour=True)
 
+    def _plants_run(self) -> Run | None:
+        """The latest result with light per plant to show: a sky's, a day's or a sun's
+        absorbed light (once computed against its canopy)."""
+        runs = [r for r in self.runs.runs.values()
+                if r.kind != "sun" or getattr(r.extra, "plant_rows", None) is not None]
+        return max(runs, key=lambda r: self.runs.in_order().index(r), default=None)
+
     def _complete_runs(self) -> None:
         """Results read from a project that were traced on the canopy shown get what the
         window shows of them, computed against it in a worker: a sun's light class per
@@ -1104,7 +1205,8 @@ class MainWindow(QMainWindow):
             if run.signature != here:
                 continue
             r = run.result
-            if run.kind == "sun" and run.classes is None:
+            if run.kind == "sun" and (run.classes is None or run.extra is not None
+                                      and run.extra.leaf_value is None):
                 if r.first_hits is not None and len(r.first_hits) >= n:
                     todo.append(run)
             elif run.kind != "sun" and run.extra is None:
@@ -1118,21 +1220,27 @@ class MainWindow(QMainWindow):
             from maizeviz.light.leaf_light import triangle_light
             from maizeviz_app import jobs
 
-            done = []
+            done: list[Any] = []
             for run in todo:
                 job.check()
-                done.append(triangle_light(canopy, run.result) if run.kind == "sun"
-                            else jobs.diffuse_of(canopy, run.result, run.kind))
+                if run.kind == "sun":
+                    absorbed = None if run.extra is None else \
+                        jobs.absorbed_of(canopy, run.extra.light)
+                    done.append((triangle_light(canopy, run.result), absorbed))
+                else:
+                    done.append(jobs.diffuse_of(canopy, run.result, run.kind))
             return done
 
         def adopt(done):
             for run, value in zip(todo, done):
                 if run.kind == "sun":
-                    run.classes = value
+                    run.classes, absorbed = value
+                    if absorbed is not None:
+                        run.extra = absorbed
                 else:
                     run.extra = value
             if self.built is not None and self.signature(self.built.label) == here:
-                self.light_panel.show_plants(self.runs.latest(None, ("sky", "day")))
+                self.light_panel.show_plants(self._plants_run())
                 self._light_to_view(colour=True)
                 if self.runner.current("figures") is None:     # else: when they are drawn
                     self.light_shown.emit()

@@ -32,6 +32,9 @@ def build_menus(w) -> dict[str, QAction]:
                            "open a digitized points CSV")
     acts["open_project"] = _action(w, f, "Open &project…", w.choose_project, "Ctrl+Shift+O",
                                    "open a maizeviz project")
+    acts["open_mesh"] = _action(w, f, "Open canopy &mesh…", w.choose_mesh, "Ctrl+Shift+M",
+                                "open a canopy from elsewhere (OpenAlea, Helios, a scan): PLY "
+                                "or OBJ with a plant and a leaf id per face")
     w.recent_menu = f.addMenu("Open &recent")
     w.recent_menu.aboutToShow.connect(lambda: fill_recent(w))
     f.addSeparator()

@@ -64,6 +64,7 @@ class StudyModel:
     Signals
     -------
     points_changed(loaded) : new points (and layout) opened; results cleared.
+    mesh_opened(path) : a canopy read from a mesh file replaces the points; results cleared.
     layout_changed(layout) : the layout edited; results of the previous layout cleared.
     canopy_changed(built) : a canopy built for the current points and layout.
     runs_changed(runs, info) : a light result added (``info``: what was traced, for the
@@ -73,6 +74,7 @@ class StudyModel:
     """
 
     points_changed = Signal(object)
+    mesh_opened = Signal(str)
     layout_changed = Signal(object)
     canopy_changed = Signal(object)
     runs_changed = Signal(object, str)
@@ -88,6 +90,7 @@ class StudyModel:
         self.measures_rows: dict[str, dict] = {}
         self.runs = LightRuns()
         self.project_path: str | None = None
+        self.mesh_path: str | None = None
         self.layout_edited = False
         self.serial = 0
         self.modified = False
@@ -116,6 +119,8 @@ class StudyModel:
     def title(self) -> str:
         """The window title: the project's or points file's name, ``[*]`` where Qt marks
         unsaved work."""
+        if self.mesh_path is not None:
+            return f"maizeviz — {Path(self.mesh_path).name}[*]"
         if self.loaded is None:
             return "maizeviz"
         name = Path(self.project_path or self.loaded.path).name
@@ -127,6 +132,7 @@ class StudyModel:
         """New points (from a points file, or a project at ``project``): every result of the
         previous points is dropped; the study starts unsaved-clean."""
         self.loaded = loaded
+        self.mesh_path = None
         self.points_bytes = points_bytes
         self.points_origin = str(Path(origin).resolve())
         self.project_path = project
@@ -134,6 +140,21 @@ class StudyModel:
         self._renew()
         self.points_changed.emit(loaded)
         self.project_changed.emit(project)
+        self._set_modified(False)
+
+    def open_mesh(self, path: str) -> None:
+        """A canopy read from a mesh file (OBJ, PLY with plant and leaf ids) is studied instead
+        of digitized points: no points, no layout to edit, one mesh level (the file's); its
+        canopy arrives by :meth:`show_built`. Nothing of it goes into a project."""
+        self.loaded = None
+        self.points_bytes = b""
+        self.points_origin = ""
+        self.project_path = None
+        self.mesh_path = str(path)
+        self.layout_edited = False
+        self._renew()
+        self.mesh_opened.emit(self.mesh_path)
+        self.project_changed.emit(None)
         self._set_modified(False)
 
     def edit_layout(self, layout: Any) -> bool:

@@ -68,11 +68,11 @@ LIGHT_SETTINGS = (("zenith_deg", (int, float)), ("azimuth_deg", (int, float)), (
                   ("par_factor", (int, float)), ("optics", bool), ("band", str),
                   ("reflectance", (int, float)), ("transmittance", (int, float)),
                   ("ground_reflectance", (int, float)), ("direct_w_m2", (int, float)),
-                  ("diffuse_w_m2", (int, float)), ("depth", int))
+                  ("diffuse_w_m2", (int, float)), ("depth", int), ("day_diffuse", str))
 #: Allowed values of the light settings that name a choice.
 LIGHT_CHOICES = {"mode": ("sun", "sky", "day"), "sky_kind": ("soc", "uoc"),
                  "sky_split": ("auto", "equal"), "source": ("clear", "weather"),
-                 "band": ("par", "nir")}
+                 "band": ("par", "nir"), "day_diffuse": ("sky", "perez")}
 
 
 def light_settings(opened: Opened) -> dict:

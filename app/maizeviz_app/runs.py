@@ -241,6 +241,11 @@ def run_info(run: Run) -> str:
                 f"take {r.intercepted_fraction:.1%} of the diffuse light")
     else:
         sky = r.sky.sky.description if r.sky is not None else "no sky"
+        if getattr(r, "diffuse", None) is not None:
+            share = float(r.step_circumsolar_mol_m2.sum()) / max(
+                float(r.step_diffuse_mol_m2.sum()), 1e-12)
+            sky = (f"Perez anisotropic: {share:.0%} of the diffuse light circumsolar, with the "
+                   f"sun; the rest from {sky}")
         info = (f"{r.n_steps} time steps and the sky ({sky}); {r.rays:,} rays per "
                 f"direction; level {run.label}; Embree scene {build}, tracing "
                 f"{secs.get('trace', 0):.2f} s")

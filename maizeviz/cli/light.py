@@ -55,6 +55,7 @@ from maizeviz.light.irradiance import (
 )
 from maizeviz.light.leaf_light import leaf_light, merge_rows, plant_light
 from maizeviz.light.optics import BANDS, optics_for
+from maizeviz.light.perez import PEREZ_MODELS, split_summary
 from maizeviz.light.reports import period_leaf_rows, sky_leaf_rows, write_steps
 from maizeviz.light.request import Sampling
 from maizeviz.light.scatter import DEFAULT_DEPTH, AbsorbedLight, absorbed_leaf_rows
@@ -65,6 +66,8 @@ from maizeviz.mesh.levels import CANOPY_LEVELS
 
 #: The subcommand.
 NAME = "light"
+#: ``--sky`` of a period whose diffuse light is split by Perez's model, step by step.
+PEREZ = "perez"
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -88,9 +91,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     sun.add_argument("--tz", default=None,
                      help="time zone, e.g. Asia/Shanghai (default UTC, or the offset of --time)")
     sky = p.add_argument_group("diffuse sky")
-    sky.add_argument("--sky", choices=sorted(SKY_KINDS),
+    sky.add_argument("--sky", choices=[*sorted(SKY_KINDS), PEREZ],
                      help="soc: standard overcast (radiance (1 + 2 cos zenith)/3), uoc: uniform "
-                          "overcast; a period uses soc unless told")
+                          "overcast; a period uses soc unless told; perez (a period only): "
+                          "each time step's diffuse light split by Perez's anisotropic model "
+                          "(pvlib), its circumsolar part traced with the sun, the rest over a "
+                          "uniform sky")
     sky.add_argument("--sky-directions", type=int, default=None, metavar="N",
                      help="directions of the sky: 6, 16, 46 (den Dulk's turtle), 145 (Tregenza) "
                           "or any N >= 1 (equal solid angles); default 46")
@@ -172,6 +178,10 @@ def _period_asked(args: argparse.Namespace) -> bool:
 def _check_options(args: argparse.Namespace) -> None:
     """Refuse options that contradict each other, one line each."""
     explicit = args.sun_zenith is not None or args.sun_azimuth is not None
+    if args.sky == PEREZ and not _period_asked(args):
+        raise MaizevizError("--sky perez splits the diffuse light of each time step by the "
+                            "sun's place and the sky's clearness: it needs a period (--day, "
+                            "--from/--to or --weather with --date, --lat and --lon)")
     if _period_asked(args):
         what = "--weather" if args.weather else ("--day" if args.day else "--from/--to")
         if explicit:
@@ -251,7 +261,7 @@ def sky_from(args: argparse.Namespace, period: Period | None) -> Sky | None:
     if args.sky is None and period is None:
         return None
     n = 46 if args.sky_directions is None else args.sky_directions
-    return make_sky(args.sky or "soc", n)
+    return make_sky("uoc" if args.sky == PEREZ else (args.sky or "soc"), n)
 
 
 # ------------------------------------------------------------------------------ run
@@ -286,7 +296,9 @@ def run(args: argparse.Namespace) -> int:
         say(f"sun: zenith {sun.zenith_deg:.2f} deg, azimuth {sun.azimuth_deg:.2f} deg"
             + (f" ({sun.when})" if sun.when else ""))
     if sky is not None:
-        say(f"sky: {sky.description}")
+        say(f"sky: {PEREZ_MODELS[PEREZ]}: each step's circumsolar part traced with the sun, "
+            f"its isotropic part over the {sky.description}" if args.sky == PEREZ
+            else f"sky: {sky.description}")
         if args.verbose:
             say(sky.table())
     if period is not None:
@@ -344,7 +356,9 @@ def run(args: argparse.Namespace) -> int:
             if want_rows:
                 tables.append(leaf_light(canopy, res))
         if period is not None:
-            per_res = engine.day(period, sky=sky, bin_cm=args.heatmap_bin,
+            per_res = engine.day(period, sky=PEREZ if args.sky == PEREZ else sky,
+                                 directions=sky.n if sky is not None else 46,
+                                 bin_cm=args.heatmap_bin,
                                  progress=Progress(f"tracing the period, {label}"))
             sky_res = per_res.sky
             warnings += per_res.warnings
@@ -356,6 +370,9 @@ def run(args: argparse.Namespace) -> int:
             rec["seconds"]["sky"] = sky_res.seconds["trace"]
         if sky_res is not None:
             rec["diffuse"] = _sky_record(sky_res, canopy, args, heights)
+            if args.sky == PEREZ:
+                rec["diffuse"]["part"] = "isotropic part of the Perez sky"
+
             if want_rows:
                 tables.append(sky_leaf_rows(canopy, sky_res))
         elif sky is not None and period is not None:
@@ -466,12 +483,23 @@ def _period_record(pl: PeriodLight, args: argparse.Namespace) -> dict[str, Any]:
         "par_diffuse_mol_m2": pl.par_diffuse_mol_m2,
         "par_intercepted_mol_m2": pl.par_intercepted_mol_m2,
         "fraction_intercepted": pl.fraction_intercepted,
+        "par_diffuse_intercepted_mol_m2": pl.par_diffuse_intercepted_mol_m2,
         "transmission_by_height": {
             "heights_cm": [float(h) for h in pl.heights_cm],
             "par_mol_m2": [float(v) for v in pl.par_transmitted_mol_m2],
             "fraction": [None if not math.isfinite(v) else float(v)
-                         for v in pl.transmission_by_height]},
+                         for v in pl.transmission_by_height],
+            "diffuse_fraction": [None if not math.isfinite(v) else float(v)
+                                 for v in pl.diffuse_transmission_by_height]},
         "source": p.source, "notes": list(p.notes)}
+    d = pl.diffuse
+    if d is not None:
+        rec["diffuse_model"] = {
+            "model": d.model, "description": d.description,
+            "isotropic_par_mol_m2": math.fsum(pl.step_sky_mol_m2),
+            "circumsolar_par_mol_m2": math.fsum(pl.step_circumsolar_mol_m2),
+            "horizon_par_mol_m2": 0.0,
+            "summary": split_summary(d, p)}
     if args.weather:
         rec["weather_file"] = str(args.weather)
         rec["weather"] = dict(p.parameters)
@@ -619,8 +647,9 @@ def _print_sky(records: list[dict], heights: tuple[float, ...],
                args: argparse.Namespace) -> None:
     d0 = records[0]["diffuse"]
     rc = ", ".join(f"{v:.1f}" for v in d0["rect_cm"])
-    print(f"diffuse light: {d0['description']}; {d0['rays_per_direction']:,} sensors per plane "
-          f"and direction over x0,y0,x1,y1 = {rc} cm"
+    part = f" (the {d0['part']}; its circumsolar part follows the sun)" if "part" in d0 else ""
+    print(f"diffuse light: {d0['description']}{part}; {d0['rays_per_direction']:,} sensors per "
+          f"plane and direction over x0,y0,x1,y1 = {rc} cm"
           f"{', periodic field' if args.periodic else ''}")
     _print_heights(heights, [(f"{r['level']} diffuse T", r["diffuse"]["transmission"])
                              for r in records],
@@ -628,7 +657,8 @@ def _print_sky(records: list[dict], heights: tuple[float, ...],
     print("leaves intercept " + ", ".join(
         f"{r['diffuse']['intercepted_fraction']:.3f}" + (f" ({r['level']})" if len(records) > 1
                                                          else "")
-        for r in records) + " of the diffuse light (first hits; scattering not followed)")
+        for r in records) + (" of this sky's light" if "part" in d0 else " of the diffuse light")
+          + " (first hits; scattering not followed)")
     if args.check:
         bl = d0["beer_lambert"]
         print(f"Beer-Lambert under the same sky: sum of w_i exp(-G_i L(h)/cos theta_i), G_i "
@@ -669,9 +699,18 @@ def _print_period(r: dict, label: bool) -> None:
           f"({frac:.1%})")
     tb = p["transmission_by_height"]
     diffuse = r.get("diffuse") or {}
+    model = p.get("diffuse_model")
+    if model is not None:
+        print(model["summary"])
+        print(f"diffuse PAR intercepted by the leaves {p['par_diffuse_intercepted_mol_m2']:.3f} "
+              f"mol/m2 of {p['par_diffuse_mol_m2']:.3f}")
+        dt = tb["diffuse_fraction"]
+        diffuse_t = [f"{v:.3f}" if v is not None else "" for v in dt]
+    else:
+        diffuse_t = [f"{v:.3f}" for v in diffuse["transmission"]] if diffuse else \
+            [""] * len(tb["heights_cm"])
     print(fmt_table(["height cm", "PAR mol/m2", "fraction", "diffuse T"],
-                    [[f"{h:g}", f"{v:.2f}", f"{f:.3f}" if f is not None else "",
-                      f"{diffuse['transmission'][i]:.3f}" if diffuse else ""]
+                    [[f"{h:g}", f"{v:.2f}", f"{f:.3f}" if f is not None else "", diffuse_t[i]]
                      for i, (h, v, f) in enumerate(zip(tb["heights_cm"], tb["par_mol_m2"],
                                                        tb["fraction"]))]))
     print()

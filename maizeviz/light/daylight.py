@@ -25,6 +25,18 @@ at each step, the sky once for the whole period. Per step,
 
 and the period's totals are the exactly rounded sums (math.fsum) of its steps. Intercepted PAR
 per triangle in mol is its share times the dose times the rectangle's area.
+
+An anisotropic diffuse sky (``diffuse``, a :class:`~maizeviz.light.perez.DiffuseSplit` from
+Perez's model): the diffuse dose of step j is split into a circumsolar part C_j, traced with the
+sun of that step, and an isotropic part I_j = S_j - C_j, spread over the directions of a uniform
+sky traced once (the horizon band brings nothing through a horizontal plane). Sky direction i
+then carries the weight (I_j / S_j) w_i of step j's diffuse light and the sun the weight
+C_j / S_j: the weights change per step but the sky's directions keep their proportions, so the
+uniform sky's sums (transmission, shares per triangle, maps) are reused and nothing is traced
+beyond today's sky and suns. Per step,
+
+    transmitted_j(h) = (D_j + C_j) T_sun_j(h) + I_j T_sky(h)
+    intercepted_j    = (D_j + C_j) f_sun_j + I_j f_sky
 """
 
 from __future__ import annotations
@@ -42,6 +54,7 @@ from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.light.bins import TransmissionMap, bin_edges, binned
 from maizeviz.light.irradiance import Period
+from maizeviz.light.perez import DiffuseSplit
 from maizeviz.light.request import (
     LightRequest,
     Sampling,
@@ -178,6 +191,9 @@ class PeriodLight(MappedLight):
     step_intercepted_fraction : (n,) float64: leaves' share of the direct beam at each step
     triangle_direct_mol, triangle_diffuse_mol : (F,) float64 mol: PAR intercepted by each scene
         triangle over the period (leaf triangles first, then stalks)
+    diffuse : DiffuseSplit or None: each step's diffuse light split by Perez's model (its
+        circumsolar part traced with the sun, the rest over the uniform ``sky``); None when the
+        whole diffuse part is spread over ``sky``
     """
 
     period: Period
@@ -186,6 +202,7 @@ class PeriodLight(MappedLight):
     step_intercepted_fraction: np.ndarray
     triangle_direct_mol: np.ndarray
     triangle_diffuse_mol: np.ndarray
+    diffuse: DiffuseSplit | None = None
 
     @property
     def n_steps(self) -> int:
@@ -207,23 +224,48 @@ class PeriodLight(MappedLight):
         return np.asarray(self.period.step_diffuse_par_mol_m2, dtype=np.float64)
 
     @cached_property
+    def step_circumsolar_mol_m2(self) -> np.ndarray:
+        """(n,) the part of each step's diffuse PAR traced with the sun (Perez's circumsolar
+        part; zeros without a diffuse split)."""
+        if self.diffuse is None:
+            return np.zeros(self.n_steps)
+        return self.step_diffuse_mol_m2 * self.diffuse.circumsolar_share
+
+    @cached_property
+    def step_sky_mol_m2(self) -> np.ndarray:
+        """(n,) the part of each step's diffuse PAR spread over the sky's directions."""
+        return self.step_diffuse_mol_m2 - self.step_circumsolar_mol_m2
+
+    @cached_property
     def step_incident_mol_m2(self) -> np.ndarray:
         """(n,) PAR incident at each step (direct + diffuse)."""
         return self.step_direct_mol_m2 + self.step_diffuse_mol_m2
 
     @cached_property
+    def step_diffuse_intercepted_mol_m2(self) -> np.ndarray:
+        """(n,) diffuse PAR intercepted by the leaves at each step."""
+        fd = self.sky.intercepted_fraction if self.sky is not None else 0.0
+        return (self.step_circumsolar_mol_m2 * self.step_intercepted_fraction
+                + self.step_sky_mol_m2 * fd)
+
+    @cached_property
     def step_intercepted_mol_m2(self) -> np.ndarray:
         """(n,) PAR intercepted by the leaves at each step."""
-        fd = self.sky.intercepted_fraction if self.sky is not None else 0.0
         return (self.step_direct_mol_m2 * self.step_intercepted_fraction
-                + self.step_diffuse_mol_m2 * fd)
+                + self.step_diffuse_intercepted_mol_m2)
+
+    @cached_property
+    def step_diffuse_transmitted_mol_m2(self) -> np.ndarray:
+        """(n, H) diffuse PAR reaching each sensor plane at each step."""
+        td = self.sky.transmission if self.sky is not None else np.zeros(len(self.heights_cm))
+        return (self.step_circumsolar_mol_m2[:, None] * self.step_transmission
+                + self.step_sky_mol_m2[:, None] * td[None, :])
 
     @cached_property
     def step_transmitted_mol_m2(self) -> np.ndarray:
         """(n, H) PAR reaching each sensor plane at each step."""
-        td = self.sky.transmission if self.sky is not None else np.zeros(len(self.heights_cm))
         return (self.step_direct_mol_m2[:, None] * self.step_transmission
-                + self.step_diffuse_mol_m2[:, None] * td[None, :])
+                + self.step_diffuse_transmitted_mol_m2)
 
     @cached_property
     def step_fraction_intercepted(self) -> np.ndarray:
@@ -248,6 +290,20 @@ class PeriodLight(MappedLight):
     @property
     def par_intercepted_mol_m2(self) -> float:
         return math.fsum(self.step_intercepted_mol_m2)
+
+    @property
+    def par_diffuse_intercepted_mol_m2(self) -> float:
+        """Diffuse PAR intercepted by the leaves over the period, mol/m2 of ground."""
+        return math.fsum(self.step_diffuse_intercepted_mol_m2)
+
+    @property
+    def diffuse_transmission_by_height(self) -> np.ndarray:
+        """(H,) transmitted / incident diffuse PAR over the period (the sky's transmission
+        without a diffuse split; NaN when no diffuse light came)."""
+        inc = self.par_diffuse_mol_m2
+        if not inc > 0:
+            return np.full(len(self.heights_cm), np.nan)
+        return np.array([math.fsum(c) for c in self.step_diffuse_transmitted_mol_m2.T]) / inc
 
     @property
     def par_transmitted_mol_m2(self) -> np.ndarray:
@@ -388,7 +444,7 @@ def trace_sky(canopy: Canopy, sky: Sky, sampling: Sampling | LightRequest,
 def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightRequest,
                  sky: Sky | SkyLight | None = None, progress: ProgressCallback | None = None,
                  with_stalks: bool = False, scene: RayScene | None = None,
-                 bin_cm: float = 5.0) -> PeriodLight:
+                 bin_cm: float = 5.0, diffuse: DiffuseSplit | None = None) -> PeriodLight:
     """Light over a period: the sun traced at every step, the sky once; see the module docstring.
 
     Parameters
@@ -405,6 +461,11 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
         time steps); returning ``False`` cancels with InterruptedError
     scene : the canopy's scene (same ``with_stalks`` and ``periodic``); built here when not given
     bin_cm : bin edge of the maps, cm
+    diffuse : each step's diffuse light split by Perez's model
+        (:func:`maizeviz.light.perez.perez_split` of ``period``): its circumsolar part is traced
+        with the sun of the step, the rest spread over ``sky``, which must then be a uniform
+        sky ("uoc"; default: the uniform turtle of 46 directions); None spreads the whole
+        diffuse part over ``sky``
 
     Returns
     -------
@@ -413,6 +474,10 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
     """
     from maizeviz.light.sky import make_sky
 
+    if diffuse is not None and (diffuse.n_steps != period.n_steps or not np.allclose(
+            diffuse.dhi_w_m2, period.dhi, rtol=1e-9, atol=1e-9)):
+        raise MaizevizError("the diffuse split is not this period's: its steps or its diffuse "
+                            "irradiance differ (split the period itself)", quantity="sky")
     smp, warnings, build_s, bins = _prepare(canopy, sampling, with_stalks, scene, bin_cm)
     edges = bins.edges
     warnings += list(period.notes)
@@ -426,7 +491,8 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
                            triangle_diffuse_mol=zeros.copy(), rect=smp.rect, rays=smp.n,
                            maps=np.full(shape, np.nan), map_edges=edges, map_rays=bins.rays,
                            level=canopy.level, warnings=tuple(warnings),
-                           seconds={"build": build_s, "trace": 0.0}, periodic=smp.periodic)
+                           seconds={"build": build_s, "trace": 0.0}, periodic=smp.periodic,
+                           diffuse=diffuse)
     sky_light = sky if isinstance(sky, SkyLight) else None
     if sky_light is not None:
         if not (np.array_equal(sky_light.heights_cm, smp.heights_cm)
@@ -434,7 +500,11 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
             raise MaizevizError("the sky light was traced with other heights, rectangle or "
                                 "density than this period", quantity="sky")
     sky_obj = sky_light.sky if sky_light is not None else \
-        (sky if isinstance(sky, Sky) else make_sky("soc", 46))
+        (sky if isinstance(sky, Sky) else make_sky("soc" if diffuse is None else "uoc", 46))
+    if diffuse is not None and sky_obj.kind != "uoc":
+        raise MaizevizError(f"Perez's isotropic part is spread over a uniform sky, not a "
+                            f"{sky_obj.kind} sky: trace the period with a uoc sky",
+                            quantity="sky")
     north = canopy.layout.north_deg
     suns = period.suns()
     sun_dirs = [s.direction(north) for s in suns]
@@ -455,15 +525,21 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
                                {"build": 0.0, "trace": trace_s})
     steps = beams[len(sky_dirs):]
     direct_mol = np.asarray(period.step_direct_par_mol_m2, dtype=np.float64)
-    diffuse_mol = math.fsum(period.step_diffuse_par_mol_m2)
+    step_diffuse = np.asarray(period.step_diffuse_par_mol_m2, dtype=np.float64)
+    circ_mol = step_diffuse * diffuse.circumsolar_share if diffuse is not None else \
+        np.zeros(len(steps))
+    diffuse_mol = math.fsum(step_diffuse - circ_mol)        # spread over the sky
     area_m2 = (smp.rect[2] - smp.rect[0]) * (smp.rect[3] - smp.rect[1]) * 1e-4
     tri_direct = np.zeros(smp.n_triangles)
     for dose, b in zip(direct_mol, steps):
         np.add.at(tri_direct, b.ids, dose * area_m2 * b.hits / smp.n)
     tri_diffuse = sky_light.triangle_share * diffuse_mol * area_m2
+    for dose, b in zip(circ_mol, steps):
+        if dose > 0:
+            np.add.at(tri_diffuse, b.ids, dose * area_m2 * b.hits / smp.n)
     incident = math.fsum(period.step_par_mol_m2)
     maps = sky_light.maps * diffuse_mol
-    for dose, b in zip(direct_mol, steps):
+    for dose, b in zip(direct_mol + circ_mol, steps):
         maps = maps + dose * b.lit_bins
     maps = maps / incident if incident > 0 else np.full(shape, np.nan)
     return PeriodLight(
@@ -473,4 +549,4 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
         triangle_direct_mol=tri_direct, triangle_diffuse_mol=tri_diffuse, rect=smp.rect,
         rays=smp.n, maps=maps, map_edges=edges, map_rays=bins.rays, level=canopy.level,
         warnings=tuple(warnings), seconds={"build": build_s, "trace": trace_s},
-        periodic=smp.periodic)
+        periodic=smp.periodic, diffuse=diffuse)

@@ -30,6 +30,7 @@ from maizeviz.canopy.scene import Canopy
 from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
 from maizeviz.light.irradiance import DEFAULT_LINKE_TURBIDITY, DEFAULT_PAR_UMOL_PER_J, Period
 from maizeviz.light.optics import SHORTWAVE_SHARE, Optics, optics_for
+from maizeviz.light.perez import PEREZ_MODELS, perez_split
 from maizeviz.light.request import LightRequest, Sampling
 from maizeviz.light.scatter import (
     DEFAULT_DEPTH,
@@ -210,7 +211,7 @@ class LightEngine:
             altitude: float = 0.0, linke: float = DEFAULT_LINKE_TURBIDITY,
             par_factor: float = DEFAULT_PAR_UMOL_PER_J, sky: Sky | str | None = None,
             sampling: Sampling | None = None, progress: ProgressCallback | None = None,
-            bin_cm: float = 5.0, **fields_) -> PeriodLight:
+            bin_cm: float = 5.0, directions: int = 46, **fields_) -> PeriodLight:
         """Light over a day (or any period): the sun traced at every time step, the sky once.
 
         Parameters
@@ -224,6 +225,11 @@ class LightEngine:
         sky : Sky or str, optional
             The sky of the diffuse part (default: standard overcast, 46 directions); the sky
             light this engine last traced is reused when its sky, sampling and bins match.
+            "perez" (or "perez-driesse") splits each step's diffuse light by Perez's
+            anisotropic model (:mod:`maizeviz.light.perez`): its circumsolar part traced with
+            the sun, its isotropic part over a uniform sky of ``directions`` directions.
+        directions : int
+            Directions of a sky given by its kind (default 46, den Dulk's turtle).
         sampling, progress, bin_cm, **fields_ : as :meth:`sky` (``progress`` after each
             direction: sky directions first, then the time steps).
 
@@ -246,11 +252,14 @@ class LightEngine:
             period = clear_sky_period(date, lat, lon, tz, step_min, start, end, altitude,
                                       linke, par_factor)
         smp = self._sampling(sampling or self.sampling, fields_)
-        sky_obj = sky if isinstance(sky, Sky) else make_sky(sky or "soc", 46)
+        model = str(sky).strip().lower() if isinstance(sky, str) else ""
+        split = perez_split(period, model) if model in PEREZ_MODELS else None
+        sky_obj = sky if isinstance(sky, Sky) else \
+            make_sky("uoc" if split is not None else (sky or "soc"), directions)
         diffuse: Sky | SkyLight = self.kept_sky(sky_obj, smp, bin_cm) or sky_obj
         scene, build_s = self._scene_and_build(smp.periodic)
         light = trace_period(self.canopy, period, smp, diffuse, progress, self.with_stalks,
-                             scene, bin_cm)
+                             scene, bin_cm, split)
         light.seconds["build"] = build_s
         if light.sky is not None:
             self._sky = (_sky_key(sky_obj, smp, bin_cm), light.sky)

@@ -55,7 +55,10 @@ def day_figure(light: PeriodLight, title: str = "", width_in: float = 11.0,
     order = np.argsort(h)
     t = light.transmission_by_height
     bx.plot(t[order], h[order], "o-", color="tab:green", label="PAR of the period")
-    if light.sky is not None:
+    if light.sky is not None and light.diffuse is not None:
+        bx.plot(light.diffuse_transmission_by_height[order], h[order], "s--",
+                color="tab:blue", ms=4, label="diffuse PAR (Perez sky)")
+    elif light.sky is not None:
         bx.plot(light.sky.transmission[order], h[order], "s--", color="tab:blue", ms=4,
                 label="diffuse sky alone")
     for hk, tk in zip(h, t):

@@ -83,22 +83,33 @@ def write_steps(path: str | Path, pl: PeriodLight) -> None:
     """One line per time step (sun up), atomically: time, step_s, zenith_deg, azimuth_deg,
     ghi_w_m2, direct_horizontal_w_m2, diffuse_w_m2, par_direct_mol_m2, par_diffuse_mol_m2,
     par_intercepted_mol_m2, fraction_intercepted, direct_transmission_h<h>cm...,
-    par_transmitted_mol_m2_h<h>cm..."""
+    par_transmitted_mol_m2_h<h>cm...; with a Perez diffuse split also perez_f1, perez_f2,
+    isotropic_w_m2, circumsolar_w_m2 (on the horizontal), par_circumsolar_mol_m2 (traced with
+    the sun) and par_diffuse_intercepted_mol_m2."""
     p = pl.period
+    d = pl.diffuse
     hs = [f"{h:g}".replace(".", "p") for h in pl.heights_cm]
     head = (["time", "step_s", "zenith_deg", "azimuth_deg", "ghi_w_m2", "direct_horizontal_w_m2",
              "diffuse_w_m2", "par_direct_mol_m2", "par_diffuse_mol_m2", "par_intercepted_mol_m2",
              "fraction_intercepted"] + [f"direct_transmission_h{h}cm" for h in hs]
             + [f"par_transmitted_mol_m2_h{h}cm" for h in hs])
+    if d is not None:
+        head += ["perez_f1", "perez_f2", "isotropic_w_m2", "circumsolar_w_m2",
+                 "par_circumsolar_mol_m2", "par_diffuse_intercepted_mol_m2"]
     with atomic_open(path, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(head)
         for j in range(pl.n_steps):
-            w.writerow([p.times[j].isoformat(), f"{p.step_s[j]:g}", f"{p.zenith_deg[j]:.3f}",
-                        f"{p.azimuth_deg[j]:.3f}", f"{p.ghi[j]:.2f}",
-                        f"{p.direct_horizontal[j]:.2f}", f"{p.dhi[j]:.2f}",
-                        f"{pl.step_direct_mol_m2[j]:.6f}", f"{pl.step_diffuse_mol_m2[j]:.6f}",
-                        f"{pl.step_intercepted_mol_m2[j]:.6f}",
-                        f"{pl.step_fraction_intercepted[j]:.5f}"]
-                       + [f"{t:.5f}" for t in pl.step_transmission[j]]
-                       + [f"{t:.6f}" for t in pl.step_transmitted_mol_m2[j]])
+            row = ([p.times[j].isoformat(), f"{p.step_s[j]:g}", f"{p.zenith_deg[j]:.3f}",
+                    f"{p.azimuth_deg[j]:.3f}", f"{p.ghi[j]:.2f}",
+                    f"{p.direct_horizontal[j]:.2f}", f"{p.dhi[j]:.2f}",
+                    f"{pl.step_direct_mol_m2[j]:.6f}", f"{pl.step_diffuse_mol_m2[j]:.6f}",
+                    f"{pl.step_intercepted_mol_m2[j]:.6f}",
+                    f"{pl.step_fraction_intercepted[j]:.5f}"]
+                   + [f"{t:.5f}" for t in pl.step_transmission[j]]
+                   + [f"{t:.6f}" for t in pl.step_transmitted_mol_m2[j]])
+            if d is not None:
+                row += [f"{d.f1[j]:.4f}", f"{d.f2[j]:.4f}", f"{d.isotropic_w_m2[j]:.2f}",
+                        f"{d.circumsolar_w_m2[j]:.2f}", f"{pl.step_circumsolar_mol_m2[j]:.6f}",
+                        f"{pl.step_diffuse_intercepted_mol_m2[j]:.6f}"]
+            w.writerow(row)

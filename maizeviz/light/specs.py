@@ -56,6 +56,11 @@ class DaySpec:
         µmol of PAR photons per joule of shortwave.
     weather : str or None
         A weather file instead of a clear sky.
+    diffuse : str
+        How each step's diffuse light comes from the sky: ``"sky"`` (the sky chosen, one
+        shape all day) or ``"perez"`` (Perez's anisotropic split per step: its circumsolar
+        part with the sun, the rest from a uniform sky of the sky's directions; see
+        :mod:`maizeviz.light.perez`).
     """
 
     date: str = "2005-08-01"
@@ -68,6 +73,7 @@ class DaySpec:
     linke: float = 3.0
     par_factor: float = DEFAULT_PAR_UMOL_PER_J
     weather: str | None = None
+    diffuse: str = "sky"
 
     def period(self):
         """The Period (maizeviz.light.irradiance) the spec describes; refused with a

@@ -33,10 +33,15 @@ from maizeviz.io.project import ProjectError, Record, get, get_numbers
 from maizeviz.light.clock import zone as iana_zone
 from maizeviz.light.request import MAX_RAYS
 
-#: Record kinds of a sun, a sky and a day result (a sun's is the only kind of maizeviz 0.2).
+#: Record kinds of a sun, a sky and a day result (a sun's is the only kind of maizeviz 0.2),
+#: and of the light a sun's leaves absorbed with scattering (kept beside that sun's record).
 SUN_KIND, SKY_KIND, DAY_KIND = "light", "light_sky", "light_day"
+ABSORBED_KIND = "light_absorbed"
 #: The light of each record kind, as results are named in tables and the app.
-KINDS = {SUN_KIND: "sun", SKY_KIND: "sky", DAY_KIND: "day"}
+KINDS = {SUN_KIND: "sun", SKY_KIND: "sky", DAY_KIND: "day", ABSORBED_KIND: "absorbed"}
+#: Balance fields of an absorbed-light record, W/m2 of ground.
+_BALANCE = ("incident", "absorbed_leaves", "absorbed_ground", "reflected_top",
+            "escaped_sides", "unresolved")
 #: Arrays of a Sky, under the record's prefix.
 _SKY_ARRAYS = ("zenith_deg", "azimuth_deg", "solid_angle_sr", "weights")
 #: Arrays of a Period (each (n,) float64), stored as ``period_<name>``.
@@ -44,6 +49,8 @@ _PERIOD_ARRAYS = ("step_s", "zenith_deg", "azimuth_deg", "ghi", "dni", "dhi",
                   "direct_horizontal")
 #: Prefix of the arrays of a day's sky light.
 _DIFFUSE = "diffuse_"
+#: Prefix of the arrays of a day's diffuse split by Perez's model.
+_PEREZ = "perez_"
 _OFFSET = re.compile(r"(Z|[+-]\d\d:?\d\d(:?\d\d(\.\d+)?)?)$")
 _FIXED_ZONE = re.compile(r"UTC([+-])(\d\d):(\d\d)")
 #: Fractions may exceed 1 by rounding (weighted sums): the bound checked on reading.
@@ -125,6 +132,8 @@ def sky_record(label: str, light, settings: dict | None = None) -> Record:
 def day_record(label: str, light, settings: dict | None = None) -> Record:
     """A day result (``PeriodLight`` traced on the canopy labelled ``label``); ``settings``
     as :func:`sky_record`."""
+    from maizeviz.light.perez import SPLIT_ARRAYS
+
     p = light.period
     meta = _common_meta(label, light)
     meta["period"] = {"times": [t.isoformat() for t in p.times],
@@ -141,6 +150,10 @@ def day_record(label: str, light, settings: dict | None = None) -> Record:
                    "triangle_direct_mol": np.asarray(light.triangle_direct_mol, np.float64),
                    "triangle_diffuse_mol": np.asarray(light.triangle_diffuse_mol, np.float64)})
     arrays.update(_map_arrays(light))
+    if light.diffuse is not None:                   # each step's diffuse light split by Perez
+        meta["diffuse_model"] = str(light.diffuse.model)
+        arrays.update({f"{_PEREZ}{name}": np.asarray(getattr(light.diffuse, name), np.float64)
+                       for name in SPLIT_ARRAYS})
     if light.sky is not None:
         sky_meta, sky_arrays = _sky_parts(light.sky, _DIFFUSE)
         meta["sky"] = sky_meta
@@ -177,15 +190,40 @@ def sun_record(label: str, result) -> Record:
     return Record(SUN_KIND, meta, arrays)
 
 
+def absorbed_record(label: str, light, settings: dict | None = None) -> Record:
+    """Light absorbed with scattering (an ``AbsorbedLight`` traced on the canopy labelled
+    ``label``); ``settings``: the optics spec as JSON (kept for reopening)."""
+    o = light.optics
+    meta = {"label": label, "level": light.level, "band": light.band,
+            "optics": {"reflectance": float(o.reflectance),
+                       "transmittance": float(o.transmittance),
+                       "ground_reflectance": float(o.ground_reflectance)},
+            "irradiance_w_m2": float(light.irradiance_w_m2),
+            "balance": {k: float(getattr(light.balance, k)) for k in _BALANCE},
+            "rect": _floats(light.rect), "rays": int(light.rays),
+            "directions": int(light.directions), "depth": int(light.depth),
+            "threshold": float(light.threshold), "seed": int(light.seed),
+            "events": int(light.events), "periodic": bool(light.periodic),
+            "seconds": {k: float(v) for k, v in light.seconds.items()}}
+    if settings is not None:
+        meta["settings"] = _jsonable(settings)
+    arrays = {"triangle_absorbed_w": np.asarray(light.triangle_absorbed_w, np.float64),
+              "triangle_sunlit_cm2": np.asarray(light.triangle_sunlit_cm2, np.float64)}
+    return Record(ABSORBED_KIND, meta, arrays)
+
+
 def run_record(label: str, result, settings: dict | None = None,
                stands: dict | None = None) -> Record:
-    """The record of any light result: a sun's ``LightResult``, a ``SkyLight`` or a
-    ``PeriodLight``; ``settings``: the settings of a sky or day run as JSON (kept for
-    reopening); ``stands``: the identity of the stands it was traced on
-    (:func:`maizeviz.project.stands.stands_identity`)."""
+    """The record of any light result: a sun's ``LightResult``, a ``SkyLight``, a
+    ``PeriodLight`` or an ``AbsorbedLight``; ``settings``: the settings of a sky, day or
+    absorbed run as JSON (kept for reopening); ``stands``: the identity of the stands it was
+    traced on (:func:`maizeviz.project.stands.stands_identity`)."""
     from maizeviz.light.daylight import PeriodLight, SkyLight
+    from maizeviz.light.scatter import AbsorbedLight
 
-    if isinstance(result, SkyLight):
+    if isinstance(result, AbsorbedLight):
+        rec = absorbed_record(label, result, settings)
+    elif isinstance(result, SkyLight):
         rec = sky_record(label, result, settings)
     elif isinstance(result, PeriodLight):
         rec = day_record(label, result, settings)
@@ -390,6 +428,7 @@ def day_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None]:
     """(label, PeriodLight, stored settings or None) from a ``light_day`` record; refused with
     ProjectError if malformed."""
     from maizeviz.light.daylight import PeriodLight
+    from maizeviz.light.perez import SPLIT_ARRAYS, DiffuseSplit
 
     m = rec.meta
     what = "a day result"
@@ -412,9 +451,20 @@ def day_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None]:
     elif n:
         raise ProjectError(f"{where}: a day result with time steps has no sky light; the "
                            "project is damaged")
+    split = None
+    model = get(m, "diffuse_model", str, None, f"{where}: {what}")
+    if model is not None:
+        parts = {name: _array(rec, f"{_PEREZ}{name}", where, what, (n,),
+                              nan=name == "clearness") for name in SPLIT_ARRAYS}
+        try:
+            split = DiffuseSplit(model, **parts)
+        except MaizevizError as exc:
+            raise ProjectError(f"{where}: {what}: its diffuse split cannot be used ({exc}); "
+                               "the project is damaged") from None
     light = PeriodLight(period=period, sky=sky, step_transmission=step_t,
                         step_intercepted_fraction=step_f, triangle_direct_mol=direct,
-                        triangle_diffuse_mol=diffuse, **_maps(rec, "", n_h, where, what), **c)
+                        triangle_diffuse_mol=diffuse, diffuse=split,
+                        **_maps(rec, "", n_h, where, what), **c)
     return (str(get(m, "label", str, light.level, where)), light,
             get(m, "settings", dict, None, where))
 
@@ -478,6 +528,45 @@ def sun_from_record(rec: Record, where: str) -> tuple[str, Any]:
     return str(get(m, "label", str, result.level, at)), result
 
 
+def absorbed_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None]:
+    """(label, AbsorbedLight, stored settings) from a ``light_absorbed`` record; refused
+    with ProjectError if malformed."""
+    from maizeviz.light.optics import Optics
+    from maizeviz.light.scatter import AbsorbedLight, Balance
+
+    m = rec.meta
+    what = "an absorbed-light result"
+    at = f"{where}: {what}"
+    band = get(m, "band", str, where=at)
+    optics = get(m, "optics", dict, where=at)
+    balance = get(m, "balance", dict, where=at)
+    rect = get_numbers(m, "rect", where=at)
+    if len(rect) != 4:
+        raise ProjectError(f"{at} has inconsistent sizes; the project is damaged")
+    n = rec.arrays.get("triangle_absorbed_w")
+    n_tri = int(n.shape[0]) if n is not None and n.ndim == 1 else -1
+    absorbed = _array(rec, "triangle_absorbed_w", where, what, (n_tri,), lo=0)
+    sunlit = _array(rec, "triangle_sunlit_cm2", where, what, (n_tri,), lo=0)
+    settings = get(m, "settings", dict, None, at)
+    try:
+        light = AbsorbedLight(
+            band, Optics(_number(optics, "reflectance", where, what, 0, 1),
+                         _number(optics, "transmittance", where, what, 0, 1),
+                         _number(optics, "ground_reflectance", where, what, 0, 1), band),
+            _number(m, "irradiance_w_m2", where, what, 0),
+            Balance(*(_number(balance, k, where, what) for k in _BALANCE)),
+            absorbed, sunlit, (rect[0], rect[1], rect[2], rect[3]),
+            get(m, "rays", int, where=at), get(m, "directions", int, where=at),
+            get(m, "depth", int, where=at), _number(m, "threshold", where, what, 0, 1),
+            get(m, "seed", int, where=at), get(m, "events", int, where=at),
+            bool(get(m, "periodic", bool, False, at)), str(get(m, "level", str, "", at)),
+            {str(k): float(v) for k, v in get(m, "seconds", dict, {}, at).items()
+             if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)})
+    except (ValueError, TypeError, MaizevizError) as exc:
+        raise ProjectError(f"{at} cannot be used ({exc})") from None
+    return str(get(m, "label", str, light.level, at)), light, settings
+
+
 def run_from_record(rec: Record, where: str) -> tuple[str, Any, str, dict | None] | None:
     """(label, result, light kind ``"sun"``/``"sky"``/``"day"``, stored settings or None) of
     a record, or None for a kind this maizeviz does not know.
@@ -496,12 +585,15 @@ def run_from_record(rec: Record, where: str) -> tuple[str, Any, str, dict | None
     if rec.kind == DAY_KIND:
         label, result, stored = day_from_record(rec, where)
         return label, result, "day", stored
+    if rec.kind == ABSORBED_KIND:
+        label, result, stored = absorbed_from_record(rec, where)
+        return label, result, "absorbed", stored
     return None
 
 
 #: Arrays of a record that hold one value per canopy triangle (stalks included).
 PER_TRIANGLE = ("first_hits", "second_hits", "triangle_share", "triangle_direct_mol",
-                "triangle_diffuse_mol")
+                "triangle_diffuse_mol", "triangle_absorbed_w", "triangle_sunlit_cm2")
 
 
 def per_triangle(rec: Record) -> int:

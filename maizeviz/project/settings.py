@@ -6,18 +6,21 @@ from __future__ import annotations
 
 from typing import Any
 
-from maizeviz.io.project import get
-from maizeviz.light.specs import DaySpec, SkySpec
+from maizeviz.errors import MaizevizError
+from maizeviz.io.project import ProjectError, get
+from maizeviz.light.specs import DaySpec, OpticsSpec, SkySpec
 
 __all__ = ["run_settings", "settings_doc"]
 
 
 def settings_doc(kind: str, settings: Any) -> dict | None:
-    """The specs of a sky result (a :class:`SkySpec`) or a day result (``(DaySpec,
-    SkySpec)``) as the JSON document a project stores with it, or None when they are not
-    those."""
+    """The specs of a sky result (a :class:`SkySpec`), a day result (``(DaySpec,
+    SkySpec)``) or absorbed light (an :class:`OpticsSpec`) as the JSON document a project
+    stores with it, or None when they are not those."""
     from dataclasses import asdict, is_dataclass
 
+    if kind == "absorbed" and isinstance(settings, OpticsSpec):
+        return {"optics": asdict(settings)}
     if kind == "sky" and is_dataclass(settings) and not isinstance(settings, type):
         return {"sky": asdict(settings)}
     if kind == "day" and isinstance(settings, tuple) and len(settings) == 2 and \
@@ -44,14 +47,24 @@ def _day_spec(doc: dict, where: str) -> DaySpec:
                    float(get(doc, "step_min", (int, float), where=at)), text_or_none("start"),
                    text_or_none("end"), float(get(doc, "linke", (int, float), where=at)),
                    float(get(doc, "par_factor", (int, float), where=at)),
-                   text_or_none("weather"))
+                   text_or_none("weather"), _choice(doc, "diffuse", ("sky", "perez"), at))
+
+
+def _choice(doc: dict, key: str, allowed: tuple[str, ...], at: str) -> str:
+    value = get(doc, key, str, allowed[0], at)
+    if value not in allowed:
+        raise ProjectError(f"{at}: '{key}' is '{value[:40]}', not one of {', '.join(allowed)}")
+    return value
 
 
 def run_settings(kind: str, result, stored: dict | None, where: str) -> Any:
     """The specs a sky or day result was traced with (a :class:`SkySpec`, or ``(DaySpec,
     SkySpec)`` for a day), as the app's light panel gives them for the same choice: from the
     stored ``settings`` document, else (an older record) the sky's from the result and None
-    for a day. Bad stored settings: ProjectError naming ``where``."""
+    for a day; for absorbed light, its :class:`OpticsSpec` (from the result when not stored).
+    Bad stored settings: ProjectError naming ``where``."""
+    if kind == "absorbed":
+        return _optics_spec(stored, result, where)
     if stored is not None:
         sky = _sky_spec(get(stored, "sky", dict, where=where), where)
         if kind == "sky":
@@ -61,3 +74,26 @@ def run_settings(kind: str, result, stored: dict | None, where: str) -> Any:
         s = result.sky
         return SkySpec(s.kind, s.n, "equal" if s.split == "equal" else "auto")
     return None
+
+
+def _optics_spec(stored: dict | None, light, where: str) -> OpticsSpec:
+    at = f"{where}: the optics settings of an absorbed-light result"
+    if stored is None:
+        o = light.optics
+        return OpticsSpec(light.band, o.reflectance, o.transmittance, o.ground_reflectance)
+    doc = get(stored, "optics", dict, where=at)
+
+    def number_or_none(key: str):
+        value = doc.get(key)
+        return None if value is None else float(get(doc, key, (int, float), where=at))
+
+    spec = OpticsSpec(get(doc, "band", str, where=at), number_or_none("reflectance"),
+                      number_or_none("transmittance"), number_or_none("ground_reflectance"),
+                      number_or_none("direct_w_m2"),
+                      float(get(doc, "diffuse_w_m2", (int, float), 0.0, at)),
+                      get(doc, "depth", int, 3, at), get(doc, "seed", int, 0, at))
+    try:
+        spec.optics()
+    except MaizevizError as exc:
+        raise ProjectError(f"{at}: {exc}") from None
+    return spec

@@ -246,8 +246,17 @@ def _light(state: _GroupState, s) -> dict:
     res = state.engine.sun(sun, classes=False, sampling=sampling)
     seconds["scene"] += res.seconds["build"]           # a periodic scene built for this row
     seconds["trace"] = time.perf_counter() - t0 - res.seconds["build"]
+    absorbed: dict = {}
+    if s.optics is not None:                           # leaves with optics: absorbed light
+        t0 = time.perf_counter()
+        light = s.optics.absorbed(state.engine, sun, sampling)
+        seconds["scatter"] = time.perf_counter() - t0
+        b = light.balance
+        absorbed = {"incident_w_m2": b.incident, "absorbed_leaves_w_m2": b.absorbed_leaves,
+                    "absorbed_ground_w_m2": b.absorbed_ground,
+                    "reflected_top_w_m2": b.reflected_top, "balance_closure": b.closure}
     m = state.measures
-    return {"key": s.key, "status": "ok", "error": None, "triangles": m["triangles"],
+    return {**absorbed,"key": s.key, "status": "ok", "error": None, "triangles": m["triangles"],
             "plants": m["plants"], "leaves": m["leaves"],
             "leaves_skipped": state.leaves_skipped, "leaf_area_m2": m["leaf_area_m2"],
             "projected_area_m2": m["projected_area_m2"],

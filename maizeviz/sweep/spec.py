@@ -23,6 +23,10 @@ Defaults are those of ``maizeviz canopy`` and ``maizeviz light``::
     heights = [0, 50, 100, 150, 200, 225]   # cm; not an axis: every scenario reports all
     periodic = true                # rays leaving the plot re-enter it (default false)
     rect = [0, 0, 180, 90]         # sample rectangle x0, y0, x1, y1 in cm (default: centre tile)
+    optics = ["black",             # leaf optics: "black" (interception only, the default) or
+              {band = "par"},      # a table: absorbed light with scattering, each key optional:
+              {band = "nir", reflectance = 0.45, transmittance = 0.40, ground_reflectance = 0.25,
+               direct_w_m2 = 520, diffuse_w_m2 = 0, depth = 3, seed = 0}]
 
     [[exclude]]                    # partial scenarios to drop (or, before [canopy]:
     level = "K4"                   # exclude = [{level = "K4", density = 16}])
@@ -44,7 +48,7 @@ import math
 import os
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from datetime import date, datetime
 from datetime import time as dtime
 from pathlib import Path
@@ -58,6 +62,7 @@ else:  # pragma: no cover - Python 3.10: the tomli backport (the sweep extra ins
 import maizeviz
 from maizeviz.errors import MaizevizError
 from maizeviz.io.inputs import read_input
+from maizeviz.light.specs import OpticsSpec
 from maizeviz.sweep import compute
 from maizeviz.sweep.errors import SweepSpecError
 
@@ -72,10 +77,16 @@ DEFAULT_HEIGHTS = (0.0, 50.0, 100.0, 150.0, 200.0, 225.0)
 
 CANOPY_KEYS = ("points", "tile", "row_spacing", "plant_spacing", "block", "layout", "level",
                "preserve_area", "cover_resolution")
-LIGHT_KEYS = ("sun", "density", "heights", "periodic", "rect")
+LIGHT_KEYS = ("sun", "density", "heights", "periodic", "rect", "optics")
 TOP_KEYS = ("canopy", "light", "exclude")
 AXES = ("points", "tile", "row_spacing", "plant_spacing", "layout", "level", "preserve_area",
-        "sun", "density", "periodic")
+        "sun", "density", "periodic", "optics")
+#: Keys of an optics table (:class:`maizeviz.light.specs.OpticsSpec`); "black" (or false) is
+#: the black leaves of interception.
+OPTICS_KEYS = ("band", "reflectance", "transmittance", "ground_reflectance", "direct_w_m2",
+               "diffuse_w_m2", "depth", "seed")
+#: Most scatterings a sweep follows.
+MAX_DEPTH = 50
 SUN_ANGLE_KEYS = ("zenith", "azimuth")
 SUN_PLACE_KEYS = ("date", "time", "solar_noon", "lat", "lon", "tz", "altitude")
 
@@ -176,6 +187,7 @@ class Scenario:
     heights_cm: tuple
     rect_cm: tuple | None
     cover_resolution: float
+    optics: OpticsSpec | None = None
 
     def axes(self) -> dict:
         """The axis values as result columns."""
@@ -186,16 +198,30 @@ class Scenario:
                 "block": f"{a.block[0]}x{a.block[1]}" if a.block else None,
                 "level": self.level, "preserve_area": self.preserve_area,
                 "sun_zenith_deg": self.sun.zenith_deg, "sun_azimuth_deg": self.sun.azimuth_deg,
-                "sun_when": self.sun.when, "density": self.density, "periodic": self.periodic}
+                "sun_when": self.sun.when, "density": self.density, "periodic": self.periodic,
+                **optics_columns(self.optics)}
+
+
+def optics_columns(optics: OpticsSpec | None) -> dict:
+    """The optics of a scenario as result columns (None for black leaves)."""
+    if optics is None:
+        return {"optics_band": None, "leaf_reflectance": None, "leaf_transmittance": None,
+                "ground_reflectance": None, "scatter_depth": None}
+    o = optics.optics()
+    return {"optics_band": o.band, "leaf_reflectance": o.reflectance,
+            "leaf_transmittance": o.transmittance, "ground_reflectance": o.ground_reflectance,
+            "scatter_depth": optics.depth}
 
 
 def _scenario_inputs(points, arr, level, preserve, sun, density, periodic, heights, rect,
-                     cover) -> tuple[dict, dict]:
+                     cover, optics=None) -> tuple[dict, dict]:
     group = {"points_sha256": points.sha256, **arr.canonical(), "level": level,
              "preserve_area": preserve, "cover_resolution": cover, "maizeviz": version_tag()}
     full = dict(group, sun_zenith_deg=sun.zenith_deg, sun_azimuth_deg=sun.azimuth_deg,
                 sun_when=sun.when, density=density, periodic=periodic, heights_cm=list(heights),
                 rect_cm=list(rect) if rect else None)
+    if optics is not None:              # black leaves keep the keys they always had
+        full["optics"] = asdict(optics)
     return group, full
 
 
@@ -364,6 +390,37 @@ class _Checker:
                 self.fail(f"{where}.time", "is missing (or set solar_noon = true)")
         return t
 
+    def optics(self, v, where) -> OpticsSpec | None:
+        """Leaf optics: "black" or false (interception), or a table of OPTICS_KEYS."""
+        if v is False or (isinstance(v, str) and v.lower() in ("black", "none")):
+            return None
+        if not isinstance(v, dict):
+            self.fail(where, 'must be "black" or a table such as {band = "par", reflectance = '
+                             '0.1, transmittance = 0.05, ground_reflectance = 0.1}')
+        self.known(v, OPTICS_KEYS, where)
+        t: dict[str, Any] = {}
+        if "band" in v:
+            t["band"] = self.text(v["band"], f"{where}.band").lower()
+        for k in ("reflectance", "transmittance", "ground_reflectance", "direct_w_m2",
+                  "diffuse_w_m2"):
+            if k in v:
+                t[k] = self.number(v[k], f"{where}.{k}", positive=False, minimum=0)
+        for k in ("depth", "seed"):
+            if k in v:
+                x = v[k]
+                if isinstance(x, bool) or not isinstance(x, int) or not 0 <= x <= (
+                        MAX_DEPTH if k == "depth" else 2**31 - 1):
+                    self.fail(f"{where}.{k}", f"must be a whole number from 0 to "
+                                              f"{MAX_DEPTH if k == 'depth' else 2**31 - 1}, "
+                                              f"got {x!r}")
+                t[k] = x
+        spec = OpticsSpec(**t)
+        try:
+            spec.optics()
+        except MaizevizError as exc:
+            self.fail(where, str(exc))
+        return spec
+
     def sun(self, v, where) -> SunSpec:
         t = self.sun_table(v, where)
         try:
@@ -484,6 +541,7 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
     suns = ck.axis(light, "sun", "light", ck.sun)
     densities = ck.axis(light, "density", "light", ck.number, [4.0])
     periodic = ck.axis(light, "periodic", "light", ck.boolean, [False])
+    optics = ck.axis(light, "optics", "light", ck.optics, [None])
     heights = DEFAULT_HEIGHTS
     if "heights" in light:
         raw = light["heights"]
@@ -508,7 +566,8 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
         ck.fail("exclude", "must be a list of tables such as [{level = \"K4\", density = 16}]")
     matchers = [_matcher(ck, e, f"exclude[{i}]") for i, e in enumerate(excludes)]
 
-    axes: list[list[Any]] = [points, arrangements, levels, preserve, densities, periodic, suns]
+    axes: list[list[Any]] = [points, arrangements, levels, preserve, densities, periodic, suns,
+                             optics]
     total = math.prod(len(a) for a in axes)
     if total > HARD_MAX_SCENARIOS:
         raise SweepSpecError(f"{source}: the axes make {total:,} combinations, beyond the "
@@ -518,18 +577,19 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
                              "confirm with --yes, or narrow the axes")
     scenarios: list[Scenario] = []
     used, excluded = [False] * len(matchers), 0
-    for pf, arr, lv, pa, dens, per, sun in itertools.product(*axes):
+    for pf, arr, lv, pa, dens, per, sun, opt in itertools.product(*axes):
         values = {"points": pf, "arrangement": arr, "level": lv, "preserve_area": pa,
-                  "density": dens, "periodic": per, "sun": sun}
+                  "density": dens, "periodic": per, "sun": sun, "optics": opt}
         hit = [i for i, m in enumerate(matchers) if m(values)]
         if hit:
             for i in hit:
                 used[i] = True
             excluded += 1
             continue
-        group, full = _scenario_inputs(pf, arr, lv, pa, sun, dens, per, heights, rect, cover)
+        group, full = _scenario_inputs(pf, arr, lv, pa, sun, dens, per, heights, rect, cover,
+                                       opt)
         scenarios.append(Scenario(len(scenarios), _digest(full)[:24], _digest(group)[:24], pf, arr,
-                                  lv, pa, sun, dens, per, heights, rect, cover))
+                                  lv, pa, sun, dens, per, heights, rect, cover, opt))
     for i, u in enumerate(used):
         if not u:
             ck.fail(f"exclude[{i}]", "matches no scenario (a typo in a value?)")
@@ -565,6 +625,8 @@ def _matcher(ck: _Checker, entry: dict, where: str) -> Callable[[dict[str, Any]]
             want = ck.level(v, w)
         elif key in ("preserve_area", "periodic"):
             want = ck.boolean(v, w)
+        elif key == "optics":
+            want = ck.optics(v, w)
         else:                                              # sun: every key given must agree
             if not isinstance(v, dict) or not v:
                 ck.fail(w, "must be a table of sun keys, such as {zenith = 30}")

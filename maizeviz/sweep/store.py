@@ -46,10 +46,16 @@ COLUMNS = (
     ("status", "string"), ("error", "string"), ("warnings", "string"),
     ("seconds_fit", "float64"), ("seconds_layout", "float64"), ("seconds_build", "float64"),
     ("seconds_scene", "float64"), ("seconds_measure", "float64"), ("seconds_trace", "float64"),
+    # leaf optics (None for black leaves): the axis, then the energy balance, W/m2 of ground
+    ("optics_band", "string"), ("leaf_reflectance", "float64"),
+    ("leaf_transmittance", "float64"), ("ground_reflectance", "float64"),
+    ("scatter_depth", "int64"), ("incident_w_m2", "float64"), ("absorbed_leaves_w_m2", "float64"),
+    ("absorbed_ground_w_m2", "float64"), ("reflected_top_w_m2", "float64"),
+    ("balance_closure", "float64"), ("seconds_scatter", "float64"),
     ("worker", "string"), ("maizeviz_version", "string"), ("finished_at", "string"),
 )
 COLUMN_NAMES = tuple(c for c, _ in COLUMNS)
-STAGES = ("fit", "layout", "build", "scene", "measure", "trace")
+STAGES = ("fit", "layout", "build", "scene", "measure", "trace", "scatter")
 #: Statuses that count as done when resuming.
 DONE = ("ok", "error")
 OWN_FILES = {"sweep.json", "parts", "results.parquet", "results.csv", "summary.csv"}
@@ -70,6 +76,9 @@ def scenario_rows(s, result: dict, worker: str | None, finished_at: str) -> list
         for k in ("rays", "triangles", "plants", "leaves", "leaves_skipped", "leaf_area_m2",
                   "projected_area_m2", "ground_cover_m2", "ground_area_m2", "lai"):
             base[k] = result[k]
+        for k in ("incident_w_m2", "absorbed_leaves_w_m2", "absorbed_ground_w_m2",
+                  "reflected_top_w_m2", "balance_closure"):
+            base[k] = result.get(k)
         warnings = result.get("warnings") or []
         base["warnings"] = "; ".join(warnings[:5]) + (
             f"; and {len(warnings) - 5} more" if len(warnings) > 5 else "") if warnings else None

@@ -16,7 +16,8 @@ from maizeviz.sweep.spec import arrangement_label, sun_label
 
 DEFAULT_TOLERANCE = 0.02
 
-SUMMARY_COLUMNS = ("points", "arrangement", "preserve_area", "density", "periodic", "sun",
+SUMMARY_COLUMNS = ("points", "arrangement", "preserve_area", "density", "periodic", "optics",
+                   "sun",
                    "levels", "finest_level", "finest_triangles", "cheapest_level",
                    "cheapest_triangles", "triangle_fraction", "max_abs_difference",
                    "tolerance")
@@ -25,6 +26,14 @@ SUMMARY_COLUMNS = ("points", "arrangement", "preserve_area", "density", "periodi
 def _arrangement(r: dict) -> str:
     return arrangement_label(r.get("layout"), r.get("tile"), r.get("row_spacing"),
                              r.get("plant_spacing"))
+
+
+def _optics(r: dict) -> str:
+    """Leaf optics in a word: "black", or band and leaf rho/tau, soil rho."""
+    if not r.get("optics_band"):
+        return "black"
+    return (f"{r['optics_band']} rho {r['leaf_reflectance']:g} tau {r['leaf_transmittance']:g} "
+            f"soil {r['ground_reflectance']:g}")
 
 
 def _sun(r: dict) -> str:
@@ -42,7 +51,8 @@ def summarize(rows: list[dict], tolerance: float = DEFAULT_TOLERANCE) -> list[di
     for r in rows:
         if r.get("status") != "ok" or r.get("transmission") is None:
             continue
-        canopy = (r["points"], _arrangement(r), r["preserve_area"], r["density"], r["periodic"])
+        canopy = (r["points"], _arrangement(r), r["preserve_area"], r["density"], r["periodic"],
+                  _optics(r))
         per_level = tree.setdefault(canopy, {}).setdefault(_sun(r), {})
         tri, ts = per_level.setdefault(r["level"], (r["triangles"], {}))
         ts[r["height_cm"]] = r["transmission"]
@@ -77,9 +87,9 @@ def summarize(rows: list[dict], tolerance: float = DEFAULT_TOLERANCE) -> list[di
 def _row(canopy, sun, levels, finest, f_tri, diffs, tri_of, tolerance) -> dict:
     ok = [lv for lv in levels if diffs[lv] <= tolerance + 1e-12]
     cheapest = min(ok, key=lambda lv: tri_of[lv])
-    points, arrangement, preserve, density, periodic = canopy
+    points, arrangement, preserve, density, periodic, optics = canopy
     return {"points": points, "arrangement": arrangement, "preserve_area": preserve,
-            "density": density, "periodic": periodic, "sun": sun,
+            "density": density, "periodic": periodic, "optics": optics, "sun": sun,
             "levels": len(list(levels)), "finest_level": finest, "finest_triangles": f_tri,
             "cheapest_level": cheapest, "cheapest_triangles": tri_of[cheapest],
             "triangle_fraction": tri_of[cheapest] / f_tri if f_tri else float("nan"),
@@ -93,7 +103,9 @@ def format_summary(summary: list[dict]) -> str:
     head = ["points", "arrangement", "density", "sun", "finest", "cheapest within tol",
             "triangles", "max |dT|"]
     rows = [[s["points"], s["arrangement"] + ("" if s["preserve_area"] else ", widths unscaled")
-             + (", periodic" if s["periodic"] else ""), f"{s['density']:g}", s["sun"],
+             + (", periodic" if s["periodic"] else "")
+             + ("" if s.get("optics", "black") == "black" else f", {s['optics']}"),
+             f"{s['density']:g}", s["sun"],
              s["finest_level"], s["cheapest_level"],
              f"{s['cheapest_triangles']:,} ({s['triangle_fraction']:.1%})",
              f"{s['max_abs_difference']:.4f}"] for s in summary]

@@ -231,6 +231,45 @@ def test_ctrl_c_on_the_command_stops_cleanly_and_the_rerun_finishes(blocks, clie
 
 
 # --------------------------------------------------------------------------- bad input
+def test_optics_axis_rows_equal_the_single_run_cli(blocks, client, tmp_path, capsys):
+    """Leaf optics as an axis: black leaves keep today's keys and numbers; each optics row
+    carries the energy balance of ``maizeviz light --reflectance ... --json``."""
+    base = load_spec(spec_file(blocks))
+    text = SPEC.replace('level = ["standard", "8"]', 'level = ["8"]').replace(
+        "periodic = true", 'periodic = true\noptics = ["black", {band = "par"}, '
+        '{band = "nir", reflectance = 0.4, transmittance = 0.4, ground_reflectance = 0.2, '
+        'depth = 2}]').replace('points = ["b*.csv"]', 'points = ["b0.csv"]')
+    spec = load_spec(spec_file(blocks, text, "optics.toml"))
+    assert len(spec.scenarios) == 3 * 3
+    black = {s.key for s in spec.scenarios if s.optics is None}
+    assert black <= {s.key for s in base.scenarios}          # the same keys as without optics
+    out = tmp_path / "r"
+    outcome = run_sweep(spec, out, client=client, progress=False)
+    assert outcome.complete and outcome.errors == 0
+    rows = [r for r in read_results(out) if r["height_cm"] == 0.0]
+    capsys.readouterr()
+    for r in rows:
+        if r["optics_band"] is None:
+            assert r["absorbed_leaves_w_m2"] is None and r["incident_w_m2"] is None
+            continue
+        args = ["light", str(blocks / "b0.csv"), "--triangles", "8", "--sun-zenith",
+                str(r["sun_zenith_deg"]), "--sun-azimuth", str(r["sun_azimuth_deg"]),
+                "--density", "0.5", "--periodic", "--heights", ",".join(map(str, HEIGHTS)),
+                "--json",
+                "--band", r["optics_band"], "--reflectance", str(r["leaf_reflectance"]),
+                "--transmittance", str(r["leaf_transmittance"]), "--ground-reflectance",
+                str(r["ground_reflectance"]), "--depth", str(r["scatter_depth"])]
+        assert cli_main(args) == 0
+        balance = json.loads(capsys.readouterr().out)["balance"]       # one level: flat
+        assert r["incident_w_m2"] == pytest.approx(balance["incident"], rel=1e-12)
+        assert r["absorbed_leaves_w_m2"] == pytest.approx(balance["absorbed_leaves"], rel=1e-9)
+        assert r["reflected_top_w_m2"] == pytest.approx(balance["reflected_top"], rel=1e-9)
+        assert abs(r["balance_closure"]) < 0.02
+    summary = summarize(read_results(out), 0.02)
+    assert {s["optics"] for s in summary} == {"black", "par rho 0.1 tau 0.05 soil 0.1",
+                                              "nir rho 0.4 tau 0.4 soil 0.2"}
+
+
 @pytest.mark.parametrize("text, says", [
     ("[canopy\npoints = 1", r"not valid TOML.*line 1"),
     (SPEC.replace("tile =", "tiles ="), r"unknown key 'canopy.tiles' \(known in canopy: points, "),
@@ -269,6 +308,18 @@ def test_ctrl_c_on_the_command_stops_cleanly_and_the_rerun_finishes(blocks, clie
      r"exclude\[0\].sun.zenith: must be a number, got an integer too large"),
     (SPEC + "[[exclude]]\nrow_spacing = 0.5\n",
      r"exclude\[0\].row_spacing: row spacing is 0.5 cm; it must be from 1"),
+    # leaf optics
+    (SPEC.replace("periodic = true", 'periodic = true\noptics = ["white"]'),
+     r"light.optics\[0\]: must be \"black\" or a table"),
+    (SPEC.replace("periodic = true", 'periodic = true\noptics = [{band = "uv"}]'),
+     r"light.optics\[0\]: unknown band 'uv'"),
+    (SPEC.replace("periodic = true",
+                  "periodic = true\noptics = [{reflectance = 0.7, transmittance = 0.6}]"),
+     r"light.optics\[0\]: .*1"),
+    (SPEC.replace("periodic = true", "periodic = true\noptics = [{depth = 1000}]"),
+     r"light.optics\[0\].depth: must be a whole number from 0 to 50"),
+    (SPEC.replace("periodic = true", "periodic = true\noptics = [{colour = 1}]"),
+     r"unknown key 'light.optics\[0\].colour'"),
 ])
 def test_bad_sweep_files_say_one_line_naming_the_key(blocks, tmp_path, text, says):
     (tmp_path / "b0.csv").write_bytes((blocks / "b0.csv").read_bytes())

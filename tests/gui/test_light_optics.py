@@ -44,14 +44,28 @@ def test_sun_with_leaf_optics_paints_absorbed_light_and_balances(window, qtbot, 
     values = w.viewport.canopy_mesh.cell_data["light_value"][:w.canopy.n_triangles]
     np.testing.assert_allclose(values, run.extra.leaf_value, rtol=1e-6)
     assert w.viewport.colouring == "light" and values.max() > 0
-    # the settings go into the project and come back
+    # the settings and the absorbed light go into the project and come back as computed
     path = tmp_path / "optics.maizeviz"
-    p.reflectance.setValue(0.12)
+    table = _rows(p.table)
     with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
         w.save_project(path)
     w2 = window(path)
-    qtbot.waitUntil(lambda: w2.light_panel.optics_box.isChecked(), timeout=TIMEOUT)
-    assert w2.light_panel.reflectance.value() == 0.12
+    qtbot.waitUntil(lambda: w2.runs.last is not None and w2.runs.last.extra is not None
+                    and w2.runs.last.extra.leaf_value is not None, timeout=TIMEOUT)
+    p2 = w2.light_panel
+    assert p2.optics_box.isChecked() and p2.reflectance.value() == 0.10
+    run2 = w2.runs.last
+    assert run2.balance == b and _rows(p2.table) == table
+    np.testing.assert_array_equal(run2.extra.light.triangle_absorbed_w, a.triangle_absorbed_w)
+    np.testing.assert_array_equal(run2.extra.leaf_value, run.extra.leaf_value)
+    qtbot.waitUntil(lambda: w2.viewport.colouring == "light", timeout=TIMEOUT)
+    np.testing.assert_allclose(
+        w2.viewport.canopy_mesh.cell_data["light_value"][:w2.canopy.n_triangles],
+        run.extra.leaf_value, rtol=1e-6)
+    assert _rows(p2.plants) == plants
+    # the same sun and optics again: the comparison goes on (same settings)
+    compute(qtbot, w2)
+    assert "starts again" not in w2.messages.toPlainText()
 
 
 def test_black_leaves_absorb_what_they_intercept(window, qtbot, small_points):
@@ -82,3 +96,25 @@ def test_optics_out_of_range_is_one_line_on_the_field(window, qtbot, small_point
         p.compute_button.click()
     assert "1" in sig.args[0] and "internal" not in sig.args[0]
     assert "border" in p.transmittance.styleSheet() or "border" in p.reflectance.styleSheet()
+
+
+def test_a_day_with_perez_diffuse_light(window, qtbot, small_points, tmp_path):
+    """Day mode with Perez's anisotropic diffuse light: the same directions traced, the
+    circumsolar share said, the choice saved in the project."""
+    w = shown(qtbot, window(small_points, tile=1))
+    p = w.light_panel
+    small_light(p, "day")
+    p.day_diffuse.setCurrentIndex(p.day_diffuse.findData("perez"))
+    compute(qtbot, w)
+    day = w.runs.last.result
+    assert day.diffuse is not None and day.diffuse.model == "perez"
+    assert "Perez anisotropic" in p.info.text() and "circumsolar" in p.info.text()
+    total = day.par_diffuse_mol_m2
+    assert abs(float(day.step_diffuse_mol_m2.sum()) - total) < 1e-9 * max(total, 1)
+    path = tmp_path / "perez.maizeviz"
+    with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
+        w.save_project(path)
+    w2 = window(path)
+    qtbot.waitUntil(lambda: w2.runs.last is not None, timeout=TIMEOUT)
+    assert w2.light_panel.day_diffuse.currentData() == "perez"
+    assert w2.runs.last.result.diffuse is not None

@@ -30,9 +30,17 @@ from PySide6.QtWidgets import (
 
 from maizeviz.mesh.levels import COMPLEXITY_STOPS, parse_level
 
+#: What the slider does.
+SLIDER_TIP = ("fine (K=4, the paper's reference mesh) to coarse (4 triangles per leaf); the "
+              "canopy is rebuilt when the slider rests")
+#: The level of a canopy read from a mesh file.
+MESH_LEVEL = "mesh"
+
 
 def describe(level: str) -> str:
     """A slider stop in words."""
+    if level == MESH_LEVEL:
+        return "the mesh file's triangles"
     return parse_level(level).description
 
 
@@ -79,8 +87,7 @@ class CanopyPanel(QWidget):
                              else COMPLEXITY_STOPS.index("36"))
         self.slider.setTickPosition(QSlider.TickPosition.TicksBelow)
         self.slider.setPageStep(1)
-        self.slider.setToolTip("fine (K=4, the paper's reference mesh) to coarse (4 triangles "
-                               "per leaf); the canopy is rebuilt when the slider rests")
+        self.slider.setToolTip(SLIDER_TIP)
         ends = QHBoxLayout()
         ends.addWidget(QLabel("fine: K=4"))
         ends.addStretch(1)
@@ -126,10 +133,22 @@ class CanopyPanel(QWidget):
 
     def _follow(self, study) -> None:
         study.points_changed.connect(self._on_points)
+        study.mesh_opened.connect(self._on_mesh)
         study.canopy_changed.connect(
             lambda built: self.show_built(built.level, list(built.columns), built.row))
 
+    def _on_mesh(self, path: str) -> None:
+        self.clear_rows()
+        self.set_file(Path(path).name, path)
+        self.slider.setEnabled(False)
+        self.slider.setToolTip("a canopy read from a mesh file has one level: the file's "
+                               "triangles (open digitized points to choose a level)")
+        self.preserve.setEnabled(False)
+
     def _on_points(self, loaded) -> None:
+        self.slider.setEnabled(True)
+        self.slider.setToolTip(SLIDER_TIP)
+        self.preserve.setEnabled(True)
         self.clear_rows()
         from_project = self.study.project_path is not None
         self.set_file(loaded.shown_name if from_project else Path(loaded.shown_name).name,

@@ -151,10 +151,15 @@ class LayoutPanel(QWidget):
         self._follow_timer = QTimer(self, singleShot=True, interval=FOLLOW_DELAY_MS)
         self._follow_timer.timeout.connect(self.apply)
         if study is not None:
-            study.points_changed.connect(lambda loaded: self.show_layout(loaded.layout,
-                                                                         loaded.plants))
+            study.points_changed.connect(self._on_points)
+            # a mesh file's canopy has no layout to edit
+            study.mesh_opened.connect(lambda _path: self.setEnabled(False))
             if study.loaded is not None:
                 self.show_layout(study.loaded.layout, study.loaded.plants)
+
+    def _on_points(self, loaded) -> None:
+        self.setEnabled(True)
+        self.show_layout(loaded.layout, loaded.plants)
 
     # ------------------------------------------------------------------------ state
     @property

@@ -257,6 +257,7 @@ class LightPanel(QWidget):
                     "time": self.place, "tz": self.place},
             "sky": {"sky": self.sky_kind, "sky_directions": self.sky_n},
             "day": {"sky": self.sky_kind, "sky_directions": self.sky_n,
+                    "diffuse": self.day_diffuse,
                     "date": self.day_date, "place": [self.lat, self.lon], "tz": self.tz,
                     "step": self.step, "period": [self.day_from, self.day_to],
                     "par_factor": self.par_factor, "linke_turbidity": self.linke,
@@ -462,6 +463,14 @@ class LightPanel(QWidget):
                                    suffix=" min")
         self.step.setToolTip("time step: the sun is traced once per step (at its middle)")
         form.addRow("time step", self.step)
+        self.day_diffuse = QComboBox()
+        self.day_diffuse.addItem("the sky chosen below, all day", "sky")
+        self.day_diffuse.addItem("Perez anisotropic: circumsolar with the sun", "perez")
+        self.day_diffuse.setToolTip(
+            "how each step's diffuse light comes from the sky: one sky shape all day, or "
+            "Perez's split of each step (its circumsolar part traced with the sun, the rest "
+            "from a uniform sky of the directions chosen below; pvlib)")
+        form.addRow("diffuse light", self.day_diffuse)
         self.day_from = QLineEdit("")
         self.day_from.setPlaceholderText("00:00")
         self.day_to = QLineEdit("")
@@ -562,6 +571,7 @@ class LightPanel(QWidget):
                 "source": "weather" if self.source_weather.isChecked() else "clear",
                 "linke_turbidity": self.linke.value(), "weather": self.weather.text(),
                 "par_factor": self.par_factor.value(),
+                "day_diffuse": self.day_diffuse.currentData(),
                 "optics": self.optics_box.isChecked(), "band": self.band.currentData(),
                 "reflectance": self.reflectance.value(),
                 "transmittance": self.transmittance.value(),
@@ -581,6 +591,8 @@ class LightPanel(QWidget):
         if "depth" in s:
             self.scatter_depth.setValue(int(s["depth"]))
         self.optics_box.setChecked(bool(s.get("optics", False)))
+        if s.get("day_diffuse") in ("sky", "perez"):
+            self.day_diffuse.setCurrentIndex(self.day_diffuse.findData(s["day_diffuse"]))
         self.zenith.setValue(float(s.get("zenith_deg", self.zenith.value())))
         self.azimuth.setValue(float(s.get("azimuth_deg", self.azimuth.value())))
         self.place.setText(str(s.get("place", self.place.text())))
@@ -656,7 +668,8 @@ class LightPanel(QWidget):
         return DaySpec(self.day_date.date().toString("yyyy-MM-dd"), self.lat.value(),
                        self.lon.value(), self.tz.text().strip(), self.step.value(),
                        self.day_from.text().strip() or None, self.day_to.text().strip() or None,
-                       self.linke.value(), self.par_factor.value(), weather)
+                       self.linke.value(), self.par_factor.value(), weather,
+                       str(self.day_diffuse.currentData()))
 
     def sampling_key(self, heights) -> tuple:
         """What every result of a comparison shares."""

@@ -1,0 +1,57 @@
+"""A canopy from elsewhere in the app: File > Open canopy mesh reads a PLY with plant and
+leaf ids, light runs on it as on digitized plants; the slider and layout do not apply, and it
+is not saved into a project."""
+
+from __future__ import annotations
+
+import numpy as np
+from test_light_modes import TIMEOUT, compute, shown, small_light
+
+
+def test_a_mesh_canopy_opens_and_is_traced(window, qtbot,
+                                                                      small_points, tmp_path):
+    from maizeviz.canopy.export import export_canopy
+
+    w = shown(qtbot, window(small_points, tile=1))
+    small_light(w.light_panel, "sun")
+    compute(qtbot, w)
+    before = np.array(w.runs.last.transmission)
+    triangles = w.canopy.n_triangles
+    ply = tmp_path / "exported.ply"
+    export_canopy(str(ply), w.canopy)
+
+    with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
+        w.open_mesh(ply, "cm", "z")
+    assert w.model.mesh_path == str(ply) and w.loaded is None and not w.runs.runs
+    assert w.canopy.n_triangles == triangles and w.built.label == "mesh"
+    assert not w.slider.isEnabled() and "mesh file" in w.canopy_panel.level_label.text()
+    assert not w.layout_panel.isEnabled() and w.windowTitle().startswith("maizeviz — exported")
+    # the same sun: a transmission profile on the mesh canopy (its field: the mesh's extent)
+    w.light_panel.heights.setText("0, 100, 200")
+    w.light_panel.set_mode("sun")
+    small_light(w.light_panel, "sun")
+    w.light_panel.periodic.setChecked(False)
+    compute(qtbot, w)
+    after = np.array(w.runs.last.transmission)
+    assert after.shape == before.shape and np.all((after >= 0) & (after <= 1))
+    # not a project
+    w.save_project(tmp_path / "no.maizeviz")
+    assert "not saved in a project" in w.messages.toPlainText()
+    assert not (tmp_path / "no.maizeviz").exists()
+    # points again: slider and layout come back
+    with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
+        w.open_points(small_points)
+    assert w.slider.isEnabled() and w.layout_panel.isEnabled() and w.model.mesh_path is None
+
+
+def test_a_mesh_without_ids_is_one_line(window, qtbot, tmp_path):
+    bad = tmp_path / "noids.ply"
+    bad.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                   "property float y\nproperty float z\nelement face 1\n"
+                   "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+                   "3 0 1 2\n")
+    w = shown(qtbot, window())
+    with qtbot.waitSignal(w.failed, timeout=TIMEOUT) as sig:
+        w.open_mesh(bad)
+    assert "noids.ply" in sig.args[0] and "\n" not in sig.args[0]
+    assert "internal" not in sig.args[0] and w.canopy is not None    # the canopy shown stays
