@@ -31,7 +31,10 @@ class Instances:
     ----------
     handle : int, the Embree scene to trace (through :mod:`maizeviz.mesh.packets`)
     offsets : (k, 2) float64 cm
-    base : the scene instanced (kept alive with this one)
+
+    Embree counts references: the instances keep the base scene's BVH (and the device) alive
+    as long as this scene lives, so no Python reference to ``base`` is kept (the base scene
+    usually owns this one).
     """
 
     def __init__(self, base, offsets: np.ndarray):
@@ -40,7 +43,6 @@ class Instances:
         if lib is None or handles is None:
             raise RuntimeError("Embree's library is not reachable for instances")
         scene, device = handles
-        self.base = base
         self.offsets = np.asarray(offsets, dtype=np.float64).reshape(-1, 2)
         if not np.array_equal(self.offsets.astype(np.float32), self.offsets):
             raise ValueError("instance offsets must be exact in float32")
