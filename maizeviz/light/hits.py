@@ -81,23 +81,25 @@ def first_hits(tracer: Tracer, rays: SunRays, a: int, b: int,
                ids: bool) -> tuple[np.ndarray | None, np.ndarray]:
     """First hits of rays a..b: triangle ids (b - a,) int32, -1 where none (None unless
     ``ids``), and the height (cm) of each hit (b - a,) float32, -inf where none."""
-    prim, dist = tracer.trace(rays.origins(a, b), np.full(b - a, rays.reach, np.float32), ids=ids)
+    prim, dist = tracer.trace(rays.origins(a, b), np.full(b - a, rays.reach, np.float32), ids=ids,
+                              row=rays.shape[1])
     z = (rays.top - dist * rays.sun[2]).astype(np.float32)
     return prim, z
 
 
 def lattice_first_hits(tracer: Tracer, rays: SunRays, i: np.ndarray, j: np.ndarray,
-                       ids: bool) -> tuple[np.ndarray | None, np.ndarray]:
+                       ids: bool, row: int = 0) -> tuple[np.ndarray | None, np.ndarray]:
     """First hits of the rays of the same family landing on lattice cells (i, j) of the ground
     grid extended beyond the rectangle (i across x, j along y; any integers): ids (k,) int32
-    (None unless ``ids``) and heights (k,) float32 cm, -inf where none."""
+    (None unless ``ids``) and heights (k,) float32 cm, -inf where none. ``row``: cells per
+    row when (i, j) run row by row over a whole box of the lattice (coherent packets), else 0."""
     nx, ny = rays.shape
     x0, y0, x1, y1 = rays.rect
     org = np.empty((len(i), 3))
     org[:, 0] = x0 + (i + 0.5) * ((x1 - x0) / nx) + rays.sun[0] * rays.reach
     org[:, 1] = y0 + (j + 0.5) * ((y1 - y0) / ny) + rays.sun[1] * rays.reach
     org[:, 2] = rays.top
-    prim, dist = tracer.trace(org, np.full(len(i), rays.reach, np.float32), ids=ids)
+    prim, dist = tracer.trace(org, np.full(len(i), rays.reach, np.float32), ids=ids, row=row)
     return prim, (rays.top - dist * rays.sun[2]).astype(np.float32)
 
 

@@ -114,133 +114,71 @@ def sensor_offsets(heights_cm: np.ndarray, toward_sun: np.ndarray, rect: Rect,
 
 class Tracer:
     """Follows rays along one direction through a scene, wrapping them across the plot when
-    periodic.
+    periodic (:func:`maizeviz.light.periodic.trace_wrapped`).
 
     Parameters
     ----------
-    scene : the canopy's Embree scene
+    scene : the canopy's Embree scene; a scene built for a periodic field carries its
+        ``wrap`` (the cell it repeats: the plot, or one block of a tiled canopy) and
+        ``resolve`` (scene triangle and cell -> canopy triangle ids)
     direction : (3,) unit vector the rays travel along (down toward the ground for sunlight)
-    bounds : (x0, y0, x1, y1) cm, the plot
+    bounds : (x0, y0, x1, y1) cm, the plot (the cell repeated when the scene has no ``wrap``)
     periodic : wrap rays that leave the plot sideways
-    size : largest number of rays traced at once (sizes the direction buffer)
+    size : largest number of rays traced at once (kept for callers; unused)
     """
 
     def __init__(self, scene: RayScene, direction: np.ndarray, bounds: Rect, periodic: bool,
-                 size: int):
+                 size: int = 0):
+        from maizeviz.light.periodic import Wrap
+
         self.scene = scene
         self.down = np.asarray(direction, dtype=np.float64)
         self.bounds = bounds
         self.periodic = periodic
-        # overhang copies of a periodic scene are reported as the triangles they copy
-        self.source = getattr(scene, "source", None)
-        # one writable float32 direction buffer, sliced per chunk (embreex needs writable input)
-        self.dirs = np.tile(self.down.astype(np.float32), (max(size, 1), 1))
+        self.wrap = (getattr(scene, "wrap", None) or Wrap.of(bounds)) if periodic else None
+        # overhang copies (and the blocks of a tiled field) are reported as canopy triangles
+        self.resolve = getattr(scene, "resolve", None)
+        self.dirs = self.down.astype(np.float32)[None, :]
 
-    def _exit(self, org: np.ndarray) -> np.ndarray:
-        """Distance along the direction to where each ray leaves the plot's vertical prism."""
-        x0, y0, x1, y1 = self.bounds
-        t = np.full(len(org), np.inf)
-        for k, lo, hi in ((0, x0, x1), (1, y0, y1)):
-            d = self.down[k]
-            if abs(d) > 1e-12:
-                edge = hi if d > 0 else lo
-                t = np.minimum(t, (edge - org[:, k]) / d)
-        return np.maximum(t, 0.0)
-
-    def _cross(self, org: np.ndarray) -> np.ndarray:
-        """Rays that reached a plot edge re-enter through the opposite one."""
-        x0, y0, x1, y1 = self.bounds
-        for k, lo, hi in ((0, x0, x1), (1, y0, y1)):
-            d = self.down[k]
-            tol = 1e-7 * (hi - lo)
-            if d > 0:
-                org[org[:, k] >= hi - tol, k] -= hi - lo
-            elif d < 0:
-                org[org[:, k] <= lo + tol, k] += hi - lo
-        return org
-
-    def _wrap(self, org: np.ndarray) -> np.ndarray:
-        x0, y0, x1, y1 = self.bounds
-        org[:, 0] = x0 + np.mod(org[:, 0] - x0, x1 - x0)
-        org[:, 1] = y0 + np.mod(org[:, 1] - y0, y1 - y0)
-        return org
-
-    def _query(self, org: np.ndarray, length: np.ndarray,
-               ids: bool) -> tuple[np.ndarray | None, np.ndarray, np.ndarray]:
-        dirs = self.dirs[: len(org)]
-        if ids:
-            prim, t = self.scene.first_hit(org, dirs, length)
-            return prim, t, prim >= 0
-        t = self.scene.distance(org, dirs, length)
-        return None, t, t < np.asarray(length, np.float32)
-
-    def occluded(self, org: np.ndarray, length: np.ndarray) -> np.ndarray:
+    def occluded(self, org: np.ndarray, length: np.ndarray, row: int = 0) -> np.ndarray:
         """Whether anything lies on the rays from ``org`` (N, 3) cm within ``length`` (N,) cm:
         (N,) bool. Embree's occlusion query (any hit, not the nearest), wrapped like
-        :meth:`trace` in a periodic field."""
-        n = len(org)
-        if not self.periodic:
-            return self.scene.occluded(org, self.dirs[:n], length)
-        blocked = np.zeros(n, dtype=bool)
-        todo = np.arange(n)
-        org = self._wrap(np.asarray(org, dtype=np.float64).copy())
-        remaining = np.asarray(length, dtype=np.float64).copy()
-        for _ in range(10_000):
-            if not len(todo):
-                break
-            seg = np.minimum(self._exit(org), remaining)
-            hit = self.scene.occluded(org, self.dirs[: len(org)], seg)
-            blocked[todo[hit]] = True
-            go = ~hit & (remaining - seg > 1e-6)
-            todo, org = todo[go], org[go] + seg[go, None] * self.down
-            remaining = remaining[go] - seg[go]
-            org = self._cross(org)
-        if len(todo):  # pragma: no cover - a ray advances by at least one plot crossing a step
-            raise MaizevizError(f"periodic tracing left {len(todo)} rays unfinished")
-        return blocked
+        :meth:`trace` in a periodic field. ``row``: rays per row of a grid laid out row by row
+        (coherent packets), else 0."""
+        from maizeviz.light.periodic import trace_wrapped
 
-    def trace(self, org: np.ndarray, length: np.ndarray,
-              ids: bool = True) -> tuple[np.ndarray | None, np.ndarray]:
+        if self.wrap is None:
+            return self.scene.occluded(org, self.dirs, length, row=row)
+        return trace_wrapped(self.scene, self.wrap, org, self.down, length, any_hit=True,
+                             row=row)
+
+    def trace(self, org: np.ndarray, length: np.ndarray, ids: bool = True,
+              row: int = 0) -> tuple[np.ndarray | None, np.ndarray]:
         """First hit of rays from ``org`` (N, 3) cm within ``length`` (N,) cm.
 
         Returns triangle ids (N,) int32, -1 where none (None unless ``ids``), and hit distances
-        (N,) float64 cm (inf where none).
+        (N,) float64 cm (inf where none). ``row`` as :meth:`occluded`.
         """
-        prim, dist = self._trace(org, length, ids)
-        if prim is not None and self.source is not None:
-            hit = prim >= 0
-            prim[hit] = self.source[prim[hit]]
-        return prim, dist
+        from maizeviz.light.periodic import trace_wrapped
 
-    def _trace(self, org: np.ndarray, length: np.ndarray,
-               ids: bool) -> tuple[np.ndarray | None, np.ndarray]:
-        n = len(org)
-        prim = np.full(n, -1, dtype=np.int32) if ids else None
-        dist = np.full(n, np.inf)
-        if not self.periodic:
-            p, t, hit = self._query(org, length, ids)
-            if prim is not None and p is not None:
-                prim[hit] = p[hit]
-            dist[hit] = t[hit]
-            return prim, dist
-        todo = np.arange(n)
-        org = self._wrap(org.astype(np.float64))
-        done = np.zeros(n)
-        remaining = length.astype(np.float64).copy()
-        for _ in range(10_000):
-            if not len(todo):
-                break
-            seg = np.minimum(self._exit(org), remaining)
-            p, t, hit = self._query(org, seg, ids)
-            hit &= t <= seg
-            if prim is not None and p is not None:
-                prim[todo[hit]] = p[hit]
-            dist[todo[hit]] = done[hit] + t[hit]
-            go = ~hit & (remaining - seg > 1e-6)
-            todo, org = todo[go], org[go] + seg[go, None] * self.down
-            done = done[go] + seg[go]
-            remaining = remaining[go] - seg[go]
-            org = self._cross(org)
-        if len(todo):  # pragma: no cover - a ray advances by at least one plot crossing a step
-            raise MaizevizError(f"periodic tracing left {len(todo)} rays unfinished")
-        return prim, dist
+        length = np.asarray(length)
+        if self.wrap is None:
+            if ids:
+                prim, t = self.scene.first_hit(org, self.dirs, length, row=row)
+                hit = prim >= 0
+            else:
+                prim, t = None, self.scene.distance(org, self.dirs, length, row=row)
+                hit = t < np.asarray(length, np.float32)
+            cell = None
+        else:
+            prim, cell, dist = trace_wrapped(self.scene, self.wrap, org, self.down, length,
+                                             ids=ids, row=row)
+            hit = np.isfinite(dist)
+            t = dist
+        out = np.full(len(hit), np.inf)
+        out[hit] = t[hit]
+        if prim is not None:
+            prim = np.where(hit, prim, -1).astype(np.int32)
+            if self.resolve is not None and hit.any():
+                prim[hit] = self.resolve(prim[hit], None if cell is None else cell[hit])
+        return prim, out

@@ -128,61 +128,58 @@ LEAF, GROUND, TOP, SIDES, LOST = range(5)
 def follow(smp: Sampler, rays: _Rays, max_crossings: int = 1000
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Where each ray ends: what it met (LEAF, GROUND, TOP, SIDES, LOST), the triangle (leaf
-    and stalk ids, -1 unless LEAF) and the end point (k, 3) cm, wrapping rays across the plot
-    in a periodic field (:class:`~maizeviz.light.rays.Tracer` does it for one direction)."""
+    and stalk ids, -1 unless LEAF) and the end point (k, 3) cm. In a periodic field rays are
+    wrapped across the plot (:func:`~maizeviz.light.periodic.trace_wrapped`, as the
+    direct-light rays are); one that has not met anything after ``max_crossings`` plot widths
+    sideways is LOST."""
     k = len(rays.org)
     kind = np.full(k, LOST, dtype=np.int8)
     prim = np.full(k, -1, dtype=np.int64)
-    end = rays.org.astype(np.float64).copy()
-    todo = np.arange(k)
-    pos = end.copy()
-    dirs = rays.dirs.astype(np.float64)
+    o = rays.org.astype(np.float64)
+    d = rays.dirs.astype(np.float64)
+    end = o.copy()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_vert = np.where(d[:, 2] < 0, -o[:, 2] / d[:, 2],
+                          np.where(d[:, 2] > 0, (smp.top - o[:, 2]) / d[:, 2], np.inf))
+    t_vert = np.maximum(t_vert, 0.0)
     x0, y0, x1, y1 = smp.bounds
-    lo, hi, size = np.array([x0, y0]), np.array([x1, y1]), np.array([x1 - x0, y1 - y0])
-    source = getattr(smp.scene, "source", None)
-    if smp.periodic:              # a start outside the plot (a primary hit seen from the
-        pos[:, :2] = lo + np.mod(pos[:, :2] - lo, size)    # sample rectangle) is its copy in it
-    for _ in range(max_crossings):
-        if not len(todo):
-            break
-        o, d = pos[todo], dirs[todo]
+    if smp.periodic:
+        from maizeviz.light.periodic import Wrap, trace_wrapped
+
+        scene = smp.scene
+        wrap = getattr(scene, "wrap", None) or Wrap.of(smp.bounds)
+        horiz = np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-300)
+        cap = max_crossings * max(x1 - x0, y1 - y0) / horiz      # distance of that many plots
+        length = np.minimum(t_vert, cap)
+        ids, cell, t = trace_wrapped(scene, wrap, o, d, length)
+        hit = np.isfinite(t)
+        resolve = getattr(scene, "resolve", None)
+        assert ids is not None
+        prim[hit] = ids[hit] if resolve is None else resolve(ids[hit], cell[hit])
+        t_side = np.where(t_vert <= cap, np.inf, 0.0)          # LOST unless it ends vertically
+    else:
+        lo, hi = np.array([x0, y0]), np.array([x1, y1])
         with np.errstate(divide="ignore", invalid="ignore"):
-            t_vert = np.where(d[:, 2] < 0, -o[:, 2] / d[:, 2],
-                              np.where(d[:, 2] > 0, (smp.top - o[:, 2]) / d[:, 2], np.inf))
-            t_side = np.full(len(todo), np.inf)
+            t_side = np.full(k, np.inf)
             for a in (0, 1):
                 edge = np.where(d[:, a] > 0, hi[a], lo[a])
                 ta = np.where(d[:, a] != 0, (edge - o[:, a]) / d[:, a], np.inf)
                 t_side = np.minimum(t_side, ta)
-        t_vert = np.maximum(t_vert, 0.0)
         t_side = np.maximum(t_side, 0.0)
         seg = np.minimum(t_vert, t_side)
-        ids, t = smp.scene.first_hit(o, d, seg)
-        hit = ids >= 0
-        where = todo[hit]
-        kind[where] = LEAF
-        prim[where] = ids[hit] if source is None else source[ids[hit]]
-        end[where] = o[hit] + t[hit, None] * d[hit]
-        vertical = ~hit & (t_vert <= t_side)
-        where = todo[vertical]
-        kind[where] = np.where(d[vertical, 2] < 0, GROUND, TOP)
-        end[where] = o[vertical] + t_vert[vertical, None] * d[vertical]
-        side = ~hit & ~vertical
-        if not smp.periodic:
-            where = todo[side]
-            kind[where] = SIDES
-            end[where] = o[side] + t_side[side, None] * d[side]
-            break
-        moved = o[side] + t_side[side, None] * d[side]
-        ds = d[side]
-        for a in (0, 1):
-            tol = 1e-7 * size[a]
-            out_hi = (ds[:, a] > 0) & (moved[:, a] >= hi[a] - tol)
-            out_lo = (ds[:, a] < 0) & (moved[:, a] <= lo[a] + tol)
-            moved[out_hi, a] -= size[a]
-            moved[out_lo, a] += size[a]
-        todo = todo[side]
-        pos[todo] = moved
+        ids32, t32 = smp.scene.first_hit(o, d, seg)
+        hit = ids32 >= 0
+        source = getattr(smp.scene, "source", None)
+        prim[hit] = ids32[hit] if source is None else source[ids32[hit]]
+        t = np.where(hit, t32.astype(np.float64), np.inf)
+    kind[hit] = LEAF
+    end[hit] = o[hit] + t[hit, None] * d[hit]
+    vertical = ~hit & (t_vert <= t_side) & np.isfinite(t_vert)
+    kind[vertical] = np.where(d[vertical, 2] < 0, GROUND, TOP)
+    end[vertical] = o[vertical] + t_vert[vertical, None] * d[vertical]
+    side = ~hit & ~vertical & np.isfinite(t_side) & (not smp.periodic)
+    kind[side] = SIDES
+    end[side] = o[side] + t_side[side, None] * d[side]
     return kind, prim, end
 
 

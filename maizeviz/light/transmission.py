@@ -41,6 +41,12 @@ from maizeviz.light.hits import SunRays, first_hits, hit_counts, lattice_first_h
 from maizeviz.light.rays import Rect, Tracer, ray_grid, sensor_offsets
 from maizeviz.light.request import LightRequest, canopy_top, check_request
 from maizeviz.light.result import TracedLight
+
+# the scenes lived here before maizeviz.light.scenes: kept importable from here
+from maizeviz.light.scenes import BlockScene as BlockScene
+from maizeviz.light.scenes import CanopyScene as CanopyScene
+from maizeviz.light.scenes import light_scene as light_scene
+from maizeviz.light.scenes import scene_for
 from maizeviz.light.sun import Sun
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, ordered_map, report
@@ -125,102 +131,6 @@ class LightResult(TracedLight):
         from maizeviz.light.leaf_light import leaf_light
 
         return leaf_light(canopy, self)
-
-
-class CanopyScene(RayScene):
-    """A canopy's Embree scene: leaf triangles, then stalk triangles, then (for a periodic
-    field) copies of the triangles that overhang the plot, moved to the opposite side.
-
-    In a periodic field a ray that leaves the plot re-enters on the opposite side, so a leaf
-    part hanging over the edge (3.7 % of the leaf area of the bundled block tiled 3 x 3) must
-    also stand just inside the opposite edge, where the next tile's plants would put it.
-
-    Attributes
-    ----------
-    n_original : int, leaf + stalk triangles (the ids hits are reported in)
-    source : (F_scene,) int64, the original triangle of each scene triangle (None: identity)
-    wrapped : (x0, y0, x1, y1) cm, the plot whose overhangs were copied, or None
-    """
-
-    def __init__(self, vertices: np.ndarray, faces: np.ndarray, n_original: int | None = None,
-                 source: np.ndarray | None = None, wrapped: Rect | None = None):
-        super().__init__(vertices, faces)
-        self.n_original = len(faces) if n_original is None else n_original
-        self.source = source
-        self.wrapped = wrapped
-
-
-def _overhang_copies(verts: np.ndarray, faces: np.ndarray,
-                     bounds: Rect) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Copies of the triangles that reach over the plot edges, moved by the plot's width and
-    height into it: vertices (3k, 3), faces (k, 3) numbered from 0, source ids (k,)."""
-    x0, y0, x1, y1 = bounds
-    w, h = x1 - x0, y1 - y0
-    tri = verts[faces]
-    lo, hi = tri.min(axis=1), tri.max(axis=1)
-    out_v, out_src = [], []
-    for dx in (-w, 0.0, w):
-        for dy in (-h, 0.0, h):
-            if dx == 0.0 and dy == 0.0:
-                continue
-            keep = np.flatnonzero((hi[:, 0] + dx > x0) & (lo[:, 0] + dx < x1) &
-                                  (hi[:, 1] + dy > y0) & (lo[:, 1] + dy < y1))
-            if len(keep):
-                out_v.append((tri[keep] + np.array([dx, dy, 0.0])).reshape(-1, 3))
-                out_src.append(keep)
-    if not out_v:
-        return np.empty((0, 3)), np.empty((0, 3), np.int64), np.empty(0, np.int64)
-    v = np.vstack(out_v)
-    return v, np.arange(len(v)).reshape(-1, 3), np.concatenate(out_src).astype(np.int64)
-
-
-def light_scene(canopy: Canopy, with_stalks: bool = False,
-                periodic: bool = False) -> CanopyScene:
-    """The Embree scene of a canopy's leaves (and stalks): build it once, trace many suns.
-
-    Parameters
-    ----------
-    with_stalks : stalks intercept light too
-    periodic : for a periodic field (``--periodic``): leaf parts overhanging the plot edges are
-        copied to the opposite side; such a scene traces periodic requests only
-    """
-    verts, faces = canopy.vertices, canopy.faces
-    if with_stalks:
-        verts = np.vstack([verts, canopy.stalk_vertices])
-        faces = np.vstack([faces, canopy.stalk_faces + len(canopy.vertices)])
-    n = len(faces)
-    if not periodic:
-        return CanopyScene(verts, faces)
-    bounds = canopy.layout.bounds
-    cv, cf, src = _overhang_copies(verts, faces, bounds)
-    return CanopyScene(np.vstack([verts, cv]), np.vstack([faces, cf + len(verts)]), n,
-                       np.concatenate([np.arange(n, dtype=np.int64), src]), bounds)
-
-
-def scene_for(canopy: Canopy, periodic: bool, scene: RayScene | None,
-              with_stalks: bool) -> tuple[RayScene, list[str]]:
-    """The scene to trace a request with, and what to say about it: ``scene`` when it suits
-    the request (built here when None).
-
-    Raises
-    ------
-    MaizevizError
-        A scene with copied overhangs (periodic) given for an open field.
-    """
-    from maizeviz.errors import MaizevizError
-
-    if scene is None:
-        return light_scene(canopy, with_stalks, periodic), []
-    wrapped = getattr(scene, "wrapped", None)
-    if wrapped is not None and not periodic:
-        raise MaizevizError("this scene holds copies of the leaves overhanging the plot edges "
-                            "(built for a periodic field): it cannot trace an open field",
-                            quantity="periodic")
-    if periodic and wrapped is None:
-        return scene, ["the scene was built without the leaves overhanging the plot edges: the "
-                       "periodic field misses them (build it with light_scene(canopy, "
-                       "periodic=True))"]
-    return scene, []
 
 
 def _chunks(n: int) -> list[tuple[int, int]]:
@@ -437,7 +347,8 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
                     org = np.empty((b - a, 3))
                     org[:, :2] = ground + offsets[k]
                     org[:, 2] = h
-                    lit = ~up.occluded(org, np.full(b - a, (smp.top - h) / s[2]))
+                    lit = ~up.occluded(org, np.full(b - a, (smp.top - h) / s[2]),
+                                       row=rays.shape[1])
                 counts[k] = np.count_nonzero(lit)
                 packed[k, a // 8:(b + 7) // 8] = np.packbits(lit)
             return counts
@@ -448,12 +359,13 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
         fz = np.empty(len(family.cells), dtype=np.float32)
         fp = np.empty(len(family.cells), dtype=np.int32) if keep_ids else None
         bh = family.index.shape[1]
+        whole = len(family.cells) == family.index.size     # the box without holes: a grid
 
         def fchunk(a: int, b: int) -> None:
             check()
             i, j = np.divmod(family.cells[a:b], bh)
             prim, z = lattice_first_hits(down, rays, i + family.lo[0], j + family.lo[1],
-                                         ids=keep_ids)
+                                         ids=keep_ids, row=bh if whole else 0)
             fz[a:b] = z
             if fp is not None and prim is not None:
                 fp[a:b] = prim

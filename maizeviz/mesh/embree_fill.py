@@ -71,7 +71,13 @@ def _embree():
             ("rtcAttachGeometry", u, [p, p]),
             ("rtcReleaseGeometry", None, [p]),
             ("rtcGetSceneDevice", p, [p]),
-            ("rtcReleaseDevice", None, [p])):
+            ("rtcReleaseDevice", None, [p]),
+            # scenes of instances (maizeviz.mesh.instances)
+            ("rtcNewScene", p, [p]),
+            ("rtcCommitScene", None, [p]),
+            ("rtcReleaseScene", None, [p]),
+            ("rtcSetGeometryInstancedScene", None, [p, p]),
+            ("rtcSetGeometryTransform", None, [p, u, ctypes.c_int, p])):
         fn = getattr(lib, name, None)
         if fn is None:
             return None

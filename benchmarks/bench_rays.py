@@ -1,0 +1,158 @@
+"""Rays per second: embreex's single rays against Embree's packets (maizeviz.mesh.packets),
+nearest hits and occlusion, in the same run.
+
+The bundled block tiled 3 x 3 at ``--level`` (K = 4: 2.68 million triangles), noon sun of
+Beijing on 2005-08-01, ``--density`` rays per cm2 over the central tile. Sensor-plane rays: from
+every sensor of the planes at 50, 100, 150 and 200 cm toward the sun, up to the canopy top (the
+paths whose blocking is transmission). Each figure is the best of ``--repeat`` runs over all
+of them, in Mrays/s:
+
+- intersect1_*: embreex's ``EmbreeScene.run`` (``rtcIntersect1`` / ``rtcOccluded1``, one ray
+  at a time): what maizeviz traced with before the packets ("today" in issue 20)
+- packets_*: the C kernel's packets of 8 (``rtcIntersect8`` / ``rtcOccluded8``, coherent flag,
+  2 x 4 tiles of the sensor grid)
+- *_nearest: the nearest hit (triangle and distance); *_occluded: any hit (Embree's cheaper
+  occlusion query)
+- open: the whole canopy's scene in an open field; periodic_block: the periodic field traced
+  through the block's scene (maizeviz.light.tiling), segments wrapped in C
+- _1t / _2t: on 1 and 2 threads (chunks of 2^16 rays, ctypes and embreex release the GIL)
+- speedup_*: ratios in this run (target: packets_occluded_2t >= 20 Mrays/s and >= 3 x
+  intersect1_occluded_2t on 2 cores)
+- sensor_answers_*: maizeviz's whole computation of one direction (``trace_direction``: the
+  ground rays and the six default planes, each sensor's path answered by an occlusion query
+  or, at this sun, by the first hit of the ray of the same family through it), in sensor
+  answers (rays x 7 planes, the ground included) per second: open field with packets and with
+  single rays, and the periodic field through the block
+
+    python benchmarks/bench_rays.py [--json] [--level K4] [--density 16] [--repeat 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import time
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+from maizeviz.canopy.layout import layout_for
+from maizeviz.canopy.scene import build_canopy
+from maizeviz.leaf.fit import read_leaves
+from maizeviz.light.rays import Tracer, ray_grid
+from maizeviz.light.sun import sun_at
+from maizeviz.light.transmission import light_scene, sampler, trace_direction
+from maizeviz.mesh.levels import parse_level
+from maizeviz.mesh.raytrace import RayScene
+from maizeviz.resources import example_points
+
+CHUNK = 1 << 16
+
+
+def best(fn, repeat: int) -> float:
+    out = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t0)
+    return min(out)
+
+
+def chunked(fn, n: int, threads: int):
+    """fn(a, b) over chunks of the n rays on ``threads`` threads."""
+    parts = [(a, min(a + CHUNK, n)) for a in range(0, n, CHUNK)]
+    if threads == 1:
+        return lambda: [fn(a, b) for a, b in parts]
+
+    def run():
+        with ThreadPoolExecutor(threads) as pool:
+            list(pool.map(lambda ab: fn(*ab), parts))
+    return run
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--json", action="store_true")
+    ap.add_argument("--level", default="K4")
+    ap.add_argument("--density", type=float, default=16.0)
+    ap.add_argument("--repeat", type=int, default=5)
+    args = ap.parse_args()
+
+    leaves = read_leaves(example_points()).leaves
+    canopy = build_canopy(leaves, layout_for(leaves, (3, 3)), parse_level(args.level))
+    sun = sun_at("2005-08-01", "12:00", 39.9, 116.4, "Asia/Shanghai")
+    s = sun.direction()
+    rect = canopy.layout.centre_bounds
+    top = float(canopy.vertices[:, 2].max()) + 1.0
+    ground, _ = ray_grid(rect, args.density)
+    ny = int(round((rect[3] - rect[1]) * np.sqrt(args.density)))
+    planes = (50.0, 100.0, 150.0, 200.0)
+    org = np.concatenate([np.column_stack([ground, np.full(len(ground), h)]) for h in planes])
+    length = np.concatenate([np.full(len(ground), (top - h) / s[2]) for h in planes])
+    org32, len32 = org.astype(np.float32), length.astype(np.float32)
+    dirs = np.tile(s.astype(np.float32), (len(org), 1))
+    n = len(org)
+
+    single = RayScene(canopy.vertices, canopy.faces, packets=False)
+    packed = RayScene(canopy.vertices, canopy.faces)
+    if not packed.packets:
+        raise SystemExit("the packet kernel is not available here (no C compiler?)")
+    block = light_scene(canopy, periodic=True)
+    wrapped = Tracer(block, s, canopy.layout.bounds, True)
+
+    def single_occ(a, b):
+        single._scene.run(org32[a:b], dirs[a:b], dists=len32[a:b].copy(), query="OCCLUDED")
+
+    def single_near(a, b):
+        single._scene.run(org32[a:b], dirs[a:b], dists=len32[a:b].copy(), output=True)
+
+    def packed_occ(a, b):
+        packed.occluded(org32[a:b], dirs[:1], len32[a:b], row=ny)
+
+    def packed_near(a, b):
+        packed.first_hit(org32[a:b], dirs[:1], len32[a:b], row=ny)
+
+    def block_occ(a, b):
+        wrapped.occluded(org[a:b], length[a:b], row=ny)
+
+    def block_near(a, b):
+        wrapped.trace(org[a:b], length[a:b], row=ny)
+
+    # the same answers, ray for ray (tests/core/test_packets.py checks it at length)
+    ref = single.occluded(org32[:CHUNK], dirs[:CHUNK], len32[:CHUNK])
+    assert np.array_equal(ref, packed.occluded(org32[:CHUNK], dirs[:1], len32[:CHUNK], row=ny))
+    out: dict[str, object] = {"triangles": canopy.n_triangles, "level": args.level,
+                              "block_triangles": block.n_triangles, "rays": n,
+                              "cores": os.cpu_count()}
+    for name, fn in (("intersect1_occluded", single_occ), ("intersect1_nearest", single_near),
+                     ("packets_occluded", packed_occ), ("packets_nearest", packed_near),
+                     ("periodic_block_occluded", block_occ),
+                     ("periodic_block_nearest", block_near)):
+        for threads in (1, 2):
+            out[f"{name}_{threads}t"] = round(n / best(chunked(fn, n, threads), args.repeat)
+                                              / 1e6, 2)
+    heights = (0.0, 50.0, 100.0, 150.0, 200.0, 225.0)
+    for name, sc, periodic in (("open_packets", packed, False), ("open_single_rays", single, False),
+                               ("periodic_block", block, True)):
+        smp = sampler(canopy, sc, rect, args.density, heights, periodic)
+        answers = smp.n * (len(heights) + 1)
+        for threads in (1, 2):
+            secs = best(lambda smp=smp, threads=threads: trace_direction(smp, s,
+                                                                           threads=threads),
+                        args.repeat)
+            out[f"sensor_answers_{name}_{threads}t"] = round(answers / secs / 1e6, 2)
+    for q in ("occluded", "nearest"):
+        for t in ("1t", "2t"):
+            out[f"speedup_{q}_{t}"] = round(out[f"packets_{q}_{t}"]            # type: ignore
+                                            / out[f"intersect1_{q}_{t}"], 2)   # type: ignore
+    out["targets"] = {"packets_occluded_2t": 20.0, "speedup_occluded_2t": 3.0}
+    if args.json:
+        print(json.dumps(out, indent=1))
+    else:
+        for k, v in out.items():
+            print(f"{k:>28}: {v}")
+
+
+if __name__ == "__main__":
+    main()
