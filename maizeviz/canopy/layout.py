@@ -310,6 +310,9 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
 #: Above this many overlapping pairs of cells, the warning gives their count only (the area
 #: counted twice would need every pair in memory).
 MAX_OVERLAP_PAIRS = 2_000_000
+#: Up to this many cells, overlaps are found among all pairs with numpy (half a million pairs
+#: at most); above, with a k-d tree.
+SMALL_FIELD = 1_000
 
 
 def _overlaps(cells: np.ndarray) -> str:
@@ -322,12 +325,21 @@ def _overlaps(cells: np.ndarray) -> str:
     """
     if len(cells) < 2:
         return ""
-    from scipy.spatial import cKDTree
-
     w = cells[0, 2] - cells[0, 0]
     h = cells[0, 3] - cells[0, 1]
     centres = np.column_stack([(cells[:, 0] + cells[:, 2]) / (2 * w),
                                (cells[:, 1] + cells[:, 3]) / (2 * h)])
+    if len(centres) <= SMALL_FIELD:             # every pair at once: no k-d tree to import
+        i, j = np.triu_indices(len(centres), 1)
+        d = np.abs(centres[i] - centres[j])
+        close = (d[:, 0] < 0.9) & (d[:, 1] < 0.9)
+        if not close.any():
+            return ""
+        d = d[close]
+        twice = float(np.sum((1 - d[:, 0]) * (1 - d[:, 1]))) * w * h
+        return f"({int(close.sum())} overlapping pairs, about {twice:.0f} cm2 counted twice)"
+    from scipy.spatial import cKDTree
+
     tree = cKDTree(centres)
     # count first (no pairs held): plants packed far closer than the spacing (100,000 plants
     # 1 cm apart with a 30 cm spacing) make ~10^8 pairs, gigabytes if listed
