@@ -332,6 +332,21 @@ class Balance:
                 "closure": self.closure}
 
 
+def _fraction_absorbed(self) -> float:
+    """Share of the incident light the leaves absorb."""
+    b = self.balance
+    return b.absorbed_leaves / b.incident if b.incident else 0.0
+
+
+def _per_plant(frame, sums: tuple[str, ...]):
+    """Leaf rows (a DataFrame of :func:`maizeviz.light.leaf_light.leaf_sums` rows) summed per
+    plant standing in the canopy: its digitized plant, place, leaves, leaf area and ``sums``."""
+    return frame.groupby("instance", as_index=False).agg(
+        plant=("plant", "first"), x_cm=("x_cm", "first"), y_cm=("y_cm", "first"),
+        leaves=("leaf", "size"), leaf_area_cm2=("leaf_area_cm2", "sum"),
+        **{name: (name, "sum") for name in sums})
+
+
 @dataclass(frozen=True)
 class AbsorbedLight:
     """Light absorbed by the leaves (and the ground) in one band, with scattering.
@@ -367,11 +382,7 @@ class AbsorbedLight:
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
 
-    @property
-    def fraction_absorbed(self) -> float:
-        """Share of the incident light the leaves absorb."""
-        b = self.balance
-        return b.absorbed_leaves / b.incident if b.incident else 0.0
+    fraction_absorbed = property(_fraction_absorbed)
 
     def table(self, by: str = "plant", canopy=None):
         """Absorbed light per leaf or per plant as a pandas DataFrame.
@@ -406,10 +417,7 @@ class AbsorbedLight:
             return frame
         frame["sunlit_area_cm2"] = np.minimum(frame["sunlit_area_cm2"], frame["leaf_area_cm2"])
         if by == "plant":
-            frame = frame.groupby("instance", as_index=False).agg(
-                plant=("plant", "first"), x_cm=("x_cm", "first"), y_cm=("y_cm", "first"),
-                leaves=("leaf", "size"), leaf_area_cm2=("leaf_area_cm2", "sum"),
-                absorbed_w=("absorbed_w", "sum"), sunlit_area_cm2=("sunlit_area_cm2", "sum"))
+            frame = _per_plant(frame, ("absorbed_w", "sunlit_area_cm2"))
         frame["shaded_area_cm2"] = frame["leaf_area_cm2"] - frame["sunlit_area_cm2"]
         frame["absorbed_w_m2_leaf"] = frame["absorbed_w"] / (frame["leaf_area_cm2"] * 1e-4)
         if self.band == "par":
@@ -463,11 +471,7 @@ class AbsorbedPeriod:
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
 
-    @property
-    def fraction_absorbed(self) -> float:
-        """Share of the period's incident light the leaves absorb."""
-        b = self.balance
-        return b.absorbed_leaves / b.incident if b.incident else 0.0
+    fraction_absorbed = property(_fraction_absorbed)
 
     @property
     def absorbed_leaves_mol_m2(self) -> float | None:
@@ -501,10 +505,7 @@ class AbsorbedPeriod:
         if frame.empty:
             return frame
         if by == "plant":
-            frame = frame.groupby("instance", as_index=False).agg(
-                plant=("plant", "first"), x_cm=("x_cm", "first"), y_cm=("y_cm", "first"),
-                leaves=("leaf", "size"), leaf_area_cm2=("leaf_area_cm2", "sum"),
-                absorbed_mj=("absorbed_mj", "sum"))
+            frame = _per_plant(frame, ("absorbed_mj",))
         frame["absorbed_mj_m2_leaf"] = frame["absorbed_mj"] / (frame["leaf_area_cm2"] * 1e-4)
         if self.band == "par":
             frame["absorbed_mol"] = frame["absorbed_mj"] * PAR_UMOL_PER_J_PAR
