@@ -70,6 +70,9 @@ if TYPE_CHECKING:
     from maizeviz_app.panels.layout import LayoutPanel
     from maizeviz_app.viewport import Viewport
 
+#: The level the view draws the plants around the sampled tile at, when the canopy has more
+#: triangles than the view's budget (maizeviz_app.viewport.VIEW_BUDGET).
+DISPLAY_LEVEL = "36"
 #: Version of the saved dock layout; bump when docks change so an old layout is not applied.
 STATE_VERSION = 3
 PROJECT_FILTER = "maizeviz project (*.maizeviz)"
@@ -639,9 +642,17 @@ class MainWindow(QMainWindow):
             measure_s = time.perf_counter() - t0
             while not view_ready.wait(0.05):        # pyvista still loading at start-up
                 job.check()
-            from maizeviz_app.viewport import canopy_polydata
+            from maizeviz_app.viewport import VIEW_BUDGET, canopy_polydata, display_polydata
 
-            mesh = canopy_polydata(canopy)
+            if canopy.n_triangles > VIEW_BUDGET and level != DISPLAY_LEVEL:
+                # a frame of millions of triangles stalls software OpenGL: the plants around
+                # the sampled tile are drawn at 36 triangles a leaf (light still per triangle)
+                coarse = jobs.build(loaded, DISPLAY_LEVEL, preserve)[0]
+                job.check()
+                mesh = display_polydata(canopy, coarse) \
+                    if coarse.n_triangles < canopy.n_triangles else canopy_polydata(canopy)
+            else:
+                mesh = canopy_polydata(canopy)
             row = table2_row(m, build_s, label)
             return jobs.Built(level, label, canopy, m, build_s, measure_s, mesh,
                               tuple(TABLE2_COLUMNS), row, serial)
@@ -681,6 +692,10 @@ class MainWindow(QMainWindow):
         self._complete_runs()
         self._light_to_view()
         m = built.measures
+        if "source" in mesh.field_data:
+            self.say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
+                     "responsive the view draws the plants around the sampled tile at 36 "
+                     "triangles a leaf (light, tables and exports use every triangle)")
         if not self.digitizing:
             self.say(f"{built.label}: {m.triangles:,} triangles, leaf area "
                      f"{m.leaf_area_m2:.2f} m², LAI {m.lai:.2f}; built in {built.build_s:.2f} s, "

@@ -62,6 +62,93 @@ def canopy_polydata(canopy) -> pv.PolyData:
     return poly
 
 
+#: Leaf and stalk triangles the view draws at most at the level asked: a frame of 2.7 M
+#: triangles costs 0.6 to 0.7 s on software OpenGL (Mesa llvmpipe), 800,000 about 0.2 s. Above
+#: it, the plants around the sampled tile are drawn at a coarser level (see display_polydata;
+#: the window uses 36 triangles a leaf).
+VIEW_BUDGET = 800_000
+
+
+def display_polydata(canopy, coarse) -> pv.PolyData:
+    """What the view draws of a canopy larger than :data:`VIEW_BUDGET`: the plants standing in
+    the sample tile (the central one, whose light is traced and reported) at the canopy's own
+    level, the others from ``coarse`` (the same plants and layout at a coarser level). Safe
+    off the GUI thread.
+
+    The mesh has the cell data of :func:`canopy_polydata`, and in field data ``source``: for
+    each drawn leaf triangle, its triangle in ``canopy`` (-1 for a coarse one);
+    ``canopy_leaf`` (each canopy triangle's leaf), ``leaf_first`` (a triangle of each leaf)
+    and ``drawn_leaf`` (each coarse triangle's leaf), so that light given per triangle of
+    ``canopy`` colours the coarse plants per leaf (:meth:`Viewport.set_light`).
+    """
+    x0, y0, x1, y1 = canopy.layout.centre_bounds
+    sampled = np.array([x0 <= p.x <= x1 and y0 <= p.y <= y1
+                        for p in canopy.layout.placements], bool)
+    fine = np.flatnonzero(sampled[canopy.face_instance])
+    rough = np.flatnonzero(~sampled[coarse.face_instance])
+    full = canopy_polydata(canopy)
+    nf = canopy.n_triangles
+    faces_fine = canopy.faces[fine]
+    faces_rough = coarse.faces[rough] + len(canopy.vertices)
+    n_stalk = full.n_cells - nf
+    stalk_faces = full.regular_faces[nf:] if n_stalk else np.empty((0, 3), np.int64)
+    # stalks index the full mesh's points after the canopy's vertices: move them past the
+    # coarse canopy's vertices appended below
+    stalk_faces = np.where(stalk_faces >= len(canopy.vertices),
+                           stalk_faces + len(coarse.vertices), stalk_faces)
+    points = np.vstack([canopy.vertices, coarse.vertices,
+                        canopy.stalk_vertices]).astype(np.float32)
+    faces = np.vstack([faces_fine, faces_rough, stalk_faces]).astype(np.int64)
+    poly = pv.PolyData.from_regular_faces(points, faces)
+    for name in ("plant", "instance", "leaf"):
+        part_fine = np.asarray(full.cell_data[name])[fine]
+        src = {"plant": coarse.face_plant, "instance": coarse.face_instance + 1,
+               "leaf": coarse.face_leaf}[name]
+        part_rough = np.asarray(src)[rough]
+        poly.cell_data[name] = np.concatenate([part_fine, part_rough,
+                                               np.asarray(full.cell_data[name])[nf:]])
+    n_leaf = len(fine) + len(rough)
+    light = np.full(poly.n_cells, NOT_TRACED, np.int8)
+    light[n_leaf:] = STALK
+    poly.cell_data["light"] = light
+    poly.field_data["leaf_triangles"] = np.array([n_leaf])
+    poly.field_data["canopy_triangles"] = np.array([nf])
+    poly.field_data["source"] = np.concatenate([fine, np.full(len(rough), -1)]).astype(np.int64)
+    # the leaves of the canopy, and for each coarse triangle drawn its leaf among them (-1: a
+    # leaf the canopy does not have), worked out here so that colouring is cheap
+    keys = canopy.face_instance.astype(np.int64) * 10_000 + canopy.face_leaf
+    uniq, first, inv = np.unique(keys, return_index=True, return_inverse=True)
+    want = coarse.face_instance[rough].astype(np.int64) * 10_000 + coarse.face_leaf[rough]
+    pos = np.clip(np.searchsorted(uniq, want), 0, len(uniq) - 1)
+    poly.field_data["canopy_leaf"] = inv.astype(np.int32)
+    poly.field_data["leaf_first"] = first.astype(np.int64)
+    poly.field_data["drawn_leaf"] = np.where(uniq[pos] == want, pos, -1).astype(np.int64)
+    return poly
+
+
+def _per_drawn(mesh: pv.PolyData, values: np.ndarray, classes: bool) -> np.ndarray:
+    """Values given per triangle of the canopy (F,) for each leaf triangle the view draws: its
+    own where it is drawn as itself, else its leaf's (the most common class of the leaf's
+    triangles, or the leaf's value: per-leaf values are the same on every triangle)."""
+    if "source" not in mesh.field_data:
+        return values
+    source = np.asarray(mesh.field_data["source"])
+    out = np.empty(len(source), values.dtype)
+    own = source >= 0
+    out[own] = values[source[own]]
+    first = np.asarray(mesh.field_data["leaf_first"])
+    if classes:                      # classes -1..2: the most common one per leaf
+        inv = np.asarray(mesh.field_data["canopy_leaf"]).astype(np.int64)
+        counts = np.bincount(inv * 4 + values.astype(np.int64) + 1, minlength=4 * len(first))
+        per_leaf = counts.reshape(len(first), 4).argmax(axis=1) - 1
+    else:
+        per_leaf = values[first]
+    drawn = np.asarray(mesh.field_data["drawn_leaf"])
+    fill = NOT_TRACED if classes else np.nan
+    out[~own] = np.where(drawn >= 0, per_leaf[np.maximum(drawn, 0)], fill)
+    return out
+
+
 def _categorical(values: dict[int, tuple[str, str]]):
     """A lookup table of named categories: value -> (label, colour)."""
     lut = pv.LookupTable()
@@ -162,12 +249,13 @@ class Viewport(QtInteractor):
             return
         light = self.canopy_mesh.cell_data["light"]
         nf = int(self.canopy_mesh.field_data["leaf_triangles"][0])
+        given = int(self.canopy_mesh.field_data.get("canopy_triangles", [nf])[0])
         if classes is None:
             light[:nf] = NOT_TRACED
         else:
-            if len(classes) != nf:
-                raise ValueError(f"{len(classes)} light classes for {nf} leaf triangles")
-            light[:nf] = classes
+            if len(classes) != given:
+                raise ValueError(f"{len(classes)} light classes for {given} leaf triangles")
+            light[:nf] = _per_drawn(self.canopy_mesh, np.asarray(classes), True)
         self.canopy_mesh.cell_data["light"] = light          # marks the array modified
         if classes is not None:
             self.light_variant = "classes"
@@ -182,10 +270,11 @@ class Viewport(QtInteractor):
         if self.canopy_mesh is None:
             return
         nf = int(self.canopy_mesh.field_data["leaf_triangles"][0])
-        if len(values) != nf:
-            raise ValueError(f"{len(values)} light values for {nf} leaf triangles")
+        given = int(self.canopy_mesh.field_data.get("canopy_triangles", [nf])[0])
+        if len(values) != given:
+            raise ValueError(f"{len(values)} light values for {given} leaf triangles")
         cells = np.full(self.canopy_mesh.n_cells, -1.0, np.float32)     # stalks below range
-        cells[:nf] = values
+        cells[:nf] = _per_drawn(self.canopy_mesh, np.asarray(values), False)
         self.canopy_mesh.cell_data["light_value"] = cells
         self.light_variant = "values"
         self._light_key = (title, unit)

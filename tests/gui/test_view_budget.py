@@ -1,0 +1,55 @@
+"""A canopy above the view's triangle budget: the plants of the sampled tile are drawn at the
+level asked, the others at the standard mesh, and light given per triangle of the canopy
+colours the drawn triangles exactly where they are the canopy's and per leaf elsewhere."""
+
+from __future__ import annotations
+
+import maizeviz_app.viewport as viewport_mod
+import numpy as np
+from test_light_modes import compute, shown, small_light
+
+
+def test_a_large_canopy_is_drawn_within_the_budget_and_coloured_by_its_light(
+        window, qtbot, small_points, monkeypatch):
+    monkeypatch.setattr(viewport_mod, "VIEW_BUDGET", 500)
+    w = shown(qtbot, window(small_points, tile=3))
+    from maizeviz.mesh.levels import COMPLEXITY_STOPS
+
+    with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
+        w.slider.setValue(COMPLEXITY_STOPS.index("standard"))     # finer than 36 a leaf
+    mesh = w.viewport.canopy_mesh
+    c = w.canopy
+    assert "source" in mesh.field_data and c.n_triangles > 500
+    assert "around the sampled tile at 36 triangles a leaf" in w.messages.toPlainText()
+    source = np.asarray(mesh.field_data["source"])
+    x0, y0, x1, y1 = c.layout.centre_bounds
+    sampled = [i for i, p in enumerate(c.layout.placements) if x0 <= p.x <= x1 and y0 <= p.y <= y1]
+    own = source[source >= 0]
+    np.testing.assert_array_equal(np.sort(own),
+                                  np.flatnonzero(np.isin(c.face_instance, sampled)))
+    n_leaf = int(mesh.field_data["leaf_triangles"][0])
+    assert n_leaf < c.n_triangles                       # fewer triangles drawn
+    small_light(w.light_panel, "sun")
+    compute(qtbot, w)
+    classes = w.runs.last.classes
+    light = np.asarray(mesh.cell_data["light"])[:n_leaf]
+    np.testing.assert_array_equal(light[source >= 0], classes[source[source >= 0]])
+    # elsewhere: the most common class of the leaf (instance, rank) among the canopy's
+    inst = np.asarray(mesh.cell_data["instance"])[:n_leaf] - 1
+    leaf = np.asarray(mesh.cell_data["leaf"])[:n_leaf]
+    for k in np.flatnonzero(source < 0)[::37]:
+        mine = (c.face_instance == inst[k]) & (c.face_leaf == leaf[k])
+        counts = np.bincount(classes[mine].astype(int) + 1, minlength=4)
+        assert light[k] == counts.argmax() - 1
+    assert w.viewport.colouring == "light"
+    qtbot.wait(100)
+    # a sky's light per leaf: the same value on every drawn triangle of a leaf
+    small_light(w.light_panel, "sky")
+    compute(qtbot, w)
+    values = np.asarray(mesh.cell_data["light_value"])[:n_leaf]
+    leaf_value = w.runs.last.extra.leaf_value
+    np.testing.assert_array_equal(values[source >= 0], leaf_value[source[source >= 0]])
+    k = int(np.flatnonzero(source < 0)[0])
+    mine = (c.face_instance == inst[k]) & (c.face_leaf == leaf[k])
+    np.testing.assert_allclose(values[k], leaf_value[mine][0], equal_nan=True)
+
