@@ -163,16 +163,17 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ab.add_argument("--diffuse", type=float, default=0.0, metavar="W_M2",
                     help="the band's diffuse irradiance on a horizontal plane, W/m2, spread "
                          "over --sky (default soc) (default 0)")
-    ab.add_argument("--depth", type=int, default=DEFAULT_DEPTH, metavar="N",
+    ab.add_argument("--depth", type=int, default=None, metavar="N",
                     help=f"most scatterings followed per ray (default {DEFAULT_DEPTH})")
-    ab.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    ab.add_argument("--seed", type=int, default=None, help="random seed (default 0)")
     p.set_defaults(run=run)
 
 
 def _absorbed_asked(args: argparse.Namespace) -> bool:
     return any(v is not None for v in (args.band, args.reflectance, args.transmittance,
                                         args.ground_reflectance, args.irradiance,
-                                        args.optics_table)) or bool(args.diffuse)
+                                        args.optics_table, args.depth, args.seed)) or \
+        bool(args.diffuse)
 
 
 # ------------------------------------------------------------------------------ what is asked
@@ -290,13 +291,16 @@ def run(args: argparse.Namespace) -> int:
                                 quantity="irradiance")
         absorbed_optics = optics_for(args.band or "par", args.reflectance, args.transmittance,
                                      args.ground_reflectance)
-        if args.optics_table:
+        if args.optics_table is not None:
             absorbed_optics = replace(absorbed_optics, ranks=read_optics_table(
                 args.optics_table, absorbed_optics.band))
         if args.irradiance is not None:
             check_range(args.irradiance, "the direct irradiance (W/m2)", 0, 5000, "irradiance")
         check_range(args.diffuse, "the diffuse irradiance (W/m2)", 0, 5000, "irradiance")
+        args.depth = DEFAULT_DEPTH if args.depth is None else args.depth
+        args.seed = 0 if args.seed is None else args.seed
         check_range(args.depth, "the scattering depth", 0, 10_000, "depth", whole=True)
+        check_range(args.seed, "the random seed", 0, 2**32 - 1, "seed", whole=True)
     rect = tuple(floats(args.rect, "the sample rectangle", "rect", 4)) if args.rect else None
     if not args.heatmap_bin > 0:
         raise MaizevizError(f"the heatmap bin must be > 0 cm, got {args.heatmap_bin}",
@@ -400,7 +404,7 @@ def run(args: argparse.Namespace) -> int:
         rec["warnings"] = list(dict.fromkeys(warnings))
         if absorbed_optics is not None and sun is None and period is not None:
             abd = engine.absorbed_day(period, optics=absorbed_optics,
-                                      sky="soc" if args.sky in (None, PEREZ) else args.sky,
+                                      sky=args.sky or "soc",
                                       directions=args.sky_directions or 46, depth=args.depth,
                                       seed=args.seed,
                                       progress=Progress(f"absorbed light over the period, "
@@ -767,7 +771,8 @@ def _print_balance(records: list[dict]) -> None:
     rows = []
     for r in records:
         b = r["balance"]
-        last = f"{r['absorbed'].get('absorbed_leaves_mol_m2') or 0:.2f}" if period else \
+        mol = r["absorbed"].get("absorbed_leaves_mol_m2")
+        last = ("-" if mol is None else f"{mol:.2f}") if period else \
             f"{r['absorbed']['sunlit_lai']:.2f}"
         rows.append([r["level"], f"{b['incident']:.2f}", f"{b['absorbed_leaves']:.2f}",
                      f"{b['absorbed_ground']:.2f}", f"{b['reflected_top']:.2f}",

@@ -19,6 +19,11 @@ _KINDS = ((stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISCHR, "a character de
           (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
 
 
+
+def _a(what: str) -> str:
+    """``what`` with its indefinite article ("a points file", "an optics table")."""
+    return f"{'an' if what[:1].lower() in 'aeiou' else 'a'} {what}"
+
 def file_kind(mode: int) -> str | None:
     """What a file that is neither regular nor a folder is, in words (else None)."""
     return next((name for test, name in _KINDS if test(mode)), None)
@@ -40,23 +45,23 @@ def open_input(path: str | Path, what: str, error: type[MaizevizError] = Maizevi
     except FileNotFoundError:
         raise error(f"{path}: no such {what}") from None
     except IsADirectoryError:
-        raise error(f"{path}: is a folder, not a {what}") from None
+        raise error(f"{path}: is a folder, not {_a(what)}") from None
     except (OSError, ValueError) as exc:
         try:                                       # a socket cannot even be opened
             kind = file_kind(os.stat(path).st_mode)
         except (OSError, ValueError):
             kind = None
         if kind:
-            raise error(f"{path}: is {kind}, not a regular file; a {what} must be a regular "
+            raise error(f"{path}: is {kind}, not a regular file; {_a(what)} must be a regular "
                         "file") from None
         raise error(f"{path}: cannot be read ({getattr(exc, 'strerror', None) or exc})") from None
     st = os.fstat(fd)
     if not stat.S_ISREG(st.st_mode):
         os.close(fd)
         if stat.S_ISDIR(st.st_mode):
-            raise error(f"{path}: is a folder, not a {what}")
+            raise error(f"{path}: is a folder, not {_a(what)}")
         raise error(f"{path}: is {file_kind(st.st_mode) or 'not a file'}, not a regular file; "
-                    f"a {what} must be a regular file")
+                    f"{_a(what)} must be a regular file")
     os.set_blocking(fd, True)
     return os.fdopen(fd, "rb", buffering=buffering), st.st_size
 
@@ -74,11 +79,11 @@ def read_input(path: str | Path, what: str, max_bytes: int,
     fh, size = open_input(path, what, error)
     with fh:
         if size > max_bytes:
-            raise error(f"{path}: more than the {_size(max_bytes)} limit for a {what}")
+            raise error(f"{path}: more than the {_size(max_bytes)} limit for {_a(what)}")
         try:
             data = fh.read(max_bytes + 1)
         except OSError as exc:
             raise error(f"{path}: cannot be read ({exc.strerror or exc})") from None
     if len(data) > max_bytes:
-        raise error(f"{path}: more than the {_size(max_bytes)} limit for a {what}")
+        raise error(f"{path}: more than the {_size(max_bytes)} limit for {_a(what)}")
     return data

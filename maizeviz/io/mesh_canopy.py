@@ -703,10 +703,11 @@ def _check_finite(vertices: np.ndarray, src: str, lines: np.ndarray | None) -> N
                             f"{vertices[i, 'xyz'.index(axis)]}, not a finite number")
 
 
-def _fan(length: np.ndarray, flat: np.ndarray, n_vertices: int, at, src: str
-         ) -> tuple[np.ndarray, np.ndarray, int]:
+def _fan(length: np.ndarray, flat: np.ndarray, n_vertices: int, at, src: str,
+         base: int = 0) -> tuple[np.ndarray, np.ndarray, int]:
     """Triangles (T, 3), the face of each, and the number of polygons, from face vertex lists
-    (lengths, flat indices); refuses short faces and indices out of range."""
+    (lengths, flat indices from 0); refuses short faces and indices out of range, said as the
+    file counts them (``base``: 1 for OBJ)."""
     short = np.flatnonzero(length < 3)
     if len(short):
         i = int(short[0])
@@ -721,9 +722,9 @@ def _fan(length: np.ndarray, flat: np.ndarray, n_vertices: int, at, src: str
     if len(out):
         k = int(out[0])
         i = int(np.searchsorted(np.cumsum(length), k, "right"))
-        span = f"0 to {n_vertices - 1}" if n_vertices else "none"
-        raise MeshFileError(f"{src}: {at(i)}: vertex index {int(flat[k])} is out of range: the "
-                            f"file has {n_vertices:,} vertices ({span})")
+        span = f"{base} to {n_vertices - 1 + base}" if n_vertices else "none"
+        raise MeshFileError(f"{src}: {at(i)}: vertex index {int(flat[k]) + base} is out of "
+                            f"range: the file has {n_vertices:,} vertices ({span})")
     offs = np.cumsum(length) - length
     tris = length - 2
     n_tri = int(tris.sum())
@@ -861,7 +862,7 @@ def _obj_mesh(vertices: np.ndarray, vline_arr: np.ndarray, flat: np.ndarray,
     def at(i: int) -> str:
         return f"face {i} (counting from 0, line {int(face_lines[i])})"
 
-    faces, tri_face, polygons = _fan(length, flat, len(vertices), at, src)
+    faces, tri_face, polygons = _fan(length, flat, len(vertices), at, src, base=1)
     if not groups:
         raise MeshFileError(f"{src}: the faces carry no plant or leaf id (no o or g names): "
                             "name each leaf's faces with a 'g' line (g plant1_leaf3)")

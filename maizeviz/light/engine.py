@@ -404,7 +404,10 @@ class LightEngine:
         ----------
         period, date, lat, lon, tz, step_min, start, end, linke : the period, as :meth:`day`
         band, optics, depth, threshold, seed, sampling, **fields_ : as :meth:`absorbed`
-        sky, directions : the diffuse light's sky (default: standard overcast, 46)
+        sky, directions : the diffuse light's sky (default: standard overcast, 46); "perez"
+            (or "perez-driesse") splits each step's diffuse light by Perez's model
+            (:mod:`maizeviz.light.perez`): its circumsolar part added to that step's direct
+            beam, the rest from a uniform sky
         progress : after the sky and after each step
 
         Returns
@@ -424,10 +427,17 @@ class LightEngine:
         common = dict(band=opt.band, optics=opt, depth=depth, threshold=threshold, seed=seed,
                       sampling=sampling, **fields_)
         steps = len(period.step_s)
-        unit = self.absorbed(direct_w_m2=0.0, diffuse_w_m2=1.0, sky=sky,
+        model = str(sky).strip().lower() if isinstance(sky, str) else ""
+        split = perez_split(period, model) if model in PEREZ_MODELS else None
+        unit = self.absorbed(direct_w_m2=0.0, diffuse_w_m2=1.0,
+                             sky="uoc" if split is not None else sky,
                              directions=directions, **common)
         report(progress, 1, steps + 1, "absorbed light: the sky")
         diffuse_w = np.asarray(period.dhi, np.float64) * share
+        circumsolar_w = np.zeros(steps)
+        if split is not None:                   # the circumsolar part comes with the sun
+            circumsolar_w = np.asarray(split.circumsolar_w_m2, np.float64) * share
+            diffuse_w = np.asarray(split.isotropic_w_m2, np.float64) * share
         step_s = np.asarray(period.step_s, np.float64)
         joules = unit.triangle_absorbed_w * float(np.sum(diffuse_w * step_s))
         ub = unit.balance
@@ -436,7 +446,7 @@ class LightEngine:
                            "escaped_sides", "unresolved")}
         leaves_w = ub.absorbed_leaves * diffuse_w
         seconds = dict(unit.seconds)
-        direct_w = np.asarray(period.direct_horizontal, np.float64) * share
+        direct_w = np.asarray(period.direct_horizontal, np.float64) * share + circumsolar_w
         for k in range(steps):
             z = float(period.zenith_deg[k])
             if direct_w[k] > 0 and z < 90.0:

@@ -159,7 +159,8 @@ def read_optics_table(path, band: str) -> tuple[tuple[int, float, float], ...]:
 
     from maizeviz.io.inputs import read_input
 
-    text = read_input(path, "optics table", max_bytes=4 * 2**20).decode("utf-8", "replace")
+    # utf-8-sig: a spreadsheet's "CSV UTF-8" starts with a byte-order mark
+    text = read_input(path, "optics table", max_bytes=4 * 2**20).decode("utf-8-sig", "replace")
     rows = list(csv.reader(text.splitlines()))
     if not rows:
         raise MaizevizError(f"{path}: the optics table is empty", quantity="optics_table")
@@ -171,6 +172,7 @@ def read_optics_table(path, band: str) -> tuple[tuple[int, float, float], ...]:
                                 quantity="optics_table")
     col = {h: i for i, h in enumerate(head)}
     out = []
+    seen: dict[int, int] = {}
     for line, row in enumerate(rows[1:], start=2):
         if not any(c.strip() for c in row):
             continue
@@ -185,6 +187,15 @@ def read_optics_table(path, band: str) -> tuple[tuple[int, float, float], ...]:
         except ValueError:
             raise MaizevizError(f"{path}, line {line}: rank, reflectance and transmittance "
                                 f"must be numbers, got {', '.join(c[:20] for c in row)}",
+                                quantity="optics_table") from None
+        if rank in seen:
+            raise MaizevizError(f"{path}, line {line}: leaf rank {rank} was given on line "
+                                f"{seen[rank]} already", quantity="optics_table")
+        seen[rank] = line
+        try:
+            Optics(0.0, 0.0, 0.0, band, ((rank, rho, tau),))       # the row alone, checked
+        except MaizevizError as exc:
+            raise MaizevizError(f"{path}, line {line}: {exc}",
                                 quantity="optics_table") from None
         out.append((rank, rho, tau))
     if not out:

@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from maizeviz.light.irradiance import DEFAULT_PAR_UMOL_PER_J
+from maizeviz.light.scatter import DEFAULT_DEPTH
 
 
 @dataclass(frozen=True)
@@ -138,7 +139,9 @@ class OpticsSpec:
         The band's diffuse irradiance on a horizontal plane, W/m2, from a standard overcast
         sky of 46 directions (0: the direct beam only).
     depth : int
-        Scatterings followed (0: first hits only).
+        Most scatterings followed per ray (0: first hits only; default
+        :data:`maizeviz.light.scatter.DEFAULT_DEPTH`, as the command line; Russian roulette
+        and the energy threshold end most paths long before).
     seed : int
         Random seed of the Monte Carlo scattering (the same seed gives the same result).
     ranks : tuple of (rank, reflectance, transmittance)
@@ -151,7 +154,7 @@ class OpticsSpec:
     ground_reflectance: float | None = None
     direct_w_m2: float | None = None
     diffuse_w_m2: float = 0.0
-    depth: int = 3
+    depth: int = DEFAULT_DEPTH
     seed: int = 0
     ranks: tuple = ()
 

@@ -153,9 +153,14 @@ def _dry_run(spec, args) -> int:
     from maizeviz.sweep.store import done_keys_on_disk
 
     done = done_keys_on_disk(args.out, spec) if args.out else set()
-    head = ["#", "key", "points", "arrangement", "level", "sun", "density", "periodic", ""]
+    from maizeviz.sweep.spec import optics_label
+
+    optics = any(s.optics is not None for s in spec.scenarios)
+    head = ["#", "key", "points", "arrangement", "level", "sun", "density", "periodic",
+            *(["optics"] if optics else []), ""]
     rows = [[s.index + 1, s.key[:12], s.points.name, s.arrangement.label, s.level, s.sun.label,
              f"{s.density:g}", "yes" if s.periodic else "no",
+             *([optics_label(s.optics)] if optics else []),
              "done" if s.key in done else ""] for s in spec.scenarios]
     cells = [head] + [[str(c) for c in r] for r in rows]
     widths = [max(len(r[i]) for r in cells) for i in range(len(head))]

@@ -88,6 +88,8 @@ OPTICS_KEYS = ("band", "reflectance", "transmittance", "ground_reflectance", "di
                "diffuse_w_m2", "depth", "seed", "ranks")
 #: Most scatterings a sweep follows.
 MAX_DEPTH = 50
+#: Largest irradiance of a band, W/m2 (as the command line's --irradiance and --diffuse).
+MAX_IRRADIANCE = 5000.0
 SUN_ANGLE_KEYS = ("zenith", "azimuth")
 SUN_PLACE_KEYS = ("date", "time", "solar_noon", "lat", "lon", "tz", "altitude")
 
@@ -207,11 +209,35 @@ def optics_columns(optics: OpticsSpec | None) -> dict:
     """The optics of a scenario as result columns (None for black leaves)."""
     if optics is None:
         return {"optics_band": None, "leaf_reflectance": None, "leaf_transmittance": None,
-                "ground_reflectance": None, "scatter_depth": None}
+                "ground_reflectance": None, "scatter_depth": None, "optics": "black"}
     o = optics.optics()
     return {"optics_band": o.band, "leaf_reflectance": o.reflectance,
             "leaf_transmittance": o.transmittance, "ground_reflectance": o.ground_reflectance,
-            "scatter_depth": optics.depth}
+            "scatter_depth": optics.depth, "optics": optics_label(optics)}
+
+
+def optics_label(optics: OpticsSpec | None) -> str:
+    """Leaf optics in words, every setting that changes the numbers: "black", or band, leaf
+    rho and tau, soil rho, then what differs from the defaults (irradiance, depth, seed,
+    ranks)."""
+    if optics is None:
+        return "black"
+    from maizeviz.light.scatter import DEFAULT_DEPTH
+
+    o = optics.optics()
+    text = (f"{o.band} rho {o.reflectance:g} tau {o.transmittance:g} soil "
+            f"{o.ground_reflectance:g}")
+    if optics.direct_w_m2 is not None:
+        text += f" direct {optics.direct_w_m2:g} W/m2"
+    if optics.diffuse_w_m2:
+        text += f" diffuse {optics.diffuse_w_m2:g} W/m2"
+    if optics.depth != DEFAULT_DEPTH:
+        text += f" depth {optics.depth}"
+    if optics.seed:
+        text += f" seed {optics.seed}"
+    if o.ranks:
+        text += " ranks " + ";".join(f"{r}:{a:g}/{b:g}" for r, a, b in o.ranks)
+    return text
 
 
 def _scenario_inputs(points, arr, level, preserve, sun, density, periodic, heights, rect,
@@ -406,6 +432,9 @@ class _Checker:
                   "diffuse_w_m2"):
             if k in v:
                 t[k] = self.number(v[k], f"{where}.{k}", positive=False, minimum=0)
+                if k.endswith("_w_m2") and t[k] > MAX_IRRADIANCE:
+                    self.fail(f"{where}.{k}", f"must be from 0 to {MAX_IRRADIANCE:g} W/m2, got "
+                                              f"{t[k]:g}")
         for k in ("depth", "seed"):
             if k in v:
                 x = v[k]

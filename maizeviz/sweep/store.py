@@ -47,7 +47,7 @@ COLUMNS = (
     ("seconds_fit", "float64"), ("seconds_layout", "float64"), ("seconds_build", "float64"),
     ("seconds_scene", "float64"), ("seconds_measure", "float64"), ("seconds_trace", "float64"),
     # leaf optics (None for black leaves): the axis, then the energy balance, W/m2 of ground
-    ("optics_band", "string"), ("leaf_reflectance", "float64"),
+    ("optics", "string"), ("optics_band", "string"), ("leaf_reflectance", "float64"),
     ("leaf_transmittance", "float64"), ("ground_reflectance", "float64"),
     ("scatter_depth", "int64"), ("incident_w_m2", "float64"), ("absorbed_leaves_w_m2", "float64"),
     ("absorbed_ground_w_m2", "float64"), ("reflected_top_w_m2", "float64"),

@@ -29,11 +29,9 @@ def _arrangement(r: dict) -> str:
 
 
 def _optics(r: dict) -> str:
-    """Leaf optics in a word: "black", or band and leaf rho/tau, soil rho."""
-    if not r.get("optics_band"):
-        return "black"
-    return (f"{r['optics_band']} rho {r['leaf_reflectance']:g} tau {r['leaf_transmittance']:g} "
-            f"soil {r['ground_reflectance']:g}")
+    """Leaf optics in words (the result's ``optics`` column: every setting that changes the
+    numbers; "black" for interception)."""
+    return r.get("optics") or "black"
 
 
 def _sun(r: dict) -> str:

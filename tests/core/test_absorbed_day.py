@@ -58,3 +58,34 @@ def test_the_cli_reports_a_days_absorbed_par(capsys):
     assert cli_main(args[:-1] + ["--irradiance", "400"]) != 0
     err = capsys.readouterr().err
     assert "over a period the irradiance is the period's" in err and "Traceback" not in err
+
+
+def test_a_perez_day_moves_the_circumsolar_light_to_the_sun(engine):
+    """Perez: the same incident light, its circumsolar part traced with the sun; black leaves
+    absorb what the Perez day intercepts."""
+    soc = engine.absorbed_day(optics=Optics(0, 0, 0), **DAY)
+    perez = engine.absorbed_day(optics=Optics(0, 0, 0), sky="perez", **DAY)
+    day = engine.day(sky="perez", **DAY)
+    assert perez.balance.incident == pytest.approx(soc.balance.incident, rel=1e-12)
+    assert perez.balance.absorbed_leaves != soc.balance.absorbed_leaves
+    assert perez.absorbed_leaves_mol_m2 == pytest.approx(day.par_intercepted_mol_m2, rel=1e-9)
+
+
+@pytest.mark.parametrize("extra, says", [
+    (["--seed", "-1"], "the random seed must be a whole number"),
+    (["--depth", "-1"], "the scattering depth"),
+    (["--optics-table", ""], "optics table"),
+])
+def test_scattering_options_alone_turn_it_on_and_are_checked(capsys, extra, says):
+    args = ["light", str(mv.example_points()), "--triangles", "8", "--density", "0.3",
+            "--sun-zenith", "30", "--sun-azimuth", "150", *extra]
+    assert cli_main(args) != 0
+    err = capsys.readouterr().err
+    assert says in err and "internal error" not in err and "Traceback" not in err
+
+
+def test_depth_alone_asks_for_absorbed_light(capsys):
+    args = ["light", str(mv.example_points()), "--triangles", "8", "--density", "0.3",
+            "--sun-zenith", "30", "--sun-azimuth", "150", "--depth", "4", "--json"]
+    assert cli_main(args) == 0
+    assert json.loads(capsys.readouterr().out)["absorbed"]["depth"] == 4

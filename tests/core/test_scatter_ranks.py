@@ -51,13 +51,20 @@ def test_two_plates_of_different_ranks_follow_their_own_optics():
     assert leaf_w[1] / area == pytest.approx(50.0, rel=0.03)
 
 
+def test_a_spreadsheets_byte_order_mark_is_read(tmp_path):
+    path = tmp_path / "excel.csv"
+    path.write_bytes(b"\xef\xbb\xbfrank,reflectance,transmittance\r\n1,0.2,0.1\r\n")
+    assert read_optics_table(path, "par") == ((1, 0.2, 0.1),)
+
+
 @pytest.mark.parametrize("text, says", [
     ("rank,reflectance\n1,0.1\n", "no 'transmittance' column"),
     ("rank,reflectance,transmittance\n1,x,0.1\n", "line 2: rank, reflectance and"),
     ("rank,reflectance,transmittance\n1,0.1\n", "line 2: 2 values for 3 columns"),
-    ("rank,reflectance,transmittance\n1,0.7,0.6\n", "more than it receives"),
-    ("rank,reflectance,transmittance\n0,0.1,0.1\n", "rank must be a whole number"),
-    ("rank,reflectance,transmittance\n1,0.1,0.1\n1,0.2,0.1\n", "appears twice"),
+    ("rank,reflectance,transmittance\n1,0.7,0.6\n", "line 2: a leaf cannot reflect"),
+    ("rank,reflectance,transmittance\n0,0.1,0.1\n", "line 2: a leaf rank must be"),
+    ("rank,reflectance,transmittance\n1,0.1,0.1\n1,0.2,0.1\n", "line 3: leaf rank 1 was given"),
+    ("rank,reflectance,transmittance\n1,nan,0.1\n", "line 2: the reflectance must be"),
     ("rank,reflectance,transmittance,band\n1,0.1,0.1,nir\n", "no row for the PAR band"),
     ("", "empty"),
 ])

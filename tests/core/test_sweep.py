@@ -238,9 +238,10 @@ def test_optics_axis_rows_equal_the_single_run_cli(blocks, client, tmp_path, cap
     text = SPEC.replace('level = ["standard", "8"]', 'level = ["8"]').replace(
         "periodic = true", 'periodic = true\noptics = ["black", {band = "par"}, '
         '{band = "nir", reflectance = 0.4, transmittance = 0.4, ground_reflectance = 0.2, '
-        'depth = 2}]').replace('points = ["b*.csv"]', 'points = ["b0.csv"]')
+        'depth = 2}, {band = "par", seed = 3}]').replace('points = ["b*.csv"]',
+                                                        'points = ["b0.csv"]')
     spec = load_spec(spec_file(blocks, text, "optics.toml"))
-    assert len(spec.scenarios) == 3 * 3
+    assert len(spec.scenarios) == 3 * 4
     black = {s.key for s in spec.scenarios if s.optics is None}
     assert black <= {s.key for s in base.scenarios}          # the same keys as without optics
     out = tmp_path / "r"
@@ -258,7 +259,8 @@ def test_optics_axis_rows_equal_the_single_run_cli(blocks, client, tmp_path, cap
                 "--json",
                 "--band", r["optics_band"], "--reflectance", str(r["leaf_reflectance"]),
                 "--transmittance", str(r["leaf_transmittance"]), "--ground-reflectance",
-                str(r["ground_reflectance"]), "--depth", str(r["scatter_depth"])]
+                str(r["ground_reflectance"]), "--depth", str(r["scatter_depth"]),
+                "--seed", "3" if r["optics"].endswith("seed 3") else "0"]
         assert cli_main(args) == 0
         balance = json.loads(capsys.readouterr().out)["balance"]       # one level: flat
         assert r["incident_w_m2"] == pytest.approx(balance["incident"], rel=1e-12)
@@ -267,7 +269,8 @@ def test_optics_axis_rows_equal_the_single_run_cli(blocks, client, tmp_path, cap
         assert abs(r["balance_closure"]) < 0.02
     summary = summarize(read_results(out), 0.02)
     assert {s["optics"] for s in summary} == {"black", "par rho 0.1 tau 0.05 soil 0.1",
-                                              "nir rho 0.4 tau 0.4 soil 0.2"}
+                                              "nir rho 0.4 tau 0.4 soil 0.2 depth 2",
+                                              "par rho 0.1 tau 0.05 soil 0.1 seed 3"}
 
 
 @pytest.mark.parametrize("text, says", [
@@ -320,6 +323,8 @@ def test_optics_axis_rows_equal_the_single_run_cli(blocks, client, tmp_path, cap
      r"light.optics\[0\].depth: must be a whole number from 0 to 50"),
     (SPEC.replace("periodic = true", "periodic = true\noptics = [{colour = 1}]"),
      r"unknown key 'light.optics\[0\].colour'"),
+    (SPEC.replace("periodic = true", "periodic = true\noptics = [{direct_w_m2 = 1e308}]"),
+     r"light.optics\[0\].direct_w_m2: must be from 0 to 5000 W/m2"),
 ])
 def test_bad_sweep_files_say_one_line_naming_the_key(blocks, tmp_path, text, says):
     (tmp_path / "b0.csv").write_bytes((blocks / "b0.csv").read_bytes())

@@ -346,9 +346,12 @@ class LightPanel(QWidget):
                                   "standard overcast sky of 46 directions (0: direct only)")
         form.addRow("direct", self.direct_w)
         form.addRow("diffuse", self.diffuse_w)
-        self.scatter_depth = QSpinBox(minimum=0, maximum=20, value=3)
-        self.scatter_depth.setToolTip("scatterings followed (0: first hits only; 3 keeps "
-                                      "> 99% of PAR and most of NIR)")
+        from maizeviz.light.scatter import DEFAULT_DEPTH
+
+        self.scatter_depth = QSpinBox(minimum=0, maximum=50, value=DEFAULT_DEPTH)
+        self.scatter_depth.setToolTip("most scatterings followed per ray (0: first hits only; "
+                                      "Russian roulette ends most paths long before, as on "
+                                      "the command line)")
         form.addRow("scattering depth", self.scatter_depth)
 
         def band_defaults(_i: int = 0) -> None:
