@@ -177,7 +177,12 @@ def triangle_terms(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:
     np.add(cx * cx + cy * cy, cz * cz, out=n2)
     ok = n2 > _DEGENERATE_SIN2 * e00 * e11          # and so e00, e11, |bc|^2 > 0 too
     out[13:] = 0.0
-    for row, x in zip((13, 14, 15, 16), (e00, e11, e00 - 2.0 * e01 + e11, n2)):
+    # |bc|^2 from bc itself: e00 - 2 e01 + e11 cancels to 0 on a sliver whose b and c nearly
+    # coincide seen from a, and its reciprocal (inf) times a 0 of the blended regions is NaN
+    bc = ac - ab
+    ebc = np.einsum("ij,ij->j", bc, bc)
+    ok &= ebc > 0
+    for row, x in zip((13, 14, 15, 16), (e00, e11, ebc, n2)):
         np.divide(1.0, x, out=out[row], where=ok)
     return out
 
