@@ -98,6 +98,11 @@ WARM_STAGES = (
               "maizeviz.light.heatmap", "maizeviz.canopy.export", "maizeviz_app.project")))
 
 
+def _count(n: int, one: str, many: str | None = None) -> str:
+    """``n`` and its noun, singular or plural ("1 plant", "2 leaves")."""
+    return f"{n} {one if n == 1 else many or one + 's'}"
+
+
 def _scrolled(widget: QWidget) -> QScrollArea:
     area = QScrollArea()
     area.setWidget(widget)
@@ -580,7 +585,8 @@ class MainWindow(QMainWindow):
             self.say(f"note: {w}")
         for e in loaded.skipped:
             self.say(f"skipped: {e}")
-        self.say(f"{len(loaded.leaves)} leaves of {len(loaded.plants)} plants; "
+        self.say(f"{_count(len(loaded.leaves), 'leaf', 'leaves')} of "
+                 f"{_count(len(loaded.plants), 'plant')}; "
                  f"{len(loaded.layout.placements)} plants in the canopy")
         self.rebuild()
 

@@ -105,6 +105,7 @@ def test_a_day_with_perez_diffuse_light(window, qtbot, small_points, tmp_path):
     p = w.light_panel
     small_light(p, "day")
     p.day_diffuse.setCurrentIndex(p.day_diffuse.findData("perez"))
+    assert not p.sky_kind.isEnabled() and "uniform sky" in p.sky_kind.toolTip()
     compute(qtbot, w)
     day = w.runs.last.result
     assert day.diffuse is not None and day.diffuse.model == "perez"
@@ -117,4 +118,6 @@ def test_a_day_with_perez_diffuse_light(window, qtbot, small_points, tmp_path):
     w2 = window(path)
     qtbot.waitUntil(lambda: w2.runs.last is not None, timeout=TIMEOUT)
     assert w2.light_panel.day_diffuse.currentData() == "perez"
+    w2.light_panel.set_mode("sky")
+    assert w2.light_panel.sky_kind.isEnabled()          # a sky alone has its own shape
     assert w2.runs.last.result.diffuse is not None

@@ -290,6 +290,7 @@ class LightPanel(QWidget):
         form.addRow("sun zenith", self.zenith)
         form.addRow("sun azimuth", self.azimuth)
         self.place = QLineEdit(DEFAULT_PLACE)
+        self.place.setCursorPosition(0)                 # the date shows, not the zone's end
         self.place.setToolTip("date, local time, latitude, longitude, time zone: the sun's "
                               "angles are computed with pvlib")
         self.place_button = QPushButton("Sun from place")
@@ -474,6 +475,7 @@ class LightPanel(QWidget):
             "Perez's split of each step (its circumsolar part traced with the sun, the rest "
             "from a uniform sky of the directions chosen below; pvlib)")
         form.addRow("diffuse light", self.day_diffuse)
+        self.day_diffuse.currentIndexChanged.connect(lambda _i: self._sync_sky_kind())
         self.day_from = QLineEdit("")
         self.day_from.setPlaceholderText("00:00")
         self.day_to = QLineEdit("")
@@ -556,6 +558,17 @@ class LightPanel(QWidget):
                               "diffuse part of the day: the sky it comes from")
         self.compute_button.setText(COMPUTE_TEXT[mode])
         self.pages.adjustSize()
+        self._sync_sky_kind()
+
+    def _sync_sky_kind(self) -> None:
+        """With Perez's diffuse light in a day, the sky's shape is Perez's (a uniform sky for
+        its isotropic part, the circumsolar part with the sun): the shape choice is off."""
+        perez = self.mode == "day" and self.day_diffuse.currentData() == "perez"
+        self.sky_kind.setEnabled(not perez)
+        self.sky_kind.setToolTip(
+            "Perez's diffuse light: its isotropic part comes from a uniform sky of the "
+            "directions chosen, its circumsolar part with the sun" if perez else
+            "how the sky's brightness varies with the zenith angle θ")
 
     # ------------------------------------------------------------------ settings
     def settings(self) -> dict:
@@ -599,6 +612,7 @@ class LightPanel(QWidget):
         self.zenith.setValue(float(s.get("zenith_deg", self.zenith.value())))
         self.azimuth.setValue(float(s.get("azimuth_deg", self.azimuth.value())))
         self.place.setText(str(s.get("place", self.place.text())))
+        self.place.setCursorPosition(0)
         self.heights.setText(str(s.get("heights", self.heights.text())))
         self.density.setValue(float(s.get("density", self.density.value())))
         self.periodic.setChecked(bool(s.get("periodic", self.periodic.isChecked())))
