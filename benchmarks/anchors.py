@@ -18,3 +18,24 @@ def matmul_anchor() -> float:
         a = a @ a
         a /= np.abs(a).max()
     return time.perf_counter() - t0
+
+
+def best(fn, repeat: int = 3) -> float:
+    """Shortest of ``repeat`` timed calls of ``fn()``, seconds."""
+    out = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t0)
+    return min(out)
+
+
+def report(out: dict, as_json: bool, width: int = 28) -> None:
+    """Print a benchmark's results: JSON, or one ``name: value`` line each."""
+    if as_json:
+        import json
+
+        print(json.dumps(out, indent=1))
+    else:
+        for k, v in out.items():
+            print(f"{k:>{width}}: {v}")

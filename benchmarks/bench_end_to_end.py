@@ -36,7 +36,7 @@ import sys
 import time
 from pathlib import Path
 
-from anchors import matmul_anchor
+from anchors import matmul_anchor, report
 
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
@@ -115,11 +115,7 @@ def main() -> None:
         / (out["build_block_s"] + out["sun_block_s"]), 1)                      # type: ignore
     out["block_speedup_day"] = round(out["day_whole_s"] / out["day_block_s"], 2)  # type: ignore
     out["targets"] = {"cli_sun_s": 1.5, "cli_day_s": 5.0}
-    if args.json:
-        print(json.dumps(out, indent=1))
-    else:
-        for k, v in out.items():
-            print(f"{k:>28}: {v}")
+    report(out, args.json)
 
 
 if __name__ == "__main__":

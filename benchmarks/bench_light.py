@@ -25,6 +25,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from anchors import best
 
 from maizeviz.canopy.layout import plant_bases, tiled_layout
 from maizeviz.canopy.scene import build_canopy
@@ -40,14 +41,6 @@ from maizeviz.mesh.raytrace import RayScene
 
 ROOT = Path(__file__).resolve().parents[1]
 
-
-def best(fn, repeat=3):
-    out = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return min(out)
 
 
 def main():

@@ -30,12 +30,11 @@ of them, in Mrays/s:
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import time
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
+from anchors import best, report
 
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
@@ -49,14 +48,6 @@ from maizeviz.resources import example_points
 
 CHUNK = 1 << 16
 
-
-def best(fn, repeat: int) -> float:
-    out = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return min(out)
 
 
 def chunked(fn, n: int, threads: int):
@@ -147,11 +138,7 @@ def main() -> None:
             out[f"speedup_{q}_{t}"] = round(out[f"packets_{q}_{t}"]            # type: ignore
                                             / out[f"intersect1_{q}_{t}"], 2)   # type: ignore
     out["targets"] = {"packets_occluded_2t": 20.0, "speedup_occluded_2t": 3.0}
-    if args.json:
-        print(json.dumps(out, indent=1))
-    else:
-        for k, v in out.items():
-            print(f"{k:>28}: {v}")
+    report(out, args.json)
 
 
 if __name__ == "__main__":

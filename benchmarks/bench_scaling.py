@@ -29,6 +29,7 @@ import os
 import time
 
 import numpy as np
+from anchors import best
 
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
@@ -68,14 +69,6 @@ def _worker_trace(level: str, zenith: list[float], azimuth: list[float], weights
               scene=_WORKER["scene"])
     return time.perf_counter() - t0
 
-
-def best(fn, repeat: int) -> float:
-    out = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        out.append(time.perf_counter() - t0)
-    return min(out)
 
 
 def dask_rows(args, sky: Sky, cores: int) -> list[dict]:
