@@ -331,22 +331,18 @@ def _overlaps(cells: np.ndarray) -> str:
                                (cells[:, 1] + cells[:, 3]) / (2 * h)])
     if len(centres) <= SMALL_FIELD:             # every pair at once: no k-d tree to import
         i, j = np.triu_indices(len(centres), 1)
-        d = np.abs(centres[i] - centres[j])
-        close = (d[:, 0] < 0.9) & (d[:, 1] < 0.9)
-        if not close.any():
-            return ""
-        d = d[close]
-        twice = float(np.sum((1 - d[:, 0]) * (1 - d[:, 1]))) * w * h
-        return f"({int(close.sum())} overlapping pairs, about {twice:.0f} cm2 counted twice)"
-    from scipy.spatial import cKDTree
+        near = np.max(np.abs(centres[i] - centres[j]), axis=1) <= 0.9    # as query_pairs
+        pairs = np.column_stack([i[near], j[near]])
+    else:
+        from scipy.spatial import cKDTree
 
-    tree = cKDTree(centres)
-    # count first (no pairs held): plants packed far closer than the spacing (100,000 plants
-    # 1 cm apart with a 30 cm spacing) make ~10^8 pairs, gigabytes if listed
-    n_pairs = (int(tree.count_neighbors(tree, 0.9, p=np.inf)) - len(centres)) // 2
-    if n_pairs > MAX_OVERLAP_PAIRS:
-        return f"({n_pairs:,} overlapping pairs)"
-    pairs = tree.query_pairs(0.9, p=np.inf, output_type="ndarray")
+        tree = cKDTree(centres)
+        # count first (no pairs held): plants packed far closer than the spacing (100,000
+        # plants 1 cm apart with a 30 cm spacing) make ~10^8 pairs, gigabytes if listed
+        n_pairs = (int(tree.count_neighbors(tree, 0.9, p=np.inf)) - len(centres)) // 2
+        if n_pairs > MAX_OVERLAP_PAIRS:
+            return f"({n_pairs:,} overlapping pairs)"
+        pairs = tree.query_pairs(0.9, p=np.inf, output_type="ndarray")
     if not len(pairs):
         return ""
     d = np.abs(centres[pairs[:, 0]] - centres[pairs[:, 1]])
