@@ -40,21 +40,29 @@ _PLANT_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564
 def canopy_polydata(canopy) -> pv.PolyData:
     """One mesh of a :class:`~maizeviz.canopy.scene.Canopy`'s leaves and stalks (float32
     vertices, cm) with the cell data listed in the module docstring. Safe off the GUI thread."""
-    nv, nf = len(canopy.vertices), len(canopy.faces)
+    return _polydata(canopy, canopy.vertices, canopy.faces, canopy.face_plant,
+                     canopy.face_instance, canopy.face_leaf)
+
+
+def _polydata(canopy, vertices: np.ndarray, faces: np.ndarray, face_plant: np.ndarray,
+              face_instance: np.ndarray, face_leaf: np.ndarray) -> pv.PolyData:
+    """The mesh of leaf triangles ``faces`` (F, 3) over ``vertices`` with their plant,
+    instance (from 0) and leaf, and ``canopy``'s stalks after them."""
+    nv, nf = len(vertices), len(faces)
     points = np.empty((nv + len(canopy.stalk_vertices), 3), np.float32)
-    points[:nv] = canopy.vertices
+    points[:nv] = vertices
     points[nv:] = canopy.stalk_vertices
-    faces = np.empty((nf + len(canopy.stalk_faces), 3), np.int64)
-    faces[:nf] = canopy.faces
-    faces[nf:] = canopy.stalk_faces + nv
-    poly = pv.PolyData.from_regular_faces(points, faces)
+    all_faces = np.empty((nf + len(canopy.stalk_faces), 3), np.int64)
+    all_faces[:nf] = faces
+    all_faces[nf:] = canopy.stalk_faces + nv
+    poly = pv.PolyData.from_regular_faces(points, all_faces)
     n_stalk = len(canopy.stalk_faces)
     per_stalk = n_stalk // max(canopy.n_plants, 1)
     stalk_inst = np.repeat(np.arange(canopy.n_plants, dtype=np.int32), per_stalk)
     plant_of_inst = np.array([p.plant for p in canopy.layout.placements], np.int32)
-    poly.cell_data["plant"] = np.concatenate([canopy.face_plant, plant_of_inst[stalk_inst]])
-    poly.cell_data["instance"] = np.concatenate([canopy.face_instance, stalk_inst]) + 1
-    poly.cell_data["leaf"] = np.concatenate([canopy.face_leaf, np.zeros(n_stalk, np.int32)])
+    poly.cell_data["plant"] = np.concatenate([face_plant, plant_of_inst[stalk_inst]])
+    poly.cell_data["instance"] = np.concatenate([face_instance, stalk_inst]) + 1
+    poly.cell_data["leaf"] = np.concatenate([face_leaf, np.zeros(n_stalk, np.int32)])
     light = np.full(nf + n_stalk, NOT_TRACED, np.int8)
     light[nf:] = STALK
     poly.cell_data["light"] = light
@@ -77,42 +85,22 @@ def display_polydata(canopy, coarse) -> pv.PolyData:
 
     The mesh has the cell data of :func:`canopy_polydata`, and in field data ``source``: for
     each drawn leaf triangle, its triangle in ``canopy`` (-1 for a coarse one);
-    ``canopy_leaf`` (each canopy triangle's leaf), ``leaf_first`` (a triangle of each leaf)
-    and ``drawn_leaf`` (each coarse triangle's leaf), so that light given per triangle of
-    ``canopy`` colours the coarse plants per leaf (:meth:`Viewport.set_light`).
+    ``canopy_triangles``; ``canopy_leaf`` (each canopy triangle's leaf), ``leaf_first`` (a
+    triangle of each leaf) and ``drawn_leaf`` (each coarse triangle's leaf), so that light
+    given per triangle of ``canopy`` colours the coarse plants per leaf
+    (:meth:`Viewport.set_light`).
     """
     x0, y0, x1, y1 = canopy.layout.centre_bounds
     sampled = np.array([x0 <= p.x <= x1 and y0 <= p.y <= y1
                         for p in canopy.layout.placements], bool)
     fine = np.flatnonzero(sampled[canopy.face_instance])
     rough = np.flatnonzero(~sampled[coarse.face_instance])
-    full = canopy_polydata(canopy)
-    nf = canopy.n_triangles
-    faces_fine = canopy.faces[fine]
-    faces_rough = coarse.faces[rough] + len(canopy.vertices)
-    n_stalk = full.n_cells - nf
-    stalk_faces = full.regular_faces[nf:] if n_stalk else np.empty((0, 3), np.int64)
-    # stalks index the full mesh's points after the canopy's vertices: move them past the
-    # coarse canopy's vertices appended below
-    stalk_faces = np.where(stalk_faces >= len(canopy.vertices),
-                           stalk_faces + len(coarse.vertices), stalk_faces)
-    points = np.vstack([canopy.vertices, coarse.vertices,
-                        canopy.stalk_vertices]).astype(np.float32)
-    faces = np.vstack([faces_fine, faces_rough, stalk_faces]).astype(np.int64)
-    poly = pv.PolyData.from_regular_faces(points, faces)
-    for name in ("plant", "instance", "leaf"):
-        part_fine = np.asarray(full.cell_data[name])[fine]
-        src = {"plant": coarse.face_plant, "instance": coarse.face_instance + 1,
-               "leaf": coarse.face_leaf}[name]
-        part_rough = np.asarray(src)[rough]
-        poly.cell_data[name] = np.concatenate([part_fine, part_rough,
-                                               np.asarray(full.cell_data[name])[nf:]])
-    n_leaf = len(fine) + len(rough)
-    light = np.full(poly.n_cells, NOT_TRACED, np.int8)
-    light[n_leaf:] = STALK
-    poly.cell_data["light"] = light
-    poly.field_data["leaf_triangles"] = np.array([n_leaf])
-    poly.field_data["canopy_triangles"] = np.array([nf])
+    poly = _polydata(
+        canopy, np.vstack([canopy.vertices, coarse.vertices]),
+        np.vstack([canopy.faces[fine], coarse.faces[rough] + len(canopy.vertices)]),
+        *(np.concatenate([getattr(canopy, name)[fine], getattr(coarse, name)[rough]])
+          for name in ("face_plant", "face_instance", "face_leaf")))
+    poly.field_data["canopy_triangles"] = np.array([canopy.n_triangles])
     poly.field_data["source"] = np.concatenate([fine, np.full(len(rough), -1)]).astype(np.int64)
     # the leaves of the canopy, and for each coarse triangle drawn its leaf among them (-1: a
     # leaf the canopy does not have), worked out here so that colouring is cheap
