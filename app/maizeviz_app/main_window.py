@@ -1208,9 +1208,9 @@ class MainWindow(QMainWindow):
     def _plants_run(self) -> Run | None:
         """The latest result with light per plant to show: a sky's, a day's or a sun's
         absorbed light (once computed against its canopy)."""
-        runs = [r for r in self.runs.runs.values()
+        runs = [r for r in self.runs.in_order()
                 if r.kind != "sun" or getattr(r.extra, "plant_rows", None) is not None]
-        return max(runs, key=lambda r: self.runs.in_order().index(r), default=None)
+        return runs[-1] if runs else None
 
     def _complete_runs(self) -> None:
         """Results read from a project that were traced on the canopy shown get what the
