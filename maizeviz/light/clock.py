@@ -104,8 +104,9 @@ def parse_clock(clock, what: str = "clock",
                           microseconds=t.microsecond), t.tzinfo)
 
 
-def local_time(day: _dt.date, clock, tz=None, what: str = "clock", quantity: str = "time"):
-    """The clock time ``clock`` on ``day`` in zone ``tz``, by the module's rule.
+def local_datetime(day: _dt.date, clock, tz=None, what: str = "clock",
+                   quantity: str = "time") -> _dt.datetime:
+    """The clock time ``clock`` on ``day`` in zone ``tz``, by the module's rule, without pandas.
 
     Parameters
     ----------
@@ -117,34 +118,52 @@ def local_time(day: _dt.date, clock, tz=None, what: str = "clock", quantity: str
 
     Returns
     -------
-    pandas.Timestamp, timezone-aware.
+    datetime.datetime, timezone-aware.
 
     Raises
     ------
     MaizevizError
         Bad clock text, unknown zone, an offset that is not the zone's on that day, a wall-clock
         time skipped or repeated by daylight saving.
+    OverflowError
+        ``24:00`` on 9999-12-31 (the next day is past :class:`datetime.date`'s calendar;
+        :func:`local_time` still reads it).
     """
-    import pandas as pd
-
     since, offset = parse_clock(clock, what, quantity)
-    # added in pandas, whose microsecond Timestamps pass 9999-12-31 24:00 (datetime's do not)
-    naive = pd.Timestamp(_dt.datetime.combine(day, _dt.time())).as_unit(TIME_UNIT) + \
-        pd.Timedelta(since)
+    naive = _dt.datetime.combine(day, _dt.time()) + since
     where = None if tz is None else (tz if isinstance(tz, _dt.tzinfo) else zone(tz))
     zoned = None
     if where is not None:
-        try:
-            zoned = naive.tz_localize(where, ambiguous="raise", nonexistent="raise")
-        except ValueError:  # pandas' NonExistentTimeError / AmbiguousTimeError
+        zoned = naive.replace(tzinfo=where)
+        # PEP 495: a wall-clock time skipped or repeated by daylight saving is the only kind
+        # whose two folds have different offsets
+        if zoned.utcoffset() != naive.replace(tzinfo=where, fold=1).utcoffset():
             raise MaizevizError(f"the {what} time {naive:%H:%M} on {naive.date()} does not exist "
                                 f"or occurs twice in {where} (a daylight-saving change); pick "
-                                "another time", quantity=quantity) from None
+                                "another time", quantity=quantity)
     if offset is None:
-        return zoned if zoned is not None else naive.tz_localize("UTC")
-    when = naive.tz_localize(offset)
+        return zoned if zoned is not None else naive.replace(tzinfo=_dt.timezone.utc)
+    when = naive.replace(tzinfo=offset)
     if zoned is not None and zoned.utcoffset() != when.utcoffset():
         raise MaizevizError(f"the {what} time {clock} carries UTC offset {when:%z} but the zone "
                             f"{where} is at {zoned:%z} on {day}: give one of them",
                             quantity=quantity)
     return when
+
+
+def local_time(day: _dt.date, clock, tz=None, what: str = "clock", quantity: str = "time"):
+    """:func:`local_datetime` as a pandas Timestamp in microseconds.
+
+    ``24:00`` on 9999-12-31 is read too: it is the next midnight, which pandas' microsecond
+    Timestamps reach (:class:`datetime.datetime` does not).
+
+    Returns
+    -------
+    pandas.Timestamp, timezone-aware, unit "us".
+    """
+    import pandas as pd
+
+    try:
+        return pd.Timestamp(local_datetime(day, clock, tz, what, quantity)).as_unit(TIME_UNIT)
+    except OverflowError:      # only 24:00, which carries no offset: the next day's 00:00
+        return local_time(day, "00:00", tz, what, quantity) + pd.Timedelta(days=1)

@@ -1,4 +1,4 @@
-"""Where the sun is: explicit angles, or place + date + clock time through pvlib.
+"""Where the sun is: explicit angles, or place + date + clock time by pvlib's SPA.
 
 Angles in degrees: zenith from the vertical, azimuth clockwise from north. Field coordinates
 have x = east and y = north unless the layout turns the field (``north_deg``: the clockwise
@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.clock import check_place, local_time, zone
+from maizeviz.light.clock import check_place, local_datetime, zone
 
 
 @dataclass(frozen=True)
@@ -49,7 +49,7 @@ def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None =
     Parameters
     ----------
     date : "YYYY-MM-DD"; time : "HH:MM" or "HH:MM:SS" local clock time in ``tz`` (or with
-        its own offset, "12:00+08:00"), read by :func:`maizeviz.light.clock.local_time`
+        its own offset, "12:00+08:00"), read by :func:`maizeviz.light.clock.local_datetime`
     lat, lon : degrees (north, east positive); tz : IANA zone such as "Asia/Shanghai" (UTC
         when neither the time nor ``tz`` says)
     solar_noon : bool, the day's true solar noon (sun transit) instead of ``time``
@@ -70,11 +70,11 @@ def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None =
     References
     ----------
     Reda, I. & Andreas, A. (2004). Solar position algorithm for solar radiation
-    applications. Solar Energy 76(5), 577-589 (pvlib's ``get_solarposition`` and
-    ``sun_rise_set_transit_spa``).
+    applications. Solar Energy 76(5), 577-589: pvlib's implementation, run as its
+    ``get_solarposition`` and ``sun_rise_set_transit_spa`` run it but without importing pandas
+    (:mod:`maizeviz.light.solar_position`).
     """
-    import pandas as pd
-    import pvlib
+    from maizeviz.light import solar_position as spa
 
     lat, lon = check_place(lat, lon)
     try:
@@ -83,14 +83,17 @@ def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None =
         raise MaizevizError(f"the date must be YYYY-MM-DD, got '{date}'", quantity="date") from None
     if solar_noon:
         where = zone(tz) if tz is not None else _dt.timezone.utc
-        midnight = pd.DatetimeIndex([pd.Timestamp(_dt.datetime.combine(day, _dt.time(), where))])
-        transit = pvlib.solarposition.sun_rise_set_transit_spa(midnight, lat, lon)
-        when = pd.Timestamp(transit["transit"].iloc[0])
+        ns = spa.transit_ns(day, lat, lon)
+        unixtime, when = ns / 1e9, spa.iso_ns(ns, where)
     else:
         if not time:
             raise MaizevizError("give a clock time HH:MM, or ask for the day's solar noon",
                                 quantity="time")
-        when = local_time(day, time, tz)
-    pos = pvlib.solarposition.get_solarposition(pd.DatetimeIndex([when]), lat, lon, altitude)
-    return Sun(float(pos["apparent_zenith"].iloc[0]), float(pos["azimuth"].iloc[0]),
-               when.isoformat())
+        try:
+            clock = local_datetime(day, time, tz)
+        except OverflowError:              # 24:00 on 9999-12-31
+            raise MaizevizError(f"{date} {time} is past the last day maizeviz reads "
+                                "(9999-12-31)", quantity="date") from None
+        unixtime, when = spa.unix_seconds(clock), clock.isoformat()
+    zenith, azimuth = spa.position(unixtime, lat, lon, altitude)
+    return Sun(zenith, azimuth, when)
