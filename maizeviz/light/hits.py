@@ -55,36 +55,15 @@ class SunRays:
         """Distance (cm) along a ray from the top plane to the ground."""
         return self.top / float(self.sun[2])
 
-    @cached_property
-    def _top_axes(self) -> tuple[np.ndarray, np.ndarray]:
-        nx, ny = self.shape
-        x0, y0, x1, y1 = self.rect
-        dx, dy = (x1 - x0) / nx, (y1 - y0) / ny
-        xs = (x0 + (np.arange(nx) + 0.5) * dx + self.sun[0] * self.reach).astype(np.float32)
-        ys = (y0 + (np.arange(ny) + 0.5) * dy + self.sun[1] * self.reach).astype(np.float32)
-        return xs, ys
-
-    def origins(self, a: int, b: int) -> np.ndarray:
-        """Start points (b - a, 3) float32 cm on the top plane of rays a..b (grid order)."""
-        xs, ys = self._top_axes
-        ny = self.shape[1]
-        k = np.arange(a, b)
-        i, j = np.divmod(k, ny)
-        org = np.empty((b - a, 3), dtype=np.float32)
-        org[:, 0] = xs[i]
-        org[:, 1] = ys[j]
-        org[:, 2] = self.top
-        return org
-
 
 def first_hits(tracer: Tracer, rays: SunRays, a: int, b: int,
                ids: bool) -> tuple[np.ndarray | None, np.ndarray]:
-    """First hits of rays a..b: triangle ids (b - a,) int32, -1 where none (None unless
-    ``ids``), and the height (cm) of each hit (b - a,) float32, -inf where none."""
-    prim, dist = tracer.trace(rays.origins(a, b), np.full(b - a, rays.reach, np.float32), ids=ids,
-                              row=rays.shape[1])
-    z = (rays.top - dist * rays.sun[2]).astype(np.float32)
-    return prim, z
+    """First hits of rays a..b (grid order: x slow, y fast): triangle ids (b - a,) int32, -1
+    where none (None unless ``ids``), and the height (cm) of each hit (b - a,) float32, -inf
+    where none. The rays of the rectangle's own lattice cells (:func:`lattice_first_hits`):
+    every path that traces ground rays starts them at the same points."""
+    i, j = np.divmod(np.arange(a, b), rays.shape[1])
+    return lattice_first_hits(tracer, rays, i, j, ids, row=rays.shape[1])
 
 
 def lattice_first_hits(tracer: Tracer, rays: SunRays, i: np.ndarray, j: np.ndarray,

@@ -40,16 +40,19 @@ class CanopyScene(RayScene):
     source : (F_scene,) int64, the original triangle of each scene triangle (None: identity)
     wrapped : (x0, y0, x1, y1) cm, the plot whose overhangs were copied, or None
     wrap : Wrap of the periodic field this scene repeats in (the plot), or None
+    period : Wrap of the field's smallest known period: the block of a tiled canopy (which
+        the field repeats exactly, :func:`~maizeviz.light.tiling.block_tiling`), else ``wrap``
     """
 
     def __init__(self, vertices: np.ndarray, faces: np.ndarray, n_original: int | None = None,
                  source: np.ndarray | None = None, wrapped: Rect | None = None,
-                 wrap: Wrap | None = None):
+                 wrap: Wrap | None = None, period: Wrap | None = None):
         super().__init__(vertices, faces)
         self.n_original = len(faces) if n_original is None else n_original
         self.source = source
         self.wrapped = wrapped
         self.wrap = wrap
+        self.period = wrap if period is None else period
 
     def resolve(self, prim: np.ndarray, cell: np.ndarray | None) -> np.ndarray:
         """Canopy triangle ids (k,) of scene triangles ``prim`` (k,) hit in field cells
@@ -161,16 +164,16 @@ def light_scene(canopy: Canopy, with_stalks: bool = False, periodic: bool = Fals
     n = len(faces)
     if not periodic:
         return CanopyScene(verts, faces)
-    if block:
-        tiling = block_tiling(canopy)
-        if tiling is not None:
-            return BlockScene(canopy, tiling, with_stalks)
+    tiling = block_tiling(canopy)
+    if block and tiling is not None:
+        return BlockScene(canopy, tiling, with_stalks)
     bounds = canopy.layout.bounds
     wrap = Wrap.of(bounds)
     verts = snap(verts, wrap.q)
     cv, cf, src, _ = overhang_copies(verts, faces, wrap)
     return CanopyScene(np.vstack([verts, cv]), np.vstack([faces, cf + len(verts)]), n,
-                       np.concatenate([np.arange(n, dtype=np.int64), src]), bounds, wrap)
+                       np.concatenate([np.arange(n, dtype=np.int64), src]), bounds, wrap,
+                       None if tiling is None else tiling.wrap)
 
 
 def scene_for(canopy: Canopy, periodic: bool, scene: RayScene | None,

@@ -235,9 +235,9 @@ class _Family:
     size: tuple[int, int]               # nx, ny
 
 
-def _family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family | None:
-    """The ray family through the planes ``planes`` and the ground, or None when per-plane
-    occlusion queries cost less (low suns: the shifted grids hardly overlap)."""
+def _lattice_shifts(smp: Sampler, s: np.ndarray, planes: list[int]) -> np.ndarray:
+    """(H, 2) int64: r_k, the ground lattice cells from a sensor of plane k to the ray of its
+    family (zero for the planes not in ``planes``); see :func:`sensor_offsets`."""
     from maizeviz.light.rays import grid_shape
 
     nx, ny = grid_shape(smp.rect, smp.density)
@@ -246,6 +246,39 @@ def _family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family | None:
     t = smp.heights_cm[:, None] * (s[:2] / s[2]) / cell
     shifts = np.round(t).astype(np.int64)
     shifts[[k for k in range(len(shifts)) if k not in planes]] = 0
+    return shifts
+
+
+#: Answer the planes of a periodic field whose sample rectangle spans whole periods by the
+#: ground rays alone (:func:`_spans_periods`); False always traces the family's box
+WRAP_FAMILY = True
+
+
+def _spans_periods(smp: Sampler) -> bool:
+    """Whether the sample rectangle spans a whole number of the periodic field's periods in x
+    and in y (the paper's case: the central block of a tiled canopy, in its own field).
+
+    Then the family ray through any sensor is a ground ray of the rectangle moved by whole
+    periods: the same ray of the field, with the same hits (the field repeats exactly, on its
+    grid: :mod:`maizeviz.light.periodic`). The ground rays answer every plane, whatever the
+    sun's elevation, and no sensor needs a query of its own.
+    """
+    wrap = getattr(smp.scene, "period", None)
+    if not (WRAP_FAMILY and smp.periodic and wrap is not None):
+        return False
+    x0, y0, x1, y1 = smp.rect
+    spans = np.array([(x1 - x0) / wrap.w, (y1 - y0) / wrap.h])
+    whole = np.round(spans)
+    return bool(np.all(whole >= 1) and np.all(np.abs(spans - whole) <= 1e-9 * whole))
+
+
+def _family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family | None:
+    """The ray family through the planes ``planes`` and the ground, or None when per-plane
+    occlusion queries cost less (low suns: the shifted grids hardly overlap)."""
+    from maizeviz.light.rays import grid_shape
+
+    nx, ny = grid_shape(smp.rect, smp.density)
+    shifts = _lattice_shifts(smp, s, planes)
     used = np.array([0, *planes])
     r = np.vstack([np.zeros((1, 2), np.int64), shifts[planes]])
     lo = (-r).min(axis=0)
@@ -302,7 +335,8 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
     h32 = heights.astype(np.float32)
     leaf_top = smp.top - 1.0
     planes = [k for k, h in enumerate(heights) if 0.0 < h <= leaf_top]
-    fam = _family(smp, s, planes) if planes else None
+    periods = bool(planes) and _spans_periods(smp)
+    fam = _family(smp, s, planes) if planes and not periods else None
     offsets = sensor_offsets(heights, s, smp.rect, smp.density)
     chunks = _chunks(n if fam is None else len(fam.cells))
     ground_chunks = _chunks(n)
@@ -325,7 +359,29 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
         if stop is not None and stop.is_set():
             raise InterruptedError("light computation cancelled")
 
-    if fam is None:
+    if periods:
+        def gchunk(a: int, b: int) -> None:
+            check()
+            prim, z = first_hits(down, rays, a, b, ids=keep_ids)
+            first_z[a:b] = z
+            if first_prim is not None and prim is not None:
+                first_prim[a:b] = prim
+
+        in_chunks(gchunk, chunks, 0)
+        grid = first_z.reshape(rays.shape)
+        shifts = _lattice_shifts(smp, s, planes)
+        transmission = np.empty(len(heights))
+        for k, h in enumerate(heights):
+            if h > leaf_top:
+                lit = np.ones(n, dtype=bool)
+            elif k in planes:        # sensor (a, b) is on ray (a, b) - r_k, modulo the grid
+                lit = np.roll(grid, (int(shifts[k, 0]), int(shifts[k, 1])), axis=(0, 1)
+                              ).ravel() < h32[k]
+            else:
+                lit = first_z < h32[k]
+            transmission[k] = np.count_nonzero(lit) / n
+            packed[k] = np.packbits(lit)
+    elif fam is None:
         up = Tracer(smp.scene, s, smp.bounds, smp.periodic, size)
 
         def chunk(a: int, b: int) -> np.ndarray:

@@ -397,6 +397,44 @@ def test_sensor_planes_by_occlusion_and_by_the_ray_family_agree(monkeypatch, per
         assert np.array_equal(occ.first_hits, fam.first_hits)
 
 
+def test_a_rectangle_of_whole_periods_answers_every_plane_by_its_ground_rays(monkeypatch):
+    """In a periodic field, a sample rectangle spanning whole periods needs no query of its own
+    for any sensor: the family ray through a sensor is one of the rectangle's ground rays
+    moved by whole periods. The same sensors, ray for ray, as the family's box; within 2 rays
+    of a query per sensor (a path asked from its two ends); the same first and second hits."""
+    import maizeviz.light.transmission as tr
+
+    calls = {"occluded": 0}
+    occluded = tr.Tracer.occluded
+
+    def count_occluded(self, *a, **k):
+        calls["occluded"] += 1
+        return occluded(self, *a, **k)
+
+    monkeypatch.setattr(tr.Tracer, "occluded", count_occluded)
+    c = _random_squares(4, n=150)                     # leaves overhang the 100 cm plot's edges
+    rect = c.layout.bounds                           # the plot: the periodic field's period
+    heights = (0.0, 20.0, 55.5, 100.0, 140.0, 400.0)
+    for zenith, azimuth in ((0, 0), (25, 160), (55, 300), (78, 45), (86, 200)):
+        req = LightRequest(Sun(zenith, azimuth), Sampling(heights, 2.0, rect, periodic=True))
+        runs = []
+        for wrap, cost in ((True, 0.7), (False, 1e9), (False, 1e-9)):
+            monkeypatch.setattr(tr, "WRAP_FAMILY", wrap)
+            monkeypatch.setattr(tr, "OCCLUSION_COST", cost)
+            calls.update(occluded=0)
+            runs.append(trace_light(c, req))
+            if wrap:
+                assert calls["occluded"] == 0, "a sensor was asked on its own"
+        periods, box, occ = runs
+        assert 0 < periods.transmission[1] < 1
+        for k in range(len(heights)):
+            assert np.array_equal(periods.lit(k), box.lit(k)), (zenith, k)
+            assert np.mean(periods.lit(k) != occ.lit(k)) <= 2 / occ.rays
+        assert np.array_equal(periods.transmission, box.transmission)
+        assert np.array_equal(periods.first_hits, box.first_hits)
+        assert np.array_equal(periods.second_hits, box.second_hits)
+
+
 def test_a_leaf_overhanging_a_periodic_plot_shades_the_opposite_edge():
     """A leaf hanging 20 cm over the east edge of a periodic 100 cm plot stands, in the
     infinite field, 20 cm inside its west edge too: its light is counted on the leaf itself."""

@@ -574,8 +574,14 @@ def test_light_of_the_exported_canopy_is_the_same(tmp_path, capsys, periodic):
                  "--leaf-light", str(tmp_path / "m.csv")]) == EXIT_OK
     back = json.loads(capsys.readouterr().out)
     assert back["level"] == "mesh" and back["triangles"] == orig["triangles"]
-    assert back["transmission"] == orig["transmission"]
-    assert back["diffuse"]["transmission"] == orig["diffuse"]["transmission"]
+    # in a periodic field the digitized canopy's field repeats its 3 x 3 block, which a mesh
+    # does not say: the planes' sensors are then answered by the ground rays moved by whole
+    # blocks instead of the mesh's own queries along the same paths, and a ray of 16,200 in a
+    # direction may fall the other side of a leaf's edge (maizeviz.light.transmission)
+    tol = 2 / orig["rays"] if periodic else 0.0
+    assert back["transmission"] == pytest.approx(orig["transmission"], abs=tol, rel=0)
+    assert back["diffuse"]["transmission"] == pytest.approx(orig["diffuse"]["transmission"],
+                                                            abs=tol, rel=0)
     assert back["diffuse"]["intercepted_fraction"] == orig["diffuse"]["intercepted_fraction"]
     assert back["balance"] == orig["balance"]                  # absorbed, with scattering
     o_rows, m_rows = _rows(tmp_path / "o.csv"), _rows(tmp_path / "m.csv")
