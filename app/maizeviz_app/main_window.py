@@ -435,14 +435,23 @@ class MainWindow(QMainWindow):
         frame, ok = QInputDialog.getItem(
             self, "Units of the mesh", "The file's coordinates are in (OpenAlea and Helios "
             "write z up, many scanners y up):", list(MESH_FRAMES), 0, False)
+        if not ok:
+            return
+        field, ok = QInputDialog.getText(
+            self, "Field of the mesh", "The ground plot x0, y0, x1, y1 in cm, in field "
+            "coordinates (it sets leaf area index, ground cover and the periodic field's tile; "
+            "leave empty for the mesh's extent seen from above):")
         if ok:
-            self.open_mesh(path, *MESH_FRAMES[frame])
+            self.open_mesh(path, *MESH_FRAMES[frame], field=field.strip() or None)
 
-    def open_mesh(self, path: str | Path, unit: str | None = None, up: str = "z") -> None:
+    def open_mesh(self, path: str | Path, unit: str | None = None, up: str = "z",
+                  field: str | tuple[float, float, float, float] | None = None) -> None:
         """Read a canopy mesh in a worker (:func:`maizeviz.canopy.from_mesh.read_mesh_canopy`:
-        ``unit`` cm, m or mm, None: cm, refused when the size says otherwise); it replaces the
-        points: light, tables and exports work on it, the slider and layout do not apply."""
-        if not self.keep_unsaved(lambda: self.open_mesh(path, unit, up)):
+        ``unit`` cm, m or mm, None: cm, refused when the size says otherwise; ``field`` x0,
+        y0, x1, y1 cm, as numbers or text, None: the mesh's extent seen from above); it
+        replaces the points: light, tables and exports work on it, the slider and layout do
+        not apply."""
+        if not self.keep_unsaved(lambda: self.open_mesh(path, unit, up, field)):
             return
         from maizeviz_app import jobs
 
@@ -451,11 +460,12 @@ class MainWindow(QMainWindow):
         runner, view_ready = self.runner, self._view_ready
 
         def work(job):
-            from maizeviz.canopy.from_mesh import read_mesh_canopy
+            from maizeviz.canopy.from_mesh import check_field, read_mesh_canopy
             from maizeviz.canopy.measures import TABLE2_COLUMNS, table2_row
 
             t0 = time.perf_counter()
-            canopy, _mesh, notes = read_mesh_canopy(path, unit, up)
+            ground = None if field is None else check_field(field)
+            canopy, _mesh, notes = read_mesh_canopy(path, unit, up, ground)  # type: ignore[arg-type]
             read_s = time.perf_counter() - t0
             job.check()
             t0 = time.perf_counter()
@@ -483,9 +493,9 @@ class MainWindow(QMainWindow):
         self.model.open_mesh(path)
         self._settings.setValue("last_folder", str(Path(path).parent))
         self._remember(path)
-        for note in notes:
-            self.say(f"note: {note}")
         canopy, m, read_s, measure_s, mesh, columns, row = parts
+        for note in [*notes, *canopy.layout.warnings]:         # the latter say the field
+            self.say(f"note: {note}")
         self._on_built(jobs.Built(MESH_LEVEL, MESH_LEVEL, canopy, m, read_s, measure_s, mesh,
                                   columns, row, self.model.serial))
 

@@ -47,9 +47,20 @@ GUESS_MAX_HEIGHT = 1000.0
 MESH_LEVEL = "mesh"
 
 
-def check_field(field: tuple[float, float, float, float] | list[float]) -> tuple[float, ...]:
-    """A field rectangle x0, y0, x1, y1 (cm): finite, within 1 km, x1 > x0 and y1 > y0."""
-    vals = tuple(float(v) for v in field)
+def check_field(field: tuple[float, float, float, float] | list[float] | str
+                ) -> tuple[float, ...]:
+    """A field rectangle x0, y0, x1, y1 (cm): finite, within 1 km, x1 > x0 and y1 > y0.
+
+    ``field`` may be text, four numbers separated by commas or spaces ("0, 0, 540, 270")."""
+    if isinstance(field, str):
+        words = field.replace(",", " ").split()
+        try:
+            vals = tuple(float(w) for w in words)
+        except ValueError:
+            raise MaizevizError(f"the field needs 4 numbers x0, y0, x1, y1 (cm), got "
+                                f"'{field[:60]}'", quantity="field") from None
+    else:
+        vals = tuple(float(v) for v in field)
     if len(vals) != 4:
         raise MaizevizError(f"the field needs 4 numbers x0, y0, x1, y1 (cm), got {len(vals)}",
                             quantity="field")

@@ -661,3 +661,23 @@ def test_stalks_intercept_only_when_asked(tmp_path, capsys):
                      *extra]) == EXIT_OK
         runs.append(json.loads(capsys.readouterr().out)["transmission"][0])
     assert runs[0] == pytest.approx(0.6, abs=0.01) and runs[1] == pytest.approx(0.4, abs=0.01)
+
+
+@pytest.mark.parametrize("text, want", [("0, 0, 540, 270", (0.0, 0.0, 540.0, 270.0)),
+                                        ("-10 -5 20.5 1e2", (-10.0, -5.0, 20.5, 100.0)),
+                                        (" 1,2 ,3, 4 ", (1.0, 2.0, 3.0, 4.0))])
+def test_a_field_typed_as_text_reads_as_its_four_numbers(text, want):
+    from maizeviz.canopy.from_mesh import check_field
+
+    assert check_field(text) == want
+
+
+@pytest.mark.parametrize("text, says", [("", "got 0"), ("1, 2, 3", "got 3"),
+                                        ("1, 2, x, 4", "'1, 2, x, 4'"), ("0 0 0 10", "x1 > x0"),
+                                        ("0 0 nan 10", "finite"), ("0 0 1e9 10", "finite")])
+def test_a_bad_field_text_is_one_line_naming_the_field(text, says):
+    from maizeviz.canopy.from_mesh import check_field
+
+    with pytest.raises(MaizevizError, match="field") as err:
+        check_field(text)
+    assert says in str(err.value) and err.value.quantity == "field"

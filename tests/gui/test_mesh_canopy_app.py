@@ -55,3 +55,27 @@ def test_a_mesh_without_ids_is_one_line(window, qtbot, tmp_path):
         w.open_mesh(bad)
     assert "noids.ply" in sig.args[0] and "\n" not in sig.args[0]
     assert "internal" not in sig.args[0] and w.canopy is not None    # the canopy shown stays
+
+
+def test_a_mesh_canopy_takes_the_field_given(window, qtbot, small_points, tmp_path):
+    """The field (ground plot) of a mesh canopy: the one typed, else the mesh's extent; a bad
+    one is one line naming the field, and the canopy shown stays."""
+    from maizeviz.canopy.export import export_canopy
+
+    w = shown(qtbot, window(small_points, tile=1))
+    ply = tmp_path / "exported.ply"
+    export_canopy(str(ply), w.canopy)
+    with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
+        w.open_mesh(ply, "cm", "z")
+    extent = tuple(w.canopy.layout.bounds)
+    wider = (extent[0] - 30.0, extent[1] - 20.0, extent[2] + 30.0, extent[3] + 20.0)
+    with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
+        w.open_mesh(ply, "cm", "z", field=", ".join(f"{v:.6f}" for v in wider))
+    assert np.allclose(w.canopy.layout.bounds, wider, atol=1e-6)
+    assert "the field is given" in w.messages.toPlainText()
+    for bad, says in (("0, 0, 100", "4 numbers"), ("0, 0, ten, 100", "4 numbers"),
+                      ("100, 0, 0, 100", "x1 > x0")):
+        with qtbot.waitSignal(w.failed, timeout=TIMEOUT) as sig:
+            w.open_mesh(ply, "cm", "z", field=bad)
+        assert says in sig.args[0] and "field" in sig.args[0] and "\n" not in sig.args[0]
+        assert np.allclose(w.canopy.layout.bounds, wider, atol=1e-6)    # the canopy stays
