@@ -43,6 +43,13 @@ def bin_edges(rect: tuple[float, float, float, float],
     return np.linspace(x0, x1, nx + 1), np.linspace(y0, y1, ny + 1)
 
 
+def _bins_of(v: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """Bin index of each of ``v`` (cm) between evenly spaced ``edges``; the last edge and beyond
+    fall in the last bin, before the first in the first."""
+    return np.clip(((v - edges[0]) * ((len(edges) - 1) / (edges[-1] - edges[0]))).astype(np.int64),
+                   0, len(edges) - 2)
+
+
 def binned(xy: np.ndarray, lit: np.ndarray, xe: np.ndarray,
            ye: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Sensors per bin and lit sensors per bin: two (a, b) float64 arrays.
@@ -53,13 +60,27 @@ def binned(xy: np.ndarray, lit: np.ndarray, xe: np.ndarray,
     xe, ye : evenly spaced bin edges (:func:`bin_edges`), cm; sensors on the last edge fall in
         the last bin
     """
-    i = np.clip(((xy[:, 0] - xe[0]) * ((len(xe) - 1) / (xe[-1] - xe[0]))).astype(np.int64),
-                0, len(xe) - 2)
-    j = np.clip(((xy[:, 1] - ye[0]) * ((len(ye) - 1) / (ye[-1] - ye[0]))).astype(np.int64),
-                0, len(ye) - 2)
-    flat = i * (len(ye) - 1) + j
+    flat = _bins_of(xy[:, 0], xe) * (len(ye) - 1) + _bins_of(xy[:, 1], ye)
     size = (len(xe) - 1) * (len(ye) - 1)
     counts = np.bincount(flat, minlength=size).astype(np.float64)
     lit_counts = np.bincount(flat, weights=np.asarray(lit, dtype=np.float64), minlength=size)
     shape = (len(xe) - 1, len(ye) - 1)
     return counts.reshape(shape), lit_counts.reshape(shape)
+
+
+def binned_grid(xs: np.ndarray, ys: np.ndarray, lit: np.ndarray, xe: np.ndarray,
+                ye: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`binned` for sensors on a grid, by its rows and columns: the same two arrays.
+
+    Parameters
+    ----------
+    xs : (nx,) cm, the grid's x; ys : (ny,) cm, its y
+    lit : (nx * ny,) bool, grid order (x slow, y fast)
+    xe, ye : as :func:`binned`
+    """
+    a, b = len(xe) - 1, len(ye) - 1
+    ix, iy = _bins_of(xs, xe), _bins_of(ys, ye)
+    counts = np.outer(np.bincount(ix, minlength=a), np.bincount(iy, minlength=b))
+    flat = (ix[:, None] * b + iy[None, :]).ravel()
+    lit_counts = np.bincount(flat[np.asarray(lit, dtype=bool)], minlength=a * b)
+    return counts.astype(np.float64), lit_counts.reshape(a, b).astype(np.float64)

@@ -52,7 +52,7 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
-from maizeviz.light.bins import TransmissionMap, bin_edges, binned
+from maizeviz.light.bins import TransmissionMap, bin_edges, binned, binned_grid
 from maizeviz.light.irradiance import Period
 from maizeviz.light.perez import DiffuseSplit
 from maizeviz.light.request import (
@@ -94,7 +94,7 @@ def _sparse_counts(prim: np.ndarray, n_triangles: int) -> tuple[np.ndarray, np.n
 
 
 def _beam(smp: Sampler, toward: np.ndarray, edges: tuple[np.ndarray, np.ndarray],
-          ground_xy: np.ndarray, stop: threading.Event) -> _Beam:
+          ground_xy: tuple[np.ndarray, np.ndarray], stop: threading.Event) -> _Beam:
     tr = trace_direction(smp, toward, ids=True, stop=stop)
     assert tr.first_prim is not None
     prim = tr.first_prim
@@ -102,9 +102,11 @@ def _beam(smp: Sampler, toward: np.ndarray, edges: tuple[np.ndarray, np.ndarray]
     ids, hits = _sparse_counts(prim, smp.n_triangles)
     xe, ye = edges
     bins = np.empty((len(smp.heights_cm), len(xe) - 1, len(ye) - 1))
+    xs, ys = ground_xy
     for k in range(len(smp.heights_cm)):
-        lit = np.unpackbits(tr.sensor_lit[k], count=smp.n).astype(bool)
-        counts, lit_counts = binned(ground_xy + tr.sensor_offset_cm[k], lit, xe, ye)
+        lit = np.unpackbits(tr.sensor_lit[k], count=smp.n).view(bool)
+        off = tr.sensor_offset_cm[k]
+        counts, lit_counts = binned_grid(xs + off[0], ys + off[1], lit, xe, ye)
         with np.errstate(invalid="ignore", divide="ignore"):
             bins[k] = np.where(counts > 0, lit_counts / counts, np.nan)
     return _Beam(tr.transmission, float(leaf), ids, hits, bins, tr.seconds["trace"])
@@ -115,9 +117,11 @@ def _beams(smp: Sampler, towards: Sequence[np.ndarray], threads: int,
            what: str) -> Iterator[_Beam]:
     """Trace ``towards`` (each (3,), toward the light) on ``threads`` threads; yields the beams
     in order, calling ``progress(done, total)`` after each."""
-    from maizeviz.light.rays import ray_grid
+    from maizeviz.light.rays import grid_shape, ray_grid
 
-    ground_xy = ray_grid(smp.rect, smp.density)[0]
+    grid = ray_grid(smp.rect, smp.density)[0]
+    nx, ny = grid_shape(smp.rect, smp.density)
+    ground_xy = (grid[::ny, 0].copy(), grid[:ny, 1].copy())     # the grid's columns and rows
     stop = threading.Event()
     return ordered_map(lambda s: _beam(smp, s, edges, ground_xy, stop), towards, threads,
                        lambda k: report(progress, k, len(towards), what), stop)

@@ -170,15 +170,15 @@ class Tracer:
                 prim, t = None, self.scene.distance(org, self.dirs, length, row=row)
                 hit = t < np.asarray(length, np.float32)
             cell = None
-        else:
-            prim, cell, dist = trace_wrapped(self.scene, self.wrap, org, self.down, length,
-                                             ids=ids, row=row)
-            hit = np.isfinite(dist)
-            t = dist
-        out = np.full(len(hit), np.inf)
-        out[hit] = t[hit]
+            out = np.where(hit, t, np.inf)
+        else:         # distances are inf and triangles -1 where nothing is hit
+            prim, cell, out = trace_wrapped(self.scene, self.wrap, org, self.down, length,
+                                            ids=ids, row=row)
+            hit = np.isfinite(out)
         if prim is not None:
-            prim = np.where(hit, prim, -1).astype(np.int32)
-            if self.resolve is not None and hit.any():
-                prim[hit] = self.resolve(prim[hit], None if cell is None else cell[hit])
+            prim = np.where(hit, prim, -1).astype(np.int32, copy=False)
+            if self.resolve is not None:
+                at = np.flatnonzero(hit)
+                if len(at):
+                    prim[at] = self.resolve(prim[at], None if cell is None else cell[at])
         return prim, out

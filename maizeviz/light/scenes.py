@@ -87,7 +87,9 @@ class BlockScene(CanopyScene):
         lo, hi = tri[:, :, :2].min(axis=1), tri[:, :, :2].max(axis=1)
         inside = np.all((hi > w.corner - COPY_MARGIN_CM) &
                         (lo < w.corner + w.period + COPY_MARGIN_CM), axis=1)
-        self._local, self._cell = local[inside], cells[inside]
+        # the block triangle and the cell offset of each scene triangle, gathered per hit
+        self._local = local[inside].astype(np.int32)
+        self._cell_x, self._cell_y = (np.ascontiguousarray(cells[inside, k]) for k in (0, 1))
         n = canopy.n_triangles + (len(canopy.stalk_faces) if with_stalks else 0)
         super().__init__(verts, faces[inside], n, None, canopy.layout.bounds, w)
         self.tiling = tiling
@@ -131,9 +133,11 @@ class BlockScene(CanopyScene):
             return got
         prim, cell, dist = got
         assert prim is not None
-        hit = prim >= 0
-        cell[hit] += self._cell[prim[hit]]            # a copy stands for its neighbour's
-        prim[hit] = self._local[prim[hit]]
+        hit = np.flatnonzero(prim >= 0)
+        p = prim[hit]
+        cell[hit, 0] += self._cell_x[p]               # a copy stands for its neighbour's
+        cell[hit, 1] += self._cell_y[p]
+        prim[hit] = self._local[p]
         return prim, cell, dist
 
     def resolve(self, prim: np.ndarray, cell: np.ndarray | None) -> np.ndarray:
