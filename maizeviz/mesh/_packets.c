@@ -114,28 +114,50 @@ static int order_next(packet_order *o, int width, int64_t *idx) {
         (r)->mask[k] = INVALID_ID; (r)->id[k] = 0; (r)->flags[k] = 0;                       \
     }
 
+/* Packets are filled, traced and read back BLOCK at a time: filling a packet right after
+ * Embree has written into the same memory (its masked store of tfar) stalls on the stores;
+ * a block keeps the fill, the traversal and the read-out apart (about 5 % of the time). */
+#define BLOCK 32
+
+/* The next block of packets of the order: their ray indices idx[b][0, m[b]); returns how
+ * many packets (0 when all rays are done). */
+static int block_next(packet_order *po, int width, int64_t (*idx)[16], int *m) {
+    int nb = 0;
+    while (nb < BLOCK && (m[nb] = order_next(po, width, idx[nb])) > 0) ++nb;
+    return nb;
+}
+
 #define INTERSECT_BODY(W)                                                                   \
     {                                                                                       \
-        rayhit##W rh;                                                                       \
-        int valid[W] __attribute__((aligned(64)));                                          \
+        rayhit##W *rh = (rayhit##W *)aligned_alloc(64, BLOCK * sizeof(rayhit##W));          \
+        int (*valid)[W] = (int (*)[W])aligned_alloc(64, BLOCK * W * sizeof(int));           \
         intersect##W##_fn fn = (intersect##W##_fn)fn_addr;                                  \
-        int64_t idx[W];                                                                     \
+        int64_t idx[BLOCK][16];                                                             \
+        int m[BLOCK];                                                                       \
         packet_order po;                                                                    \
+        if (!rh || !valid) { free(rh); free(valid); return -3; }                            \
         order_init(&po, n, row, W);                                                         \
-        for (int m; (m = order_next(&po, W, idx)) > 0;) {                                   \
-            FILL_RAYS(W, &rh.ray, valid, idx, m)                                            \
-            for (int k = 0; k < W; ++k) {                                                   \
-                rh.hit.geom_id[k] = INVALID_ID; rh.hit.prim_id[k] = INVALID_ID;             \
-                rh.hit.inst_id[k] = INVALID_ID;                                             \
+        for (int nb; (nb = block_next(&po, W, idx, m)) > 0;) {                              \
+            for (int b = 0; b < nb; ++b) {                                                  \
+                FILL_RAYS(W, &rh[b].ray, valid[b], idx[b], m[b])                            \
+                for (int k = 0; k < W; ++k) {                                               \
+                    rh[b].hit.geom_id[k] = INVALID_ID; rh[b].hit.prim_id[k] = INVALID_ID;   \
+                    rh[b].hit.inst_id[k] = INVALID_ID;                                      \
+                }                                                                           \
             }                                                                               \
-            fn(valid, scene, &rh, &args);                                                   \
-            for (int k = 0; k < m; ++k) {                                                   \
-                uint32_t p = rh.hit.prim_id[k];                                             \
-                if (prim_out) prim_out[idx[k]] = p == INVALID_ID ? -1 : (int32_t)p;         \
-                if (tfar_out) tfar_out[idx[k]] = rh.ray.tfar[k];                            \
-                if (inst_out) inst_out[idx[k]] = p == INVALID_ID ? -1 : (int32_t)rh.hit.inst_id[k]; \
-            }                                                                               \
+            for (int b = 0; b < nb; ++b) fn(valid[b], scene, &rh[b], &args);                \
+            for (int b = 0; b < nb; ++b)                                                    \
+                for (int k = 0; k < m[b]; ++k) {                                            \
+                    int64_t j = idx[b][k];                                                  \
+                    uint32_t p = rh[b].hit.prim_id[k];                                      \
+                    if (prim_out) prim_out[j] = p == INVALID_ID ? -1 : (int32_t)p;          \
+                    if (tfar_out) tfar_out[j] = rh[b].ray.tfar[k];                          \
+                    if (inst_out)                                                           \
+                        inst_out[j] = p == INVALID_ID ? -1 : (int32_t)rh[b].hit.inst_id[k]; \
+                }                                                                           \
         }                                                                                   \
+        free(rh);                                                                           \
+        free(valid);                                                                        \
     }
 
 /* Nearest hits of n rays: origins org (n, 3), directions dir (n, 3) (dir_step 1) or one
@@ -144,7 +166,7 @@ static int order_next(packet_order *o, int width, int64_t *idx) {
  * none) and inst_out (n,) int32, the instance hit in a scene of instances (-1: none); any
  * may be NULL. coherent: Embree's coherent-rays flag. row: rays per row when
  * the rays form a grid laid out row by row (packets then take tiles of it), else 0.
- * Returns 0, or -1 for an unknown packet width. */
+ * Returns 0, -1 for an unknown packet width, -3 when memory runs out. */
 int mz_intersect(void *fn_addr, int width, void *scene, int64_t n, const float *org,
                  const float *dir, int dir_step, const float *tfar, int32_t *prim_out,
                  float *tfar_out, int32_t *inst_out, int coherent, int64_t row) {
@@ -161,23 +183,27 @@ int mz_intersect(void *fn_addr, int width, void *scene, int64_t n, const float *
 
 #define OCCLUDED_BODY(W)                                                                    \
     {                                                                                       \
-        ray##W r;                                                                           \
-        int valid[W] __attribute__((aligned(64)));                                          \
+        ray##W *r = (ray##W *)aligned_alloc(64, BLOCK * sizeof(ray##W));                    \
+        int (*valid)[W] = (int (*)[W])aligned_alloc(64, BLOCK * W * sizeof(int));           \
         occluded##W##_fn fn = (occluded##W##_fn)fn_addr;                                    \
-        int64_t idx[W];                                                                     \
+        int64_t idx[BLOCK][16];                                                             \
+        int m[BLOCK];                                                                       \
         packet_order po;                                                                    \
+        if (!r || !valid) { free(r); free(valid); return -3; }                              \
         order_init(&po, n, row, W);                                                         \
-        for (int m; (m = order_next(&po, W, idx)) > 0;) {                                   \
-            FILL_RAYS(W, &r, valid, idx, m)                                                 \
-            fn(valid, scene, &r, &args);                                                    \
-            for (int k = 0; k < m; ++k)                                                     \
-                out[idx[k]] = r.tfar[k] < 0.0f ? 1 : 0; /* Embree sets -inf when blocked */ \
+        for (int nb; (nb = block_next(&po, W, idx, m)) > 0;) {                              \
+            for (int b = 0; b < nb; ++b) FILL_RAYS(W, &r[b], valid[b], idx[b], m[b])        \
+            for (int b = 0; b < nb; ++b) fn(valid[b], scene, &r[b], &args);                 \
+            for (int b = 0; b < nb; ++b)          /* Embree sets -inf where blocked */      \
+                for (int k = 0; k < m[b]; ++k) out[idx[b][k]] = r[b].tfar[k] < 0.0f;        \
         }                                                                                   \
+        free(r);                                                                            \
+        free(valid);                                                                        \
     }
 
 /* Whether anything lies on each of n rays within tfar (as mz_intersect): out (n,) uint8,
- * 1 where blocked; coherent and row as mz_intersect. Returns 0, or -1 for an unknown
- * packet width. */
+ * 1 where blocked; coherent and row as mz_intersect. Returns 0, -1 for an unknown packet
+ * width, -3 when memory runs out. */
 int mz_occluded(void *fn_addr, int width, void *scene, int64_t n, const float *org,
                 const float *dir, int dir_step, const float *tfar, uint8_t *out, int coherent,
                 int64_t row) {
@@ -287,58 +313,67 @@ static void lane_advance(lane *L, const segment *S, int done) {
     if (S->t_next <= S->end) L->k += 1;
 }
 
-/* One pass over the rays still travelling (act[0, n_act), in packets of W): each traces its
- * current segment; those not done are kept, in order, at the front of act. Returns how many. */
+/* One pass over the rays still travelling (act[0, n_act), in packets of W, BLOCK packets at
+ * a time): each traces its current segment; those not done are kept, in order, at the front
+ * of act. Returns how many. rh, valid and seg: room for BLOCK packets. */
 #define WRAPPED_PASS(W)                                                                     \
     static int64_t wrapped_pass##W(void *fn, int any_hit, void *scene, query_args *args,     \
                                    lane *st, int64_t *act, int64_t n_act,                   \
-                                   const double *wrap) {                                    \
-        rayhit##W rh;                                                                       \
-        int valid[W] __attribute__((aligned(64)));                                          \
-        segment seg[W];                                                                     \
+                                   const double *wrap, rayhit##W *rh, int (*valid)[W],      \
+                                   segment (*seg)[W]) {                                     \
         int64_t kept = 0;                                                                   \
-        for (int64_t i = 0; i < n_act; i += W) {                                            \
-            int m = (int)(n_act - i < W ? n_act - i : W);                                   \
-            for (int k = 0; k < W; ++k) {                                                   \
-                int on = k < m;                                                             \
-                lane *L = &st[act[i + (on ? k : 0)]];                                       \
-                valid[k] = on ? -1 : 0;                                                     \
-                if (on || k == 0) lane_segment(L, wrap, &seg[k]);                           \
-                const segment *S = &seg[on ? k : 0];                                        \
-                rh.ray.org_x[k] = (float)S->qo[0]; rh.ray.org_y[k] = (float)S->qo[1];       \
-                rh.ray.org_z[k] = (float)S->qo[2]; rh.ray.tnear[k] = S->tnear;              \
-                rh.ray.dir_x[k] = (float)L->d[0]; rh.ray.dir_y[k] = (float)L->d[1];          \
-                rh.ray.dir_z[k] = (float)L->d[2]; rh.ray.time[k] = 0.0f;                    \
-                rh.ray.tfar[k] = S->tfar;                                                   \
-                rh.ray.mask[k] = INVALID_ID; rh.ray.id[k] = 0; rh.ray.flags[k] = 0;         \
-                rh.hit.geom_id[k] = INVALID_ID; rh.hit.prim_id[k] = INVALID_ID;             \
-                rh.hit.inst_id[k] = INVALID_ID;                                             \
-            }                                                                               \
-            if (any_hit) ((occluded##W##_fn)fn)(valid, scene, &rh.ray, args);               \
-            else ((intersect##W##_fn)fn)(valid, scene, &rh, args);                          \
-            for (int k = 0; k < m; ++k) {                                                   \
-                int64_t j = act[i + k];                                                     \
-                lane *L = &st[j];                                                           \
-                const segment *S = &seg[k];                                                 \
-                int done;                                                                   \
-                if (any_hit) {                                                              \
-                    int hit = rh.ray.tfar[k] < 0.0f;                                        \
-                    if (hit) L->prim = 0;                                                   \
-                    done = hit || S->end >= L->len;                                         \
-                } else {                                                                    \
-                    uint32_t p = rh.hit.prim_id[k];                                         \
-                    if (p != INVALID_ID) {                                                  \
-                        double dist = S->t_anchor + (double)rh.ray.tfar[k];                 \
-                        if (dist < L->best) {                                               \
-                            L->best = dist; L->prim = (int32_t)p;                           \
-                            L->inst = (int32_t)rh.hit.inst_id[k];                           \
-                            L->bcell[0] = L->cell[0]; L->bcell[1] = L->cell[1];             \
-                        }                                                                   \
-                    }                                                                       \
-                    done = L->best <= S->end || S->end >= L->len;                           \
+        for (int64_t i0 = 0; i0 < n_act; i0 += BLOCK * W) {                                 \
+            int nb = 0;                                                                     \
+            for (int64_t i = i0; i < n_act && nb < BLOCK; i += W, ++nb) {                   \
+                int m = (int)(n_act - i < W ? n_act - i : W);                               \
+                for (int k = 0; k < W; ++k) {                                               \
+                    int on = k < m;                                                         \
+                    lane *L = &st[act[i + (on ? k : 0)]];                                   \
+                    valid[nb][k] = on ? -1 : 0;                                             \
+                    if (on || k == 0) lane_segment(L, wrap, &seg[nb][k]);                   \
+                    const segment *S = &seg[nb][on ? k : 0];                                \
+                    rayhit##W *q = &rh[nb];                                                 \
+                    q->ray.org_x[k] = (float)S->qo[0]; q->ray.org_y[k] = (float)S->qo[1];   \
+                    q->ray.org_z[k] = (float)S->qo[2]; q->ray.tnear[k] = S->tnear;          \
+                    q->ray.dir_x[k] = (float)L->d[0]; q->ray.dir_y[k] = (float)L->d[1];      \
+                    q->ray.dir_z[k] = (float)L->d[2]; q->ray.time[k] = 0.0f;                \
+                    q->ray.tfar[k] = S->tfar;                                               \
+                    q->ray.mask[k] = INVALID_ID; q->ray.id[k] = 0; q->ray.flags[k] = 0;     \
+                    q->hit.geom_id[k] = INVALID_ID; q->hit.prim_id[k] = INVALID_ID;         \
+                    q->hit.inst_id[k] = INVALID_ID;                                         \
                 }                                                                           \
-                lane_advance(L, S, done);                                                   \
-                if (!done) act[kept++] = j;      /* kept <= i + k: never overwrites ahead */ \
+            }                                                                               \
+            for (int b = 0; b < nb; ++b) {                                                  \
+                if (any_hit) ((occluded##W##_fn)fn)(valid[b], scene, &rh[b].ray, args);     \
+                else ((intersect##W##_fn)fn)(valid[b], scene, &rh[b], args);                \
+            }                                                                               \
+            for (int b = 0; b < nb; ++b) {                                                  \
+                int64_t i = i0 + (int64_t)b * W;                                            \
+                int m = (int)(n_act - i < W ? n_act - i : W);                               \
+                for (int k = 0; k < m; ++k) {                                               \
+                    int64_t j = act[i + k];                                                 \
+                    lane *L = &st[j];                                                       \
+                    const segment *S = &seg[b][k];                                          \
+                    int done;                                                               \
+                    if (any_hit) {                                                          \
+                        int hit = rh[b].ray.tfar[k] < 0.0f;                                 \
+                        if (hit) L->prim = 0;                                               \
+                        done = hit || S->end >= L->len;                                     \
+                    } else {                                                                \
+                        uint32_t p = rh[b].hit.prim_id[k];                                  \
+                        if (p != INVALID_ID) {                                              \
+                            double dist = S->t_anchor + (double)rh[b].ray.tfar[k];          \
+                            if (dist < L->best) {                                           \
+                                L->best = dist; L->prim = (int32_t)p;                       \
+                                L->inst = (int32_t)rh[b].hit.inst_id[k];                    \
+                                L->bcell[0] = L->cell[0]; L->bcell[1] = L->cell[1];         \
+                            }                                                               \
+                        }                                                                   \
+                        done = L->best <= S->end || S->end >= L->len;                       \
+                    }                                                                       \
+                    lane_advance(L, S, done);                                               \
+                    if (!done) act[kept++] = j;  /* kept <= i + k: never overwrites ahead */ \
+                }                                                                           \
             }                                                                               \
         }                                                                                   \
         return kept;                                                                        \
@@ -367,7 +402,14 @@ int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene, in
     init_args(&args, coherent);
     lane *st = (lane *)malloc((size_t)(n > 0 ? n : 1) * sizeof(lane));
     int64_t *act = (int64_t *)malloc((size_t)(n > 0 ? n : 1) * sizeof(int64_t));
-    if (!st || !act) { free(st); free(act); return -3; }
+    /* room for BLOCK packets of the widest width, reused by every width */
+    void *rh = aligned_alloc(64, BLOCK * sizeof(rayhit16));
+    void *valid = aligned_alloc(64, BLOCK * 16 * sizeof(int));
+    segment *seg = (segment *)malloc(BLOCK * 16 * sizeof(segment));
+    if (!st || !act || !rh || !valid || !seg) {
+        free(st); free(act); free(rh); free(valid); free(seg);
+        return -3;
+    }
     /* the first pass in the packet order of the grid (compact tiles), then in that order */
     packet_order po;
     int64_t idx[16], n_act = 0;
@@ -381,9 +423,12 @@ int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene, in
     for (int64_t pass = 0; n_act > 0; ++pass) {
         if (pass > 1000000) { rc = -2; break; }
         switch (width) {
-        case 4: n_act = wrapped_pass4(fn, any_hit, scene, &args, st, act, n_act, wrap); break;
-        case 8: n_act = wrapped_pass8(fn, any_hit, scene, &args, st, act, n_act, wrap); break;
-        default: n_act = wrapped_pass16(fn, any_hit, scene, &args, st, act, n_act, wrap);
+        case 4: n_act = wrapped_pass4(fn, any_hit, scene, &args, st, act, n_act, wrap, rh,
+                                      valid, (segment (*)[4])seg); break;
+        case 8: n_act = wrapped_pass8(fn, any_hit, scene, &args, st, act, n_act, wrap, rh,
+                                      valid, (segment (*)[8])seg); break;
+        default: n_act = wrapped_pass16(fn, any_hit, scene, &args, st, act, n_act, wrap, rh,
+                                        valid, (segment (*)[16])seg);
         }
     }
     for (int64_t j = 0; j < n && rc == 0; ++j) {
@@ -401,6 +446,9 @@ int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene, in
     }
     free(st);
     free(act);
+    free(rh);
+    free(valid);
+    free(seg);
     return rc;
 }
 
