@@ -116,7 +116,9 @@ static int order_next(packet_order *o, int width, int64_t *idx) {
 
 /* Packets are filled, traced and read back BLOCK at a time: filling a packet right after
  * Embree has written into the same memory (its masked store of tfar) stalls on the stores;
- * a block keeps the fill, the traversal and the read-out apart (about 5 % of the time). */
+ * a block keeps the fill, the traversal and the read-out apart (occlusion 7-12 % faster a
+ * core). The periodic passes below fill one packet at a time: blocks measured no faster
+ * there, where the lanes' float64 segments cost more than the fill. */
 #define BLOCK 32
 
 /* The next block of packets of the order: their ray indices idx[b][0, m[b]); returns how
@@ -313,67 +315,58 @@ static void lane_advance(lane *L, const segment *S, int done) {
     if (S->t_next <= S->end) L->k += 1;
 }
 
-/* One pass over the rays still travelling (act[0, n_act), in packets of W, BLOCK packets at
- * a time): each traces its current segment; those not done are kept, in order, at the front
- * of act. Returns how many. rh, valid and seg: room for BLOCK packets. */
+/* One pass over the rays still travelling (act[0, n_act), in packets of W): each traces its
+ * current segment; those not done are kept, in order, at the front of act. Returns how many. */
 #define WRAPPED_PASS(W)                                                                     \
     static int64_t wrapped_pass##W(void *fn, int any_hit, void *scene, query_args *args,     \
                                    lane *st, int64_t *act, int64_t n_act,                   \
-                                   const double *wrap, rayhit##W *rh, int (*valid)[W],      \
-                                   segment (*seg)[W]) {                                     \
+                                   const double *wrap) {                                    \
+        rayhit##W rh;                                                                       \
+        int valid[W] __attribute__((aligned(64)));                                          \
+        segment seg[W];                                                                     \
         int64_t kept = 0;                                                                   \
-        for (int64_t i0 = 0; i0 < n_act; i0 += BLOCK * W) {                                 \
-            int nb = 0;                                                                     \
-            for (int64_t i = i0; i < n_act && nb < BLOCK; i += W, ++nb) {                   \
-                int m = (int)(n_act - i < W ? n_act - i : W);                               \
-                for (int k = 0; k < W; ++k) {                                               \
-                    int on = k < m;                                                         \
-                    lane *L = &st[act[i + (on ? k : 0)]];                                   \
-                    valid[nb][k] = on ? -1 : 0;                                             \
-                    if (on || k == 0) lane_segment(L, wrap, &seg[nb][k]);                   \
-                    const segment *S = &seg[nb][on ? k : 0];                                \
-                    rayhit##W *q = &rh[nb];                                                 \
-                    q->ray.org_x[k] = (float)S->qo[0]; q->ray.org_y[k] = (float)S->qo[1];   \
-                    q->ray.org_z[k] = (float)S->qo[2]; q->ray.tnear[k] = S->tnear;          \
-                    q->ray.dir_x[k] = (float)L->d[0]; q->ray.dir_y[k] = (float)L->d[1];      \
-                    q->ray.dir_z[k] = (float)L->d[2]; q->ray.time[k] = 0.0f;                \
-                    q->ray.tfar[k] = S->tfar;                                               \
-                    q->ray.mask[k] = INVALID_ID; q->ray.id[k] = 0; q->ray.flags[k] = 0;     \
-                    q->hit.geom_id[k] = INVALID_ID; q->hit.prim_id[k] = INVALID_ID;         \
-                    q->hit.inst_id[k] = INVALID_ID;                                         \
-                }                                                                           \
+        for (int64_t i = 0; i < n_act; i += W) {                                            \
+            int m = (int)(n_act - i < W ? n_act - i : W);                                   \
+            for (int k = 0; k < W; ++k) {                                                   \
+                int on = k < m;                                                             \
+                lane *L = &st[act[i + (on ? k : 0)]];                                       \
+                valid[k] = on ? -1 : 0;                                                     \
+                if (on || k == 0) lane_segment(L, wrap, &seg[k]);                           \
+                const segment *S = &seg[on ? k : 0];                                        \
+                rh.ray.org_x[k] = (float)S->qo[0]; rh.ray.org_y[k] = (float)S->qo[1];       \
+                rh.ray.org_z[k] = (float)S->qo[2]; rh.ray.tnear[k] = S->tnear;              \
+                rh.ray.dir_x[k] = (float)L->d[0]; rh.ray.dir_y[k] = (float)L->d[1];          \
+                rh.ray.dir_z[k] = (float)L->d[2]; rh.ray.time[k] = 0.0f;                    \
+                rh.ray.tfar[k] = S->tfar;                                                   \
+                rh.ray.mask[k] = INVALID_ID; rh.ray.id[k] = 0; rh.ray.flags[k] = 0;         \
+                rh.hit.geom_id[k] = INVALID_ID; rh.hit.prim_id[k] = INVALID_ID;             \
+                rh.hit.inst_id[k] = INVALID_ID;                                             \
             }                                                                               \
-            for (int b = 0; b < nb; ++b) {                                                  \
-                if (any_hit) ((occluded##W##_fn)fn)(valid[b], scene, &rh[b].ray, args);     \
-                else ((intersect##W##_fn)fn)(valid[b], scene, &rh[b], args);                \
-            }                                                                               \
-            for (int b = 0; b < nb; ++b) {                                                  \
-                int64_t i = i0 + (int64_t)b * W;                                            \
-                int m = (int)(n_act - i < W ? n_act - i : W);                               \
-                for (int k = 0; k < m; ++k) {                                               \
-                    int64_t j = act[i + k];                                                 \
-                    lane *L = &st[j];                                                       \
-                    const segment *S = &seg[b][k];                                          \
-                    int done;                                                               \
-                    if (any_hit) {                                                          \
-                        int hit = rh[b].ray.tfar[k] < 0.0f;                                 \
-                        if (hit) L->prim = 0;                                               \
-                        done = hit || S->end >= L->len;                                     \
-                    } else {                                                                \
-                        uint32_t p = rh[b].hit.prim_id[k];                                  \
-                        if (p != INVALID_ID) {                                              \
-                            double dist = S->t_anchor + (double)rh[b].ray.tfar[k];          \
-                            if (dist < L->best) {                                           \
-                                L->best = dist; L->prim = (int32_t)p;                       \
-                                L->inst = (int32_t)rh[b].hit.inst_id[k];                    \
-                                L->bcell[0] = L->cell[0]; L->bcell[1] = L->cell[1];         \
-                            }                                                               \
+            if (any_hit) ((occluded##W##_fn)fn)(valid, scene, &rh.ray, args);               \
+            else ((intersect##W##_fn)fn)(valid, scene, &rh, args);                          \
+            for (int k = 0; k < m; ++k) {                                                   \
+                int64_t j = act[i + k];                                                     \
+                lane *L = &st[j];                                                           \
+                const segment *S = &seg[k];                                                 \
+                int done;                                                                   \
+                if (any_hit) {                                                              \
+                    int hit = rh.ray.tfar[k] < 0.0f;                                        \
+                    if (hit) L->prim = 0;                                                   \
+                    done = hit || S->end >= L->len;                                         \
+                } else {                                                                    \
+                    uint32_t p = rh.hit.prim_id[k];                                         \
+                    if (p != INVALID_ID) {                                                  \
+                        double dist = S->t_anchor + (double)rh.ray.tfar[k];                 \
+                        if (dist < L->best) {                                               \
+                            L->best = dist; L->prim = (int32_t)p;                           \
+                            L->inst = (int32_t)rh.hit.inst_id[k];                           \
+                            L->bcell[0] = L->cell[0]; L->bcell[1] = L->cell[1];             \
                         }                                                                   \
-                        done = L->best <= S->end || S->end >= L->len;                       \
                     }                                                                       \
-                    lane_advance(L, S, done);                                               \
-                    if (!done) act[kept++] = j;  /* kept <= i + k: never overwrites ahead */ \
+                    done = L->best <= S->end || S->end >= L->len;                           \
                 }                                                                           \
+                lane_advance(L, S, done);                                                   \
+                if (!done) act[kept++] = j;      /* kept <= i + k: never overwrites ahead */ \
             }                                                                               \
         }                                                                                   \
         return kept;                                                                        \
@@ -402,14 +395,7 @@ int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene, in
     init_args(&args, coherent);
     lane *st = (lane *)malloc((size_t)(n > 0 ? n : 1) * sizeof(lane));
     int64_t *act = (int64_t *)malloc((size_t)(n > 0 ? n : 1) * sizeof(int64_t));
-    /* room for BLOCK packets of the widest width, reused by every width */
-    void *rh = aligned_alloc(64, BLOCK * sizeof(rayhit16));
-    void *valid = aligned_alloc(64, BLOCK * 16 * sizeof(int));
-    segment *seg = (segment *)malloc(BLOCK * 16 * sizeof(segment));
-    if (!st || !act || !rh || !valid || !seg) {
-        free(st); free(act); free(rh); free(valid); free(seg);
-        return -3;
-    }
+    if (!st || !act) { free(st); free(act); return -3; }
     /* the first pass in the packet order of the grid (compact tiles), then in that order */
     packet_order po;
     int64_t idx[16], n_act = 0;
@@ -423,12 +409,9 @@ int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene, in
     for (int64_t pass = 0; n_act > 0; ++pass) {
         if (pass > 1000000) { rc = -2; break; }
         switch (width) {
-        case 4: n_act = wrapped_pass4(fn, any_hit, scene, &args, st, act, n_act, wrap, rh,
-                                      valid, (segment (*)[4])seg); break;
-        case 8: n_act = wrapped_pass8(fn, any_hit, scene, &args, st, act, n_act, wrap, rh,
-                                      valid, (segment (*)[8])seg); break;
-        default: n_act = wrapped_pass16(fn, any_hit, scene, &args, st, act, n_act, wrap, rh,
-                                        valid, (segment (*)[16])seg);
+        case 4: n_act = wrapped_pass4(fn, any_hit, scene, &args, st, act, n_act, wrap); break;
+        case 8: n_act = wrapped_pass8(fn, any_hit, scene, &args, st, act, n_act, wrap); break;
+        default: n_act = wrapped_pass16(fn, any_hit, scene, &args, st, act, n_act, wrap);
         }
     }
     for (int64_t j = 0; j < n && rc == 0; ++j) {
@@ -446,9 +429,6 @@ int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene, in
     }
     free(st);
     free(act);
-    free(rh);
-    free(valid);
-    free(seg);
     return rc;
 }
 
