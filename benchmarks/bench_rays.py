@@ -15,9 +15,14 @@ of them, in Mrays/s:
   occlusion query)
 - open: the whole canopy's scene in an open field; periodic_block: the periodic field traced
   through the block's scene (maizeviz.light.tiling), segments wrapped in C
+- bare_embree_occluded_*: bare Embree's ceiling for packets_occluded: the same packets (the
+  same rays, 2 x 4 tiles) laid out in memory beforehand and traced by a C loop that only calls
+  ``rtcOccluded8`` (``benchmarks/_bare_embree.c``, compiled here; skipped without a C
+  compiler); packets_occluded_* can only come near it
 - _1t / _2t: on 1 and 2 threads (chunks of 2^16 rays, ctypes and embreex release the GIL)
 - speedup_*: ratios in this run (target: packets_occluded_2t >= 20 Mrays/s and >= 3 x
-  intersect1_occluded_2t on 2 cores)
+  intersect1_occluded_2t on 2 cores); of_bare_occluded_*: packets_occluded over
+  bare_embree_occluded (1: the kernel costs nothing around Embree)
 - sensor_answers_*: maizeviz's whole computation of one direction (``trace_direction``: the
   ground rays and the six default planes, each sensor's path answered by an occlusion query
   or, at this sun, by the first hit of the ray of the same family through it), in sensor
@@ -30,8 +35,14 @@ of them, in Mrays/s:
 from __future__ import annotations
 
 import argparse
+import ctypes
 import os
+import shutil
+import subprocess
+import tempfile
+import time
 from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 
 import numpy as np
 from anchors import best, report
@@ -42,12 +53,13 @@ from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.rays import Tracer, ray_grid
 from maizeviz.light.sun import sun_at
 from maizeviz.light.transmission import light_scene, sampler, trace_direction
+from maizeviz.mesh import packets
 from maizeviz.mesh.levels import parse_level
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.resources import example_points
 
 CHUNK = 1 << 16
-
+BARE_SOURCE = Path(__file__).with_name("_bare_embree.c")
 
 
 def chunked(fn, n: int, threads: int):
@@ -60,6 +72,69 @@ def chunked(fn, n: int, threads: int):
         with ThreadPoolExecutor(threads) as pool:
             list(pool.map(lambda ab: fn(*ab), parts))
     return run
+
+
+def tile_order(n: int, row: int, th: int = 2, tw: int = 4) -> np.ndarray:
+    """Ray indices (P, 8) of the packets maizeviz.mesh.packets forms from n rays laid out
+    row rays a row: th x tw tiles, tiles along the row, then the next th rows; -1 pads."""
+    r0, c0 = np.meshgrid(np.arange(0, -(-n // row), th), np.arange(0, row, tw), indexing="ij")
+    a, b = np.divmod(np.arange(th * tw), tw)
+    col = c0.reshape(-1, 1) + b
+    idx = (r0.reshape(-1, 1) + a) * row + col
+    idx[(col >= row) | (idx >= n)] = -1
+    return idx[(idx >= 0).any(axis=1)]
+
+
+def bare_embree(scene: RayScene, org32: np.ndarray, direction: np.ndarray, len32: np.ndarray,
+                row: int):
+    """(reset, trace(a, b)) for bare Embree on the rays' packets (``_bare_embree.c``): reset
+    lays the packets out again (untimed), trace(a, b) traces those of rays [a, b) (a and b
+    multiples of 8); None without a C compiler or the packet kernel."""
+    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
+    k = packets.kernel()
+    if cc is None or k is None or not scene.packets:
+        return None
+    so = Path(tempfile.mkdtemp()) / "_bare_embree.so"
+    if subprocess.run([cc, "-O2", "-shared", "-fPIC", str(BARE_SOURCE), "-o", str(so)],
+                      capture_output=True).returncode != 0:
+        return None
+    lib = ctypes.CDLL(str(so))
+    p, i64 = ctypes.c_void_p, ctypes.c_int64
+    lib.bare_prepare.argtypes = [i64, p, p, p, p, p, p]
+    lib.bare_occluded8.argtypes = [p, p, i64, p, p]
+    idx = np.ascontiguousarray(tile_order(len(org32), row), dtype=np.int64)
+    npk = len(idx)
+    raw = np.zeros(npk * 96 + 16, np.float32)          # 96 floats a packet, 64-byte aligned
+    buf = raw[(-raw.ctypes.data % 64) // 4:][:npk * 96]
+    valid_raw = np.zeros(npk * 8 + 16, np.int32)
+    valid = valid_raw[(-valid_raw.ctypes.data % 64) // 4:][:npk * 8]
+    d = np.ascontiguousarray(direction, dtype=np.float32).reshape(3)
+
+    def reset():
+        lib.bare_prepare(npk, idx.ctypes.data, org32.ctypes.data, d.ctypes.data,
+                         len32.ctypes.data, buf.ctypes.data, valid.ctypes.data)
+
+    def trace(a, b):
+        lib.bare_occluded8(k.occluded[8], scene._handle, (b - a) // 8,
+                           valid[a:].ctypes.data, buf[a // 8 * 96:].ctypes.data)
+
+    def blocked():
+        out = np.zeros(len(org32), bool)
+        sel = idx >= 0
+        out[idx[sel]] = buf.reshape(npk, 12, 8)[:, 8, :][sel] < 0
+        return out
+    return reset, trace, blocked, npk * 8
+
+
+def best_reset(fn, reset, repeat: int) -> float:
+    """Shortest of ``repeat`` timed calls of ``fn()``, each after an untimed ``reset()``."""
+    out = []
+    for _ in range(repeat):
+        reset()
+        t0 = time.perf_counter()
+        fn()
+        out.append(time.perf_counter() - t0)
+    return min(out)
 
 
 def main() -> None:
@@ -123,6 +198,15 @@ def main() -> None:
         for threads in (1, 2):
             out[f"{name}_{threads}t"] = round(n / best(chunked(fn, n, threads), args.repeat)
                                               / 1e6, 2)
+    bare = bare_embree(packed, org32, s, len32, ny)
+    if bare is not None:
+        reset, trace, blocked, n_lanes = bare
+        reset()
+        trace(0, n_lanes)
+        assert np.array_equal(blocked(), packed.occluded(org32, dirs[:1], len32, row=ny))
+        for threads in (1, 2):
+            secs = best_reset(chunked(trace, n_lanes, threads), reset, args.repeat)
+            out[f"bare_embree_occluded_{threads}t"] = round(n / secs / 1e6, 2)
     heights = (0.0, 50.0, 100.0, 150.0, 200.0, 225.0)
     for name, sc, periodic in (("open_packets", packed, False), ("open_single_rays", single, False),
                                ("periodic_block", block, True)):
@@ -137,6 +221,10 @@ def main() -> None:
         for t in ("1t", "2t"):
             out[f"speedup_{q}_{t}"] = round(out[f"packets_{q}_{t}"]            # type: ignore
                                             / out[f"intersect1_{q}_{t}"], 2)   # type: ignore
+    for t in ("1t", "2t"):
+        if f"bare_embree_occluded_{t}" in out:
+            out[f"of_bare_occluded_{t}"] = round(out[f"packets_occluded_{t}"]           # type: ignore
+                                                 / out[f"bare_embree_occluded_{t}"], 2)  # type: ignore
     out["targets"] = {"packets_occluded_2t": 20.0, "speedup_occluded_2t": 3.0}
     report(out, args.json)
 

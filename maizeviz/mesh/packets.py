@@ -147,6 +147,14 @@ def _ptr(a: np.ndarray | None) -> int | None:
     return None if a is None else a.ctypes.data
 
 
+def _check(rc: int, width: int) -> None:
+    """Raise for a kernel's error code (0: done; -1: unknown width; -3: out of memory)."""
+    if rc == -3:  # pragma: no cover - a few kilobytes a call
+        raise MemoryError("the ray packet kernel ran out of memory")
+    if rc != 0:  # pragma: no cover - widths come from the kernel's own table
+        raise ValueError(f"packet width {width} not supported")
+
+
 def intersect(k: Kernel, scene_handle: int, origins: np.ndarray, directions: np.ndarray,
               tfar: np.ndarray | None, ids: bool = True, coherent: bool = True,
               width: int | None = None, row: int = 0, inst: np.ndarray | None = None
@@ -167,11 +175,9 @@ def intersect(k: Kernel, scene_handle: int, origins: np.ndarray, directions: np.
     dist = np.empty(n, np.float32)
     w = width or k.width
     if n:
-        rc = k.lib.mz_intersect(k.intersect[w], w, scene_handle, n, _ptr(o), _ptr(d), step,
-                                _ptr(t), _ptr(prim), _ptr(dist), _ptr(inst), int(coherent),
-                                int(row))
-        if rc != 0:  # pragma: no cover - widths are checked above
-            raise ValueError(f"packet width {w} not supported")
+        _check(k.lib.mz_intersect(k.intersect[w], w, scene_handle, n, _ptr(o), _ptr(d), step,
+                                  _ptr(t), _ptr(prim), _ptr(dist), _ptr(inst), int(coherent),
+                                  int(row)), w)
     return prim, dist
 
 
@@ -186,8 +192,8 @@ def occluded(k: Kernel, scene_handle: int, origins: np.ndarray, directions: np.n
     out = np.zeros(n, np.uint8)
     w = width or k.width
     if n:
-        k.lib.mz_occluded(k.occluded[w], w, scene_handle, n, _ptr(o), _ptr(d), step, _ptr(t),
-                          _ptr(out), int(coherent), int(row))
+        _check(k.lib.mz_occluded(k.occluded[w], w, scene_handle, n, _ptr(o), _ptr(d), step,
+                                 _ptr(t), _ptr(out), int(coherent), int(row)), w)
     return out.view(bool)
 
 
