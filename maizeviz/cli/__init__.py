@@ -11,27 +11,32 @@ The desktop app is not imported from here: it registers itself under the entry-p
 from __future__ import annotations
 
 import argparse
+import importlib
 import os
 import sys
 import traceback
 from collections.abc import Callable, Sequence
 
 from maizeviz import __version__
-from maizeviz.cli import canopy, leaf, light, phenomenal, record, simulate, synth
 from maizeviz.cli.common import EXIT_FAIL, EXIT_OK, EXIT_PARTIAL, EXIT_USAGE, error_line, say
 from maizeviz.errors import MaizevizError
-from maizeviz.sweep import command as sweep
 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_FAIL", "EXIT_USAGE", "EXIT_PARTIAL"]
 
-#: The subcommands, in the order ``--help`` lists them.
-COMMANDS = (leaf, canopy, light, sweep, record, simulate, synth, phenomenal)
+#: The subcommands, in the order ``--help`` lists them: name -> the module that defines it
+#: (``NAME``, ``add_parser``), imported only when it runs or help lists every command.
+COMMANDS = {"leaf": "maizeviz.cli.leaf", "canopy": "maizeviz.cli.canopy",
+            "light": "maizeviz.cli.light", "sweep": "maizeviz.sweep.command",
+            "record": "maizeviz.cli.record", "fastrak-sim": "maizeviz.cli.simulate",
+            "synth": "maizeviz.cli.synth", "import-phenomenal": "maizeviz.cli.phenomenal"}
 #: Entry-point group under which the desktop app registers its ``run(argv) -> int``.
 GUI_GROUP = "maizeviz.gui"
 GUI_HINT = 'the desktop app is not installed: pip install "maizeviz[gui]"'
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The command line's parser: every subcommand, or only the one named ``only`` (the others'
+    modules are then not imported: a run pays only for its own)."""
     parser = argparse.ArgumentParser(
         prog="maizeviz",
         description="Digitized maize plants: leaf surfaces, mesh complexity, canopies, light. "
@@ -39,8 +44,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"maizeviz {__version__}")
     parser.add_argument("--debug", action="store_true", help="show tracebacks")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    for command in COMMANDS:
-        command.add_parser(sub)
+    for name, module in COMMANDS.items():
+        if only is None or name == only:
+            importlib.import_module(module).add_parser(sub)
     return parser
 
 
@@ -88,13 +94,11 @@ def _no_command(argv: list[str]) -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
     tokens = list(sys.argv[1:] if argv is None else argv)
-    names = {command.NAME for command in COMMANDS}
     first = next((t for t in tokens if t != "--debug"), None)
-    if first not in names and first not in ("-h", "--help", "--version"):
+    if first not in COMMANDS and first not in ("-h", "--help", "--version"):
         return _no_command(tokens)                 # the app, with its own options
-    args = parser.parse_args(tokens)
+    args = build_parser(first if first in COMMANDS else None).parse_args(tokens)
     debug = args.debug or bool(os.environ.get("MAIZEVIZ_DEBUG"))
     try:
         return int(args.run(args))

@@ -111,3 +111,25 @@ def test_hostile_texts_are_one_line_or_run(capsys, monkeypatch, tiny, name, flag
     assert "internal error" not in err and "Traceback" not in err, err[-500:]
     errors = [ln for ln in err.splitlines() if ln.startswith("error")]
     assert code in (0, 3) or (code == 1 and len(errors) == 1), (code, err[-500:])
+
+
+def test_each_command_is_found_under_its_own_name():
+    """The command table names each module by the NAME it registers, and a run imports only
+    its own command (the others' modules cost ~0.1 s to import)."""
+    import importlib
+    import subprocess
+    import sys
+
+    from maizeviz.cli import COMMANDS
+
+    for name, module in COMMANDS.items():
+        assert importlib.import_module(module).NAME == name
+    code = ("import sys\nfrom maizeviz.cli import main\n"
+            "try:\n    main(['fastrak-sim', '--help'])\nexcept SystemExit:\n    pass\n"
+            "print(sorted(m for m in sys.modules if m.startswith('maizeviz.cli.') or "
+            "m.startswith('maizeviz.sweep')))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.strip().splitlines()[-1]
+    assert "maizeviz.cli.simulate" in out
+    for other in ("maizeviz.cli.light", "maizeviz.cli.record", "maizeviz.sweep.command"):
+        assert other not in out
