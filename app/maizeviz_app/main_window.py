@@ -112,6 +112,20 @@ def _scrolled(widget: QWidget) -> QScrollArea:
     return area
 
 
+def _own_window(centre: QWidget) -> None:
+    """Give the 3D view's place a native window of its own (on X11).
+
+    The 3D view is a QOpenGLWidget (pyvistaqt): Qt then composes the window it lies in through
+    OpenGL at every repaint, and on software OpenGL (Mesa llvmpipe) composing the whole main
+    window costs 20-30 ms a frame, for a label or a progress bar as for the view. In a native
+    window of its own, only the view's area is composed (8-11 ms) and the other widgets paint
+    as plain raster (1-2 ms instead of about 30). Its siblings (the docks) stay non-native."""
+    if QApplication.platformName() != "xcb":
+        return
+    QApplication.setAttribute(Qt.ApplicationAttribute.AA_DontCreateNativeWidgetSiblings)
+    centre.setAttribute(Qt.WidgetAttribute.WA_NativeWindow)
+
+
 class MainWindow(QMainWindow):
     """Open a points file or a project, choose the mesh level, compute light, export.
 
@@ -155,6 +169,7 @@ class MainWindow(QMainWindow):
         self._centre = QStackedWidget()
         self._centre.setMinimumSize(320, 200)
         self._centre.addWidget(placeholder)
+        _own_window(self._centre)
         self.setCentralWidget(self._centre)
         self.docks: dict[str, QDockWidget] = {}
         self._build_panels()
