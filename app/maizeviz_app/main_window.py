@@ -169,7 +169,6 @@ class MainWindow(QMainWindow):
         self._centre = QStackedWidget()
         self._centre.setMinimumSize(320, 200)
         self._centre.addWidget(placeholder)
-        _own_window(self._centre)
         self.setCentralWidget(self._centre)
         self.docks: dict[str, QDockWidget] = {}
         self._build_panels()
@@ -355,6 +354,7 @@ class MainWindow(QMainWindow):
             # the central widget stays (a new one would make the docks take its room)
             self._centre.addWidget(self.viewport)
             self._centre.setCurrentWidget(self.viewport)
+            _own_window(self._centre)
             self._make_late_panels()
             self.ready.emit()
         else:

@@ -257,6 +257,9 @@ def test_the_view_is_on_screen_in_a_window_of_its_own(window, qtbot, small_point
         assert w.centralWidget().testAttribute(native)
         assert not any(d.testAttribute(native) for d in w.docks.values())
     view = w.viewport
+    # its native window made once the view is in it: the docks keep their first-start sizes
+    # (made earlier, the view's place fell to its minimum height, the figures took the rest)
+    assert view.height() > 0.45 * w.height() and view.width() > 0.6 * w.width()
     screen = QApplication.primaryScreen()
     area = QRect(view.mapToGlobal(QPoint(0, 0)), view.size()) & screen.geometry()
     image = screen.grabWindow(0, area.x(), area.y(), area.width(), area.height()).toImage()
