@@ -248,6 +248,7 @@ def test_the_view_is_on_screen_in_a_window_of_its_own(window, qtbot, small_point
     the whole main window at each repaint); the docks are not. What the display shows there
     (grabbed from the screen, not rendered again) is the canopy on its ground."""
     from PySide6.QtCore import QPoint, QRect, Qt
+    from PySide6.QtGui import QSurface
     from PySide6.QtWidgets import QApplication
 
     w = shown(qtbot, window(small_points, tile=1))
@@ -256,9 +257,12 @@ def test_the_view_is_on_screen_in_a_window_of_its_own(window, qtbot, small_point
     if QApplication.platformName() == "xcb":
         assert w.centralWidget().testAttribute(native)
         assert not any(d.testAttribute(native) for d in w.docks.values())
+        # only the view's window is composed through OpenGL; the main window paints as raster
+        assert w.centralWidget().windowHandle().surfaceType() == QSurface.SurfaceType.OpenGLSurface
+        assert w.windowHandle().surfaceType() == QSurface.SurfaceType.RasterSurface
     view = w.viewport
-    # its native window made once the view is in it: the docks keep their first-start sizes
-    # (made earlier, the view's place fell to its minimum height, the figures took the rest)
+    # the docks keep their first-start sizes (the view once made as a child of the main window
+    # itself: its place fell to its minimum height, the figures took the rest)
     assert view.height() > 0.45 * w.height() and view.width() > 0.6 * w.width()
     screen = QApplication.primaryScreen()
     area = QRect(view.mapToGlobal(QPoint(0, 0)), view.size()) & screen.geometry()
