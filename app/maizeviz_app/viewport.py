@@ -11,7 +11,9 @@ Rendering happens only when something changed, once:
 
 The canopy is one actor over one merged mesh (leaves and stalks), with per-triangle cell data
 ``plant`` (digitized plant id), ``instance`` (placement, from 1), ``leaf`` (rank; 0 for
-stalks) and ``light`` (2 direct, 1 second class, 0 none, -1 not traced; -2 for stalks).
+stalks) and ``light`` (2 direct, 1 second class, 0 none, -1 not traced; -2 for stalks), and
+``plant`` and ``leaf`` per vertex too: those colourings use them (cheaper to draw on software
+OpenGL than colours per triangle; see :func:`_point_values`), light uses the cell data.
 Colouring switches the mapper's array and lookup table; nothing is rebuilt. The mesh is made
 by :func:`canopy_polydata`, which worker threads call, so the GUI thread only swaps it in.
 
