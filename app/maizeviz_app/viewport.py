@@ -93,10 +93,15 @@ def _point_values(points: np.ndarray, faces: np.ndarray, plant: np.ndarray, leaf
     if all(np.array_equal(p[faces], v[:, None].repeat(3, axis=1))
            for p, v in zip(per_point, (plant, leaf))):
         return points, faces, tuple(per_point)
-    keys = np.column_stack([flat, np.repeat(plant, 3), np.repeat(leaf, 3)])
-    uniq, inverse = np.unique(keys, axis=0, return_inverse=True)
-    return (points[uniq[:, 0]], inverse.reshape(faces.shape).astype(faces.dtype),
-            (uniq[:, 1].astype(np.int32), uniq[:, 2].astype(np.int32)))
+    # one vertex per (vertex, plant and leaf) pair, by 1-D keys (fast for millions)
+    p, lf = plant.astype(np.int64) - plant.min(), leaf.astype(np.int64) - leaf.min()
+    _, first, pair = np.unique(p * (lf.max() + 1) + lf, return_index=True, return_inverse=True)
+    n_pairs = len(first)
+    keys, inverse = np.unique(flat.astype(np.int64) * n_pairs + np.repeat(pair, 3),
+                              return_inverse=True)
+    mine = first[keys % n_pairs]                    # a triangle of each new vertex's leaf
+    return (points[keys // n_pairs], inverse.reshape(faces.shape).astype(faces.dtype),
+            (plant[mine].astype(np.int32), leaf[mine].astype(np.int32)))
 
 
 def _settle(poly: pv.PolyData) -> pv.PolyData:
