@@ -94,14 +94,16 @@ def _point_values(points: np.ndarray, faces: np.ndarray, plant: np.ndarray, leaf
            for p, v in zip(per_point, (plant, leaf))):
         return points, faces, tuple(per_point)
     # one vertex per (vertex, plant and leaf) pair, by 1-D keys (fast for millions)
-    p, lf = plant.astype(np.int64) - plant.min(), leaf.astype(np.int64) - leaf.min()
-    _, first, pair = np.unique(p * (lf.max() + 1) + lf, return_index=True, return_inverse=True)
+    by_plant = plant.astype(np.int64) - plant.min()
+    by_leaf = leaf.astype(np.int64) - leaf.min()
+    _, first, pair = np.unique(by_plant * (by_leaf.max() + 1) + by_leaf, return_index=True,
+                               return_inverse=True)
     n_pairs = len(first)
     keys, inverse = np.unique(flat.astype(np.int64) * n_pairs + np.repeat(pair, 3),
                               return_inverse=True)
-    mine = first[keys % n_pairs]                    # a triangle of each new vertex's leaf
+    leaf_of = first[keys % n_pairs]                 # a triangle of each new vertex's leaf
     return (points[keys // n_pairs], inverse.reshape(faces.shape).astype(faces.dtype),
-            (plant[mine].astype(np.int32), leaf[mine].astype(np.int32)))
+            (plant[leaf_of].astype(np.int32), leaf[leaf_of].astype(np.int32)))
 
 
 def _settle(poly: pv.PolyData) -> pv.PolyData:
