@@ -59,8 +59,11 @@ def _polydata(canopy, vertices: np.ndarray, faces: np.ndarray, face_plant: np.nd
     all_faces[:nf] = faces
     all_faces[nf:] = canopy.stalk_faces + nv
     n_stalk = len(canopy.stalk_faces)
-    per_stalk = n_stalk // max(canopy.n_plants, 1)
-    stalk_inst = np.repeat(np.arange(canopy.n_plants, dtype=np.int32), per_stalk)
+    if canopy.stalk_instance is not None:          # a mesh's plants: stalks of their own sizes
+        stalk_inst = np.asarray(canopy.stalk_instance, np.int32)
+    else:
+        per_stalk = n_stalk // max(canopy.n_plants, 1)
+        stalk_inst = np.repeat(np.arange(canopy.n_plants, dtype=np.int32), per_stalk)
     plant_of_inst = np.array([p.plant for p in canopy.layout.placements], np.int32)
     plant = np.concatenate([face_plant, plant_of_inst[stalk_inst]]).astype(np.int32)
     leaf = np.concatenate([face_leaf, np.zeros(n_stalk, np.int32)]).astype(np.int32)

@@ -134,3 +134,23 @@ def test_a_vertex_shared_by_two_leaves_is_split(small_canopy):
     np.testing.assert_array_equal(np.asarray(mesh.point_data["leaf"])[mesh.regular_faces],
                                   [[1, 1, 1], [2, 2, 2]])
     np.testing.assert_allclose(np.asarray(mesh.points)[mesh.regular_faces], square[faces])
+
+
+def test_stalks_of_different_sizes(small_canopy):
+    """A canopy read from a mesh gives each stalk triangle its plant (stalks of their own
+    sizes): the view's mesh takes them (it assumed equal shares and failed)."""
+    from dataclasses import replace
+
+    from maizeviz_app.viewport import canopy_polydata
+
+    n = len(small_canopy.stalk_faces)
+    per = n // small_canopy.n_plants
+    inst = np.repeat(np.arange(small_canopy.n_plants, dtype=np.int32), per)[3:]
+    canopy = replace(small_canopy, stalk_faces=small_canopy.stalk_faces[3:], stalk_instance=inst)
+    mesh = canopy_polydata(canopy)
+    stalks = slice(canopy.n_triangles, None)
+    assert mesh.n_cells == canopy.n_triangles + n - 3
+    np.testing.assert_array_equal(np.asarray(mesh.cell_data["instance"])[stalks], inst + 1)
+    plants = np.array([p.plant for p in canopy.layout.placements])
+    np.testing.assert_array_equal(np.asarray(mesh.cell_data["plant"])[stalks], plants[inst])
+    assert np.all(np.asarray(mesh.cell_data["leaf"])[stalks] == 0)
