@@ -29,6 +29,12 @@ def test_a_large_canopy_is_drawn_within_the_budget_and_coloured_by_its_light(
                                   np.flatnonzero(np.isin(c.face_instance, sampled)))
     n_leaf = int(mesh.field_data["leaf_triangles"][0])
     assert n_leaf < c.n_triangles                       # fewer triangles drawn
+    # only the vertices of the triangles drawn, the sampled plants' where the canopy has them
+    faces = mesh.regular_faces
+    np.testing.assert_array_equal(np.unique(faces), np.arange(mesh.n_points))
+    mine = np.flatnonzero(source >= 0)
+    np.testing.assert_allclose(np.asarray(mesh.points)[faces[mine]],
+                               c.vertices[c.faces[source[mine]]], rtol=1e-6)
     small_light(w.light_panel, "sun")
     compute(qtbot, w)
     classes = w.runs.last.classes

@@ -89,3 +89,68 @@ def test_digitizing_hides_and_restores_the_canopy(qtbot, viewport, small_canopy)
     viewport.restore_canopy()
     assert viewport.actors["canopy"].GetVisibility() and "ground" in viewport.actors
     assert "leafsurf" not in viewport.actors and "digitized" not in viewport.actors
+
+
+def test_plant_and_leaf_colour_per_vertex_as_per_triangle(viewport, small_canopy):
+    """Plant and leaf colour the mesh per vertex (cheaper to draw than per triangle), with the
+    colour of every triangle the vertex belongs to; light stays per triangle."""
+    viewport.show_canopy(small_canopy)
+    mesh = viewport.canopy_mesh
+    faces = mesh.regular_faces
+    mapper = viewport.actors["canopy"].mapper
+    for what in ("plant", "leaf"):
+        cells = np.asarray(mesh.cell_data[what])
+        np.testing.assert_array_equal(np.asarray(mesh.point_data[what])[faces],
+                                      np.repeat(cells[:, None], 3, axis=1))
+        viewport.colour_by(what)
+        assert mapper.GetScalarModeAsString() == "UsePointFieldData"
+        assert mapper.GetArrayName() == what and not mapper.GetInterpolateScalarsBeforeMapping()
+        per_vertex = np.asarray(mapper.MapScalars(1.0)).copy()       # what OpenGL receives
+        mapper.SetScalarModeToUseCellFieldData()                     # as it was: per triangle
+        per_triangle = np.asarray(mapper.MapScalars(1.0)).copy()
+        mapper.SetScalarModeToUsePointFieldData()
+        assert per_vertex.shape == (mesh.n_points, 4) and per_triangle.shape == (len(faces), 4)
+        assert len(np.unique(per_triangle, axis=0)) >= 2                # plants, leaves, stalks
+        np.testing.assert_array_equal(per_vertex[faces],
+                                      np.repeat(per_triangle[:, None], 3, axis=1))
+    viewport.set_light(np.full(small_canopy.n_triangles, 2, np.int8))
+    assert viewport.colour_by("light")
+    assert mapper.GetScalarModeAsString() == "UseCellFieldData"
+
+
+def test_a_vertex_shared_by_two_leaves_is_split(small_canopy):
+    """An imported mesh may share a vertex between leaves: the view splits it, so that colours
+    per vertex are those of each triangle."""
+    from maizeviz_app.viewport import canopy_polydata
+
+    from maizeviz.canopy.scene import Canopy
+
+    square = np.array([[0, 0, 10], [10, 0, 10], [10, 10, 12], [0, 10, 12]], float)
+    faces = np.array([[0, 1, 2], [0, 2, 3]])                  # sharing the edge 0-2
+    canopy = Canopy.from_triangles(square, faces, small_canopy.layout,
+                                   face_leaf=np.array([1, 2]))
+    mesh = canopy_polydata(canopy)
+    assert mesh.n_points == 6 and mesh.n_cells == 2
+    np.testing.assert_array_equal(np.asarray(mesh.point_data["leaf"])[mesh.regular_faces],
+                                  [[1, 1, 1], [2, 2, 2]])
+    np.testing.assert_allclose(np.asarray(mesh.points)[mesh.regular_faces], square[faces])
+
+
+def test_stalks_of_different_sizes(small_canopy):
+    """A canopy read from a mesh gives each stalk triangle its plant (stalks of their own
+    sizes): the view's mesh takes them (it assumed equal shares and failed)."""
+    from dataclasses import replace
+
+    from maizeviz_app.viewport import canopy_polydata
+
+    n = len(small_canopy.stalk_faces)
+    per = n // small_canopy.n_plants
+    inst = np.repeat(np.arange(small_canopy.n_plants, dtype=np.int32), per)[3:]
+    canopy = replace(small_canopy, stalk_faces=small_canopy.stalk_faces[3:], stalk_instance=inst)
+    mesh = canopy_polydata(canopy)
+    stalks = slice(canopy.n_triangles, None)
+    assert mesh.n_cells == canopy.n_triangles + n - 3
+    np.testing.assert_array_equal(np.asarray(mesh.cell_data["instance"])[stalks], inst + 1)
+    plants = np.array([p.plant for p in canopy.layout.placements])
+    np.testing.assert_array_equal(np.asarray(mesh.cell_data["plant"])[stalks], plants[inst])
+    assert np.all(np.asarray(mesh.cell_data["leaf"])[stalks] == 0)

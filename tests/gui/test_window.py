@@ -241,3 +241,38 @@ def test_project_keeps_an_edited_layout(window, qtbot, small_points, tmp_path):
         [(p.plant, p.x, p.y, p.azimuth_deg) for p in sorted(turned, key=key)]
     assert w2.loaded.layout.ground_area_cm2 == layout.ground_area_cm2
     np.testing.assert_array_equal(w2.loaded.layout.cells, layout.cells)
+
+
+def test_the_view_is_on_screen_in_a_window_of_its_own(window, qtbot, small_points):
+    """On X11 the 3D view's place is a native window (Qt composes only it through OpenGL, not
+    the whole main window at each repaint); the docks are not. What the display shows there
+    (grabbed from the screen, not rendered again) is the canopy on its ground."""
+    from PySide6.QtCore import QPoint, QRect, Qt
+    from PySide6.QtGui import QSurface
+    from PySide6.QtWidgets import QApplication
+
+    w = shown(qtbot, window(small_points, tile=1))
+    qtbot.wait(500)
+    native = Qt.WidgetAttribute.WA_NativeWindow
+    if QApplication.platformName() == "xcb":
+        assert w.centralWidget().testAttribute(native)
+        assert not any(d.testAttribute(native) for d in w.docks.values())
+        # only the view's window is composed through OpenGL; the main window paints as raster
+        assert w.centralWidget().windowHandle().surfaceType() == QSurface.SurfaceType.OpenGLSurface
+        assert w.windowHandle().surfaceType() == QSurface.SurfaceType.RasterSurface
+    view = w.viewport
+    # the docks keep their first-start sizes (the view once made as a child of the main window
+    # itself: its place fell to its minimum height, the figures took the rest)
+    assert view.height() > 0.45 * w.height() and view.width() > 0.6 * w.width()
+    screen = QApplication.primaryScreen()
+    area = QRect(view.mapToGlobal(QPoint(0, 0)), view.size()) & screen.geometry()
+    image = screen.grabWindow(0, area.x(), area.y(), area.width(), area.height()).toImage()
+    key = view.key.geometry()                              # the legend has greens too
+    rgb = np.array([image.pixelColor(x, y).getRgb()[:3]
+                    for y in range(0, image.height(), 3) for x in range(0, image.width(), 3)
+                    if not key.contains(x, y)], float)
+    background = np.array([0xe4, 0xed, 0xf5])
+    drawn = np.abs(rgb - background).sum(axis=1) > 30
+    assert 0.01 < drawn.mean() < 0.9                      # something drawn, not all black
+    leafy = (rgb[:, 1] > 1.3 * rgb[:, 2] + 10) & (rgb[:, 1] >= rgb[:, 0] - 10)   # leaf rank
+    assert leafy.sum() >= 20
