@@ -16,7 +16,7 @@ import math
 import os
 from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from maizeviz.canopy.layout import CanopyLayout
 from maizeviz.canopy.measures import check_cover_resolution
@@ -199,7 +199,11 @@ def cover_cost(layout: CanopyLayout, resolution_cm: float) -> Cost:
     """Measuring the ground cover of ``layout``'s plot with one vertical ray per
     ``resolution_cm`` pixel (:func:`maizeviz.canopy.measures.ground_cover`)."""
     check_cover_resolution(resolution_cm)
-    return light_cost(layout.bounds, 1 / resolution_cm**2, 1)
+    x0, y0, x1, y1 = layout.bounds
+    rays = light_cost(layout.bounds, 1 / resolution_cm**2, 1)
+    return replace(rays, what=f"the ground cover of the {(x1 - x0) / 100:g} x "
+                              f"{(y1 - y0) / 100:g} m plot at {resolution_cm:g} cm",
+                   quantity="field")
 
 
 def heatmap_cost(rect: Rect, bin_cm: float, heights: int) -> Cost:

@@ -488,6 +488,13 @@ class MainWindow(QMainWindow):
             canopy, _mesh, notes = read_mesh_canopy(path, unit, up, ground)  # type: ignore[arg-type]
             read_s = time.perf_counter() - t0
             job.check()
+            from maizeviz.cost import TooSlow, check, cover_cost
+
+            try:       # the ground cover is measured over the whole field, as for points
+                check([[cover_cost(canopy.layout, jobs.APP_COVER_RESOLUTION_CM)]])
+            except TooSlow as exc:
+                raise MaizevizError(f"{exc.estimate}: give a smaller field",
+                                    quantity="field") from None
             t0 = time.perf_counter()
             m = runner.cover_process.call("measure", object(), canopy,
                                           (jobs.APP_COVER_RESOLUTION_CM,), job)

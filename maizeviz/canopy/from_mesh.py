@@ -47,6 +47,10 @@ GUESS_MAX_HEIGHT = 1000.0
 MESH_LEVEL = "mesh"
 
 
+#: Smallest side of a field, cm (a plot narrower than a leaf is not one).
+MIN_FIELD_CM = 1.0
+
+
 def check_field(field: tuple[float, float, float, float] | list[float] | str
                 ) -> tuple[float, ...]:
     """A field rectangle x0, y0, x1, y1 (cm): finite, within 1 km, x1 > x0 and y1 > y0.
@@ -71,6 +75,10 @@ def check_field(field: tuple[float, float, float, float] | list[float] | str
     if not (x1 > x0 and y1 > y0):
         raise MaizevizError(f"the field x0, y0, x1, y1 = {x0:g}, {y0:g}, {x1:g}, {y1:g} cm needs "
                             "x1 > x0 and y1 > y0", quantity="field")
+    if x1 - x0 < MIN_FIELD_CM or y1 - y0 < MIN_FIELD_CM:
+        raise MaizevizError(f"the field x0, y0, x1, y1 = {x0:g}, {y0:g}, {x1:g}, {y1:g} cm is "
+                            f"less than {MIN_FIELD_CM:g} cm across: is it in cm?",
+                            quantity="field")
     return vals
 
 
@@ -231,6 +239,13 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
         fsrc = "given"
         x0, y0, x1, y1 = field
         outside = [p.plant for p in placements if not (x0 <= p.x <= x1 and y0 <= p.y <= y1)]
+        if len(outside) == len(placements):
+            raise MaizevizError(f"{source}: none of the {len(placements):,} plants stands in the "
+                                f"field x {x0:g}..{x1:g}, y {y0:g}..{y1:g} cm (the plants stand "
+                                f"in x {min(p.x for p in placements):.1f}.."
+                                f"{max(p.x for p in placements):.1f}, y "
+                                f"{min(p.y for p in placements):.1f}.."
+                                f"{max(p.y for p in placements):.1f} cm)", quantity="field")
         if outside:
             shown = ", ".join(map(str, outside[:5])) + (", ..." if len(outside) > 5 else "")
             notes.append(f"{source}: {len(outside):,} plant(s) stand outside the field: "

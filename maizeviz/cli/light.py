@@ -245,7 +245,8 @@ def sun_from(args: argparse.Namespace) -> Sun | None:
     if not args.time and not args.solar_noon:
         raise MaizevizError("give --time HH:MM or --solar-noon for one sun, or --day (or "
                             "--from/--to) for a period")
-    return sun_at(args.date, args.time, args.lat, args.lon, args.tz, args.solar_noon)
+    return sun_at(args.date, args.time, args.lat, args.lon, args.tz, args.solar_noon,
+                  args.altitude)
 
 
 def period_from(args: argparse.Namespace) -> Period | None:

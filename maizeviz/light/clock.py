@@ -21,6 +21,8 @@ References
 from __future__ import annotations
 
 import datetime as _dt
+import math
+import numbers
 
 from maizeviz.errors import MaizevizError
 from maizeviz.light.dates import TIME_UNIT
@@ -71,6 +73,23 @@ def check_place(lat, lon) -> tuple[float, float]:
         raise MaizevizError(f"latitude must be in [-90, 90] and longitude in [-180, 360], "
                             f"got {lat}, {lon}", quantity="place")
     return lat, lon
+
+
+def check_altitude(altitude) -> float:
+    """A site altitude as a float, m above sea level, in [-500, 9000] (the Dead Sea's shore to
+    above Everest; pvlib's pressure formula has no real value past 44 km).
+
+    Raises
+    ------
+    MaizevizError
+        Not a finite number in that range (``quantity`` "altitude").
+    """
+    value = float(altitude) if isinstance(altitude, numbers.Real) and \
+        not isinstance(altitude, bool) else math.nan
+    if not (math.isfinite(value) and -500 <= value <= 9000):
+        raise MaizevizError(f"site altitude must be a number of metres in [-500, 9000], "
+                            f"got {altitude!r}", quantity="altitude")
+    return value
 
 
 def parse_clock(clock, what: str = "clock",

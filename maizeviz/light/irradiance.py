@@ -58,6 +58,7 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.io.inputs import read_input
+from maizeviz.light.clock import check_altitude as _check_altitude
 from maizeviz.light.clock import check_place as _check_place
 from maizeviz.light.clock import local_time
 from maizeviz.light.clock import zone as _time_zone
@@ -116,14 +117,6 @@ def _fmt_duration(seconds: float) -> str:
     if seconds >= 60:
         return f"{seconds / 60:g} min"
     return f"{seconds:g} s"
-
-
-def _check_altitude(altitude) -> float:
-    if not isinstance(altitude, (int, float, np.floating, np.integer)) \
-            or not math.isfinite(altitude) or not (-500 <= altitude <= 9000):
-        raise MaizevizError(f"site altitude must be a number of metres in [-500, 9000], "
-                            f"got {altitude!r}", quantity="altitude")
-    return float(altitude)
 
 
 def _check_par_factor(par_umol_per_j) -> float:

@@ -115,12 +115,13 @@ def transit_ns(day: _dt.date, lat: float, lon: float) -> int:
 
     pvlib's ``sun_rise_set_transit_spa``: the SPA is given that day's 00:00 labelled UTC and
     its seconds become whole nanoseconds as pvlib's ``pd.to_datetime(..., unit="ns")`` makes
-    them.
+    them (truncated), as a Python integer: every year from 1 to 9999, where pandas'
+    nanoseconds stop at 1677 and 2262.
     """
     midnight = float((day - _EPOCH.date()).days * 86400)
     transit, _rise, _set = spa().transit_sunrise_sunset(np.array([midnight]), lat, lon,
                                                         DELTA_T_S, 1)
-    return int(np.asarray(transit * 1e9).astype(np.int64)[0])
+    return int(float(transit[0]) * 1e9)
 
 
 def iso_ns(ns: int, where: _dt.tzinfo) -> str:

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.clock import check_place, local_datetime, zone
+from maizeviz.light.clock import check_altitude, check_place, local_datetime, zone
 
 
 @dataclass(frozen=True)
@@ -77,6 +77,7 @@ def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None =
     from maizeviz.light import solar_position as spa
 
     lat, lon = check_place(lat, lon)
+    altitude = check_altitude(altitude)
     try:
         day = _dt.date.fromisoformat(str(date))
     except (TypeError, ValueError):

@@ -674,10 +674,21 @@ def test_a_field_typed_as_text_reads_as_its_four_numbers(text, want):
 
 @pytest.mark.parametrize("text, says", [("", "got 0"), ("1, 2, 3", "got 3"),
                                         ("1, 2, x, 4", "'1, 2, x, 4'"), ("0 0 0 10", "x1 > x0"),
-                                        ("0 0 nan 10", "finite"), ("0 0 1e9 10", "finite")])
+                                        ("0 0 nan 10", "finite"), ("0 0 1e9 10", "finite"),
+                                        ("-0,-0,1e-300,1e-300", "less than 1 cm")])
 def test_a_bad_field_text_is_one_line_naming_the_field(text, says):
     from maizeviz.canopy.from_mesh import check_field
 
     with pytest.raises(MaizevizError, match="field") as err:
         check_field(text)
     assert says in str(err.value) and err.value.quantity == "field"
+
+
+def test_a_field_without_any_plant_is_one_line(tmp_path):
+    from maizeviz.canopy.from_mesh import read_mesh_canopy
+
+    ply = tmp_path / "c.ply"
+    assert main(["canopy", B, "--tile", "1x1", "--interp", "0", "--export", str(ply)]) == EXIT_OK
+    with pytest.raises(MaizevizError, match="none of the 9 plants stands in the field") as err:
+        read_mesh_canopy(ply, "cm", "z", (1000.0, 1000.0, 1100.0, 1100.0))
+    assert err.value.quantity == "field" and "\n" not in str(err.value)

@@ -126,3 +126,30 @@ def test_a_wall_clock_time_skipped_or_repeated_is_refused(day, clock, tz):
 def test_the_last_midnight_of_the_calendar_is_one_line():
     with pytest.raises(MaizevizError, match="past the last day maizeviz reads"):
         sun_at("9999-12-31", "24:00", 0.0, 0.0, "UTC")
+
+
+@pytest.mark.parametrize("day", ["0001-01-01", "1500-03-01", "2300-06-01", "3000-06-01",
+                                 "9999-12-31"])
+def test_solar_noon_over_the_whole_calendar(day, recwarn):
+    """pandas' nanoseconds stop at 1677 and 2262: the noon is still that day's, and the sun at
+    it is the SPA's at that instant (the sun stands north at noon at 30 deg S)."""
+    import warnings
+
+    warnings.simplefilter("error", RuntimeWarning)
+    sun = sun_at(day, None, -30.0, 150.0, "Australia/Sydney", solar_noon=True)
+    assert sun.when.startswith(f"{day}T1")
+    assert min(sun.azimuth_deg, 360 - sun.azimuth_deg) < 1e-3
+    ns = solar_position.transit_ns(dt.date.fromisoformat(day), -30.0, 150.0)
+    assert (sun.zenith_deg, sun.azimuth_deg) == solar_position.position(ns / 1e9, -30.0, 150.0)
+
+
+def test_the_altitude_changes_the_refraction_and_is_checked():
+    low = sun_at("2005-08-01", "07:00", 39.9, 116.4, "Asia/Shanghai")
+    high = sun_at("2005-08-01", "07:00", 39.9, 116.4, "Asia/Shanghai", altitude=3000.0)
+    assert 1e-4 < abs(low.zenith_deg - high.zenith_deg) < 0.05        # thinner air bends less
+    assert high.zenith_deg == pvlib_sun("2005-08-01", "07:00", 39.9, 116.4, "Asia/Shanghai",
+                                        False, 3000.0)[0]
+    for bad in (1e9, float("nan"), -600.0, "high", True):
+        with pytest.raises(MaizevizError, match="altitude") as err:
+            sun_at("2005-08-01", "12:00", 39.9, 116.4, "Asia/Shanghai", altitude=bad)
+        assert err.value.quantity == "altitude"
