@@ -16,6 +16,7 @@ import os
 import sys
 import traceback
 from collections.abc import Callable, Sequence
+from pathlib import Path
 
 from maizeviz import __version__
 from maizeviz.cli.common import EXIT_FAIL, EXIT_OK, EXIT_PARTIAL, EXIT_USAGE, error_line, say
@@ -75,6 +76,14 @@ def _no_command(argv: list[str]) -> int:
     from maizeviz.resources import example_points
 
     rest = [a for a in argv if a != "--debug"]
+    if rest and not rest[0].startswith("-") and not Path(rest[0]).exists():
+        import difflib
+
+        close = difflib.get_close_matches(rest[0].lower(), list(COMMANDS), n=1, cutoff=0.6)
+        if close:                               # a mistyped command, not a file to open
+            say(f"error: unknown command '{rest[0]}' (did you mean '{close[0]}'? "
+                "maizeviz --help lists the commands)")
+            return EXIT_USAGE
     gui, why = find_gui()
     if gui is None:
         say(f"note: {why}")

@@ -133,3 +133,15 @@ def test_each_command_is_found_under_its_own_name():
     assert "maizeviz.cli.simulate" in out
     for other in ("maizeviz.cli.light", "maizeviz.cli.record", "maizeviz.sweep.command"):
         assert other not in out
+
+
+def test_a_mistyped_command_is_a_usage_error_not_the_app(capsys, tmp_path, monkeypatch):
+    """'maizeviz lihgt' names no file: it is a typo of a command, refused with exit 2 rather
+    than opening the app (or, without a screen, printing the bundled report and exit 0)."""
+    from maizeviz.cli import EXIT_USAGE
+
+    monkeypatch.chdir(tmp_path)
+    for typo, meant in (("lihgt", "light"), ("Light", "light"), ("canopyy", "canopy")):
+        assert main([typo]) == EXIT_USAGE
+        err = capsys.readouterr().err
+        assert f"unknown command '{typo}'" in err and f"did you mean '{meant}'" in err
