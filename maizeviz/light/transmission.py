@@ -233,6 +233,7 @@ class _Family:
     cells: np.ndarray                   # (k,) int64: flat box cells of the rays, x slow
     shifts: np.ndarray                  # (H, 2) int64: r_k
     size: tuple[int, int]               # nx, ny
+    wraps: bool = False                 # the box is the grid, read modulo (_spans_periods)
 
 
 def _lattice_shifts(smp: Sampler, s: np.ndarray, planes: list[int]) -> np.ndarray:
@@ -300,8 +301,22 @@ def _family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family | None:
     return _Family((int(lo[0]), int(lo[1])), index, cells, shifts, (nx, ny))
 
 
+def _period_family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family:
+    """The ray family of a rectangle spanning whole periods (:func:`_spans_periods`): its own
+    ground rays, read modulo the grid."""
+    from maizeviz.light.rays import grid_shape
+
+    nx, ny = grid_shape(smp.rect, smp.density)
+    cells = np.arange(nx * ny, dtype=np.int64)
+    return _Family((0, 0), cells.astype(np.int32).reshape(nx, ny), cells,
+                   _lattice_shifts(smp, s, planes), (nx, ny), wraps=True)
+
+
 def _plane_rays(fam: _Family, k: int) -> np.ndarray:
     """(N,) int64: the family ray through each sensor of plane k, in sensor grid order."""
+    if fam.wraps:            # sensor (a, b) is on ray (a, b) - r_k, modulo the grid
+        return np.roll(fam.index, (int(fam.shifts[k, 0]), int(fam.shifts[k, 1])),
+                       axis=(0, 1)).ravel()
     nx, ny = fam.size
     ox, oy = -fam.shifts[k] - np.array(fam.lo)
     return fam.index[ox:ox + nx, oy:oy + ny].ravel()
@@ -335,8 +350,8 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
     h32 = heights.astype(np.float32)
     leaf_top = smp.top - 1.0
     planes = [k for k, h in enumerate(heights) if 0.0 < h <= leaf_top]
-    periods = bool(planes) and _spans_periods(smp)
-    fam = _family(smp, s, planes) if planes and not periods else None
+    fam = None if not planes else (_period_family(smp, s, planes) if _spans_periods(smp)
+                                   else _family(smp, s, planes))
     offsets = sensor_offsets(heights, s, smp.rect, smp.density)
     chunks = _chunks(n if fam is None else len(fam.cells))
     ground_chunks = _chunks(n)
@@ -359,29 +374,7 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
         if stop is not None and stop.is_set():
             raise InterruptedError("light computation cancelled")
 
-    if periods:
-        def gchunk(a: int, b: int) -> None:
-            check()
-            prim, z = first_hits(down, rays, a, b, ids=keep_ids)
-            first_z[a:b] = z
-            if first_prim is not None and prim is not None:
-                first_prim[a:b] = prim
-
-        in_chunks(gchunk, chunks, 0)
-        grid = first_z.reshape(rays.shape)
-        shifts = _lattice_shifts(smp, s, planes)
-        transmission = np.empty(len(heights))
-        for k, h in enumerate(heights):
-            if h > leaf_top:
-                lit = np.ones(n, dtype=bool)
-            elif k in planes:        # sensor (a, b) is on ray (a, b) - r_k, modulo the grid
-                lit = np.roll(grid, (int(shifts[k, 0]), int(shifts[k, 1])), axis=(0, 1)
-                              ).ravel() < h32[k]
-            else:
-                lit = first_z < h32[k]
-            transmission[k] = np.count_nonzero(lit) / n
-            packed[k] = np.packbits(lit)
-    elif fam is None:
+    if fam is None:
         up = Tracer(smp.scene, s, smp.bounds, smp.periodic, size)
 
         def chunk(a: int, b: int) -> np.ndarray:
