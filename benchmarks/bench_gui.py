@@ -246,10 +246,10 @@ def gui_child(levels: list[str], repeat: int = 1) -> None:
                  "view_px": [view.width(), view.height()]}
     samples: dict = {"slider_to_view_s": {}, "event_loop_max_gap_ms": {}, "renders_per_level": {}}
     gaps = GapTimer()
-    current = window.level
+    current = window.model.settings.canopy.level
     for level in levels * repeat:
         if level == current:
-            window.slider.setValue(COMPLEXITY_STOPS.index("4" if level != "4" else "8"))
+            window.canopy_panel.slider.setValue(COMPLEXITY_STOPS.index("4" if level != "4" else "8"))
             assert spin(TIMEOUT_S, lambda: bool(shown) and window.runner.current("build") is None
                         and not window.canopy_panel.asked_label.text())
             spin(1.0)
@@ -257,7 +257,7 @@ def gui_child(levels: list[str], repeat: int = 1) -> None:
         frames_before = view.render_count
         gaps.start()
         t0 = time.perf_counter()
-        window.slider.setValue(COMPLEXITY_STOPS.index(level))
+        window.canopy_panel.slider.setValue(COMPLEXITY_STOPS.index(level))
         assert spin(TIMEOUT_S, lambda before=before: len(shown) > before), f"no canopy at {level}"
         framed = view.render_count
         spin(TIMEOUT_S, lambda framed=framed: view.render_count > framed)
@@ -274,7 +274,7 @@ def gui_child(levels: list[str], repeat: int = 1) -> None:
     out["renders_per_canopy"] = max(out["renders_per_level"].values(), default=None)
     # a light run at 36 triangles: the event loop while the child traces
     if "36" in levels:
-        window.slider.setValue(COMPLEXITY_STOPS.index("36"))
+        window.canopy_panel.slider.setValue(COMPLEXITY_STOPS.index("36"))
         spin(TIMEOUT_S, lambda: shown[-1] == "36 triangles" and
              window.runner.current("build") is None)
         spin(1.0)
@@ -282,7 +282,7 @@ def gui_child(levels: list[str], repeat: int = 1) -> None:
         window.light_shown.connect(lambda: lit.append(1))
         gaps.start()
         t0 = time.perf_counter()
-        window.compute_light()
+        window.model.compute_light()
         spin(TIMEOUT_S, lambda: bool(lit))
         out["light_36_s"] = time.perf_counter() - t0
         out["light_event_loop_max_gap_ms"] = gaps.stop()

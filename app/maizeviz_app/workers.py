@@ -24,45 +24,13 @@ from __future__ import annotations
 
 import itertools
 import sys
-import threading
-import time
-import traceback
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from typing import Any
 
 from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
 
 from maizeviz_app.process import CoreProcess
-
-
-@dataclass
-class Job:
-    """A unit of work: id, kind, what it is doing (for the status bar), a cancel flag."""
-
-    id: int
-    kind: str
-    label: str
-    runner: JobRunner
-    cancel: threading.Event = field(default_factory=threading.Event)
-    started: float = field(default_factory=time.perf_counter)
-
-    def report(self, done: int, total: int, text: str = "") -> bool:
-        """Progress from any thread (``text``: what is being done, e.g. "time step 7 of 29";
-        else the job's label); False once the job is cancelled (the work should stop)."""
-        if self.cancel.is_set():
-            return False
-        self.runner._progress_from_thread(self, done, total, text)
-        return not self.cancel.is_set()
-
-    @property
-    def cancelled(self) -> bool:
-        return self.cancel.is_set()
-
-    def check(self) -> None:
-        """Raise InterruptedError if cancelled (between steps of a job)."""
-        if self.cancel.is_set():
-            raise InterruptedError(f"{self.kind} cancelled")
+from maizeviz_app.runner import Job, describe_internal  # noqa: F401 - the app's names
 
 
 class JobRunner(QObject):
@@ -218,10 +186,3 @@ class _Task(QRunnable):
 
     def run(self) -> None:
         self._fn()
-
-
-def describe_internal(exc: BaseException) -> None:
-    """Write an unexpected exception's traceback to stderr (the window shows one line)."""
-    child = getattr(exc, "child_traceback", None)
-    text = child or "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
-    print(f"maizeviz: internal error\n{text}", file=sys.stderr)

@@ -198,13 +198,13 @@ def test_layout_editor_in_the_window_turns_a_plant(window, two_plants, qtbot):
     panel = w.layout_panel
     assert panel.rows.rowCount() == 2
     first = panel.model.placements[0].plant
-    before = w.canopy.vertices[w.canopy.faces[w.canopy.face_plant == first]].copy()
+    before = w.model.canopy.vertices[w.model.canopy.faces[w.model.canopy.face_plant == first]].copy()
     with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
         panel.rows.setData(panel.rows.index(0, 3), "90")      # the 3D view follows
-    after = w.canopy.vertices[w.canopy.faces[w.canopy.face_plant == first]]
+    after = w.model.canopy.vertices[w.model.canopy.faces[w.model.canopy.face_plant == first]]
     assert not np.allclose(before, after)
-    assert [p.azimuth_deg for p in w.loaded.layout.placements if p.plant == first] == [90]
-    assert w.loaded.layout.ground_area_cm2 == pytest.approx(60 * 60)   # the tiling's ground
+    assert [p.azimuth_deg for p in w.model.loaded.layout.placements if p.plant == first] == [90]
+    assert w.model.loaded.layout.ground_area_cm2 == pytest.approx(60 * 60)   # the tiling's ground
 
 
 def test_the_tiling_has_one_place_and_the_window_follows_it(window, two_plants, qtbot, tmp_path):
@@ -221,13 +221,13 @@ def test_the_tiling_has_one_place_and_the_window_follows_it(window, two_plants, 
     assert tilings == [w.layout_panel.tiling]                # one control, in the layout panel
     with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
         assert w.layout_panel.set_tiling(3)                  # the preset; the view follows
-    assert w.tile_n == 3 and len(w.canopy.layout.placements) == 18
+    assert w.model.tile_n == 3 and len(w.model.canopy.layout.placements) == 18
     path = tmp_path / "tiled.maizeviz"
     with qtbot.waitSignal(w.saved, timeout=120_000):
-        w.save_project(path)
+        w.model.save_project(path)
     with zipfile.ZipFile(path) as zf:
         assert json.loads(zf.read("project.json"))["settings"]["canopy"]["tile"] == 3
     with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
         w.open_points(two_plants)                            # reopened with the tiling shown
-    assert len(w.loaded.layout.placements) == 18
+    assert len(w.model.loaded.layout.placements) == 18
     assert w.layout_panel.tiling.currentData() == 3

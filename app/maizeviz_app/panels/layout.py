@@ -65,14 +65,15 @@ class LayoutPanel(QWidget):
     applied = Signal(object)
     problem = Signal(str)
 
-    def __init__(self, study=None, parent=None):
+    def __init__(self, study=None, stack: QUndoStack | None = None, parent=None):
         super().__init__(parent)
         self.study = study
         self.model = EditedLayout(self)
         self.model.changed.connect(self._on_changed)
+        self.model.changed.connect(self._on_edit)
         self.bases: dict[int, tuple[float, float]] = {}
-        self.undo_stack = QUndoStack(self)
-        self.undo_stack.indexChanged.connect(self._on_edit)
+        # the study's one history (the Edit menu's), else a history of the panel's own
+        self.undo_stack = stack if stack is not None else QUndoStack(self)
         self._quiet = False
         self._said: tuple = ()
         self._applied: tuple | None = None
@@ -98,9 +99,12 @@ class LayoutPanel(QWidget):
         self.redo_action.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")])
         for action, icon in ((self.undo_action, QStyle.StandardPixmap.SP_ArrowBack),
                              (self.redo_action, QStyle.StandardPixmap.SP_ArrowForward)):
-            action.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+            if stack is not None:               # the Edit menu's shortcuts act everywhere
+                action.setShortcuts([])
+            else:
+                action.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+                self.addAction(action)
             action.setIcon(self.style().standardIcon(icon))
-            self.addAction(action)
             button = QToolButton()
             button.setDefaultAction(action)
             button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonIconOnly)
@@ -151,6 +155,7 @@ class LayoutPanel(QWidget):
         self._follow_timer = QTimer(self, singleShot=True, interval=FOLLOW_DELAY_MS)
         self._follow_timer.timeout.connect(self.apply)
         if study is not None:
+            self.applied.connect(study.apply_layout)
             study.points_changed.connect(self._on_points)
             # a mesh file's canopy has no layout to edit
             study.mesh_opened.connect(lambda _path: self.setEnabled(False))
@@ -273,7 +278,7 @@ class LayoutPanel(QWidget):
     def _on_picked(self, index: int) -> None:
         self.table.selectRow(index)
 
-    def _on_edit(self, _index: int) -> None:
+    def _on_edit(self, _index: int = -1) -> None:
         if self._quiet:
             return
         self._show_state()

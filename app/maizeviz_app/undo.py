@@ -1,0 +1,157 @@
+"""One undo history for the study: every edit of a setting (level, area preservation, light,
+sky, day, optics) and of the layout is a step of one ``QUndoStack`` (Qt's undo framework, as
+the Edit menu and its history view need), whatever panel it was made in.
+
+:class:`UndoRecorder` listens to the study's evented settings and pushes a
+:class:`SettingsEdit` for each change a person makes (not for those the study makes itself
+while opening a project). Undoing sets the old values back through the same settings, so an
+undo has exactly the consequences of an edit: an undone level rebuilds the canopy, an undone
+light setting makes the next light run start a new comparison, an undone layout edit is
+applied like any layout edit.
+
+What makes one step: everything that changed in one turn of the event loop (a band and the
+optics it sets, a sky split and its directions), and consecutive changes of one field less
+than :data:`MERGE_S` apart (typing a number, holding a spin box's arrow, dragging the slider).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+from PySide6.QtCore import QObject, QTimer
+from PySide6.QtGui import QUndoCommand, QUndoStack
+
+from maizeviz_app.settings import field_names
+
+#: Settings groups whose edits are undoable (the digitizer's connection is not an edit of the
+#: study).
+UNDOABLE = ("canopy", "light", "sun", "sampling", "sky", "day", "optics")
+#: Edits of one field closer than this (s) are one step.
+MERGE_S = 1.5
+#: Merge id of settings edits (the layout's edits use their own).
+SETTINGS_ID = 1000
+#: What a field is called in the Edit menu and the history.
+NAMES = {"level": "mesh level", "preserve_area": "area preservation", "mode": "light",
+         "zenith_deg": "sun zenith", "azimuth_deg": "sun azimuth", "place": "place",
+         "heights": "heights", "density": "ray density", "periodic": "infinite field",
+         "kind": "sky", "split": "sky directions", "directions": "sky directions",
+         "date": "date", "latitude": "latitude", "longitude": "longitude", "tz": "time zone",
+         "step_min": "time step", "start": "hours from", "end": "hours to",
+         "source": "irradiance source", "linke_turbidity": "Linke turbidity",
+         "weather": "weather file", "par_factor": "PAR factor", "diffuse": "diffuse light",
+         "enabled": "leaf optics", "band": "band", "reflectance": "leaf reflectance",
+         "transmittance": "leaf transmittance", "ground_reflectance": "soil reflectance",
+         "direct_w_m2": "direct irradiance", "diffuse_w_m2": "diffuse irradiance",
+         "depth": "scattering depth", "tile": "tiling"}
+
+
+def _shown(value: Any) -> str:
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    if isinstance(value, float):
+        return f"{value:g}"
+    text = str(value)
+    return text if len(text) <= 24 else text[:23] + "…"
+
+
+class SettingsEdit(QUndoCommand):
+    """Settings changed by one person's action: ``changes`` (group, field) -> (old, new)."""
+
+    def __init__(self, recorder: UndoRecorder, group: str, name: str, old: Any, new: Any):
+        super().__init__()
+        self.recorder = recorder
+        self.changes: dict[tuple[str, str], tuple[Any, Any]] = {(group, name): (old, new)}
+        self.turn = recorder.turn
+        self.at = time.monotonic()
+        self._pushed = False
+        self._name()
+
+    def _name(self) -> None:
+        (group, name), (_old, new) = next(reversed(self.changes.items()))
+        names = {NAMES.get(f, f) for _g, f in self.changes}
+        if len(names) == 1:
+            self.setText(f"{NAMES.get(name, name)} {_shown(new)}")
+        else:
+            self.setText(f"{NAMES.get(name, name)} {_shown(new)} and "
+                         f"{len(names) - 1} more")
+
+    def id(self) -> int:  # noqa: A003 - Qt's name
+        return SETTINGS_ID
+
+    def mergeWith(self, other) -> bool:  # noqa: N802 - Qt's name
+        if not isinstance(other, SettingsEdit):
+            return False
+        same_turn = other.turn == self.turn
+        typing = set(other.changes) == set(self.changes) and len(self.changes) == 1 and \
+            other.at - self.at < MERGE_S
+        if not (same_turn or typing):
+            return False
+        for key, (old, new) in other.changes.items():
+            first = self.changes.get(key, (old, new))[0]
+            self.changes[key] = (first, new)
+        self.at = other.at
+        self.changes = {k: v for k, v in self.changes.items() if v[0] != v[1]}
+        if not self.changes:
+            self.setObsolete(True)                 # back where it started: no step
+        else:
+            self._name()
+        return True
+
+    def redo(self) -> None:
+        if not self._pushed:                       # pushed after the change was made
+            self._pushed = True
+            return
+        self.recorder.apply(self.changes, 1)
+
+    def undo(self) -> None:
+        self.recorder.apply(self.changes, 0)
+
+
+class UndoRecorder(QObject):
+    """Records the study's settings edits on :attr:`stack` (see the module docstring); the
+    history starts again with every study opened."""
+
+    def __init__(self, study, parent=None):
+        super().__init__(parent)
+        self.study = study
+        self.stack = QUndoStack(self)
+        self.turn = 0
+        self._replaying = False
+        self._turn_pending = False
+        for name in UNDOABLE:
+            group = study.settings.groups[name]
+            group.events.connect(lambda info, name=name: self._changed(name, info))
+        study.points_changed.connect(lambda *_: self.stack.clear())
+        study.mesh_opened.connect(lambda *_: self.stack.clear())
+
+    def _changed(self, group: str, info) -> None:
+        if self._replaying or self.study.applying or self.study.closing:
+            return
+        name = info.signal.name
+        if group == "canopy" and name == "tile":
+            return                                 # set by opening, not an edit
+        new, old = info.args[0], info.args[1]
+        self.stack.push(SettingsEdit(self, group, name, old, new))
+        if not self._turn_pending:                 # the next turn of the loop: a new step
+            self._turn_pending = True
+            QTimer.singleShot(0, self._next_turn)
+
+    def _next_turn(self) -> None:
+        self._turn_pending = False
+        self.turn += 1
+
+    def apply(self, changes: dict[tuple[str, str], tuple[Any, Any]], which: int) -> None:
+        """Set the ``which`` values (0: old, 1: new) of ``changes``, group by group in the
+        fields' order (a band before the optics it sets), without recording them."""
+        settings = self.study.settings
+        self._replaying = True
+        try:
+            for group in UNDOABLE:
+                values = {f: v[which] for (g, f), v in changes.items() if g == group}
+                if values:
+                    order = field_names(settings.groups[group])
+                    settings.set(group, dict(sorted(values.items(),
+                                                    key=lambda kv: order.index(kv[0]))))
+        finally:
+            self._replaying = False
