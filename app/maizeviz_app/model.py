@@ -41,6 +41,7 @@ from psygnal import Signal
 from maizeviz.errors import MaizevizError
 from maizeviz_app import building, lighting, studyfiles
 from maizeviz_app.figures import Figures
+from maizeviz_app.layout_draft import LayoutDraft
 from maizeviz_app.messages import user_message
 from maizeviz_app.runner import InlineRunner, Runner, describe_internal
 from maizeviz_app.runs import LightRuns, Run
@@ -82,6 +83,8 @@ class StudyModel:
         The result whose light per plant is shown.
     project_path : str or None
         The ``.maizeviz`` file the study was opened from or saved to.
+    draft : LayoutDraft
+        The layout being edited (applied by :meth:`apply_layout`).
     layout_edited : bool
         The layout is not the plain tiling of the settings (saved into the project).
     serial : int
@@ -182,6 +185,7 @@ class StudyModel:
         self.measures_rows: dict[str, dict] = {}
         self.runs = LightRuns()
         self.figures = Figures()
+        self.draft = LayoutDraft()
         self.summary = ""
         self.plants_run: Run | None = None
         self.pending_runs: list[Any] = []       # a project's results, waiting for a canopy
@@ -273,6 +277,7 @@ class StudyModel:
         self.project_path = project
         self.layout_edited = layout_edited
         self._renew()
+        self.draft.start(loaded.layout, loaded.plants)
         self.points_changed.emit(loaded)
         self.project_changed.emit(project)
         self._set_modified(False)
@@ -288,6 +293,7 @@ class StudyModel:
         self.mesh_path = str(path)
         self.layout_edited = False
         self._renew()
+        self.draft.start(None, set())
         self.mesh_opened.emit(self.mesh_path)
         self.project_changed.emit(None)
         self._set_modified(False)
@@ -306,6 +312,8 @@ class StudyModel:
             return False
         dropped = bool(self.runs.runs)
         self.loaded = replace(self.loaded, layout=layout)
+        if tuple(self.draft.placements) != tuple(layout.placements):
+            self.draft.start(layout, self.loaded.plants)    # laid out by a script
         self.layout_edited = True
         self._renew()
         self.layout_changed.emit(layout)

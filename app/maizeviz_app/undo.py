@@ -22,6 +22,7 @@ from typing import Any
 from PySide6.QtCore import QObject, QTimer
 from PySide6.QtGui import QUndoCommand, QUndoStack
 
+from maizeviz_app.layout_draft import Change, LayoutDraft
 from maizeviz_app.settings import field_names
 
 #: Settings groups whose edits are undoable (the digitizer's connection is not an edit of the
@@ -29,8 +30,9 @@ from maizeviz_app.settings import field_names
 UNDOABLE = ("canopy", "light", "sun", "sampling", "sky", "day", "optics")
 #: Edits of one field closer than this (s) are one step.
 MERGE_S = 1.5
-#: Merge id of settings edits (the layout's edits use their own).
+#: Merge ids of settings edits and of layout edits.
 SETTINGS_ID = 1000
+LAYOUT_ID = 1001
 #: What a field is called in the Edit menu and the history.
 NAMES = {"level": "mesh level", "preserve_area": "area preservation", "mode": "light",
          "zenith_deg": "sun zenith", "azimuth_deg": "sun azimuth", "place": "place",
@@ -108,22 +110,68 @@ class SettingsEdit(QUndoCommand):
         self.recorder.apply(self.changes, 0)
 
 
-class UndoRecorder(QObject):
-    """Records the study's settings edits on :attr:`stack` (see the module docstring); the
-    history starts again with every study opened."""
+class LayoutEdit(QUndoCommand):
+    """An edit of the layout draft (a :class:`~maizeviz_app.layout_draft.Change`); edits with
+    the same ``merge`` key (the wheel turning one plant) are one step."""
 
-    def __init__(self, study, parent=None):
+    def __init__(self, draft: LayoutDraft, change: Change, text: str, merge: Any = None):
+        super().__init__(text)
+        self.draft, self.change, self.merge = draft, change, merge
+        self._pushed = False
+
+    def id(self) -> int:  # noqa: A003 - Qt's name
+        return LAYOUT_ID if self.merge is not None else -1
+
+    def mergeWith(self, other) -> bool:  # noqa: N802 - Qt's name
+        if not isinstance(other, LayoutEdit) or other.merge != self.merge:
+            return False
+        self.change = Change(self.change.index, self.change.before, other.change.after)
+        if self.change.before == self.change.after:
+            self.setObsolete(True)
+        return True
+
+    def redo(self) -> None:
+        if not self._pushed:                       # pushed after the edit was made
+            self._pushed = True
+            return
+        self.draft.apply(self.change, 1)
+
+    def undo(self) -> None:
+        self.draft.apply(self.change, 0)
+
+
+class UndoRecorder(QObject):
+    """Records the study's settings edits and its layout draft's edits on :attr:`stack` (see
+    the module docstring); the history starts again with every study opened. Without a study,
+    the edits of ``draft`` alone."""
+
+    def __init__(self, study, parent=None, draft: LayoutDraft | None = None):
         super().__init__(parent)
         self.study = study
         self.stack = QUndoStack(self)
+        self.stack.setUndoLimit(500)
         self.turn = 0
         self._replaying = False
         self._turn_pending = False
+        self.draft = study.draft if study is not None else draft
+        if self.draft is not None:
+            self.draft.edited.connect(self._edited)
+        if study is None:
+            return
         for name in UNDOABLE:
             group = study.settings.groups[name]
             group.events.connect(lambda info, name=name: self._changed(name, info))
-        study.points_changed.connect(lambda *_: self.stack.clear())
-        study.mesh_opened.connect(lambda *_: self.stack.clear())
+        study.points_changed.connect(self._clear)
+        study.mesh_opened.connect(self._clear)
+
+    def _clear(self, *_args) -> None:
+        self.stack.clear()
+
+    def _edited(self, change: Change, text: str, merge: Any) -> None:
+        if self.study is not None and self.study.closing:
+            return
+        self.stack.push(LayoutEdit(self.draft, change, text, merge))  # type: ignore[arg-type]
+        self._new_turn_soon()
 
     def _changed(self, group: str, info) -> None:
         if self._replaying or self.study.applying or self.study.closing:
@@ -133,6 +181,9 @@ class UndoRecorder(QObject):
             return                                 # set by opening, not an edit
         new, old = info.args[0], info.args[1]
         self.stack.push(SettingsEdit(self, group, name, old, new))
+        self._new_turn_soon()
+
+    def _new_turn_soon(self) -> None:
         if not self._turn_pending:                 # the next turn of the loop: a new step
             self._turn_pending = True
             QTimer.singleShot(0, self._next_turn)

@@ -32,6 +32,8 @@ from maizeviz_app.panels.layout_model import fmt
 WHEEL_STEP_DEG = 5.0
 PLANT = QColor("#2e7d32")
 PICKED = QColor("#ff8f00")
+#: Plants standing on another's ground.
+OVERLAPPING = QColor("#d32f2f")
 
 
 @lru_cache(maxsize=32)
@@ -139,6 +141,7 @@ class FieldView(QGraphicsView):
         self._spacing = 30.0
         self._zoomed = False
         self._picked = -1
+        self._overlapping: set[int] = set()
 
     # ------------------------------------------------------------------------ content
     def show_layout(self, layout, placements) -> None:
@@ -147,6 +150,7 @@ class FieldView(QGraphicsView):
         scene.clear()
         self.items_ = []
         self._picked = -1
+        self._overlapping = set()
         if layout is None:
             return
         rs, ps = layout.row_spacing, layout.plant_spacing
@@ -194,11 +198,28 @@ class FieldView(QGraphicsView):
         if 0 <= index < len(self.items_):
             self.items_[index].set_placement(placement)
 
+    def _colour(self, index: int) -> QColor:
+        if index == self._picked:
+            return PICKED
+        return OVERLAPPING if index in self._overlapping else PLANT
+
+    def set_overlapping(self, indices: set[int]) -> None:
+        """Draw the plants at ``indices`` red: they stand on another's ground."""
+        changed = self._overlapping ^ set(indices)
+        self._overlapping = set(indices)
+        for i in changed:
+            if 0 <= i < len(self.items_):
+                self.items_[i].setBrush(QBrush(self._colour(i)))
+
+    def is_overlapping(self, index: int) -> bool:
+        return index in self._overlapping
+
     def select(self, index: int) -> None:
         """Show placement ``index`` as the picked one (-1: none)."""
-        if 0 <= self._picked < len(self.items_):
-            self.items_[self._picked].setBrush(QBrush(PLANT))
+        old = self._picked
         self._picked = index if 0 <= index < len(self.items_) else -1
+        if 0 <= old < len(self.items_):
+            self.items_[old].setBrush(QBrush(self._colour(old)))
         if self._picked >= 0:
             item = self.items_[self._picked]
             item.setBrush(QBrush(PICKED))
