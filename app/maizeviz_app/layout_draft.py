@@ -42,15 +42,24 @@ from maizeviz.canopy.layout import (
 OVERLAP_REACH = 0.9
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Snapshot:
     """Everything a whole-layout change replaces: the ground (``base``), the placements and
-    the tiling they came from (None: a layout file or rows x plants by parameters)."""
+    the tiling they came from (None: a layout file or rows x plants by parameters). Equal
+    snapshots have the same base (the same object: a ground holds arrays) and equal
+    placements, tiling and source."""
 
     base: CanopyLayout | None
     placements: tuple[Placement, ...]
     tiling: tuple[int, int] | None
     source: str = ""
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Snapshot) and other.base is self.base and \
+            (other.placements, other.tiling, other.source) == \
+            (self.placements, self.tiling, self.source)
+
+    __hash__ = None  # type: ignore[assignment]
 
 
 @dataclass(frozen=True)
@@ -105,10 +114,12 @@ class LayoutDraft:
     changed(index) : placement ``index`` changed; -1: everything did.
     edited(change, text, merge) : an edit was made (``merge``: a key shared by edits that
         are one step, such as the turns of one plant by the mouse wheel; None).
+    replayed(change, which) : an edit undone (``which`` 0) or redone (1).
     """
 
     changed = Signal(int)
     edited = Signal(object, str, object)
+    replayed = Signal(object, int)
 
     def __init__(self) -> None:
         self.base: CanopyLayout | None = None
@@ -154,13 +165,15 @@ class LayoutDraft:
         return block_lattice(self.bases, self.base.row_spacing, self.base.plant_spacing)[0]
 
     def grid(self) -> tuple[int, int]:
-        """Rows x plants per row of the placements (rows by x to 0.1 cm; the most plants of
-        a row)."""
-        rows: dict[float, int] = {}
-        for p in self.placements:
-            key = round(p.x, 1)
-            rows[key] = rows.get(key, 0) + 1
-        return len(rows), max(rows.values(), default=0)
+        """Rows x plants per row of the placements: stalks closer than half a row spacing
+        across the rows share a row (digitizing noise stays within a row); the most plants
+        of a row."""
+        if not self.placements:
+            return 0, 0
+        xs = np.sort([p.x for p in self.placements])
+        half = (self.base.row_spacing if self.base is not None else 60.0) / 2
+        row = np.concatenate([[0], np.cumsum(np.diff(xs) > half)])
+        return int(row[-1]) + 1, int(np.bincount(row).max())
 
     def overlaps(self) -> list[tuple[int, int, float]]:
         """Placements standing on each other's ground: (i, j, distance cm), i < j."""
@@ -190,9 +203,14 @@ class LayoutDraft:
         self.changed.emit(-1)
 
     # ------------------------------------------------------------------ edits
+    def replay(self, change: Change, which: int) -> None:
+        """Undo (``which`` 0) or redo (1) an edit: its state set back, said by ``replayed``
+        (the editor follows an undo as it follows an edit)."""
+        self.apply(change, which)
+        self.replayed.emit(change, which)
+
     def apply(self, change: Change, which: int) -> None:
-        """Set a change's ``before`` (``which`` 0) or ``after`` (1) state: an undo or redo,
-        not an edit."""
+        """Set a change's ``before`` (``which`` 0) or ``after`` (1) state."""
         state = (change.before, change.after)[which]
         if change.index >= 0:
             self.placements[change.index] = state
@@ -293,11 +311,20 @@ class LayoutDraft:
         after = Snapshot(self.base, tuple(self.placements) + (new,), self.tiling, self.source)
         return self._whole(after, f"add plant {plant}")
 
-    def duplicate(self, index: int) -> bool:
-        """A copy of placement ``index`` one plant spacing further along its row (snapped)."""
+    def row_end(self, index: int) -> tuple[float, float]:
+        """The place one plant spacing beyond the end of placement ``index``'s row (the
+        stalks closer than half a row spacing across the rows), cm."""
         p = self.placements[self._index(index)]
-        step = self.base.plant_spacing if self.base is not None else 30.0
-        return self.add(p.x, p.y + step, p.plant, p.azimuth_deg)
+        rs = self.base.row_spacing if self.base is not None else 60.0
+        ps = self.base.plant_spacing if self.base is not None else 30.0
+        end = max(q.y for q in self.placements if abs(q.x - p.x) < rs / 2)
+        return p.x, end + ps
+
+    def duplicate(self, index: int) -> bool:
+        """A copy of placement ``index`` (the same plant, turned the same) at the end of its
+        row (:meth:`row_end`, snapped)."""
+        p = self.placements[self._index(index)]
+        return self.add(*self.row_end(index), p.plant, p.azimuth_deg)
 
     def remove(self, index: int) -> bool:
         """Take placement ``index`` out of the layout (the last one stays: a canopy has a

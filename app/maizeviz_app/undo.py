@@ -134,10 +134,10 @@ class LayoutEdit(QUndoCommand):
         if not self._pushed:                       # pushed after the edit was made
             self._pushed = True
             return
-        self.draft.apply(self.change, 1)
+        self.draft.replay(self.change, 1)
 
     def undo(self) -> None:
-        self.draft.apply(self.change, 0)
+        self.draft.replay(self.change, 0)
 
 
 class UndoRecorder(QObject):

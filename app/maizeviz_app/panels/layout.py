@@ -157,6 +157,7 @@ class LayoutPanel(QWidget):
         self._sync_buttons()
         self.model.changed.connect(self._on_changed)
         self.model.edited.connect(self._on_edit)
+        self.model.replayed.connect(self._on_edit)
         self.destroyed.connect(lambda *_: self._forget(self.model))
         self._follow_timer = QTimer(self, singleShot=True, interval=FOLLOW_DELAY_MS)
         self._follow_timer.timeout.connect(self.apply)
@@ -170,7 +171,8 @@ class LayoutPanel(QWidget):
             self._on_changed(-1)
 
     def _forget(self, draft: LayoutDraft) -> None:
-        for signal, slot in ((draft.changed, self._on_changed), (draft.edited, self._on_edit)):
+        for signal, slot in ((draft.changed, self._on_changed), (draft.edited, self._on_edit),
+                             (draft.replayed, self._on_edit)):
             try:
                 signal.disconnect(slot)
             except (ValueError, RuntimeError):
@@ -246,8 +248,8 @@ class LayoutPanel(QWidget):
                                  "beyond the end of the picked plant's row (or the last row)")
         self.add_button.clicked.connect(self.add_plant)
         self.duplicate_button = _named(QPushButton("Duplicate"), "Duplicate",
-                                       "a copy of the picked plant one plant spacing further "
-                                       "along its row")
+                                       "a copy of the picked plant (the same plant, turned "
+                                       "the same) at the end of its row")
         self.duplicate_button.clicked.connect(
             lambda: self._edit(self.model.duplicate, self.picked, select_new=True))
         self.remove_button = _named(QPushButton("Remove"), "Remove", "take the picked plant "
@@ -455,16 +457,14 @@ class LayoutPanel(QWidget):
         self.model.snap_cm = self.snap_step.value() if self.snap.isChecked() else 0.0
 
     def add_plant(self) -> bool:
-        """A new plant one plant spacing beyond the end of the picked plant's row (or of the
-        last row), the lowest digitized plant id; it is picked."""
+        """A new plant (the lowest digitized plant id) one plant spacing beyond the end of
+        the picked plant's row (or of the last row); it is picked."""
         ps = self.model.placements
-        base = self.model.base
-        if base is None or not ps:
+        if self.model.base is None or not ps:
             return False
-        at = ps[self.picked] if 0 <= self.picked < len(ps) else max(ps, key=lambda p: p.x)
-        row = [p for p in ps if abs(p.x - at.x) < 0.05 * base.row_spacing]
-        return self._edit(self.model.add, at.x, max(p.y for p in row) + base.plant_spacing,
-                          select_new=True)
+        at = self.picked if 0 <= self.picked < len(ps) else \
+            max(range(len(ps)), key=lambda i: ps[i].x)
+        return self._edit(self.model.add, *self.model.row_end(at), select_new=True)
 
     def lay_out(self) -> bool:
         """Rows x plants at the spacings typed (asks first over edits)."""
