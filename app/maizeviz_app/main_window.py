@@ -38,6 +38,7 @@ from maizeviz import __version__
 from maizeviz.mesh.levels import COMPLEXITY_STOPS as LEVELS  # noqa: F401 - the slider's stops
 from maizeviz.resources import example_points
 from maizeviz_app import dialogs, docks
+from maizeviz_app.accessible import name_controls
 from maizeviz_app.model import StudyModel
 from maizeviz_app.panels.canopy import CanopyPanel
 from maizeviz_app.panels.light import LightPanel, LightPlots
@@ -111,6 +112,7 @@ class MainWindow(QMainWindow):
         from maizeviz_app.menus import build_menus
 
         self.menu_actions = build_menus(self)
+        name_controls(self)
         self._state_restored = docks.restore_window(self, self._settings)
         self._to_open = str(points) if points is not None else self._last_opened()
         self._warmed.connect(self._on_warmed)
@@ -278,6 +280,7 @@ class MainWindow(QMainWindow):
         self.digitizer.stopped.connect(self._digitizing_stopped)
         self.docks["layout"].setWidget(docks.scrolled(self.layout_panel))
         self.docks["digitizer"].setWidget(docks.scrolled(self.digitizer))
+        name_controls(self)
 
     def _start_processes(self) -> None:
         for proc in (self.runner.cover_process, self.runner.light_process):

@@ -107,6 +107,9 @@ class CanopyPanel(QWidget):
         lay.addWidget(group)
         lay.addWidget(QLabel("canopy measures per level (the paper's Table 2)"))
         self.table = QTableWidget(0, 0)
+        self.table.setAccessibleName("canopy measures per level")
+        self.table.setToolTip("each level built: its triangles, leaf area, area projected on "
+                              "the ground, ground cover, leaf area index and build time")
         self.table.verticalHeader().setVisible(False)
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
@@ -188,12 +191,16 @@ class CanopyPanel(QWidget):
         self.level_label.setText(f"showing: {describe(level)}")
         self.asked_label.setText("")
         # units on a second line: the table fits a 400 px panel without scrolling sideways
-        headers = [h.rsplit(" ", 1)[0] + "\n" + h.rsplit(" ", 1)[1] if " " in h else h
-                   for _, h in columns]
+        # a word a line in the headers, the level wrapped in its cell: the table fits a
+        # 400 px panel (1366 x 768) without scrolling sideways
+        headers = [h.replace(" ", "\n") for _, h in columns]
         if headers != self.columns:
             self.columns = headers
             self.table.setColumnCount(len(headers))
             self.table.setHorizontalHeaderLabels(headers)
+            head = self.table.horizontalHeader()
+            head.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+            head.setSectionResizeMode(0, QHeaderView.ResizeMode.Stretch)
         values = [row[k] for k, _ in columns]
         self.rows[values[0]] = values
         self.table.setRowCount(len(self.rows))
@@ -204,5 +211,6 @@ class CanopyPanel(QWidget):
                 item.setTextAlignment((align.AlignLeft if c == 0 else align.AlignRight)
                                       | align.AlignVCenter)
                 self.table.setItem(r, c, item)
+        self.table.resizeRowsToContents()
         shown = list(self.rows).index(values[0])
         self.table.selectRow(shown)

@@ -68,6 +68,12 @@ def _named(widget: W, name: str, tip: str) -> W:
     return widget
 
 
+def _tool(text: str) -> QToolButton:
+    button = QToolButton()
+    button.setText(text)
+    return button
+
+
 class LayoutPanel(QWidget):
     """Edit the layout of ``study`` (a :class:`~maizeviz_app.model.StudyModel`: its draft,
     shown for the points it opens; what is applied is built); without a study, a draft of
@@ -256,12 +262,12 @@ class LayoutPanel(QWidget):
                                     "out of the layout (Delete)")
         self.remove_button.clicked.connect(lambda: self._edit(self.model.remove, self.picked))
         self.remove_button.setShortcut(QKeySequence(QKeySequence.StandardKey.Delete))
-        self.left_button = _named(QPushButton(f"⟲ {ROTATE_STEP_DEG:g}°"), "rotate left",
+        self.left_button = _named(_tool("⟲"), "rotate left",
                                   f"turn the picked plant {ROTATE_STEP_DEG:g}° about its "
                                   "stalk, counter-clockwise seen from above")
         self.left_button.clicked.connect(
             lambda: self._edit(self.model.rotate, self.picked, ROTATE_STEP_DEG))
-        self.right_button = _named(QPushButton(f"⟳ {ROTATE_STEP_DEG:g}°"), "rotate right",
+        self.right_button = _named(_tool("⟳"), "rotate right",
                                    f"turn the picked plant {ROTATE_STEP_DEG:g}° about its "
                                    "stalk, clockwise seen from above")
         self.right_button.clicked.connect(
@@ -271,7 +277,7 @@ class LayoutPanel(QWidget):
             bar.addWidget(b)
         rows.addLayout(bar)
         bar2 = QHBoxLayout()
-        self.snap = _named(QCheckBox("snap to a grid of"), "snap to a grid",
+        self.snap = _named(QCheckBox("snap to a grid of"), "snap to a grid of",
                            "plants dragged, added or duplicated land on a grid")
         self.snap_step = _named(QDoubleSpinBox(decimals=1, minimum=0.5, maximum=100.0,
                                                value=5.0, suffix=" cm"),

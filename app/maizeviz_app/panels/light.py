@@ -304,7 +304,7 @@ class LightPanel(QWidget):
         self.place = QLineEdit()
         self.place.setToolTip("date, local time, latitude, longitude, time zone: the sun's "
                               "angles are computed with pvlib")
-        bind(self.place, s, "place", "date time lat lon tz")
+        bind(self.place, s, "place", "date, time, latitude, longitude, time zone")
         self.place_button = QPushButton("Sun from place")
         self.place_button.setToolTip("compute the sun's zenith and azimuth from the date, "
                                      "time and place typed (Ctrl+Shift+L)")
@@ -312,7 +312,9 @@ class LightPanel(QWidget):
         place_row = QHBoxLayout()
         place_row.addWidget(self.place, 1)
         place_row.addWidget(self.place_button)
-        form.addRow("date time lat lon tz", place_row)
+        # the place on a row of its own: the whole of it shows in a narrow dock
+        form.addRow(QLabel("date, time, latitude, longitude, time zone"))
+        form.addRow(place_row)
         form.addRow(self._optics_group())
         return page
 
@@ -454,15 +456,14 @@ class LightPanel(QWidget):
         self.weather.setPlaceholderText("CSV: time, ghi (W/m²) [, dni, dhi]")
         self.weather.setToolTip(self.source_weather.toolTip())
         bind(self.weather, d, "weather", "weather file path")
-        self.weather_button = QPushButton("Choose…")
+        self.weather_button = QPushButton("Weather file…")
         self.weather_button.setToolTip("choose the weather file")
-        self.weather_button.setAccessibleName("choose the weather file")
         self.weather_button.clicked.connect(self.choose_weather)
         weather_row = QHBoxLayout()
         weather_row.addWidget(self.source_weather)
-        weather_row.addWidget(self.weather, 1)
         weather_row.addWidget(self.weather_button)
         form.addRow(weather_row)
+        form.addRow(self.weather)
         self.source_group = bind_choice({"clear": self.source_clear,
                                          "weather": self.source_weather}, d, "source")
         self.step = QDoubleSpinBox(decimals=1, suffix=" min")
@@ -556,6 +557,7 @@ class LightPanel(QWidget):
         self.sky_box.setTitle("diffuse sky" if mode == "sky" else
                               "diffuse part of the day: the sky it comes from")
         self.compute_button.setText(COMPUTE_TEXT[mode])
+        self.compute_button.setAccessibleName(COMPUTE_TEXT[mode])
         self.pages.adjustSize()
         self._sync_sky_kind()
 
@@ -792,12 +794,14 @@ class LightPlots(QWidget):
         self.source.setToolTip("which light's map: the direct sun, the diffuse sky or the "
                                "day's PAR")
         self.source.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToContents)
+        self.source.setAccessibleName("heatmap of")
         top.addWidget(self.source)
         top.addWidget(QLabel("at"))
         self.height_box = QComboBox()
         self.source.currentIndexChanged.connect(lambda _i: self._show_height(
             self.height_box.currentIndex()))
         self.height_box.setToolTip("height of the sample plane shown (PgUp / PgDown)")
+        self.height_box.setAccessibleName("heatmap height")
         self.height_box.currentIndexChanged.connect(self._show_height)
         top.addWidget(self.height_box)
         top.addStretch(1)
