@@ -1,7 +1,7 @@
 """One light engine over a canopy: its Embree scenes built once, every sun, sky and day traced
 on them.
 
-A scene (:func:`~maizeviz.light.transmission.light_scene`) costs about as much as tracing one
+A scene (:func:`~maizeviz.light.trace.direct.light_scene`) costs about as much as tracing one
 sun, and is the same for every direction traced through the canopy; an engine builds it when a
 request first needs it (one for an open field, one with the overhanging leaves copied for a
 periodic field) and keeps it. The command line, the sweep's workers and the app's core process
@@ -27,22 +27,23 @@ from dataclasses import fields, replace
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
-from maizeviz.light.irradiance import DEFAULT_LINKE_TURBIDITY, DEFAULT_PAR_UMOL_PER_J, Period
-from maizeviz.light.optics import SHORTWAVE_SHARE, Optics, optics_for
-from maizeviz.light.perez import PEREZ_MODELS, perez_split
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.scatter import (
-    DEFAULT_DEPTH,
-    DEFAULT_THRESHOLD,
-    AbsorbedLight,
-    AbsorbedPeriod,
-    Balance,
-    scatter_beam,
+from maizeviz.light.results.absorbed import AbsorbedLight, AbsorbedPeriod, Balance
+from maizeviz.light.results.diffuse import PeriodLight, SkyLight
+from maizeviz.light.results.direct import LightResult
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.scene.scenes import light_scene
+from maizeviz.light.sources.irradiance import (
+    DEFAULT_LINKE_TURBIDITY,
+    DEFAULT_PAR_UMOL_PER_J,
+    Period,
 )
-from maizeviz.light.sky import Sky, make_sky
-from maizeviz.light.sun import Sun, sun_at
-from maizeviz.light.transmission import LightResult, light_scene, trace_light
+from maizeviz.light.sources.perez import PEREZ_MODELS, perez_split
+from maizeviz.light.sources.sky import Sky, make_sky
+from maizeviz.light.sources.sun import Sun, sun_at
+from maizeviz.light.trace.diffuse import trace_period, trace_sky
+from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.optics import SHORTWAVE_SHARE, Optics, optics_for
+from maizeviz.light.trace.scatter import DEFAULT_DEPTH, DEFAULT_THRESHOLD, scatter_beam
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, report
 
@@ -62,7 +63,7 @@ class LightEngine:
         Stalks intercept light too (their triangles follow the leaves' in per-triangle
         results).
     **fields
-        Any field of :class:`~maizeviz.light.request.Sampling`: ``heights_cm``, ``density``,
+        Any field of :class:`~maizeviz.light.scene.request.Sampling`: ``heights_cm``, ``density``,
         ``rect``, ``periodic``, ``threads``.
 
     Attributes
@@ -133,7 +134,7 @@ class LightEngine:
         sun : Sun, optional
             The sun's angles; else ``zenith`` and ``azimuth`` (deg), or a place and time.
         date, time : str
-            "YYYY-MM-DD" and local clock time "HH:MM" (:mod:`maizeviz.light.clock`).
+            "YYYY-MM-DD" and local clock time "HH:MM" (:mod:`maizeviz.light.sources.clock`).
         lat, lon : float
             deg north and east. ``tz``: IANA time zone. ``solar_noon``: the day's true solar
             noon instead of ``time``. ``altitude``: m above sea level.
@@ -180,7 +181,7 @@ class LightEngine:
         Parameters
         ----------
         sky : Sky or str
-            A :class:`~maizeviz.light.sky.Sky`, or its kind: "soc" (standard overcast) or
+            A :class:`~maizeviz.light.sources.sky.Sky`, or its kind: "soc" (standard overcast) or
             "uoc" (uniform overcast), split into ``directions`` directions (``split``: "auto",
             "turtle", "tregenza", "equal").
         sampling, progress, **fields_ : as :meth:`sun` (``progress`` after each direction).
@@ -218,8 +219,8 @@ class LightEngine:
         Parameters
         ----------
         period : Period, optional
-            From :func:`~maizeviz.light.irradiance.clear_sky_period` or
-            :func:`~maizeviz.light.irradiance.weather_period`; else a clear day from ``date``
+            From :func:`~maizeviz.light.sources.irradiance.clear_sky_period` or
+            :func:`~maizeviz.light.sources.irradiance.weather_period`; else a clear day from ``date``
             ("YYYY-MM-DD"), ``lat``, ``lon`` (deg), ``tz`` (IANA), ``step_min`` (min),
             ``start``/``end`` (local "HH:MM"), ``altitude`` (m), ``linke`` (Linke turbidity)
             and ``par_factor`` (umol of PAR per J of shortwave).
@@ -227,7 +228,7 @@ class LightEngine:
             The sky of the diffuse part (default: standard overcast, 46 directions); the sky
             light this engine last traced is reused when its sky, sampling and bins match.
             "perez" (or "perez-driesse") splits each step's diffuse light by Perez's
-            anisotropic model (:mod:`maizeviz.light.perez`): its circumsolar part traced with
+            anisotropic model (:mod:`maizeviz.light.sources.perez`): its circumsolar part traced with
             the sun, its isotropic part over a uniform sky of ``directions`` directions.
         directions : int
             Directions of a sky given by its kind (default 46, den Dulk's turtle).
@@ -245,7 +246,7 @@ class LightEngine:
         Ineichen, P. & Perez, R. (2002). A new airmass independent formulation for the Linke
         turbidity coefficient. Solar Energy 73(3), 151-157 (the clear sky).
         """
-        from maizeviz.light.irradiance import clear_sky_period
+        from maizeviz.light.sources.irradiance import clear_sky_period
 
         if period is None:
             if date is None or lat is None or lon is None:
@@ -286,14 +287,14 @@ class LightEngine:
                  time: str | None = None, lat: float | None = None, lon: float | None = None,
                  tz: str | None = None, **fields_) -> AbsorbedLight:
         """Light absorbed by leaves and ground in one band, with scattering
-        (:mod:`maizeviz.light.scatter`): the sun's direct beam and, when ``diffuse_w_m2`` > 0,
+        (:mod:`maizeviz.light.trace.scatter`): the sun's direct beam and, when ``diffuse_w_m2`` > 0,
         the diffuse light of a sky.
 
         Parameters
         ----------
         sun, zenith, azimuth, date, time, lat, lon, tz : the sun, as :meth:`sun`
         band : "par" or "nir"; optics : the band's Optics (default
-            :data:`maizeviz.light.optics.DEFAULT_OPTICS`)
+            :data:`maizeviz.light.trace.optics.DEFAULT_OPTICS`)
         direct_w_m2 : the band's direct irradiance on a horizontal plane above the canopy,
             W/m2 (default: the band's share of 1000 W/m2 of shortwave, 480 in PAR)
         diffuse_w_m2 : the band's diffuse irradiance on a horizontal plane, W/m2, spread over
@@ -314,8 +315,8 @@ class LightEngine:
         import numpy as np
 
         from maizeviz.errors import check_range
-        from maizeviz.light.request import check_sampling
-        from maizeviz.light.transmission import sampler
+        from maizeviz.light.scene.request import check_sampling
+        from maizeviz.light.trace.direct import sampler
 
         opt = optics if optics is not None else optics_for(band)
         if sun is None:
@@ -406,7 +407,7 @@ class LightEngine:
         band, optics, depth, threshold, seed, sampling, **fields_ : as :meth:`absorbed`
         sky, directions : the diffuse light's sky (default: standard overcast, 46); "perez"
             (or "perez-driesse") splits each step's diffuse light by Perez's model
-            (:mod:`maizeviz.light.perez`): its circumsolar part added to that step's direct
+            (:mod:`maizeviz.light.sources.perez`): its circumsolar part added to that step's direct
             beam, the rest from a uniform sky
         progress : after the sky and after each step
 
@@ -416,7 +417,7 @@ class LightEngine:
             ``balance`` in MJ/m2 of ground, J per triangle, ``absorbed_leaves_mol_m2`` (PAR),
             ``table("plant", canopy)``.
         """
-        from maizeviz.light.irradiance import clear_sky_period
+        from maizeviz.light.sources.irradiance import clear_sky_period
 
         if period is None:
             if date is None or lat is None or lon is None:

@@ -7,7 +7,7 @@ import pytest
 
 import maizeviz as mv
 from maizeviz.cli import main as cli_main
-from maizeviz.light.optics import Optics
+from maizeviz.light.trace.optics import Optics
 
 DAY = dict(date="2005-08-01", lat=39.9, lon=116.4, tz="Asia/Shanghai", step_min=60)
 

@@ -34,7 +34,7 @@ import math
 from dataclasses import dataclass
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.irradiance import PAR_FRACTION
+from maizeviz.light.sources.irradiance import PAR_FRACTION
 
 #: Wavebands traced: photosynthetically active radiation and near infrared.
 BANDS = ("par", "nir")
