@@ -77,14 +77,12 @@ def compute_light(study: StudyModel) -> bool:
         out = runner.light_process.call(op, key, canopy, args, job)
         job.check()
         if mode == "sun":
-            from maizeviz.light.leaf_light import triangle_light
-
             absorbed = None
             if optics is not None:              # leaves with optics: absorbed light too
                 absorbed = runner.light_process.call("absorbed", key, canopy,
                                                      (args[0], optics), job)
                 job.check()
-            run = Run(label, signature, out, triangle_light(canopy, out), extra=absorbed)
+            run = Run(label, signature, out, out.triangle_light(canopy), extra=absorbed)
         else:
             run = Run(label, signature, out.light, None, mode, out)
         maps = plots.heatmap_images(run.result, first=first, check=job.check, kind=mode)
@@ -178,7 +176,7 @@ def sun_from_place(study: StudyModel) -> None:
     text = study.settings.sun.place
 
     def work(job, t):
-        from maizeviz.light.sun import sun_at
+        from maizeviz.light.sources.sun import sun_at
 
         parts = t.split()
         if len(parts) != 5:
@@ -303,7 +301,6 @@ def complete_runs(study: StudyModel) -> None:
         return
 
     def work(job):
-        from maizeviz.light.leaf_light import triangle_light
         from maizeviz_app import jobs
 
         done: list[Any] = []
@@ -312,7 +309,7 @@ def complete_runs(study: StudyModel) -> None:
             if run.kind == "sun":
                 absorbed = None if run.extra is None else \
                     jobs.absorbed_of(canopy, run.extra.light)
-                done.append((triangle_light(canopy, run.result), absorbed))
+                done.append((run.result.triangle_light(canopy), absorbed))
             else:
                 done.append(jobs.diffuse_of(canopy, run.result, run.kind))
         return done

@@ -59,11 +59,11 @@ PAPER = ("Xinyu Guo, Chunjiang Zhao, Boxiang Xiao, Shenglian Lu, Changfeng Li. <
 #: Modules the warm-up thread imports while the window is already on screen, in three stages:
 #: the core (then the points file opens), the 3D view (then the view is made), the rest.
 WARM_STAGES = (
-    ("core", ("maizeviz_app.jobs", "maizeviz.light.leaf_light")),
+    ("core", ("maizeviz_app.jobs", "maizeviz.light.results.per_leaf")),
     ("view", ("pyvista", "pyvistaqt", "maizeviz_app.viewport", "maizeviz_app.panels.layout",
               "maizeviz_app.panels.digitizer")),
     ("rest", ("matplotlib.figure", "matplotlib.backends.backend_agg", "maizeviz_app.plots",
-              "maizeviz.light.heatmap", "maizeviz.canopy.export", "maizeviz_app.project")))
+              "maizeviz.light.report.heatmap", "maizeviz.canopy.export", "maizeviz_app.project")))
 #: The jobs the status bar names while they run (and Cancel stops).
 SHOWN_JOBS = ("load", "build", "light", "open", "save", "export")
 

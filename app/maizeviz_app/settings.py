@@ -29,13 +29,13 @@ from maizeviz.errors import MaizevizError
 
 DEFAULT_PLACE = "2005-08-01 12:00 39.9 116.4 Asia/Shanghai"
 DEFAULT_HEIGHTS = "0, 50, 100, 150, 200, 225"
-#: µmol of PAR photons per joule of shortwave (maizeviz.light.irradiance's default, 0.48 x 4.57,
-#: kept here as a number: the window makes its settings before the core is imported; a test
-#: holds it equal to the core's).
+#: µmol of PAR photons per joule of shortwave (maizeviz.light.sources.irradiance's default,
+#: 0.48 x 4.57, kept here as a number: the window makes its settings before the core is
+#: imported; a test holds it equal to the core's).
 DEFAULT_PAR_FACTOR = 0.48 * 4.57
-#: Most scatterings followed per ray (maizeviz.light.scatter.DEFAULT_DEPTH, likewise).
+#: Most scatterings followed per ray (maizeviz.light.trace.scatter.DEFAULT_DEPTH, likewise).
 DEFAULT_DEPTH = 20
-#: Band defaults of the leaf and soil optics (maizeviz.light.optics.DEFAULT_OPTICS) and the
+#: Band defaults of the leaf and soil optics (maizeviz.light.trace.optics.DEFAULT_OPTICS) and the
 #: band's direct irradiance (its share of 1000 W/m2 of shortwave), filled in lazily.
 _BAND_DEFAULTS: dict[str, tuple[float, float, float, float]] = {}
 #: The lights the app computes.
@@ -74,7 +74,7 @@ def parse_heights(text: str) -> tuple[float, ...]:
 def band_defaults(band: str) -> tuple[float, float, float, float]:
     """Leaf reflectance, leaf transmittance, soil reflectance and direct W/m2 of a band."""
     if band not in _BAND_DEFAULTS:
-        from maizeviz.light.optics import DEFAULT_OPTICS, SHORTWAVE_SHARE
+        from maizeviz.light.trace.optics import DEFAULT_OPTICS, SHORTWAVE_SHARE
 
         d = DEFAULT_OPTICS[band]
         _BAND_DEFAULTS[band] = (d.reflectance, d.transmittance, d.ground_reflectance,
@@ -347,9 +347,9 @@ class StudySettings:
 
     # ------------------------------------------------------------------ requests
     def sampling_spec(self):
-        """Heights, density and field (:class:`maizeviz.light.request.Sampling`, 2 tracing
+        """Heights, density and field (:class:`maizeviz.light.scene.request.Sampling`, 2 tracing
         threads)."""
-        from maizeviz.light.request import Sampling
+        from maizeviz.light.scene.request import Sampling
 
         s = self.sampling
         return Sampling(parse_heights(s.heights), s.density, None, s.periodic, 2)
@@ -361,8 +361,8 @@ class StudySettings:
 
     def sun_request(self):
         """The sun's light request (hit classes on: the canopy is coloured)."""
-        from maizeviz.light.request import LightRequest
-        from maizeviz.light.sun import Sun
+        from maizeviz.light.scene.request import LightRequest
+        from maizeviz.light.sources.sun import Sun
 
         return LightRequest(Sun(self.sun.zenith_deg, self.sun.azimuth_deg),
                             self.sampling_spec(), classes=True)

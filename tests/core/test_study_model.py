@@ -155,8 +155,8 @@ def test_bad_heights_fail_the_light_naming_the_field(study, points):
 def test_the_settings_defaults_are_the_cores():
     from maizeviz_app.settings import StudySettings, band_defaults
 
-    from maizeviz.light.irradiance import DEFAULT_PAR_UMOL_PER_J
-    from maizeviz.light.scatter import DEFAULT_DEPTH
+    from maizeviz.light.sources.irradiance import DEFAULT_PAR_UMOL_PER_J
+    from maizeviz.light.trace.scatter import DEFAULT_DEPTH
 
     s = StudySettings()
     assert s.day.par_factor == DEFAULT_PAR_UMOL_PER_J and s.optics.depth == DEFAULT_DEPTH
