@@ -16,8 +16,8 @@ How it stays responsive:
   (:mod:`maizeviz_app.process`). The GUI thread only swaps in results: a new canopy's mesh is
   prepared by the worker (:mod:`maizeviz_app.view_mesh`), the figures are drawn by the worker.
 - The 3D view renders once per change and never when idle (:mod:`maizeviz_app.viewport`).
-- While the digitizer records, the view keeps the plant being digitized and a canopy built
-  meanwhile waits until the session stops.
+- The 3D view follows the study (:mod:`maizeviz_app.view_link`); while the digitizer
+  records, it keeps the plant being digitized and a canopy built meanwhile waits.
 
 Errors go to the status bar and the Messages panel as one line for people
 (:mod:`maizeviz_app.messages`), never as a modal box that would stop a technician in the field;
@@ -42,8 +42,8 @@ from maizeviz_app.accessible import name_controls
 from maizeviz_app.model import StudyModel
 from maizeviz_app.panels.canopy import CanopyPanel
 from maizeviz_app.panels.light import LightPanel, LightPlots
-from maizeviz_app.runs import value_legend
 from maizeviz_app.undo import UndoRecorder
+from maizeviz_app.view_link import ViewLink
 from maizeviz_app.workers import JobRunner, describe_internal
 
 if TYPE_CHECKING:
@@ -94,7 +94,7 @@ class MainWindow(QMainWindow):
         self.model = StudyModel(tile, self.runner)
         self.undo = UndoRecorder(self.model, self)
         self.viewport: Viewport | None = None
-        self._view_pending: tuple | None = None   # (canopy, mesh) built while digitizing
+        self.view_link = ViewLink(self)
         self._after_save = None           # what to do once the project is saved (close, open)
         self._progress_shown = 0.0
         self._view_ready = threading.Event()  # the build job waits for it before meshing
@@ -136,14 +136,12 @@ class MainWindow(QMainWindow):
         m.project_changed.connect(lambda _p: self.setWindowTitle(m.title))
         m.points_changed.connect(self._on_points)
         m.mesh_opened.connect(self._on_mesh)
-        m.canopy_changed.connect(self._on_built)
         m.built_shown.connect(lambda label: self.canopy_shown.emit(label))
         m.said.connect(self.say)
         m.failed.connect(self._on_failed)
         m.light_running.connect(self._on_light_running)
         m.light_added.connect(lambda _run: self.docks["results"].raise_())
         m.light_shown.connect(lambda: self.light_shown.emit())
-        m.view_light.connect(self._light_to_view)
         m.project_saved.connect(self._on_saved)
         m.exported.connect(lambda path: self.saved.emit(path))
         self.runner.progressed.connect(self._on_progress)
@@ -277,7 +275,7 @@ class MainWindow(QMainWindow):
         self.layout_panel.problem.connect(self.say)
         self.digitizer = DigitizerPanel(self.viewport)
         self.digitizer.alert.connect(lambda text: self.say(text, error=True, status_only=True))
-        self.digitizer.stopped.connect(self._digitizing_stopped)
+        self.digitizer.stopped.connect(self.view_link.digitizing_stopped)
         self.docks["layout"].setWidget(docks.scrolled(self.layout_panel))
         self.docks["digitizer"].setWidget(docks.scrolled(self.digitizer))
         name_controls(self)
@@ -396,91 +394,21 @@ class MainWindow(QMainWindow):
         self._settings.setValue("last_folder", str(Path(path).parent))
         self._remember(path)
 
-    # ------------------------------------------------------------------ canopy and view
-    def _on_built(self, built) -> None:
-        """A canopy built: the level label, Table 2 (their panel follows the study) and the
-        view change together; while the digitizer records, the view keeps the plant being
-        digitized and the canopy waits (``canopy_shown`` is emitted either way)."""
-        mesh = built.polydata
-        if self.viewport is None:
-            return
-        if self.digitizing:
-            self._view_pending = (built.canopy, mesh)
-            self.say(f"{built.label} is ready; it shows when the digitizing session stops",
-                     status_only=True)
-        else:
-            self._view_pending = None
-            self.viewport.show_canopy(built.canopy, mesh)
-        m = built.measures
-        if mesh is not None and "source" in mesh.field_data:
-            self.say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
-                     "responsive the view draws the plants around the sampled tile at 36 "
-                     "triangles a leaf (light, tables and exports use every triangle)")
-        if not self.digitizing:
-            self.say(f"{built.label}: {m.triangles:,} triangles, leaf area "
-                     f"{m.leaf_area_m2:.2f} m², LAI {m.lai:.2f}; built in {built.build_s:.2f} s, "
-                     f"measured in {built.measure_s:.2f} s", status_only=True)
-
+    # ------------------------------------------------------------------ view
     @property
     def digitizing(self) -> bool:
         """A digitizing session is recording (the view shows the plant being digitized)."""
-        return self.digitizer is not None and self.digitizer.recording
-
-    def _light_to_view(self, colour: bool = False) -> None:
-        """Colour the canopy in view by the light last computed on it (the sun's classes, or a
-        sky's or day's light per leaf), unless the view is busy with the digitizer;
-        ``colour``: switch the colouring to light."""
-        m = self.model
-        if self.viewport is None or m.built is None or self.digitizing or \
-                self._view_pending is not None:
-            return
-        run = m.runs.latest(m.shown_signature)
-        if run is not None and run.kind == "sun" and run.classes is not None and \
-                (run.extra is None or run.extra.leaf_value is None):
-            self.viewport.set_light(run.classes)
-        elif run is not None and run.extra is not None and \
-                getattr(run.extra, "leaf_value", None) is not None:
-            title, unit = value_legend(run)
-            self.viewport.set_light_values(run.extra.leaf_value, title, unit)
-        if colour and run is not None:
-            self.colour_by("light")
-        self._sync_colour_actions()
+        return self.view_link.digitizing
 
     def step_level(self, step: int) -> None:
         s = self.canopy_panel.slider
         s.setValue(max(s.minimum(), min(s.maximum(), s.value() + step)))
 
     def camera(self, name: str) -> None:
-        if self.viewport is not None:
-            self.viewport.camera_preset(name)
+        self.view_link.camera(name)
 
     def colour_by(self, what: str) -> None:
-        if self.viewport is None:
-            return
-        if not self.viewport.colour_by(what):
-            self.say("no light result for the canopy shown: compute direct light first "
-                     "(Ctrl+L)")
-        self._sync_colour_actions()
-
-    def _sync_colour_actions(self) -> None:
-        if self.viewport is None:
-            return
-        for name in ("plant", "leaf", "light"):
-            act = self.menu_actions.get(f"colour_{name}")
-            if act is not None:
-                act.setChecked(self.viewport.colouring == name)
-
-    def _digitizing_stopped(self, _why: str) -> None:
-        """The canopy comes back after a session: the one built meanwhile if any."""
-        if self.viewport is None or self.model.canopy is None:
-            return
-        pending, self._view_pending = self._view_pending, None
-        if pending is not None:
-            self.viewport.show_canopy(*pending)
-            self.viewport.camera_preset("perspective")
-        else:
-            self.viewport.restore_canopy()
-        self._light_to_view()
+        self.view_link.colour_by(what)
 
     # ------------------------------------------------------------------ jobs
     def _on_light_running(self, text: str) -> None:
