@@ -163,3 +163,20 @@ def test_the_settings_defaults_are_the_cores():
     o = s.optics
     assert (o.reflectance, o.transmittance, o.ground_reflectance, o.direct_w_m2) == \
         band_defaults("par")
+
+
+def test_the_scripting_example_of_docs_app_runs(tmp_path):
+    """docs/app.md's script, run as written in a folder holding a block.csv."""
+    import re
+    from pathlib import Path
+
+    doc = (Path(__file__).parents[2] / "docs" / "app.md").read_text()
+    code = re.search(r"```python\n(.*?)```", doc, re.S).group(1)
+    write_points(tmp_path / "block.csv", block_grids(1, 2, seed=3))
+    (tmp_path / "script.py").write_text(code)
+    proc = subprocess.run([sys.executable, "script.py"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=600)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert "8 triangles: transmission" in proc.stdout and "PAR incident" in proc.stdout
+    assert "saved the project study.maizeviz" in proc.stdout
+    assert (tmp_path / "study.maizeviz").stat().st_size > 0
