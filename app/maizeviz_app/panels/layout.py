@@ -299,6 +299,7 @@ class LayoutPanel(QWidget):
         self.setEnabled(True)
         self._applied = tuple(loaded.layout.placements)
         self._said = ()
+        self._show_state()
 
     def _on_mesh(self, _path: str) -> None:
         self.setEnabled(False)                  # a mesh file's canopy has no layout to edit
