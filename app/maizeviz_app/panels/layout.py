@@ -107,6 +107,16 @@ class LayoutPanel(QWidget):
         lay.addWidget(self._parameters())
         lay.addLayout(self._plant_bar())
 
+        self.overlaps = QListWidget()
+        _named(self.overlaps, "overlapping plants", "plants standing on each other's ground "
+               "(closer than 0.9 of a spacing across and along the rows); click one to pick it")
+        self.overlaps.setStyleSheet("color: #b3261e;")
+        self.overlaps.itemClicked.connect(
+            lambda item: self.select(int(item.data(Qt.ItemDataRole.UserRole))))
+        self.overlaps.hide()
+        # above the view: seen without scrolling the panel
+        lay.addWidget(self.overlaps)
+
         self.splitter = QSplitter(Qt.Orientation.Horizontal)
         self.view = FieldView()
         self.view.setAccessibleName("field seen from above")
@@ -133,15 +143,6 @@ class LayoutPanel(QWidget):
         self.splitter.setStretchFactor(0, 3)
         self.splitter.setStretchFactor(1, 2)
         lay.addWidget(self.splitter, 1)
-
-        self.overlaps = QListWidget()
-        _named(self.overlaps, "overlapping plants", "plants standing on each other's ground "
-               "(closer than 0.9 of a spacing across and along the rows); click one to pick it")
-        self.overlaps.setMaximumHeight(90)
-        self.overlaps.itemClicked.connect(
-            lambda item: self.select(int(item.data(Qt.ItemDataRole.UserRole))))
-        self.overlaps.hide()
-        lay.addWidget(self.overlaps)
 
         row = QHBoxLayout()
         self.state = QLabel("")
@@ -379,6 +380,10 @@ class LayoutPanel(QWidget):
             self.overlaps.addItem(item)
         if len(pairs) > OVERLAPS_LISTED:
             self.overlaps.addItem(f"… and {len(pairs) - OVERLAPS_LISTED} more pairs")
+        if pairs:                               # as tall as its lines, three at most
+            rows = min(self.overlaps.count(), 3)
+            self.overlaps.setFixedHeight(rows * self.overlaps.sizeHintForRow(0)
+                                         + 2 * self.overlaps.frameWidth() + 2)
         self.overlaps.setVisible(bool(pairs))
 
     def _fill_tilings(self) -> None:
