@@ -396,11 +396,6 @@ class MainWindow(QMainWindow):
         self._remember(path)
 
     # ------------------------------------------------------------------ view
-    @property
-    def digitizing(self) -> bool:
-        """A digitizing session is recording (the view shows the plant being digitized)."""
-        return self.view_link.digitizing
-
     def step_level(self, step: int) -> None:
         s = self.canopy_panel.slider
         s.setValue(max(s.minimum(), min(s.maximum(), s.value() + step)))

@@ -21,7 +21,8 @@ from maizeviz.canopy.layout import tiled_layout
 
 BASES = {1: (30.0, 15.0), 2: (30.0, 45.0)}
 #: Values each setting may take in the machine (all valid, some equal to the defaults).
-VALUES = {("canopy", "preserve_area"): [True, False],
+VALUES = {("canopy", "level"): ["36", "8", "K4"],
+          ("canopy", "preserve_area"): [True, False],
           ("light", "mode"): ["sun", "sky", "day"],
           ("sun", "zenith_deg"): [10.0, 22.34, 45.5],
           ("sampling", "heights"): ["0, 100", "0, 50, 100, 150, 200, 225"],
