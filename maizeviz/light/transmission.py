@@ -280,8 +280,7 @@ def _family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family | None:
 
     nx, ny = grid_shape(smp.rect, smp.density)
     shifts = _lattice_shifts(smp, s, planes)
-    used = np.array([0, *planes])
-    r = np.vstack([np.zeros((1, 2), np.int64), shifts[planes]])
+    r = np.vstack([np.zeros((1, 2), np.int64), shifts[planes]])   # the ground, then planes
     lo = (-r).min(axis=0)
     hi = (np.array([nx, ny]) - r).max(axis=0)
     bw, bh = (hi - lo).tolist()
@@ -290,8 +289,8 @@ def _family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family | None:
     if bw * bh > 8 * n and bw * bh > budget:
         return None                                 # too spread out to be worth a box
     mask = np.zeros((bw, bh), dtype=bool)
-    for k in used:
-        ox, oy = -shifts[k] - lo
+    for rk in r:             # by shift, not by height index: index 0 need not be the ground
+        ox, oy = -rk - lo
         mask[ox:ox + nx, oy:oy + ny] = True
     cells = np.flatnonzero(mask)
     if len(cells) > budget:
