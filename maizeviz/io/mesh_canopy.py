@@ -47,6 +47,7 @@ or :data:`MAX_BINARY_BYTES` (binary PLY).
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -69,8 +70,8 @@ MAX_HEADER_BYTES = 2**20
 PLANT_PROPERTIES = ("plant", "plant_id", "plantid")
 #: Face property names read as the leaf id, in order of preference (any case).
 LEAF_PROPERTIES = ("leaf", "leaf_id", "leafid", "organ", "organ_id", "label", "object_label")
-#: Largest leaf id (light tables number leaves within a plant below 10,000); 0 is not a leaf.
-MAX_LEAF_ID = 9999
+#: Largest leaf id, as in points files; 0 is not a leaf.
+MAX_LEAF_ID = MAX_ID
 #: Largest plant id (absolute value), as in points files.
 MAX_PLANT_ID = MAX_ID
 #: Most vertices of one polygon face.
@@ -606,9 +607,18 @@ def _typed(v: np.ndarray, code: str, el: _Element, name: str, line_no: np.ndarra
     if len(bad):
         k = int(bad[0])
         i = int(item[k]) if item is not None else k
+        kind = np.dtype(code).name
+        why = (f"beyond the range of its type {kind} ({info.min:,} to {info.max:,})"
+               if v[k] == np.round(v[k]) else f"not a whole number of type {kind}")
         raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i}: {name} is "
-                            f"{v[k]:g}, not a whole number of type {np.dtype(code).name}")
+                            f"{_number(v[k])}, {why}")
     return v.astype(np.int64)
+
+
+def _number(x: float) -> str:
+    """A value for a message: whole numbers written out (2147483648, not 2.14748e+09)."""
+    x = float(x)
+    return f"{int(x)}" if math.isfinite(x) and x == round(x) and abs(x) < 1e18 else f"{x:g}"
 
 
 def _ply_mesh(elements: list[_Element], values: list[_Values], src: str, kind: str,
@@ -681,15 +691,15 @@ def _ids(v: np.ndarray, name: str, what: str, low: int, high: int, at, src: str)
             bad = np.flatnonzero(~(v == np.round(v)))
         if len(bad):
             i = int(bad[0])
-            raise MeshFileError(f"{src}: {at(i)}: the {what} id ('{name}') is {v[i]:g}, not a "
-                                "whole number")
+            raise MeshFileError(f"{src}: {at(i)}: the {what} id ('{name}') is "
+                                f"{_number(v[i])}, not a whole number")
     with np.errstate(invalid="ignore"):
         bad = np.flatnonzero((v < low) | (v > high))
     if len(bad):
         i = int(bad[0])
         rule = "0 (not a leaf: a stalk) to" if what == "leaf" else f"{low:,} to"
-        raise MeshFileError(f"{src}: {at(i)}: the {what} id ('{name}') is {v[i]:g}; {what} "
-                            f"ids go from {rule} {high:,}")
+        raise MeshFileError(f"{src}: {at(i)}: the {what} id ('{name}') is {_number(v[i])}; "
+                            f"{what} ids go from {rule} {high:,}")
     return v.astype(np.int64)
 
 

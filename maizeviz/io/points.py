@@ -62,8 +62,10 @@ MAX_POINTS = 20_000_000
 #: Most lines read from one file (blank, skipped and control lines count): 50 million lines
 #: take a few minutes to read.
 MAX_LINES = 50_000_000
-#: Largest plant or leaf id (absolute value); larger ones are typing mistakes.
-MAX_ID = 1_000_000_000
+#: Largest plant or leaf id (absolute value): the largest 32-bit integer, the width the canopy
+#: keeps ids in (segmenters number organs with such ids; ids are never packed together, see
+#: :mod:`maizeviz.ids`).
+MAX_ID = 2**31 - 1
 #: Largest row or col index: a leaf has at most a few hundred cross-sections.
 MAX_INDEX = 10_000
 #: Problem lines and bad-leaf messages kept for the report; the rest are counted.

@@ -11,6 +11,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -122,3 +123,57 @@ def test_day_transmission_follows_its_height_whatever_the_order():
     np.testing.assert_array_equal(b.maps, a.maps[perm])
     np.testing.assert_array_equal(b.triangle_direct_mol, a.triangle_direct_mol)
     np.testing.assert_array_equal(b.triangle_diffuse_mol, a.triangle_diffuse_mol)
+
+
+# ------------------------------------------------------------------ mesh files: faces
+
+
+@pytest.fixture(scope="module")
+def block_mesh(tmp_path_factory):
+    """The bundled block's canopy at 36 triangles a leaf, exported as PLY and read back:
+    (vertices (V, 3) cm, faces (T, 3), plant (T,), leaf (T,))."""
+    from maizeviz.canopy.export import export_canopy
+    from maizeviz.canopy.layout import layout_for
+    from maizeviz.canopy.scene import build_canopy
+    from maizeviz.io.mesh_canopy import read_mesh
+    from maizeviz.leaf.fit import read_leaves
+    from maizeviz.mesh.levels import Level
+
+    found = read_leaves(BLOCK)
+    canopy = build_canopy(found.leaves, layout_for(found.leaves, (1, 1)), Level(triangles=36))
+    mesh = read_mesh(export_canopy(tmp_path_factory.mktemp("mesh") / "c.ply", canopy))
+    return mesh.vertices, mesh.faces, mesh.plant, mesh.leaf
+
+
+def _canopy_json(capsys, path, *extra):
+    capsys.readouterr()
+    assert main(["canopy", str(path), "--mesh-unit", "cm", "--json", *extra]) == 0
+    out, err = capsys.readouterr()
+    return json.loads(out), err
+
+
+def _measures(doc):
+    """The canopy measures of `maizeviz canopy --json` (one level), without timings."""
+    return {k: v for k, v in doc.items() if not k.endswith("_s")}
+
+
+@pytest.mark.parametrize("how", ["same order", "reversed corners", "new vertices"])
+def test_a_mesh_written_twice_measures_as_once(tmp_path, capsys, block_mesh, how):
+    """Issue 25 case 3: every face written twice gave twice the leaf area and LAI, no word.
+    A repeated triangle (the same three corners, by position, in any order) counts once, and
+    a note says how many were left out."""
+    from tests.core.test_mesh_canopy import write_ply
+
+    v, f, plant, leaf = block_mesh
+    once = write_ply(tmp_path / "once.ply", v, f, {"plant": plant, "leaf": leaf},
+                     fmt="binary_little_endian")
+    second = {"same order": f, "reversed corners": f[:, ::-1], "new vertices": f + len(v)}[how]
+    verts = np.vstack([v, v]) if how == "new vertices" else v
+    twice = write_ply(tmp_path / "twice.ply", verts, np.vstack([f, second]),
+                      {"plant": np.concatenate([plant, plant]),
+                       "leaf": np.concatenate([leaf, leaf])}, fmt="binary_little_endian")
+    a, _ = _canopy_json(capsys, once)
+    b, said = _canopy_json(capsys, twice)
+    assert _measures(b) == _measures(a)
+    assert f"{len(f):,} of the {2 * len(f):,} triangles repeat an earlier triangle" in said
+
