@@ -9,11 +9,13 @@ its cells (tiling) or the field rectangle (layout file).
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -117,6 +119,27 @@ class CanopyLayout:
     def centre_bounds(self) -> tuple[float, float, float, float]:
         c = self.centre_cells if len(self.centre_cells) else self.cells
         return float(c[:, 0].min()), float(c[:, 1].min()), float(c[:, 2].max()), float(c[:, 3].max())
+
+
+#: Columns of :func:`placements_array`.
+PLACEMENT_COLUMNS = ("plant", "x_cm", "y_cm", "azimuth_deg", "tile_i", "tile_j")
+
+
+def placements_array(layout: CanopyLayout) -> np.ndarray:
+    """(n, 6) float64: plant, x, y (cm), azimuth (degrees), tile i, tile j of each stand, in
+    the layout's order."""
+    rows = [(p.plant, p.x, p.y, p.azimuth_deg, p.tile[0], p.tile[1]) for p in layout.placements]
+    return np.array(rows, np.float64).reshape(-1, len(PLACEMENT_COLUMNS))
+
+
+def stands_identity(layout: CanopyLayout) -> dict[str, Any]:
+    """``{"n": stands, "sha256": hex}``: what identifies the stands of a canopy, in order (the
+    digitized plant of each, where it stands to 1e-6 cm, its rotation to 1e-6 degrees and its
+    tile). Every traced light result carries that of the canopy it was traced on, so that it
+    is never stored or shown on other stands."""
+    a = placements_array(layout)
+    key = np.round(a, 6) + 0.0             # + 0.0 turns -0.0 into 0.0
+    return {"n": int(len(a)), "sha256": hashlib.sha256(key.tobytes()).hexdigest()}
 
 
 def union_area(rects: np.ndarray) -> float:

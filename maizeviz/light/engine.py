@@ -26,6 +26,7 @@ from dataclasses import fields, replace
 
 import numpy as np
 
+from maizeviz.canopy.layout import stands_identity
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
 from maizeviz.light.irradiance import DEFAULT_LINKE_TURBIDITY, DEFAULT_PAR_UMOL_PER_J, Period
@@ -383,7 +384,7 @@ class LightEngine:
                                                                  "unresolved")))
         return AbsorbedLight(opt.band, opt, incident, balance, absorbed, sunlit, rect, smp.n,
                              len(beams), depth, threshold, seed, events, smp_req.periodic,
-                             self.canopy.level, seconds)
+                             self.canopy.level, seconds, stands_identity(self.canopy.layout))
 
     def absorbed_day(self, period: Period | None = None, *, band: str = "par",
                      optics: Optics | None = None, sky: Sky | str = "soc",
@@ -466,7 +467,7 @@ class LightEngine:
                                                        "unresolved")))
         return AbsorbedPeriod(opt.band, opt, period, balance, joules, leaves_w, incident_w,
                               unit.rect, unit.rays, depth, seed, unit.periodic,
-                              self.canopy.level, seconds)
+                              self.canopy.level, seconds, stands_identity(self.canopy.layout))
 
     def _normals(self):
         """Unit normals (F, 3) of the scene's leaf triangles, then its stalks' if traced

@@ -363,6 +363,8 @@ class AbsorbedLight:
     rect : (x0, y0, x1, y1) cm; rays : primary rays per direction; directions : beams traced
     depth, threshold, seed : as traced; events : scatterings followed; periodic : bool
     level : the canopy's mesh level; seconds : "trace" (primary beams), "scatter", "build"
+    stands : identity of the stands traced on (:func:`maizeviz.canopy.layout.stands_identity`),
+        None where not known
     """
 
     band: str
@@ -381,6 +383,7 @@ class AbsorbedLight:
     periodic: bool
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
+    stands: dict | None = None
 
     fraction_absorbed = property(_fraction_absorbed)
 
@@ -453,7 +456,7 @@ class AbsorbedPeriod:
     step_absorbed_leaves_w_m2 : (n,) float64 W/m2 of ground the leaves absorb at each step
     step_incident_w_m2 : (n,) float64 the band's irradiance on a horizontal plane at each step
     rect, rays, depth, seed, periodic, level : as traced; seconds : "trace", "scatter",
-        "build"
+        "build"; stands : identity of the stands traced on, None where not known
     """
 
     band: str
@@ -470,6 +473,7 @@ class AbsorbedPeriod:
     periodic: bool
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
+    stands: dict | None = None
 
     fraction_absorbed = property(_fraction_absorbed)
 

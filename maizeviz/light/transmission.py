@@ -36,6 +36,7 @@ from typing import TypeVar
 
 import numpy as np
 
+from maizeviz.canopy.layout import stands_identity
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.hits import SunRays, first_hits, hit_counts, lattice_first_hits, second_hits
 from maizeviz.light.rays import Rect, Tracer, ray_grid, sensor_offsets
@@ -482,4 +483,5 @@ def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | 
                        first_hits=counts[0], second_hits=counts[1], direction=s,
                        seconds=seconds, warnings=tuple(warnings), level=canopy.level,
                        density=req.density, sensor_lit=tr.sensor_lit,
-                       sensor_offset_cm=tr.sensor_offset_cm, periodic=req.periodic)
+                       sensor_offset_cm=tr.sensor_offset_cm, periodic=req.periodic,
+                       stands=stands_identity(canopy.layout))
