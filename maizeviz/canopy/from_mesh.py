@@ -36,6 +36,7 @@ from maizeviz.errors import MaizevizError
 from maizeviz.ids import groups
 from maizeviz.io.mesh_canopy import MeshData, read_mesh
 from maizeviz.mesh.tessellate import triangle_areas_normals
+from maizeviz.numbers import number
 
 #: cm per unit of a mesh file.
 UNITS = {"m": 100.0, "cm": 1.0, "mm": 0.1}
@@ -61,12 +62,12 @@ def check_field(field: tuple[float, float, float, float] | list[float] | str
     if isinstance(field, str):
         words = field.replace(",", " ").split()
         try:
-            vals = tuple(float(w) for w in words)
+            vals = tuple(number(w) for w in words)
         except ValueError:
             raise MaizevizError(f"the field needs 4 numbers x0, y0, x1, y1 (cm), got "
                                 f"'{field[:60]}'", quantity="field") from None
     else:
-        vals = tuple(float(v) for v in field)
+        vals = tuple(number(v) if isinstance(v, (str, bytes)) else float(v) for v in field)
     if len(vals) != 4:
         raise MaizevizError(f"the field needs 4 numbers x0, y0, x1, y1 (cm), got {len(vals)}",
                             quantity="field")

@@ -25,6 +25,7 @@ from maizeviz.io.inputs import read_input
 from maizeviz.io.points import MAX_ID as MAX_PLANT_ID  # plant ids as in points files
 from maizeviz.leaf.fit import Leaf
 from maizeviz.leaf.grid import stalk_base
+from maizeviz.numbers import whole
 
 LAYOUT_SCHEMA = 1
 #: Plants a layout may hold (a hectare at 60 x 30 cm is about 55,000).
@@ -198,7 +199,7 @@ def parse_shape(text: str, quantity: str = "tile") -> tuple[int, int]:
     what = quantity.replace("_", " ")
     parts = str(text).lower().replace(" ", "").split("x")
     try:
-        a, b = (int(p) for p in parts)
+        a, b = (whole(p) for p in parts)
     except ValueError:
         raise LayoutError(f"{what} must look like 3x3, got '{text}'", quantity=quantity) from None
     if a < 1 or b < 1:

@@ -40,6 +40,7 @@ import numpy as np
 from maizeviz.errors import PointsFileError
 from maizeviz.io.atomic import atomic_open
 from maizeviz.io.inputs import open_input
+from maizeviz.numbers import number, whole
 
 REQUIRED = ("plant", "leaf", "row", "col", "x", "y", "z")
 ID_COLUMNS = ("plant", "leaf", "row", "col")
@@ -119,12 +120,13 @@ class _BadValue(ValueError):
 
 
 def _parse_int(text: str) -> int:
-    """A whole number written as ``3``, ``3.0`` or `` 3 ``; ValueError otherwise."""
+    """A whole number written as ``3``, ``3.0`` or `` 3 ``; ValueError otherwise (``1_000``
+    too: :mod:`maizeviz.numbers`)."""
     try:
-        return int(text)
+        return whole(text)
     except ValueError:
         pass
-    value = float(text)
+    value = number(text)
     if not math.isfinite(value) or value != int(value):
         raise ValueError
     return int(value)
@@ -468,7 +470,7 @@ class LineParser:
         coords = []
         for axis, value in zip("xyz", (x, y, z)):
             try:
-                coords.append(float(value))
+                coords.append(number(value))
             except ValueError:
                 return ("bad", ((plant, leaf), f"row {row}, col {col} (line {lineno}): {axis} is "
                         f"not a number ('{shown(value)}')"), lineno)
