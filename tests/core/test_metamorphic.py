@@ -177,3 +177,34 @@ def test_a_mesh_written_twice_measures_as_once(tmp_path, capsys, block_mesh, how
     assert _measures(b) == _measures(a)
     assert f"{len(f):,} of the {2 * len(f):,} triangles repeat an earlier triangle" in said
 
+
+
+# ------------------------------------------------------------------ sweep files
+
+
+def test_a_sweep_file_with_a_byte_order_mark_lists_the_same_scenarios(tmp_path):
+    """A sweep TOML saved by a Windows editor begins with a byte order mark; it was refused
+    as invalid TOML at line 1. It reads as the same file without it."""
+    from maizeviz.sweep.spec import load_spec
+
+    text = (Path(BLOCK).with_name("sweep-example.toml").read_text()
+            .replace('"block3x3.csv"', json.dumps(BLOCK)))
+    plain, marked = tmp_path / "plain.toml", tmp_path / "marked.toml"
+    plain.write_text(text)
+    marked.write_bytes(b"\xef\xbb\xbf" + text.encode())
+    a, b = load_spec(plain, yes=True), load_spec(marked, yes=True)
+    assert len(a.scenarios) > 1
+    assert [s.key for s in b.scenarios] == [s.key for s in a.scenarios]
+
+
+def test_a_sweep_height_given_twice_is_refused_naming_it(tmp_path):
+    from maizeviz.errors import MaizevizError
+    from maizeviz.sweep.spec import load_spec
+
+    text = (Path(BLOCK).with_name("sweep-example.toml").read_text()
+            .replace('"block3x3.csv"', json.dumps(BLOCK)))
+    assert "heights = [0, 50, 100, 150" in text
+    path = tmp_path / "twice.toml"
+    path.write_text(text.replace("heights = [0, 50, 100, 150", "heights = [0, 50, 50.0, 100, 150"))
+    with pytest.raises(MaizevizError, match=r"light.heights\[2\]: height 50 cm is given twice"):
+        load_spec(path, yes=True)
