@@ -63,7 +63,7 @@ else:  # pragma: no cover - Python 3.10: the tomli backport (the sweep extra ins
 import maizeviz
 from maizeviz.errors import MaizevizError
 from maizeviz.io.inputs import read_input
-from maizeviz.light.request import MAX_HEIGHTS
+from maizeviz.light.scene.request import MAX_HEIGHTS
 from maizeviz.light.specs import OpticsSpec
 from maizeviz.sweep import compute
 from maizeviz.sweep.errors import SweepSpecError
@@ -223,7 +223,7 @@ def optics_label(optics: OpticsSpec | None) -> str:
     ranks)."""
     if optics is None:
         return "black"
-    from maizeviz.light.scatter import DEFAULT_DEPTH
+    from maizeviz.light.trace.scatter import DEFAULT_DEPTH
 
     o = optics.optics()
     text = (f"{o.band} rho {o.reflectance:g} tau {o.transmittance:g} soil "

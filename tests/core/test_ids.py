@@ -126,10 +126,9 @@ def test_mesh_leaf_ids_beyond_9999_read_export_and_come_back(tmp_path):
     id, through reading, the leaf table and an export read back."""
     from maizeviz.canopy.export import export_canopy
     from maizeviz.canopy.from_mesh import read_mesh_canopy
-    from maizeviz.light.leaf_light import leaf_light
-    from maizeviz.light.request import LightRequest, Sampling
-    from maizeviz.light.sun import Sun
-    from maizeviz.light.transmission import trace_light
+    from maizeviz.light.scene.request import LightRequest, Sampling
+    from maizeviz.light.sources.sun import Sun
+    from maizeviz.light.trace.direct import trace_light
     from tests.core.test_mesh_canopy import write_ply
 
     leaves = [1, 9_999, 10_000, 10_003, BIG]
@@ -145,8 +144,8 @@ def test_mesh_leaf_ids_beyond_9999_read_export_and_come_back(tmp_path):
     canopy, _, _ = read_mesh_canopy(path, unit="cm")
     assert sorted(set(canopy.face_leaf.tolist())) == leaves
     r = trace_light(canopy, LightRequest(Sun(0, 0), Sampling((0,), 4.0)))
-    got = {(int(x["plant"]), int(x["leaf"])): float(x["sunlit_area_cm2"])
-           for x in leaf_light(canopy, r)}
+    got = {(int(x.plant), int(x.leaf)): float(x.sunlit_area_cm2)
+           for x in r.table("leaf", canopy).itertuples()}
     # each leaf is an 8 x 8 cm square seen from above, rising 5 cm across, alone under a
     # vertical sun: all of its 8 x sqrt(8^2 + 5^2) cm2 is sunlit
     assert got == pytest.approx({(BIG if k % 2 else 7, lid): 8 * 89**0.5

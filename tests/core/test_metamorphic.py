@@ -18,12 +18,12 @@ from hypothesis import strategies as st
 from maizeviz.canopy.layout import layout_from_dict
 from maizeviz.canopy.scene import Canopy
 from maizeviz.cli import main
-from maizeviz.light.daylight import trace_period, trace_sky
-from maizeviz.light.irradiance import clear_sky_period
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.sky import make_sky
-from maizeviz.light.sun import Sun
-from maizeviz.light.transmission import trace_light
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.sources.irradiance import clear_sky_period
+from maizeviz.light.sources.sky import make_sky
+from maizeviz.light.sources.sun import Sun
+from maizeviz.light.trace.diffuse import trace_period, trace_sky
+from maizeviz.light.trace.direct import trace_light
 
 BLOCK = str(Path(__file__).resolve().parents[2] / "maizeviz/resources/block3x3.csv")
 

@@ -22,9 +22,9 @@ from maizeviz.io.points import write_points
 from maizeviz.io.project import Project, ProjectError, load_project, save_project
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.leaf.synth import block_grids
-from maizeviz.light.daylight import trace_sky
-from maizeviz.light.request import Sampling
-from maizeviz.light.sky import make_sky
+from maizeviz.light.scene.request import Sampling
+from maizeviz.light.sources.sky import make_sky
+from maizeviz.light.trace.diffuse import trace_sky
 from maizeviz.mesh.levels import parse_level
 from maizeviz.project import study
 
@@ -421,9 +421,9 @@ def test_save_study_refuses_a_result_traced_on_other_stands(points, leaves, tmp_
     written."""
     from maizeviz.canopy.layout import stands_identity
     from maizeviz.errors import MaizevizError
-    from maizeviz.light.request import LightRequest
-    from maizeviz.light.sun import Sun
-    from maizeviz.light.transmission import trace_light
+    from maizeviz.light.scene.request import LightRequest
+    from maizeviz.light.sources.sun import Sun
+    from maizeviz.light.trace.direct import trace_light
 
     shown = layout_for(leaves, (2, 2))
     other = edited(leaves, (2, 2), 3, 0, 2)              # the same 16 plants, two turned
@@ -449,8 +449,8 @@ def test_a_day_refuses_a_sky_traced_on_other_stands(points, leaves):
     """A day reuses a sky traced with the same sampling; traced on other stands, its shares
     per triangle belong to other plants."""
     from maizeviz.errors import MaizevizError
-    from maizeviz.light.daylight import trace_period
-    from maizeviz.light.irradiance import clear_sky_period
+    from maizeviz.light.sources.irradiance import clear_sky_period
+    from maizeviz.light.trace.diffuse import trace_period
 
     sky = trace_sky(build_canopy(leaves, edited(leaves, (2, 2), 3, 0, 2), LEVEL),
                     make_sky("soc", 16), SAMPLING)

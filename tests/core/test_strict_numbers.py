@@ -121,7 +121,7 @@ def test_long_lists_are_refused_before_any_work(capsys, argv, says):
 def test_the_core_bounds_heights_too():
     """The app and sweeps reach the core without the command line's text: the sampling
     itself refuses more than MAX_HEIGHTS planes and repeated heights."""
-    from maizeviz.light.request import MAX_HEIGHTS, Sampling, check_sampling
+    from maizeviz.light.scene.request import MAX_HEIGHTS, Sampling, check_sampling
     from tests.core.test_metamorphic import _squares
 
     canopy = _squares(1)
@@ -180,8 +180,8 @@ def test_mesh_files_with_underscores(tmp_path, kind):
 
 
 def test_weather_and_optics_files_with_underscores(tmp_path):
-    from maizeviz.light.irradiance import read_weather
-    from maizeviz.light.optics import read_optics_table
+    from maizeviz.light.sources.irradiance import read_weather
+    from maizeviz.light.trace.optics import read_optics_table
 
     weather = tmp_path / "w.csv"
     rows = "\n".join(f"2005-08-01T{h:02d}:00+08:00,{v}" for h, v in
