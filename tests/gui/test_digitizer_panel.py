@@ -184,7 +184,7 @@ def test_unwritable_output_and_missing_port_are_said(qtbot, make_panel, tmp_path
         panel.connect_button.click()
     assert stopped.args == ["could not connect"]
     texts = [panel.log.item(i).text() for i in range(panel.log.count())]
-    assert any("cannot open /dev/does-not-exist" in t for t in texts)
+    assert any("no serial port /dev/does-not-exist: nothing is plugged in" in t for t in texts)
     assert panel.connect_button.isEnabled() and panel.session is None
 
 
