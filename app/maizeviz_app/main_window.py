@@ -179,7 +179,8 @@ class MainWindow(QMainWindow):
         from maizeviz_app.menus import build_menus
         from maizeviz_app.workspaces import Workspaces
 
-        self.workspaces = Workspaces(self, self._settings, STATE_VERSION)
+        self.workspaces = Workspaces(self, self._settings, STATE_VERSION,
+                                     sizes=self._apply_default_sizes)
         self.workspaces.changed.connect(self._workspace_changed)
         self._canopy_away = False         # the digitizer has the view (until Analyse)
         self.light_shown.connect(lambda: None if self.digitizing else
@@ -296,8 +297,7 @@ class MainWindow(QMainWindow):
         self._default_state = self.saveState(STATE_VERSION)
         if self._state_restored:
             self.restoreState(restored, STATE_VERSION)
-        else:
-            self.workspaces.apply_default()
+        self.workspaces.settle(self._state_restored)
 
     def _apply_default_sizes(self) -> None:
         w, h = self.width(), self.height()

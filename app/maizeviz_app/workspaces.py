@@ -39,6 +39,7 @@ class Workspaces(QObject):
     settings : where the current workspace and each one's arrangement are remembered
     version : the window's dock-state version (an arrangement saved with another is not
         applied: the docks have changed since)
+    sizes : sets the docks of Analyse to their first-start sizes (the window's)
 
     Signals
     -------
@@ -47,13 +48,17 @@ class Workspaces(QObject):
 
     changed = Signal(str)
 
-    def __init__(self, window, settings: QSettings, version: int = 0):
+    def __init__(self, window, settings: QSettings, version: int = 0, sizes=None):
         super().__init__(window)
         self.window = window
         self.settings = settings
         self.version = version
+        self._sizes = sizes
         name = str(settings.value("workspace", DEFAULT))
         self.current = name if name in WORKSPACES else DEFAULT
+        #: The workspace whose arrangement the window restored at start-up (None: none).
+        self._restored_as: str | None = self.current
+        self._settled = False
         self.actions: dict[str, QAction] = {}
 
     # ------------------------------------------------------------------ menu
@@ -76,19 +81,34 @@ class Workspaces(QObject):
 
     # ------------------------------------------------------------------ switching
     def show(self, name: str) -> None:
-        """Switch to workspace ``name``: its remembered arrangement, else its default."""
+        """Switch to workspace ``name``: its remembered arrangement, else its default. Before
+        the window is first laid out (:meth:`settle`) only the name changes."""
         if name not in WORKSPACES:
             raise ValueError(f"no workspace {name!r}: {', '.join(WORKSPACES)}")
         if name == self.current:
             return
-        self._remember(self.current)
+        if self._settled:
+            self._remember(self.current)
         self.current = name
-        state = self.settings.value(f"workspace_state/{name}")
-        if not (state and self.window.restoreState(state, self.version)):
-            self.apply_default()
+        if self._settled:
+            self._arrange()
         self._check()
         self.settings.setValue("workspace", name)
         self.changed.emit(name)
+
+    def settle(self, restored: bool) -> None:
+        """The window's first layout is done (``restored``: it restored the arrangement it was
+        closed with, which is the arrangement of the workspace it was closed in). From now on
+        switching re-arranges the docks; until now it could not (docks not yet shown do not
+        know whether they are open)."""
+        self._settled = True
+        if not restored or self._restored_as != self.current:
+            self._arrange()
+
+    def _arrange(self) -> None:
+        state = self.settings.value(f"workspace_state/{self.current}")
+        if not (state and self.window.restoreState(state, self.version)):
+            self.apply_default()
 
     def apply_default(self) -> None:
         """The current workspace's docks shown, the others hidden, at their first sizes."""
@@ -105,6 +125,8 @@ class Workspaces(QObject):
         if self.current == "digitize" and "digitizer" in docks:
             self.window.resizeDocks([docks["digitizer"]], [DIGITIZER_PX],
                                     Qt.Orientation.Horizontal)
+        elif self._sizes is not None:
+            self._sizes()
 
     def reset(self) -> None:
         """Forget the arrangements the user made; the current workspace at its default."""

@@ -626,7 +626,9 @@ class DigitizerPanel(QWidget):
 
         The GUI thread only lets go: the reader's join, the port's close, the demo's end and
         the journal's last presses happen in a worker, and ``stopped(why)`` is emitted once
-        they are done. With ``wait`` (the window is closing) it all happens here and now.
+        they are done. Presses the reader had queued are recorded, not dropped. No frame is
+        drawn for the stop: the plant stays as it was. With ``wait`` (the window is closing)
+        it all happens here and now.
         """
         self.timer.stop()
         connecting, self._connecting = self._connecting, None
@@ -678,8 +680,8 @@ class DigitizerPanel(QWidget):
             summary = recorder.session.summary()
             self._say(summary)
             self.counts.setText(summary)
-            if any(u.kind in ("recorded", "control") for u in late):
-                self.plant.update(recorder.session.history, recorder.session.pos)
+            # a press that arrived as the session stopped is recorded and listed, but not
+            # drawn: a frame costs 50-80 ms on software OpenGL, and Stop must not freeze
         self._lock(self.recording, self._connecting is not None)
         if self.recording or self._connecting is not None:
             return                                      # a new session began meanwhile
