@@ -25,6 +25,8 @@ from __future__ import annotations
 
 import threading
 import time
+from collections.abc import Callable
+from functools import partial
 from pathlib import Path
 
 from PySide6.QtCore import QEvent, QObject, QSettings, Qt, QThreadPool, QTimer, Signal
@@ -242,7 +244,8 @@ class DigitizerPanel(QWidget):
         self.ports.searched.connect(self._searched)
         form.addRow("serial port", self.ports)
         self.baud = QSpinBox(minimum=1200, maximum=115200, value=115200, singleStep=9600)
-        self.baud.setValue(int(self._settings.value("baud", 115200)))
+        baud = str(self._settings.value("baud", 115200))
+        self.baud.setValue(int(baud) if baud.isdigit() else 115200)
         self.baud.setAccessibleName("baud")
         self.baud.setToolTip("bits per second: must match the unit's rear DIP switches "
                              "(factory setting 115200)")
@@ -357,7 +360,8 @@ class DigitizerPanel(QWidget):
             return
         # parented to the window, which is visible even when this dock is a hidden tab
         owner = self.window()
-        keys = [(key, lambda c=key: self.control(c)) for key, _ in CONTROLS]
+        keys: list[tuple[str, Callable[[], None]]] = [
+            (key, partial(self.control, key)) for key, _ in CONTROLS]
         keys.append((PAUSE_KEY, self.toggle_pause))
         for key, slot in keys:
             sc = QShortcut(QKeySequence(key.upper()), owner)

@@ -62,7 +62,7 @@ class PortPicker(QWidget):
         self.find_button.setAccessibleName("Find FASTRAK")
         self.find_button.setToolTip("ask each listed port (and the one typed) for a FASTRAK status "
                                     "record, and choose the port that answers")
-        self.find_button.clicked.connect(self.find)
+        self.find_button.clicked.connect(self.search)
         lay.addWidget(self.box, 1)
         lay.addWidget(self.refresh_button)
         lay.addWidget(self.find_button)
@@ -119,7 +119,7 @@ class PortPicker(QWidget):
         self.listed.emit(self.ports)
 
     # ------------------------------------------------------------------ searching
-    def find(self) -> None:
+    def search(self) -> None:
         """Probe every candidate port in a worker; the first that answers as a FASTRAK is
         chosen. Each answer is :attr:`probed`; the end is :attr:`searched`."""
         if self.busy:
