@@ -9,6 +9,8 @@ panels name the few controls whose label is elsewhere (a row of two fields) them
 
 from __future__ import annotations
 
+import re
+
 from PySide6.QtWidgets import (
     QAbstractButton,
     QAbstractItemView,
@@ -25,8 +27,10 @@ from PySide6.QtWidgets import (
 
 
 def label_text(text: str) -> str:
-    """A label as a name: no mnemonic ampersand, no trailing colon."""
-    return text.replace("&&", "\0").replace("&", "").replace("\0", "&").strip().rstrip(":")
+    """A label as a name: no mnemonic ampersand, no trailing colon, no key written after it
+    (``Next leaf   [N]``: the key is the button's shortcut, not its name)."""
+    text = text.replace("&&", "\0").replace("&", "").replace("\0", "&").strip().rstrip(":")
+    return re.sub(r"\s+\[[^\[\]]{1,12}\]$", "", text)
 
 
 def controls(root: QWidget) -> list[QWidget]:

@@ -93,6 +93,23 @@ def bind(widget: QWidget, group: Any, name: str, label: str = "") -> None:
         widget.setKeyboardTracking(True)
 
 
+def bind_text(box: QComboBox, group: Any, name: str) -> None:
+    """An editable combo box's text (a choice or what is typed) bound to ``group.<name>``,
+    both ways (the digitizer's serial port: listed ports, or one typed)."""
+    box.currentTextChanged.connect(lambda v: _set(group, name, v.strip()))
+
+    def follow(value: Any, *_old: Any) -> None:
+        if box.currentText().strip() != value:
+            with QSignalBlocker(box):
+                k = box.findText(value)
+                if k >= 0:
+                    box.setCurrentIndex(k)
+                box.setEditText(value)
+
+    getattr(group.events, name).connect(follow)
+    box.destroyed.connect(lambda *_: _disconnect(group, name, follow))
+
+
 def bind_choice(buttons: Mapping[Any, QAbstractButton], group: Any, name: str) -> QButtonGroup:
     """Exclusive buttons (``value -> button``) bound to ``group.<name>``: the checked button
     is the value."""

@@ -158,15 +158,16 @@ def _size_docks(window, restored: bool) -> None:
     if window._closing or window._default_state is not None:
         return
     if not restored:
-        _default_sizes(window)
+        default_sizes(window)
     kept = window.saveState(STATE_VERSION)
-    _default_sizes(window)
+    default_sizes(window)
     window._default_state = window.saveState(STATE_VERSION)
     if restored:
         window.restoreState(kept, STATE_VERSION)
+    window.workspaces.settle(restored)
 
 
-def _default_sizes(window) -> None:
+def default_sizes(window) -> None:
     w, h = window.width(), window.height()
     window.resizeDocks([window.docks["canopy"]], [max(380, min(480, int(w * 0.33)))],
                        Qt.Orientation.Horizontal)
@@ -185,3 +186,4 @@ def reset(window) -> None:
         dock.show()
     window.docks["canopy"].raise_()
     window.docks["results"].raise_()
+    window.workspaces.reset()

@@ -39,6 +39,7 @@ from maizeviz.mesh.levels import COMPLEXITY_STOPS as LEVELS  # noqa: F401 - the 
 from maizeviz.resources import example_points
 from maizeviz_app import dialogs, docks
 from maizeviz_app.accessible import name_controls
+from maizeviz_app.bind import bind, bind_text
 from maizeviz_app.model import StudyModel
 from maizeviz_app.panels.canopy import CanopyPanel
 from maizeviz_app.panels.light import LightPanel, LightPlots
@@ -111,6 +112,13 @@ class MainWindow(QMainWindow):
         self.job_label, self.cancel_button = docks.status_widgets(self)
         self.cancel_button.clicked.connect(lambda: self.cancel_jobs())
         from maizeviz_app.menus import build_menus
+        from maizeviz_app.workspaces import Workspaces
+
+        self.workspaces = Workspaces(self, self._settings, docks.STATE_VERSION,
+                                     sizes=lambda: docks.default_sizes(self))
+        self.workspaces.changed.connect(self.view_link.workspace_changed)
+        self.light_shown.connect(lambda: None if self.view_link.digitizing else
+                                 self.workspaces.show("analyse"))
 
         self.menu_actions = build_menus(self)
         name_controls(self)
@@ -277,6 +285,13 @@ class MainWindow(QMainWindow):
         self.digitizer = DigitizerPanel(self.viewport)
         self.digitizer.alert.connect(lambda text: self.say(text, error=True, status_only=True))
         self.digitizer.stopped.connect(self.view_link.digitizing_stopped)
+        self.digitizer.started.connect(self.view_link.digitizing_started)
+        # the study's digitizer settings start as the panel remembered them, then follow it
+        d, settings = self.digitizer, self.model.settings.digitizer
+        with self.model.quietly():
+            self.model.settings.set("digitizer", {"port": d.port, "baud": d.baud.value()})
+        bind(d.baud, settings, "baud")
+        bind_text(d.ports.box, settings, "port")
         self.docks["layout"].setWidget(docks.scrolled(self.layout_panel))
         self.docks["digitizer"].setWidget(docks.scrolled(self.digitizer))
         name_controls(self)
@@ -491,6 +506,10 @@ class MainWindow(QMainWindow):
         """Stop the reader, cancel and wait for the jobs, kill the core processes, save the
         window's geometry and docks, close the 3D view explicitly. Unsaved work is asked
         about first (:meth:`keep_unsaved`)."""
+        if not self._closing and self.digitizer is not None and \
+                not self.digitizer.may_close(self):
+            event.ignore()
+            return
         if not self._closing and not self.keep_unsaved(self.close):
             event.ignore()
             return
@@ -498,12 +517,13 @@ class MainWindow(QMainWindow):
         self.model.closing = True
         try:
             if self.digitizer is not None:
-                self.digitizer.stop("window closed")
+                self.digitizer.stop("window closed", wait=True)
         except Exception as exc:  # noqa: BLE001 - closing must go on
             import sys
 
             print(f"maizeviz: the digitizer did not stop cleanly: {exc}", file=sys.stderr)
         self.runner.shutdown(10.0)
+        self.workspaces.save()
         docks.save_window(self, self._settings)
         if self.viewport is not None:
             self.viewport.close()

@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from psygnal import SignalGroup, evented
 
 from maizeviz.errors import MaizevizError
+from maizeviz.numbers import number
 
 DEFAULT_PLACE = "2005-08-01 12:00 39.9 116.4 Asia/Shanghai"
 DEFAULT_HEIGHTS = "0, 50, 100, 150, 200, 225"
@@ -58,7 +59,7 @@ def parse_heights(text: str) -> tuple[float, ...]:
         if not part:
             continue
         try:
-            h = float(part.removesuffix("cm").strip())
+            h = number(part.removesuffix("cm").strip())
         except ValueError:
             raise InputProblem(f"heights: '{part}' is not a number of centimetres; write them "
                                "separated by commas, e.g. 0, 50, 100", "heights") from None

@@ -1,7 +1,8 @@
 """The 3D view kept in step with the study: the canopy built is shown, coloured by the light
-last computed on it; the View menu's colourings and cameras act on it; while the digitizer
-records, the view keeps the plant being digitized and a canopy built meanwhile waits until
-the session stops.
+last computed on it; the View menu's colourings and cameras act on it. From the start of a
+digitizing session the view is the digitizer's (the plant being digitized): a canopy built
+meanwhile waits, and comes back in the Analyse workspace once the session has stopped
+(:mod:`maizeviz_app.workspaces`).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ class ViewLink:
     def __init__(self, window) -> None:
         self.window = window
         self.pending: tuple | None = None     # (canopy, mesh) built while digitizing
+        self.away = False                     # the digitizer has the view (until Analyse)
         m = window.model
         m.canopy_changed.connect(self.show_built)
         m.view_light.connect(self.light_to_view)
@@ -38,10 +40,10 @@ class ViewLink:
         mesh = built.polydata
         if self.view is None:
             return
-        if self.digitizing:
+        if self.digitizing or self.away:
             self.pending = (built.canopy, mesh)
-            say(f"{built.label} is ready; it shows when the digitizing session stops",
-                status_only=True)
+            say(f"{built.label} is ready; it shows in the Analyse workspace once the "
+                "digitizing session stops", status_only=True)
         else:
             self.pending = None
             self.view.show_canopy(built.canopy, mesh)
@@ -60,7 +62,8 @@ class ViewLink:
         sky's or day's light per leaf), unless the view is busy with the digitizer;
         ``colour``: switch the colouring to light."""
         m = self.window.model
-        if self.view is None or m.built is None or self.digitizing or self.pending is not None:
+        if self.view is None or m.built is None or self.digitizing or self.away or \
+                self.pending is not None:
             return
         run = m.runs.latest(m.shown_signature)
         if run is not None and run.kind == "sun" and run.classes is not None and \
@@ -94,8 +97,27 @@ class ViewLink:
             if act is not None:
                 act.setChecked(self.view.colouring == name)
 
+    def digitizing_started(self) -> None:
+        self.away = True
+        self.window.workspaces.show("digitize")
+
     def digitizing_stopped(self, _why: str = "") -> None:
-        """The canopy comes back after a session: the one built meanwhile if any."""
+        """In Digitize the plant just digitized stays in the view (no canopy frame on Stop);
+        in Analyse the canopy comes back at once."""
+        if self.window.workspaces.current == "analyse":
+            self.canopy_back()
+
+    def workspace_changed(self, name: str) -> None:
+        if name == "analyse" and not self.digitizing:
+            self.canopy_back()
+
+    def canopy_back(self) -> None:
+        """The canopy back in the view after a session: the one built meanwhile if any."""
+        if not self.away:
+            return
+        self.away = False
+        if self.window.digitizer is not None:
+            self.window.digitizer.release_view()
         if self.view is None or self.window.model.canopy is None:
             return
         pending, self.pending = self.pending, None

@@ -151,3 +151,15 @@ def test_discarding_lets_another_file_open(window, qtbot, small_points):
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
         w.open_points(small_points)
     assert w.model.serial == serial + 1 and not w.model.runs.runs and not w.isWindowModified()
+
+
+def test_the_digitizer_connection_is_a_setting_of_the_study(window, qtbot):
+    w = window(wait_ready=True)
+    d, settings = w.digitizer, w.model.settings.digitizer
+    assert settings.port == d.port and settings.baud == d.baud.value()
+    settings.port, settings.baud = "/dev/ttyS7", 9600          # set by a script: shown
+    assert d.port == "/dev/ttyS7" and d.baud.value() == 9600
+    d.ports.box.setEditText("/dev/ttyUSB3")                     # typed: the study's
+    d.baud.setValue(38400)
+    assert (settings.port, settings.baud) == ("/dev/ttyUSB3", 38400)
+    assert w.undo.stack.count() == 0                            # not an edit of the study

@@ -17,7 +17,7 @@ from PySide6.QtWidgets import (
 from test_light_modes import TIMEOUT, shown
 
 #: The docks of the panels, raised in turn.
-PANELS = ("canopy", "light", "layout")
+PANELS = ("canopy", "light", "layout", "digitizer")
 
 
 def find(root, name: str, kind=None):

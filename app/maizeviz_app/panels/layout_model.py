@@ -14,6 +14,8 @@ from PySide6.QtCore import QAbstractTableModel, QModelIndex, Qt
 from PySide6.QtGui import QColor
 
 from maizeviz.canopy.layout import LayoutError
+from maizeviz.numbers import number as read_number
+from maizeviz.numbers import whole
 from maizeviz_app.layout_draft import LayoutDraft
 
 COLUMNS = ("x cm", "y cm", "plant", "azimuth °")
@@ -86,7 +88,7 @@ class PlacementTable(QAbstractTableModel):
         text = str(value).strip()
         p = self.model.placements[row]
         try:
-            number = int(text) if col == 2 else float(text)
+            number = whole(text) if col == 2 else read_number(text)
         except ValueError:
             self._refuse(f"row {row + 1}, {name}: '{text}' is not a number")
             return False
