@@ -59,6 +59,24 @@ class Job:
             raise InterruptedError(f"{self.kind} cancelled")
 
 
+class JobTable:
+    """The latest job of each kind (``_current``), shared by the runners."""
+
+    _current: dict[str, Job]
+    _closed: bool
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    def running(self) -> list[Job]:
+        """The latest job of each kind that has not finished."""
+        return [j for j in self._current.values() if not j.cancelled]
+
+    def current(self, kind: str) -> Job | None:
+        return self._current.get(kind)
+
+
 class Runner(Protocol):
     """What the model needs of a runner (:class:`InlineRunner`, ``workers.JobRunner``)."""
 
@@ -80,7 +98,7 @@ class Runner(Protocol):
     def cancel(self, kind: str | None = None) -> None: ...
 
 
-class InlineRunner:
+class InlineRunner(JobTable):
     """Runs each job at once, in the calling thread, with the core processes of the window
     (Embree work in children). ``on_done`` or ``on_error`` is called before :meth:`run`
     returns; an InterruptedError (a cancelled job) calls neither.
@@ -99,16 +117,6 @@ class InlineRunner:
         self.light_process = CoreProcess("light")
         #: every job run, in order (kind, label): what a script or test can check
         self.log: list[tuple[str, str]] = []
-
-    @property
-    def closed(self) -> bool:
-        return self._closed
-
-    def running(self) -> list[Job]:
-        return [j for j in self._current.values() if not j.cancelled]
-
-    def current(self, kind: str) -> Job | None:
-        return self._current.get(kind)
 
     def run(self, kind: str, label: str, func: Callable[..., Any], *args: Any,
             on_done: Callable[[Any], None],

@@ -30,10 +30,10 @@ from typing import Any
 from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
 
 from maizeviz_app.process import CoreProcess
-from maizeviz_app.runner import Job, describe_internal  # noqa: F401 - the app's names
+from maizeviz_app.runner import Job, JobTable, describe_internal  # noqa: F401 - the app's names
 
 
-class JobRunner(QObject):
+class JobRunner(QObject, JobTable):
     """Runs jobs on the thread pool; see the module docstring.
 
     Signals (GUI thread): ``progressed(job id, kind, text, done, total)`` (text: what the job
@@ -62,17 +62,6 @@ class JobRunner(QObject):
         self.light_process = CoreProcess("light")
 
     # ------------------------------------------------------------------ running
-    @property
-    def closed(self) -> bool:
-        return self._closed
-
-    def running(self) -> list[Job]:
-        """The latest job of each kind that has not finished."""
-        return [j for j in self._current.values() if not j.cancelled]
-
-    def current(self, kind: str) -> Job | None:
-        return self._current.get(kind)
-
     def run(self, kind: str, label: str, func: Callable[..., Any], *args: Any,
             on_done: Callable[[Any], None],
             on_error: Callable[[BaseException], None] | None = None,
