@@ -195,3 +195,30 @@ def test_weather_and_optics_files_with_underscores(tmp_path):
     optics.write_text("rank,reflectance,transmittance\n1,0.1,0.05\n2,0_1,0.05\n")
     with pytest.raises(MaizevizError, match="line 3: rank, reflectance and transmittance"):
         read_optics_table(optics, "par")
+
+
+# ------------------------------------------------------------------ names too long
+LONG = "a" * 300
+
+
+@pytest.mark.parametrize("argv", [
+    ["leaf", B, "--triangles", "8", "--export", "DIR/LONG.ply"],
+    ["canopy", B, "--tile", "1x1", "--triangles", "8", "--export", "DIR/LONG.obj"],
+    ["canopy", B, "--tile", "1x1", "--triangles", "8", "--save-layout", "DIR/LONG.json"],
+    ["light", B, *SUN, "--tile", "1x1", "--triangles", "8", "--leaf-light", "DIR/LONG.csv"],
+    ["light", B, *SUN, "--tile", "1x1", "--triangles", "8", "--plant-light", "DIR/LONG.csv"],
+    ["light", B, *SUN, "--tile", "1x1", "--triangles", "8", "--heatmaps", "DIR/LONG"],
+    ["synth", "--plants", "1x1", "--out", "DIR/LONG.csv"],
+    ["leaf", "DIR/LONG.csv"],
+    ["canopy", B, "--layout", "DIR/LONG.json"],
+])
+def test_a_name_too_long_is_one_line_for_every_file(capsys, tmp_path, argv):
+    """``--export`` with a 300-character name was an internal error (OSError: File name too
+    long) where every other output refused it in one line."""
+    argv = [a.replace("DIR", str(tmp_path)).replace("LONG", LONG) for a in argv]
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if ln.startswith(("error", "internal"))]
+    assert len(lines) == 1 and lines[0].startswith("error:"), err[-400:]
+    assert "too long" in lines[0].lower()
+    assert list(tmp_path.iterdir()) == []
