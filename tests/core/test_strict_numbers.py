@@ -222,3 +222,19 @@ def test_a_name_too_long_is_one_line_for_every_file(capsys, tmp_path, argv):
     assert len(lines) == 1 and lines[0].startswith("error:"), err[-400:]
     assert "too long" in lines[0].lower()
     assert list(tmp_path.iterdir()) == []
+
+
+def test_weather_rows_with_dhi_above_ghi_are_said(tmp_path):
+    """Doubtful case decided: a row whose dhi exceeds its ghi was cut to no direct light and
+    its dni ignored without a word; the light is the same, now with a note naming it."""
+    from maizeviz.light.sources.irradiance import read_weather, weather_period
+
+    path = tmp_path / "w.csv"
+    path.write_text("time,ghi,dni,dhi\n2005-08-01T11:00+08:00,600,500,200\n"
+                    "2005-08-01T12:00+08:00,300,700,350\n2005-08-01T13:00+08:00,500,400,100\n")
+    period = weather_period(read_weather(path), 39.9, 116.4)
+    said = [n for n in period.notes if "dhi above ghi" in n]
+    assert len(said) == 1 and said[0].startswith("1 row of w.csv with the sun up has dhi above ghi")
+    assert "2005-08-01T12:00:00+08:00" in said[0] and "dni is not used" in said[0]
+    assert period.direct_horizontal[1] == 0 and period.dhi[1] == 300
+    assert period.direct_horizontal[0] == 400 and period.dhi[0] == 200
