@@ -500,6 +500,11 @@ def sun_from_record(rec: Record, where: str) -> tuple[str, Any]:
     for name in ("first_hits", "second_hits"):
         hits[name] = None if name not in rec.arrays else \
             _array(rec, name, where, what, (None,), counts=True, lo=0)
+    if (hits["first_hits"] is None) != (hits["second_hits"] is None) or (
+            hits["first_hits"] is not None
+            and len(hits["first_hits"]) != len(hits["second_hits"])):
+        raise ProjectError(f"{at}: its first and second hits per triangle do not match "
+                           "(one missing, or of other lengths); the project is damaged")
     planes: dict[str, Any] = {}
     if "sensor_lit" in rec.arrays:
         lit = rec.arrays["sensor_lit"]
