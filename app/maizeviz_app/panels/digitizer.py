@@ -635,6 +635,8 @@ class DigitizerPanel(QWidget):
         it all happens here and now.
         """
         self.timer.stop()
+        if wait:                                        # an earlier stop's port closed first
+            self._close_pool.waitForDone(10_000)
         connecting, self._connecting = self._connecting, None
         recorder, self.recorder = self.recorder, None
         sim, self.sim = self.sim, None
