@@ -692,6 +692,9 @@ class DigitizerPanel(QWidget):
         if self.recording or self._connecting is not None:
             return                                      # a new session began meanwhile
         self._set_paused(False)
+        if recorder is not None and recorder.session.history:
+            # Connect again continues this file where it stopped (the journal replays it)
+            self.resume.setChecked(True)
         where = f"not recording ({why})"
         if self.band.state in ("error", "warn") and why != "finished":
             self.band.set_state(self.band.state, where=where)   # keep the trouble in sight
