@@ -53,7 +53,7 @@ from PySide6.QtWidgets import (
 )
 
 from maizeviz.digitizer.port import FastrakPort
-from maizeviz.digitizer.recorder import LiveTip, Recorder, Update
+from maizeviz.digitizer.recorder import PAUSE_KEY, LiveTip, Recorder, Update
 from maizeviz.digitizer.session import Session
 from maizeviz.errors import MaizevizError
 from maizeviz.resources import example_points
@@ -63,8 +63,6 @@ from maizeviz_app.workers import JobRunner
 
 #: The technician's controls: key, button text.
 CONTROLS = (("n", "Next leaf"), ("p", "Next plant"), ("r", "End row"), ("u", "Undo"))
-#: The pause key (S: suspend), a toggle.
-PAUSE_KEY = "s"
 #: Seconds between the reader's polls for the stylus's live position.
 LIVE_EVERY_S = 0.1
 #: Band colours (background, text) per state.
