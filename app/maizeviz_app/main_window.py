@@ -219,15 +219,22 @@ class MainWindow(QMainWindow):
         self.digitizer: DigitizerPanel | None = None
         self.plots = LightPlots()
         self.plots.heatmap_needed.connect(self._draw_heatmap)
+        self.model.colour.heatmap.events.connect(lambda _info: self.plots.redraw())
+        self.model.colour.events.shared.connect(lambda _on: self.plots.redraw())
         self.messages = QPlainTextEdit(readOnly=True)
         self.messages.setMaximumBlockCount(1000)
+        from maizeviz_app.panels.colour import ColourPanel
+
+        self.colour_panel = ColourPanel(self.model.colour)
+        self.plots.heatmap.limits_shown.connect(self.colour_panel.heatmap_editor.show_limits)
 
         right = Qt.DockWidgetArea.RightDockWidgetArea
         canopy = self._dock("canopy", "Canopy", self.canopy_panel, right)
         light = self._dock("light", "Light", self.light_panel, right)
         layout = self._dock("layout", "Layout", QLabel("starting…"), right)
         digitizer = self._dock("digitizer", "Digitizer", QLabel("starting…"), right)
-        for d in (light, layout, digitizer):
+        colour = self._dock("colour", "Colour", self.colour_panel, right)
+        for d in (light, layout, digitizer, colour):
             self.tabifyDockWidget(canopy, d)
         canopy.raise_()
         bottom = Qt.DockWidgetArea.BottomDockWidgetArea
@@ -357,6 +364,8 @@ class MainWindow(QMainWindow):
             # Qt compose the whole window again (see _own_window), and re-laying it out then
             # gives the docks all the room but the view's minimum height
             self.viewport = Viewport(self._centre)
+            self.viewport.set_colour_scale(self.model.colour.view)
+            self.viewport.limits_shown.connect(self.colour_panel.view_editor.show_limits)
             # the central widget stays (a new one would make the docks take its room)
             self._centre.addWidget(self.viewport)
             self._centre.setCurrentWidget(self.viewport)
@@ -820,6 +829,7 @@ class MainWindow(QMainWindow):
         key = self._canopy_id
         runner = self.runner
         shown_height = max(self.plots.height_box.currentIndex(), 0)
+        look = plots.Look.of(self.model.colour, self._heatmaps_for)
 
         def work(job):
             out = runner.light_process.call(op, key, canopy, args, job)
@@ -836,7 +846,7 @@ class MainWindow(QMainWindow):
             else:
                 run = Run(label, signature, out.light, None, mode, out)
             maps = plots.heatmap_images(run.result, first=shown_height, check=job.check,
-                                        kind=mode)
+                                        kind=mode, look=look.sharing(mode, run.result))
             runs.add(run, settings, sampling_key)
             plot = plots.rgba(plots.transmission_figure(runs.curves(), plot_title(runs)))
             return run, settings, sampling_key, maps, plot
@@ -924,6 +934,8 @@ class MainWindow(QMainWindow):
         self._heatmaps_for[run.kind] = run
         self.plots.keep_only(set(self._heatmaps_for))
         self.plots.set_heatmaps(maps, run.kind)
+        if self.model.colour.shared:                  # the others' scale includes this run
+            self.plots.redraw(keep=run.kind)
         self.plots.set_transmission(plot)
         for w in r.warnings:
             self.say(f"{'note' if 'sun never rises' in w else 'warning'}: {w}")
@@ -947,13 +959,14 @@ class MainWindow(QMainWindow):
 
         result = run.result
         height = float(result.heights_cm[index])
+        look = plots.Look.of(self.model.colour, self._heatmaps_for)
 
         def done(rgba):
             if self._heatmaps_for.get(kind) is run:
                 self.plots.set_heatmap(index, rgba, kind)
 
         self.runner.run("heatmap", f"drawing the heatmap at {height:g} cm",
-                        lambda job: plots.heatmap_image(result, height, kind=kind),
+                        lambda job: plots.heatmap_image(result, height, kind=kind, look=look),
                         on_done=done, on_error=lambda e: self._fail(e, "light"))
 
     def sun_from_place(self) -> None:
@@ -1086,6 +1099,7 @@ class MainWindow(QMainWindow):
         canopy = {"tile": self.tile_n, "level": self.level,
                   "preserve_area": self.canopy_panel.preserve.isChecked()}
         light = self.light_panel.settings()
+        view = self.model.colour.to_doc()
         runs = []
         sun_settings = self.runs.settings.get("sun")
         optics = sun_settings[2] if isinstance(sun_settings, tuple) and \
@@ -1103,7 +1117,8 @@ class MainWindow(QMainWindow):
             from maizeviz.project.study import make_project
 
             # the runs were all traced on the layout shown (a layout edit clears them)
-            proj = make_project(origin, data, layout, loaded.layout, canopy, light, runs)
+            proj = make_project(origin, data, layout, loaded.layout, canopy, light, runs,
+                                view)
             save_project(path, proj)
             return path
 
@@ -1141,6 +1156,7 @@ class MainWindow(QMainWindow):
             opened = study.open_project(path, cache)
             tile, level, preserve = project.canopy_settings(opened)
             light = project.light_settings(opened)
+            project.view_settings(opened)
             found = jobs.load_points(opened.points_path, (tile, tile),
                                      shown_name=opened.shown_name)
             layout = study.restore_layout(opened, found.plants) or found.layout
@@ -1170,6 +1186,7 @@ class MainWindow(QMainWindow):
         self.canopy_panel.preserve.setChecked(preserve)
         self.canopy_panel.preserve.blockSignals(False)
         self.light_panel.apply_settings(light)
+        self.model.colour.update_from_doc(opened.view, opened.path)
         self._project_layout = opened.project.layout is not None
         self._on_loaded(loaded, opened.project.points_csv, opened.path,
                         opened.project.points_path)
@@ -1224,9 +1241,11 @@ class MainWindow(QMainWindow):
         title = plot_title(self.runs)
         self._heatmaps_for = dict(shown)
         results = [(k, shown[k].result) for k in order]
+        look = plots.Look.of(self.model.colour, shown)
 
         def work(job):
-            maps = [(k, plots.heatmap_images(r, check=job.check, kind=k)) for k, r in results]
+            maps = [(k, plots.heatmap_images(r, check=job.check, kind=k, look=look))
+                    for k, r in results]
             plot = plots.rgba(plots.transmission_figure(curves, title))
             return maps, plot
 

@@ -25,6 +25,7 @@ from typing import Any
 
 from psygnal import Signal
 
+from maizeviz_app.colour import ColourSettings
 from maizeviz_app.runs import LightRuns, Run
 
 
@@ -60,6 +61,8 @@ class StudyModel:
         the serial it was made for, and one made for an older serial is dropped.
     modified : bool
         There is work a project does not hold yet (see the module docstring).
+    colour : ColourSettings
+        How the 3D view and the heatmaps colour light (evented; saved in a project).
 
     Signals
     -------
@@ -94,6 +97,7 @@ class StudyModel:
         self.layout_edited = False
         self.serial = 0
         self.modified = False
+        self.colour = ColourSettings()
 
     # ------------------------------------------------------------------ reading
     @property

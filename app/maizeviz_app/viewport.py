@@ -13,8 +13,12 @@ The canopy is one actor over one merged mesh (leaves and stalks), with per-trian
 ``plant`` (digitized plant id), ``instance`` (placement, from 1), ``leaf`` (rank; 0 for
 stalks) and ``light`` (2 direct, 1 second class, 0 none, -1 not traced; -2 for stalks), and
 ``plant`` and ``leaf`` per vertex too: those colourings use them (cheaper to draw on software
-OpenGL than colours per triangle; see :func:`_point_values`), light uses the cell data.
-Colouring switches the mapper's array and lookup table; nothing is rebuilt. The mesh is made
+OpenGL than colours per triangle; see :func:`_point_values`), light uses the cell data: the
+sun's classes through a lookup table, light values (a sky's, a day's, a leaf's sunlit share)
+as one RGB per triangle (``light_rgb``) computed from the view's colour scale
+(:mod:`maizeviz_app.colour`: range, colour map, log), so that a clipped range clamps leaves to
+the ends of the map and stalks keep their colour. Colouring switches the mapper's array and
+lookup table; nothing is rebuilt. The mesh is made
 by :func:`canopy_polydata`, which worker threads call, so the GUI thread only swaps it in.
 
 Touch the widget from the GUI thread only.
@@ -29,6 +33,7 @@ from PySide6.QtGui import QColor, QFont, QImage, QLinearGradient, QPainter, QPen
 from PySide6.QtWidgets import QWidget
 from pyvistaqt import QtInteractor
 
+from maizeviz_app.colour import tick_text
 from maizeviz_app.options import CAMERAS, COLOURINGS, LIGHT_CLASSES, NOT_TRACED, STALK
 
 #: Text alignments of the painted axes and legends.
@@ -194,6 +199,12 @@ def _per_drawn(mesh: pv.PolyData, values: np.ndarray, classes: bool) -> np.ndarr
     return out
 
 
+def _rgb(colour: str) -> tuple[int, int, int]:
+    """A colour name or #rrggbb as 0-255 RGB."""
+    r, g, b = pv.Color(colour).int_rgb
+    return int(r), int(g), int(b)
+
+
 def _categorical(values: dict[int, tuple[str, str]]):
     """A lookup table of named categories: value -> (label, colour)."""
     lut = pv.LookupTable()
@@ -211,6 +222,8 @@ class Viewport(QtInteractor):
 
     #: After each frame: the number of frames rendered so far.
     rendered = Signal(int)
+    #: The (low, high) the light values' colours span, each time they are painted.
+    limits_shown = Signal(float, float)
 
     def __init__(self, parent=None):
         super().__init__(parent, auto_update=False, multi_samples=0, lighting="none")
@@ -239,6 +252,9 @@ class Viewport(QtInteractor):
         self._layout = None
         self._framed = False
         self._digitizing_frame = None
+        self._scale = None                   # the light values' ColourScale (set_colour_scale)
+        #: The (low, high) the light values' colours span, once painted.
+        self.shown_limits: tuple[float, float] | None = None
 
     # ------------------------------------------------------------------ rendering
     def render(self) -> None:
@@ -348,24 +364,13 @@ class Viewport(QtInteractor):
         cells = self.canopy_mesh.cell_data
         array = what
         if what == "light" and self.light_variant == "values":
-            array = "light_value"
-            values = cells["light_value"]
-            leaf = values[np.isfinite(values) & (values >= 0)]
-            lo, hi = 0.0, float(leaf.max()) if len(leaf) and leaf.max() > 0 else 1.0
-            lut = pv.LookupTable(cmap="inferno", n_values=256)
-            lut.SetBelowRangeColor(*pv.Color(LIGHT_CLASSES[STALK][1]).float_rgb, 1.0)
-            lut.UseBelowRangeColorOn()
-            lut.SetNanColor(*pv.Color(LIGHT_CLASSES[NOT_TRACED][1]).float_rgb, 1.0)
-            title, unit = self._light_key
-            items = [LIGHT_CLASSES[STALK]]
-            if np.isnan(values).any():
-                items.append(LIGHT_CLASSES[NOT_TRACED])
-            self.key.set_gradient(title, np.asarray(lut.values), "0", f"{hi:.3g} {unit}",
-                                  items)
-        elif what == "light":
+            self._paint_values(mapper)
+            return
+        mapper.SetColorModeToMapScalars()
+        if what == "light":
             shown = {k: v for k, v in LIGHT_CLASSES.items() if k != NOT_TRACED}
             lut = _categorical(LIGHT_CLASSES)
-            lo, hi = min(LIGHT_CLASSES), max(LIGHT_CLASSES)
+            lo, hi = float(min(LIGHT_CLASSES)), float(max(LIGHT_CLASSES))
             self.key.set_categories("light received (the paper's classes)",
                                        [shown[k] for k in sorted(shown, reverse=True)])
         elif what == "plant":
@@ -394,6 +399,58 @@ class Viewport(QtInteractor):
         mapper.SetScalarRange(lo, hi)
         mapper.SetUseLookupTableScalarRange(True)
         mapper.ScalarVisibilityOn()
+        self.key.show()
+
+    def set_colour_scale(self, scale) -> None:
+        """Colour light values by ``scale`` (a :class:`~maizeviz_app.colour.ColourScale`,
+        followed: a change repaints the canopy if it shows light values)."""
+        if self._scale is not None:
+            self._scale.events.disconnect(self._on_scale)
+        self._scale = scale
+        scale.events.connect(self._on_scale)
+        self._on_scale()
+
+    def _on_scale(self, *_args) -> None:
+        if self.colouring == "light" and self.light_variant == "values":
+            self._apply_colouring()
+            self.render()
+
+    def _paint_values(self, mapper) -> None:
+        """Light values (cell data ``light_value``: leaves' values, NaN not traced, -1 for
+        stalks) as colours of the view's scale, one RGB per triangle (``light_rgb``): stalks
+        and triangles not traced keep their own colours whatever the range clips."""
+        from maizeviz_app.colour import ColourError, ColourScale, colour_table, colours_of
+
+        mesh = self.canopy_mesh
+        assert mesh is not None
+        nf = int(mesh.field_data["leaf_triangles"][0])
+        values = np.asarray(mesh.cell_data["light_value"])
+        scale = self._scale if self._scale is not None else ColourScale(cmap="inferno")
+        try:
+            lo, hi = scale.limits(values[:nf])
+        except ColourError:                       # a range being typed: the data's for now
+            lo, hi = ColourScale(log=scale.log).limits(values[:nf])
+        table = colour_table(scale.cmap)
+        rgb = np.empty((mesh.n_cells, 3), np.uint8)
+        rgb[:nf] = colours_of(values[:nf], lo, hi, table, scale.log,
+                              nan=_rgb(LIGHT_CLASSES[NOT_TRACED][1]))
+        rgb[nf:] = _rgb(LIGHT_CLASSES[STALK][1])
+        mesh.cell_data["light_rgb"] = rgb
+        self.shown_limits = (lo, hi)
+        self.limits_shown.emit(lo, hi)
+        mapper.SetScalarModeToUseCellFieldData()
+        mapper.SelectColorArray("light_rgb")
+        mapper.SetColorModeToDirectScalars()
+        mapper.ScalarVisibilityOn()
+        title, unit = self._light_key
+        leaf = values[:nf][np.isfinite(values[:nf])]
+        low = ("≤ " if len(leaf) and leaf.min() < lo else "") + tick_text(lo)
+        high = ("≥ " if len(leaf) and leaf.max() > hi else "") + tick_text(hi)
+        items = [LIGHT_CLASSES[STALK]]
+        if np.isnan(values[:nf]).any():
+            items.append(LIGHT_CLASSES[NOT_TRACED])
+        self.key.set_gradient(title + (" (log scale)" if scale.log else ""), table,
+                              low, f"{high} {unit}".rstrip(), items)
         self.key.show()
 
     # ------------------------------------------------------------------ ground
