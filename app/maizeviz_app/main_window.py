@@ -221,6 +221,7 @@ class MainWindow(QMainWindow):
         self.plots.heatmap_needed.connect(self._draw_heatmap)
         self.model.colour.heatmap.events.connect(lambda _info: self.plots.redraw())
         self.model.colour.events.shared.connect(lambda _on: self.plots.redraw())
+        self.model.colour.events.painting.connect(lambda _p: self._light_to_view())
         self.messages = QPlainTextEdit(readOnly=True)
         self.messages.setMaximumBlockCount(1000)
         from maizeviz_app.panels.colour import ColourPanel
@@ -769,7 +770,8 @@ class MainWindow(QMainWindow):
         run = self.runs.latest(self.signature(self.built.label))
         if run is not None and run.kind == "sun" and run.classes is not None and \
                 (run.extra is None or run.extra.leaf_value is None):
-            self.viewport.set_light(run.classes)
+            self.viewport.set_sun(run.painting, self.model.colour.painting, run.classes)
+            self.colour_panel.show_painting(self.viewport.painting_note)
         elif run is not None and run.extra is not None and \
                 getattr(run.extra, "leaf_value", None) is not None:
             title, unit = value_legend(run)
@@ -835,14 +837,16 @@ class MainWindow(QMainWindow):
             out = runner.light_process.call(op, key, canopy, args, job)
             job.check()
             if mode == "sun":
-                from maizeviz.light.leaf_light import triangle_light
+                from maizeviz.light.painting import sun_painting
 
                 absorbed = None
                 if optics is not None:              # leaves with optics: absorbed light too
                     absorbed = runner.light_process.call("absorbed", key, canopy,
                                                          (args[0], optics), job)
                     job.check()
-                run = Run(label, signature, out, triangle_light(canopy, out), extra=absorbed)
+                painting = sun_painting(canopy, out)
+                run = Run(label, signature, out, painting.classes, extra=absorbed,
+                          painting=painting)
             else:
                 run = Run(label, signature, out.light, None, mode, out)
             maps = plots.heatmap_images(run.result, first=shown_height, check=job.check,
@@ -941,6 +945,8 @@ class MainWindow(QMainWindow):
             self.say(f"{'note' if 'sun never rises' in w else 'warning'}: {w}")
         if self.built is not None and self.signature(self.built.label) == run.signature:
             self._light_to_view(colour=True)
+            if run.painting is not None and self.viewport is not None:
+                self.say(f"note: the view shows {self.viewport.painting_note}")
         self.docks["results"].raise_()
         if run.kind == "day":
             self.say(summary.replace("\n", "; "), status_only=True)
@@ -1294,7 +1300,7 @@ class MainWindow(QMainWindow):
             return
 
         def work(job):
-            from maizeviz.light.leaf_light import triangle_light
+            from maizeviz.light.painting import sun_painting
             from maizeviz_app import jobs
 
             done: list[Any] = []
@@ -1303,7 +1309,7 @@ class MainWindow(QMainWindow):
                 if run.kind == "sun":
                     absorbed = None if run.extra is None else \
                         jobs.absorbed_of(canopy, run.extra.light)
-                    done.append((triangle_light(canopy, run.result), absorbed))
+                    done.append((sun_painting(canopy, run.result), absorbed))
                 else:
                     done.append(jobs.diffuse_of(canopy, run.result, run.kind))
             return done
@@ -1311,7 +1317,8 @@ class MainWindow(QMainWindow):
         def adopt(done):
             for run, value in zip(todo, done):
                 if run.kind == "sun":
-                    run.classes, absorbed = value
+                    run.painting, absorbed = value
+                    run.classes = run.painting.classes
                     if absorbed is not None:
                         run.extra = absorbed
                 else:

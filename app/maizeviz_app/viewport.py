@@ -253,6 +253,8 @@ class Viewport(QtInteractor):
         self._framed = False
         self._digitizing_frame = None
         self._scale = None                   # the light values' ColourScale (set_colour_scale)
+        #: What a sun's painting shows and why (set_sun).
+        self.painting_note = ""
         #: The (low, high) the light values' colours span, once painted.
         self.shown_limits: tuple[float, float] | None = None
 
@@ -323,6 +325,24 @@ class Viewport(QtInteractor):
         if self.colouring == "light":
             self._apply_colouring()
             self.render()
+
+    def set_sun(self, painting, asked: str = "auto", classes: np.ndarray | None = None) -> None:
+        """A sun's light as ``painting`` (a :class:`maizeviz.light.painting.SunPainting`)
+        says is honest, or as ``asked`` (``auto``, ``triangles``, ``leaves``): each triangle's
+        class, or each leaf's sunlit share on the colour scale. Without a painting, the
+        triangles' ``classes``. :attr:`painting_note` says which and why."""
+        if painting is None:
+            self.painting_note = ""
+            self.set_light(classes)
+            return
+        per = painting.chosen(asked)
+        self.painting_note = painting.note(per)
+        if per == "leaves":
+            self.set_light_values(painting.share, "sunlit share of each leaf (too few rays "
+                                  "per triangle to class each)" if painting.per == "leaves"
+                                  else "sunlit share of each leaf", "")
+        else:
+            self.set_light(painting.classes)
 
     def set_light_values(self, values: np.ndarray, title: str, unit: str) -> None:
         """A value per leaf triangle (F,) (a sky's or a day's light per m2 of leaf, NaN where

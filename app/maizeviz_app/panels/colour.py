@@ -177,6 +177,9 @@ class ColourPanel(QWidget):
                "none) where triangles are large enough for rays to sample each, else the "
                "sunlit share of each leaf")
         self.view_editor.form.addRow("Sun painted as", self.painting)
+        self.painting_note = QLabel("")
+        self.painting_note.setWordWrap(True)
+        self.view_editor.form.addRow(self.painting_note)
         lay.addWidget(self.view_editor)
         self.heatmap_editor = ScaleEditor("Heatmaps", settings.heatmap)
         self.shared = QCheckBox("one scale for every height and light")
@@ -191,6 +194,10 @@ class ColourPanel(QWidget):
         self.shared.toggled.connect(lambda on: setattr(settings, "shared", bool(on)))
         settings.events.connect(self._follow)
         self._follow()
+
+    def show_painting(self, note: str) -> None:
+        """What the 3D view paints of a sun and why."""
+        self.painting_note.setText(note)
 
     def _follow(self, *_args) -> None:
         for w in (self.painting, self.shared):
