@@ -112,6 +112,7 @@ def _share(canopy: Canopy, result: LightResult, classes: np.ndarray, area: np.nd
     nf = canopy.n_triangles
     if nf == 0:
         return np.zeros(0, np.float32)
+    assert result.first_hits is not None
     s = np.asarray(result.direction, dtype=np.float64)
     lit = result.ray_area_cm2 * s[2] / np.maximum(np.abs(normals @ s), 1e-6)
     first = np.asarray(result.first_hits[:nf], dtype=np.float64)
