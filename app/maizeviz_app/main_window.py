@@ -511,10 +511,10 @@ class MainWindow(QMainWindow):
             measure_s = time.perf_counter() - t0
             while not view_ready.wait(0.05):
                 job.check()
-            from maizeviz_app.viewport import canopy_polydata
+            from maizeviz_app.mesh_view import mesh_polydata
 
             row = table2_row(m, read_s, MESH_LEVEL)
-            return notes, (canopy, m, read_s, measure_s, canopy_polydata(canopy),
+            return notes, (canopy, m, read_s, measure_s, mesh_polydata(canopy),
                            tuple(TABLE2_COLUMNS), row)
 
         self.runner.run("load", f"reading {Path(path).name}", work,
@@ -745,7 +745,10 @@ class MainWindow(QMainWindow):
         self._complete_runs()
         self._light_to_view()
         m = built.measures
-        if "source" in mesh.field_data:
+        if "view_note" in mesh.field_data:
+            self.say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
+                     f"responsive {mesh.field_data['view_note'][0]}")
+        elif "source" in mesh.field_data:
             self.say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
                      "responsive the view draws the plants around the sampled tile at 36 "
                      "triangles a leaf (light, tables and exports use every triangle)")

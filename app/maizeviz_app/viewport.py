@@ -132,7 +132,7 @@ def _settle(poly: pv.PolyData) -> pv.PolyData:
 VIEW_BUDGET = 800_000
 
 
-def display_polydata(canopy, coarse) -> pv.PolyData:
+def display_polydata(canopy, coarse, fine: np.ndarray | None = None) -> pv.PolyData:
     """What the view draws of a canopy larger than :data:`VIEW_BUDGET`: the plants standing in
     the sample tile (the central one, whose light is traced and reported) at the canopy's own
     level, the others from ``coarse`` (the same plants and layout at a coarser level). Safe
@@ -143,11 +143,14 @@ def display_polydata(canopy, coarse) -> pv.PolyData:
     ``canopy_triangles``; ``canopy_leaf`` (each canopy triangle's leaf), ``leaf_first`` (a
     triangle of each leaf) and ``drawn_leaf`` (each coarse triangle's leaf), so that light
     given per triangle of ``canopy`` colours the coarse plants per leaf
-    (:meth:`Viewport.set_light`).
+    (:meth:`Viewport.set_light`). ``fine``: (P,) bool, the placements drawn at the canopy's
+    level, if not those of the sample tile.
     """
-    x0, y0, x1, y1 = canopy.layout.centre_bounds
-    sampled = np.array([x0 <= p.x <= x1 and y0 <= p.y <= y1
-                        for p in canopy.layout.placements], bool)
+    if fine is None:
+        x0, y0, x1, y1 = canopy.layout.centre_bounds
+        fine = np.array([x0 <= p.x <= x1 and y0 <= p.y <= y1
+                         for p in canopy.layout.placements], bool)
+    sampled = np.asarray(fine, bool)
     fine = np.flatnonzero(sampled[canopy.face_instance])
     rough = np.flatnonzero(~sampled[coarse.face_instance])
     # only the vertices these triangles use (the canopy's other plants' would be uploaded to
