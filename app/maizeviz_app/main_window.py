@@ -367,6 +367,10 @@ class MainWindow(QMainWindow):
             self.viewport = Viewport(self._centre)
             self.viewport.set_colour_scale(self.model.colour.view)
             self.viewport.limits_shown.connect(self.colour_panel.view_editor.show_limits)
+            from maizeviz_app.linked import LinkedSelection
+
+            self.linked = LinkedSelection(self.model, self.viewport, self.light_panel.plants,
+                                          lambda text: self.say(text, status_only=True))
             # the central widget stays (a new one would make the docks take its room)
             self._centre.addWidget(self.viewport)
             self._centre.setCurrentWidget(self.viewport)

@@ -27,6 +27,7 @@ from psygnal import Signal
 
 from maizeviz_app.colour import ColourSettings
 from maizeviz_app.runs import LightRuns, Run
+from maizeviz_app.selection import Selection
 
 
 class StudyModel:
@@ -63,6 +64,8 @@ class StudyModel:
         There is work a project does not hold yet (see the module docstring).
     colour : ColourSettings
         How the 3D view and the heatmaps colour light (evented; saved in a project).
+    selection : Selection
+        The plant or leaf selected (evented; the 3D view and the plants table follow it).
 
     Signals
     -------
@@ -98,6 +101,7 @@ class StudyModel:
         self.serial = 0
         self.modified = False
         self.colour = ColourSettings()
+        self.selection = Selection()
 
     # ------------------------------------------------------------------ reading
     @property

@@ -26,6 +26,8 @@ Touch the widget from the GUI thread only.
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import pyvista as pv
 from PySide6.QtCore import QPointF, QRectF, Qt, Signal
@@ -35,6 +37,7 @@ from pyvistaqt import QtInteractor
 
 from maizeviz_app.colour import tick_text
 from maizeviz_app.options import CAMERAS, COLOURINGS, LIGHT_CLASSES, NOT_TRACED, STALK
+from maizeviz_app.picking import Pick, make_pickable, part_bounds, part_mesh, pick
 
 #: Text alignments of the painted axes and legends.
 CENTRE = Qt.AlignmentFlag.AlignCenter
@@ -122,7 +125,7 @@ def _settle(poly: pv.PolyData) -> pv.PolyData:
     poly.GetBounds()
     poly.GetCellsBounds([0.0] * 6)
     poly.GetPoints().GetData().GetRange(0)
-    return poly
+    return make_pickable(poly)
 
 
 #: Leaf and stalk triangles the view draws at most at the level asked: a frame of 2.7 M
@@ -227,6 +230,15 @@ class Viewport(QtInteractor):
     rendered = Signal(int)
     #: The (low, high) the light values' colours span, each time they are painted.
     limits_shown = Signal(float, float)
+    #: A click on the canopy (a :class:`~maizeviz_app.picking.Pick`), or beside it (None).
+    picked = Signal(object)
+    #: A canopy's mesh was put on screen (show_canopy).
+    canopy_set = Signal()
+
+    #: A press and release closer than this (pixels) is a click, not a drag of the camera.
+    CLICK_PX = 4
+    #: Colour of the picked leaf or plant.
+    HIGHLIGHT = "#00e5ff"
 
     def __init__(self, parent=None):
         super().__init__(parent, auto_update=False, multi_samples=0, lighting="none")
@@ -258,6 +270,13 @@ class Viewport(QtInteractor):
         self._scale = None                   # the light values' ColourScale (set_colour_scale)
         #: What a sun's painting shows and why (set_sun).
         self.painting_note = ""
+        #: Milliseconds the last click took to be answered (the pick and every slot of
+        #: ``picked``: the selection, the info card), from the release event's delivery.
+        self.last_pick_ms: float | None = None
+        self._press: tuple[float, float] | None = None
+        self._held = None                       # a left press not yet handed to VTK
+        self.info = InfoCard(self)
+        self.info.hide()
         #: The (low, high) the light values' colours span, once painted.
         self.shown_limits: tuple[float, float] | None = None
 
@@ -300,6 +319,7 @@ class Viewport(QtInteractor):
             self.camera_preset("perspective")
             self._framed = True
         self.render()
+        self.canopy_set.emit()
 
     def has_light(self) -> bool:
         if self.canopy_mesh is None:
@@ -520,8 +540,9 @@ class Viewport(QtInteractor):
     def hide_canopy(self) -> None:
         """Make room for a digitizing session: the canopy and the ground go (the canopy comes
         back with :meth:`restore_canopy` or the next :meth:`show_canopy`)."""
-        for name in ("canopy", "ground"):
+        for name in ("canopy", "ground", "selection"):
             self.remove_actor(name, render=False)
+        self.info.set_lines([])
         self._canopy_actor = None
         self._ground_bounds = None
         self.key.hide()
@@ -611,12 +632,144 @@ class Viewport(QtInteractor):
                 self.frame_bounds(np.column_stack(self._digitizing_frame).ravel(), render=False)
         self.render()
 
+    # ------------------------------------------------------------------ picking
+    def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        super().resizeEvent(event)
+        if self.info.isVisible():
+            self.info.set_lines(self.info.text().splitlines())
+
+    # A left press is held back from VTK until the mouse moves: a click then picks without
+    # VTK's camera interaction starting and stopping, each of which renders a frame at once
+    # (two frames of 150-300 ms per click at K = 4 on software OpenGL); a drag is handed to
+    # VTK from the press's own position, so the camera turns as before.
+    def mousePressEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if event.button() == Qt.MouseButton.LeftButton and event.buttons() == event.button():
+            self._press = (event.position().x(), event.position().y())
+            self._held = event.clone()
+            return
+        self._release_held()
+        super().mousePressEvent(event)
+
+    def mouseMoveEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if self._held is not None and self._press is not None:
+            pos = event.position()
+            if abs(pos.x() - self._press[0]) + abs(pos.y() - self._press[1]) > self.CLICK_PX:
+                self._release_held()
+        super().mouseMoveEvent(event)
+
+    def mouseReleaseEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        t0 = time.perf_counter()
+        if self._held is not None and event.button() == Qt.MouseButton.LeftButton:
+            self._held, self._press = None, None                  # a click: VTK never saw it
+            pos = event.position()
+            self.picked.emit(self.pick_at(pos.x(), pos.y()))
+            self.last_pick_ms = 1000 * (time.perf_counter() - t0)
+            return
+        self._press = None
+        super().mouseReleaseEvent(event)
+
+    def _release_held(self) -> None:
+        """Hand the held press to VTK (a drag begins)."""
+        held, self._held = self._held, None
+        if held is not None:
+            super().mousePressEvent(held)
+
+    def pick_at(self, x: float, y: float) -> Pick | None:
+        """What of the canopy is under the widget point (``x``, ``y``), None if nothing."""
+        if self._canopy_actor is None or not self._canopy_actor.GetVisibility():
+            return None
+        ratio = self.devicePixelRatioF()
+        return pick(self.canopy_mesh, self.renderer, x * ratio, (self.height() - y - 1) * ratio)
+
+    def display_point(self, world) -> tuple[float, float]:
+        """The widget point (x, y) where the world point ``world`` (cm) is drawn."""
+        ren = self.renderer
+        ren.SetWorldPoint(float(world[0]), float(world[1]), float(world[2]), 1.0)
+        ren.WorldToDisplay()
+        dx, dy, _ = ren.GetDisplayPoint()
+        ratio = self.devicePixelRatioF()
+        return dx / ratio, self.height() - 1 - dy / ratio
+
+    def highlight(self, instance: int, leaf: int = -1) -> bool:
+        """Draw placement ``instance``'s leaf ``leaf`` (or the whole plant, -1) highlighted,
+        over the canopy; a negative ``instance`` clears. False if none of it is drawn."""
+        self.remove_actor("selection", render=False)
+        part = None
+        if instance >= 0 and self.canopy_mesh is not None:
+            part = part_mesh(self.canopy_mesh, instance, leaf)
+        if part is not None:
+            actor = self.add_mesh(part, name="selection", color=self.HIGHLIGHT, render=False,
+                                  reset_camera=False, pickable=False, lighting=True)
+            # drawn over the canopy's same triangles, not fighting them for the pixels
+            actor.mapper.SetResolveCoincidentTopologyToPolygonOffset()
+            actor.mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(-2.0, -2.0)
+        self.render()
+        return part is not None
+
+    def frame_part(self, instance: int, leaf: int = -1) -> bool:
+        """Point the camera at placement ``instance`` (its leaf ``leaf``), keeping its
+        direction; False if none of it is drawn."""
+        if self.canopy_mesh is None:
+            return False
+        bounds = part_bounds(self.canopy_mesh, instance, leaf)
+        if bounds is None:
+            return False
+        self.frame_bounds(bounds)
+        return True
+
     def close(self) -> None:
         try:
             self.ren_win.RemoveObservers("EndEvent")
         except AttributeError:
             pass
         super().close()
+
+
+class InfoCard(QWidget):
+    """What was picked, over the 3D view's bottom left: a few lines of text on a white card
+    (a Qt widget: nothing is drawn in the 3D scene). Clicks go through it to the view."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents)
+        self._lines: list[str] = []
+
+    def set_lines(self, lines: list[str]) -> None:
+        """Show ``lines`` (none: hide the card)."""
+        self._lines = list(lines)
+        if not self._lines:
+            self.hide()
+            return
+        fm = self.fontMetrics()
+        width = max(fm.horizontalAdvance(t) for t in self._lines) + 20
+        height = (fm.height() + 2) * len(self._lines) + 12
+        self.resize(width, height)
+        parent = self.parentWidget()
+        if parent is not None:
+            self.move(10, max(parent.height() - height - 10, 10))
+        self.show()
+        self.raise_()
+        self.update()
+
+    def text(self) -> str:
+        return "\n".join(self._lines)
+
+    def paintEvent(self, _event) -> None:  # noqa: N802 - Qt's name
+        p = QPainter(self)
+        p.setRenderHint(QPainter.RenderHint.Antialiasing)
+        p.setPen(Qt.PenStyle.NoPen)
+        p.setBrush(QColor(255, 255, 255, 225))
+        p.drawRoundedRect(QRectF(self.rect()), 6, 6)
+        p.setPen(QColor("#222222"))
+        fm = self.fontMetrics()
+        y = 6
+        for k, line in enumerate(self._lines):
+            font = p.font()
+            font.setBold(k == 0)
+            p.setFont(font)
+            p.drawText(QRectF(10, y, self.width() - 20, fm.height() + 2), LEFT, line)
+            y += fm.height() + 2
+        p.end()
 
 
 class _Shown:
