@@ -36,7 +36,7 @@ RANGES = {"auto": "auto (min to max)", "fixed": "typed min and max",
           "percentile": "percentile clip"}
 #: How a sun's light is painted on the canopy: the light class of each triangle, the sunlit
 #: share of each leaf, or whichever is honest for the triangles' size (see
-#: :func:`maizeviz.light.painting.sun_painting`).
+#: :func:`maizeviz.light.results.painting.sun_painting`).
 PAINTINGS = {"auto": "auto (honest for the triangles' size)",
              "triangles": "per triangle: light class", "leaves": "per leaf: sunlit share"}
 

@@ -78,7 +78,7 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
         look = Look.of(model.colour, shown_runs or {kind: run})    # as shown
 
         def work(job):
-            from maizeviz.light.heatmap import save_figure
+            from maizeviz.light.report.heatmap import save_figure
             from maizeviz_app.plots import heatmap_figure_of
 
             save_figure(heatmap_figure_of(result, height, kind, look=look), path)
@@ -91,7 +91,7 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
         title = plot_title(model.runs)
 
         def work(job):
-            from maizeviz.light.heatmap import save_figure
+            from maizeviz.light.report.heatmap import save_figure
 
             save_figure(plots.transmission_figure(curves, title, width_in=7, dpi=110), path)
             return path
@@ -112,7 +112,7 @@ def _diffuse_job(what: str, path: str, model: StudyModel):
     light, extra, label = run.result, run.extra, run.label
     if what == "steps":
         def work(job):
-            from maizeviz.light.reports import write_steps
+            from maizeviz.light.report.tables import write_steps
 
             write_steps(path, light)
             return path
@@ -121,8 +121,8 @@ def _diffuse_job(what: str, path: str, model: StudyModel):
         title = day_title(light, label)
 
         def work(job):
-            from maizeviz.light.heatmap import save_figure
-            from maizeviz.light.plots import day_figure
+            from maizeviz.light.report.heatmap import save_figure
+            from maizeviz.light.report.plots import day_figure
 
             save_figure(day_figure(light, title), path)
             return path
@@ -134,7 +134,7 @@ def _diffuse_job(what: str, path: str, model: StudyModel):
 
     def write_table(job):
         from maizeviz.io.atomic import write_rows
-        from maizeviz.light.leaf_light import plant_light
+        from maizeviz.light.results.per_leaf import plant_light
 
         write_rows(path, rows if what == "leaves" else plant_light(rows))
         return path

@@ -91,11 +91,11 @@ PAPER = ("Xinyu Guo, Chunjiang Zhao, Boxiang Xiao, Shenglian Lu, Changfeng Li. <
 #: Modules the warm-up thread imports while the window is already on screen, in three stages:
 #: the core (then the points file opens), the 3D view (then the view is made), the rest.
 WARM_STAGES = (
-    ("core", ("maizeviz_app.jobs", "maizeviz.light.leaf_light")),
+    ("core", ("maizeviz_app.jobs", "maizeviz.light.results.per_leaf")),
     ("view", ("pyvista", "pyvistaqt", "maizeviz_app.viewport", "maizeviz_app.panels.layout",
               "maizeviz_app.panels.digitizer")),
     ("rest", ("matplotlib.figure", "matplotlib.backends.backend_agg", "maizeviz_app.plots",
-              "maizeviz.light.heatmap", "maizeviz.canopy.export", "maizeviz_app.project")))
+              "maizeviz.light.report.heatmap", "maizeviz.canopy.export", "maizeviz_app.project")))
 
 
 def _count(n: int, one: str, many: str | None = None) -> str:
@@ -844,7 +844,7 @@ class MainWindow(QMainWindow):
             out = runner.light_process.call(op, key, canopy, args, job)
             job.check()
             if mode == "sun":
-                from maizeviz.light.painting import sun_painting
+                from maizeviz.light.results.painting import sun_painting
 
                 absorbed = None
                 if optics is not None:              # leaves with optics: absorbed light too
@@ -987,7 +987,7 @@ class MainWindow(QMainWindow):
         text = self.light_panel.place.text()
 
         def work(job, t):
-            from maizeviz.light.sun import sun_at
+            from maizeviz.light.sources.sun import sun_at
 
             parts = t.split()
             if len(parts) != 5:
@@ -1307,7 +1307,7 @@ class MainWindow(QMainWindow):
             return
 
         def work(job):
-            from maizeviz.light.painting import sun_painting
+            from maizeviz.light.results.painting import sun_painting
             from maizeviz_app import jobs
 
             done: list[Any] = []

@@ -1,6 +1,6 @@
 """Light figures drawn off the GUI thread (matplotlib's Agg canvas; no Qt here).
 
-The heatmaps are the core's own figures (:func:`maizeviz.light.heatmap.result_figure`, the
+The heatmaps are the core's own figures (:func:`maizeviz.light.report.heatmap.result_figure`, the
 same as ``maizeviz light --heatmaps``) for a sun, a sky or a day; the transmission-vs-height
 plot compares the mesh levels and lights traced with the same sampling (the paper's Table 3 as
 a plot, with the diffuse sky and the day's PAR beside it). Figures are drawn to RGBA arrays in
@@ -125,7 +125,7 @@ class Look:
         if self.shared is None:
             return self.scale.limits(tmap.transmission)
         if self._shared_limits is None:
-            from maizeviz.light.heatmap import result_map
+            from maizeviz.light.report.heatmap import result_map
 
             values = [result_map(r, float(h), kind, self.bin_cm).transmission.ravel()
                       for kind, r in self.shared.items() for h in r.heights_cm]
@@ -134,7 +134,7 @@ class Look:
         return self._shared_limits
 
     def colours(self, tmap) -> dict:
-        """The keywords of :func:`maizeviz.light.heatmap.heatmap_figure` for ``tmap``."""
+        """The keywords of :func:`maizeviz.light.report.heatmap.heatmap_figure` for ``tmap``."""
         from maizeviz_app.colour import CMAPS
 
         lo, hi = self.limits(tmap)
@@ -183,9 +183,9 @@ def heatmap_figure_of(result, height: float, kind: str = "sun", width_in: float 
                       dpi: int = 110, bin_cm: float = HEATMAP_BIN_CM, look: Look | None = None):
     """The core's heatmap figure of one height of a light result (a sun's ``LightResult``, a
     ``SkyLight`` or a ``PeriodLight``; ``kind`` sun, sky or day), a sun's in ``bin_cm`` bins
-    (:func:`maizeviz.light.heatmap.result_figure`, titled as ``maizeviz light --heatmaps``),
-    coloured as ``look`` says (None: the core's 0 to 1)."""
-    from maizeviz.light.heatmap import result_figure, result_map
+    (:func:`maizeviz.light.report.heatmap.result_figure`, titled as
+    ``maizeviz light --heatmaps``), coloured as ``look`` says (None: the core's 0 to 1)."""
+    from maizeviz.light.report.heatmap import result_figure, result_map
 
     tmap = result_map(result, float(height), kind, bin_cm)
     colours = (look or Look()).colours(tmap)
@@ -197,7 +197,7 @@ def heatmap_image(result, height: float, bin_cm: float = HEATMAP_BIN_CM, width_i
                   dpi: int = 64, kind: str = "sun", look: Look | None = None) -> Heatmap:
     """The core's heatmap of one height of a light result (:func:`heatmap_figure_of`),
     drawn, with where its bins lie in the picture (for the value under the mouse)."""
-    from maizeviz.light.heatmap import map_title, result_figure, result_map
+    from maizeviz.light.report.heatmap import map_title, result_figure, result_map
 
     tmap = result_map(result, float(height), kind, bin_cm)
     colours = (look or Look()).colours(tmap)

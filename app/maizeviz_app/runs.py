@@ -41,7 +41,7 @@ class Run:
     holds what the light process made of it (per-leaf and per-plant rows, per-triangle
     values: :class:`maizeviz_app.jobs.Diffuse`); for a sun traced with leaf optics, the light
     absorbed with scattering (:class:`maizeviz_app.jobs.Absorbed`). A sun's ``painting``
-    (:class:`maizeviz.light.painting.SunPainting`, made with its classes) says how its light
+    (:class:`maizeviz.light.results.painting.SunPainting`, made with its classes) says how its light
     can be painted honestly: per triangle or per leaf."""
 
     label: str
@@ -63,8 +63,8 @@ class Run:
 
     @property
     def balance(self) -> Any:
-        """The energy balance (:class:`maizeviz.light.scatter.Balance`, W/m2 of ground) of a
-        sun traced with leaf optics, else None."""
+        """The energy balance (:class:`maizeviz.light.results.absorbed.Balance`, W/m2 of
+        ground) of a sun traced with leaf optics, else None."""
         light = getattr(self.extra, "light", None) if self.kind == "sun" else None
         return getattr(light, "balance", None)
 

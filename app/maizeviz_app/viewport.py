@@ -329,7 +329,7 @@ class Viewport(QtInteractor):
         return bool(np.any(self.canopy_mesh.cell_data["light"] >= 0))
 
     def set_light(self, classes: np.ndarray | None) -> None:
-        """Light class of every leaf triangle (F,) (see ``maizeviz.light.leaf_light.
+        """Light class of every leaf triangle (F,) (see ``maizeviz.light.results.per_leaf.
         triangle_light``), or None to forget it; the view follows if coloured by light."""
         if self.canopy_mesh is None:
             return
@@ -350,7 +350,7 @@ class Viewport(QtInteractor):
             self.render()
 
     def set_sun(self, painting, asked: str = "auto", classes: np.ndarray | None = None) -> None:
-        """A sun's light as ``painting`` (a :class:`maizeviz.light.painting.SunPainting`)
+        """A sun's light as ``painting`` (a :class:`maizeviz.light.results.painting.SunPainting`)
         says is honest, or as ``asked`` (``auto``, ``triangles``, ``leaves``): each triangle's
         class, or each leaf's sunlit share on the colour scale. Without a painting, the
         triangles' ``classes``. :attr:`painting_note` says which and why."""

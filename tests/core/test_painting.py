@@ -9,16 +9,16 @@ import pytest
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
-from maizeviz.light.leaf_light import leaf_light, tile_representatives, triangle_light
-from maizeviz.light.painting import (
+from maizeviz.light.results.painting import (
     MIN_RAYS,
     expected_rays,
     leaf_sunlit_share,
     sun_painting,
 )
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.sun import Sun
-from maizeviz.light.transmission import trace_light
+from maizeviz.light.results.per_leaf import tile_representatives
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.sources.sun import Sun
+from maizeviz.light.trace.direct import trace_light
 from maizeviz.mesh.levels import parse_level
 
 
@@ -42,8 +42,8 @@ def test_a_leafs_share_is_the_leaf_tables_sunlit_area_over_its_area(leaves, tile
     canopy = build_canopy(leaves, layout_for(leaves, tiles), parse_level("16"))
     result = _sun(canopy, 1.0, periodic)
     share = leaf_sunlit_share(canopy, result)
-    classes = triangle_light(canopy, result)
-    rows = leaf_light(canopy, result)
+    classes = result.triangle_light(canopy)
+    rows = result.leaf_rows(canopy)
     assert rows
     checked = 0
     for row in rows:

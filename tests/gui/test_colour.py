@@ -208,10 +208,10 @@ def test_heatmaps_take_the_scale_share_it_and_tell_the_value_under_the_mouse(sma
     from maizeviz_app.panels.heatmap_view import hover_text
     from maizeviz_app.plots import Look, heatmap_image
 
-    from maizeviz.light.heatmap import transmission_map
-    from maizeviz.light.request import LightRequest, Sampling
-    from maizeviz.light.sun import Sun
-    from maizeviz.light.transmission import trace_light
+    from maizeviz.light.report.heatmap import transmission_map
+    from maizeviz.light.scene.request import LightRequest, Sampling
+    from maizeviz.light.sources.sun import Sun
+    from maizeviz.light.trace.direct import trace_light
 
     result = trace_light(small_canopy, LightRequest(Sun(30.0, 160.0),
                                                     Sampling((0.0, 60.0), 1.0), classes=True))
@@ -246,8 +246,8 @@ def test_heatmaps_take_the_scale_share_it_and_tell_the_value_under_the_mouse(sma
 def test_the_heatmap_pixels_follow_the_colour_map():
     from maizeviz_app.plots import Look
 
-    from maizeviz.light.bins import TransmissionMap
-    from maizeviz.light.heatmap import heatmap_figure
+    from maizeviz.light.report.heatmap import heatmap_figure
+    from maizeviz.light.results.maps import TransmissionMap
 
     t = np.full((4, 3), 0.5)
     tmap = TransmissionMap(10.0, np.arange(5.0) * 5, np.arange(4.0) * 5, t,

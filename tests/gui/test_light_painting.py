@@ -7,7 +7,6 @@ from __future__ import annotations
 import numpy as np
 from test_light_modes import TIMEOUT, compute, shown, small_light
 
-from maizeviz.light.leaf_light import leaf_light
 from maizeviz.mesh.levels import COMPLEXITY_STOPS
 
 
@@ -24,7 +23,7 @@ def test_k4_sun_paints_each_leaf_with_its_sunlit_share(window, qtbot, small_poin
     painted = np.asarray(view.canopy_mesh.cell_data["light_value"])[:n]
     # every triangle of a leaf the sun reaches is painted as lit; those the table says took
     # no sun, as 0
-    rows = leaf_light(c, run.result)
+    rows = run.result.leaf_rows(c)
     for r in rows:
         mine = (c.face_instance == int(r["instance"]) - 1) & (c.face_leaf == int(r["leaf"]))
         want = min(r["sunlit_area_cm2"] / r["leaf_area_cm2"], 1.0)

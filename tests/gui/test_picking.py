@@ -201,11 +201,10 @@ def test_selection_changes_once_and_describes_a_leaf_with_the_tables_numbers(sma
     from maizeviz_app.runs import Run
     from maizeviz_app.selection import Selection, describe
 
-    from maizeviz.light.leaf_light import leaf_light
-    from maizeviz.light.painting import sun_painting
-    from maizeviz.light.request import LightRequest, Sampling
-    from maizeviz.light.sun import Sun
-    from maizeviz.light.transmission import trace_light
+    from maizeviz.light.results.painting import sun_painting
+    from maizeviz.light.scene.request import LightRequest, Sampling
+    from maizeviz.light.sources.sun import Sun
+    from maizeviz.light.trace.direct import trace_light
 
     sel = Selection()
     seen = []
@@ -219,7 +218,7 @@ def test_selection_changes_once_and_describes_a_leaf_with_the_tables_numbers(sma
                                          classes=True))
     painting = sun_painting(c, result)
     run = Run("36 triangles", (1, "36 triangles"), result, painting.classes, painting=painting)
-    for row in leaf_light(c, result)[:6]:
+    for row in result.leaf_rows(c)[:6]:
         lines = describe(c, "36 triangles", [run], int(row["instance"]) - 1, int(row["leaf"]))
         assert lines[0].startswith(f"plant {row['plant']}, leaf {row['leaf']} (stand "
                                    f"{row['instance']}")

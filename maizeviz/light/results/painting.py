@@ -5,8 +5,9 @@ A sun is traced with rays on a lattice over the sample rectangle (``density`` ra
 ground). A leaf triangle of area ``a`` whose normal makes the angle theta with the sun, under a
 sun at zenith z, casts a shadow of ``a |cos theta| / cos z`` cm2 on the ground and so expects
 ``density * a |cos theta| / cos z`` rays. When that is well below one, most triangles of a
-sunlit leaf get no ray and their class (:func:`maizeviz.light.leaf_light.triangle_light`) reads
-"no direct light" though the leaf is in the sun: at K = 4 and 2 rays/cm2 the median triangle
+sunlit leaf get no ray and their class
+(:func:`~maizeviz.light.results.per_leaf.triangle_light`) reads "no direct light" though the
+leaf is in the sun: at K = 4 and 2 rays/cm2 the median triangle
 expects 0.23 rays and 82.5 % of the triangles are classed unlit (9.8 % direct), against 26 %
 unlit at 36 triangles a leaf, whose median triangle expects 12. A leaf's sunlit share (the
 rays' lit area over the leaf, the quantity of the per-leaf table) stays an honest estimate at
@@ -27,8 +28,8 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
-from maizeviz.light.leaf_light import NOT_TRACED, tile_representatives, triangle_light
-from maizeviz.light.transmission import LightResult
+from maizeviz.light.results.direct import LightResult
+from maizeviz.light.results.per_leaf import NOT_TRACED, tile_representatives
 from maizeviz.mesh.tessellate import triangle_areas_normals
 
 #: Rays the median leaf triangle must expect for the triangles to be painted one by one.
@@ -44,7 +45,7 @@ class SunPainting:
     Attributes
     ----------
     classes : (F,) int8, each leaf triangle's light class (2 direct, 1 second class, 0 none,
-        -1 not traced; :func:`~maizeviz.light.leaf_light.triangle_light`)
+        -1 not traced; :meth:`~maizeviz.light.results.direct.LightResult.triangle_light`)
     share : (F,) float32, the sunlit share of each triangle's leaf, 0 to 1 (NaN where no
         traced ray could reach the leaf)
     rays_per_triangle : the rays the median leaf triangle expects (see the module docstring)
@@ -96,13 +97,14 @@ def _expected(result: LightResult, area: np.ndarray, normals: np.ndarray) -> np.
 def leaf_sunlit_share(canopy: Canopy, result: LightResult,
                       classes: np.ndarray | None = None) -> np.ndarray:
     """(F,) float32: for each leaf triangle, the sunlit share of its leaf, the sunlit area of
-    :func:`~maizeviz.light.leaf_light.leaf_light` (ray count x footprint / |cos theta| over the
-    leaf's triangles, its plant's copies in a tile-periodic field together) over the leaf's
-    area that traced rays could reach, capped at 1; NaN for a leaf no traced ray could reach.
+    :func:`~maizeviz.light.results.per_leaf.leaf_light` (ray count x footprint / |cos theta|
+    over the leaf's triangles, its plant's copies in a tile-periodic field together) over the
+    leaf's area that traced rays could reach, capped at 1; NaN for a leaf no traced ray could
+    reach.
     ``classes``: the triangles' classes when already made (their -1 marks untraced)."""
     if result.first_hits is None:
         raise MaizevizError("hit classes were not traced")
-    classes = triangle_light(canopy, result) if classes is None else classes
+    classes = result.triangle_light(canopy) if classes is None else classes
     area, normals = triangle_areas_normals(canopy.vertices, canopy.faces)
     return _share(canopy, result, classes, area, normals)
 
@@ -139,7 +141,7 @@ def sun_painting(canopy: Canopy, result: LightResult) -> SunPainting:
     """How to paint ``result`` (a sun traced with hit classes) on ``canopy``."""
     if result.first_hits is None:
         raise MaizevizError("hit classes were not traced")
-    classes = triangle_light(canopy, result)
+    classes = result.triangle_light(canopy)
     area, normals = triangle_areas_normals(canopy.vertices, canopy.faces)
     share = _share(canopy, result, classes, area, normals)
     rays = _expected(result, area, normals)[classes != NOT_TRACED]
