@@ -1011,6 +1011,31 @@ class MainWindow(QMainWindow):
                  f"{sun.azimuth_deg:.2f}°")
 
     # ------------------------------------------------------------------ view
+    def choose_view_image(self) -> None:
+        """File > Save view as image: ask the width and the file, then save."""
+        if self.viewport is None:
+            return
+        from maizeviz_app.snapshot import ask_view_image
+
+        chosen = ask_view_image(self, self.viewport, self._folder())
+        if chosen is not None:
+            self.save_view_image(*chosen)
+
+    def save_view_image(self, path: str | Path, width: int | None = None) -> None:
+        """The 3D view as a PNG ``width`` pixels wide (None: the view's), with its colour key
+        (:mod:`maizeviz_app.snapshot`)."""
+        if self.viewport is None:
+            return
+        from maizeviz_app.snapshot import save_view_image
+
+        try:
+            written = save_view_image(self.viewport, path, width)
+        except (MaizevizError, OSError, ValueError) as exc:
+            self._fail(exc, "export")
+            return
+        self.say(f"saved the view as {written}")
+        self.saved.emit(str(written))
+
     def camera(self, name: str) -> None:
         if self.viewport is not None:
             self.viewport.camera_preset(name)
@@ -1038,7 +1063,7 @@ class MainWindow(QMainWindow):
         pending, self._view_pending = self._view_pending, None
         if pending is not None:
             self.viewport.show_canopy(*pending)
-            self.viewport.camera_preset("perspective")
+            self.viewport.camera_preset("reset")
         else:
             self.viewport.restore_canopy()
         self._light_to_view()

@@ -36,7 +36,14 @@ from PySide6.QtWidgets import QWidget
 from pyvistaqt import QtInteractor
 
 from maizeviz_app.colour import tick_text
-from maizeviz_app.options import CAMERAS, COLOURINGS, LIGHT_CLASSES, NOT_TRACED, STALK
+from maizeviz_app.options import (
+    CAMERA_ALIASES,
+    CAMERAS,
+    COLOURINGS,
+    LIGHT_CLASSES,
+    NOT_TRACED,
+    STALK,
+)
 from maizeviz_app.picking import Pick, make_pickable, part_bounds, part_mesh, pick
 
 #: Text alignments of the painted axes and legends.
@@ -316,7 +323,7 @@ class Viewport(QtInteractor):
             self.colouring = "leaf"
         self._apply_colouring()
         if not self._framed:
-            self.camera_preset("perspective")
+            self.camera_preset("reset")
             self._framed = True
         self.render()
         self.canopy_set.emit()
@@ -516,23 +523,28 @@ class Viewport(QtInteractor):
 
     # ------------------------------------------------------------------ camera
     def camera_preset(self, name: str) -> None:
-        """``top``, ``along`` (looking along the rows, +y), ``across`` (along +x) or
-        ``perspective``; frames the canopy."""
+        """``top``, ``front`` (looking along the rows, +y), ``side`` (across them, +x),
+        ``iso`` (from the south-west corner, 45 degrees up) or ``reset`` (the view a canopy
+        first opens in: from the south-west, above, so that the ground's labels read the right
+        way up); each frames the canopy. The earlier names ``along``, ``across`` and
+        ``perspective`` are understood."""
+        name = CAMERA_ALIASES.get(name, name)
         if name not in CAMERAS:
             raise ValueError(f"unknown camera preset {name}")
         cam = self.camera
         if name == "top":
             self.view_xy(render=False)
-        elif name == "along":
+        elif name == "front":
             self.view_xz(render=False)
-        elif name == "across":
-            self.view_yz(render=False)
+        elif name == "side":
+            self.view_yz(negative=True, render=False)
+        elif name == "iso":
+            self.view_vector((-1.0, -1.0, np.sqrt(2.0)), viewup=(0, 0, 1), render=False)
         else:
-            # from the south-west, above: the ground's labels read the right way up
             self.view_vector((-0.75, -1.3, 0.95), viewup=(0, 0, 1), render=False)
         cam.SetParallelProjection(False)
         self.reset_camera(render=False)
-        if name == "perspective":
+        if name == "reset":
             cam.Zoom(1.25)
         self.render()
 
@@ -554,7 +566,7 @@ class Viewport(QtInteractor):
         self._clear_digitizing()
         if self.canopy_mesh is not None and self._layout is not None:
             self.show_canopy(_Shown(self._layout), self.canopy_mesh)
-            self.camera_preset("perspective")
+            self.camera_preset("reset")
         self.render()
 
     def _clear_digitizing(self) -> None:
