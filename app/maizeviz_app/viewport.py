@@ -26,6 +26,7 @@ Touch the widget from the GUI thread only.
 
 from __future__ import annotations
 
+import threading
 import time
 
 import numpy as np
@@ -56,7 +57,9 @@ _PLANT_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564
 
 def canopy_polydata(canopy) -> pv.PolyData:
     """One mesh of a :class:`~maizeviz.canopy.scene.Canopy`'s leaves and stalks (float32
-    vertices, cm) with the cell data listed in the module docstring. Safe off the GUI thread."""
+    vertices, cm) with the cell data listed in the module docstring, its ground made too
+    (:func:`ground_for`). Safe off the GUI thread."""
+    _prepare_ground(canopy.layout)
     return _settle(_polydata(canopy, canopy.vertices, canopy.faces, canopy.face_plant,
                              canopy.face_instance, canopy.face_leaf))
 
@@ -186,6 +189,7 @@ def display_polydata(canopy, coarse, fine: np.ndarray | None = None) -> pv.PolyD
     poly.field_data["canopy_leaf"] = inv.astype(np.int32)
     poly.field_data["leaf_first"] = first.astype(np.int64)
     poly.field_data["drawn_leaf"] = np.where(uniq[pos] == want, pos, -1).astype(np.int64)
+    _prepare_ground(canopy.layout)
     return _settle(poly)
 
 
@@ -506,19 +510,14 @@ class Viewport(QtInteractor):
     # ------------------------------------------------------------------ ground
     def _set_ground(self, layout) -> None:
         """The ground: the field with its plant cells as a grid, and the x and y axes with
-        cm labels in a margin around it, all one textured rectangle (one cheap draw)."""
-        bounds = tuple(round(v, 6) for v in layout.bounds) + (layout.row_spacing,
-                                                              layout.plant_spacing)
-        if bounds == self._ground_bounds:
+        cm labels in a margin around it, all one textured rectangle (one cheap draw); made by
+        the worker that made the canopy's mesh when it could (:func:`ground_for`)."""
+        key = _ground_key(layout)
+        if key == self._ground_bounds:
             return
-        self._ground_bounds = bounds
-        x0, y0, x1, y1, rs, ps = bounds
-        margin = max(25.0, 0.09 * max(x1 - x0, y1 - y0))
-        gx0, gy0, gx1, gy1 = x0 - margin, y0 - margin, x1 + margin, y1 + margin
-        ground = pv.Plane(center=((gx0 + gx1) / 2, (gy0 + gy1) / 2, -0.05),
-                          i_size=gx1 - gx0, j_size=gy1 - gy0)
-        image = ground_image((x0, y0, x1, y1), margin, _ticks(x0, x1, rs), _ticks(y0, y1, ps))
-        self.add_mesh(ground, name="ground", texture=pv.Texture(image), render=False,
+        self._ground_bounds = key
+        ground, texture = ground_for(layout)
+        self.add_mesh(ground, name="ground", texture=texture, render=False,
                       pickable=False, lighting=False)
 
     # ------------------------------------------------------------------ camera
@@ -704,19 +703,29 @@ class Viewport(QtInteractor):
 
     def highlight(self, instance: int, leaf: int = -1) -> bool:
         """Draw placement ``instance``'s leaf ``leaf`` (or the whole plant, -1) highlighted,
-        over the canopy; a negative ``instance`` clears. False if none of it is drawn."""
-        self.remove_actor("selection", render=False)
+        over the canopy; a negative ``instance`` clears. False if none of it is drawn. One
+        actor, made once, takes each selection's triangles (a new actor per click costs
+        pyvista's set-up, 5-50 ms)."""
         part = None
         if instance >= 0 and self.canopy_mesh is not None:
             part = part_mesh(self.canopy_mesh, instance, leaf)
-        if part is not None:
+        actor = self.actors.get("selection")
+        if part is None:
+            if actor is not None and actor.GetVisibility():
+                actor.SetVisibility(False)
+                self.render()
+            return False
+        if actor is None:
             actor = self.add_mesh(part, name="selection", color=self.HIGHLIGHT, render=False,
                                   reset_camera=False, pickable=False, lighting=True)
             # drawn over the canopy's same triangles, not fighting them for the pixels
             actor.mapper.SetResolveCoincidentTopologyToPolygonOffset()
             actor.mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(-2.0, -2.0)
+        else:
+            actor.mapper.dataset = part
+        actor.SetVisibility(True)
         self.render()
-        return part is not None
+        return True
 
     def frame_part(self, instance: int, leaf: int = -1) -> bool:
         """Point the camera at placement ``instance`` (its leaf ``leaf``), keeping its
@@ -791,6 +800,48 @@ class _Shown:
         self.layout = layout
 
 
+#: Grounds made for the last few layouts (key -> plane, texture), by the workers that make the
+#: canopies' meshes, so that a new field's first frame does not wait for its texture (50-150
+#: ms of painting and copying on the GUI thread).
+_GROUNDS: dict[tuple, tuple[pv.PolyData, pv.Texture]] = {}
+_GROUNDS_LOCK = threading.Lock()
+
+
+def _ground_key(layout) -> tuple:
+    return tuple(round(v, 6) for v in layout.bounds) + (layout.row_spacing,
+                                                        layout.plant_spacing)
+
+
+def ground_for(layout) -> tuple[pv.PolyData, pv.Texture]:
+    """The ground plane and its texture (:func:`ground_image`) of ``layout``'s field, made
+    once per field (any thread: the texture is painted on a QImage)."""
+    key = _ground_key(layout)
+    with _GROUNDS_LOCK:
+        made = _GROUNDS.get(key)
+    if made is not None:
+        return made
+    x0, y0, x1, y1, rs, ps = key
+    margin = max(25.0, 0.09 * max(x1 - x0, y1 - y0))
+    gx0, gy0, gx1, gy1 = x0 - margin, y0 - margin, x1 + margin, y1 + margin
+    ground = pv.Plane(center=((gx0 + gx1) / 2, (gy0 + gy1) / 2, -0.05),
+                      i_size=gx1 - gx0, j_size=gy1 - gy0)
+    image = ground_image((x0, y0, x1, y1), margin, _ticks(x0, x1, rs), _ticks(y0, y1, ps))
+    made = (ground, pv.Texture(image))
+    with _GROUNDS_LOCK:
+        while len(_GROUNDS) >= 4:
+            _GROUNDS.pop(next(iter(_GROUNDS)))
+        _GROUNDS[key] = made
+    return made
+
+
+def _prepare_ground(layout) -> None:
+    """Make ``layout``'s ground ahead (a worker, where an application exists to paint text)."""
+    from PySide6.QtGui import QGuiApplication
+
+    if QGuiApplication.instance() is not None:
+        ground_for(layout)
+
+
 def _ticks(lo: float, hi: float, step: float) -> np.ndarray:
     """Grid positions from ``lo`` to ``hi`` every ``step`` (both ends included)."""
     n = int(np.floor((hi - lo) / step + 1e-9))
@@ -805,7 +856,7 @@ def ground_image(field: tuple[float, float, float, float], margin: float, xs: np
     """The ground texture (h, w, 4) uint8, row 0 at the largest y (as pyvista maps an image
     on a plane): the field (tan) with grid
     lines at ``xs`` / ``ys`` (cm), and a ``margin`` (cm) carrying the tick labels in cm and
-    the axis names. GUI thread (QPainter)."""
+    the axis names. Any thread (QPainter on a QImage), once an application exists."""
     x0, y0, x1, y1 = field
     width_cm, height_cm = x1 - x0 + 2 * margin, y1 - y0 + 2 * margin
     scale = min(4.0, max_px / max(width_cm, height_cm))
