@@ -13,6 +13,7 @@ from PySide6.QtWidgets import (
     QGroupBox,
     QHBoxLayout,
     QLabel,
+    QSizePolicy,
     QVBoxLayout,
     QWidget,
 )
@@ -22,9 +23,12 @@ from maizeviz_app.colour import CMAPS, PAINTINGS, RANGES, ColourError, ColourSca
 
 def _named(widget: QWidget, name: str, tip: str) -> QWidget:
     """A control with its accessible name (what screen readers say, and tests find it by) and
-    tooltip."""
+    tooltip; a combo box as narrow as the dock needs (its longest choice may be cut)."""
     widget.setAccessibleName(name)
     widget.setToolTip(tip)
+    if isinstance(widget, QComboBox):
+        widget.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
+        widget.setMinimumContentsLength(8)
     return widget
 
 
@@ -38,6 +42,7 @@ class ScaleEditor(QGroupBox):
         self.scale = scale
         self._shown: tuple[float, float] | None = None
         self.form = form = QFormLayout(self)
+        form.setRowWrapPolicy(QFormLayout.RowWrapPolicy.WrapLongRows)
         form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
         self.range = QComboBox()
         for key, text in RANGES.items():
@@ -50,15 +55,18 @@ class ScaleEditor(QGroupBox):
         self.vmin, self.vmax = QDoubleSpinBox(), QDoubleSpinBox()
         for box, end in ((self.vmin, "min"), (self.vmax, "max")):
             box.setDecimals(4)
-            box.setRange(-1e9, 1e9)
+            box.setRange(-1e6, 1e6)
             box.setKeyboardTracking(False)          # applied on Enter or leaving the field
             box.setSingleStep(0.05)
+            box.setMinimumWidth(70)
+            box.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
             verb = "starts" if end == "min" else "ends"
             _named(box, f"{title} {end}", f"the value the colour map {verb} at (a typed "
                                           "range); values beyond take the end colour")
-            limits.addWidget(QLabel(end))
             limits.addWidget(box, 1)
-        form.addRow("Limits", limits)
+        dash = QLabel("to")
+        limits.insertWidget(1, dash)
+        form.addRow("Min, max", limits)
         self.clip = QDoubleSpinBox()
         self.clip.setRange(0.0, 49.0)
         self.clip.setDecimals(1)
@@ -67,7 +75,7 @@ class ScaleEditor(QGroupBox):
         _named(self.clip, f"{title} clip", "percent of the values left out at each end "
                                            "(percentile clip): a few bright or dark bins do "
                                            "not flatten the rest")
-        form.addRow("Clip at each end", self.clip)
+        form.addRow("Clip each end", self.clip)
         self.cmap = QComboBox()
         self.cmap.addItems(list(CMAPS))
         _named(self.cmap, f"{title} colour map",
