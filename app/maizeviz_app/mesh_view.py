@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pyvista as pv
 
+from maizeviz.ids import groups
 from maizeviz.mesh.cluster import cell_for, cluster_triangles
 from maizeviz.mesh.tessellate import triangle_areas_normals
 from maizeviz_app import viewport
@@ -67,7 +68,7 @@ def simplified(canopy, plants: np.ndarray, triangles: int) -> Coarse:
     triangles (at most 1.1 times that)."""
     mine = np.flatnonzero(plants[canopy.face_instance])
     faces = canopy.faces[mine]
-    group = canopy.face_instance[mine].astype(np.int64) * 10_000 + canopy.face_leaf[mine]
+    _, group = groups(canopy.face_instance[mine], canopy.face_leaf[mine])
     area, _ = triangle_areas_normals(canopy.vertices, faces)
     cell = cell_for(float(area.sum()), triangles)
     for _ in range(4):                          # the estimate is rough: enlarge until it fits

@@ -28,6 +28,7 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
+from maizeviz.ids import groups
 from maizeviz.light.results.direct import LightResult
 from maizeviz.light.results.per_leaf import NOT_TRACED, tile_representatives
 from maizeviz.mesh.tessellate import triangle_areas_normals
@@ -120,18 +121,19 @@ def _share(canopy: Canopy, result: LightResult, classes: np.ndarray, area: np.nd
     first = np.asarray(result.first_hits[:nf], dtype=np.float64)
     rep = tile_representatives(canopy.layout, result.rect, result.periodic)
     inst = canopy.face_instance.astype(np.int64)
-    keys = rep[inst] * 10_000 + canopy.face_leaf
-    # a leaf's triangles lie together: find the runs, and the leaves among the runs' keys (a
-    # sort of thousands of runs, not of millions of triangles)
-    starts = np.flatnonzero(np.r_[True, (keys[1:] != keys[:-1]) | (inst[1:] != inst[:-1])])
-    _, run_leaf = np.unique(keys[starts], return_inverse=True)
+    owner, rank = rep[inst], np.asarray(canopy.face_leaf, np.int64)
+    # a leaf's triangles lie together: find the runs, and the leaves among the runs' (owner,
+    # leaf) pairs (a sort of thousands of runs, not of millions of triangles)
+    starts = np.flatnonzero(np.r_[True, (owner[1:] != owner[:-1]) | (rank[1:] != rank[:-1])
+                                  | (inst[1:] != inst[:-1])])
+    _, run_leaf = groups(owner[starts], rank[starts])
     leaf = np.repeat(run_leaf, np.diff(np.r_[starts, nf]))
     n = int(run_leaf.max()) + 1
     sunlit = np.bincount(leaf, weights=first * lit, minlength=n)
     traced = np.bincount(leaf, weights=np.where(classes >= 0, area, 0.0), minlength=n)
     # the copies of a plant share their light: the leaf's area is one copy's
-    _, pair = np.unique(run_leaf * (int(inst.max()) + 1) + inst[starts], return_index=True)
-    copies = np.bincount(run_leaf[pair], minlength=n)
+    pairs, _ = groups(run_leaf, inst[starts])
+    copies = np.bincount(pairs[:, 0], minlength=n)
     with np.errstate(invalid="ignore", divide="ignore"):
         share = np.where(traced > 0, np.minimum(sunlit / (traced / copies), 1.0), np.nan)
     return share[leaf].astype(np.float32)
