@@ -33,11 +33,13 @@ from maizeviz.light.optics import SHORTWAVE_SHARE, Optics, optics_for
 from maizeviz.light.perez import PEREZ_MODELS, perez_split
 from maizeviz.light.request import LightRequest, Sampling
 from maizeviz.light.scatter import (
+    BATCHES,
     DEFAULT_DEPTH,
     DEFAULT_THRESHOLD,
     AbsorbedLight,
     AbsorbedPeriod,
     Balance,
+    Batches,
     scatter_beam,
 )
 from maizeviz.light.sky import Sky, make_sky
@@ -352,7 +354,12 @@ class LightEngine:
             rank[:self.canopy.n_triangles] = self.canopy.face_leaf
             leaf_optics = opt.per_triangle(rank)
             kept = 1.0 - (leaf_optics[0] + leaf_optics[1])
-        absorbed, sunlit = np.zeros(nf), np.zeros(nf)
+        from scipy.sparse import csr_array
+
+        absorbed, sunlit, direct_t = np.zeros(nf), np.zeros(nf), np.zeros(nf)
+        empty = csr_array((BATCHES, nf))
+        absorbed_b, direct_b, sunlit_b = empty, empty, empty
+        sun_dir = None
         parts = dict.fromkeys(("ground", "top", "sides", "unresolved"), 0.0)
         events, seconds = 0, {"build": build_s, "trace": 0.0, "scatter": 0.0}
         for k, (toward, irradiance) in enumerate(beams):
@@ -361,6 +368,7 @@ class LightEngine:
                                        leaf_optics=leaf_optics)
             per_ray = irradiance * smp.ray_area_cm2 * 1e-4       # W carried by one ray
             absorbed += tally.per_triangle(nf, kept * per_ray)
+            absorbed_b = absorbed_b + tally.per_batch(nf, kept * per_ray)
             if k == 0 and sun is not None and direct > 0:
                 # cm2 of leaf a ray's beam covers: its footprint across the beam over the
                 # cosine of the leaf's tilt to it
@@ -371,6 +379,10 @@ class LightEngine:
                 factor[lit] = smp.ray_area_cm2 * toward[2] / np.maximum(
                     np.abs(normals[lit] @ toward), 1e-6)
                 sunlit = tally.sunlit(nf, factor)
+                direct_b = tally.per_batch(nf, kept * per_ray, first=True)
+                direct_t = np.asarray(direct_b.sum(axis=0)).ravel()
+                sunlit_b = tally.per_batch(nf, factor, first=True)
+                sun_dir = (float(toward[0]), float(toward[1]), float(toward[2]))
             for name in parts:
                 parts[name] += getattr(tally, name) * per_ray
             events += tally.events
@@ -383,7 +395,9 @@ class LightEngine:
                                                                  "unresolved")))
         return AbsorbedLight(opt.band, opt, incident, balance, absorbed, sunlit, rect, smp.n,
                              len(beams), depth, threshold, seed, events, smp_req.periodic,
-                             self.canopy.level, seconds)
+                             self.canopy.level, seconds, triangle_direct_w=direct_t,
+                             batches=Batches(absorbed_b, direct_b, sunlit_b),
+                             sun_direction=sun_dir)
 
     def absorbed_day(self, period: Period | None = None, *, band: str = "par",
                      optics: Optics | None = None, sky: Sky | str = "soc",

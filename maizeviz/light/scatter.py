@@ -58,6 +58,10 @@ DEFAULT_THRESHOLD = 1e-4
 EPS_CM = 1e-3
 #: Primary rays followed together (bounded memory: a few arrays of this length).
 CHUNK_RAYS = 1 << 19
+#: Independent batches the primary rays are dealt into (each ray and all it scatters belong
+#: to one): the spread of the batches' estimates gives each figure's Monte Carlo standard
+#: error (:func:`batch_error`).
+BATCHES = 8
 
 
 @dataclass
@@ -72,10 +76,14 @@ class Tally:
     ground, top, sides, unresolved : float, absorbed by the ground, reflected out of the
         canopy top, escaped sideways (open field), still travelling when tracing stopped
     rays : primary rays; events : scatterings followed
+    leaf_batch, first_batch : int8 arrays beside ``leaf_hits`` and ``first_hits``: the batch
+        of the primary ray each arrival descends from
     """
 
     leaf_hits: list = field(default_factory=list)
     first_hits: list = field(default_factory=list)
+    leaf_batch: list = field(default_factory=list)
+    first_batch: list = field(default_factory=list)
     ground: float = 0.0
     top: float = 0.0
     sides: float = 0.0
@@ -86,6 +94,8 @@ class Tally:
     def add(self, other: Tally) -> None:
         self.leaf_hits += other.leaf_hits
         self.first_hits += other.first_hits
+        self.leaf_batch += other.leaf_batch
+        self.first_batch += other.first_batch
         for name in ("ground", "top", "sides", "unresolved", "rays", "events"):
             setattr(self, name, getattr(self, name) + getattr(other, name))
 
@@ -93,6 +103,22 @@ class Tally:
         """(F,) float64: what each triangle absorbed (``absorbed_share`` of each arrival)."""
         ids = np.concatenate(self.leaf_hits) if self.leaf_hits else np.empty(0, np.int64)
         return np.bincount(ids, minlength=n_triangles) * absorbed_share
+
+    def per_batch(self, n_triangles: int, weight: float | np.ndarray, first: bool = False):
+        """(BATCHES, F) scipy.sparse CSR array: what each batch's rays deposited on each
+        triangle, ``weight`` per arrival (a number, or (F,) per triangle); ``first``: the
+        primary hits only. Rows sum to :meth:`per_triangle`'s (for the same weight)."""
+        from scipy.sparse import csr_array
+
+        hits, batch = (self.first_hits, self.first_batch) if first else \
+            (self.leaf_hits, self.leaf_batch)
+        ids = np.concatenate(hits) if hits else np.empty(0, np.int64)
+        bat = np.concatenate(batch).astype(np.int64) if batch else np.empty(0, np.int64)
+        w = np.broadcast_to(np.asarray(weight, np.float64), (n_triangles,))[ids] \
+            if np.ndim(weight) else np.full(len(ids), float(weight))
+        out = csr_array((w, (bat, ids)), shape=(BATCHES, n_triangles))
+        out.sum_duplicates()
+        return out
 
     def sunlit(self, n_triangles: int, area_factor: np.ndarray) -> np.ndarray:
         """(F,) float64 cm2 in the direct beam: primary hits times each triangle's
@@ -116,10 +142,12 @@ def lambertian(normals: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 
 @dataclass
 class _Rays:
-    """Rays travelling: origins (k, 3) cm, unit directions (k, 3)."""
+    """Rays travelling: origins (k, 3) cm, unit directions (k, 3), the batch (k,) int8 of
+    the primary ray each descends from."""
 
     org: np.ndarray
     dirs: np.ndarray
+    batch: np.ndarray
 
 
 LEAF, GROUND, TOP, SIDES, LOST = range(5)
@@ -185,22 +213,21 @@ def follow(smp: Sampler, rays: _Rays, max_crossings: int = 1000
 
 def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng,
             kind: np.ndarray, prim: np.ndarray, end: np.ndarray, dirs: np.ndarray,
-            leaf_optics: tuple | None = None) -> _Rays:
+            batch: np.ndarray, leaf_optics: tuple | None = None) -> _Rays:
     """Deposit what rays ending at leaves and the ground absorb, count those leaving, and draw
     the rays that go on (Russian roulette on the scattering coefficient); ``leaf_optics``:
     (reflectance, transmittance) per triangle (F,) when leaves differ by rank."""
     leaf = kind == LEAF
     sc = optics.scattering
-    if leaf_optics is not None:
+    if leaf_optics is not None or sc < 1.0:
         tally.leaf_hits.append(prim[leaf])
-    elif sc < 1.0:
-        tally.leaf_hits.append(prim[leaf])
+        tally.leaf_batch.append(batch[leaf])
     ground = kind == GROUND
     tally.ground += np.count_nonzero(ground) * (1.0 - optics.ground_reflectance)
     tally.top += np.count_nonzero(kind == TOP)
     tally.sides += np.count_nonzero(kind == SIDES)
     tally.unresolved += np.count_nonzero(kind == LOST)
-    parts_o, parts_d = [], []
+    parts_o, parts_d, parts_b = [], [], []
     go = np.flatnonzero(leaf)
     if leaf_optics is not None:
         rho_t, tau_t = leaf_optics[0][prim[go]], leaf_optics[1][prim[go]]
@@ -218,6 +245,7 @@ def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng
         side = np.where(reflect[:, None], back, -back)
         parts_o.append(end[go] + EPS_CM * side)
         parts_d.append(lambertian(side, rng))
+        parts_b.append(batch[go])
     up = np.flatnonzero(ground)
     rg = optics.ground_reflectance
     up = up[rng.random(len(up)) < rg] if rg > 0 else up[:0]
@@ -227,9 +255,10 @@ def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng
         o[:, 2] = EPS_CM
         parts_o.append(o)
         parts_d.append(lambertian(zplus, rng))
+        parts_b.append(batch[up])
     if not parts_o:
-        return _Rays(np.empty((0, 3)), np.empty((0, 3)))
-    return _Rays(np.vstack(parts_o), np.vstack(parts_d))
+        return _Rays(np.empty((0, 3)), np.empty((0, 3)), np.empty(0, np.int8))
+    return _Rays(np.vstack(parts_o), np.vstack(parts_d), np.concatenate(parts_b))
 
 
 def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.ndarray,
@@ -265,6 +294,8 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
     chunks = [(a, min(a + CHUNK_RAYS, n)) for a in range(0, n, CHUNK_RAYS)]
     first_prim = primary.first_prim
     assert first_prim is not None
+    # primary rays dealt into equal batches at random (the same whatever ``threads``)
+    batches = (np.random.default_rng([seed, 0xBA7C]).permutation(n) % BATCHES).astype(np.int8)
 
     def chunk(k_ab: tuple[int, tuple[int, int]]) -> Tally:
         k, (a, b) = k_ab
@@ -280,15 +311,18 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
         end[:, :2] = g + s[:2] * (height / s[2])[:, None]
         end[:, 2] = height
         tally.first_hits.append(prim[hit])
+        batch = batches[a:b]
+        tally.first_batch.append(batch[hit])
         dirs = np.broadcast_to(-s, (b - a, 3))
-        rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, dirs, leaf_optics)
+        rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, dirs, batch,
+                       leaf_optics)
         for _ in range(depth):
             if len(rays.org) <= threshold * (b - a):
                 break
             tally.events += len(rays.org)
             kind, prim, end = follow(smp, rays)
             rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, rays.dirs,
-                           leaf_optics)
+                           rays.batch, leaf_optics)
         tally.unresolved += len(rays.org)
         return tally
 
@@ -300,6 +334,49 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
     for part in ordered_map(chunk, list(enumerate(chunks)), threads, done, stop):
         total.add(part)
     return total, {"trace": t1 - t0, "scatter": time.perf_counter() - t1}
+
+
+def batch_error(per_batch) -> float | np.ndarray:
+    """Monte Carlo standard error of a total from its batches' shares.
+
+    Parameters
+    ----------
+    per_batch : (BATCHES, ...) float64, what each batch's rays contributed to the total (the
+        rows sum to the estimate)
+
+    Returns
+    -------
+    standard error of the estimate (same unit, shape ``per_batch.shape[1:]``): the batches
+    are independent estimates ``BATCHES x row``, whose mean is the estimate; its standard
+    error is their standard deviation over ``sqrt(BATCHES)``.
+    """
+    x = np.asarray(per_batch, dtype=np.float64)
+    k = x.shape[0]
+    return np.std(k * x, axis=0, ddof=1) / np.sqrt(k)
+
+
+@dataclass(frozen=True)
+class Batches:
+    """Per-batch shares of an absorbed-light result (each row one batch; rows sum to the
+    result's per-triangle arrays): what standard errors are computed from.
+
+    Attributes
+    ----------
+    absorbed : (BATCHES, F) scipy.sparse CSR array, W (or J over a period) per triangle
+    direct : (BATCHES, F) the part of ``absorbed`` from the sun's direct beam
+    sunlit_cm2 : (BATCHES, F) area in the direct beam, cm2
+    """
+
+    absorbed: Any
+    direct: Any
+    sunlit_cm2: Any
+
+    def error(self, weights=None, what: str = "absorbed") -> float:
+        """Standard error of ``sum(weights * what)`` over the triangles (weights (F,), None:
+        all 1)."""
+        m = getattr(self, what)
+        per = m.sum(axis=1) if weights is None else m @ np.asarray(weights, np.float64)
+        return float(batch_error(np.asarray(per)))
 
 
 @dataclass(frozen=True)
@@ -381,8 +458,20 @@ class AbsorbedLight:
     periodic: bool
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
+    triangle_direct_w: np.ndarray | None = None
+    batches: Batches | None = None
+    sun_direction: tuple[float, float, float] | None = None
 
     fraction_absorbed = property(_fraction_absorbed)
+
+    @property
+    def absorbed_leaves_error(self) -> float | None:
+        """Monte Carlo standard error of ``balance.absorbed_leaves`` (W/m2 of ground), from
+        independent batches of rays; None when the result was not traced in batches."""
+        total = float(self.triangle_absorbed_w.sum())
+        if self.batches is None or total <= 0:
+            return None if self.batches is None else 0.0
+        return self.batches.error() * self.balance.absorbed_leaves / total
 
     def table(self, by: str = "plant", canopy=None):
         """Absorbed light per leaf or per plant as a pandas DataFrame.
