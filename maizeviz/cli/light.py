@@ -41,6 +41,7 @@ from maizeviz.errors import LeafError, MaizevizError, check_range
 from maizeviz.io.atomic import file_tag, make_folder, write_rows
 from maizeviz.io.outputs import OutputFolder, check_run_paths
 from maizeviz.leaf.fit import Leaf
+from maizeviz.light.assimilation import assimilate
 from maizeviz.light.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping
 from maizeviz.light.daylight import PeriodLight, SkyLight
 from maizeviz.light.engine import LightEngine
@@ -64,6 +65,7 @@ from maizeviz.light.sky import SKY_KINDS, Sky, make_sky
 from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import LightResult
 from maizeviz.mesh.levels import CANOPY_LEVELS
+from maizeviz.photosynthesis.split import MODELS, LeafModel, leaf_model
 
 #: The subcommand.
 NAME = "light"
@@ -166,14 +168,59 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ab.add_argument("--depth", type=int, default=None, metavar="N",
                     help=f"most scatterings followed per ray (default {DEFAULT_DEPTH})")
     ab.add_argument("--seed", type=int, default=None, help="random seed (default 0)")
+    ph = p.add_argument_group(
+        "photosynthesis from the absorbed PAR (turns absorbed light on; the sun, or a period)")
+    ph.add_argument("--photosynthesis", choices=MODELS, default=None,
+                    help="leaf model: c4 (Collatz et al. 1992, maize) or wofost (negative "
+                         "exponential)")
+    ph.add_argument("--amax", type=float, default=None, metavar="KG_HA_H",
+                    help="wofost: gross assimilation at light saturation, kg CO2/ha leaf/h "
+                         "(default 70)")
+    ph.add_argument("--eff", type=float, default=None, metavar="KG_HA_H_PER_W_M2",
+                    help="wofost: initial light use efficiency, kg CO2/ha/h per J/m2/s of "
+                         "absorbed PAR (default 0.45)")
+    ph.add_argument("--vmax", type=float, default=None, metavar="UMOL_M2_S",
+                    help="c4: Rubisco capacity at 25 C, umol/m2/s (default 39)")
+    ph.add_argument("--alpha", type=float, default=None, metavar="MOL_MOL",
+                    help="c4: quantum yield, mol CO2 per mol of absorbed photons "
+                         "(default 0.04)")
+    ph.add_argument("--co2", type=float, default=None, metavar="PPM",
+                    help="c4: ambient CO2, umol/mol (default 400; intercellular 0.4 of it)")
+    ph.add_argument("--temperature", type=float, default=None, metavar="C",
+                    help="air (leaf) temperature, C (default 25; a weather file's own air "
+                         "temperature when it has one)")
     p.set_defaults(run=run)
 
 
 def _absorbed_asked(args: argparse.Namespace) -> bool:
     return any(v is not None for v in (args.band, args.reflectance, args.transmittance,
                                         args.ground_reflectance, args.irradiance,
-                                        args.optics_table, args.depth, args.seed)) or \
-        bool(args.diffuse)
+                                        args.optics_table, args.depth, args.seed,
+                                        args.photosynthesis)) or bool(args.diffuse)
+
+
+def _leaf_model_from(args: argparse.Namespace) -> LeafModel | None:
+    """The leaf model ``--photosynthesis`` names, with its flags; refuses another model's
+    flags and photosynthesis from NIR."""
+    own = {"c4": ("vmax", "alpha", "co2"), "wofost": ("amax", "eff")}
+    given = [k for k in ("vmax", "alpha", "co2", "amax", "eff", "temperature")
+             if getattr(args, k) is not None]
+    if args.photosynthesis is None:
+        if given:
+            raise MaizevizError(f"--{given[0]} is a parameter of leaf photosynthesis: add "
+                                "--photosynthesis c4 or wofost", quantity="photosynthesis")
+        return None
+    other = [k for k in given if k != "temperature" and k not in own[args.photosynthesis]]
+    if other:
+        raise MaizevizError(f"--{other[0]} is not a parameter of the {args.photosynthesis} "
+                            "model", quantity="photosynthesis")
+    if args.band == "nir":
+        raise MaizevizError("photosynthesis works from absorbed PAR: give no --band nir",
+                            quantity="band")
+    if args.temperature is not None:
+        check_range(args.temperature, "the air temperature (C)", -50, 70, "temperature")
+    return leaf_model(args.photosynthesis, vmax=args.vmax, alpha=args.alpha,
+                      co2_ppm=args.co2, amax=args.amax, eff=args.eff)
 
 
 # ------------------------------------------------------------------------------ what is asked
@@ -292,6 +339,9 @@ def run(args: argparse.Namespace) -> int:
                                 quantity="irradiance")
         absorbed_optics = optics_for(args.band or "par", args.reflectance, args.transmittance,
                                      args.ground_reflectance)
+    leaf_model_ = _leaf_model_from(args)
+    temp_c = 25.0 if args.temperature is None else args.temperature
+    if absorbed_optics is not None:
         if args.optics_table is not None:
             absorbed_optics = replace(absorbed_optics, ranks=read_optics_table(
                 args.optics_table, absorbed_optics.band))
@@ -362,6 +412,7 @@ def run(args: argparse.Namespace) -> int:
                                "seconds": {"canopy": canopy_s, "scene": scene_s}}
         warnings: list[str] = []
         tables: list[list[dict]] = []
+        plant_extra: dict[int, dict[str, float]] = {}
         res = sky_res = per_res = None
         if sun is not None:
             res = engine.sun(sun, classes=want_rows or len(labels) == 1,
@@ -407,11 +458,20 @@ def run(args: argparse.Namespace) -> int:
             abd = engine.absorbed_day(period, optics=absorbed_optics,
                                       sky=args.sky or "soc",
                                       directions=args.sky_directions or 46, depth=args.depth,
-                                      seed=args.seed,
+                                      seed=args.seed, photosynthesis=leaf_model_,
+                                      temperature_c=temp_c,
                                       progress=Progress(f"absorbed light over the period, "
                                                         f"{label}"))
             rec["balance"] = dict(abd.balance.as_dict(), units="MJ/m2 of ground")
             rec["absorbed"] = _absorbed_period_record(abd)
+            if abd.assimilation is not None:
+                rec["photosynthesis"] = abd.assimilation.as_dict()
+                if want_rows:
+                    tables.append(_assimilation_rows(canopy, abd.assimilation))
+                    _merge(plant_extra, _plant_errors(canopy, abd.assimilation))
+            if want_rows:
+                tables.append(_assimilation_rows(canopy, abd))
+                _merge(plant_extra, _plant_errors(canopy, abd))
             rec["seconds"]["scatter"] = abd.seconds.get("trace", 0.0) + \
                 abd.seconds.get("scatter", 0.0)
         elif absorbed_optics is not None:
@@ -424,12 +484,24 @@ def run(args: argparse.Namespace) -> int:
             rec["seconds"]["scatter"] = ab.seconds["trace"] + ab.seconds["scatter"]
             if want_rows:
                 tables.append(absorbed_leaf_rows(canopy, ab))
+                _merge(plant_extra, _plant_errors(canopy, ab))
+            if leaf_model_ is not None:
+                asm = assimilate(canopy, ab, leaf_model_, temp_c)
+                rec["photosynthesis"] = asm.as_dict()
+                for w in asm.warnings:
+                    if w not in said:
+                        said.add(w)
+                        say(f"warning: {w}")
+                if want_rows:
+                    tables.append(_assimilation_rows(canopy, asm))
+                    _merge(plant_extra, _plant_errors(canopy, asm))
         if sun is None:
             rays = per_res.rays if per_res else sky_res.rays if sky_res else 0
             x0, y0, x1, y1 = per_res.rect if per_res else sky_res.rect if sky_res else (0, 0, 1, 1)
             rec.update(sun=None, transmission=None, rays=rays, rect_cm=[x0, y0, x1, y1],
                        density_per_cm2=rays / ((x1 - x0) * (y1 - y0)))
-        _write_outputs(args, canopy, label, len(labels), res, sky_res, per_res, tables)
+        _write_outputs(args, canopy, label, len(labels), res, sky_res, per_res, tables,
+                       plant_extra)
         records.append(rec)
 
     if args.json:
@@ -452,8 +524,11 @@ def _absorbed_record(ab: AbsorbedLight, canopy: Canopy) -> dict[str, Any]:
         "sunlit_lai": _sunlit_m2(ab, canopy),
         "rays": ab.rays, "directions": ab.directions, "depth": ab.depth, "seed": ab.seed,
         "scatterings": ab.events}
+    se = ab.absorbed_leaves_error
+    out["absorbed_leaves_se"] = se
     if ab.band == "par":
         out["absorbed_leaves_umol_m2_s"] = ab.balance.absorbed_leaves * PAR_UMOL_PER_J_PAR
+        out["absorbed_leaves_umol_m2_s_se"] = None if se is None else se * PAR_UMOL_PER_J_PAR
     return out
 
 
@@ -468,9 +543,33 @@ def _absorbed_period_record(ab) -> dict[str, Any]:
         "seed": ab.seed,
         "step_absorbed_leaves_w_m2": [float(w) for w in ab.step_absorbed_leaves_w_m2],
         "step_incident_w_m2": [float(w) for w in ab.step_incident_w_m2]}
+    se = ab.absorbed_leaves_error
+    out["absorbed_leaves_se"] = se
     if ab.band == "par":
         out["absorbed_leaves_mol_m2"] = ab.absorbed_leaves_mol_m2
+        out["absorbed_leaves_mol_m2_se"] = None if se is None else se * PAR_UMOL_PER_J_PAR
     return out
+
+
+def _assimilation_rows(canopy: Canopy, asm: Any) -> list[dict]:
+    """Leaf rows of a result's leaf table (an Assimilation, PeriodAssimilation or
+    AbsorbedPeriod) for the command line's leaf table."""
+    frame = asm.table("leaf", canopy)
+    return [] if frame.empty else frame.to_dict("records")
+
+
+def _merge(into: dict[int, dict[str, float]], more: dict[int, dict[str, float]]) -> None:
+    for k, v in more.items():
+        into.setdefault(k, {}).update(v)
+
+
+def _plant_errors(canopy: Canopy, result: Any) -> dict[int, dict[str, float]]:
+    """Standard errors per plant (instance): columns ending ``_se`` of ``result``'s plant
+    table (absorbed light or assimilation)."""
+    frame = result.table("plant", canopy)
+    cols = [c for c in frame.columns if c.endswith("_se")]
+    return {int(r["instance"]): {c: float(r[c]) for c in cols}
+            for r in frame.to_dict("records")}
 
 
 def _sunlit_m2(ab: AbsorbedLight, canopy: Canopy) -> float:
@@ -594,7 +693,8 @@ def _check_paths(args: argparse.Namespace, labels: list[str], sun: bool,
 
 def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_levels: int,
                    res: LightResult | None, sky: SkyLight | None, pl: PeriodLight | None,
-                   tables: list[list[dict]]) -> None:
+                   tables: list[list[dict]],
+                   plant_extra: dict[int, dict[str, float]] | None = None) -> None:
     if args.heatmaps:
         folder = make_folder(args.heatmaps)
         n = 0
@@ -624,7 +724,10 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
         if args.leaf_light:
             write_rows(level_path(args.leaf_light, label, n_levels), rows)
         if args.plant_light:
-            write_rows(level_path(args.plant_light, label, n_levels), plant_light(rows))
+            plants = plant_light(rows)
+            for r in plants:            # standard errors do not add: computed per plant
+                r.update((plant_extra or {}).get(int(r["instance"]), {}))
+            write_rows(level_path(args.plant_light, label, n_levels), plants)
 
 
 # ------------------------------------------------------------------------------ tables
@@ -640,6 +743,8 @@ def _print_tables(records: list[dict], sun: Sun | None, heights: tuple[float, ..
             _print_period(r, len(records) > 1)
     if "balance" in r0:
         _print_balance(records)
+    if r0.get("photosynthesis"):
+        _print_photosynthesis(records)
     print()
     t_ref = _cost(r0)
     cols = ["level", "triangles", "canopy s", "scene s"]
@@ -758,6 +863,30 @@ def _print_period(r: dict, label: bool) -> None:
                      for i, (h, v, f) in enumerate(zip(tb["heights_cm"], tb["par_mol_m2"],
                                                        tb["fraction"]))]))
     print()
+
+
+def _print_photosynthesis(records: list[dict]) -> None:
+    """Canopy gross assimilation per level, with its Monte Carlo standard error."""
+    ph = records[0]["photosynthesis"]
+    period = "canopy_gross_mol_m2" in ph
+    params = ", ".join(f"{k} {v:g}" for k, v in ph["parameters"].items()
+                       if k in ("vmax", "alpha", "co2_ppm", "amax", "eff"))
+    print(f"\ngross CO2 assimilation, {ph['model']} leaf model ({params}), per m2 of ground"
+          + ("" if period else f", leaves at {ph['temperature_c']:g} C") + ":")
+    rows = []
+    for r in records:
+        p = r["photosynthesis"]
+        if period:
+            se = p["canopy_gross_mol_m2_se"] or 0.0
+            rows.append([r["level"], f"{p['canopy_gross_mol_m2']:.4f} +- {se:.4f}",
+                         f"{p['canopy_gross_g_co2_m2']:.2f} +- {se * 44.0095:.2f}"])
+        else:
+            se = p["canopy_gross_umol_m2_s_se"] or 0.0
+            rows.append([r["level"], f"{p['canopy_gross_umol_m2_s']:.2f} +- {se:.2f}",
+                         f"{p['canopy_gross_kg_co2_ha_h']:.2f} +- "
+                         f"{p['canopy_gross_kg_co2_ha_h_se'] or 0.0:.2f}"])
+    print(fmt_table(["level", "mol CO2/m2" if period else "umol CO2/m2/s",
+                     "g CO2/m2" if period else "kg CO2/ha/h"], rows))
 
 
 def _print_balance(records: list[dict]) -> None:

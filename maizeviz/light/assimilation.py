@@ -33,7 +33,7 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.photosynthesis.split import LeafModel, model_from_dict, split_assimilation
-from maizeviz.photosynthesis.units import KG_HA_H_PER_UMOL_M2_S
+from maizeviz.photosynthesis.units import CO2_G_PER_MOL, KG_HA_H_PER_UMOL_M2_S
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -144,55 +144,129 @@ class Assimilation:
     def table(self, by: str = "plant", canopy: Canopy | None = None) -> pd.DataFrame:
         """Gross assimilation per leaf or plant: ``gross_umol_s`` (umol CO2/s), its standard
         error ``gross_umol_s_se``, ``gross_umol_m2_leaf_s`` (per m2 of leaf)."""
-        import pandas as pd
+        return _table(self.triangle_gross_umol_s, self.triangle_batches, "gross_umol_s",
+                      "gross_umol_m2_leaf_s", self.rect, self.periodic, by, canopy)
 
-        from maizeviz.light.leaf_light import leaf_sums
 
-        if by not in ("leaf", "plant") or canopy is None:
-            raise MaizevizError("assimilation is tabled by 'leaf' or 'plant', with the canopy "
-                                "it was computed on", quantity="table")
-        rows = leaf_sums(canopy, {"gross_umol_s": self.triangle_gross_umol_s}, self.rect,
-                         self.periodic)
-        if self.triangle_batches is not None:
-            from maizeviz.light.scatter import batch_error
+@dataclass(frozen=True)
+class PeriodAssimilation:
+    """Gross CO2 assimilation of the leaves over a period (a day, a weather file): each time
+    step's light through the leaf model at that step's temperature, times the step.
 
-            per = [{(r["instance"], r["leaf"]): r["gross_umol_s"] for r in
-                    leaf_sums(canopy, {"gross_umol_s": b}, self.rect, self.periodic)}
-                   for b in self.triangle_batches]
-            for r in rows:
-                key = (r["instance"], r["leaf"])
-                r["gross_umol_s_se"] = float(np.asarray(batch_error(np.array(
-                    [[p.get(key, 0.0)] for p in per])))[0])
-        if by == "plant":
-            frame = pd.DataFrame(rows)
-            if frame.empty:
-                return frame
-            agg = {"plant": ("plant", "first"), "x_cm": ("x_cm", "first"),
-                   "y_cm": ("y_cm", "first"), "leaf_area_cm2": ("leaf_area_cm2", "sum"),
-                   "gross_umol_s": ("gross_umol_s", "sum")}
-            frame2 = frame.groupby("instance", as_index=False).agg(**agg)
-            if self.triangle_batches is not None:
-                frame2["gross_umol_s_se"] = self._plant_errors(canopy, frame2["instance"])
-            out = frame2
-        else:
-            out = pd.DataFrame(rows)
-            if out.empty:
-                return out
-        out["gross_umol_m2_leaf_s"] = out["gross_umol_s"] / (out["leaf_area_cm2"] * 1e-4)
-        return out
+    Attributes
+    ----------
+    model : dict, the leaf model (:meth:`LeafModel.as_dict`)
+    temperature_c : (n,) float64, air (leaf) temperature of each step, C
+    triangle_gross_mol : (F,) float64 mol CO2 per leaf triangle over the period (tile-periodic
+        fields: on the copy inside the sample rectangle)
+    triangle_batches : (BATCHES, F) float64 the same from each batch of rays alone
+    ground_m2 : m2 of ground (the sample rectangle)
+    step_gross_umol_m2_s : (n,) float64 canopy gross assimilation at each step, umol/m2 of
+        ground/s
+    rect, periodic : as traced
+    """
 
-    def _plant_errors(self, canopy: Canopy, instances) -> np.ndarray:
-        from maizeviz.light.leaf_light import leaf_sums
+    model: dict
+    temperature_c: np.ndarray
+    triangle_gross_mol: np.ndarray
+    triangle_batches: np.ndarray | None
+    ground_m2: float
+    step_gross_umol_m2_s: np.ndarray
+    rect: tuple[float, float, float, float]
+    periodic: bool
+
+    @property
+    def canopy_gross_mol_m2(self) -> float:
+        """mol CO2 per m2 of ground over the period."""
+        return float(self.triangle_gross_mol.sum()) / self.ground_m2
+
+    @property
+    def canopy_gross_g_m2(self) -> float:
+        """g CO2 per m2 of ground over the period."""
+        return self.canopy_gross_mol_m2 * CO2_G_PER_MOL
+
+    @property
+    def canopy_gross_error_mol_m2(self) -> float | None:
+        if self.triangle_batches is None:
+            return None
         from maizeviz.light.scatter import batch_error
 
-        assert self.triangle_batches is not None
-        per = []
-        for b in self.triangle_batches:
-            sums: dict[int, float] = {}
-            for r in leaf_sums(canopy, {"g": b}, self.rect, self.periodic):
-                sums[int(r["instance"])] = sums.get(int(r["instance"]), 0.0) + float(r["g"])
-            per.append([sums.get(int(i), 0.0) for i in instances])
-        return np.asarray(batch_error(np.array(per)))
+        return float(batch_error(self.triangle_batches.sum(axis=1))) / self.ground_m2
+
+    def as_dict(self) -> dict[str, Any]:
+        se = self.canopy_gross_error_mol_m2
+        return {"model": self.model["model"],
+                "parameters": {k: v for k, v in self.model.items() if k != "model"},
+                "temperature_c": [float(t) for t in self.temperature_c],
+                "canopy_gross_mol_m2": self.canopy_gross_mol_m2,
+                "canopy_gross_mol_m2_se": se,
+                "canopy_gross_g_co2_m2": self.canopy_gross_g_m2,
+                "canopy_gross_g_co2_m2_se": None if se is None else se * CO2_G_PER_MOL,
+                "step_gross_umol_m2_s": [float(v) for v in self.step_gross_umol_m2_s]}
+
+    def table(self, by: str = "plant", canopy: Canopy | None = None) -> pd.DataFrame:
+        """Per leaf or plant: ``gross_mol`` (mol CO2 over the period), ``gross_mol_se``,
+        ``gross_g_co2`` (g), ``gross_mol_m2_leaf``."""
+        frame = _table(self.triangle_gross_mol, self.triangle_batches, "gross_mol",
+                       "gross_mol_m2_leaf", self.rect, self.periodic, by, canopy)
+        if not frame.empty:
+            frame["gross_g_co2"] = frame["gross_mol"] * CO2_G_PER_MOL
+        return frame
+
+
+def dense_rows(batches) -> np.ndarray | None:
+    """(BATCHES, F) float64 of a sparse per-batch array (None stays None)."""
+    if batches is None:
+        return None
+    return np.asarray(batches.todense(), dtype=np.float64) if hasattr(batches, "todense") \
+        else np.asarray(batches, dtype=np.float64)
+
+
+def errors_by(canopy: Canopy, batches, col: str, rect, periodic: bool,
+              by: str) -> dict:
+    """Standard error of ``col`` per leaf ((instance, leaf) keys) or per plant (instance
+    keys) from per-batch per-triangle shares ``batches`` (BATCHES, F), dense or sparse."""
+    import pandas as pd
+
+    from maizeviz.light.leaf_light import leaf_sums
+    from maizeviz.light.scatter import batch_error
+
+    key = ["instance"] if by == "plant" else ["instance", "leaf"]
+    parts = []
+    for b in dense_rows(batches):  # type: ignore[union-attr]
+        part = pd.DataFrame(leaf_sums(canopy, {col: b}, rect, periodic))
+        parts.append(part.groupby(key)[col].sum() if not part.empty
+                     else pd.Series(dtype=float))
+    keys = sorted(set().union(*(p.index for p in parts)))
+    per = np.array([[p.get(k, 0.0) for k in keys] for p in parts], dtype=np.float64)
+    se = np.asarray(batch_error(per)) if keys else np.zeros(0)
+    return dict(zip(keys, se.tolist()))
+
+
+def _table(values: np.ndarray, batches: np.ndarray | None, col: str, per_leaf_col: str,
+           rect, periodic: bool, by: str, canopy: Canopy | None) -> pd.DataFrame:
+    """Per-leaf or per-plant sums of per-triangle ``values`` (column ``col``), their standard
+    errors from ``batches`` (column ``col + "_se"``), and ``per_leaf_col``: per m2 of leaf."""
+    import pandas as pd
+
+    from maizeviz.light.leaf_light import leaf_sums
+
+    if by not in ("leaf", "plant") or canopy is None:
+        raise MaizevizError("assimilation is tabled by 'leaf' or 'plant', with the canopy it "
+                            "was computed on", quantity="table")
+    frame = pd.DataFrame(leaf_sums(canopy, {col: values}, rect, periodic))
+    if frame.empty:
+        return frame
+    key = ["instance"] if by == "plant" else ["instance", "leaf"]
+    if by == "plant":
+        frame = frame.groupby("instance", as_index=False).agg(
+            plant=("plant", "first"), x_cm=("x_cm", "first"), y_cm=("y_cm", "first"),
+            leaves=("leaf", "size"), leaf_area_cm2=("leaf_area_cm2", "sum"), **{col: (col, "sum")})
+    if batches is not None:
+        se = errors_by(canopy, batches, col, rect, periodic, by)
+        frame[col + "_se"] = [se.get(k, 0.0) for k in frame.set_index(key).index]
+    frame[per_leaf_col] = frame[col] / (frame["leaf_area_cm2"] * 1e-4)
+    return frame
 
 
 def assimilate(canopy: Canopy, light: AbsorbedLight, model: LeafModel,

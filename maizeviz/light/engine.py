@@ -408,6 +408,7 @@ class LightEngine:
                      lat: float | None = None, lon: float | None = None, tz: str = "UTC",
                      step_min: float = 30.0, start: str | None = None,
                      end: str | None = None, linke: float = DEFAULT_LINKE_TURBIDITY,
+                     photosynthesis=None, temperature_c=25.0,
                      **fields_) -> AbsorbedPeriod:
         """Light absorbed with scattering over a period (a day), in one band: each step's
         sun with the band's share of its direct irradiance, and the diffuse part spread over
@@ -423,6 +424,13 @@ class LightEngine:
             (:mod:`maizeviz.light.perez`): its circumsolar part added to that step's direct
             beam, the rest from a uniform sky
         progress : after the sky and after each step
+        photosynthesis : LeafModel, optional
+            Also the leaves' gross CO2 assimilation at every step (PAR only,
+            :func:`maizeviz.light.assimilation.assimilate`), added up over the period
+            (``AbsorbedPeriod.assimilation``).
+        temperature_c : float or (n,) float64
+            Air (leaf) temperature at each step, C (default 25; a period read from a weather
+            file with an air temperature column gives its own).
 
         Returns
         -------
@@ -454,6 +462,41 @@ class LightEngine:
             diffuse_w = np.asarray(split.isotropic_w_m2, np.float64) * share
         step_s = np.asarray(period.step_s, np.float64)
         joules = unit.triangle_absorbed_w * float(np.sum(diffuse_w * step_s))
+        assert unit.batches is not None
+        joules_b = unit.batches.absorbed * float(np.sum(diffuse_w * step_s))
+        temps = np.broadcast_to(np.asarray(
+            getattr(period, "temp_air_c", None) if getattr(period, "temp_air_c", None)
+            is not None else temperature_c, np.float64), (steps,))
+        gross_mol = gross_b = None
+        step_gross = np.zeros(steps)
+        if photosynthesis is not None:
+            from maizeviz.light.assimilation import assimilate
+
+            gross_mol = np.zeros(self.canopy.n_triangles)
+            gross_b = np.zeros((BATCHES, self.canopy.n_triangles))
+
+        def add_gross(k: int, light: AbsorbedLight | None) -> None:
+            # the step's light: its sun (if any) plus the sky's unit light scaled
+            if photosynthesis is None or gross_mol is None or gross_b is None:
+                return
+            ub = unit.batches
+            assert ub is not None
+            if light is None:
+                step = replace(unit, triangle_absorbed_w=unit.triangle_absorbed_w
+                               * diffuse_w[k], batches=Batches(ub.absorbed * diffuse_w[k],
+                                                               ub.direct, ub.sunlit_cm2))
+            else:
+                lb = light.batches
+                assert lb is not None
+                step = replace(light, triangle_absorbed_w=light.triangle_absorbed_w
+                               + unit.triangle_absorbed_w * diffuse_w[k],
+                               batches=Batches(lb.absorbed + ub.absorbed * diffuse_w[k],
+                                               lb.direct, lb.sunlit_cm2))
+            a = assimilate(self.canopy, step, photosynthesis, float(temps[k]))
+            gross_mol[:] += a.triangle_gross_umol_s * step_s[k] * 1e-6
+            if a.triangle_batches is not None:
+                gross_b[:] += a.triangle_batches * step_s[k] * 1e-6
+            step_gross[k] = a.canopy_gross_umol_m2_s
         ub = unit.balance
         parts = {k: getattr(ub, k) * float(np.sum(diffuse_w * step_s))
                  for k in ("absorbed_leaves", "absorbed_ground", "reflected_top",
@@ -467,20 +510,34 @@ class LightEngine:
                 light = self.absorbed(Sun(z, float(period.azimuth_deg[k])),
                                       direct_w_m2=float(direct_w[k]), **common)
                 joules += light.triangle_absorbed_w * step_s[k]
+                assert light.batches is not None
+                joules_b = joules_b + light.batches.absorbed * step_s[k]
+                add_gross(k, light)
                 for name in parts:
                     parts[name] += getattr(light.balance, name) * step_s[k]
                 leaves_w[k] += light.balance.absorbed_leaves
                 for name in ("trace", "scatter"):
                     seconds[name] = seconds.get(name, 0.0) + light.seconds.get(name, 0.0)
+            elif diffuse_w[k] > 0:
+                add_gross(k, None)
             report(progress, k + 2, steps + 1, f"absorbed light: time step {k + 1} of {steps}")
         incident_w = diffuse_w + direct_w
         balance = Balance(float(np.sum(incident_w * step_s)) * 1e-6,
                           *(float(parts[k]) * 1e-6 for k in ("absorbed_leaves", "absorbed_ground",
                                                        "reflected_top", "escaped_sides",
                                                        "unresolved")))
+        assimilation = None
+        if gross_mol is not None and gross_b is not None and photosynthesis is not None:
+            from maizeviz.light.assimilation import PeriodAssimilation
+
+            x0, y0, x1, y1 = unit.rect
+            assimilation = PeriodAssimilation(
+                photosynthesis.as_dict(), temps.copy(), gross_mol, gross_b,
+                (x1 - x0) * (y1 - y0) * 1e-4, step_gross, unit.rect, unit.periodic)
         return AbsorbedPeriod(opt.band, opt, period, balance, joules, leaves_w, incident_w,
                               unit.rect, unit.rays, depth, seed, unit.periodic,
-                              self.canopy.level, seconds)
+                              self.canopy.level, seconds, batches=Batches(joules_b, None, None),
+                              assimilation=assimilation)
 
     def _normals(self):
         """Unit normals (F, 3) of the scene's leaf triangles, then its stalks' if traced

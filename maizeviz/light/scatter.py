@@ -507,6 +507,13 @@ class AbsorbedLight:
         frame["sunlit_area_cm2"] = np.minimum(frame["sunlit_area_cm2"], frame["leaf_area_cm2"])
         if by == "plant":
             frame = _per_plant(frame, ("absorbed_w", "sunlit_area_cm2"))
+        if self.batches is not None:
+            from maizeviz.light.assimilation import errors_by
+
+            se = errors_by(canopy, self.batches.absorbed, "absorbed_w", self.rect,
+                           self.periodic, by)
+            keys = frame["instance"] if by == "plant" else zip(frame["instance"], frame["leaf"])
+            frame["absorbed_w_se"] = [se.get(k, 0.0) for k in keys]
         frame["shaded_area_cm2"] = frame["leaf_area_cm2"] - frame["sunlit_area_cm2"]
         frame["absorbed_w_m2_leaf"] = frame["absorbed_w"] / (frame["leaf_area_cm2"] * 1e-4)
         if self.band == "par":
@@ -522,8 +529,16 @@ def absorbed_leaf_rows(canopy, light: AbsorbedLight) -> list[dict]:
     rows = leaf_sums(canopy, {"absorbed_w": light.triangle_absorbed_w,
                               "absorbed_sunlit_area_cm2": light.triangle_sunlit_cm2},
                      light.rect, light.periodic)
+    se = {}
+    if light.batches is not None:
+        from maizeviz.light.assimilation import errors_by
+
+        se = errors_by(canopy, light.batches.absorbed, "absorbed_w", light.rect,
+                       light.periodic, "leaf")
     for r in rows:
         r["absorbed_w_m2_leaf"] = float(r["absorbed_w"]) / (float(r["leaf_area_cm2"]) * 1e-4)
+        if light.batches is not None:
+            r["absorbed_w_se"] = se.get((r["instance"], r["leaf"]), 0.0)
     return rows
 
 
@@ -543,6 +558,10 @@ class AbsorbedPeriod:
     step_incident_w_m2 : (n,) float64 the band's irradiance on a horizontal plane at each step
     rect, rays, depth, seed, periodic, level : as traced; seconds : "trace", "scatter",
         "build"
+    batches : per-batch shares of ``triangle_absorbed_j`` (``absorbed`` only), for standard
+        errors
+    assimilation : PeriodAssimilation (:mod:`maizeviz.light.assimilation`) when a leaf model
+        was given, else None
     """
 
     band: str
@@ -559,8 +578,18 @@ class AbsorbedPeriod:
     periodic: bool
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
+    batches: Batches | None = None
+    assimilation: Any = None
 
     fraction_absorbed = property(_fraction_absorbed)
+
+    @property
+    def absorbed_leaves_error(self) -> float | None:
+        """Monte Carlo standard error of ``balance.absorbed_leaves`` (MJ/m2 of ground)."""
+        total = float(self.triangle_absorbed_j.sum())
+        if self.batches is None or total <= 0:
+            return None if self.batches is None else 0.0
+        return self.batches.error() * self.balance.absorbed_leaves / total
 
     @property
     def absorbed_leaves_mol_m2(self) -> float | None:
@@ -595,6 +624,13 @@ class AbsorbedPeriod:
             return frame
         if by == "plant":
             frame = _per_plant(frame, ("absorbed_mj",))
+        if self.batches is not None:
+            from maizeviz.light.assimilation import errors_by
+
+            se = errors_by(canopy, self.batches.absorbed * 1e-6, "absorbed_mj", self.rect,
+                           self.periodic, by)
+            keys = frame["instance"] if by == "plant" else zip(frame["instance"], frame["leaf"])
+            frame["absorbed_mj_se"] = [se.get(k, 0.0) for k in keys]
         frame["absorbed_mj_m2_leaf"] = frame["absorbed_mj"] / (frame["leaf_area_cm2"] * 1e-4)
         if self.band == "par":
             frame["absorbed_mol"] = frame["absorbed_mj"] * PAR_UMOL_PER_J_PAR
