@@ -50,6 +50,12 @@ _EXPORTS = {
     "PeriodLight": "maizeviz.light.daylight",
     "AbsorbedLight": "maizeviz.light.scatter",
     "AbsorbedPeriod": "maizeviz.light.scatter",
+    "Assimilation": "maizeviz.light.assimilation",
+    "PeriodAssimilation": "maizeviz.light.assimilation",
+    # photosynthesis
+    "leaf_model": "maizeviz.photosynthesis.split",
+    "C4Leaf": "maizeviz.photosynthesis.c4",
+    "WofostLeaf": "maizeviz.photosynthesis.wofost",
     "MaizevizError": "maizeviz.errors",
 }
 

@@ -399,6 +399,38 @@ class LightEngine:
                              batches=Batches(absorbed_b, direct_b, sunlit_b),
                              sun_direction=sun_dir)
 
+    def photosynthesis(self, sun: Sun | None = None, *, model="c4",
+                       temperature_c: float = 25.0, **absorbed):
+        """Gross CO2 assimilation of the leaves under one sun (and sky): absorbed PAR
+        (:meth:`absorbed`, same keywords) through a leaf model, each triangle's sunlit and
+        shaded parts at their own light (:mod:`maizeviz.light.assimilation`).
+
+        Parameters
+        ----------
+        sun, **absorbed : as :meth:`absorbed` (``zenith=``, ``diffuse_w_m2=``, ``optics=``...)
+        model : "c4", "wofost" or a leaf model
+            (:func:`maizeviz.photosynthesis.split.leaf_model` for other parameters)
+        temperature_c : air (leaf) temperature, C
+
+        Returns
+        -------
+        Assimilation
+            ``canopy_gross_umol_m2_s`` (per m2 of ground), ``canopy_gross_kg_co2_ha_h``, their
+            standard errors; ``table("plant", canopy)`` as a DataFrame.
+
+        References
+        ----------
+        Collatz, G. J., Ribas-Carbo, M. & Berry, J. A. (1992). Australian Journal of Plant
+        Physiology 19, 519-538. Spitters, C. J. T. (1986). Agricultural and Forest
+        Meteorology 38, 231-242.
+        """
+        from maizeviz.light.assimilation import assimilate
+        from maizeviz.photosynthesis.split import leaf_model
+
+        leaf = leaf_model(model) if isinstance(model, str) else model
+        light = self.absorbed(sun, band="par", **absorbed)
+        return assimilate(self.canopy, light, leaf, temperature_c)
+
     def absorbed_day(self, period: Period | None = None, *, band: str = "par",
                      optics: Optics | None = None, sky: Sky | str = "soc",
                      directions: int = 46, depth: int = DEFAULT_DEPTH,
@@ -464,9 +496,15 @@ class LightEngine:
         joules = unit.triangle_absorbed_w * float(np.sum(diffuse_w * step_s))
         assert unit.batches is not None
         joules_b = unit.batches.absorbed * float(np.sum(diffuse_w * step_s))
-        temps = np.broadcast_to(np.asarray(
-            getattr(period, "temp_air_c", None) if getattr(period, "temp_air_c", None)
-            is not None else temperature_c, np.float64), (steps,))
+        given_t = getattr(period, "temp_air_c", None)
+        temps = np.asarray(temperature_c if given_t is None else given_t, np.float64)
+        if temps.ndim > 1 or temps.size not in (1, steps) or not np.all(np.isfinite(temps)):
+            from maizeviz.errors import MaizevizError
+
+            raise MaizevizError(f"give one air temperature or one for each of the period's "
+                                f"{steps} steps (finite, C), got {temps.size}",
+                                quantity="temperature")
+        temps = np.broadcast_to(temps.reshape(-1), (steps,)) if temps.size == 1 else temps
         gross_mol = gross_b = None
         step_gross = np.zeros(steps)
         if photosynthesis is not None:

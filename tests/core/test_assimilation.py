@@ -126,3 +126,31 @@ def test_photosynthesis_needs_par_and_a_sane_temperature(spherical):
     with pytest.raises(MaizevizError) as err:
         assimilate(canopy, par, leaf_model("c4"), temp_c=math.nan)
     assert err.value.quantity == "temperature"
+
+
+def test_the_facade_traces_photosynthesis_in_a_few_lines(spherical):
+    import maizeviz as mv
+
+    canopy = spherical[2.0]
+    eng = mv.LightEngine(canopy, periodic=True, density=1.0, heights_cm=(0.0,))
+    a = eng.photosynthesis(zenith=30, azimuth=180, diffuse_w_m2=60.0, directions=16,
+                           model="wofost", temperature_c=20.0)
+    b = assimilate(canopy, eng.absorbed(zenith=30, azimuth=180, diffuse_w_m2=60.0,
+                                        directions=16), mv.WofostLeaf(), 20.0)
+    assert isinstance(a, mv.Assimilation) and a.as_dict() == b.as_dict()
+    frame = a.table("leaf", canopy)
+    assert frame["gross_umol_s"].sum() == pytest.approx(float(a.triangle_gross_umol_s.sum()))
+    period = mv.clear_sky_period("2005-08-01", 39.9, 116.4, "Asia/Shanghai", 120)
+    temps = np.linspace(20, 30, len(period.step_s))
+    day = eng.absorbed_day(period, directions=16, photosynthesis=mv.leaf_model("c4"),
+                           temperature_c=temps)
+    np.testing.assert_array_equal(day.assimilation.temperature_c, temps)
+    with pytest.raises(MaizevizError, match="one for each of the period's 7 steps"):
+        eng.absorbed_day(period, directions=16, photosynthesis=mv.leaf_model("c4"),
+                         temperature_c=[20.0, 25.0])
+    got = day.assimilation
+    assert isinstance(got, mv.PeriodAssimilation)
+    assert np.sum(got.step_gross_umol_m2_s * day.period.step_s) * 1e-6 == pytest.approx(
+        got.canopy_gross_mol_m2, rel=1e-12)
+    assert got.table("plant", canopy)["gross_g_co2"].sum() / got.ground_m2 == pytest.approx(
+        got.canopy_gross_g_m2, rel=1e-12)
