@@ -58,6 +58,7 @@ from maizeviz.light.irradiance import (
 from maizeviz.light.leaf_light import leaf_light, merge_rows, plant_light
 from maizeviz.light.optics import BANDS, optics_for, read_optics_table
 from maizeviz.light.perez import PEREZ_MODELS, split_summary
+from maizeviz.light.precision import check_precision, trace_until
 from maizeviz.light.reports import period_leaf_rows, sky_leaf_rows, write_steps
 from maizeviz.light.request import Sampling
 from maizeviz.light.scatter import DEFAULT_DEPTH, AbsorbedLight, absorbed_leaf_rows
@@ -168,6 +169,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ab.add_argument("--depth", type=int, default=None, metavar="N",
                     help=f"most scatterings followed per ray (default {DEFAULT_DEPTH})")
     ab.add_argument("--seed", type=int, default=None, help="random seed (default 0)")
+    ab.add_argument("--precision", type=float, default=None, metavar="REL_SE",
+                    help="trace denser until the relative Monte Carlo standard error of the "
+                         "leaves' absorbed light (of the canopy's assimilation with "
+                         "--photosynthesis) is at most this (0.005: 0.5 %%)")
     ph = p.add_argument_group(
         "photosynthesis from the absorbed PAR (turns absorbed light on; the sun, or a period)")
     ph.add_argument("--photosynthesis", choices=MODELS, default=None,
@@ -196,7 +201,8 @@ def _absorbed_asked(args: argparse.Namespace) -> bool:
     return any(v is not None for v in (args.band, args.reflectance, args.transmittance,
                                         args.ground_reflectance, args.irradiance,
                                         args.optics_table, args.depth, args.seed,
-                                        args.photosynthesis)) or bool(args.diffuse)
+                                        args.photosynthesis, args.precision)) or \
+        bool(args.diffuse)
 
 
 def _leaf_model_from(args: argparse.Namespace) -> LeafModel | None:
@@ -352,6 +358,8 @@ def run(args: argparse.Namespace) -> int:
         args.seed = 0 if args.seed is None else args.seed
         check_range(args.depth, "the scattering depth", 0, 10_000, "depth", whole=True)
         check_range(args.seed, "the random seed", 0, 2**32 - 1, "seed", whole=True)
+        if args.precision is not None:
+            check_precision(args.precision)
     rect = tuple(floats(args.rect, "the sample rectangle", "rect", 4)) if args.rect else None
     if not args.heatmap_bin > 0:
         raise MaizevizError(f"the heatmap bin must be > 0 cm, got {args.heatmap_bin}",
@@ -455,13 +463,21 @@ def run(args: argparse.Namespace) -> int:
                 say(f"{'note' if w in (period.notes if period else ()) else 'warning'}: {w}")
         rec["warnings"] = list(dict.fromkeys(warnings))
         if absorbed_optics is not None and sun is None and period is not None:
-            abd = engine.absorbed_day(period, optics=absorbed_optics,
-                                      sky=args.sky or "soc",
-                                      directions=args.sky_directions or 46, depth=args.depth,
-                                      seed=args.seed, photosynthesis=leaf_model_,
-                                      temperature_c=temp_c,
-                                      progress=Progress(f"absorbed light over the period, "
-                                                        f"{label}"))
+            def trace_day(density: float, engine=engine, label=label):
+                d = engine.absorbed_day(period, optics=absorbed_optics,
+                                        sky=args.sky or "soc",
+                                        directions=args.sky_directions or 46,
+                                        depth=args.depth, seed=args.seed,
+                                        photosynthesis=leaf_model_, temperature_c=temp_c,
+                                        density=density,
+                                        progress=Progress(f"absorbed light over the period, "
+                                                          f"{label}"))
+                if d.assimilation is not None:
+                    return (d, d.assimilation.canopy_gross_mol_m2,
+                            d.assimilation.canopy_gross_error_mol_m2 or 0.0)
+                return d, d.balance.absorbed_leaves, d.absorbed_leaves_error or 0.0
+
+            abd = _traced(trace_day, args, rec, said)
             rec["balance"] = dict(abd.balance.as_dict(), units="MJ/m2 of ground")
             rec["absorbed"] = _absorbed_period_record(abd)
             if abd.assimilation is not None:
@@ -475,10 +491,17 @@ def run(args: argparse.Namespace) -> int:
             rec["seconds"]["scatter"] = abd.seconds.get("trace", 0.0) + \
                 abd.seconds.get("scatter", 0.0)
         elif absorbed_optics is not None:
-            ab = engine.absorbed(sun, optics=absorbed_optics, direct_w_m2=args.irradiance,
-                                 diffuse_w_m2=args.diffuse, sky=args.sky or "soc",
-                                 directions=args.sky_directions or 46, depth=args.depth,
-                                 seed=args.seed)
+            def trace_sun(density: float, engine=engine, canopy=canopy):
+                a = engine.absorbed(sun, optics=absorbed_optics, direct_w_m2=args.irradiance,
+                                    diffuse_w_m2=args.diffuse, sky=args.sky or "soc",
+                                    directions=args.sky_directions or 46, depth=args.depth,
+                                    seed=args.seed, density=density)
+                if leaf_model_ is not None:
+                    g = assimilate(canopy, a, leaf_model_, temp_c)
+                    return a, g.canopy_gross_umol_m2_s, g.canopy_gross_error_umol_m2_s or 0.0
+                return a, a.balance.absorbed_leaves, a.absorbed_leaves_error or 0.0
+
+            ab = _traced(trace_sun, args, rec, said)
             rec["balance"] = ab.balance.as_dict()
             rec["absorbed"] = _absorbed_record(ab, canopy)
             rec["seconds"]["scatter"] = ab.seconds["trace"] + ab.seconds["scatter"]
@@ -549,6 +572,24 @@ def _absorbed_period_record(ab) -> dict[str, Any]:
         out["absorbed_leaves_mol_m2"] = ab.absorbed_leaves_mol_m2
         out["absorbed_leaves_mol_m2_se"] = None if se is None else se * PAR_UMOL_PER_J_PAR
     return out
+
+
+def _traced(trace, args: argparse.Namespace, rec: dict[str, Any], said: set[str]) -> Any:
+    """``trace(density)``'s result at ``--density``, or with ``--precision`` at the density
+    that meets it (recorded in ``rec["precision"]``, a warning when it cannot be)."""
+    if args.precision is None:
+        return trace(args.density)[0]
+    result, prec = trace_until(trace, args.density, args.precision)
+    rec["precision"] = prec.as_dict()
+    say(f"precision: relative standard error {prec.achieved:.2%} at {prec.density:g} rays "
+        f"per cm2 after {prec.passes} trace{'s' if prec.passes > 1 else ''}")
+    if not prec.met:
+        w = (f"the relative standard error {prec.achieved:.2%} is above the {prec.target:.2%} "
+             f"asked for at the densest tracing allowed ({prec.density:g} rays per cm2)")
+        said.add(w)
+        say(f"warning: {w}")
+        rec["warnings"].append(w)
+    return result
 
 
 def _assimilation_rows(canopy: Canopy, asm: Any) -> list[dict]:

@@ -85,3 +85,34 @@ def test_bad_photosynthesis_options_are_one_line(capsys, extra, says):
     code, out, err = run_cli(capsys, *cli_args(**extra))
     assert code == 2 or code == 1
     assert says in err and err.count("\n") == 1 and out == ""
+
+
+def test_precision_traces_denser_until_the_standard_error_is_met(capsys):
+    code, out, err = run_cli(capsys, *cli_args(photosynthesis="wofost", density=0.1,
+                                               precision=0.004))
+    assert code == 0, err
+    rec = json.loads(out)
+    prec, ph = rec["precision"], rec["photosynthesis"]
+    assert prec["met"] and prec["passes"] >= 2 and prec["density_per_cm2"] > 0.1
+    assert ph["canopy_gross_umol_m2_s_se"] / ph["canopy_gross_umol_m2_s"] == pytest.approx(
+        prec["relative_se"], rel=1e-9) and prec["relative_se"] <= 0.004
+    assert "precision: relative standard error" in err
+    # absorbed light alone: the leaves' absorbed light is the figure
+    code, out, err = run_cli(capsys, *cli_args(band="par", density=0.1, precision=0.02))
+    rec = json.loads(out)
+    assert rec["precision"]["relative_se"] == pytest.approx(
+        rec["absorbed"]["absorbed_leaves_se"] / rec["balance"]["absorbed_leaves"], rel=1e-9)
+
+
+def test_a_precision_that_cannot_be_met_is_said(capsys, monkeypatch):
+    import maizeviz.light.precision as precision
+
+    monkeypatch.setattr(precision, "MAX_DENSITY", 0.5)
+    code, out, err = run_cli(capsys, *cli_args(photosynthesis="c4", density=0.25,
+                                               precision=1e-5))
+    rec = json.loads(out)
+    assert code == 0 and not rec["precision"]["met"]
+    assert rec["precision"]["density_per_cm2"] == 0.5
+    assert any("above the 0.00% asked for" in w for w in rec["warnings"]), rec["warnings"]
+    code, out, err = run_cli(capsys, *cli_args(photosynthesis="c4", precision=0))
+    assert code != 0 and "(--precision)" in err
