@@ -478,6 +478,7 @@ def run(args: argparse.Namespace) -> int:
                 return d, d.balance.absorbed_leaves, d.absorbed_leaves_error or 0.0
 
             abd = _traced(trace_day, args, rec, said)
+            _warn_unresolved(abd.balance, abd.depth, rec, said)
             rec["balance"] = dict(abd.balance.as_dict(), units="MJ/m2 of ground")
             rec["absorbed"] = _absorbed_period_record(abd)
             if abd.assimilation is not None:
@@ -502,6 +503,7 @@ def run(args: argparse.Namespace) -> int:
                 return a, a.balance.absorbed_leaves, a.absorbed_leaves_error or 0.0
 
             ab = _traced(trace_sun, args, rec, said)
+            _warn_unresolved(ab.balance, ab.depth, rec, said)
             rec["balance"] = ab.balance.as_dict()
             rec["absorbed"] = _absorbed_record(ab, canopy)
             rec["seconds"]["scatter"] = ab.seconds["trace"] + ab.seconds["scatter"]
@@ -572,6 +574,18 @@ def _absorbed_period_record(ab) -> dict[str, Any]:
         out["absorbed_leaves_mol_m2"] = ab.absorbed_leaves_mol_m2
         out["absorbed_leaves_mol_m2_se"] = None if se is None else se * PAR_UMOL_PER_J_PAR
     return out
+
+
+def _warn_unresolved(balance, depth: int, rec: dict[str, Any], said: set[str]) -> None:
+    """Warn when more than 1 % of the incident light was left unresolved."""
+    from maizeviz.light.scatter import UNRESOLVED_WARN, unresolved_warning
+
+    if balance.incident and balance.unresolved > UNRESOLVED_WARN * balance.incident:
+        w = unresolved_warning(balance.unresolved / balance.incident, depth)
+        rec["warnings"].append(w)
+        if w not in said:
+            said.add(w)
+            say(f"warning: {w}")
 
 
 def _traced(trace, args: argparse.Namespace, rec: dict[str, Any], said: set[str]) -> Any:

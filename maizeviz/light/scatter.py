@@ -64,6 +64,17 @@ CHUNK_RAYS = 1 << 19
 BATCHES = 8
 
 
+#: Share of the incident light left unresolved (still travelling when scattering stopped)
+#: above which a result says so.
+UNRESOLVED_WARN = 0.01
+
+
+def unresolved_warning(share: float, depth: int) -> str:
+    """The warning for a result that left ``share`` of its light unresolved."""
+    return (f"{share:.1%} of the incident light was still travelling after {depth} "
+            "scatterings and is not in the absorbed figures: raise the depth")
+
+
 @dataclass
 class Tally:
     """What one beam's rays deposited, in units of one primary ray's power.

@@ -116,3 +116,16 @@ def test_a_precision_that_cannot_be_met_is_said(capsys, monkeypatch):
     assert any("above the 0.00% asked for" in w for w in rec["warnings"]), rec["warnings"]
     code, out, err = run_cli(capsys, *cli_args(photosynthesis="c4", precision=0))
     assert code != 0 and "(--precision)" in err
+
+
+def test_light_left_unresolved_above_one_percent_is_warned(capsys):
+    code, out, err = run_cli(capsys, *cli_args(band="nir", depth=2))
+    rec = json.loads(out)
+    share = rec["balance"]["unresolved"] / rec["balance"]["incident"]
+    assert share > 0.01
+    assert any(f"{share:.1%} of the incident light was still travelling after 2 scatterings"
+               in w for w in rec["warnings"]) and "raise the depth" in err
+    code, out, err = run_cli(capsys, *cli_args(band="nir"))          # the default depth, 20
+    rec = json.loads(out)
+    assert rec["balance"]["unresolved"] < 0.01 * rec["balance"]["incident"]
+    assert not any("still travelling" in w for w in rec["warnings"])
