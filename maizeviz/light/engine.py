@@ -41,12 +41,16 @@ from maizeviz.light.scatter import (
     Balance,
     Batches,
     scatter_beam,
+    scatter_sky,
 )
 from maizeviz.light.sky import Sky, make_sky
 from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import LightResult, light_scene, trace_light
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, report
+
+#: Primary rays per grid cell of a sky traced with its directions drawn per ray.
+SKY_PASSES = 4
 
 
 class LightEngine:
@@ -286,7 +290,8 @@ class LightEngine:
                  progress: ProgressCallback | None = None, zenith: float | None = None,
                  azimuth: float | None = None, date: str | None = None,
                  time: str | None = None, lat: float | None = None, lon: float | None = None,
-                 tz: str | None = None, **fields_) -> AbsorbedLight:
+                 tz: str | None = None, sky_passes: int = SKY_PASSES,
+                 **fields_) -> AbsorbedLight:
         """Light absorbed by leaves and ground in one band, with scattering
         (:mod:`maizeviz.light.scatter`): the sun's direct beam and, when ``diffuse_w_m2`` > 0,
         the diffuse light of a sky.
@@ -302,6 +307,11 @@ class LightEngine:
             ``sky`` (kind or Sky) split into ``directions`` directions
         depth, threshold, seed : scatterings followed, share of the incident power left
             travelling where tracing stops, random seed
+        sky_passes : with leaves or soil that scatter, in a periodic field, the diffuse light
+            is traced as one beam whose rays each take a sky direction of their own
+            (:func:`~maizeviz.light.scatter.scatter_sky`), this many rays per grid cell
+            (default 4; 0: every sky direction traced over the whole grid, as black leaves
+            are)
         sampling, progress, **fields_ : as :meth:`sun` (``progress`` after each beam)
 
         Returns
@@ -342,10 +352,18 @@ class LightEngine:
         beams: list[tuple[np.ndarray, float]] = []
         if sun is not None and direct > 0:
             beams.append((sun.direction(self.canopy.layout.north_deg), direct))
+        # leaves that scatter, in a periodic field: the sky's directions are drawn per ray
+        # (one beam's rays, ``sky_passes`` per cell) instead of each traced over the grid
+        sky_per_ray = diffuse_w_m2 > 0 and smp_req.periodic and sky_passes > 0 and (
+            opt.scattering > 0 or opt.ground_reflectance > 0 or bool(opt.ranks))
+        n_sky = 0
         if diffuse_w_m2 > 0:
             sky_obj = sky if isinstance(sky, Sky) else make_sky(sky, directions)
-            for toward, weight in zip(sky_obj.directions, sky_obj.weights):
-                beams.append((np.asarray(toward, np.float64), diffuse_w_m2 * float(weight)))
+            n_sky = len(sky_obj.weights)
+            if not sky_per_ray:
+                for toward, weight in zip(sky_obj.directions, sky_obj.weights):
+                    beams.append((np.asarray(toward, np.float64),
+                                  diffuse_w_m2 * float(weight)))
         area_m2 = smp.ray_area_cm2 * 1e-4 * smp.n
         nf = len(normals)
         leaf_optics, kept = None, 1.0 - opt.scattering
@@ -388,13 +406,27 @@ class LightEngine:
             events += tally.events
             seconds["trace"] += secs["trace"]
             seconds["scatter"] += secs["scatter"]
-            report(progress, k + 1, len(beams), "absorbed light")
+            report(progress, k + 1, len(beams) + sky_per_ray, "absorbed light")
+        if sky_per_ray:
+            tally, secs = scatter_sky(smp, np.asarray(sky_obj.directions, np.float64),
+                                      np.asarray(sky_obj.weights, np.float64), opt, normals,
+                                      depth, threshold, seed + 7919 * len(beams),
+                                      smp_req.threads, sky_passes, leaf_optics=leaf_optics)
+            per_ray = diffuse_w_m2 * smp.ray_area_cm2 * 1e-4 / sky_passes
+            absorbed += tally.per_triangle(nf, kept * per_ray)
+            absorbed_b = absorbed_b + tally.per_batch(nf, kept * per_ray)
+            for name in parts:
+                parts[name] += getattr(tally, name) * per_ray
+            events += tally.events
+            seconds["scatter"] += secs["scatter"]
+            report(progress, len(beams) + 1, len(beams) + 1, "absorbed light")
         incident = direct * (sun is not None) + diffuse_w_m2
         balance = Balance(float(incident), float(absorbed.sum()) / area_m2,
                           *(float(parts[k]) / area_m2 for k in ("ground", "top", "sides",
                                                                  "unresolved")))
         return AbsorbedLight(opt.band, opt, incident, balance, absorbed, sunlit, rect, smp.n,
-                             len(beams), depth, threshold, seed, events, smp_req.periodic,
+                             len(beams) + (n_sky if sky_per_ray else 0), depth, threshold,
+                             seed, events, smp_req.periodic,
                              self.canopy.level, seconds, triangle_direct_w=direct_t,
                              batches=Batches(absorbed_b, direct_b, sunlit_b),
                              sun_direction=sun_dir)

@@ -347,6 +347,86 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
     return total, {"trace": t1 - t0, "scatter": time.perf_counter() - t1}
 
 
+def scatter_sky(smp: Sampler, directions: np.ndarray, weights: np.ndarray, optics: Optics,
+                normals: np.ndarray, depth: int = DEFAULT_DEPTH,
+                threshold: float = DEFAULT_THRESHOLD, seed: int = 0, threads: int = 1,
+                passes: int = 1, stop: threading.Event | None = None,
+                leaf_optics: tuple | None = None) -> tuple[Tally, dict[str, float]]:
+    """Follow a whole sky's diffuse light through a periodic canopy, each primary ray in a
+    sky direction of its own: ``passes`` rays per cell of the sample grid, their directions
+    dealt in proportion to the sky's ``weights`` (stratified, then shuffled over the cells).
+
+    Each ray carries the same power (the sky's horizontal irradiance over its footprint, over
+    ``passes``): drawing a direction with probability ``weight`` makes that unbiased. Tracing
+    every direction over the whole grid (:func:`scatter_beam` per direction) costs as many
+    times more primary rays as the sky has directions; this costs one beam's, for a Monte Carlo
+    error the batches report.
+
+    Parameters
+    ----------
+    smp : Sampler of a periodic field; directions : (K, 3) unit vectors toward the sky
+    weights : (K,) shares of the horizontal diffuse irradiance (sum 1)
+    optics, normals, depth, threshold, seed, threads, stop, leaf_optics : as
+        :func:`scatter_beam`
+    passes : primary rays per grid cell
+
+    Returns
+    -------
+    Tally in units of one primary ray's power, and seconds ("trace": 0, "scatter": all).
+    """
+    if not smp.periodic:
+        raise ValueError("a sky sampled per ray needs a periodic field")
+    t0 = time.perf_counter()
+    dirs_k = np.asarray(directions, dtype=np.float64)
+    w = np.asarray(weights, dtype=np.float64)
+    n_cells = smp.n
+    n = n_cells * passes
+    rng0 = np.random.default_rng([seed, 0x5C1])
+    # stratified: each direction gets its share of the rays (largest remainders), shuffled
+    want = w / w.sum() * n
+    counts = np.floor(want).astype(np.int64)
+    rest = n - int(counts.sum())
+    if rest:
+        counts[np.argsort(want - counts)[::-1][:rest]] += 1
+    which = rng0.permutation(np.repeat(np.arange(len(w)), counts))
+    batches = (rng0.permutation(n) % BATCHES).astype(np.int8)
+    chunks = [(a, min(a + CHUNK_RAYS, n)) for a in range(0, n, CHUNK_RAYS)]
+    grid = ray_grid(smp.rect, smp.density)[0]
+
+    def chunk(k_ab: tuple[int, tuple[int, int]]) -> Tally:
+        k, (a, b) = k_ab
+        rng = np.random.default_rng([seed, k, 0x5C1])
+        tally = Tally(rays=b - a)
+        g = grid[np.arange(a, b) % n_cells]
+        s = dirs_k[which[a:b]]
+        # start on the plane above the canopy, on the line through the grid point toward the
+        # sky direction, going down along it
+        org = np.empty((b - a, 3))
+        org[:, :2] = g + s[:, :2] * (smp.top / s[:, 2])[:, None]
+        org[:, 2] = smp.top
+        batch = batches[a:b]
+        kind, prim, end = follow(smp, _Rays(org, -s, batch))
+        hit = kind == LEAF
+        tally.first_hits.append(prim[hit])
+        tally.first_batch.append(batch[hit])
+        rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, -s, batch,
+                       leaf_optics)
+        for _ in range(depth):
+            if len(rays.org) <= threshold * (b - a):
+                break
+            tally.events += len(rays.org)
+            kind, prim, end = follow(smp, rays)
+            rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, rays.dirs,
+                           rays.batch, leaf_optics)
+        tally.unresolved += len(rays.org)
+        return tally
+
+    total = Tally()
+    for part in ordered_map(chunk, list(enumerate(chunks)), threads, None, stop):
+        total.add(part)
+    return total, {"trace": 0.0, "scatter": time.perf_counter() - t0}
+
+
 def batch_error(per_batch) -> float | np.ndarray:
     """Monte Carlo standard error of a total from its batches' shares.
 

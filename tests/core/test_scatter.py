@@ -279,3 +279,28 @@ def test_per_plant_tables_add_up_to_the_balance(homogeneous):
     assert list(got.table("balance").columns[:2]) == ["band", "incident"]
     with pytest.raises(MaizevizError, match="give the canopy"):
         got.table("leaf")
+
+
+# ----------------------------------------------------------------------------- the sky per ray
+@pytest.mark.parametrize("band", ["par", "nir"])
+def test_a_sky_drawn_per_ray_gives_the_directions_answers_within_their_errors(homogeneous,
+                                                                               band):
+    """Leaves that scatter, in a periodic field: the sky's directions drawn per ray (4 rays a
+    cell, one beam's work) give what tracing every direction over the whole grid gives, within
+    their standard errors (batches); black leaves and open fields keep the exact
+    direction-by-direction tracing."""
+    eng = LightEngine(homogeneous, periodic=True, density=2.0, heights_cm=(0.0,))
+    kw = dict(direct_w_m2=0.0, diffuse_w_m2=100.0, sky="uoc", directions=46, band=band)
+    per_ray = eng.absorbed(**kw, seed=1)
+    every = eng.absorbed(**kw, seed=2, sky_passes=0)
+    assert per_ray.directions == every.directions == 46
+    se = math.hypot(per_ray.absorbed_leaves_error, every.absorbed_leaves_error)
+    assert abs(per_ray.balance.absorbed_leaves - every.balance.absorbed_leaves) < 4 * se
+    assert se < 0.005 * every.balance.absorbed_leaves
+    assert abs(per_ray.balance.closure) < 5 / math.sqrt(4 * per_ray.rays)
+    # per plant too (one plant here), and the events are a fraction of the directions'
+    assert per_ray.events < every.events / 4
+    black = Optics(0, 0, 0)
+    a = eng.absorbed(**{**kw, "band": "par"}, optics=black)
+    b = eng.absorbed(**{**kw, "band": "par"}, optics=black, sky_passes=0)
+    np.testing.assert_array_equal(a.triangle_absorbed_w, b.triangle_absorbed_w)
