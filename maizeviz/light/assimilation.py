@@ -26,7 +26,7 @@ Standard errors come from the independent batches of rays the absorbed light was
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -84,6 +84,7 @@ class Assimilation:
     respiration_umol_m2_leaf : the model's leaf respiration at ``temp_c``, umol/m2 leaf/s
     leaf_area_m2 : m2 of leaf the triangles stand for (one copy in a tile-periodic field)
     rect, periodic : as traced
+    warnings : what the user should know (leaves partly out of the rays' reach)
     """
 
     model: dict
@@ -96,7 +97,6 @@ class Assimilation:
     rect: tuple[float, float, float, float]
     periodic: bool
     warnings: tuple[str, ...] = ()
-    extra: dict[str, Any] = field(default_factory=dict)
 
     @property
     def canopy_gross_umol_m2_s(self) -> float:

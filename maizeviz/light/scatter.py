@@ -272,6 +272,20 @@ def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng
     return _Rays(np.vstack(parts_o), np.vstack(parts_d), np.concatenate(parts_b))
 
 
+def _scatter_on(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng,
+                rays: _Rays, depth: int, least: float, leaf_optics: tuple | None) -> None:
+    """Follow scattered ``rays`` for up to ``depth`` more scatterings, or until no more than
+    ``least`` are still travelling; what is left is unresolved."""
+    for _ in range(depth):
+        if len(rays.org) <= least:
+            break
+        tally.events += len(rays.org)
+        kind, prim, end = follow(smp, rays)
+        rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, rays.dirs,
+                       rays.batch, leaf_optics)
+    tally.unresolved += len(rays.org)
+
+
 def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.ndarray,
                  depth: int = DEFAULT_DEPTH, threshold: float = DEFAULT_THRESHOLD,
                  seed: int = 0, threads: int = 1, progress: ProgressCallback | None = None,
@@ -327,14 +341,8 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
         dirs = np.broadcast_to(-s, (b - a, 3))
         rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, dirs, batch,
                        leaf_optics)
-        for _ in range(depth):
-            if len(rays.org) <= threshold * (b - a):
-                break
-            tally.events += len(rays.org)
-            kind, prim, end = follow(smp, rays)
-            rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, rays.dirs,
-                           rays.batch, leaf_optics)
-        tally.unresolved += len(rays.org)
+        _scatter_on(smp, optics, normals, tally, rng, rays, depth, threshold * (b - a),
+                    leaf_optics)
         return tally
 
     total = Tally()
@@ -411,14 +419,8 @@ def scatter_sky(smp: Sampler, directions: np.ndarray, weights: np.ndarray, optic
         tally.first_batch.append(batch[hit])
         rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, -s, batch,
                        leaf_optics)
-        for _ in range(depth):
-            if len(rays.org) <= threshold * (b - a):
-                break
-            tally.events += len(rays.org)
-            kind, prim, end = follow(smp, rays)
-            rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, rays.dirs,
-                           rays.batch, leaf_optics)
-        tally.unresolved += len(rays.org)
+        _scatter_on(smp, optics, normals, tally, rng, rays, depth, threshold * (b - a),
+                    leaf_optics)
         return tally
 
     total = Tally()
