@@ -493,8 +493,9 @@ class LightEngine:
             :func:`maizeviz.light.assimilation.assimilate`), added up over the period
             (``AbsorbedPeriod.assimilation``).
         temperature_c : float or (n,) float64
-            Air (leaf) temperature at each step, C (default 25; a period read from a weather
-            file with an air temperature column gives its own).
+            Air (leaf) temperature at each step, C (default 25); a period read from a weather
+            file with an air temperature column (``Period.temp_air``) gives its own, these
+            filling the steps it lacks (NaN).
 
         Returns
         -------
@@ -528,8 +529,11 @@ class LightEngine:
         joules = unit.triangle_absorbed_w * float(np.sum(diffuse_w * step_s))
         assert unit.batches is not None
         joules_b = unit.batches.absorbed * float(np.sum(diffuse_w * step_s))
-        given_t = getattr(period, "temp_air_c", None)
-        temps = np.asarray(temperature_c if given_t is None else given_t, np.float64)
+        temps = np.asarray(temperature_c, np.float64)
+        given_t = getattr(period, "temp_air", None)          # a weather file's air temperature
+        if given_t is not None and len(given_t) == steps:
+            fill = temps.reshape(-1)[0] if temps.size == 1 else temps
+            temps = np.where(np.isfinite(given_t), np.asarray(given_t, np.float64), fill)
         if temps.ndim > 1 or temps.size not in (1, steps) or not np.all(np.isfinite(temps)):
             from maizeviz.errors import MaizevizError
 

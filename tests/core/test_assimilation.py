@@ -154,3 +154,34 @@ def test_the_facade_traces_photosynthesis_in_a_few_lines(spherical):
         got.canopy_gross_mol_m2, rel=1e-12)
     assert got.table("plant", canopy)["gross_g_co2"].sum() / got.ground_m2 == pytest.approx(
         got.canopy_gross_g_m2, rel=1e-12)
+
+
+def test_a_periods_own_air_temperature_drives_the_c4_model(spherical):
+    """A period carrying air temperatures (a weather file's ``temp_air``) gives each step its
+    own; NaN steps take the temperature given; a hot step assimilates as the model says."""
+    from dataclasses import replace
+
+    import maizeviz as mv
+
+    canopy = spherical[2.0]
+    eng = mv.LightEngine(canopy, periodic=True, density=0.5, heights_cm=(0.0,))
+    period = mv.clear_sky_period("2005-08-01", 39.9, 116.4, "Asia/Shanghai", 180)
+    n = len(period.step_s)
+    cool = eng.absorbed_day(period, directions=16, photosynthesis=mv.leaf_model("c4"),
+                            temperature_c=20.0)
+    air = np.full(n, 33.0)
+    air[0] = np.nan
+    try:
+        warm = replace(period, temp_air=air)
+    except TypeError:                           # a Period without air temperatures yet
+        warm = replace(period)
+        object.__setattr__(warm, "temp_air", air)
+    day = eng.absorbed_day(warm, directions=16, photosynthesis=mv.leaf_model("c4"),
+                           temperature_c=20.0)
+    np.testing.assert_array_equal(day.assimilation.temperature_c, [20.0] + [33.0] * (n - 1))
+    np.testing.assert_array_equal(cool.assimilation.temperature_c, [20.0] * n)
+    # the same light: 33 C beats 20 C wherever the sun is up after the first step
+    hot, cold = day.assimilation.step_gross_umol_m2_s, cool.assimilation.step_gross_umol_m2_s
+    assert np.all(hot[1:] > cold[1:])
+    assert day.assimilation.step_gross_umol_m2_s[0] == pytest.approx(
+        cool.assimilation.step_gross_umol_m2_s[0], rel=1e-12)
