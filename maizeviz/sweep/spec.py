@@ -28,7 +28,7 @@ Defaults are those of ``maizeviz canopy`` and ``maizeviz light``::
               {band = "nir", reflectance = 0.45, transmittance = 0.40, ground_reflectance = 0.25,
                direct_w_m2 = 520, diffuse_w_m2 = 0, depth = 20, seed = 0,
                ranks = [[1, 0.5, 0.35], [2, 0.48, 0.38]]}]   # [rank, rho, tau] per leaf rank
-                                   # (NIR leaves scatter 85 %: depth 20 leaves 0.3 % of it
+                                   # (NIR leaves scatter 85 %: depth 20 leaves 0.2 % of it
                                    # unresolved on the bundled canopy, depth 3 left 28 %)
     photosynthesis = ["none",      # gross CO2 assimilation of scenarios with PAR optics:
                       {model = "c4", temperature = 30, co2_ppm = 400},   # "none", or a leaf
