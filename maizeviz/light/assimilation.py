@@ -21,7 +21,7 @@ within a leaf at one height, so it is pooled over each leaf's triangles in 5 cm 
 triangle (sunflecks, orientation), is kept per triangle, its ray count entering linearly.
 
 Standard errors come from the independent batches of rays the absorbed light was traced in
-(:class:`~maizeviz.light.scatter.Batches`): the model is run on each batch's light alone.
+(:class:`~maizeviz.light.uncertainty.Batches`): the model is run on each batch's light alone.
 """
 
 from __future__ import annotations
@@ -113,7 +113,7 @@ class Assimilation:
         """Monte Carlo standard error of :attr:`canopy_gross_umol_m2_s` (None: no batches)."""
         if self.triangle_batches is None:
             return None
-        from maizeviz.light.scatter import batch_error
+        from maizeviz.light.uncertainty import batch_error
 
         return float(batch_error(self.triangle_batches.sum(axis=1))) / self.ground_m2
 
@@ -189,7 +189,7 @@ class PeriodAssimilation:
     def canopy_gross_error_mol_m2(self) -> float | None:
         if self.triangle_batches is None:
             return None
-        from maizeviz.light.scatter import batch_error
+        from maizeviz.light.uncertainty import batch_error
 
         return float(batch_error(self.triangle_batches.sum(axis=1))) / self.ground_m2
 
@@ -214,35 +214,6 @@ class PeriodAssimilation:
         return frame
 
 
-def dense_rows(batches) -> np.ndarray | None:
-    """(BATCHES, F) float64 of a sparse per-batch array (None stays None)."""
-    if batches is None:
-        return None
-    return np.asarray(batches.todense(), dtype=np.float64) if hasattr(batches, "todense") \
-        else np.asarray(batches, dtype=np.float64)
-
-
-def errors_by(canopy: Canopy, batches, col: str, rect, periodic: bool,
-              by: str) -> dict:
-    """Standard error of ``col`` per leaf ((instance, leaf) keys) or per plant (instance
-    keys) from per-batch per-triangle shares ``batches`` (BATCHES, F), dense or sparse."""
-    import pandas as pd
-
-    from maizeviz.light.leaf_light import leaf_sums
-    from maizeviz.light.scatter import batch_error
-
-    key = ["instance"] if by == "plant" else ["instance", "leaf"]
-    parts = []
-    for b in dense_rows(batches):  # type: ignore[union-attr]
-        part = pd.DataFrame(leaf_sums(canopy, {col: b}, rect, periodic))
-        parts.append(part.groupby(key)[col].sum() if not part.empty
-                     else pd.Series(dtype=float))
-    keys = sorted(set().union(*(p.index for p in parts)))
-    per = np.array([[p.get(k, 0.0) for k in keys] for p in parts], dtype=np.float64)
-    se = np.asarray(batch_error(per)) if keys else np.zeros(0)
-    return dict(zip(keys, se.tolist()))
-
-
 def _table(values: np.ndarray, batches: np.ndarray | None, col: str, per_leaf_col: str,
            rect, periodic: bool, by: str, canopy: Canopy | None) -> pd.DataFrame:
     """Per-leaf or per-plant sums of per-triangle ``values`` (column ``col``), their standard
@@ -250,6 +221,7 @@ def _table(values: np.ndarray, batches: np.ndarray | None, col: str, per_leaf_co
     import pandas as pd
 
     from maizeviz.light.leaf_light import leaf_sums
+    from maizeviz.light.uncertainty import errors_by
 
     if by not in ("leaf", "plant") or canopy is None:
         raise MaizevizError("assimilation is tabled by 'leaf' or 'plant', with the canopy it "
@@ -341,7 +313,7 @@ def assimilate(canopy: Canopy, light: AbsorbedLight, model: LeafModel,
     gross = gross_of(light.triangle_absorbed_w, direct_full, light.triangle_sunlit_cm2)
     batches = None
     if light.batches is not None:
-        from maizeviz.light.scatter import BATCHES
+        from maizeviz.light.uncertainty import BATCHES
 
         b = light.batches
         rows = []

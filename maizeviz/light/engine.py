@@ -33,19 +33,18 @@ from maizeviz.light.optics import SHORTWAVE_SHARE, Optics, optics_for
 from maizeviz.light.perez import PEREZ_MODELS, perez_split
 from maizeviz.light.request import LightRequest, Sampling
 from maizeviz.light.scatter import (
-    BATCHES,
     DEFAULT_DEPTH,
     DEFAULT_THRESHOLD,
     AbsorbedLight,
     AbsorbedPeriod,
     Balance,
-    Batches,
     scatter_beam,
     scatter_sky,
 )
 from maizeviz.light.sky import Sky, make_sky
 from maizeviz.light.sun import Sun, sun_at
 from maizeviz.light.transmission import LightResult, light_scene, trace_light
+from maizeviz.light.uncertainty import BATCHES, Batches
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, report
 

@@ -48,6 +48,7 @@ import numpy as np
 from maizeviz.light.optics import Optics
 from maizeviz.light.rays import ray_grid
 from maizeviz.light.transmission import Sampler, trace_direction
+from maizeviz.light.uncertainty import BATCHES, Batches
 from maizeviz.progress import ProgressCallback, ordered_map, report
 
 #: Default largest number of scatterings followed per ray.
@@ -58,10 +59,6 @@ DEFAULT_THRESHOLD = 1e-4
 EPS_CM = 1e-3
 #: Primary rays followed together (bounded memory: a few arrays of this length).
 CHUNK_RAYS = 1 << 19
-#: Independent batches the primary rays are dealt into (each ray and all it scatters belong
-#: to one): the spread of the batches' estimates gives each figure's Monte Carlo standard
-#: error (:func:`batch_error`).
-BATCHES = 8
 
 
 #: Share of the incident light left unresolved (still travelling when scattering stopped)
@@ -429,49 +426,6 @@ def scatter_sky(smp: Sampler, directions: np.ndarray, weights: np.ndarray, optic
     return total, {"trace": 0.0, "scatter": time.perf_counter() - t0}
 
 
-def batch_error(per_batch) -> float | np.ndarray:
-    """Monte Carlo standard error of a total from its batches' shares.
-
-    Parameters
-    ----------
-    per_batch : (BATCHES, ...) float64, what each batch's rays contributed to the total (the
-        rows sum to the estimate)
-
-    Returns
-    -------
-    standard error of the estimate (same unit, shape ``per_batch.shape[1:]``): the batches
-    are independent estimates ``BATCHES x row``, whose mean is the estimate; its standard
-    error is their standard deviation over ``sqrt(BATCHES)``.
-    """
-    x = np.asarray(per_batch, dtype=np.float64)
-    k = x.shape[0]
-    return np.std(k * x, axis=0, ddof=1) / np.sqrt(k)
-
-
-@dataclass(frozen=True)
-class Batches:
-    """Per-batch shares of an absorbed-light result (each row one batch; rows sum to the
-    result's per-triangle arrays): what standard errors are computed from.
-
-    Attributes
-    ----------
-    absorbed : (BATCHES, F) scipy.sparse CSR array, W (or J over a period) per triangle
-    direct : (BATCHES, F) the part of ``absorbed`` from the sun's direct beam
-    sunlit_cm2 : (BATCHES, F) area in the direct beam, cm2
-    """
-
-    absorbed: Any
-    direct: Any
-    sunlit_cm2: Any
-
-    def error(self, weights=None, what: str = "absorbed") -> float:
-        """Standard error of ``sum(weights * what)`` over the triangles (weights (F,), None:
-        all 1)."""
-        m = getattr(self, what)
-        per = m.sum(axis=1) if weights is None else m @ np.asarray(weights, np.float64)
-        return float(batch_error(np.asarray(per)))
-
-
 @dataclass(frozen=True)
 class Balance:
     """Where the incident light went, W/m2 of sample ground (or, for a period, MJ/m2 or mol/m2
@@ -601,7 +555,7 @@ class AbsorbedLight:
         if by == "plant":
             frame = _per_plant(frame, ("absorbed_w", "sunlit_area_cm2"))
         if self.batches is not None:
-            from maizeviz.light.assimilation import errors_by
+            from maizeviz.light.uncertainty import errors_by
 
             se = errors_by(canopy, self.batches.absorbed, "absorbed_w", self.rect,
                            self.periodic, by)
@@ -624,7 +578,7 @@ def absorbed_leaf_rows(canopy, light: AbsorbedLight) -> list[dict]:
                      light.rect, light.periodic)
     se = {}
     if light.batches is not None:
-        from maizeviz.light.assimilation import errors_by
+        from maizeviz.light.uncertainty import errors_by
 
         se = errors_by(canopy, light.batches.absorbed, "absorbed_w", light.rect,
                        light.periodic, "leaf")
@@ -718,7 +672,7 @@ class AbsorbedPeriod:
         if by == "plant":
             frame = _per_plant(frame, ("absorbed_mj",))
         if self.batches is not None:
-            from maizeviz.light.assimilation import errors_by
+            from maizeviz.light.uncertainty import errors_by
 
             se = errors_by(canopy, self.batches.absorbed * 1e-6, "absorbed_mj", self.rect,
                            self.periodic, by)

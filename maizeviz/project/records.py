@@ -227,7 +227,7 @@ def _batches_from(rec: Record, where: str, what: str, n_tri: int):
     """The per-batch shares of an absorbed-light record (None when it has none)."""
     from scipy.sparse import csr_array
 
-    from maizeviz.light.scatter import BATCHES, Batches
+    from maizeviz.light.uncertainty import BATCHES, Batches
 
     if "batches_absorbed" not in rec.arrays:
         return None
