@@ -40,7 +40,7 @@ from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.optics import DEFAULT_OPTICS, Optics
+from maizeviz.light.trace.optics import DEFAULT_OPTICS, Optics
 from maizeviz.mesh.levels import parse_level
 from maizeviz.resources import example_points
 
@@ -101,7 +101,7 @@ def main() -> None:
 def sky_part(canopy, args) -> dict:
     """The sky: black leaves against absorbed PAR and NIR, per ray and direction by
     direction (each timed once: the direction-by-direction NIR sky takes about a minute)."""
-    from maizeviz.light.sky import make_sky
+    from maizeviz.light.sources.sky import make_sky
 
     sky = make_sky("uoc", args.sky_directions)
     eng = LightEngine(canopy, periodic=True, density=args.sky_density, heights_cm=(0.0,),

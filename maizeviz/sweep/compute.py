@@ -38,8 +38,8 @@ from maizeviz.errors import MaizevizError
 from maizeviz.io.hashing import sha256_stream
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.request import Sampling
-from maizeviz.light.sun import Sun, sun_at
+from maizeviz.light.scene.request import Sampling
+from maizeviz.light.sources.sun import Sun, sun_at
 from maizeviz.mesh.levels import parse_level
 from maizeviz.sweep.errors import WorkerInputError
 
@@ -257,14 +257,14 @@ def _light(state: _GroupState, s) -> dict:
                     "reflected_top_w_m2": b.reflected_top, "balance_closure": b.closure,
                     "absorbed_leaves_se_w_m2": light.absorbed_leaves_error,
                     "unresolved_w_m2": b.unresolved}
-        from maizeviz.light.scatter import UNRESOLVED_WARN, unresolved_warning
+        from maizeviz.light.results.absorbed import UNRESOLVED_WARN, unresolved_warning
 
         if b.incident and b.unresolved > UNRESOLVED_WARN * b.incident:
             state_warnings = [unresolved_warning(b.unresolved / b.incident, light.depth)]
         else:
             state_warnings = []
         if s.photosynthesis is not None:
-            from maizeviz.light.assimilation import assimilate
+            from maizeviz.light.results.assimilation import assimilate
             from maizeviz.photosynthesis.split import model_from_dict
 
             ph = dict(s.photosynthesis)

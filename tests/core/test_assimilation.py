@@ -1,4 +1,4 @@
-"""Canopy photosynthesis from traced absorbed PAR (maizeviz.light.assimilation), through real
+"""Canopy photosynthesis from traced absorbed PAR (maizeviz.light.results.assimilation), through real
 Embree, against WOFOST's canopy routine as PCSE implements it (a source we did not write), and
 the data's own oracles: sums per leaf = per plant = canopy, a tiled block sampled on its tile
 = the same field sampled whole, standard errors that shrink with the rays."""
@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.assimilation import assimilate
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.optics import Optics
+from maizeviz.light.results.assimilation import assimilate
+from maizeviz.light.trace.optics import Optics
 from maizeviz.mesh.tessellate import triangle_areas_normals
 from maizeviz.photosynthesis.split import leaf_model, mean_assimilation
 

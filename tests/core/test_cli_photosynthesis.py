@@ -105,7 +105,7 @@ def test_precision_traces_denser_until_the_standard_error_is_met(capsys):
 
 
 def test_a_precision_that_cannot_be_met_is_said(capsys, monkeypatch):
-    import maizeviz.light.precision as precision
+    import maizeviz.light.trace.precision as precision
 
     monkeypatch.setattr(precision, "MAX_DENSITY", 0.5)
     code, out, err = run_cli(capsys, *cli_args(photosynthesis="c4", density=0.25,

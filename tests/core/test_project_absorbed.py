@@ -68,7 +68,7 @@ def test_absorbed_light_round_trips_with_its_optics(traced, tmp_path):
 
 
 def test_a_par_records_photosynthesis_comes_back_the_same(traced, tmp_path):
-    from maizeviz.light.assimilation import assimilate
+    from maizeviz.light.results.assimilation import assimilate
     from maizeviz.photosynthesis.split import leaf_model
 
     path, leaves, layout, canopy, _ = traced

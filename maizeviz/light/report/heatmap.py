@@ -1,0 +1,177 @@
+"""Transmission maps: binned transmission over a sensor plane (the sample rectangle raised to a
+height, in its own x, y), as a matplotlib figure, PNG and CSV (matplotlib's Agg canvas: no GUI
+toolkit; the app shows the same figure)."""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+from typing import TYPE_CHECKING, TypeAlias, cast
+
+import numpy as np
+
+from maizeviz.io.atomic import atomic_open, atomic_path, file_tag, make_folder
+from maizeviz.light.results.direct import LightResult
+from maizeviz.light.results.maps import TransmissionMap, bin_edges, binned
+from maizeviz.light.sources.sky import SKY_KINDS
+
+if TYPE_CHECKING:                                   # matplotlib is imported when drawing
+    from matplotlib.figure import Figure
+
+    from maizeviz.light.results.diffuse import PeriodLight, SkyLight
+
+    AnyLight: TypeAlias = LightResult | SkyLight | PeriodLight
+
+#: The kinds of light results mapped (the app calls a period a ``day``), and the file-name
+#: prefix of each kind's maps.
+MAP_PREFIXES = {"sun": "transmission", "sky": "diffuse", "period": "period", "day": "period"}
+
+
+def transmission_map(result: LightResult, height: float, bin_cm: float = 5.0) -> TransmissionMap:
+    """Binned transmission on the sensor plane at ``height`` (one of the traced heights), in the
+    rectangle's own x, y."""
+    xe, ye = bin_edges(result.rect, bin_cm)
+    k = result.height_index(height)
+    counts, lit = binned(result.sensor_xy(k), result.lit(k), xe, ye)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        t = np.where(counts > 0, lit / counts, np.nan)
+    return TransmissionMap(float(result.heights_cm[k]), xe, ye, t, counts.astype(np.int64),
+                           float(result.transmission[k]))
+
+
+def heatmap_figure(tmap: TransmissionMap, result: LightResult | None = None,
+                   width_in: float = 8.0, dpi: int = 110, title: str | None = None,
+                   what: str = "direct-light transmission") -> Figure:
+    """A figure of one map: colour bar, axes in cm; the title names the sun angles, level and
+    rays of ``result``, or is ``title`` (the first line always names ``what``, the height and
+    the plane's total)."""
+    from matplotlib.figure import Figure
+
+    xe, ye = tmap.x_edges, tmap.y_edges
+    aspect = (ye[-1] - ye[0]) / (xe[-1] - xe[0])
+    fig = Figure(figsize=(width_in, width_in * aspect * 0.8 + 0.2 * width_in), dpi=dpi)
+    ax = fig.add_subplot()
+    im = ax.pcolormesh(xe, ye, tmap.transmission.T, vmin=0, vmax=1, cmap="viridis",
+                       shading="flat")
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (cm, across rows)")
+    ax.set_ylabel("y (cm, along rows)")
+    if title is None and result is not None:
+        title = map_title(result, "sun", (xe[-1] - xe[0]) / max(len(xe) - 1, 1))[1]
+    import textwrap
+
+    ax.set_title(f"{what} at {tmap.height_cm:g} cm: {tmap.total:.3f}"
+                 + ("\n" + "\n".join(textwrap.wrap(title, 95)) if title else ""), fontsize=9)
+    fig.colorbar(im, ax=ax, label="transmission (fraction of the light reaching this height)",
+                 shrink=0.8)
+    fig.tight_layout()
+    return fig
+
+
+def write_map_csv(path: str | Path, tmap: TransmissionMap) -> None:
+    """One line per bin: x_cm, y_cm (bin centre), height_cm, transmission (empty if no ray),
+    rays (atomically)."""
+    xc = 0.5 * (tmap.x_edges[1:] + tmap.x_edges[:-1])
+    yc = 0.5 * (tmap.y_edges[1:] + tmap.y_edges[:-1])
+    with atomic_open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["x_cm", "y_cm", "height_cm", "transmission", "rays"])
+        t = tmap.transmission
+        for i, x in enumerate(xc):
+            for j, y in enumerate(yc):
+                w.writerow([f"{x:.2f}", f"{y:.2f}", f"{tmap.height_cm:g}",
+                            "" if np.isnan(t[i, j]) else f"{t[i, j]:.4f}", int(tmap.rays[i, j])])
+
+
+def save_figure(fig: Figure, path: str | Path) -> None:
+    """Save a figure as PNG (or the format of the extension), atomically."""
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format=Path(path).suffix.lstrip(".") or "png")
+
+
+def map_title(result: AnyLight, kind: str, bin_cm: float = 5.0) -> tuple[str, str]:
+    """(what is mapped, the second title line) of the maps of a sun's ``LightResult``
+    (``kind`` sun; ``bin_cm``, the bin named in the title), a ``SkyLight`` (sky) or a
+    ``PeriodLight`` (period, or day)."""
+    _check_kind(kind)
+    if kind == "sun":
+        sun_res = cast(LightResult, result)
+        sun = sun_res.sun
+        return ("direct-light transmission",
+                f"sun zenith {sun.zenith_deg:.1f} deg, azimuth {sun.azimuth_deg:.1f} deg; "
+                f"level {result.level}; {sun_res.rays:,} sensors, {bin_cm:.3g} cm bins")
+    if kind == "sky":
+        sky_res = cast("SkyLight", result)
+        sky = sky_res.sky
+        return ("diffuse transmission",
+                f"{SKY_KINDS[sky.kind].split(',')[0]}, {sky.split} split of {sky.n} "
+                f"directions; level {result.level}; {sky_res.rays:,} sensors per direction")
+    p = cast("PeriodLight", result).period
+    return ("fraction of the period's PAR",
+            f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M}, {p.n_steps} steps; "
+            f"level {result.level}")
+
+
+def _check_kind(kind: str) -> None:
+    if kind not in MAP_PREFIXES:
+        raise ValueError(f"unknown kind of light result {kind!r} (one of "
+                         f"{', '.join(MAP_PREFIXES)})")
+
+
+def result_map(result: AnyLight, height: float, kind: str = "sun",
+               bin_cm: float = 5.0) -> TransmissionMap:
+    """The map of one traced height of a light result: a sun's binned in ``bin_cm`` bins, a
+    sky's or a period's as binned when traced."""
+    _check_kind(kind)
+    if kind == "sun":
+        return transmission_map(cast(LightResult, result), float(height), bin_cm)
+    return cast("SkyLight | PeriodLight", result).transmission_map(float(height))
+
+
+def result_figure(result: AnyLight, height: float, kind: str = "sun", bin_cm: float = 5.0,
+                  width_in: float = 8.0, dpi: int = 110,
+                  tmap: TransmissionMap | None = None) -> Figure:
+    """The figure of one height of a light result (:func:`result_map`, or ``tmap`` when
+    already made), titled by :func:`map_title`."""
+    tmap = result_map(result, height, kind, bin_cm) if tmap is None else tmap
+    if kind == "sun":
+        return heatmap_figure(tmap, cast(LightResult, result), width_in=width_in, dpi=dpi)
+    what, title = map_title(result, kind)
+    return heatmap_figure(tmap, width_in=width_in, dpi=dpi, title=title, what=what)
+
+
+def heatmap_stems(result: AnyLight, kind: str = "sun") -> list[str]:
+    """Distinct file stems of a result's maps, one per height (see :func:`map_stems`)."""
+    return map_stems(kind, result.level, result.heights_cm)
+
+
+def map_stems(kind: str, level: str, heights_cm) -> list[str]:
+    """Distinct file stems, one per height of ``heights_cm`` (cm) at the mesh level labelled
+    ``level``: ``transmission_<level>_h<height>cm`` (a sun's maps), ``diffuse_...`` (a sky's)
+    or ``period_...`` (a period's). Known before anything is traced, so output names can be
+    checked first."""
+    _check_kind(kind)
+    level = file_tag(level) or "level"
+    stems: list[str] = []
+    for h in heights_cm:
+        stem = f"{MAP_PREFIXES[kind]}_{level}_h{h:g}cm".replace(".", "p")
+        while stem in stems:                         # heights equal to %g precision
+            stem += "_"
+        stems.append(stem)
+    return stems
+
+
+def write_heatmaps(folder: str | Path, result: AnyLight, bin_cm: float = 5.0,
+                   kind: str = "sun") -> list[Path]:
+    """One PNG and one CSV per height of a light result (``kind`` as for :func:`map_title`)
+    in ``folder`` (created if needed); returns the paths written, PNG and CSV alternating."""
+    _check_kind(kind)
+    folder = make_folder(folder)
+    written = []
+    for h, stem in zip(result.heights_cm, heatmap_stems(result, kind)):
+        tmap = result_map(result, float(h), kind, bin_cm)
+        png, csv_path = folder / f"{stem}.png", folder / f"{stem}.csv"
+        save_figure(result_figure(result, float(h), kind, tmap=tmap), png)
+        write_map_csv(csv_path, tmap)
+        written += [png, csv_path]
+    return written

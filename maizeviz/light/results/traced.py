@@ -1,0 +1,131 @@
+"""What every traced light result shares: where it was sampled, how, and what it says.
+
+:class:`~maizeviz.light.results.direct.LightResult` (one sun),
+:class:`~maizeviz.light.results.diffuse.SkyLight` (a sky) and
+:class:`~maizeviz.light.results.diffuse.PeriodLight` (a day) are :class:`TracedLight`; the last two
+also carry binned maps (:class:`MappedLight`). Every result gives its numbers as a pandas
+DataFrame with :meth:`TracedLight.table`: per height, or per leaf or plant of the canopy it was
+traced on.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from maizeviz.errors import MaizevizError
+from maizeviz.light.results.maps import TransmissionMap
+from maizeviz.light.results.per_leaf import LightRow, plant_light
+from maizeviz.light.scene.rays import Rect
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from maizeviz.canopy.scene import Canopy
+
+#: What :meth:`TracedLight.table` tabulates.
+TABLES = ("height", "leaf", "plant")
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class TracedLight:
+    """The fields every light result shares (keyword-only in the results' constructors).
+
+    Attributes
+    ----------
+    heights_cm : (H,) float64 cm, heights of the sensor planes
+    rect : (x0, y0, x1, y1) cm, the sample rectangle
+    rays : int, rays per direction (and sensors per plane)
+    level : str, mesh level label of the canopy
+    warnings : tuple of str, what the user should know about this result
+    seconds : dict, "build" (the scene), "trace", ..., s
+    periodic : bool, rays and sensor paths wrapped across the plot
+    """
+
+    heights_cm: np.ndarray
+    rect: Rect
+    rays: int
+    level: str = ""
+    warnings: tuple[str, ...] = ()
+    seconds: dict[str, float] = field(default_factory=dict)
+    periodic: bool = False
+
+    @property
+    def rect_area_cm2(self) -> float:
+        """Area of the sample rectangle, cm2."""
+        x0, y0, x1, y1 = self.rect
+        return (x1 - x0) * (y1 - y0)
+
+    def height_index(self, height: float) -> int:
+        """Index of ``height`` (cm) among the traced heights; MaizevizError if not traced."""
+        k = np.flatnonzero(np.isclose(self.heights_cm, height, rtol=0, atol=1e-9))
+        if not len(k):
+            raise MaizevizError(f"height {height:g} cm was not traced (traced: "
+                                f"{', '.join(f'{h:g}' for h in self.heights_cm)} cm)",
+                                quantity="heights")
+        return int(k[0])
+
+    def table(self, by: str = "height", canopy: Canopy | None = None) -> pd.DataFrame:
+        """The result as a table.
+
+        Parameters
+        ----------
+        by : {"height", "leaf", "plant"}
+            One row per sensor height (column ``height_cm``, cm, then the result's values
+            there), per leaf or per plant (the light each intercepts, areas in cm2, PAR in mol).
+        canopy : Canopy
+            The canopy the light was traced on; needed by leaf and plant.
+
+        Returns
+        -------
+        pandas.DataFrame
+        """
+        import pandas as pd
+
+        if by == "height":
+            return pd.DataFrame({"height_cm": np.asarray(self.heights_cm, dtype=np.float64),
+                                 **self._height_columns()})
+        if by not in TABLES:
+            raise MaizevizError(f"a light table is by {', '.join(TABLES)}, got '{by}'",
+                                quantity="by")
+        if canopy is None:
+            raise MaizevizError(f"a table by {by} needs the canopy the light was traced on: "
+                                f"table('{by}', canopy)", quantity="canopy")
+        rows = self.leaf_rows(canopy)
+        return pd.DataFrame(plant_light(rows) if by == "plant" else rows)
+
+    def _height_columns(self) -> dict[str, Any]:
+        """The per-height columns of :meth:`table`, each (H,)."""
+        raise NotImplementedError
+
+    def leaf_rows(self, canopy: Canopy) -> list[LightRow]:
+        """One row per leaf that received light: its plant, place, area and the light it
+        received (:mod:`maizeviz.light.results.per_leaf`); ``table("leaf", canopy)`` as
+        dicts."""
+        raise NotImplementedError
+
+
+@dataclass(frozen=True, eq=False, kw_only=True)
+class MappedLight(TracedLight):
+    """A result that carries its transmission binned over each sensor plane.
+
+    Attributes
+    ----------
+    maps : (H, a, b) float64, the binned value of each plane (NaN: no sensor in the bin)
+    map_edges : x (a + 1,) and y (b + 1,) bin edges, cm
+    map_rays : (a, b) int64, sensors per bin (ground grid)
+    """
+
+    maps: np.ndarray
+    map_edges: tuple[np.ndarray, np.ndarray]
+    map_rays: np.ndarray
+
+    def _map_at(self, height: float, totals: np.ndarray) -> TransmissionMap:
+        """The map of the plane at ``height`` (a traced height), ``totals`` (H,) the planes'
+        whole values."""
+        i = self.height_index(height)
+        xe, ye = self.map_edges
+        return TransmissionMap(float(self.heights_cm[i]), xe, ye, self.maps[i], self.map_rays,
+                               float(totals[i]))

@@ -1,0 +1,865 @@
+"""Sunlight over a day or a period: sun positions, clear-sky or measured irradiance, PAR.
+
+A period (a day, or the hours between two clock times, or the span of a weather file) is cut
+into time steps. Each step stands for an interval of ``step_s`` seconds and carries the sun
+position and the irradiance at the middle of that interval (the midpoint rule): the energy of a
+step is its irradiance times ``step_s``, and the energy of the period is the sum of the energies
+of its steps, by construction. Only the steps with the sun above the horizon (apparent zenith
+below 90 deg) are kept, since only they can be traced; the period keeps its own bounds. A period
+in which the sun never rises (polar night) has zero steps and says so once in its notes.
+
+Irradiance (W/m2 on a horizontal plane unless said otherwise): ``ghi`` global horizontal,
+``dni`` direct normal, ``dhi`` diffuse horizontal, ``direct_horizontal`` = dni cos(zenith); for
+every step ghi = direct_horizontal + dhi.
+
+- Clear sky, no downloaded data: the Ineichen-Perez model (Ineichen & Perez 2002) as
+  implemented by pvlib, with a stated Linke turbidity (default 3, no climatology lookup file)
+  and site altitude; air mass by Kasten & Young (1989); sun positions by pvlib's NREL SPA
+  (Reda & Andreas 2004).
+- Weather file (:func:`read_weather`): measured ``ghi`` and optionally ``dni``/``dhi``. Where
+  only ghi is given it is split into direct and diffuse by the Erbs et al. (1982)
+  diffuse-fraction correlation (pvlib). See :func:`read_weather` for the format and the rules.
+
+PAR is taken as a fixed fraction of shortwave: ``par_umol_per_j`` umol of PAR photons per J of
+shortwave, by default 0.48 (PAR share of global radiation) x 4.57 umol/J (photons per joule of
+daylight PAR, McCree 1972) = 2.1936 umol/J.
+
+Angles in degrees: zenith from the vertical, azimuth clockwise from north (as
+:class:`maizeviz.light.sources.sun.Sun`).
+
+References
+----------
+- Ineichen, P. & Perez, R. (2002). A new airmass independent formulation for the Linke
+  turbidity coefficient. Solar Energy 73(3), 151-157.
+- Erbs, D.G., Klein, S.A. & Duffie, J.A. (1982). Estimation of the diffuse radiation fraction
+  for hourly, daily and monthly-average global radiation. Solar Energy 28(4), 293-302.
+- Kasten, F. & Young, A.T. (1989). Revised optical air mass tables and approximation formula.
+  Applied Optics 28, 4735-4738.
+- Reda, I. & Andreas, A. (2004). Solar position algorithm for solar radiation applications.
+  Solar Energy 76(5), 577-589.
+- McCree, K.J. (1972). Test of current definitions of photosynthetically active radiation
+  against leaf photosynthesis data. Agricultural Meteorology 10, 443-453.
+"""
+
+from __future__ import annotations
+
+import csv
+import datetime as _dt
+import io
+import math
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+from types import MappingProxyType
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from maizeviz.errors import MaizevizError
+from maizeviz.io.inputs import read_input
+from maizeviz.light.sources.clock import check_altitude as _check_altitude
+from maizeviz.light.sources.clock import check_place as _check_place
+from maizeviz.light.sources.clock import local_time
+from maizeviz.light.sources.clock import zone as _time_zone
+from maizeviz.light.sources.dates import FIRST_YEAR, LAST_YEAR, TIME_UNIT, check_year
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+#: Share of shortwave (global) radiation in the PAR band (400-700 nm).
+PAR_FRACTION = 0.48
+#: Photons per joule of daylight PAR, umol/J (McCree 1972).
+PAR_UMOL_PER_J_PAR = 4.57
+#: Default conversion from shortwave energy to PAR photons, umol per J of shortwave.
+DEFAULT_PAR_UMOL_PER_J = PAR_FRACTION * PAR_UMOL_PER_J_PAR
+#: Default Linke turbidity of the clear sky (a clean to average rural atmosphere).
+DEFAULT_LINKE_TURBIDITY = 3.0
+#: Weather files larger than this are refused (a year of 1-minute rows is about 35 MiB).
+MAX_WEATHER_BYTES = 64 * 2 ** 20
+#: A step longer than this many times the median step of a weather file is a gap.
+GAP_FACTOR = 1.5
+#: Irradiance above this is refused as a unit mistake (the solar constant is ~1361 W/m2;
+#: cloud enhancement rarely passes 1600 W/m2 on a horizontal sensor).
+MAX_IRRADIANCE_W_M2 = 2000.0
+#: More time steps than this are refused.
+MAX_STEPS = 1_000_000
+
+WEATHER_REQUIRED = ("time", "ghi")
+WEATHER_OPTIONAL = ("dni", "dhi")
+WEATHER_LABELS = ("center", "start", "end")
+# a clock time followed by a UTC offset or Z, at the end of the text
+_ZONE_SUFFIX = re.compile(r"\d{2}:\d{2}(?::\d{2}(?:[.,]\d+)?)?\s*(?:Z|[+-]\d{2}(?::?\d{2})?)$",
+                          re.IGNORECASE)
+
+
+class WeatherFileError(MaizevizError):
+    """A weather file cannot be used: the message names the file, line, time and column.
+    Its ``quantity`` is ``"weather"`` (the file as an input), so the app can mark the field
+    that names the file and the command line can name ``--weather``."""
+
+    def __init__(self, message: str = "", quantity: str | None = "weather"):
+        super().__init__(message, quantity)
+
+
+# --------------------------------------------------------------------------- small helpers
+
+
+def _frozen(a, dtype=np.float64) -> np.ndarray:
+    a = np.array(a, dtype=dtype)
+    a.setflags(write=False)
+    return a
+
+
+def _fmt_duration(seconds: float) -> str:
+    if seconds >= 3600 and seconds % 3600 == 0:
+        return f"{seconds / 3600:g} h"
+    if seconds >= 60:
+        return f"{seconds / 60:g} min"
+    return f"{seconds:g} s"
+
+
+def _check_par_factor(par_umol_per_j) -> float:
+    if not isinstance(par_umol_per_j, (int, float, np.floating, np.integer)) \
+            or not math.isfinite(par_umol_per_j) or not (0 < par_umol_per_j <= 10):
+        raise MaizevizError(f"PAR conversion factor must be in (0, 10] umol per J of "
+                            f"shortwave, got {par_umol_per_j!r}", quantity="par_factor")
+    return float(par_umol_per_j)
+
+
+def _localize(day: _dt.date, clock: str, tz, what: str):
+    """Local clock time ``clock`` on ``day`` in zone ``tz``, a tz-aware Timestamp
+    (:func:`maizeviz.light.sources.clock.local_time`)."""
+    return local_time(day, clock, tz, what, quantity="period")
+
+
+def _solar_position(times, lat, lon, altitude):
+    """pvlib solar position; returns apparent zenith, true zenith, azimuth as (n,) arrays."""
+    import pvlib
+
+    if len(times) == 0:
+        empty = np.zeros(0)
+        return empty, empty, empty
+    pos = pvlib.solarposition.get_solarposition(times, lat, lon, altitude)
+    return (pos["apparent_zenith"].to_numpy(float), pos["zenith"].to_numpy(float),
+            pos["azimuth"].to_numpy(float))
+
+
+def _no_sun_note(start, end, lat, lon) -> str:
+    return (f"the sun stays below the horizon from {start.isoformat()} to {end.isoformat()} at "
+            f"latitude {lat:g}, longitude {lon:g}: no sunlight in this period (zero steps)")
+
+
+# --------------------------------------------------------------------------- sun track
+
+
+@dataclass(frozen=True, eq=False)
+class SunTrack:
+    """Sun positions at the middle of each time step of a period, sun above the horizon only.
+
+    Attributes
+    ----------
+    times : (n,) pandas DatetimeIndex, time-zone aware: middle of each step
+    step_s : (n,) float64, s: length of the interval each step stands for
+    zenith_deg : (n,) float64, deg: apparent (refraction-corrected) zenith, < 90
+    true_zenith_deg : (n,) float64, deg: geometric zenith (for decomposition models)
+    azimuth_deg : (n,) float64, deg, clockwise from north
+    start, end : pandas Timestamp, time-zone aware: bounds of the whole period
+    latitude, longitude : float, deg (north, east positive); altitude_m : float, m
+    tz : str, time zone of ``times``
+    notes : tuple of str: things said once about the period (polar night...)
+    """
+
+    times: pd.DatetimeIndex
+    step_s: np.ndarray
+    zenith_deg: np.ndarray
+    true_zenith_deg: np.ndarray
+    azimuth_deg: np.ndarray
+    start: pd.Timestamp
+    end: pd.Timestamp
+    latitude: float
+    longitude: float
+    altitude_m: float
+    tz: str
+    notes: tuple[str, ...] = ()
+
+    def __post_init__(self):
+        for name in ("step_s", "zenith_deg", "true_zenith_deg", "azimuth_deg"):
+            object.__setattr__(self, name, _frozen(getattr(self, name)))
+
+    @property
+    def n_steps(self) -> int:
+        """Steps with the sun above the horizon."""
+        return len(self.step_s)
+
+    @property
+    def period_s(self) -> float:
+        """Length of the whole period, s (night included)."""
+        return (self.end - self.start).total_seconds()
+
+    @property
+    def sun_never_up(self) -> bool:
+        """True when the sun stays below the horizon for the whole period."""
+        return self.n_steps == 0
+
+
+def _step_edges(total_s: float, step_s: float) -> np.ndarray:
+    """Offsets (s) of the step edges from the period start; the last step may be shorter."""
+    full = math.floor(total_s / step_s + 1e-9)
+    edges = np.arange(full + 1, dtype=np.float64) * step_s
+    if total_s - edges[-1] > 1e-6:
+        edges = np.append(edges, total_s)
+    edges[-1] = total_s
+    return edges
+
+
+def sun_track(date, lat: float, lon: float, tz: str, step_min: float = 30.0,
+              start: str | None = None, end: str | None = None,
+              altitude: float = 0.0) -> SunTrack:
+    """Sun positions over a day (or part of it) at a fixed time step.
+
+    Parameters
+    ----------
+    date : "YYYY-MM-DD" or datetime.date: the local day
+    lat, lon : float, deg (north, east positive)
+    tz : str, IANA time zone such as "Asia/Shanghai"; clock times are local times there
+    step_min : float > 0, min: step length; the last step is shorter when the period is not a
+        whole number of steps
+    start, end : "HH:MM" local clock times, default 00:00 and 24:00 (the whole day);
+        daylight-saving changes are honoured (a spring-forward day is 23 h long)
+    altitude : float, m above sea level (refraction and air mass)
+
+    Returns
+    -------
+    SunTrack with the steps whose middle has the sun above the horizon
+
+    Raises
+    ------
+    MaizevizError
+        Bad place, date, zone or clock time, a step of 0 or longer than the period, a period
+        that ends before it starts, more than MAX_STEPS steps.
+    """
+    import pandas as pd
+
+    lat, lon = _check_place(lat, lon)
+    altitude = _check_altitude(altitude)
+    try:
+        day = date if isinstance(date, _dt.date) else _dt.date.fromisoformat(str(date))
+    except ValueError:
+        raise MaizevizError(f"the date must be YYYY-MM-DD, got '{date}'",
+                            quantity="date") from None
+    zone = _time_zone(tz)
+    if isinstance(step_min, bool) or not isinstance(step_min, (int, float, np.integer,
+                                                              np.floating)) \
+            or not math.isfinite(step_min) or step_min <= 0:
+        raise MaizevizError(f"the time step must be > 0 min, got {step_min!r}", quantity="step")
+    t0 = _localize(day, start or "00:00", zone, "start")
+    t1 = _localize(day, end or "24:00", zone, "end")
+    total = (t1 - t0).total_seconds()
+    if total <= 0:
+        raise MaizevizError(f"the period must end after it starts, got {start or '00:00'} to "
+                            f"{end or '24:00'}", quantity="period")
+    step_s = float(step_min) * 60.0
+    if step_s > total + 1e-6:
+        raise MaizevizError(f"the time step ({_fmt_duration(step_s)}) is longer than the "
+                            f"period ({_fmt_duration(total)})", quantity="step")
+    if total / step_s > MAX_STEPS:
+        raise MaizevizError(f"a time step of {step_min:g} min gives {total / step_s:.0f} steps, "
+                            f"more than {MAX_STEPS}", quantity="step")
+    edges = _step_edges(total, step_s)
+    mids = (edges[:-1] + edges[1:]) / 2.0
+    times = t0 + pd.to_timedelta(np.round(mids * 1e6).astype(np.int64), unit="us")
+    zen, true_zen, azi = _solar_position(times, lat, lon, altitude)
+    up = zen < 90.0
+    notes = () if up.any() else (_no_sun_note(t0, t1, lat, lon),)
+    return SunTrack(times=times[up], step_s=np.diff(edges)[up], zenith_deg=zen[up],
+                    true_zenith_deg=true_zen[up], azimuth_deg=azi[up], start=t0, end=t1,
+                    latitude=lat, longitude=lon, altitude_m=altitude, tz=str(zone),
+                    notes=notes)
+
+
+# --------------------------------------------------------------------------- period
+
+
+@dataclass(frozen=True, eq=False)
+class Period:
+    """Irradiance at each time step of a period, sun above the horizon only.
+
+    Attributes
+    ----------
+    times : (n,) pandas DatetimeIndex, time-zone aware: middle of each step
+    step_s : (n,) float64, s: length of the interval each step stands for
+    zenith_deg : (n,) float64, deg: apparent zenith, < 90
+    azimuth_deg : (n,) float64, deg, clockwise from north
+    ghi, dni, dhi : (n,) float64, W/m2: global horizontal, direct normal, diffuse horizontal
+    direct_horizontal : (n,) float64, W/m2: dni cos(zenith) = ghi - dhi
+    start, end : pandas Timestamp: bounds of the whole period (night included)
+    source : str: where the irradiance comes from, with the model and its parameters
+    parameters : read-only mapping: the same as data (model, linke_turbidity, altitude_m...)
+    par_umol_per_j : float, umol of PAR per J of shortwave
+    notes : tuple of str: things said once about the period (polar night, dropped rows...)
+
+    Integration: step i contributes ``ghi[i] * step_s[i]`` J/m2; every total is the exactly
+    rounded sum (math.fsum) of its steps.
+    """
+
+    times: pd.DatetimeIndex
+    step_s: np.ndarray
+    zenith_deg: np.ndarray
+    azimuth_deg: np.ndarray
+    ghi: np.ndarray
+    dni: np.ndarray
+    dhi: np.ndarray
+    direct_horizontal: np.ndarray
+    start: pd.Timestamp
+    end: pd.Timestamp
+    source: str
+    parameters: Mapping[str, object] = field(default_factory=dict)
+    par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J
+    notes: tuple[str, ...] = ()
+
+    def __reduce__(self):
+        # the read-only parameters mapping does not pickle; a period crosses process
+        # boundaries (the app's light process, Dask workers) as its fields, checked again
+        values = {f.name: getattr(self, f.name) for f in fields(self)}
+        values["parameters"] = dict(self.parameters)
+        return (_period_from_fields, (values,))
+
+    def __post_init__(self):
+        n = len(self.times)
+        for name in ("step_s", "zenith_deg", "azimuth_deg", "ghi", "dni", "dhi",
+                     "direct_horizontal"):
+            arr = _frozen(getattr(self, name))
+            if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+                raise MaizevizError(f"period {name} must be {n} finite numbers")
+            object.__setattr__(self, name, arr)
+        object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
+        object.__setattr__(self, "par_umol_per_j", _check_par_factor(self.par_umol_per_j))
+        object.__setattr__(self, "notes", tuple(self.notes))
+        if np.any(self.step_s <= 0) or np.any(self.zenith_deg >= 90):
+            raise MaizevizError("period steps must last > 0 s and have the sun above the horizon")
+        if np.any(self.dhi < 0) or np.any(self.direct_horizontal < 0):
+            raise MaizevizError("period irradiance must be >= 0 W/m2")
+        if not np.allclose(self.direct_horizontal + self.dhi, self.ghi, rtol=1e-9, atol=1e-9):
+            raise MaizevizError("period ghi must equal direct_horizontal + dhi at every step")
+
+    # ---- per step
+    @property
+    def n_steps(self) -> int:
+        """Steps with the sun above the horizon."""
+        return len(self.step_s)
+
+    @property
+    def sun_never_up(self) -> bool:
+        """True when the sun stays below the horizon for the whole period."""
+        return self.n_steps == 0
+
+    @property
+    def step_shortwave_j_m2(self) -> np.ndarray:
+        """(n,) float64, J/m2: global shortwave received during each step."""
+        return self.ghi * self.step_s
+
+    @property
+    def par_umol_m2_s(self) -> np.ndarray:
+        """(n,) float64, umol/m2/s: incident PAR photon flux (PPFD) at each step."""
+        return self.ghi * self.par_umol_per_j
+
+    @property
+    def step_par_mol_m2(self) -> np.ndarray:
+        """(n,) float64, mol/m2: incident PAR during each step."""
+        return self.ghi * self.step_s * self.par_umol_per_j * 1e-6
+
+    @property
+    def step_direct_par_mol_m2(self) -> np.ndarray:
+        """(n,) float64, mol/m2: direct (sun) part of :attr:`step_par_mol_m2`."""
+        return self.direct_horizontal * self.step_s * self.par_umol_per_j * 1e-6
+
+    @property
+    def step_diffuse_par_mol_m2(self) -> np.ndarray:
+        """(n,) float64, mol/m2: diffuse (sky) part of :attr:`step_par_mol_m2`."""
+        return self.dhi * self.step_s * self.par_umol_per_j * 1e-6
+
+    # ---- period totals: the sums of the steps
+    @property
+    def shortwave_mj_m2(self) -> float:
+        """Global shortwave over the period, MJ/m2."""
+        return math.fsum(self.step_shortwave_j_m2) * 1e-6
+
+    @property
+    def direct_mj_m2(self) -> float:
+        """Direct (sun) shortwave on the horizontal over the period, MJ/m2."""
+        return math.fsum(self.direct_horizontal * self.step_s) * 1e-6
+
+    @property
+    def diffuse_mj_m2(self) -> float:
+        """Diffuse (sky) shortwave on the horizontal over the period, MJ/m2."""
+        return math.fsum(self.dhi * self.step_s) * 1e-6
+
+    @property
+    def par_mol_m2(self) -> float:
+        """Incident PAR over the period, mol/m2."""
+        return math.fsum(self.step_par_mol_m2)
+
+    @property
+    def direct_par_mol_m2(self) -> float:
+        """Direct (sun) part of the incident PAR, mol/m2."""
+        return math.fsum(self.step_direct_par_mol_m2)
+
+    @property
+    def diffuse_par_mol_m2(self) -> float:
+        """Diffuse (sky) part of the incident PAR, mol/m2."""
+        return math.fsum(self.step_diffuse_par_mol_m2)
+
+    def daily_totals(self):
+        """Totals per local day (a step belongs to the day of its middle).
+
+        Returns
+        -------
+        pandas DataFrame indexed by date, columns shortwave_mj_m2, direct_mj_m2,
+        diffuse_mj_m2, par_mol_m2, steps
+        """
+        import pandas as pd
+
+        days = pd.Index(self.times.date if self.n_steps else [], name="date")
+        frame = pd.DataFrame({"shortwave_mj_m2": self.step_shortwave_j_m2 * 1e-6,
+                              "direct_mj_m2": self.direct_horizontal * self.step_s * 1e-6,
+                              "diffuse_mj_m2": self.dhi * self.step_s * 1e-6,
+                              "par_mol_m2": self.step_par_mol_m2,
+                              "steps": np.ones(self.n_steps, dtype=np.int64)}, index=days)
+        return frame.groupby(level="date").sum()
+
+    def with_par_factor(self, par_umol_per_j: float) -> Period:
+        """The same period with another PAR conversion factor (umol per J of shortwave)."""
+        return replace(self, par_umol_per_j=_check_par_factor(par_umol_per_j))
+
+    def suns(self) -> list:
+        """One :class:`maizeviz.light.sources.sun.Sun` per step, for tracing the direct light."""
+        from maizeviz.light.sources.sun import Sun
+
+        return [Sun(float(z), float(a), t.isoformat())
+                for z, a, t in zip(self.zenith_deg, self.azimuth_deg, self.times, strict=True)]
+
+
+def _period_from_fields(values: dict) -> Period:
+    return Period(**values)
+
+
+# --------------------------------------------------------------------------- clear sky
+
+
+def clear_sky(track: SunTrack, linke_turbidity: float = DEFAULT_LINKE_TURBIDITY,
+              par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J) -> Period:
+    """Clear-sky irradiance at each step of a sun track: pvlib's Ineichen-Perez model.
+
+    Parameters
+    ----------
+    track : SunTrack (its altitude is the site altitude of the model)
+    linke_turbidity : float in [1, 10]: Linke turbidity (1 = clean dry air, 3 = average rural,
+        5 and more = hazy or polluted); no climatology lookup file is read
+    par_umol_per_j : float, umol of PAR per J of shortwave
+
+    Returns
+    -------
+    Period whose ``source`` and ``parameters`` name the model and its parameters
+    """
+    import pandas as pd
+    import pvlib
+
+    if isinstance(linke_turbidity, bool) or not isinstance(
+            linke_turbidity, (int, float, np.integer, np.floating)) \
+            or not math.isfinite(linke_turbidity) or not (1 <= linke_turbidity <= 10):
+        raise MaizevizError(f"Linke turbidity must be a number in [1, 10], got "
+                            f"{linke_turbidity!r}", quantity="linke_turbidity")
+    par = _check_par_factor(par_umol_per_j)
+    params = {"model": "ineichen", "linke_turbidity": float(linke_turbidity),
+              "altitude_m": track.altitude_m, "airmass_model": "kastenyoung1989",
+              "solar_position": "pvlib nrel_numpy (SPA)", "pvlib": pvlib.__version__}
+    source = (f"clear sky: Ineichen-Perez model (Ineichen & Perez 2002) in pvlib "
+              f"{pvlib.__version__}, Linke turbidity {linke_turbidity:g}, altitude "
+              f"{track.altitude_m:g} m, Kasten-Young air mass")
+    n = track.n_steps
+    if n:
+        pos = pd.DataFrame({"apparent_zenith": track.zenith_deg,
+                            "zenith": track.true_zenith_deg,
+                            "apparent_elevation": 90.0 - track.zenith_deg}, index=track.times)
+        site = pvlib.location.Location(track.latitude, track.longitude, tz=track.tz,
+                                       altitude=track.altitude_m)
+        cs = site.get_clearsky(track.times, model="ineichen", solar_position=pos,
+                               linke_turbidity=float(linke_turbidity))
+        ghi = cs["ghi"].to_numpy(float)
+        dni = cs["dni"].to_numpy(float)
+    else:
+        ghi = dni = np.zeros(0)
+    direct_h = np.minimum(dni * np.cos(np.radians(track.zenith_deg)), ghi)
+    return Period(times=track.times, step_s=track.step_s, zenith_deg=track.zenith_deg,
+                  azimuth_deg=track.azimuth_deg, ghi=ghi, dni=dni, dhi=ghi - direct_h,
+                  direct_horizontal=direct_h, start=track.start, end=track.end, source=source,
+                  parameters=params, par_umol_per_j=par, notes=track.notes)
+
+
+def clear_sky_period(date, lat: float, lon: float, tz: str, step_min: float = 30.0,
+                     start: str | None = None, end: str | None = None, altitude: float = 0.0,
+                     linke_turbidity: float = DEFAULT_LINKE_TURBIDITY,
+                     par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J) -> Period:
+    """``clear_sky(sun_track(...))``: a clear day (or part of it) at a place; see both."""
+    return clear_sky(sun_track(date, lat, lon, tz, step_min=step_min, start=start, end=end,
+                               altitude=altitude),
+                     linke_turbidity=linke_turbidity, par_umol_per_j=par_umol_per_j)
+
+
+# --------------------------------------------------------------------------- weather file
+
+
+@dataclass(frozen=True, eq=False)
+class Weather:
+    """Irradiance read from a weather file, one entry per data row.
+
+    Attributes
+    ----------
+    path : str
+    times : (n,) pandas DatetimeIndex, time-zone aware: middle of the interval of each row
+    step_s : (n,) float64, s: length of the interval each row stands for
+    ghi : (n,) float64, W/m2
+    dni, dhi : (n,) float64 W/m2, or None when the file has no such column
+    line : (n,) int64: line of each row in the file, for messages
+    label : "center", "start" or "end": where the file's times sit in their interval
+    start, end : pandas Timestamp: bounds of the period the file covers
+    """
+
+    path: str
+    times: pd.DatetimeIndex
+    step_s: np.ndarray
+    ghi: np.ndarray
+    dni: np.ndarray | None
+    dhi: np.ndarray | None
+    line: np.ndarray
+    label: str
+    start: pd.Timestamp
+    end: pd.Timestamp
+
+    def __post_init__(self):
+        for name in ("step_s", "ghi", "dni", "dhi"):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, _frozen(getattr(self, name)))
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """Irradiance columns the file gave."""
+        return ("ghi", *(c for c in WEATHER_OPTIONAL if getattr(self, c) is not None))
+
+
+def _read_text(path: Path, max_bytes: int) -> str:
+    raw = read_input(path, "weather file", max_bytes, WeatherFileError)
+    if not raw:
+        raise WeatherFileError(f"{path}: the weather file is empty")
+    if b"\x00" in raw[:4096]:
+        raise WeatherFileError(f"{path}: not a CSV text file (binary content)")
+    try:
+        return raw.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return raw.decode("latin-1")
+
+
+def _rows(text: str, path: Path):
+    """(line, fields) of the header and data rows: blank lines and '#' comments skipped."""
+    reader = csv.reader(io.StringIO(text))
+    try:
+        for fields in reader:
+            if not any(f.strip() for f in fields) or fields[0].lstrip().startswith("#"):
+                continue
+            yield reader.line_num, [f.strip() for f in fields]
+    except csv.Error as exc:
+        raise WeatherFileError(f"{path}, line {reader.line_num}: not readable as CSV "
+                               f"({exc})") from None
+
+
+def _header(line: int, fields: list, path: Path) -> dict:
+    names = [f.lower() for f in fields]
+    known = WEATHER_REQUIRED + WEATHER_OPTIONAL
+    for k, name in enumerate(names):
+        if not name:
+            raise WeatherFileError(f"{path}, line {line}: column {k + 1} of the header has no "
+                                   f"name (known columns: {', '.join(known)})")
+        if name not in known:
+            raise WeatherFileError(f"{path}, line {line}: unknown column '{fields[k]}' (known "
+                                   f"columns: {', '.join(known)}; irradiance in W/m2)")
+        if names.index(name) != k:
+            raise WeatherFileError(f"{path}, line {line}: column '{name}' appears twice")
+    for need in WEATHER_REQUIRED:
+        if need not in names:
+            raise WeatherFileError(f"{path}, line {line}: missing column '{need}' (required: "
+                                   f"time with a time zone, ghi in W/m2; optional: dni, dhi)")
+    return {name: k for k, name in enumerate(names)}
+
+
+def _parse_times(texts: list, lines: list, path: Path, tz):
+    """Time texts -> tz-aware DatetimeIndex in microseconds (in ``tz``, or the first row's
+    offset); every local date in the years :func:`~maizeviz.light.sources.dates.check_year` allows."""
+    import pandas as pd
+
+    zoned = np.array([bool(_ZONE_SUFFIX.search(t)) for t in texts])
+    if tz is None and not zoned.all():
+        k = int(np.argmin(zoned))
+        raise WeatherFileError(f"{path}, line {lines[k]}, column time: '{texts[k]}' has no time "
+                               f"zone; write ISO 8601 with an offset (2005-08-01T12:00+08:00) "
+                               f"or give the zone")
+
+    def parse_one(k):
+        try:
+            stamp = pd.Timestamp(texts[k])
+        except (ValueError, TypeError, OverflowError):
+            raise WeatherFileError(f"{path}, line {lines[k]}, column time: cannot read "
+                                   f"'{texts[k]}' as an ISO 8601 time") from None
+        check_year(stamp.year, f"{path}, line {lines[k]}, column time", texts[k],
+                   WeatherFileError, "weather")
+        return stamp.as_unit(TIME_UNIT)
+
+    def parse_all(idx, **kw):
+        sub = [texts[k] for k in idx]
+        try:
+            found = pd.to_datetime(sub, format="ISO8601", **kw)
+        except (ValueError, TypeError, OverflowError):
+            # pandas refuses a mix it cannot hold in one resolution (nanosecond digits and a
+            # year out of the nanosecond range): row by row, naming the first bad one
+            found = pd.DatetimeIndex([parse_one(k) for k in idx])
+            found = found.tz_convert("UTC") if kw.get("utc") else found
+        return found.as_unit(TIME_UNIT)
+
+    utc = np.empty(len(texts), dtype=f"datetime64[{TIME_UNIT}]")
+    with_zone = np.flatnonzero(zoned)
+    if len(with_zone):
+        utc[with_zone] = parse_all(with_zone, utc=True).tz_localize(None).to_numpy()
+    naive = np.flatnonzero(~zoned)
+    if len(naive):
+        local = parse_all(naive)
+        try:
+            aware = local.tz_localize(tz, ambiguous="raise", nonexistent="raise")
+        except ValueError:  # pandas' NonExistentTimeError / AmbiguousTimeError
+            for k, t in zip(naive.tolist(), local, strict=True):
+                try:
+                    t.tz_localize(tz, ambiguous="raise", nonexistent="raise")
+                except ValueError:
+                    raise WeatherFileError(
+                        f"{path}, line {lines[k]}, column time: '{texts[k]}' does not exist or "
+                        f"occurs twice in {tz} (a daylight-saving change); write it with an "
+                        f"offset") from None
+            raise
+        utc[naive] = aware.tz_convert("UTC").tz_localize(None).to_numpy()
+    zone = tz if tz is not None else parse_one(0).tz
+    times = pd.DatetimeIndex(utc).tz_localize("UTC").tz_convert(zone)
+    years = np.asarray(times.year)
+    for row in np.flatnonzero((years < FIRST_YEAR) | (years > LAST_YEAR)).tolist():
+        check_year(int(years[row]), f"{path}, line {lines[row]}, column time", texts[row],
+                   WeatherFileError, "weather")
+    return times
+
+
+def _value_problem(text: str) -> str | None:
+    """What is wrong with one irradiance cell, or None."""
+    if text == "":
+        return "missing value"
+    try:
+        value = float(text)
+    except ValueError:
+        return f"'{text}' is not a number"
+    if math.isnan(value):
+        return f"missing value ('{text}')"
+    if not math.isfinite(value):
+        return f"'{text}' is not a finite number"
+    if value < 0:
+        return f"negative irradiance {value:g} W/m2"
+    if value > MAX_IRRADIANCE_W_M2:
+        return f"{value:g} W/m2 is more than {MAX_IRRADIANCE_W_M2:g} W/m2; is the unit W/m2?"
+    return None
+
+
+def _parse_values(texts: list, lines: list, times: list, column: str, path: Path) -> np.ndarray:
+    """Irradiance cells -> (n,) float64 W/m2; refuses the first bad cell in file order."""
+    try:
+        values = np.array(texts, dtype=np.float64)
+        ok = np.isfinite(values) & (values >= 0) & (values <= MAX_IRRADIANCE_W_M2)
+        bad = np.flatnonzero(~ok)
+    except ValueError:                              # an empty or non-numeric cell somewhere
+        values, bad = None, np.arange(len(texts))
+    for k in bad:
+        problem = _value_problem(texts[k])
+        if problem:
+            raise WeatherFileError(f"{path}, line {lines[k]} ({times[k]}), column {column}: "
+                                   f"{problem}")
+    if values is None:                              # forms float() reads and numpy does not
+        values = np.array([float(t) for t in texts])
+    return values
+
+
+def _check_order(utc_us: np.ndarray, lines: list, texts: list, path: Path) -> np.ndarray:
+    """Seconds between consecutive rows (times ``utc_us`` in int64 microseconds); refuses
+    unsorted, repeated times and gaps."""
+    steps = np.diff(utc_us).astype(np.float64) / 1e6
+    for k in np.flatnonzero(steps <= 0):
+        what = "repeats the time of" if steps[k] == 0 else "is earlier than"
+        raise WeatherFileError(f"{path}, line {lines[k + 1]}, column time: '{texts[k + 1]}' "
+                               f"{what} line {lines[k]} ('{texts[k]}'); times must increase")
+    usual = float(np.median(steps))
+    gaps = np.flatnonzero(steps > GAP_FACTOR * usual)
+    if len(gaps):
+        k = gaps[0]
+        raise WeatherFileError(f"{path}, line {lines[k + 1]}, column time: a gap of "
+                               f"{_fmt_duration(steps[k])} after line {lines[k]} "
+                               f"('{texts[k]}'), more than {GAP_FACTOR:g} x the usual step of "
+                               f"{_fmt_duration(usual)}; fill the gap or split the file")
+    return steps
+
+
+def _intervals(utc_us: np.ndarray, label: str) -> np.ndarray:
+    """Interval edges (n + 1,) int64 microseconds for rows at times ``utc_us`` (n,) int64
+    microseconds sitting at ``label`` of their interval. Integers, not float seconds: a float
+    holds a year-0001 time only to about 8 microseconds."""
+    steps = np.diff(utc_us)
+    if label == "start":
+        return np.append(utc_us, utc_us[-1] + steps[-1])
+    if label == "end":
+        return np.concatenate([[utc_us[0] - steps[0]], utc_us])
+    mids = utc_us[:-1] + steps // 2
+    return np.concatenate([[utc_us[0] - steps[0] // 2], mids, [utc_us[-1] + steps[-1] // 2]])
+
+
+def read_weather(path, tz: str | None = None, label: str = "center",
+                 max_bytes: int = MAX_WEATHER_BYTES) -> Weather:
+    """Read a weather CSV file of irradiance.
+
+    Format: comma-separated, a header line, blank lines and lines starting with '#' ignored.
+    Columns (any order and case): ``time`` (ISO 8601 with a UTC offset such as
+    2005-08-01T12:00+08:00 or a trailing Z; without an offset only when ``tz`` is given, the
+    times are then local clock times in ``tz``), ``ghi`` W/m2 (required), ``dni``, ``dhi`` W/m2
+    (optional); no other column.
+
+    Rules: at least 2 rows; times strictly increasing; a step longer than GAP_FACTOR (1.5) x the
+    median step is a gap and refused; values must be numbers in [0, MAX_IRRADIANCE_W_M2]
+    (no NaN, no empty cell); files over ``max_bytes`` are refused before reading.
+
+    Each row stands for an interval (the midpoint rule of this module): with ``label`` "center"
+    (default) the row's time is the middle of an interval reaching halfway to the neighbouring
+    rows; "start" means the interval begins at the row's time and ends at the next row's;
+    "end" means it ends at the row's time (hourly means stamped at the end of the hour).
+
+    Parameters
+    ----------
+    path : str or Path
+    tz : IANA time zone, or None: times must then carry their offset
+    label : "center", "start" or "end"
+    max_bytes : int, largest file accepted
+
+    Raises
+    ------
+    WeatherFileError (a MaizevizError)
+        One line naming the file, the line, the time and the column at fault.
+    """
+    path = Path(path)
+    key = str(label).strip().lower()
+    if key not in WEATHER_LABELS:
+        raise MaizevizError(f"unknown weather time label '{label}' (known: "
+                            f"{', '.join(WEATHER_LABELS)})")
+    zone = _time_zone(tz) if tz is not None else None
+    text = _read_text(path, max_bytes)
+    rows = _rows(text, path)
+    first = next(rows, None)
+    if first is None:
+        raise WeatherFileError(f"{path}: the weather file is empty (no header, no rows)")
+    columns = _header(first[0], first[1], path)
+    lines, data = [], []
+    for line, cells in rows:
+        if len(cells) != len(columns):
+            raise WeatherFileError(f"{path}, line {line}: {len(cells)} values for "
+                                   f"{len(columns)} columns ({', '.join(columns)})")
+        lines.append(line)
+        data.append(cells)
+    if not data:
+        raise WeatherFileError(f"{path}: the weather file has a header but no data rows")
+    if len(data) < 2:
+        raise WeatherFileError(f"{path}: one data row is not enough to know the time step; "
+                               f"give at least 2")
+    texts = [row[columns["time"]] for row in data]
+    times = _parse_times(texts, lines, path, zone)
+    values = {c: _parse_values([row[columns[c]] for row in data], lines, texts, c, path)
+              for c in ("ghi", *WEATHER_OPTIONAL) if c in columns}
+    utc_us = times.tz_convert("UTC").tz_localize(None).to_numpy(
+        f"datetime64[{TIME_UNIT}]").astype(np.int64)
+    _check_order(utc_us, lines, texts, path)
+    edges = _intervals(utc_us, key)
+    mids = edges[:-1] + np.diff(edges) // 2
+    import pandas as pd
+
+    def stamp(micros):
+        return pd.DatetimeIndex(np.asarray(micros).astype(f"datetime64[{TIME_UNIT}]")
+                                ).tz_localize("UTC").tz_convert(times.tz)
+
+    bounds = stamp(edges[[0, -1]])
+    return Weather(path=str(path), times=stamp(mids), step_s=_frozen(np.diff(edges) / 1e6),
+                   ghi=_frozen(values["ghi"]), dni=values.get("dni"), dhi=values.get("dhi"),
+                   line=_frozen(lines, np.int64), label=key, start=bounds[0], end=bounds[1])
+
+
+def _split_direct_diffuse(weather: Weather, up: np.ndarray, zen: np.ndarray,
+                          true_zen: np.ndarray):
+    """(direct_horizontal, dhi, decomposition name or None) for the rows with the sun up."""
+    import pvlib
+
+    ghi = weather.ghi[up]
+    cosz = np.cos(np.radians(zen[up]))
+    if weather.dhi is not None:
+        dhi = np.minimum(weather.dhi[up], ghi)
+        return ghi - dhi, dhi, None
+    if weather.dni is not None:
+        direct = np.minimum(weather.dni[up] * cosz, ghi)
+        return direct, ghi - direct, None
+    split = pvlib.irradiance.erbs(ghi, true_zen[up], weather.times[up])
+    dhi = np.minimum(np.asarray(split["dhi"], dtype=float), ghi)
+    return ghi - dhi, dhi, "erbs"
+
+
+def weather_period(weather: Weather, lat: float, lon: float, altitude: float = 0.0,
+                   par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J) -> Period:
+    """Period of a weather file at a place: sun positions, direct and diffuse parts.
+
+    The direct and diffuse parts keep the file's ghi: with ``dhi`` given, direct_horizontal =
+    ghi - dhi (dhi above ghi is cut to ghi); with only ``dni``, direct_horizontal = dni
+    cos(zenith) (cut to ghi) and dhi the rest; with ghi alone, the Erbs et al. (1982)
+    diffuse fraction (pvlib; geometric zenith, day of year) gives dhi. ``dni`` is then
+    direct_horizontal / cos(zenith). Rows whose middle has the sun below the horizon are
+    dropped; their energy (twilight, sensor offsets) is stated in the notes.
+
+    Parameters
+    ----------
+    weather : Weather from :func:`read_weather`
+    lat, lon : float, deg; altitude : float, m
+    par_umol_per_j : float, umol of PAR per J of shortwave
+    """
+    lat, lon = _check_place(lat, lon)
+    altitude = _check_altitude(altitude)
+    par = _check_par_factor(par_umol_per_j)
+    zen, true_zen, azi = _solar_position(weather.times, lat, lon, altitude)
+    up = zen < 90.0
+    direct, dhi, decomposition = _split_direct_diffuse(weather, up, zen, true_zen)
+    ghi = direct + dhi
+    dni = direct / np.cos(np.radians(zen[up]))
+    notes = []
+    if not up.any():
+        notes.append(_no_sun_note(weather.start, weather.end, lat, lon))
+    night = ~up
+    night_j = math.fsum(weather.ghi[night] * weather.step_s[night])
+    if night_j > 0:
+        notes.append(f"{int(night.sum())} rows of {Path(weather.path).name} have the sun below "
+                     f"the horizon; their {night_j / 1e3:.1f} kJ/m2 of ghi (twilight or sensor "
+                     f"offset) is not traced")
+    name = Path(weather.path).name
+    given = ", ".join(weather.columns)
+    source = f"weather file {name} ({given} given"
+    source += "; dni and dhi from the Erbs et al. 1982 decomposition in pvlib)" \
+        if decomposition else ")"
+    params = {"weather_file": weather.path, "columns": list(weather.columns),
+              "decomposition": decomposition, "time_label": weather.label,
+              "altitude_m": altitude}
+    return Period(times=weather.times[up], step_s=weather.step_s[up], zenith_deg=zen[up],
+                  azimuth_deg=azi[up], ghi=ghi, dni=dni, dhi=dhi, direct_horizontal=direct,
+                  start=weather.start, end=weather.end, source=source, parameters=params,
+                  par_umol_per_j=par, notes=tuple(notes))
