@@ -481,6 +481,7 @@ def run(args: argparse.Namespace) -> int:
             abd = _traced(trace_day, args, rec, said)
             _warn_unresolved(abd.balance, abd.depth, rec, said)
             rec["balance"] = dict(abd.balance.as_dict(), units="MJ/m2 of ground")
+            rec["balance_se"] = abd.balance_errors
             rec["absorbed"] = _absorbed_period_record(abd)
             if abd.assimilation is not None:
                 rec["photosynthesis"] = abd.assimilation.as_dict()
@@ -506,6 +507,7 @@ def run(args: argparse.Namespace) -> int:
             ab = _traced(trace_sun, args, rec, said)
             _warn_unresolved(ab.balance, ab.depth, rec, said)
             rec["balance"] = ab.balance.as_dict()
+            rec["balance_se"] = ab.balance_errors
             rec["absorbed"] = _absorbed_record(ab, canopy)
             rec["seconds"]["scatter"] = ab.seconds["trace"] + ab.seconds["scatter"]
             if want_rows:

@@ -35,6 +35,12 @@ def test_a_sun_json_and_tables(capsys, tmp_path, model, extra):
         ph["canopy_gross_umol_m2_s"] * 1.584342, rel=1e-6)
     assert 0 < ph["canopy_gross_umol_m2_s_se"] < 0.02 * ph["canopy_gross_umol_m2_s"]
     assert rec["absorbed"]["absorbed_leaves_se"] > 0
+    se = rec["balance_se"]                     # every part of the balance has its error
+    assert se["absorbed_leaves"] == rec["absorbed"]["absorbed_leaves_se"]
+    assert se["absorbed_ground"] > 0 and se["reflected_top"] > 0
+    assert se["escaped_sides"] == 0.0                                  # periodic: none
+    for k, v in se.items():
+        assert v < 0.02 * rec["balance"]["incident"], k
     lv, pl = rows(leaves), rows(plants)
     assert {"gross_umol_s", "gross_umol_s_se", "absorbed_w", "absorbed_w_se"} <= set(lv[0])
     assert {"gross_umol_s", "gross_umol_s_se", "absorbed_w_se"} <= set(pl[0])
@@ -62,6 +68,7 @@ def test_a_day_in_mol_and_grams(capsys, tmp_path):
     assert ph["canopy_gross_g_co2_m2"] == pytest.approx(ph["canopy_gross_mol_m2"] * 44.0095)
     assert 20 < ph["canopy_gross_g_co2_m2"] < 150                       # g CO2/m2 a day
     assert ph["canopy_gross_mol_m2_se"] > 0
+    assert rec["balance_se"]["absorbed_ground"] > 0 and rec["balance_se"]["absorbed_leaves"] > 0
     steps = ph["step_gross_umol_m2_s"]
     assert len(steps) == len(ph["temperature_c"]) and max(steps) > 0
     pl = rows(plants)

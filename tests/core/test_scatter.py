@@ -304,3 +304,21 @@ def test_a_sky_drawn_per_ray_gives_the_directions_answers_within_their_errors(ho
     a = eng.absorbed(**{**kw, "band": "par"}, optics=black)
     b = eng.absorbed(**{**kw, "band": "par"}, optics=black, sky_passes=0)
     np.testing.assert_array_equal(a.triangle_absorbed_w, b.triangle_absorbed_w)
+
+
+def test_the_balances_errors_shrink_with_the_rays_and_cover_two_seeds(homogeneous):
+    """Each part of the energy balance has a standard error from the batches: they shrink
+    with the rays, and two seeds' parts differ by no more than their errors allow."""
+    out = {}
+    for density in (0.5, 4.0):
+        eng = LightEngine(homogeneous, periodic=True, density=density, heights_cm=(0.0,))
+        out[density] = [eng.absorbed(zenith=35, azimuth=60, diffuse_w_m2=80.0, directions=16,
+                                     seed=seed) for seed in (1, 2)]
+    for name in ("absorbed_leaves", "absorbed_ground", "reflected_top", "unresolved"):
+        coarse = out[0.5][0].balance_errors[name]
+        fine = out[4.0][0].balance_errors[name]
+        assert fine <= coarse or coarse == 0.0, name
+    a, b = out[4.0]
+    for name in ("absorbed_leaves", "absorbed_ground", "reflected_top"):
+        se = math.hypot(a.balance_errors[name], b.balance_errors[name])
+        assert abs(getattr(a.balance, name) - getattr(b.balance, name)) < 5 * se + 1e-12, name

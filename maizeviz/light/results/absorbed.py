@@ -131,6 +131,16 @@ class AbsorbedLight:
             return None if self.batches is None else 0.0
         return self.batches.error() * self.balance.absorbed_leaves / total
 
+    @property
+    def balance_errors(self) -> dict[str, float] | None:
+        """Monte Carlo standard errors of the energy balance's parts, in its units:
+        ``absorbed_leaves`` (:attr:`absorbed_leaves_error`), ``absorbed_ground``,
+        ``reflected_top``, ``escaped_sides``, ``unresolved``; None without batches."""
+        if self.batches is None or self.batches.parts is None:
+            return None
+        return {"absorbed_leaves": float(self.absorbed_leaves_error or 0.0),
+                **(self.batches.balance_errors(1.0) or {})}
+
     def table(self, by: str = "plant", canopy=None):
         """Absorbed light per leaf or per plant as a pandas DataFrame.
 
@@ -239,6 +249,16 @@ class AbsorbedPeriod:
         if self.batches is None or total <= 0:
             return None if self.batches is None else 0.0
         return self.batches.error() * self.balance.absorbed_leaves / total
+
+    @property
+    def balance_errors(self) -> dict[str, float] | None:
+        """Monte Carlo standard errors of the energy balance's parts, in its units:
+        ``absorbed_leaves`` (:attr:`absorbed_leaves_error`), ``absorbed_ground``,
+        ``reflected_top``, ``escaped_sides``, ``unresolved``; None without batches."""
+        if self.batches is None or self.batches.parts is None:
+            return None
+        return {"absorbed_leaves": float(self.absorbed_leaves_error or 0.0),
+                **(self.batches.balance_errors(1.0) or {})}
 
     @property
     def absorbed_leaves_mol_m2(self) -> float | None:

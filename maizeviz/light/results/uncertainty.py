@@ -52,11 +52,24 @@ class Batches:
     absorbed : (BATCHES, F) scipy.sparse CSR array, W (or J over a period) per triangle
     direct : (BATCHES, F) the part of ``absorbed`` from the sun's direct beam
     sunlit_cm2 : (BATCHES, F) area in the direct beam, cm2
+    parts : (4, BATCHES) float64 or None, each batch's share of the ground's absorbed light,
+        of the light reflected out of the top, escaped sideways and left unresolved (the
+        balance's own units)
     """
 
     absorbed: Any
     direct: Any
     sunlit_cm2: Any
+    parts: np.ndarray | None = None
+
+    def balance_errors(self, scale: float) -> dict[str, float] | None:
+        """Standard errors of the balance's parts other than the leaves' (``absorbed_ground``,
+        ``reflected_top``, ``escaped_sides``, ``unresolved``), each batch's ``parts`` (4,
+        BATCHES) times ``scale`` (to the balance's unit); None without them."""
+        if self.parts is None:
+            return None
+        names = ("absorbed_ground", "reflected_top", "escaped_sides", "unresolved")
+        return {n: float(batch_error(self.parts[i] * scale)) for i, n in enumerate(names)}
 
     def error(self, weights=None, what: str = "absorbed") -> float:
         """Standard error of ``sum(weights * what)`` over the triangles (weights (F,), None:

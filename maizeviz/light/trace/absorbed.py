@@ -128,6 +128,7 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
     empty = csr_array((BATCHES, nf))
     absorbed_b, direct_b, sunlit_b = empty, empty, empty
     sun_dir = None
+    parts_b = np.zeros((4, BATCHES))
     parts = dict.fromkeys(("ground", "top", "sides", "unresolved"), 0.0)
     events, seconds = 0, {"build": build_s, "trace": 0.0, "scatter": 0.0}
     for k, (toward, irradiance) in enumerate(beams):
@@ -153,6 +154,7 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
             sun_dir = (float(toward[0]), float(toward[1]), float(toward[2]))
         for name in parts:
             parts[name] += getattr(tally, name) * per_ray
+        parts_b += tally.parts_batch * per_ray
         events += tally.events
         seconds["trace"] += secs["trace"]
         seconds["scatter"] += secs["scatter"]
@@ -168,6 +170,7 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
         absorbed_b = absorbed_b + tally.per_batch(nf, kept * per_ray)
         for name in parts:
             parts[name] += getattr(tally, name) * per_ray
+        parts_b += tally.parts_batch * per_ray
         events += tally.events
         seconds["scatter"] += secs["scatter"]
         report(progress, len(beams) + 1, len(beams) + 1, "absorbed light")
@@ -179,7 +182,8 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
                          len(beams) + (n_sky if sky_per_ray else 0), depth, threshold, seed,
                          events, smp.periodic, canopy.level, seconds,
                          triangle_direct_w=direct_t,
-                         batches=Batches(absorbed_b, direct_b, sunlit_b), sun_direction=sun_dir)
+                         batches=Batches(absorbed_b, direct_b, sunlit_b, parts_b / area_m2),
+                         sun_direction=sun_dir)
 
 
 def period_temperatures(period: Period, temperature_c) -> np.ndarray:
@@ -261,6 +265,8 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
     ub_ = unit.batches
     assert ub_ is not None
     joules_b = ub_.absorbed * float(np.sum(diffuse_w * step_s))
+    parts_b = (ub_.parts if ub_.parts is not None else np.zeros((4, BATCHES))) * float(
+        np.sum(diffuse_w * step_s))
     carbon = _Carbon(canopy, photosynthesis, unit, diffuse_w, step_s, temps)
     ub = unit.balance
     parts = {k: getattr(ub, k) * float(np.sum(diffuse_w * step_s))
@@ -277,6 +283,8 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
             joules += light.triangle_absorbed_w * step_s[k]
             assert light.batches is not None
             joules_b = joules_b + light.batches.absorbed * step_s[k]
+            if light.batches.parts is not None:
+                parts_b = parts_b + light.batches.parts * step_s[k]
             carbon.add(k, light)
             for name in parts:
                 parts[name] += getattr(light.balance, name) * step_s[k]
@@ -293,7 +301,8 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
                                                    "unresolved")))
     return AbsorbedPeriod(optics.band, optics, period, balance, joules, leaves_w, incident_w,
                           unit.rect, unit.rays, unit.depth, unit.seed, unit.periodic,
-                          unit.level, seconds, batches=Batches(joules_b, None, None),
+                          unit.level, seconds,
+                          batches=Batches(joules_b, None, None, parts_b * 1e-6),
                           assimilation=carbon.result())
 
 

@@ -80,6 +80,8 @@ class Tally:
     first_hits: list = field(default_factory=list)
     leaf_batch: list = field(default_factory=list)
     first_batch: list = field(default_factory=list)
+    #: ground, top, sides, unresolved by batch: (4, BATCHES) float64
+    parts_batch: np.ndarray = field(default_factory=lambda: np.zeros((4, BATCHES)))
     ground: float = 0.0
     top: float = 0.0
     sides: float = 0.0
@@ -92,6 +94,7 @@ class Tally:
         self.first_hits += other.first_hits
         self.leaf_batch += other.leaf_batch
         self.first_batch += other.first_batch
+        self.parts_batch = self.parts_batch + other.parts_batch
         for name in ("ground", "top", "sides", "unresolved", "rays", "events"):
             setattr(self, name, getattr(self, name) + getattr(other, name))
 
@@ -223,6 +226,11 @@ def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng
     tally.top += np.count_nonzero(kind == TOP)
     tally.sides += np.count_nonzero(kind == SIDES)
     tally.unresolved += np.count_nonzero(kind == LOST)
+    for row, (what, share) in enumerate(((ground, 1.0 - optics.ground_reflectance),
+                                         (kind == TOP, 1.0), (kind == SIDES, 1.0),
+                                         (kind == LOST, 1.0))):
+        if what.any():
+            tally.parts_batch[row] += np.bincount(batch[what], minlength=BATCHES) * share
     parts_o, parts_d, parts_b = [], [], []
     go = np.flatnonzero(leaf)
     if leaf_optics is not None:
@@ -269,6 +277,8 @@ def _scatter_on(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally,
         rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, rays.dirs,
                        rays.batch, leaf_optics)
     tally.unresolved += len(rays.org)
+    if len(rays.org):
+        tally.parts_batch[3] += np.bincount(rays.batch, minlength=BATCHES)
 
 
 def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.ndarray,
