@@ -323,6 +323,18 @@ def test_photosynthesis_axis_rows_equal_the_cli_and_the_summary_names_the_carbon
         assert s["assimilation_tolerance"] == 0.01
 
 
+def test_the_carbon_example_asks_the_mesh_question_for_carbon():
+    from maizeviz.resources import example_points
+
+    spec = load_spec(Path(example_points()).parent / "sweep-carbon.toml")
+    assert len(spec.scenarios) == 8
+    assert {s.level for s in spec.scenarios} == {"K=4", "standard", "36 triangles",
+                                                  "8 triangles"}
+    assert all(s.optics is not None and s.optics.band == "par" and s.photosynthesis
+               for s in spec.scenarios)
+    assert {dict(s.photosynthesis)["model"] for s in spec.scenarios} == {"c4", "wofost"}
+
+
 @pytest.mark.parametrize("text, says", [
     ("[canopy\npoints = 1", r"not valid TOML.*line 1"),
     (SPEC.replace("tile =", "tiles ="), r"unknown key 'canopy.tiles' \(known in canopy: points, "),
