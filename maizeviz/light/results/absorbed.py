@@ -98,6 +98,8 @@ class AbsorbedLight:
     rect : (x0, y0, x1, y1) cm; rays : primary rays per direction; directions : beams traced
     depth, threshold, seed : as traced; events : scatterings followed; periodic : bool
     level : the canopy's mesh level; seconds : "trace" (primary beams), "scatter", "build"
+    stands : identity of the stands traced on (:func:`maizeviz.canopy.layout.stands_identity`),
+        None where not known
     """
 
     band: str
@@ -119,6 +121,7 @@ class AbsorbedLight:
     triangle_direct_w: np.ndarray | None = None
     batches: Batches | None = None
     sun_direction: tuple[float, float, float] | None = None
+    stands: dict | None = None
 
     fraction_absorbed = property(_fraction_absorbed)
 
@@ -221,6 +224,7 @@ class AbsorbedPeriod:
         errors
     assimilation : PeriodAssimilation (:mod:`maizeviz.light.results.assimilation`) when a
         leaf model was given, else None
+    stands : identity of the stands traced on, None where not known
     """
 
     band: str
@@ -239,6 +243,7 @@ class AbsorbedPeriod:
     seconds: dict[str, float] = field(default_factory=dict)
     batches: Batches | None = None
     assimilation: Any = None
+    stands: dict | None = None
 
     fraction_absorbed = property(_fraction_absorbed)
 

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.sparse import csr_array
 
+from maizeviz.canopy.layout import stands_identity
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import check_range
 from maizeviz.light.results.absorbed import AbsorbedLight, AbsorbedPeriod, Balance
@@ -183,7 +184,7 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
                          events, smp.periodic, canopy.level, seconds,
                          triangle_direct_w=direct_t,
                          batches=Batches(absorbed_b, direct_b, sunlit_b, parts_b / area_m2),
-                         sun_direction=sun_dir)
+                         sun_direction=sun_dir, stands=stands_identity(canopy.layout))
 
 
 def period_temperatures(period: Period, temperature_c) -> np.ndarray:
@@ -303,7 +304,7 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
                           unit.rect, unit.rays, unit.depth, unit.seed, unit.periodic,
                           unit.level, seconds,
                           batches=Batches(joules_b, None, None, parts_b * 1e-6),
-                          assimilation=carbon.result())
+                          assimilation=carbon.result(), stands=unit.stands)
 
 
 class _Carbon:
