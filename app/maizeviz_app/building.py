@@ -91,7 +91,7 @@ def open_mesh(study: StudyModel, path: str | Path, unit: str | None = None, up: 
         m = runner.cover_process.call("measure", object(), canopy,
                                       (jobs.APP_COVER_RESOLUTION_CM,), job)
         measure_s = time.perf_counter() - t0
-        mesh = mesher(job, canopy, None) if mesher is not None else None
+        mesh = mesher(job, canopy, None, True) if mesher is not None else None
         row = table2_row(m, read_s, MESH_LEVEL)
         return notes, (canopy, m, read_s, measure_s, mesh, tuple(TABLE2_COLUMNS), row)
 
@@ -139,7 +139,7 @@ def build(study: StudyModel) -> None:
                 return None
             return jobs.build(loaded, DISPLAY_LEVEL, preserve)[0]
 
-        mesh = mesher(job, canopy, coarse) if mesher is not None else None
+        mesh = mesher(job, canopy, coarse, False) if mesher is not None else None
         return jobs.Built(level, label, canopy, m, build_s, measure_s, mesh,
                           tuple(TABLE2_COLUMNS), table2_row(m, build_s, label), serial)
 

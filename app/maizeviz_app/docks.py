@@ -69,21 +69,20 @@ def _dock(window: QMainWindow, docks: dict, name: str, title: str, widget: QWidg
     return dock
 
 
-def make_docks(window: QMainWindow, panels: dict[str, tuple[str, QWidget]], plots: QWidget,
-               messages: QWidget, history: QWidget) -> dict[str, QDockWidget]:
-    """The panels tabbed on the right (``panels``: name -> (title, widget), then the layout
-    editor and the digitizer, made later), the figures, messages and undo history tabbed at
-    the bottom."""
+def make_docks(window: QMainWindow, panels: dict[str, tuple[str, QWidget | None]],
+               plots: QWidget, messages: QWidget, history: QWidget) -> dict[str, QDockWidget]:
+    """The panels tabbed on the right (``panels``: name -> (title, widget); None: a panel
+    made later, such as the layout editor and the digitizer), the figures, messages and undo
+    history tabbed at the bottom."""
     window.setCorner(Qt.Corner.BottomRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
     window.setCorner(Qt.Corner.TopRightCorner, Qt.DockWidgetArea.RightDockWidgetArea)
     window.setDockOptions(QMainWindow.DockOption.AnimatedDocks
                           | QMainWindow.DockOption.AllowTabbedDocks)
     docks: dict[str, QDockWidget] = {}
     right = Qt.DockWidgetArea.RightDockWidgetArea
-    made = [_dock(window, docks, name, title, widget, right)
+    made = [_dock(window, docks, name, title,
+                  widget if widget is not None else QLabel("starting…"), right)
             for name, (title, widget) in panels.items()]
-    made += [_dock(window, docks, "layout", "Layout", QLabel("starting…"), right),
-             _dock(window, docks, "digitizer", "Digitizer", QLabel("starting…"), right)]
     for d in made[1:]:
         window.tabifyDockWidget(made[0], d)
     made[0].raise_()

@@ -25,11 +25,14 @@ class Figures:
         forgotten; None maps: that light's forgotten).
     map_drawn(kind, index, rgba) : one height's heatmap drawn after it was asked for.
     plot_changed(rgba) : the transmission plot (None: none).
+    restyled(keep) : the maps of every light but ``keep`` are to be drawn again (the scale
+        they share took in a new result).
     """
 
     maps_changed = Signal(str)
     map_drawn = Signal(str, int, object)
     plot_changed = Signal(object)
+    restyled = Signal(object)
 
     def __init__(self) -> None:
         self.shown_for: dict[str, Any] = {}     # light -> the run whose maps are shown
@@ -75,6 +78,13 @@ class Figures:
         maps[index] = (maps[index][0], rgba)
         self.map_drawn.emit(kind, index, rgba)
         return True
+
+    def restyle(self, keep: str | None = None) -> None:
+        """Forget the maps of every light but ``keep`` (drawn again when shown)."""
+        for kind, maps in self.maps.items():
+            if kind != keep:
+                self.maps[kind] = [(h, None) for h, _ in maps]
+        self.restyled.emit(keep)
 
     def set_plot(self, rgba: np.ndarray | None) -> None:
         self.plot = rgba

@@ -72,20 +72,26 @@ def compute_light(study: StudyModel) -> bool:
     runs = study.runs.copy()
     key, runner = study.canopy_key, study.runner
     first = max(study.figures.shown_index, 0)
+    look = plots.Look.of(study.colour, study.figures.shown_for)
 
     def work(job):
         out = runner.light_process.call(op, key, canopy, args, job)
         job.check()
         if mode == "sun":
+            from maizeviz.light.results.painting import sun_painting
+
             absorbed = None
             if optics is not None:              # leaves with optics: absorbed light too
                 absorbed = runner.light_process.call("absorbed", key, canopy,
                                                      (args[0], optics), job)
                 job.check()
-            run = Run(label, signature, out, out.triangle_light(canopy), extra=absorbed)
+            painting = sun_painting(canopy, out)
+            run = Run(label, signature, out, painting.classes, extra=absorbed,
+                      painting=painting)
         else:
             run = Run(label, signature, out.light, None, mode, out)
-        maps = plots.heatmap_images(run.result, first=first, check=job.check, kind=mode)
+        maps = plots.heatmap_images(run.result, first=first, check=job.check, kind=mode,
+                                    look=look.sharing(mode, run.result))
         runs.add(run, compared, sampling_key)
         plot = plots.rgba(plots.transmission_figure(runs.curves(), plot_title(runs)))
         return run, compared, sampling_key, maps, plot
@@ -140,6 +146,8 @@ def _lit(study: StudyModel, out) -> None:
     f = study.figures
     f.keep_only({k for k in f.shown_for if study.runs.of_kind(k) is not None} | {run.kind})
     f.set_maps(run.kind, run, maps)
+    if study.colour.shared:                     # the others' scale includes this run
+        f.restyle(keep=run.kind)
     f.set_plot(plot)
     for w in r.warnings:
         study.say(f"{'note' if 'sun never rises' in w else 'warning'}: {w}")
@@ -163,11 +171,13 @@ def draw_heatmap(study: StudyModel, kind: str, index: int) -> None:
 
     result = run.result
     height = float(result.heights_cm[index])
+    look = plots.Look.of(study.colour, study.figures.shown_for)
+
     def done(rgba) -> None:
         study.figures.set_map(kind, run, index, rgba)
 
     study.runner.run("heatmap", f"drawing the heatmap at {height:g} cm",
-                     lambda job: plots.heatmap_image(result, height, kind=kind),
+                     lambda job: plots.heatmap_image(result, height, kind=kind, look=look),
                      on_done=done, on_error=lambda e: study.fail(e, "light"))
 
 def sun_from_place(study: StudyModel) -> None:
@@ -250,9 +260,11 @@ def adopt_pending_runs(study: StudyModel) -> None:
     title = plot_title(study.runs)
     study.figures.shown_for = dict(shown)
     results = [(k, shown[k].result) for k in order]
+    look = plots.Look.of(study.colour, shown)
 
     def work(job):
-        maps = [(k, plots.heatmap_images(r, check=job.check, kind=k)) for k, r in results]
+        maps = [(k, plots.heatmap_images(r, check=job.check, kind=k, look=look))
+                for k, r in results]
         plot = plots.rgba(plots.transmission_figure(curves, title))
         return maps, plot
 
@@ -301,6 +313,7 @@ def complete_runs(study: StudyModel) -> None:
         return
 
     def work(job):
+        from maizeviz.light.results.painting import sun_painting
         from maizeviz_app import jobs
 
         done: list[Any] = []
@@ -309,7 +322,7 @@ def complete_runs(study: StudyModel) -> None:
             if run.kind == "sun":
                 absorbed = None if run.extra is None else \
                     jobs.absorbed_of(canopy, run.extra.light)
-                done.append((run.result.triangle_light(canopy), absorbed))
+                done.append((sun_painting(canopy, run.result), absorbed))
             else:
                 done.append(jobs.diffuse_of(canopy, run.result, run.kind))
         return done
@@ -317,7 +330,8 @@ def complete_runs(study: StudyModel) -> None:
     def adopt(done):
         for run, value in zip(todo, done):
             if run.kind == "sun":
-                run.classes, absorbed = value
+                run.painting, absorbed = value
+                run.classes = run.painting.classes
                 if absorbed is not None:
                     run.extra = absorbed
             else:

@@ -35,6 +35,7 @@ from PySide6.QtCore import QSettings, Qt, QTimer, Signal
 from PySide6.QtWidgets import QLabel, QMainWindow, QMessageBox, QStackedWidget, QUndoView
 
 from maizeviz import __version__
+from maizeviz.errors import MaizevizError
 from maizeviz.mesh.levels import COMPLEXITY_STOPS as LEVELS  # noqa: F401 - the slider's stops
 from maizeviz.resources import example_points
 from maizeviz_app import dialogs, docks
@@ -135,10 +136,10 @@ class MainWindow(QMainWindow):
         m.cache_folder = dialogs.cache_folder()
         ready = self._view_ready
 
-        def mesher(job, canopy, coarse):
+        def mesher(job, canopy, coarse, from_file=False):
             from maizeviz_app.view_mesh import view_mesh
 
-            return view_mesh(job, canopy, coarse, ready)
+            return view_mesh(job, canopy, coarse, ready, from_file)
 
         m.mesher = mesher
         m.modified_changed.connect(lambda on: self.setWindowModified(on))
@@ -173,13 +174,20 @@ class MainWindow(QMainWindow):
         self.digitizer: DigitizerPanel | None = None
         self.plots = LightPlots()
         self._wire_figures()
+        from maizeviz_app.panels.colour import ColourPanel
+
+        self.colour_panel = ColourPanel(m.colour)
+        self.plots.heatmap.limits_shown.connect(self.colour_panel.heatmap_editor.show_limits)
         self.messages = docks.messages_widget()
         self.history = QUndoView(self.undo.stack)
         self.history.setEmptyLabel("the study as opened")
         self.history.setAccessibleName("undo history")
         self.history.setToolTip("every edit of this study; click one to go back to it")
         self.docks = docks.make_docks(self, {"canopy": ("Canopy", self.canopy_panel),
-                                             "light": ("Light", self.light_panel)},
+                                             "light": ("Light", self.light_panel),
+                                             "layout": ("Layout", None),
+                                             "digitizer": ("Digitizer", None),
+                                             "colour": ("Colour", self.colour_panel)},
                                       self.plots, self.messages, self.history)
 
     def _wire_figures(self) -> None:
@@ -197,11 +205,19 @@ class MainWindow(QMainWindow):
             f.shown_kind, f.shown_index = plots.kind, plots.height_box.currentIndex()
 
         f.maps_changed.connect(maps_changed)
+        f.restyled.connect(lambda keep: plots.redraw(keep=keep))
+        colour = self.model.colour                  # new colours: the maps drawn again
+        colour.heatmap.events.connect(lambda _info: self._restyle())
+        colour.events.shared.connect(lambda _on: self._restyle())
         f.map_drawn.connect(lambda kind, index, rgba: plots.set_heatmap(index, rgba, kind))
         f.plot_changed.connect(plots.set_transmission)
         plots.heatmap_needed.connect(self.model.draw_heatmap)
         plots.source.currentIndexChanged.connect(shown)
         plots.height_box.currentIndexChanged.connect(shown)
+
+    def _restyle(self) -> None:
+        """The heatmaps' colours changed: every map is drawn again (the one shown at once)."""
+        self.model.figures.restyle()
 
     def showEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().showEvent(event)
@@ -266,6 +282,12 @@ class MainWindow(QMainWindow):
             # Qt compose the whole window again (see docks.own_window), and re-laying it out
             # then gives the docks all the room but the view's minimum height
             self.viewport = Viewport(self._centre)
+            self.viewport.set_colour_scale(self.model.colour.view)
+            self.viewport.limits_shown.connect(self.colour_panel.view_editor.show_limits)
+            from maizeviz_app.linked import LinkedSelection
+
+            self.linked = LinkedSelection(self.model, self.viewport, self.light_panel.plants,
+                                          lambda text: self.say(text, status_only=True))
             # the central widget stays (a new one would make the docks take its room)
             self._centre.addWidget(self.viewport)
             self._centre.setCurrentWidget(self.viewport)
@@ -417,6 +439,31 @@ class MainWindow(QMainWindow):
 
     def camera(self, name: str) -> None:
         self.view_link.camera(name)
+
+    def choose_view_image(self) -> None:
+        """File > Save view as image: ask the width and the file, then save."""
+        if self.viewport is None:
+            return
+        from maizeviz_app.snapshot import ask_view_image
+
+        chosen = ask_view_image(self, self.viewport, self.folder())
+        if chosen is not None:
+            self.save_view_image(*chosen)
+
+    def save_view_image(self, path: str | Path, width: int | None = None) -> None:
+        """The 3D view as a PNG ``width`` pixels wide (None: the view's), with its colour key
+        (:mod:`maizeviz_app.snapshot`)."""
+        if self.viewport is None:
+            return
+        from maizeviz_app.snapshot import save_view_image
+
+        try:
+            written = save_view_image(self.viewport, path, width)
+        except (MaizevizError, OSError, ValueError) as exc:
+            self.model.fail(exc, "export")
+            return
+        self.say(f"saved the view as {written}")
+        self.saved.emit(str(written))
 
     def colour_by(self, what: str) -> None:
         self.view_link.colour_by(what)

@@ -40,11 +40,13 @@ from psygnal import Signal
 
 from maizeviz.errors import MaizevizError
 from maizeviz_app import building, lighting, studyfiles
+from maizeviz_app.colour import ColourSettings
 from maizeviz_app.figures import Figures
 from maizeviz_app.layout_draft import LayoutDraft
 from maizeviz_app.messages import user_message
 from maizeviz_app.runner import InlineRunner, Runner, describe_internal
 from maizeviz_app.runs import LightRuns, Run
+from maizeviz_app.selection import Selection
 from maizeviz_app.settings import StudySettings
 
 
@@ -99,9 +101,13 @@ class StudyModel:
         Asked before starting work estimated at over a quarter of an hour (the window asks
         the user; with no window: no).
     mesher : callable or None
-        ``mesher(job, canopy, coarse)`` makes what the 3D view draws of a canopy, in the
-        worker (``coarse()``: the canopy at the view's display level, or None); None: nothing
-        is drawn (no window).
+        ``mesher(job, canopy, coarse, from_file)`` makes what the 3D view draws of a canopy,
+        in the worker (``coarse()``: the canopy at the view's display level, or None;
+        ``from_file``: a canopy read from a mesh file); None: nothing is drawn (no window).
+    colour : ColourSettings
+        How the 3D view and the heatmaps colour light (evented; saved in a project).
+    selection : Selection
+        The plant or leaf selected (evented; the 3D view and the plants table follow it).
 
     Signals
     -------
@@ -204,6 +210,8 @@ class StudyModel:
         events: Any = self.settings.canopy.events       # psygnal's, made by @evented
         events.level.connect(self._canopy_setting)
         events.preserve_area.connect(self._canopy_setting)
+        self.colour = ColourSettings()
+        self.selection = Selection()
 
     # ------------------------------------------------------------------ reading
     @property

@@ -22,6 +22,7 @@ def open_project(study: StudyModel, path: str | Path) -> None:
     join the comparison once the canopy is built). The current canopy stays if the
     project cannot be used."""
     from maizeviz_app import jobs, project
+    from maizeviz_app.settings import StudySettings
 
     path = str(path)
     study.say(f"opening the project {path}")
@@ -34,6 +35,8 @@ def open_project(study: StudyModel, path: str | Path) -> None:
         opened = stored.open_project(path, cache)
         tile, level, preserve = project.canopy_settings(opened)
         light = project.light_settings(opened)
+        StudySettings().apply_light_doc(light)      # each value checked before any change
+        project.view_settings(opened)
         found = jobs.load_points(opened.points_path, (tile, tile),
                                  shown_name=opened.shown_name)
         layout = stored.restore_layout(opened, found.plants) or found.layout
@@ -56,6 +59,7 @@ def _project_read(study: StudyModel, out) -> None:
                                    "preserve_area": preserve})
     with study.quietly():
         study.settings.apply_light_doc(light)
+    study.colour.update_from_doc(opened.view, opened.path)
     study.project_layout = opened.project.layout is not None
     study.pending_runs = list(runs)
     study.points_loaded(loaded, opened.project.points_csv, opened.path,
@@ -77,6 +81,7 @@ def save_project(study: StudyModel, path: str | Path) -> bool:
     layout = loaded.layout if study.layout_edited else None   # else: the tiling, exactly
     canopy = dict(study.settings.canopy_doc(), tile=study.tile_n)
     light = study.settings.light_doc()
+    view = study.colour.to_doc()
     runs = []
     sun_settings = study.runs.settings.get("sun")
     optics = sun_settings[2] if isinstance(sun_settings, tuple) and \
@@ -94,7 +99,7 @@ def save_project(study: StudyModel, path: str | Path) -> bool:
         from maizeviz.project.study import make_project
 
         # the runs were all traced on the layout shown (a layout edit clears them)
-        proj = make_project(origin, data, layout, loaded.layout, canopy, light, runs)
+        proj = make_project(origin, data, layout, loaded.layout, canopy, light, runs, view)
         save_project(path, proj)
         return path
 

@@ -22,6 +22,8 @@ class ViewLink:
         m = window.model
         m.canopy_changed.connect(self.show_built)
         m.view_light.connect(self.light_to_view)
+        m.light_added.connect(self._painted)
+        m.colour.events.painting.connect(lambda _p: self.light_to_view())
 
     @property
     def view(self) -> Any:
@@ -48,7 +50,10 @@ class ViewLink:
             self.pending = None
             self.view.show_canopy(built.canopy, mesh)
         m = built.measures
-        if mesh is not None and "source" in mesh.field_data:
+        if mesh is not None and "view_note" in mesh.field_data:
+            say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
+                f"responsive {mesh.field_data['view_note'][0]}")
+        elif mesh is not None and "source" in mesh.field_data:
             say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
                 "responsive the view draws the plants around the sampled tile at 36 "
                 "triangles a leaf (light, tables and exports use every triangle)")
@@ -68,7 +73,8 @@ class ViewLink:
         run = m.runs.latest(m.shown_signature)
         if run is not None and run.kind == "sun" and run.classes is not None and \
                 (run.extra is None or run.extra.leaf_value is None):
-            self.view.set_light(run.classes)
+            self.view.set_sun(run.painting, m.colour.painting, run.classes)
+            self.window.colour_panel.show_painting(self.view.painting_note)
         elif run is not None and run.extra is not None and \
                 getattr(run.extra, "leaf_value", None) is not None:
             title, unit = value_legend(run)
@@ -76,6 +82,14 @@ class ViewLink:
         if colour and run is not None:
             self.colour_by("light")
         self.sync_colour_actions()
+
+    def _painted(self, run) -> None:
+        """A new sun: say how the view paints it (per triangle, or per leaf where triangles
+        are smaller than the ray spacing)."""
+        m = self.window.model
+        if run.painting is not None and self.view is not None and \
+                m.shown_signature == run.signature:
+            self.window.say(f"note: the view shows {self.view.painting_note}")
 
     def camera(self, name: str) -> None:
         if self.view is not None:
@@ -104,7 +118,7 @@ class ViewLink:
     def digitizing_stopped(self, _why: str = "") -> None:
         """In Digitize the plant just digitized stays in the view (no canopy frame on Stop);
         in Analyse the canopy comes back at once."""
-        if self.window.workspaces.current == "analyse":
+        if not self.window.model.closing and self.window.workspaces.current == "analyse":
             self.canopy_back()
 
     def workspace_changed(self, name: str) -> None:
@@ -123,7 +137,7 @@ class ViewLink:
         pending, self.pending = self.pending, None
         if pending is not None:
             self.view.show_canopy(*pending)
-            self.view.camera_preset("perspective")
+            self.view.camera_preset("reset")
         else:
             self.view.restore_canopy()
         self.light_to_view()
