@@ -35,7 +35,6 @@ from PySide6.QtCore import QSettings, Qt, QTimer, Signal
 from PySide6.QtWidgets import QLabel, QMainWindow, QMessageBox, QStackedWidget, QUndoView
 
 from maizeviz import __version__
-from maizeviz.errors import MaizevizError
 from maizeviz.mesh.levels import COMPLEXITY_STOPS as LEVELS  # noqa: F401 - the slider's stops
 from maizeviz.resources import example_points
 from maizeviz_app import dialogs, docks
@@ -439,31 +438,6 @@ class MainWindow(QMainWindow):
 
     def camera(self, name: str) -> None:
         self.view_link.camera(name)
-
-    def choose_view_image(self) -> None:
-        """File > Save view as image: ask the width and the file, then save."""
-        if self.viewport is None:
-            return
-        from maizeviz_app.snapshot import ask_view_image
-
-        chosen = ask_view_image(self, self.viewport, self.folder())
-        if chosen is not None:
-            self.save_view_image(*chosen)
-
-    def save_view_image(self, path: str | Path, width: int | None = None) -> None:
-        """The 3D view as a PNG ``width`` pixels wide (None: the view's), with its colour key
-        (:mod:`maizeviz_app.snapshot`)."""
-        if self.viewport is None:
-            return
-        from maizeviz_app.snapshot import save_view_image
-
-        try:
-            written = save_view_image(self.viewport, path, width)
-        except (MaizevizError, OSError, ValueError) as exc:
-            self.model.fail(exc, "export")
-            return
-        self.say(f"saved the view as {written}")
-        self.saved.emit(str(written))
 
     def colour_by(self, what: str) -> None:
         self.view_link.colour_by(what)

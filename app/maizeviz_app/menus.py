@@ -68,7 +68,7 @@ def build_menus(w) -> dict[str, QAction]:
                                     lambda: w.choose_export("plants"))
     acts["export_day"] = _action(w, results, "Day figure (PNG)…",
                                  lambda: w.choose_export("day"))
-    acts["view_image"] = _action(w, f, "Save view as &image…", w.choose_view_image,
+    acts["view_image"] = _action(w, f, "Save view as &image…", w.view_link.choose_image,
                                  "Ctrl+Alt+S", "the 3D view as a PNG of a chosen width, with "
                                                "its colour key")
     f.addSeparator()

@@ -91,6 +91,32 @@ class ViewLink:
                 m.shown_signature == run.signature:
             self.window.say(f"note: the view shows {self.view.painting_note}")
 
+    def choose_image(self) -> None:
+        """File > Save view as image: ask the width and the file, then save."""
+        if self.view is None:
+            return
+        from maizeviz_app.snapshot import ask_view_image
+
+        chosen = ask_view_image(self.window, self.view, self.window.folder())
+        if chosen is not None:
+            self.save_image(*chosen)
+
+    def save_image(self, path, width: int | None = None) -> None:
+        """The 3D view as a PNG ``width`` pixels wide (None: the view's), with its colour key
+        (:mod:`maizeviz_app.snapshot`)."""
+        if self.view is None:
+            return
+        from maizeviz.errors import MaizevizError
+        from maizeviz_app.snapshot import save_view_image
+
+        try:
+            written = save_view_image(self.view, path, width)
+        except (MaizevizError, OSError, ValueError) as exc:
+            self.window.model.fail(exc, "export")
+            return
+        self.window.say(f"saved the view as {written}")
+        self.window.saved.emit(str(written))
+
     def camera(self, name: str) -> None:
         if self.view is not None:
             self.view.camera_preset(name)
