@@ -352,3 +352,18 @@ def test_a_points_line_written_twice_is_reported_not_counted_twice(capsys, tmp_p
     err = capsys.readouterr().err
     plant, leaf = lines[10].split(",")[:2]
     assert f"plant {plant}, leaf {leaf}: row 1, col 4 appears twice (lines 11 and 21)" in err
+
+
+def test_a_stand_written_twice_in_a_layout_is_reported(capsys, tmp_path):
+    """The same plant at the same place twice is two plants standing in one another: kept
+    (a layout may overlap on purpose) but said, with the area counted twice."""
+    layout = tmp_path / "twice.json"
+    layout.write_text(json.dumps({
+        "maizeviz_layout": 1, "row_spacing": 60, "plant_spacing": 30,
+        "field": {"x0": -30, "y0": -30, "x1": 90, "y1": 30},
+        "rows": [{"x": 0, "plants": [{"y": 0, "plant": 1}, {"y": 0, "plant": 1}]},
+                 {"x": 60, "plants": [{"y": 0, "plant": 2}]}]}))
+    capsys.readouterr()
+    assert main(["canopy", BLOCK, "--layout", str(layout), "--triangles", "8"]) == 0
+    err = capsys.readouterr().err
+    assert "closer than the spacing" in err and "counted twice" in err
