@@ -25,7 +25,7 @@ import tempfile
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import (
     RuleBasedStateMachine,
@@ -445,6 +445,14 @@ def _journal(lines) -> bytes:
 
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(_LINE, max_size=25), st.integers(1, 4), st.integers(0, 6))
+# the issue's cases, kept whatever the draws: an undo of a point never recorded, the same
+# undo twice, a line the reader skips after a row's last point
+@example([("point", (1, 1, 0, 0), "recorded"), ("undo", (2, 2, 1, 1), "undone")], 2, 2)
+@example([("point", (1, 1, 0, 0), "recorded"), ("point", (1, 1, 0, 1), "recorded"),
+          ("undo", (1, 1, 0, 1), "undone"), ("undo", (1, 1, 0, 1), "undone")], 2, 3)
+@example([("point", (1, 1, 0, 0), "recorded"), ("point", (1, 1, 0, 1), "recorded"),
+          ("point", (1, 1, 1, 0), "recorded"), ("point", (1, 1, 1, 1), "recorded"),
+          ("junk", "unknown status", "")], 2, 3)
 def test_any_journal_the_reader_accepts_resumes_without_losing_a_point(lines, cols, presses):
     """Whatever a recording holds (points anywhere, controls, undos, lines the reader skips),
     resuming it keeps the points the reader reads, in their order, and every new press lands
