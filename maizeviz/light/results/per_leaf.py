@@ -15,7 +15,8 @@ from maizeviz.mesh.tessellate import triangle_areas_normals
 #: Per-leaf sums that :func:`plant_light` adds up per plant (those present in the rows).
 LIGHT_SUMS = ("sunlit_area_cm2", "second_class_area_cm2", "sunlit_intercepted_cm2",
               "second_class_intercepted_cm2", "diffuse_intercepted_cm2", "par_intercepted_mol",
-              "direct_par_intercepted_mol", "diffuse_par_intercepted_mol", "absorbed_w")
+              "direct_par_intercepted_mol", "diffuse_par_intercepted_mol", "absorbed_w",
+              "absorbed_mj", "absorbed_mol", "gross_umol_s", "gross_mol", "gross_g_co2")
 #: Columns that identify a leaf row.
 LEAF_KEYS = ("instance", "plant", "leaf", "x_cm", "y_cm", "leaf_area_cm2")
 
