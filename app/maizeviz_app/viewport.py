@@ -751,6 +751,18 @@ class Viewport(QtInteractor):
         super().close()
 
 
+def _card(widget: QWidget) -> QPainter:
+    """A painter on ``widget`` after its card: a rounded, nearly opaque white rectangle (the
+    view shows through a little); the pen set for dark text."""
+    p = QPainter(widget)
+    p.setRenderHint(QPainter.RenderHint.Antialiasing)
+    p.setPen(Qt.PenStyle.NoPen)
+    p.setBrush(QColor(255, 255, 255, 220))
+    p.drawRoundedRect(QRectF(widget.rect()), 6, 6)
+    p.setPen(QColor("#222222"))
+    return p
+
+
 class InfoCard(QWidget):
     """What was picked, over the 3D view's bottom left: a few lines of text on a white card
     (a Qt widget: nothing is drawn in the 3D scene). Clicks go through it to the view."""
@@ -781,12 +793,7 @@ class InfoCard(QWidget):
         return "\n".join(self._lines)
 
     def paintEvent(self, _event) -> None:  # noqa: N802 - Qt's name
-        p = QPainter(self)
-        p.setRenderHint(QPainter.RenderHint.Antialiasing)
-        p.setPen(Qt.PenStyle.NoPen)
-        p.setBrush(QColor(255, 255, 255, 225))
-        p.drawRoundedRect(QRectF(self.rect()), 6, 6)
-        p.setPen(QColor("#222222"))
+        p = _card(self)
         fm = self.fontMetrics()
         y = 6
         for k, line in enumerate(self._lines):
@@ -946,14 +953,9 @@ class Legend(QWidget):
         self.update()
 
     def paintEvent(self, _event) -> None:  # noqa: N802 - Qt's name
-        p = QPainter(self)
-        p.setRenderHint(QPainter.RenderHint.Antialiasing)
-        p.setPen(Qt.PenStyle.NoPen)
-        p.setBrush(QColor(255, 255, 255, 215))
-        p.drawRoundedRect(QRectF(self.rect()), 6, 6)
+        p = _card(self)
         fm = self.fontMetrics()
         line = fm.height() + 4
-        p.setPen(QColor("#222222"))
         y = 6
         p.drawText(QRectF(8, y, self.width() - 16, line), LEFT, self._title)
         y += line
