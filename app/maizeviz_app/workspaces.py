@@ -19,7 +19,8 @@ from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 
 #: name -> (menu text, shortcut, docks shown, the dock raised in each tab group, what it is for)
 WORKSPACES = {
-    "analyse": ("&Analyse", "Ctrl+Alt+1", ("canopy", "light", "layout", "results", "messages"),
+    "analyse": ("&Analyse", "Ctrl+Alt+1", ("canopy", "light", "layout", "colour", "results",
+                                           "messages"),
                 ("canopy", "results"), "the canopy, light and layout panels with the light "
                                        "results under the view"),
     "digitize": ("&Digitize", "Ctrl+Alt+2", ("digitizer",), ("digitizer",),
