@@ -1074,7 +1074,7 @@ class MainWindow(QMainWindow):
     def _digitizing_stopped(self, _why: str) -> None:
         """In Digitize the plant just digitized stays in the view (no canopy frame on Stop);
         in Analyse the canopy comes back at once."""
-        if self.workspaces.current == "analyse":
+        if not self._closing and self.workspaces.current == "analyse":
             self._canopy_back()
 
     def _workspace_changed(self, name: str) -> None:
