@@ -150,6 +150,7 @@ def test_every_package_folder_is_a_package_of_its_own_name():
     """Each folder with an __init__.py under maizeviz/ and app/maizeviz_app/ installs under its
     own name (packages.find, no package-dir renames), and nothing else does."""
     import tomllib
+
     from setuptools import find_namespace_packages
 
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
@@ -210,6 +211,10 @@ def test_wheel_holds_the_app_and_the_data_under_our_names(wheel_env):
                    "maizeviz/resources/phenotrack3d/1649057232.json.gz",
                    "maizeviz_app/main_window.py"):
         assert needed in names
+    # a platform wheel carrying the built ray-packet kernel (stable ABI) and its source
+    assert "-cp311-abi3-" in wheel.name and not wheel.name.endswith("-any.whl")
+    assert {"maizeviz/mesh/_packets.abi3.so", "maizeviz/mesh/_packets.pyi",
+            "maizeviz/mesh/_packets.c"} <= set(names)
     meta = next(n for n in names if n.endswith("entry_points.txt"))
     text = zipfile.ZipFile(wheel).read(meta).decode()
     assert "maizeviz = maizeviz.cli:main" in text and "maizeviz_app.main:run" in text
@@ -229,6 +234,15 @@ def test_installed_wheel_runs_from_an_empty_folder(wheel_env):
                 "4", "--json")
     assert proc.returncode == 0, proc.stderr
     assert '"plants": 9' in proc.stdout
+    # the wheel's own kernel traces, with no compiler on PATH and nothing written to home
+    home = empty.parent / "home"
+    home.mkdir()
+    info = _run(py, empty, "-m", "maizeviz", "--info",
+                env={"HOME": str(home), "PATH": str(empty), "XDG_CACHE_HOME": str(home)})
+    assert info.returncode == 0, info.stderr
+    kernel = next(line for line in info.stdout.splitlines() if line.startswith("ray kernel"))
+    assert kernel.startswith("ray kernel: packets") and str(ROOT) not in kernel, kernel
+    assert list(home.rglob("*")) == []
 
 
 def test_without_the_gui_extra_the_app_is_one_line_away(wheel_env):
