@@ -36,6 +36,8 @@ if TYPE_CHECKING:  # what a user's type checker sees (at run time the names load
     from maizeviz.light.engine import LightEngine as LightEngine
     from maizeviz.light.results.absorbed import AbsorbedLight as AbsorbedLight
     from maizeviz.light.results.absorbed import AbsorbedPeriod as AbsorbedPeriod
+    from maizeviz.light.results.assimilation import Assimilation as Assimilation
+    from maizeviz.light.results.assimilation import PeriodAssimilation as PeriodAssimilation
     from maizeviz.light.results.diffuse import PeriodLight as PeriodLight
     from maizeviz.light.results.diffuse import SkyLight as SkyLight
     from maizeviz.light.results.direct import LightResult as LightResult
@@ -50,6 +52,9 @@ if TYPE_CHECKING:  # what a user's type checker sees (at run time the names load
     from maizeviz.light.specs import DaySpec as DaySpec
     from maizeviz.light.specs import OpticsSpec as OpticsSpec
     from maizeviz.light.specs import SkySpec as SkySpec
+    from maizeviz.photosynthesis.c4 import C4Leaf as C4Leaf
+    from maizeviz.photosynthesis.split import leaf_model as leaf_model
+    from maizeviz.photosynthesis.wofost import WofostLeaf as WofostLeaf
     from maizeviz.project.study import read_study as read_study
     from maizeviz.project.study import save_study as save_study
 
@@ -84,6 +89,12 @@ _EXPORTS = {
     "PeriodLight": "maizeviz.light.results.diffuse",
     "AbsorbedLight": "maizeviz.light.results.absorbed",
     "AbsorbedPeriod": "maizeviz.light.results.absorbed",
+    "Assimilation": "maizeviz.light.results.assimilation",
+    "PeriodAssimilation": "maizeviz.light.results.assimilation",
+    # photosynthesis
+    "leaf_model": "maizeviz.photosynthesis.split",
+    "C4Leaf": "maizeviz.photosynthesis.c4",
+    "WofostLeaf": "maizeviz.photosynthesis.wofost",
     "MaizevizError": "maizeviz.errors",
 }
 

@@ -114,6 +114,10 @@ QUANTITIES = {
     "irradiance": "irradiance of a band on a horizontal plane, W/m2",
     "depth": "scatterings followed per ray",
     "threshold": "share of the incident light left travelling where scattering stops",
+    "photosynthesis": "leaf photosynthesis model and its parameters",
+    "temperature": "air (leaf) temperature, C",
+    "co2": "ambient CO2, umol/mol",
+    "precision": "target standard error of the Monte Carlo estimate",
     "plant": "plant id",
     "pace": "seconds between simulated presses",
     "noise": "simulated digitizer noise, cm",
@@ -127,4 +131,5 @@ QUANTITIES = {
     "up": "up axis of a mesh file (z, y)",
     "field": "field rectangle of a mesh canopy x0, y0, x1, y1, cm",
     "mesh_ids": "face properties holding a mesh's plant and leaf ids",
+    "connect_timeout": "seconds to wait for a Dask scheduler",
 }

@@ -6,7 +6,8 @@ the core follow in a warm-up thread (see :mod:`maizeviz_app.main_window`).
 
 ``--screenshot PNG`` builds the canopy, computes light once, colours the leaves by light,
 saves a picture of the window (canopy, heatmap and transmission plot) and quits: the way to look
-at the app on a machine without a screen (under ``xvfb-run``).
+at the app on a machine without a screen (under ``xvfb-run``). With ``--workspace digitize`` it
+pictures the Digitize workspace instead, during a Demo session (a simulated FASTRAK).
 """
 
 from __future__ import annotations
@@ -56,6 +57,8 @@ def run(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--screenshot", metavar="PNG", help="save the window and quit")
     ap.add_argument("--size", default="1366x768", metavar="WxH",
                     help="window size for --screenshot (default 1366x768, a laptop screen)")
+    ap.add_argument("--workspace", choices=("analyse", "digitize"),
+                    help="start in this workspace (default: the one the app was closed in)")
     args = ap.parse_args(argv)
     os.environ.setdefault("QT_API", "pyside6")
     from PySide6.QtWidgets import QApplication
@@ -72,6 +75,8 @@ def run(argv: Sequence[str] | None = None) -> int:
 
         points = str(example_points())
     window = MainWindow(points, args.tile)
+    if args.workspace:
+        window.workspaces.show(args.workspace)
     code = {"value": 0}
     if args.screenshot:
         try:
@@ -79,21 +84,28 @@ def run(argv: Sequence[str] | None = None) -> int:
         except ValueError:
             ap.error(f"--size must look like 1366x768, got {args.size}")
         window.resize(w, h)
-        _screenshot_flow(app, window, args.screenshot, code)
+        # nothing to save: without this the unsaved-results question waited, unanswered,
+        # until the flow's 300 s timeout (and the exit code was 1)
+        window.confirm_unsaved = False
+        if args.workspace == "digitize":
+            _digitize_screenshot_flow(app, window, args.screenshot, code)
+        else:
+            _screenshot_flow(app, window, args.screenshot, code)
     window.show()
     app.exec()
     return code["value"]
 
 
-def _screenshot_flow(app, window, path: str, code: dict) -> None:
-    """Canopy -> light -> a frame coloured by light -> grab -> quit."""
+def _ends(app, window, path: str, code: dict, before=None):
+    """A screenshot flow's two ends: ``shoot`` (grab, save, quit; ``before()`` first) and
+    ``fail(message)`` (exit code 1); both close the window. A flow fails after 300 s."""
     from PySide6.QtCore import QTimer
-
-    state = {"lit": False}
 
     def shoot() -> None:
         window.grab().save(path)
         print(f"saved {path}")
+        if before is not None:
+            before()
         window.close()
         app.quit()
 
@@ -103,6 +115,17 @@ def _screenshot_flow(app, window, path: str, code: dict) -> None:
         window.close()
         app.quit()
 
+    QTimer.singleShot(300_000, lambda: fail("timed out"))
+    return shoot, fail
+
+
+def _screenshot_flow(app, window, path: str, code: dict) -> None:
+    """Canopy -> light -> a frame coloured by light -> grab -> quit."""
+    from PySide6.QtCore import QTimer
+
+    state = {"lit": False}
+    shoot, fail = _ends(app, window, path, code)
+
     def on_canopy(_label: str) -> None:
         if not state["lit"]:
             state["lit"] = True
@@ -111,7 +134,43 @@ def _screenshot_flow(app, window, path: str, code: dict) -> None:
     window.canopy_shown.connect(on_canopy)
     window.light_shown.connect(lambda: QTimer.singleShot(800, shoot))
     window.failed.connect(fail)
-    QTimer.singleShot(300_000, lambda: fail("timed out"))
+
+
+def _digitize_screenshot_flow(app, window, path: str, code: dict, points: int = 26) -> None:
+    """The Demo records ``points`` presses into a temporary file, then pauses (the presses
+    that follow are refused), the leaves are meshed -> grab -> quit."""
+    import tempfile
+
+    from PySide6.QtCore import QTimer
+
+    folder = tempfile.mkdtemp(prefix="maizeviz-screenshot-")
+
+    def stop_demo() -> None:
+        window.digitizer.stopped.disconnect(stopped)
+        window.digitizer.stop("screenshot", wait=True)
+
+    shoot, fail = _ends(app, window, path, code, before=stop_demo)
+
+    def recorded(n: int) -> None:
+        panel = window.digitizer
+        if n == points:
+            panel.toggle_pause()
+            panel.plant.wait()
+            QTimer.singleShot(1500, shoot)
+
+    def start() -> None:
+        panel = window.digitizer
+        panel.out_edit.setText(f"{folder}/session.csv")
+        panel.cols.setValue(5)
+        panel.demo_pace = 0.1
+        panel.recorded.connect(recorded)
+        panel.stopped.connect(stopped)
+        panel.start(demo=True)
+
+    def stopped(why: str) -> None:
+        fail(f"the demo stopped ({why})")
+
+    window.ready.connect(start)
 
 
 if __name__ == "__main__":

@@ -52,6 +52,7 @@ from maizeviz.light.sources.irradiance import (
     PAR_FRACTION,
     PAR_UMOL_PER_J_PAR,
 )
+from maizeviz.numbers import number
 from maizeviz_app.runs import MODES, SKIES, LightRuns, Run, level_order  # noqa: F401 - re-exported
 
 DEFAULT_PLACE = "2005-08-01 12:00 39.9 116.4 Asia/Shanghai"
@@ -85,7 +86,7 @@ def parse_heights(text: str) -> tuple[float, ...]:
         if not part:
             continue
         try:
-            h = float(part.removesuffix("cm").strip())
+            h = number(part.removesuffix("cm").strip())
         except ValueError:
             raise InputProblem(f"heights: '{part}' is not a number of centimetres; write them "
                                "separated by commas, e.g. 0, 50, 100", "heights") from None
@@ -916,8 +917,15 @@ class LightPlots(QWidget):
         top.addWidget(self.height_box)
         top.addStretch(1)
         left.addLayout(top)
-        self.heatmap = ImageView("compute light to see where it reaches each height")
+        from maizeviz_app.panels.heatmap_view import HeatmapView
+
+        self.heatmap = HeatmapView("compute light to see where it reaches each height")
         left.addWidget(self.heatmap, 1)
+        # the value under the mouse (always in place: showing a widget relayouts the dock)
+        self.hover = QLabel(" ")
+        self.hover.setToolTip("the value of the heatmap's bin under the mouse")
+        self.heatmap.hovered.connect(lambda text: self.hover.setText(text or " "))
+        left.addWidget(self.hover)
         lay.addLayout(left, 1)
         self.transmission = ImageView("transmission by height appears here")
         lay.addWidget(self.transmission, 1)
@@ -969,6 +977,14 @@ class LightPlots(QWidget):
             del self._maps[k]
         if gone:
             self._fill_sources(None)
+
+    def redraw(self, keep: str | None = None) -> None:
+        """The colours changed: every map (but those of the light ``keep``) is drawn again
+        when shown (the one shown now is asked for at once, by ``heatmap_needed``)."""
+        for kind, maps in self._maps.items():
+            if kind != keep:
+                self._maps[kind] = [(h, None) for h, _ in maps]
+        self._show_height(self.height_box.currentIndex())
 
     def set_heatmap(self, index: int, rgba: np.ndarray, kind: str = "sun") -> None:
         """A height's figure, drawn after it was asked for."""

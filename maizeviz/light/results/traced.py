@@ -28,9 +28,9 @@ if TYPE_CHECKING:
 #: What :meth:`TracedLight.table` tabulates.
 TABLES = ("height", "leaf", "plant")
 #: What a result's ``table(by=...)`` can be by: its summary (``"height"`` for a sun, a sky
-#: or a period; ``"balance"`` for absorbed light; None is the summary), or per leaf or plant
-#: of the canopy it was traced on.
-TableBy = Literal["height", "balance", "leaf", "plant"]
+#: or a period; ``"balance"`` for absorbed light; ``"canopy"`` for assimilation; None is the
+#: summary), or per leaf or plant of the canopy it was traced on.
+TableBy = Literal["height", "balance", "canopy", "leaf", "plant"]
 
 
 def table_kind(by: str | None, summary: str, canopy: Canopy | None) -> str:
@@ -41,7 +41,7 @@ def table_kind(by: str | None, summary: str, canopy: Canopy | None) -> str:
     ----------
     by : str or None
         Asked for.
-    summary : {"height", "balance"}
+    summary : {"height", "balance", "canopy"}
         The result's own summary table.
     canopy : Canopy or None
         The canopy the light was traced on (per-leaf and per-plant tables need it).
@@ -80,6 +80,8 @@ class TracedLight:
     warnings : tuple of str, what the user should know about this result
     seconds : dict, "build" (the scene), "trace", ..., s
     periodic : bool, rays and sensor paths wrapped across the plot
+    stands : ``{"n", "sha256"}``, the identity of the stands of the canopy it was traced on
+        (:func:`maizeviz.canopy.layout.stands_identity`), or None where not known
     """
 
     heights_cm: np.ndarray
@@ -89,6 +91,7 @@ class TracedLight:
     warnings: tuple[str, ...] = ()
     seconds: dict[str, float] = field(default_factory=dict)
     periodic: bool = False
+    stands: dict | None = None
 
     @property
     def rect_area_cm2(self) -> float:

@@ -63,6 +63,7 @@ from maizeviz.light.sources.clock import check_place as _check_place
 from maizeviz.light.sources.clock import local_time
 from maizeviz.light.sources.clock import zone as _time_zone
 from maizeviz.light.sources.dates import FIRST_YEAR, LAST_YEAR, TIME_UNIT, check_year
+from maizeviz.numbers import NUMBER, first_unplain, number
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -659,7 +660,7 @@ def _value_problem(text: str) -> str | None:
     if text == "":
         return "missing value"
     try:
-        value = float(text)
+        value = number(text)
     except ValueError:
         return f"'{text}' is not a number"
     if math.isnan(value):
@@ -678,6 +679,8 @@ def _parse_values(texts: list, lines: list, times: list, column: str, path: Path
     try:
         values = np.array(texts, dtype=np.float64)
         ok = np.isfinite(values) & (values >= 0) & (values <= MAX_IRRADIANCE_W_M2)
+        if first_unplain(texts) is not None:          # numpy reads 1_000 as float does
+            ok &= np.array([NUMBER.fullmatch(t) is not None for t in texts], bool)
         bad = np.flatnonzero(~ok)
     except ValueError:                              # an empty or non-numeric cell somewhere
         values, bad = None, np.arange(len(texts))
@@ -687,7 +690,7 @@ def _parse_values(texts: list, lines: list, times: list, column: str, path: Path
             raise WeatherFileError(f"{path}, line {lines[k]} ({times[k]}), column {column}: "
                                    f"{problem}")
     if values is None:                              # forms float() reads and numpy does not
-        values = np.array([float(t) for t in texts])
+        values = np.array([number(t) for t in texts])
     return values
 
 
@@ -822,7 +825,8 @@ def weather_period(weather: Weather, lat: float, lon: float, altitude: float = 0
     """Period of a weather file at a place: sun positions, direct and diffuse parts.
 
     The direct and diffuse parts keep the file's ghi: with ``dhi`` given, direct_horizontal =
-    ghi - dhi (dhi above ghi is cut to ghi); with only ``dni``, direct_horizontal = dni
+    ghi - dhi (dhi above ghi is cut to ghi, said in a note naming the first such row; a
+    ``dni`` column is then not used); with only ``dni``, direct_horizontal = dni
     cos(zenith) (cut to ghi) and dhi the rest; with ghi alone, the Erbs et al. (1982)
     diffuse fraction (pvlib; geometric zenith, day of year) gives dhi. ``dni`` is then
     direct_horizontal / cos(zenith). Rows whose middle has the sun below the horizon are
@@ -843,6 +847,16 @@ def weather_period(weather: Weather, lat: float, lon: float, altitude: float = 0
     ghi = direct + dhi
     dni = direct / np.cos(np.radians(zen[up]))
     notes = []
+    if weather.dhi is not None:
+        over = np.flatnonzero(weather.dhi[up] > weather.ghi[up])
+        if len(over):                  # a sensor's offset at low sun, or columns swapped
+            first = weather.times[up][int(over[0])]
+            unused = " (its dni is not used: ghi - dhi gives the direct part)" \
+                if weather.dni is not None else ""
+            rows = f"{len(over)} rows" if len(over) > 1 else "1 row"
+            notes.append(f"{rows} of {Path(weather.path).name} with the sun up "
+                         f"{'have' if len(over) > 1 else 'has'} dhi above ghi (first: "
+                         f"{first.isoformat()}): diffuse cut to ghi, no direct light{unused}")
     if not up.any():
         notes.append(_no_sun_note(weather.start, weather.end, lat, lon))
     night = ~up
