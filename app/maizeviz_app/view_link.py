@@ -79,6 +79,7 @@ class ViewLink:
                 getattr(run.extra, "leaf_value", None) is not None:
             title, unit = value_legend(run)
             self.view.set_light_values(run.extra.leaf_value, title, unit)
+            self.window.colour_panel.show_painting("")      # a sun's painting is not shown
         if colour and run is not None:
             self.colour_by("light")
         self.sync_colour_actions()
