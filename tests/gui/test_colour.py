@@ -260,7 +260,7 @@ def test_the_heatmap_pixels_follow_the_colour_map():
 
 def test_a_project_keeps_the_colours(window, qtbot, tmp_path):
     w = window()
-    qtbot.waitUntil(lambda: w.built is not None, timeout=120_000)
+    qtbot.waitUntil(lambda: w.model.built is not None, timeout=120_000)
     w.model.colour.update_from_doc({"view": {"range": "percentile", "clip": 5.0,
                                              "cmap": "cividis"},
                                     "heatmap": {"log": True}, "shared": True})
@@ -269,7 +269,7 @@ def test_a_project_keeps_the_colours(window, qtbot, tmp_path):
     assert w.colour_panel.shared.isChecked()
     path = tmp_path / "colours.maizeviz"
     with qtbot.waitSignal(w.saved, timeout=120_000):
-        w.save_project(path)
+        w.model.save_project(path)
     with zipfile.ZipFile(path) as zf:
         names = [n for n in zf.namelist() if n.endswith(".json")]
         docs = [json.loads(zf.read(n)) for n in names]
