@@ -364,6 +364,9 @@ def edit_part(window, spin, gaps, shown: list) -> dict:
     timed("move_one_of_900", lambda: draft.move(450, p.x + 40.0, p.y + 10.0))
     timed("undo_move_of_900", undo.trigger)
     timed("undo_lay_out_900", undo.trigger)
+    return out
+
+
 def stop_gaps(window, gaps: GapTimer, spin, repeat: int = 1) -> dict:
     """The event loop while the digitizer stops: a session on a simulated unit (a leaf's worth
     of presses, its surface meshed) and a Demo, ``max(5, repeat)`` times each."""
