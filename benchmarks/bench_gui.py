@@ -24,7 +24,7 @@ Run under a display (``xvfb-run -a -s "-screen 0 1366x768x24" python benchmarks/
   field of 30 x 30 plants (the 3D view not following): laying it out by rows x plants, moving
   one plant, undoing the move, undoing the whole field (target: an edit or an undo on 900
   plants leaves no gap over 200 ms; laying out 900 plants where there were 81 makes 819 new
-  items in the top view, about 0.3 s once).
+  items in the top view once: 47 ms on a quiet machine, 0.24 s on a busy one).
 - ``pick_ms``: a click on a leaf of the K = 4 canopy, from the release event's delivery to the
   leaf picked, highlighted and described (the event loop is held that long; target under 50
   ms), median and worst of ``pick_samples`` clicks; ``pick_frame_gap_ms``: the longest gap of
