@@ -293,7 +293,7 @@ def test_the_window_redraws_its_heatmaps_when_their_colours_change(window, qtbot
     compute(qtbot, w)
     heat = w.plots.heatmap
     qtbot.waitUntil(lambda: heat.heatmap is not None, timeout=120_000)
-    result = w.runs.last.result
+    result = w.model.runs.last.result
     maps = [result_map(result, float(h), "sun").transmission for h in result.heights_cm]
     own = maps[0]
     assert heat.heatmap.limits == (np.nanmin(own), np.nanmax(own))

@@ -52,7 +52,7 @@ def test_k4_sun_paints_each_leaf_with_its_sunlit_share(window, qtbot, small_poin
 
     out = tmp_path / "k4.vtu"
     with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
-        w.export("canopy", out)
+        w.model.export("canopy", out)
     mesh = pv.read(out)
     np.testing.assert_array_equal(np.asarray(mesh.cell_data["light"])[:n], run.classes)
     np.testing.assert_allclose(np.asarray(mesh.cell_data["sunlit_share"])[:n],
