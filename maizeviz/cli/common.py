@@ -122,7 +122,7 @@ def levels_from(args: argparse.Namespace, default_k: int = 4) -> list[Level]:
 
 
 def add_canopy_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("points", help="points CSV of the digitized plants (field coordinates, cm), "
+    p.add_argument("points", help="points file of the digitized plants (CSV or Parquet; field coordinates, cm), "
                                   "a .maizeviz project (its points and its layout), or a mesh "
                                   "file (.ply, .obj) with a plant and leaf id per face")
     p.add_argument("--tile", metavar="AxB",

@@ -29,7 +29,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="cross-sections of a long leaf (default 13)")
     p.add_argument("--points-across", type=int, default=5,
                    help="points per cross-section, margin to margin (default 5)")
-    p.add_argument("--out", required=True, help="points CSV to write")
+    p.add_argument("--out", required=True, help="points file to write: CSV, or Parquet if it ends in .parquet or .pq")
     p.set_defaults(run=run)
 
 

@@ -71,6 +71,9 @@ MAX_BAD_LEAVES = 100_000
 _BINARY_SNIFF = 4096
 #: Bytes read at a time; blocks of plain numeric lines are parsed by numpy in one go.
 BLOCK_BYTES = 1 << 20
+#: Files at least this large read their numeric blocks through pyarrow (whose import costs
+#: about what numpy takes to parse 4 MB).
+COLUMNAR_BYTES = 4 << 20
 #: What a block of plain numeric lines may hold, besides its delimiter.
 _NUMERIC = b"0123456789+-.eE \r\n"
 
@@ -234,9 +237,11 @@ class LineParser:
         self.header: list[str] | None = None
         self.header_line = 0
         self.delimiter = ","
-        self.ids = array("q")
-        self.xyz = array("d")
+        self.ids = array("q")                     # points read line by line, not yet
+        self.xyz = array("d")                     # moved to ``blocks``
         self.lines = array("q")
+        self.blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []   # in file order
+        self.in_blocks = 0                        # points held in ``blocks``
         self.extra: dict[str, list] = {}
         self.problems: list[str] = []
         self.dropped = 0                          # problem lines not kept in ``problems``
@@ -248,6 +253,7 @@ class LineParser:
         self.carry_start = 0
         self.torn: tuple[int, str] | None = None  # (line number, text) of a cut-off last line
         self.journal = False
+        self.columnar = False                     # blocks through pyarrow (_numbers)
 
     # ------------------------------------------------------------------ header
     def _set_header(self, lineno: int, text: str) -> None:
@@ -436,7 +442,7 @@ class LineParser:
         kind = outcome[0]
         if kind == "point":
             plant, leaf, row, col, coords, extras = outcome[1]
-            if len(self.lines) >= self.max_points:
+            if self.points >= self.max_points:
                 raise PointsFileError(
                     f"{self.source}: line {outcome[2]}: more than {self.max_points:,} points; "
                     "that many would take over "
@@ -462,7 +468,7 @@ class LineParser:
             elif len(msgs) == 5:
                 msgs.append("more lines like these")
         elif kind == "undo":
-            self.undone.append((outcome[1], len(self.lines)))
+            self.undone.append((outcome[1], self.points))
 
     # ------------------------------------------------------------------ blocks
     def feed_block(self, block: bytes, lineno: int) -> int:
@@ -495,19 +501,16 @@ class LineParser:
         """Parse a block of plain numeric lines with numpy; returns the lines taken (0: the
         block is not plain, read it line by line)."""
         delim = self.delimiter.encode()
-        if block.translate(None, _NUMERIC + delim) or block.count(b"\r") != block.count(b"\r\n"):
+        if block.translate(None, _NUMERIC + delim) or \
+                (b"\r" in block and block.count(b"\r") != block.count(b"\r\n")):
             return 0                                   # quotes, words, nan, blanks in lines...
         ends = np.flatnonzero(np.frombuffer(block, np.uint8) == 10)
         n = len(ends) + (0 if block.endswith(b"\n") else 1)
         lengths = np.diff(np.concatenate([[-1], ends, [len(block) - 1]]))[:n]
         if not n or lengths.max() > MAX_LINE_BYTES + 1 or lineno + n > self.max_lines:
             return 0                                   # the line-by-line checks say why
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("error")
-                values = np.loadtxt(io.BytesIO(block), delimiter=self.delimiter, comments=None,
-                                    dtype=np.float64, ndmin=2, encoding="latin-1")
-        except (ValueError, Warning):
+        values = _numbers(block, self.delimiter, len(REQUIRED), self.columnar)
+        if values is None:
             return 0
         if values.shape != (n, len(REQUIRED)) or not np.isfinite(values).all():
             return 0
@@ -517,15 +520,30 @@ class LineParser:
         low = np.array([-MAX_ID, -MAX_ID, 0, 0], dtype=np.float64)
         if not (np.all(ids == np.floor(ids)) and np.all(ids <= limit) and np.all(ids >= low)):
             return 0
-        if len(self.lines) + n > self.max_points:
+        if self.points + n > self.max_points:
             return 0
-        self.ids.frombytes(ids.astype(np.int64).tobytes())
-        self.xyz.frombytes(np.ascontiguousarray(xyz).tobytes())
-        self.lines.frombytes(np.arange(lineno + 1, lineno + n + 1, dtype=np.int64).tobytes())
+        self._flush()
+        self.blocks.append((ids.astype(np.int64), np.ascontiguousarray(xyz),
+                            np.arange(lineno + 1, lineno + n + 1, dtype=np.int64)))
+        self.in_blocks += n
         self.data_lines += n
         if not block.endswith(b"\n"):
             self.torn = (lineno + n, "")
         return n
+
+    @property
+    def points(self) -> int:
+        """Points kept so far."""
+        return self.in_blocks + len(self.lines)
+
+    def _flush(self) -> None:
+        """Move the points read line by line to ``blocks``."""
+        if len(self.lines):
+            self.blocks.append((np.frombuffer(self.ids, np.int64).reshape(-1, 4).copy(),
+                                np.frombuffer(self.xyz, np.float64).reshape(-1, 3).copy(),
+                                np.frombuffer(self.lines, np.int64).copy()))
+            self.in_blocks += len(self.lines)
+            self.ids, self.xyz, self.lines = array("q"), array("d"), array("q")
 
     # ------------------------------------------------------------------ result
     def finish(self) -> PointsTable:
@@ -539,12 +557,15 @@ class LineParser:
             raise PointsFileError(f"{self.source}: the file is empty")
         if self.dropped:
             self.problems.append(f"... and {self.dropped:,} more lines skipped")
-        n = len(self.lines)
-        ids = np.frombuffer(self.ids, dtype=np.int64).reshape(-1, 4) if n else \
-            np.empty((0, 4), np.int64)
-        xyz = np.frombuffer(self.xyz, dtype=np.float64).reshape(-1, 3) if n else \
-            np.empty((0, 3), np.float64)
-        lines = np.frombuffer(self.lines, dtype=np.int64) if n else np.empty(0, np.int64)
+        self._flush()
+        if len(self.blocks) == 1:
+            ids, xyz, lines = self.blocks[0]
+        elif self.blocks:
+            ids, xyz, lines = (np.concatenate([b[k] for b in self.blocks]) for k in range(3))
+        else:
+            ids, xyz, lines = (np.empty((0, 4), np.int64), np.empty((0, 3), np.float64),
+                               np.empty(0, np.int64))
+        self.blocks = []
         extra = self.extra
         if self.undone:
             keep = _undo_mask(ids, self.undone)
@@ -560,6 +581,47 @@ class LineParser:
             raise PointsFileError(f"{self.source}: header only, no points")
         return PointsTable(ids=ids, xyz=xyz, line=lines, extra=extra, problems=self.problems,
                            bad_leaves=self.bad_leaves, source=self.source)
+
+
+def _numbers(block: bytes, delimiter: str, columns: int, columnar: bool
+             ) -> np.ndarray | None:
+    """The numbers of a block of plain numeric lines, (lines, columns) float64, or None where
+    the block does not parse as such (a line with another number of fields, a field that is
+    not a number); blank lines are left out (the caller counts lines and finds them missing).
+
+    ``columnar``: through pyarrow's CSV reader (C++, on its own threads), which reads a number
+    as Python's ``float`` does (both round correctly; both refuse ``1e``, ``.``, ``1.2.3``) and
+    an empty field as NaN; otherwise (or without pyarrow) numpy's ``loadtxt``, about 15 times
+    slower but without pyarrow's 0.3 s import.
+    """
+    try:
+        if not columnar:
+            raise ImportError
+        import pyarrow as pa
+        import pyarrow.csv as pacsv
+    except ImportError:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                return np.loadtxt(io.BytesIO(block), delimiter=delimiter, comments=None,
+                                  dtype=np.float64, ndmin=2, encoding="latin-1")
+        except (ValueError, Warning):
+            return None
+    names = [str(i) for i in range(columns)]
+    try:
+        table = pacsv.read_csv(
+            pa.py_buffer(block),
+            read_options=pacsv.ReadOptions(column_names=names, block_size=max(len(block), 1)),
+            parse_options=pacsv.ParseOptions(delimiter=delimiter, quote_char=False,
+                                             double_quote=False),
+            convert_options=pacsv.ConvertOptions(
+                column_types=dict.fromkeys(names, pa.float64()), quoted_strings_can_be_null=False))
+    except (pa.ArrowInvalid, pa.ArrowTypeError, ValueError):
+        return None
+    out = np.empty((table.num_rows, columns))
+    for k in range(columns):
+        out[:, k] = table.column(k).to_numpy(zero_copy_only=False)
+    return out
 
 
 def shown(text: str, limit: int = 30) -> str:
@@ -600,7 +662,8 @@ def _parse_stream(lines, source: str, max_points: int, max_lines: int) -> Points
 
 def read_points(path: str | Path, max_points: int = MAX_POINTS,
                 max_lines: int = MAX_LINES) -> PointsTable:
-    """Read a points CSV file, streaming (memory follows the points kept).
+    """Read a points CSV file, streaming (memory follows the points kept), or a Parquet
+    points file (:mod:`maizeviz.io.parquet`: taken by its content, whatever its name).
 
     Blocks of plain numeric lines (no status or extra column, no quote, no blank line, every
     value a number and every id in range) are parsed by numpy in one go; any other block goes
@@ -615,11 +678,16 @@ def read_points(path: str | Path, max_points: int = MAX_POINTS,
     """
     path = Path(path)
     source = str(path)
-    fh, _ = open_regular(path)
+    fh, size = open_regular(path)
     with fh:
+        if fh.peek(4)[:4] == b"PAR1":
+            from maizeviz.io.parquet import read_points_parquet
+
+            return read_points_parquet(path, max_points, max_lines)
         try:
             refuse_binary(fh, source)
             parser = LineParser(source, max_points, max_lines)
+            parser.columnar = size >= COLUMNAR_BYTES
             lineno = 0
             for block in file_blocks(fh):
                 lineno = parser.feed_block(block, lineno)
@@ -640,13 +708,19 @@ def parse_points(text: str, source: str = "<memory>", max_points: int = MAX_POIN
 
 def write_points(path: str | Path, grids, decimals: int = 3) -> None:
     """Write point grids in the points format (one line per point, tip rows written once),
-    atomically.
+    atomically: CSV, or Parquet where ``path`` ends in ``.parquet`` or ``.pq``
+    (:func:`maizeviz.io.parquet.write_points_parquet`, the same numbers).
 
     Parameters
     ----------
     grids : iterable of leaf grids (``plant``, ``leaf``, ``points`` (m, n, 3) cm,
         ``tip_collapsed``), e.g. :class:`maizeviz.leaf.grid.LeafGrid`
     """
+    if is_parquet_name(path):
+        from maizeviz.io.parquet import write_points_parquet
+
+        write_points_parquet(path, grids, decimals)
+        return
     with atomic_open(path, "w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(REQUIRED)
@@ -657,3 +731,12 @@ def write_points(path: str | Path, grids, decimals: int = 3) -> None:
                     row = row[:1]
                 for c, p in enumerate(row):
                     writer.writerow([g.plant, g.leaf, r, c, *(f"{v:.{decimals}f}" for v in p)])
+
+
+#: Names of points files written as Parquet.
+PARQUET_SUFFIXES = (".parquet", ".pq")
+
+
+def is_parquet_name(path: str | Path) -> bool:
+    """Whether a points file to write at ``path`` is a Parquet file (by its name)."""
+    return Path(path).suffix.lower() in PARQUET_SUFFIXES
