@@ -18,6 +18,8 @@ from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from maizeviz.canopy.layout import CanopyLayout
 from maizeviz.canopy.measures import check_cover_resolution
 from maizeviz.errors import MaizevizError
@@ -112,13 +114,13 @@ def memory_available() -> int:
         return 8 * 2**30
 
 
-def leaf_triangles(rows: int, cols: int, tip_collapsed: bool, level: Level) -> int:
+def leaf_triangles(rows, cols, tip_collapsed, level: Level):
     """Triangles of one leaf of an m x n point grid at ``level`` (an upper bound below the
-    standard mesh)."""
+    standard mesh); ints, or arrays of them leaf by leaf."""
     k = level.interp if level.interp is not None else 0
     a, b = (rows - 1) * (k + 1), (cols - 1) * (k + 1)
-    full = 2 * a * b - (b if tip_collapsed else 0)          # the collapsed tip row's slivers
-    return full if level.triangles is None else min(level.triangles, full)
+    full = 2 * a * b - b * np.asarray(tip_collapsed, dtype=np.int64)   # the tip's slivers
+    return full if level.triangles is None else np.minimum(level.triangles, full)
 
 
 def canopy_cost(leaves: Iterable[Leaf], placements: Mapping[int, int], level: Level,
@@ -127,12 +129,18 @@ def canopy_cost(leaves: Iterable[Leaf], placements: Mapping[int, int], level: Le
     digitized plant standing in the field (set by the input ``quantity``: a tiling or a
     layout)."""
     per_plant: dict[int, int] = {}
-    for lf in leaves:
+    shapes = getattr(leaves, "shapes", None)          # a field's (FieldLeaves): arrays
+    if shapes is not None:
+        each = leaf_triangles(shapes.rows.astype(np.int64), shapes.cols.astype(np.int64),
+                              shapes.tip, level)
+        ids, at = np.unique(shapes.plant, return_inverse=True)
+        per_plant = dict(zip(ids.tolist(), np.bincount(at, each).astype(np.int64).tolist()))
+    for lf in leaves if shapes is None else ():
         m, n = lf.grid.shape
-        per_plant[lf.plant] = per_plant.get(lf.plant, 0) + leaf_triangles(
-            m, n, lf.grid.tip_collapsed, level)
-    tris = sum(per_plant.get(p, 0) * count for p, count in placements.items())
-    plants = sum(placements.values())
+        per_plant[lf.plant] = per_plant.get(lf.plant, 0) + int(leaf_triangles(
+            m, n, lf.grid.tip_collapsed, level))
+    tris = int(sum(per_plant.get(p, 0) * count for p, count in placements.items()))
+    plants = int(sum(placements.values()))
     return Cost(f"the canopy of {plants:,} plants at {level}", quantity, tris, "triangles",
                 tris * BYTES_PER_TRIANGLE, tris / TRIANGLES_PER_S)
 
@@ -142,7 +150,7 @@ def leaves_cost(leaves: Sequence[Leaf], level: Level, quantity: str, batch: int,
     """Meshing and measuring ``leaves`` one at a time at ``level`` (``maizeviz leaf``): the
     meshes of ``batch`` leaves are held at once (of all of them when ``keep``, for an export).
     ``quantity`` is the input that chose the level ("interp", "triangles" or "level")."""
-    tris = [leaf_triangles(*lf.grid.shape, lf.grid.tip_collapsed, level) for lf in leaves]
+    tris = [int(leaf_triangles(*lf.grid.shape, lf.grid.tip_collapsed, level)) for lf in leaves]
     held = sum(tris) if keep else max((sum(tris[s:s + batch])
                                        for s in range(0, len(tris), batch)), default=0)
     return Cost(f"meshing {len(tris):,} leaves at {level}", quantity, sum(tris), "triangles",

@@ -13,9 +13,10 @@ column where a number belongs, a ``status`` column) is read as the CSV the same 
 then names record N - 1, counted from 1.
 
 Writing (:func:`write_points_parquet`): the grids' points rounded as the CSV writer rounds
-them (the same numbers a CSV of the same grids reads back), ids in the narrowest integer type
-holding them, in row groups of whole plants (about :data:`ROW_GROUP_POINTS` points each) so
-that a reader can take a field plant by plant.
+them (the same numbers a CSV of the same grids reads back), plant and leaf ids as int32, rows
+and columns as int16, in row groups of whole plants (about :data:`ROW_GROUP_POINTS` points
+each), written as the grids come: a field is written without being held, and read plant by
+plant.
 
 References
 ----------
@@ -50,13 +51,22 @@ ROW_GROUP_POINTS = 1 << 20
 
 
 def is_parquet(path: str | Path) -> bool:
-    """Whether the file at ``path`` is a Parquet file (its first four bytes); False when it
-    cannot be read (the reader then says why)."""
+    """Whether the file at ``path`` is a Parquet file (its first four bytes); False when it is
+    not a regular file or cannot be read (the reader then says why; a named pipe is never
+    opened here: that would wait for a writer)."""
+    import os
+    import stat
+
     try:
-        with open(path, "rb") as fh:
-            return fh.read(4) == MAGIC
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except (OSError, ValueError):
+        return False
+    try:
+        return stat.S_ISREG(os.fstat(fd).st_mode) and os.read(fd, 4) == MAGIC
     except OSError:
         return False
+    finally:
+        os.close(fd)
 
 
 def _pyarrow(source: str):
@@ -191,32 +201,43 @@ def write_points_parquet(path: str | Path, grids: Iterable, decimals: int = 3) -
     from maizeviz.io.atomic import atomic_open
 
     pa, pq = _pyarrow(str(path))
+    id_types = (pa.int32(), pa.int32(), pa.int16(), pa.int16())     # ids within MAX_ID, rows
+    schema = pa.schema([(n, t) for n, t in zip(REQUIRED[:4], id_types)] +   # within MAX_INDEX
+                       [(n, pa.float64()) for n in REQUIRED[4:]])
     parts: list[np.ndarray] = []
     ids: list[np.ndarray] = []
-    for g in grids:
-        pts = np.asarray(g.points, dtype=np.float64)
-        m, n = pts.shape[:2]
-        keep = m * n - ((n - 1) if g.tip_collapsed else 0)
-        r, c = np.divmod(np.arange(keep), n)
-        parts.append(pts.reshape(-1, 3)[:keep])
-        ids.append(np.column_stack([np.full(keep, g.plant), np.full(keep, g.leaf), r, c]))
-    xyz = exact_rounding(np.concatenate(parts) if parts else np.empty((0, 3)), decimals)
-    idv = np.concatenate(ids).astype(np.int64) if ids else np.empty((0, 4), np.int64)
-    columns = {}
-    for k, name in enumerate(REQUIRED[:4]):
-        columns[name] = pa.array(_narrow(idv[:, k]))
-    for k, name in enumerate(REQUIRED[4:]):
-        columns[name] = pa.array(xyz[:, k])
-    table = pa.table(columns)
-    starts = np.flatnonzero(np.diff(idv[:, 0], prepend=np.nan if len(idv) else 0)) \
-        if len(idv) else np.zeros(1, np.int64)
+    held = 0
+    last_plant = None
+
+    def group(writer) -> None:
+        xyz = exact_rounding(np.concatenate(parts), decimals)
+        idv = np.concatenate(ids)
+        columns = [pa.array(idv[:, k], type=id_types[k]) for k in range(4)] + \
+            [pa.array(xyz[:, k]) for k in range(3)]
+        writer.write_table(pa.Table.from_arrays(columns, schema=schema))
+        parts.clear()
+        ids.clear()
+
     with atomic_open(path, "wb") as fh:
-        with pq.ParquetWriter(fh, table.schema, compression="zstd") as writer:
-            begin = 0
-            for s in list(starts[1:]) + [len(idv)]:
-                if s - begin >= ROW_GROUP_POINTS or s == len(idv):
-                    writer.write_table(table.slice(begin, s - begin))
-                    begin = s
+        with pq.ParquetWriter(fh, schema, compression="zstd") as writer:
+            for g in grids:
+                if g.plant != last_plant and held >= ROW_GROUP_POINTS:
+                    group(writer)                       # whole plants in each row group
+                    held = 0
+                last_plant = g.plant
+                pts = np.asarray(g.points, dtype=np.float64)
+                m, n = pts.shape[:2]
+                keep = m * n - ((n - 1) if g.tip_collapsed else 0)
+                r, c = np.divmod(np.arange(keep), n)
+                parts.append(pts.reshape(-1, 3)[:keep])
+                ids.append(np.column_stack([np.full(keep, g.plant), np.full(keep, g.leaf),
+                                            r, c]))
+                held += keep
+            if parts or not held:
+                if not parts:
+                    parts.append(np.empty((0, 3)))
+                    ids.append(np.empty((0, 4), np.int64))
+                group(writer)
 
 
 def _narrow(a: np.ndarray) -> np.ndarray:
@@ -262,3 +283,84 @@ def write_table(path: str | Path, table: PointsTable, decimals: int | None = Non
         for ids, p, more in zip(table.ids.tolist(), xyz.tolist(), extra):
             writer.writerow([*ids, *(repr(v) if decimals is None else f"{v:.{decimals}f}"
                                      for v in p), *more])
+
+
+class NotStreamable(Exception):
+    """A Parquet points file that cannot be read plant chunk by plant chunk (records needing
+    the CSV reader's checks, or a plant's records not together): read it whole instead."""
+
+
+def parquet_rows(path: str | Path) -> int | None:
+    """Records of a Parquet file from its footer (None when it is not a readable one)."""
+    try:
+        _, pq = _pyarrow(str(path))
+        return int(pq.ParquetFile(path).metadata.num_rows)
+    except Exception:                                    # noqa: BLE001 - the reader says why
+        return None
+
+
+def point_chunks(path: str | Path, chunk_points: int = ROW_GROUP_POINTS):
+    """The points of a Parquet file in tables of whole plants, about ``chunk_points`` points
+    each, in the file's order (line numbers as :func:`read_points_parquet` gives them; extra
+    columns left out).
+
+    Yields
+    ------
+    PointsTable
+
+    Raises
+    ------
+    PointsFileError
+        As :func:`read_points_parquet`, for the file as a whole.
+    NotStreamable
+        A chunk holds records the CSV reader must check, or a plant's records are not
+        together in the file.
+    """
+    source = str(path)
+    pa, pq = _pyarrow(source)
+    try:
+        pf = pq.ParquetFile(path)
+    except (pa.ArrowException, OSError) as exc:
+        raise PointsFileError(f"{source}: not a readable Parquet file ({exc})") from None
+    names = pf.schema_arrow.names
+    lower = [n.strip().lower() for n in names]
+    missing = [c for c in REQUIRED if c not in lower]
+    if missing:
+        found = shown(",".join(lower), 80)
+        raise PointsFileError(f"{source}: missing column(s) {', '.join(missing)}; a points file "
+                              f"needs the columns plant,leaf,row,col,x,y,z (found '{found}')")
+    if "status" in lower or len(set(lower)) != len(lower):
+        raise NotStreamable(source)
+    wanted = [names[lower.index(c)] for c in REQUIRED]
+    done: set[int] = set()
+    carry: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    first = 0
+
+    def emit(ids, xyz, line) -> PointsTable:
+        plants = set(np.unique(ids[:, 0]).tolist())
+        if plants & done:
+            raise NotStreamable(f"{source}: the records of a plant are not together")
+        done.update(plants)
+        return PointsTable(ids=ids, xyz=xyz, line=line, source=source)
+
+    try:
+        for batch in pf.iter_batches(batch_size=max(1, chunk_points), columns=wanted):
+            table = pa.Table.from_batches([batch]).rename_columns(list(REQUIRED))
+            got = _plain(table, pa)
+            if got is None:
+                raise NotStreamable(source)
+            ids, xyz = got
+            line = np.arange(first + 2, first + 2 + len(ids), dtype=np.int64)
+            first += len(ids)
+            if carry is not None:
+                ids, xyz, line = (np.concatenate([c, x]) for c, x in zip(carry, (ids, xyz, line)))
+            # the last plant may go on in the next batch: hold it back
+            tail = len(ids) - int(np.argmax(ids[::-1, 0] != ids[-1, 0])) \
+                if np.any(ids[:, 0] != ids[-1, 0]) else 0
+            carry = (ids[tail:], xyz[tail:], line[tail:])
+            if tail:
+                yield emit(ids[:tail], xyz[:tail], line[:tail])
+    except (pa.ArrowException, OSError) as exc:
+        raise PointsFileError(f"{source}: not a readable Parquet file ({exc})") from None
+    if carry is not None and len(carry[0]):
+        yield emit(*carry)

@@ -237,11 +237,9 @@ class LineParser:
         self.header: list[str] | None = None
         self.header_line = 0
         self.delimiter = ","
-        self.ids = array("q")                     # points read line by line, not yet
-        self.xyz = array("d")                     # moved to ``blocks``
+        self.ids = array("q")
+        self.xyz = array("d")
         self.lines = array("q")
-        self.blocks: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []   # in file order
-        self.in_blocks = 0                        # points held in ``blocks``
         self.extra: dict[str, list] = {}
         self.problems: list[str] = []
         self.dropped = 0                          # problem lines not kept in ``problems``
@@ -510,22 +508,22 @@ class LineParser:
         if not n or lengths.max() > MAX_LINE_BYTES + 1 or lineno + n > self.max_lines:
             return 0                                   # the line-by-line checks say why
         values = _numbers(block, self.delimiter, len(REQUIRED), self.columnar)
-        if values is None:
+        if values is None or len(values[0]) != n or \
+                not all(np.isfinite(c).all() for c in values):
             return 0
-        if values.shape != (n, len(REQUIRED)) or not np.isfinite(values).all():
-            return 0
-        ids = values[:, self.index[:4]]
-        xyz = values[:, self.index[4:]]
-        limit = np.array([MAX_ID, MAX_ID, MAX_INDEX, MAX_INDEX], dtype=np.float64)
-        low = np.array([-MAX_ID, -MAX_ID, 0, 0], dtype=np.float64)
-        if not (np.all(ids == np.floor(ids)) and np.all(ids <= limit) and np.all(ids >= low)):
-            return 0
+        limits = ((MAX_ID, -MAX_ID), (MAX_ID, -MAX_ID), (MAX_INDEX, 0), (MAX_INDEX, 0))
+        for k, (high, low) in zip(self.index[:4], limits):
+            c = values[k]
+            if not (np.all(c == np.floor(c)) and c.max() <= high and c.min() >= low):
+                return 0
+        ids = np.column_stack([values[k] for k in self.index[:4]]).astype(np.int64)
+        xyz = np.column_stack([values[k] for k in self.index[4:]])
         if self.points + n > self.max_points:
             return 0
-        self._flush()
-        self.blocks.append((ids.astype(np.int64), np.ascontiguousarray(xyz),
-                            np.arange(lineno + 1, lineno + n + 1, dtype=np.int64)))
-        self.in_blocks += n
+        # appended in place (an array grows by a share of its size: no copy of the whole)
+        self.ids.frombytes(_bytes_of(np.ascontiguousarray(ids, dtype=np.int64)))
+        self.xyz.frombytes(_bytes_of(np.ascontiguousarray(xyz)))
+        self.lines.frombytes(_bytes_of(np.arange(lineno + 1, lineno + n + 1, dtype=np.int64)))
         self.data_lines += n
         if not block.endswith(b"\n"):
             self.torn = (lineno + n, "")
@@ -534,16 +532,7 @@ class LineParser:
     @property
     def points(self) -> int:
         """Points kept so far."""
-        return self.in_blocks + len(self.lines)
-
-    def _flush(self) -> None:
-        """Move the points read line by line to ``blocks``."""
-        if len(self.lines):
-            self.blocks.append((np.frombuffer(self.ids, np.int64).reshape(-1, 4).copy(),
-                                np.frombuffer(self.xyz, np.float64).reshape(-1, 3).copy(),
-                                np.frombuffer(self.lines, np.int64).copy()))
-            self.in_blocks += len(self.lines)
-            self.ids, self.xyz, self.lines = array("q"), array("d"), array("q")
+        return len(self.lines)
 
     # ------------------------------------------------------------------ result
     def finish(self) -> PointsTable:
@@ -557,15 +546,12 @@ class LineParser:
             raise PointsFileError(f"{self.source}: the file is empty")
         if self.dropped:
             self.problems.append(f"... and {self.dropped:,} more lines skipped")
-        self._flush()
-        if len(self.blocks) == 1:
-            ids, xyz, lines = self.blocks[0]
-        elif self.blocks:
-            ids, xyz, lines = (np.concatenate([b[k] for b in self.blocks]) for k in range(3))
-        else:
-            ids, xyz, lines = (np.empty((0, 4), np.int64), np.empty((0, 3), np.float64),
-                               np.empty(0, np.int64))
-        self.blocks = []
+        n = len(self.lines)
+        ids = np.frombuffer(self.ids, dtype=np.int64).reshape(-1, 4) if n else \
+            np.empty((0, 4), np.int64)
+        xyz = np.frombuffer(self.xyz, dtype=np.float64).reshape(-1, 3) if n else \
+            np.empty((0, 3), np.float64)
+        lines = np.frombuffer(self.lines, dtype=np.int64) if n else np.empty(0, np.int64)
         extra = self.extra
         if self.undone:
             keep = _undo_mask(ids, self.undone)
@@ -583,11 +569,17 @@ class LineParser:
                            bad_leaves=self.bad_leaves, source=self.source)
 
 
+def _bytes_of(a: np.ndarray) -> memoryview:
+    """The bytes of a C-contiguous array, without a copy."""
+    return a.data.cast("B")
+
+
 def _numbers(block: bytes, delimiter: str, columns: int, columnar: bool
-             ) -> np.ndarray | None:
-    """The numbers of a block of plain numeric lines, (lines, columns) float64, or None where
-    the block does not parse as such (a line with another number of fields, a field that is
-    not a number); blank lines are left out (the caller counts lines and finds them missing).
+             ) -> list[np.ndarray] | None:
+    """The numbers of a block of plain numeric lines, one (lines,) float64 array per column, or
+    None where the block does not parse as such (a line with another number of fields, a
+    field that is not a number); blank lines are left out (the caller counts lines and finds
+    them missing).
 
     ``columnar``: through pyarrow's CSV reader (C++, on its own threads), which reads a number
     as Python's ``float`` does (both round correctly; both refuse ``1e``, ``.``, ``1.2.3``) and
@@ -603,25 +595,25 @@ def _numbers(block: bytes, delimiter: str, columns: int, columnar: bool
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("error")
-                return np.loadtxt(io.BytesIO(block), delimiter=delimiter, comments=None,
-                                  dtype=np.float64, ndmin=2, encoding="latin-1")
+                values = np.loadtxt(io.BytesIO(block), delimiter=delimiter, comments=None,
+                                    dtype=np.float64, ndmin=2, encoding="latin-1")
         except (ValueError, Warning):
             return None
+        if values.shape[1] != columns:
+            return None
+        return [values[:, k] for k in range(columns)]
     names = [str(i) for i in range(columns)]
     try:
         table = pacsv.read_csv(
             pa.py_buffer(block),
-            read_options=pacsv.ReadOptions(column_names=names, block_size=max(len(block), 1)),
+            read_options=pacsv.ReadOptions(column_names=names, block_size=1 << 18),
             parse_options=pacsv.ParseOptions(delimiter=delimiter, quote_char=False,
                                              double_quote=False),
             convert_options=pacsv.ConvertOptions(
                 column_types=dict.fromkeys(names, pa.float64()), quoted_strings_can_be_null=False))
     except (pa.ArrowInvalid, pa.ArrowTypeError, ValueError):
         return None
-    out = np.empty((table.num_rows, columns))
-    for k in range(columns):
-        out[:, k] = table.column(k).to_numpy(zero_copy_only=False)
-    return out
+    return [table.column(k).to_numpy(zero_copy_only=False) for k in range(columns)]
 
 
 def shown(text: str, limit: int = 30) -> str:

@@ -223,13 +223,7 @@ def mesh_leaf(leaf: Leaf, level: Level, preserve_area: bool = True) -> LeafMesh:
 def _stack(surfaces: list[NurbsSurfaces]) -> NurbsSurfaces:
     from maizeviz.leaf.nurbs import NurbsSurfaces
 
-    if len(surfaces) == 1:
-        return surfaces[0]
-    s0 = surfaces[0]
-    return NurbsSurfaces(s0.degree_u, s0.degree_v,
-                         *(np.concatenate([getattr(s, f) for s in surfaces])
-                           for f in ("knots_u", "knots_v", "control", "weights",
-                                     "params_u", "params_v")))
+    return NurbsSurfaces.join(surfaces)
 
 
 @dataclass(frozen=True)

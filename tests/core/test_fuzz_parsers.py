@@ -164,8 +164,8 @@ def test_block_numbers_are_pythons_floats(fields):
         got = _numbers(block, ",", 2, columnar)
         if got is None:
             continue
-        assert got.shape == (len(fields), 2)
-        for value, text in zip(got[:, 1], fields):
+        assert len(got) == 2 and len(got[1]) == len(fields)
+        for value, text in zip(got[1], fields):
             try:
                 expected = float(text)
             except ValueError:
@@ -186,7 +186,7 @@ def test_block_numbers_round_as_python(values, fmt):
     for columnar in (True, False):
         got = _numbers(block, ",", 2, columnar)
         assert got is not None
-        assert [float(t) for t in texts] == got[:, 1].tolist()
+        assert [float(t) for t in texts] == got[1].tolist()
 
 
 def _readers_agree(text):

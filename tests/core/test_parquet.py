@@ -54,14 +54,24 @@ def test_exact_rounding_is_the_csv_writers(values, decimals):
     assert [np.signbit(v) for v in got] == [np.signbit(v) for v in expected]
 
 
-def test_parquet_is_taken_by_its_content_and_ids_stored_narrow(tmp_path):
+def test_parquet_is_taken_by_its_content_and_ids_stored_narrow(tmp_path, monkeypatch):
+    import maizeviz.io.parquet as parquet
+
     grids = block_grids(2, 2)
+    monkeypatch.setattr(parquet, "ROW_GROUP_POINTS", 500)     # row groups of whole plants
     write_points(tmp_path / "p.parquet", grids)
+    meta = pq.ParquetFile(tmp_path / "p.parquet").metadata
+    assert meta.num_row_groups == 4
+    firsts = pq.read_table(tmp_path / "p.parquet")["plant"].to_numpy()
+    sizes = [meta.row_group(k).num_rows for k in range(4)]
+    assert [len(set(firsts[a:a + n])) for a, n in zip(np.cumsum([0] + sizes), sizes)] == \
+        [1, 1, 1, 1]
     named_csv = tmp_path / "really-parquet.csv"
     named_csv.write_bytes((tmp_path / "p.parquet").read_bytes())
     same_table(read_points(named_csv), read_points(tmp_path / "p.parquet"))
     schema = pq.read_schema(tmp_path / "p.parquet")
-    assert str(schema.field("plant").type) == "int8" and str(schema.field("x").type) == "double"
+    assert [str(schema.field(c).type) for c in ("plant", "leaf", "row", "col", "x")] == \
+        ["int32", "int32", "int16", "int16", "double"]
     assert (tmp_path / "p.parquet").stat().st_size < 0.6 * _csv_size(tmp_path, grids)
 
 

@@ -1,0 +1,164 @@
+"""A field of distinct plants read plant chunk by plant chunk: points too many to hold as
+fitted leaves at once (a hectare: 70,000 plants, 1.1 million leaves, 72 million points, where
+the fitted leaves alone would take about 5 GB).
+
+A Parquet points file with more than :data:`FIELD_POINTS` records whose plants' records lie
+together (as every writer of maizeviz writes them) is read twice, :data:`CHUNK_POINTS` at a
+time, whole plants per chunk (:func:`maizeviz.io.parquet.point_chunks`):
+
+1. the survey (:class:`FieldLeaves`): each chunk's leaf grids are built and only what the
+   commands need before any long work is kept: each leaf's plant and grid shape (the cost
+   estimates), each plant's stalk base (the layout), the leaves refused and the repairs made;
+2. the build (:meth:`FieldLeaves.canopy`): each chunk's grids are built again, fitted and
+   meshed at the level (:func:`~maizeviz.canopy.scene.plant_meshes`), the chunk's leaves let
+   go; the plants' meshes are then placed (:func:`~maizeviz.canopy.scene.place_plants`).
+
+Leaves are gridded, fitted and meshed alone or in batches alike (every stage works leaf by
+leaf, whatever the batch), so the canopy is the one the whole file read at once gives, to the
+bit (``tests/core/test_field.py``); memory follows one chunk plus the meshes.
+"""
+
+from __future__ import annotations
+
+import os
+from collections import defaultdict
+from pathlib import Path
+
+import numpy as np
+
+from maizeviz.canopy.layout import CanopyLayout
+from maizeviz.canopy.scene import Canopy, PlantMesh, place_plants, plant_meshes
+from maizeviz.errors import LeafError
+from maizeviz.io.parquet import NotStreamable, is_parquet, parquet_rows, point_chunks
+from maizeviz.leaf.fit import fit_leaves
+from maizeviz.leaf.grid import build_grids, stalk_base
+from maizeviz.mesh.levels import Level
+from maizeviz.progress import ProgressCallback, report
+
+#: Parquet points files with more records than this are read plant chunk by plant chunk.
+FIELD_POINTS = int(os.environ.get("MAIZEVIZ_FIELD_POINTS", 4_000_000))
+#: Points read, gridded, fitted and meshed at a time.
+CHUNK_POINTS = 1 << 20
+
+
+def field_input(path: str | Path) -> bool:
+    """Whether ``path`` is read as a field (:class:`FieldLeaves`): a Parquet points file of
+    more than :data:`FIELD_POINTS` records."""
+    if not is_parquet(path):
+        return False
+    rows = parquet_rows(path)
+    return rows is not None and rows > FIELD_POINTS
+
+
+class LeafShapes:
+    """Plant and grid shape of every leaf of a field, as arrays (L,): ``plant`` int64,
+    ``rows`` and ``cols`` int32, ``tip`` bool (a collapsed tip row)."""
+
+    def __init__(self, plant: np.ndarray, rows: np.ndarray, cols: np.ndarray, tip: np.ndarray):
+        self.plant, self.rows, self.cols, self.tip = plant, rows, cols, tip
+
+    def __len__(self) -> int:
+        return len(self.plant)
+
+
+class FieldLeaves:
+    """The leaves of a field points file, surveyed chunk by chunk (see the module docstring).
+
+    Stands in for the list of fitted leaves where the commands take one: its length is the
+    number of leaves, :attr:`shapes` gives the cost estimates their grid shapes, :attr:`bases`
+    the layout its plants' stalk bases; :meth:`canopy` builds a canopy at a level.
+
+    Attributes
+    ----------
+    path : the points file
+    shapes : LeafShapes of the leaves kept
+    bases : {plant: (x, y) cm}, stalk bases (median of the leaves' insertions)
+    skipped : LeafError of each leaf refused
+    notes : repairs made, in words ("plant 3, leaf 2: ...")
+    rows : records in the file
+    """
+
+    def __init__(self, path: str | Path, strict: bool = False, degree: int = 3,
+                 method: str = "chord", progress: ProgressCallback | None = None):
+        self.path = Path(path)
+        self.strict, self.degree, self.method = strict, degree, method
+        self.rows = parquet_rows(path) or 0
+        plant, nrows, ncols, tip = [], [], [], []
+        collars: dict[int, list] = defaultdict(list)
+        self.skipped: list[LeafError] = []
+        self.notes: list[str] = []
+        done = 0
+        for table in point_chunks(path, CHUNK_POINTS):
+            grids, errors = build_grids(table, strict=strict)
+            self.skipped += errors
+            for g in grids:
+                plant.append(g.plant)
+                nrows.append(g.points.shape[0])
+                ncols.append(g.points.shape[1])
+                tip.append(g.tip_collapsed)
+                collars[g.plant].append(g)
+                self.notes += [f"plant {g.plant}, leaf {g.leaf}: {n}" for n in g.notes]
+            done += len(table)
+            report(progress, done, max(self.rows, done), "reading the field")
+        self.shapes = LeafShapes(np.array(plant, np.int64), np.array(nrows, np.int32),
+                                 np.array(ncols, np.int32), np.array(tip, bool))
+        self.bases = {p: stalk_base(gs) for p, gs in collars.items()}
+
+    def __len__(self) -> int:
+        return len(self.shapes)
+
+    @property
+    def plants(self) -> set[int]:
+        return set(self.bases)
+
+    def plant_meshes(self, level: Level, preserve_area: bool = True, only: set[int] | None = None,
+                     progress: ProgressCallback | None = None) -> dict[int, PlantMesh]:
+        """The meshes of the field's plants (those in ``only``, default all) at ``level``,
+        relative to their stalk bases, chunk by chunk; ``progress`` counts records read."""
+        out: dict[int, PlantMesh] = {}
+        done = 0
+        for table in point_chunks(self.path, CHUNK_POINTS):
+            done += len(table)
+            if only is not None:
+                keep = np.isin(table.ids[:, 0], list(only))
+                if not keep.any():
+                    continue
+                table = type(table)(ids=table.ids[keep], xyz=table.xyz[keep],
+                                    line=table.line[keep], source=table.source)
+            grids, _ = build_grids(table, strict=self.strict)       # said by the survey
+            leaves, errors = fit_leaves(grids, self.degree, self.method, strict=self.strict)
+            self.skipped += errors
+            out.update(plant_meshes(leaves, level, preserve_area))
+            report(progress, done, max(self.rows, done), f"building the field at {level}")
+        return out
+
+    def canopy(self, layout: CanopyLayout, level: Level, preserve_area: bool = True,
+               progress: ProgressCallback | None = None) -> Canopy:
+        """The canopy of the plants ``layout`` places, meshed at ``level``: the canopy
+        :func:`~maizeviz.canopy.scene.build_canopy` makes of the same leaves."""
+        placed = {p.plant for p in layout.placements}
+        meshes = self.plant_meshes(level, preserve_area, placed, progress)
+        return place_plants(meshes, layout, level.label)
+
+
+def canopy_of(leaves, layout: CanopyLayout, level: Level, preserve_area: bool = True,
+              progress: ProgressCallback | None = None) -> Canopy:
+    """:func:`~maizeviz.canopy.scene.build_canopy` of a list of fitted leaves, or
+    :meth:`FieldLeaves.canopy` of a field: what the commands build a canopy with."""
+    if isinstance(leaves, FieldLeaves):
+        return leaves.canopy(layout, level, preserve_area, progress)
+    from maizeviz.canopy.scene import build_canopy
+
+    return build_canopy(leaves, layout, level, preserve_area, progress)
+
+
+def read_field(path: str | Path, strict: bool = False,
+               progress: ProgressCallback | None = None) -> FieldLeaves | None:
+    """The survey of a field points file (:func:`field_input`), or None where the file
+    cannot be read chunk by chunk (records the CSV reader must check, a plant's records not
+    together): the caller then reads it whole."""
+    try:
+        return FieldLeaves(path, strict, progress=progress)
+    except NotStreamable:
+        return None
+
