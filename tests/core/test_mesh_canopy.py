@@ -577,7 +577,7 @@ def test_light_of_the_exported_canopy_is_the_same(tmp_path, capsys, periodic):
     # in a periodic field the digitized canopy's field repeats its 3 x 3 block, which a mesh
     # does not say: the planes' sensors are then answered by the ground rays moved by whole
     # blocks instead of the mesh's own queries along the same paths, and a ray of 16,200 in a
-    # direction may fall the other side of a leaf's edge (maizeviz.light.transmission)
+    # direction may fall the other side of a leaf's edge (maizeviz.light.trace.direct)
     tol = 2 / orig["rays"] if periodic else 0.0
     assert back["transmission"] == pytest.approx(orig["transmission"], abs=tol, rel=0)
     assert back["diffuse"]["transmission"] == pytest.approx(orig["diffuse"]["transmission"],
@@ -600,7 +600,7 @@ def test_light_of_the_exported_canopy_is_the_same(tmp_path, capsys, periodic):
         # rectangle; the mesh's plants are all different, so add its copies up
         found = read_leaves(B)
         layout = layout_for(found.leaves, (3, 3))
-        from maizeviz.light.leaf_light import tile_representatives
+        from maizeviz.light.results.per_leaf import tile_representatives
 
         rep = tile_representatives(layout, tuple(orig["rect_cm"]), True)
         sums: dict = {}
