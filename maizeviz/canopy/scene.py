@@ -22,6 +22,7 @@ import numpy as np
 from maizeviz.canopy.layout import CanopyLayout, plant_bases
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import Leaf
+from maizeviz.memory import release
 from maizeviz.mesh.levels import Level, mesh_leaves
 from maizeviz.mesh.tessellate import LeafMesh
 from maizeviz.progress import ProgressCallback, report, scaled
@@ -269,8 +270,10 @@ def place_plants(plants: dict[int, PlantMesh], layout: CanopyLayout, label: str,
             del plants[pl.plant]                    # its last placement: let its mesh go
         if i % 9 == 8 or i == n_place - 1:
             report(progress, i + 1, n_place, "canopy build")
-    return Canopy(vertices, faces, inst, plant_ids, leaf_ids, layout, label,
-                  stalk_vertices, stalk_faces, nleaves)
+    canopy = Canopy(vertices, faces, inst, plant_ids, leaf_ids, layout, label,
+                    stalk_vertices, stalk_faces, nleaves)
+    release()                           # the plants' meshes, freed, back to the system
+    return canopy
 
 
 def build_canopy(leaves: list[Leaf], layout: CanopyLayout, level: Level,
