@@ -200,10 +200,13 @@ def fill(scene, vertices, faces, snap_q: float | None = None, share: bool = Fals
         for part in vparts:
             for s in range(0, len(part), FILL_CHUNK):
                 chunk = part[s:s + FILL_CHUNK]
-                if snap_q is not None:
-                    chunk = np.array(chunk, dtype=np.float64)
-                    chunk[:, :2] = np.round(chunk[:, :2] / snap_q) * snap_q
-                vview[at:at + len(chunk), :3] = chunk
+                if snap_q is None:
+                    vview[at:at + len(chunk), :3] = chunk
+                else:           # q a power of two: x * (1 / q) is x / q, to the bit
+                    xy = np.multiply(chunk[:, :2], 1.0 / snap_q)
+                    np.round(xy, out=xy)
+                    vview[at:at + len(chunk), :2] = np.multiply(xy, snap_q, out=xy)
+                    vview[at:at + len(chunk), 2] = chunk[:, 2]
                 at += len(chunk)
         if not shared:
             iview = np.ctypeslib.as_array((ctypes.c_uint32 * (nt * 3)).from_address(ibuf))

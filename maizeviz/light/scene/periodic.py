@@ -116,13 +116,16 @@ def overhang_copies(verts: np.ndarray, faces: np.ndarray, wrap: Wrap, q: float |
     slack = m + (q or 0.0)                 # rounding moves a coordinate by q / 2 at most
     near = ((verts[:, 0] < x0 + slack) | (verts[:, 0] > x0 + w - slack) |
             (verts[:, 1] < y0 + slack) | (verts[:, 1] > y0 + h - slack))
-    cand_parts = [s + np.flatnonzero(near[faces[s:s + (1 << 20)]].any(axis=1))
-                  for s in range(0, len(faces), 1 << 20)]
+    cand_parts = []
+    for s in range(0, len(faces), 1 << 20):
+        corner = near.take(faces[s:s + (1 << 20)])          # (k, 3): far faster than
+        cand_parts.append(s + np.flatnonzero(corner[:, 0] | corner[:, 1] | corner[:, 2]))
     cand = np.concatenate(cand_parts) if cand_parts else np.empty(0, np.int64)
-    tri = verts[faces[cand]]
+    tri = verts[faces[cand]]                                # any() over an axis of three
     if q is not None:
         tri = snap(tri, q)
-    lo, hi = tri.min(axis=1), tri.max(axis=1)
+    lo = np.minimum(np.minimum(tri[:, 0], tri[:, 1]), tri[:, 2])   # so are these than
+    hi = np.maximum(np.maximum(tri[:, 0], tri[:, 1]), tri[:, 2])   # min / max over it
     out_v, out_src, out_cell = [], [], []
     for i in (-1, 0, 1):
         for j in (-1, 0, 1):
