@@ -27,9 +27,12 @@ from maizeviz.leaf.fit import Leaf
 from maizeviz.light.scene.rays import Rect, ray_count
 from maizeviz.mesh.levels import Level
 
-#: Peak bytes per canopy triangle: the canopy arrays, its Embree scene, the ground-cover scene
-#: and the transients of building them (measured: 345 B at K = 4 on the bundled example).
-BYTES_PER_TRIANGLE = 400
+#: Peak bytes per canopy triangle: the canopy arrays (28 at K = 4), its Embree scene (a float32
+#: copy of the vertices, the indices, a compact BVH: about 54), per-triangle results and the
+#: transients of building them. Measured (benchmarks/bench_field.py): 128 B at K = 4 on 900
+#: plants (30.5 million triangles, periodic), the process's own 0.3 GB included; 345 B before
+#: issue 30.
+BYTES_PER_TRIANGLE = 160
 #: Peak bytes per leaf triangle meshed and measured by ``maizeviz leaf`` (measured on the
 #: bundled example: 272 B from K = 4 to K = 16, 3.2 million more triangles).
 BYTES_PER_LEAF_TRIANGLE = 300

@@ -31,7 +31,7 @@ from maizeviz.canopy.scene import Canopy, PlantMesh, place_plants, plant_meshes
 from maizeviz.errors import LeafError
 from maizeviz.io.parquet import NotStreamable, is_parquet, parquet_rows, point_chunks
 from maizeviz.leaf.fit import fit_leaves
-from maizeviz.leaf.grid import build_grids, stalk_base
+from maizeviz.leaf.grid import base_of_collars, build_grids
 from maizeviz.mesh.levels import Level
 from maizeviz.progress import ProgressCallback, report
 
@@ -76,33 +76,60 @@ class FieldLeaves:
     skipped : LeafError of each leaf refused
     notes : repairs made, in words ("plant 3, leaf 2: ...")
     rows : records in the file
+    extents : {plant: (x0, y0, x1, y1) cm}, the bounding box of its points from above
+    highest : cm, the highest point
     """
 
     def __init__(self, path: str | Path, strict: bool = False, degree: int = 3,
-                 method: str = "chord", progress: ProgressCallback | None = None):
+                 method: str = "chord", progress: ProgressCallback | None = None,
+                 survey: bool = True):
         self.path = Path(path)
         self.strict, self.degree, self.method = strict, degree, method
         self.rows = parquet_rows(path) or 0
-        plant, nrows, ncols, tip = [], [], [], []
-        collars: dict[int, list] = defaultdict(list)
+        plant: list[int] = []
+        nrows: list[int] = []
+        ncols: list[int] = []
+        tip: list[bool] = []
+        collars: dict[int, list] = defaultdict(list)      # (x, y) of each leaf's collar
         self.skipped: list[LeafError] = []
         self.notes: list[str] = []
+        lo: dict[int, np.ndarray] = {}
+        hi: dict[int, np.ndarray] = {}
+        self.highest = -np.inf
         done = 0
-        for table in point_chunks(path, CHUNK_POINTS):
+        for table in point_chunks(path, CHUNK_POINTS) if survey else ():
             grids, errors = build_grids(table, strict=strict)
             self.skipped += errors
+            plant += [g.plant for g in grids]
+            nrows += [g.points.shape[0] for g in grids]
+            ncols += [g.points.shape[1] for g in grids]
+            tip += [g.tip_collapsed for g in grids]
             for g in grids:
-                plant.append(g.plant)
-                nrows.append(g.points.shape[0])
-                ncols.append(g.points.shape[1])
-                tip.append(g.tip_collapsed)
-                collars[g.plant].append(g)
-                self.notes += [f"plant {g.plant}, leaf {g.leaf}: {n}" for n in g.notes]
+                collars[g.plant].append(g.collar[:2].copy())
+            self.notes += [f"plant {g.plant}, leaf {g.leaf}: {n}" for g in grids if g.notes
+                           for n in g.notes]
+            # each plant's points seen from above (its records lie together in the chunk)
+            ids, xyz = table.ids[:, 0], table.xyz
+            starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
+            for p, a, b in zip(ids[starts].tolist(), np.minimum.reduceat(xyz, starts),
+                               np.maximum.reduceat(xyz, starts)):
+                lo[p] = np.minimum(lo[p], a) if p in lo else a
+                hi[p] = np.maximum(hi[p], b) if p in hi else b
+            if len(xyz):
+                self.highest = max(self.highest, float(xyz[:, 2].max()))
             done += len(table)
             report(progress, done, max(self.rows, done), "reading the field")
         self.shapes = LeafShapes(np.array(plant, np.int64), np.array(nrows, np.int32),
                                  np.array(ncols, np.int32), np.array(tip, bool))
-        self.bases = {p: stalk_base(gs) for p, gs in collars.items()}
+        self.bases = {p: base_of_collars(np.array(c)) for p, c in collars.items()}
+        self.extents = {p: (float(lo[p][0]), float(lo[p][1]), float(hi[p][0]), float(hi[p][1]))
+                        for p in self.bases}
+
+    def spread(self, plant: int) -> float:
+        """How far (cm) the plant's points lie from its stalk base, seen from above (at most)."""
+        x0, y0, x1, y1 = self.extents[plant]
+        bx, by = self.bases[plant]
+        return float(max(np.hypot(x - bx, y - by) for x in (x0, x1) for y in (y0, y1)))
 
     def __len__(self) -> int:
         return len(self.shapes)

@@ -89,3 +89,43 @@ def test_windows_cover_the_lattice_once():
         for w in windows(shape, parts):
             cells[w.i0:w.i1, w.j0:w.j1] += 1
         assert (cells == 1).all()
+
+
+def test_on_dask_workers_each_building_its_plants_from_the_file(tmp_path, capsys):
+    """The sub-plots traced on a local Dask cluster of 2 workers, each reading and building its
+    own plants from the Parquet points file: the whole field's answer; and the command."""
+    pytest.importorskip("distributed")
+    import json
+
+    from maizeviz.canopy.field import FieldLeaves, canopy_of
+    from maizeviz.cli import main
+    from maizeviz.io.points import write_points
+    from maizeviz.sweep.run import dask_client
+    from maizeviz.sweep.subplots import trace_field
+
+    path = tmp_path / "field.parquet"
+    write_points(path, block_grids(4, 6, seed=4))
+    field = FieldLeaves(path)
+    layout = layout_for(field, (1, 1))
+    level = parse_level("36")
+    canopy = canopy_of(field, layout, level)
+    sun = Sun(30.0, 160.0)
+    whole = LightEngine(canopy, heights_cm=HEIGHTS, density=0.5).sun(sun, classes=True)
+    expect = whole_counts(canopy, whole.first_hits, whole.second_hits, whole.transmission,
+                          whole.rays)
+    with dask_client(workers=2) as (client, _):
+        got, plan = trace_field(client, field, layout, level, sun.direction(0.0),
+                                layout.centre_bounds, 0.5, HEIGHTS, (2, 2))
+    assert len(plan) == 4 and all(len(p.placements) for p in plan)
+    np.testing.assert_array_equal(got.lit, expect.lit)
+    np.testing.assert_array_equal(got.first.sum(axis=1), expect.first.sum(axis=1))
+    np.testing.assert_array_equal(got.second.sum(axis=1), expect.second.sum(axis=1))
+    capsys.readouterr()
+    table = tmp_path / "plants.csv"
+    assert main(["subplots", str(path), "--parts", "2x1", "--sun-zenith", "30",
+                 "--sun-azimuth", "160", "--density", "0.5", "--workers", "2",
+                 "--plant-light", str(table), "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["transmission"] == whole.transmission.tolist()
+    rows = table.read_text().splitlines()
+    assert len(rows) == 1 + len(layout.placements)
