@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import os
 from collections import defaultdict
+from collections.abc import Iterable
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +40,10 @@ from maizeviz.progress import ProgressCallback, report
 FIELD_POINTS = int(os.environ.get("MAIZEVIZ_FIELD_POINTS", 4_000_000))
 #: Points read, gridded, fitted and meshed at a time.
 CHUNK_POINTS = 1 << 20
+#: Processes building a field's chunks side by side, unless a FieldLeaves says (the command
+#: line: one per core; from Python, which starts new processes only from a script guarded by
+#: ``if __name__ == "__main__"``, this process alone).
+WORKERS: int | None = None
 
 
 def field_input(path: str | Path) -> bool:
@@ -82,8 +87,10 @@ class FieldLeaves:
 
     def __init__(self, path: str | Path, strict: bool = False, degree: int = 3,
                  method: str = "chord", progress: ProgressCallback | None = None,
-                 survey: bool = True):
+                 survey: bool = True, workers: int = 1):
         self.path = Path(path)
+        #: processes building chunks side by side (:meth:`plant_meshes`)
+        self.workers = workers
         self.strict, self.degree, self.method = strict, degree, method
         self.rows = parquet_rows(path) or 0
         plant: list[int] = []
@@ -96,8 +103,11 @@ class FieldLeaves:
         lo: dict[int, np.ndarray] = {}
         hi: dict[int, np.ndarray] = {}
         self.highest = -np.inf
+        #: records [start, stop) of each chunk of whole plants, in the file's order
+        self.chunks: list[tuple[int, int]] = []
         done = 0
         for table in point_chunks(path, CHUNK_POINTS) if survey else ():
+            self.chunks.append((int(table.line[0]) - 2, int(table.line[-1]) - 1))
             grids, errors = build_grids(table, strict=strict)
             self.skipped += errors
             plant += [g.plant for g in grids]
@@ -139,24 +149,46 @@ class FieldLeaves:
         return set(self.bases)
 
     def plant_meshes(self, level: Level, preserve_area: bool = True, only: set[int] | None = None,
-                     progress: ProgressCallback | None = None) -> dict[int, PlantMesh]:
+                     progress: ProgressCallback | None = None,
+                     workers: int | None = None) -> dict[int, PlantMesh]:
         """The meshes of the field's plants (those in ``only``, default all) at ``level``,
-        relative to their stalk bases, chunk by chunk; ``progress`` counts records read."""
+        relative to their stalk bases, chunk by chunk; ``progress`` counts chunks.
+
+        ``workers``: processes building chunks side by side (default: :attr:`workers`, else
+        :data:`WORKERS`); each reads its chunk's records from the file. The meshes are the same
+        either way.
+        """
+        chunks = self.chunks                               # none when not surveyed
+        n = workers or WORKERS or self.workers
         out: dict[int, PlantMesh] = {}
-        done = 0
-        for table in point_chunks(self.path, CHUNK_POINTS):
-            done += len(table)
-            if only is not None:
-                keep = np.isin(table.ids[:, 0], list(only))
-                if not keep.any():
-                    continue
-                table = type(table)(ids=table.ids[keep], xyz=table.xyz[keep],
-                                    line=table.line[keep], source=table.source)
-            grids, _ = build_grids(table, strict=self.strict)       # said by the survey
-            leaves, errors = fit_leaves(grids, self.degree, self.method, strict=self.strict)
-            self.skipped += errors
-            out.update(plant_meshes(leaves, level, preserve_area))
-            report(progress, done, max(self.rows, done), f"building the field at {level}")
+        jobs = [(str(self.path), a, b, level, preserve_area, self.strict, self.degree,
+                 self.method, only) for a, b in chunks]
+        if not jobs:                                        # a field known only by its path
+            for table in point_chunks(self.path, CHUNK_POINTS):
+                meshes, errors = _mesh_table(table, level, preserve_area, self.strict,
+                                             self.degree, self.method, only)
+                out.update(meshes)
+                self.skipped += errors
+            return out
+        results: Iterable
+        if n <= 1 or len(jobs) <= 1:
+            results = (_mesh_rows(*job) for job in jobs)
+            pool = None
+        else:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor
+
+            pool = ProcessPoolExecutor(min(n, len(jobs)),
+                                       mp_context=multiprocessing.get_context("forkserver"))
+            results = pool.map(_mesh_rows, *zip(*jobs))
+        try:
+            for k, (meshes, errors) in enumerate(results, start=1):
+                out.update(meshes)
+                self.skipped += [LeafError(*e) for e in errors]
+                report(progress, k, len(jobs), f"building the field at {level}")
+        finally:
+            if pool is not None:
+                pool.shutdown(cancel_futures=True)
         return out
 
     def canopy(self, layout: CanopyLayout, level: Level, preserve_area: bool = True,
@@ -166,6 +198,32 @@ class FieldLeaves:
         placed = {p.plant for p in layout.placements}
         meshes = self.plant_meshes(level, preserve_area, placed, progress)
         return place_plants(meshes, layout, level.label)
+
+
+def _mesh_table(table, level: Level, preserve_area: bool, strict: bool, degree: int,
+                method: str, only: set[int] | None):
+    """The plant meshes of a table of whole plants (those in ``only``), and the leaves that
+    could not be fitted (as LeafErrors)."""
+    if only is not None:
+        keep = np.isin(table.ids[:, 0], list(only))
+        if not keep.any():
+            return {}, []
+        table = type(table)(ids=table.ids[keep], xyz=table.xyz[keep], line=table.line[keep],
+                            source=table.source)
+    grids, _ = build_grids(table, strict=strict)                  # said by the survey
+    leaves, errors = fit_leaves(grids, degree, method, strict=strict)
+    return plant_meshes(leaves, level, preserve_area), errors
+
+
+def _mesh_rows(path: str, start: int, stop: int, level: Level, preserve_area: bool,
+               strict: bool, degree: int, method: str, only: set[int] | None):
+    """:func:`_mesh_table` of the records [start, stop) of a Parquet points file (in a worker
+    process: errors as (plant, leaf, detail), which pickle)."""
+    from maizeviz.io.parquet import read_rows
+
+    meshes, errors = _mesh_table(read_rows(path, start, stop), level, preserve_area, strict,
+                                 degree, method, only)
+    return meshes, [(e.plant, e.leaf, e.detail) for e in errors]
 
 
 def canopy_of(leaves, layout: CanopyLayout, level: Level, preserve_area: bool = True,
@@ -180,12 +238,12 @@ def canopy_of(leaves, layout: CanopyLayout, level: Level, preserve_area: bool = 
 
 
 def read_field(path: str | Path, strict: bool = False,
-               progress: ProgressCallback | None = None) -> FieldLeaves | None:
+               progress: ProgressCallback | None = None, workers: int = 1) -> FieldLeaves | None:
     """The survey of a field points file (:func:`field_input`), or None where the file
     cannot be read chunk by chunk (records the CSV reader must check, a plant's records not
     together): the caller then reads it whole."""
     try:
-        return FieldLeaves(path, strict, progress=progress)
+        return FieldLeaves(path, strict, progress=progress, workers=workers)
     except NotStreamable:
         return None
 

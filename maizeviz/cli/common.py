@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 from collections.abc import Sequence
@@ -191,7 +192,8 @@ def load_leaves(path: str, strict: bool = False, degree: int = 3, method: str = 
         from maizeviz.canopy.field import field_input, read_field
 
         if field_input(path):
-            field = read_field(path, strict, progress or Progress("reading the field"))
+            field = read_field(path, strict, progress or Progress("reading the field"),
+                               workers=os.cpu_count() or 1)
             if field is not None:
                 for note in field.notes:
                     say(f"note: {note}")

@@ -299,6 +299,36 @@ def parquet_rows(path: str | Path) -> int | None:
         return None
 
 
+def read_rows(path: str | Path, start: int, stop: int) -> PointsTable:
+    """The records [start, stop) of a Parquet points file whose records are plain (as
+    :func:`point_chunks` found them), line numbers as :func:`read_points_parquet` gives them.
+
+    Raises
+    ------
+    NotStreamable
+        They are not plain (the file changed since).
+    """
+    source = str(path)
+    pa, pq = _pyarrow(source)
+    pf = pq.ParquetFile(path)
+    names = pf.schema_arrow.names
+    lower = [n.strip().lower() for n in names]
+    wanted = [names[lower.index(c)] for c in REQUIRED]
+    sizes = [pf.metadata.row_group(k).num_rows for k in range(pf.metadata.num_row_groups)]
+    ends = np.cumsum(sizes)
+    first = int(np.searchsorted(ends, start, side="right"))
+    last = int(np.searchsorted(ends, stop - 1, side="right")) if stop > start else first
+    table = pf.read_row_groups(list(range(first, last + 1)), columns=wanted)
+    begin = start - (int(ends[first - 1]) if first else 0)
+    table = table.slice(begin, stop - start).rename_columns(list(REQUIRED))
+    got = _plain(table, pa)
+    if got is None:
+        raise NotStreamable(source)
+    ids, xyz = got
+    return PointsTable(ids=ids, xyz=xyz, line=np.arange(start + 2, stop + 2, dtype=np.int64),
+                       source=source)
+
+
 def point_chunks(path: str | Path, chunk_points: int = ROW_GROUP_POINTS):
     """The points of a Parquet file in tables of whole plants, about ``chunk_points`` points
     each, in the file's order (line numbers as :func:`read_points_parquet` gives them; extra

@@ -44,6 +44,7 @@ def small_chunks(monkeypatch):
     of the file: the reader must hold them back)."""
     monkeypatch.setattr(field, "FIELD_POINTS", 0)
     monkeypatch.setattr(field, "CHUNK_POINTS", 333)
+    monkeypatch.setattr(field, "WORKERS", 1)
 
 
 def same_canopy(a, b):
@@ -72,6 +73,7 @@ def test_a_field_builds_the_canopy_of_its_leaves_read_whole(points, small_chunks
 
 def test_the_light_command_reads_a_field_as_the_whole_file(points, small_chunks, capsys,
                                                            monkeypatch):
+    monkeypatch.setattr(field, "WORKERS", 2)           # chunks built in 2 processes
     argv = ["light", str(points), "--triangles", "36", "--sun-zenith", "35", "--sun-azimuth",
             "120", "--density", "1", "--json"]
     assert main(argv) == EXIT_PARTIAL                       # the spoiled leaf
