@@ -16,7 +16,7 @@ alone (``rtcCommitScene``); the target is the scene stage within 1.3x of it, and
 every stage at most 150 bytes a triangle for K = 4 of 900 plants.
 
     python benchmarks/bench_field.py --points field.parquet [--level K4] [--periodic]
-        [--density 4] [--json]
+        [--density 4] [--row-spacing 60 --plant-spacing 30] [--json]
 """
 
 from __future__ import annotations
@@ -65,7 +65,7 @@ def stage(name, fn):
     return got
 
 leaves, skipped = stage("read", lambda: load_leaves(args["points"]))
-layout = layout_for(leaves, (1, 1))
+layout = layout_for(leaves, (1, 1), args["row_spacing"], args["plant_spacing"])
 canopy = stage("canopy", lambda: canopy_of(leaves, layout, parse_level(args["level"])))
 del leaves
 F = canopy.n_triangles
@@ -109,10 +109,12 @@ print(json.dumps(out))
 """
 
 
-def run(points: str, level: str, periodic: bool, density: float) -> dict:
+def run(points: str, level: str, periodic: bool, density: float, row_spacing: float = 60.0,
+        plant_spacing: float = 30.0) -> dict:
     """The stages of one field in a fresh process."""
     arg = json.dumps({"points": points, "level": level, "periodic": periodic,
-                      "density": density})
+                      "density": density, "row_spacing": row_spacing,
+                      "plant_spacing": plant_spacing})
     done = subprocess.run([sys.executable, "-c", CHILD, arg], capture_output=True, text=True)
     if done.returncode:
         raise SystemExit(done.stderr[-3000:])
@@ -125,9 +127,12 @@ def main() -> None:
     ap.add_argument("--level", default="K4")
     ap.add_argument("--periodic", action="store_true")
     ap.add_argument("--density", type=float, default=4.0)
+    ap.add_argument("--row-spacing", type=float, default=60.0)
+    ap.add_argument("--plant-spacing", type=float, default=30.0)
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args()
-    out = run(args.points, args.level, args.periodic, args.density)
+    out = run(args.points, args.level, args.periodic, args.density, args.row_spacing,
+              args.plant_spacing)
     if args.json:
         print(json.dumps(out, indent=1))
         return

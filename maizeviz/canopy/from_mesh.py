@@ -25,6 +25,7 @@ What is taken from the file, and nothing else changed:
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -32,8 +33,10 @@ import numpy as np
 from maizeviz.canopy.layout import MAX_COORD_CM, CanopyLayout, Placement
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
-from maizeviz.io.mesh_canopy import MAX_LEAF_ID, MeshData, read_mesh
+from maizeviz.ids import groups
+from maizeviz.io.mesh_canopy import MeshData, read_mesh
 from maizeviz.mesh.tessellate import triangle_areas_normals
+from maizeviz.numbers import number
 
 #: cm per unit of a mesh file.
 UNITS = {"m": 100.0, "cm": 1.0, "mm": 0.1}
@@ -59,12 +62,12 @@ def check_field(field: tuple[float, float, float, float] | list[float] | str
     if isinstance(field, str):
         words = field.replace(",", " ").split()
         try:
-            vals = tuple(float(w) for w in words)
+            vals = tuple(number(w) for w in words)
         except ValueError:
             raise MaizevizError(f"the field needs 4 numbers x0, y0, x1, y1 (cm), got "
                                 f"'{field[:60]}'", quantity="field") from None
     else:
-        vals = tuple(float(v) for v in field)
+        vals = tuple(number(v) if isinstance(v, (str, bytes)) else float(v) for v in field)
     if len(vals) != 4:
         raise MaizevizError(f"the field needs 4 numbers x0, y0, x1, y1 (cm), got {len(vals)}",
                             quantity="field")
@@ -130,6 +133,41 @@ def _distinct(a: np.ndarray) -> np.ndarray:
     return np.unique(a[starts])
 
 
+def repeated_triangles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(T,) bool: the triangles whose three corners (by position, in any order and either
+    orientation) are those of an earlier triangle.
+
+    vertices : (V, 3) float64; faces : (T, 3) int64. A surface written twice (a file
+    concatenated with itself, a double-sided export) would otherwise count its area, and
+    intercept its light, twice.
+    """
+    out = np.zeros(len(faces), dtype=bool)
+    if len(faces) < 2:
+        return out
+    _, same = np.unique(vertices, axis=0, return_inverse=True)
+    corners = np.sort(same.reshape(-1)[faces], axis=1)
+    order = np.lexsort(corners.T[::-1])                # stable: the first of equals first
+    ranked = corners[order]
+    out[order[1:][np.all(ranked[1:] == ranked[:-1], axis=1)]] = True
+    return out
+
+
+def _without_repeats(mesh: MeshData, source: str) -> tuple[MeshData, list[str]]:
+    """The mesh with each repeated triangle (:func:`repeated_triangles`) left out, and the
+    note saying so."""
+    repeat = repeated_triangles(mesh.vertices, mesh.faces)
+    n = int(repeat.sum())
+    if not n:
+        return mesh, []
+    t = int(np.flatnonzero(repeat)[0])
+    keep = ~repeat
+    note = (f"{source}: {n:,} of the {mesh.n_triangles:,} triangles repeat an earlier triangle "
+            f"(the same three corners; first: {mesh.where_triangle(t)}): each surface is "
+            "counted once")
+    return replace(mesh, faces=mesh.faces[keep], triangle_face=mesh.triangle_face[keep],
+                   plant=mesh.plant[keep], leaf=mesh.leaf[keep]), [note]
+
+
 def _split(vertices: np.ndarray, faces: np.ndarray, is_leaf: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Leaf vertices and faces, stalk vertices and faces, each renumbered, vertices in file
@@ -170,8 +208,8 @@ def _positions(plants: np.ndarray, leaf_v: np.ndarray, leaf_f: np.ndarray, area:
                              plain / np.maximum(count, 1))
     if len(stalk_f):
         # each stalk vertex once per plant that uses it
-        vi = np.unique(stalk_inst.astype(np.int64)[:, None] * len(stalk_v) + stalk_f)
-        owner, vert = vi // len(stalk_v), vi % len(stalk_v)
+        used, _ = groups(np.repeat(stalk_inst, 3), stalk_f.ravel())
+        owner, vert = used[:, 0], used[:, 1]
         has = np.bincount(owner, minlength=n) > 0
         for k in range(2):
             mean = np.bincount(owner, stalk_v[vert, k], n) / np.maximum(
@@ -202,6 +240,8 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
     notes = list(mesh.notes)
     if field is not None:
         field = check_field(field)                                    # type: ignore[assignment]
+    mesh, said = _without_repeats(mesh, source)
+    notes += said
     verts = _field_coordinates(mesh, unit, up, source)
     is_leaf = mesh.leaf != 0
     n_leaf = int(is_leaf.sum())
@@ -222,8 +262,8 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
     inst = np.searchsorted(plants, mesh.plant).astype(np.int32)
     leaf_inst, stalk_inst = inst[is_leaf], inst[~is_leaf]
     leaf_ids = mesh.leaf[is_leaf].astype(np.int32)
-    pairs = _distinct(leaf_inst.astype(np.int64) * (MAX_LEAF_ID + 1) + leaf_ids)
-    leaves_per = np.bincount(pairs // (MAX_LEAF_ID + 1), minlength=len(plants)).astype(np.int32)
+    pairs, _ = groups(leaf_inst, leaf_ids)
+    leaves_per = np.bincount(pairs[:, 0], minlength=len(plants)).astype(np.int32)
     xy = _positions(plants, leaf_v, leaf_f, area, leaf_inst, stalk_v, stalk_f, stalk_inst)
     placements = tuple(Placement(int(p), float(x), float(y)) for p, (x, y) in zip(plants, xy))
     if field is None:

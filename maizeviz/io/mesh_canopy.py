@@ -47,6 +47,7 @@ or :data:`MAX_BINARY_BYTES` (binary PLY).
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
@@ -56,6 +57,7 @@ import numpy as np
 from maizeviz.errors import MaizevizError
 from maizeviz.io.inputs import open_input
 from maizeviz.io.points import MAX_ID
+from maizeviz.numbers import first_unplain, number, whole
 
 #: File name endings read as meshes.
 MESH_SUFFIXES = (".ply", ".obj")
@@ -69,8 +71,8 @@ MAX_HEADER_BYTES = 2**20
 PLANT_PROPERTIES = ("plant", "plant_id", "plantid")
 #: Face property names read as the leaf id, in order of preference (any case).
 LEAF_PROPERTIES = ("leaf", "leaf_id", "leafid", "organ", "organ_id", "label", "object_label")
-#: Largest leaf id (light tables number leaves within a plant below 10,000); 0 is not a leaf.
-MAX_LEAF_ID = 9999
+#: Largest leaf id, as in points files; 0 is not a leaf.
+MAX_LEAF_ID = MAX_ID
 #: Largest plant id (absolute value), as in points files.
 MAX_PLANT_ID = MAX_ID
 #: Most vertices of one polygon face.
@@ -270,7 +272,7 @@ def _ply_header(head: bytes, src: str) -> tuple[str, list[_Element], int]:
                 raise MeshFileError(f"{where}: PLY version {words[2][:20]}, only 1.0 is known")
             fmt = _FORMATS[words[1]]
         elif key == "element":
-            if len(words) != 3 or not words[2].isdigit():
+            if len(words) != 3 or not (words[2].isascii() and words[2].isdigit()):
                 raise MeshFileError(f"{where}: '{text[:60]}': an element needs a name and a "
                                     "count (a whole number >= 0)")
             if any(e.name == words[1] for e in elements):
@@ -492,13 +494,14 @@ def _numbers(tokens: list[bytes], counts: np.ndarray, line_no: np.ndarray, src: 
         raise MeshFileError(f"{src}: line {line}: a value of {longest:,} characters; a number "
                             f"has at most {MAX_VALUE_CHARS}")
     try:
-        return np.array(tokens, dtype=bytes).astype(np.float64) if tokens else np.zeros(0)
+        if first_unplain(tokens) is None:        # numpy reads 1_000 as float does
+            return np.array(tokens, dtype=bytes).astype(np.float64) if tokens else np.zeros(0)
     except (ValueError, OverflowError):
         pass
     ends = np.cumsum(counts)
     for k, tok in enumerate(tokens):
         try:
-            float(tok)
+            number(tok)
         except ValueError:
             line = int(line_no[int(np.searchsorted(ends, k, "right"))])
             shown = tok[:30].decode("ascii", "backslashreplace")
@@ -606,9 +609,18 @@ def _typed(v: np.ndarray, code: str, el: _Element, name: str, line_no: np.ndarra
     if len(bad):
         k = int(bad[0])
         i = int(item[k]) if item is not None else k
+        kind = np.dtype(code).name
+        why = (f"beyond the range of its type {kind} ({info.min:,} to {info.max:,})"
+               if v[k] == np.round(v[k]) else f"not a whole number of type {kind}")
         raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i}: {name} is "
-                            f"{v[k]:g}, not a whole number of type {np.dtype(code).name}")
+                            f"{_number(v[k])}, {why}")
     return v.astype(np.int64)
+
+
+def _number(x: float) -> str:
+    """A value for a message: whole numbers written out (2147483648, not 2.14748e+09)."""
+    x = float(x)
+    return f"{int(x)}" if math.isfinite(x) and x == round(x) and abs(x) < 1e18 else f"{x:g}"
 
 
 def _ply_mesh(elements: list[_Element], values: list[_Values], src: str, kind: str,
@@ -681,15 +693,15 @@ def _ids(v: np.ndarray, name: str, what: str, low: int, high: int, at, src: str)
             bad = np.flatnonzero(~(v == np.round(v)))
         if len(bad):
             i = int(bad[0])
-            raise MeshFileError(f"{src}: {at(i)}: the {what} id ('{name}') is {v[i]:g}, not a "
-                                "whole number")
+            raise MeshFileError(f"{src}: {at(i)}: the {what} id ('{name}') is "
+                                f"{_number(v[i])}, not a whole number")
     with np.errstate(invalid="ignore"):
         bad = np.flatnonzero((v < low) | (v > high))
     if len(bad):
         i = int(bad[0])
         rule = "0 (not a leaf: a stalk) to" if what == "leaf" else f"{low:,} to"
-        raise MeshFileError(f"{src}: {at(i)}: the {what} id ('{name}') is {v[i]:g}; {what} "
-                            f"ids go from {rule} {high:,}")
+        raise MeshFileError(f"{src}: {at(i)}: the {what} id ('{name}') is {_number(v[i])}; "
+                            f"{what} ids go from {rule} {high:,}")
     return v.astype(np.int64)
 
 
@@ -740,7 +752,7 @@ _IGNORED = {"vt", "vn", "vp", "s", "usemtl", "mtllib", "l", "p", "mg", "lod", "s
             "trace_obj", "bevel", "c_interp", "d_interp", "maplib", "usemap"}
 _FREE_FORM = {"cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm", "trim", "hole",
               "scrv", "sp", "end", "con", "ctech", "stech"}
-_F_LINE = re.compile(r"f(?:[ \t]+-?\d+(?:/-?\d*(?:/-?\d+)?)?)+")
+_F_LINE = re.compile(r"f(?:[ \t]+-?\d+(?:/-?\d*(?:/-?\d+)?)?)+", re.ASCII)
 _SEP = r"[\s_./:|\-]*"
 _PLANT_NAME = re.compile(r"^(?:plant|p)[\s_\-]*(\d+)(?:" + _SEP + r"(.*))?$", re.I | re.S)
 _LEAF_NAME = re.compile(r"^(?:leaf|l)[\s_\-]*(\d+)$", re.I)
@@ -796,7 +808,7 @@ def _obj_statements(lines: list[str], src: str) -> tuple[
             try:
                 if len(words) < 4:
                     raise ValueError
-                coords.extend(map(float, words[1:4]))
+                coords.extend(map(number, words[1:4]))
             except ValueError:
                 raise MeshFileError(f"{src}: line {no}: a vertex needs x, y and z numbers, got "
                                     f"'{line.strip()[:60]}'") from None
@@ -807,9 +819,9 @@ def _obj_statements(lines: list[str], src: str) -> tuple[
                 if "/" in line:
                     if not _F_LINE.fullmatch(line.strip()):
                         raise ValueError
-                    idx = [int(w.partition("/")[0]) for w in words[1:]]
+                    idx = [whole(w.partition("/")[0]) for w in words[1:]]
                 else:
-                    idx = list(map(int, words[1:]))
+                    idx = list(map(whole, words[1:]))
                 if 0 in idx:
                     raise ValueError
             except ValueError:
@@ -880,7 +892,7 @@ def _obj_mesh(vertices: np.ndarray, vline_arr: np.ndarray, flat: np.ndarray,
 
 def _is_float(w: str) -> bool:
     try:
-        float(w)
+        number(w)
         return True
     except ValueError:
         return False

@@ -17,7 +17,7 @@ NAME = "subplots"
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
-    from maizeviz.cli.common import add_canopy_options
+    from maizeviz.cli.common import NUMBER_ARG, WHOLE_ARG, add_canopy_options
     from maizeviz.sweep.run import CONNECT_TIMEOUT_S
 
     p = sub.add_parser(
@@ -32,20 +32,20 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="sub-plots across x and along y (default 2x2)")
     p.add_argument("--level", default="36", help="mesh level (default 36 triangles a leaf)")
     p.add_argument("--no-preserve-area", dest="preserve_area", action="store_false")
-    p.add_argument("--sun-zenith", type=float, required=True, metavar="DEG")
-    p.add_argument("--sun-azimuth", type=float, required=True, metavar="DEG")
+    p.add_argument("--sun-zenith", type=NUMBER_ARG, required=True, metavar="DEG")
+    p.add_argument("--sun-azimuth", type=NUMBER_ARG, required=True, metavar="DEG")
     p.add_argument("--heights", default="0,50,100,150,200,225", metavar="CM,...")
-    p.add_argument("--density", type=float, default=1.0,
+    p.add_argument("--density", type=NUMBER_ARG, default=1.0,
                    help="rays per cm2 of the sample rectangle (default 1)")
     p.add_argument("--rect", metavar="X0,Y0,X1,Y1", help="sample rectangle, cm (default: the "
                                                            "field)")
     p.add_argument("--plant-light", metavar="CSV", help="write the light of every plant")
-    p.add_argument("--workers", type=int, metavar="N",
+    p.add_argument("--workers", type=WHOLE_ARG, metavar="N",
                    help="worker processes of a local Dask cluster (default: one per core)")
     p.add_argument("--scheduler", metavar="ADDR",
                    help="a running Dask scheduler, e.g. tcp://10.0.0.5:8786 (its workers need "
                         "maizeviz and the points file at the same path)")
-    p.add_argument("--connect-timeout", type=float, default=CONNECT_TIMEOUT_S, metavar="S")
+    p.add_argument("--connect-timeout", type=NUMBER_ARG, default=CONNECT_TIMEOUT_S, metavar="S")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.set_defaults(run=run)
 
