@@ -123,7 +123,9 @@ def leaf_triangles(rows, cols, tip_collapsed, level: Level):
     k = level.interp if level.interp is not None else 0
     a, b = (rows - 1) * (k + 1), (cols - 1) * (k + 1)
     full = 2 * a * b - b * np.asarray(tip_collapsed, dtype=np.int64)   # the tip's slivers
-    return full if level.triangles is None else np.minimum(level.triangles, full)
+    if level.triangles is None:
+        return full
+    return np.minimum(min(level.triangles, 2**62), full)       # a budget past int64: no limit
 
 
 def canopy_cost(leaves: Iterable[Leaf], placements: Mapping[int, int], level: Level,

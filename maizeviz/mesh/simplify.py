@@ -149,6 +149,7 @@ def select_lines_many(grids: np.ndarray, budget: int, tip_collapsed: np.ndarray
     grids = np.asarray(grids, dtype=np.float64)
     tip = np.asarray(tip_collapsed, dtype=bool).reshape(-1)
     nl, m, n = grids.shape[:3]
+    budget = min(budget, 2**62)          # past any grid's triangles, and within int64
     least = count_triangles(2, 2, tip)
     if np.any(budget < least):
         worst = int(least[np.flatnonzero(budget < least)[0]])
