@@ -15,7 +15,8 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
     in a worker as ``work(job, *args)``: returns ``(work, args)``. ``heatmap``: the light
     whose map is shown, the run shown for each light, the height shown (cm).
 
-    ``what``: canopy (mesh with each triangle's light), table (transmission by height),
+    ``what``: canopy (mesh with each triangle's light: its class and its leaf's sunlit share
+    for a sun, its leaf's light per m2 of leaf for a sky or a day), table (transmission by height),
     measures (Table 2), heatmap, plot; steps, leaves, plants, day (of a sky or a day). Nothing
     to export yet: MaizevizError saying what to do first."""
     if what == "canopy":
@@ -27,6 +28,8 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
         run = model.runs.for_signature(signature)
         if run is not None and run.classes is not None:
             cells["light"] = run.classes.astype("int32")
+        if run is not None and run.painting is not None:   # honest where triangles are small
+            cells["sunlit_share"] = run.painting.share.astype("float32")
         for kind, name in (("sky", "diffuse_per_m2_leaf"), ("day", "par_mol_per_m2_leaf")):
             run = model.runs.for_signature(signature, kind)
             if run is not None and run.extra is not None:
@@ -73,12 +76,15 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
         if height is None:
             height = float(run.result.heights_cm[0])
         result = run.result
+        from maizeviz_app.plots import Look
+
+        look = Look.of(model.colour, shown_runs or {kind: run})    # as shown
 
         def work(job):
             from maizeviz.light.report.heatmap import save_figure
             from maizeviz_app.plots import heatmap_figure_of
 
-            save_figure(heatmap_figure_of(result, height, kind), path)
+            save_figure(heatmap_figure_of(result, height, kind, look=look), path)
             return path
         return work, ()
     if what == "plot":

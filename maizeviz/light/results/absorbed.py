@@ -16,9 +16,24 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.results.per_leaf import LightRow, leaf_sums
+from maizeviz.light.results.traced import TableBy, table_kind
+from maizeviz.light.results.uncertainty import Batches, errors_by
 
-if TYPE_CHECKING:                       # the optics live with the tracing that uses them
-    from maizeviz.light.trace.optics import Optics
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from maizeviz.light.trace.optics import Optics  # with the tracing that uses them
+
+
+#: Share of the incident light left unresolved (still travelling when scattering stopped)
+#: above which a result says so.
+UNRESOLVED_WARN = 0.01
+
+
+def unresolved_warning(share: float, depth: int) -> str:
+    """The warning for a result that left ``share`` of its light unresolved."""
+    return (f"{share:.1%} of the incident light was still travelling after {depth} "
+            "scatterings and is not in the absorbed figures: raise the depth")
 
 
 @dataclass(frozen=True)
@@ -79,6 +94,10 @@ class AbsorbedLight:
     triangle_absorbed_w : (F,) float64 W absorbed by each triangle of the scene (leaves, then
         stalks), from the light falling on the sample rectangle
     triangle_sunlit_cm2 : (F,) float64 cm2 of each triangle in the direct beam (0 for a sky)
+    triangle_direct_w : (F,) float64 the part of ``triangle_absorbed_w`` the sun's direct beam
+        deposited (on the sunlit area), or None (a record older than photosynthesis)
+    batches : Batches, the per-batch shares the standard errors come from, or None
+    sun_direction : (3,) unit vector toward the sun, or None (no direct beam)
     rect : (x0, y0, x1, y1) cm; rays : primary rays per direction; directions : beams traced
     depth, threshold, seed : as traced; events : scatterings followed; periodic : bool
     level : the canopy's mesh level; seconds : "trace" (primary beams), "scatter", "build"
@@ -102,32 +121,62 @@ class AbsorbedLight:
     periodic: bool
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
+    triangle_direct_w: np.ndarray | None = None
+    batches: Batches | None = None
+    sun_direction: tuple[float, float, float] | None = None
     stands: dict | None = None
 
     fraction_absorbed = property(_fraction_absorbed)
 
-    def table(self, by: str = "plant", canopy=None):
-        """Absorbed light per leaf or per plant as a pandas DataFrame.
+    @property
+    def absorbed_leaves_error(self) -> float | None:
+        """Monte Carlo standard error of ``balance.absorbed_leaves`` (W/m2 of ground), from
+        independent batches of rays; None when the result was not traced in batches."""
+        total = float(self.triangle_absorbed_w.sum())
+        if self.batches is None or total <= 0:
+            return None if self.batches is None else 0.0
+        return self.batches.error() * self.balance.absorbed_leaves / total
 
-        Columns: ``absorbed_w`` (W), ``absorbed_w_m2_leaf`` (W per m2 of one-sided leaf area),
-        ``sunlit_area_cm2`` and ``shaded_area_cm2`` (leaf area in and out of the direct beam),
-        and for PAR ``absorbed_umol_s`` (umol/s: 4.57 umol per J of PAR). ``by="balance"``:
-        the energy balance (W/m2 of ground) as one row.
+    @property
+    def balance_errors(self) -> dict[str, float] | None:
+        """Monte Carlo standard errors of the energy balance's parts, in its units:
+        ``absorbed_leaves`` (:attr:`absorbed_leaves_error`), ``absorbed_ground``,
+        ``reflected_top``, ``escaped_sides``, ``unresolved``; None without batches."""
+        if self.batches is None or self.batches.parts is None:
+            return None
+        return {"absorbed_leaves": float(self.absorbed_leaves_error or 0.0),
+                **(self.batches.balance_errors(1.0) or {})}
+
+    def table(self, by: TableBy | None = None, canopy: Canopy | None = None) -> pd.DataFrame:
+        """Absorbed light as a table: the energy balance, or per leaf or per plant.
+
+        Parameters
+        ----------
+        by : {None, "balance", "leaf", "plant"}
+            None (the default) or "balance": the energy balance [W m-2 of ground] as one
+            row. "leaf" or "plant": ``absorbed_w`` [W], ``absorbed_w_m2_leaf`` [W m-2 of
+            one-sided leaf area], ``sunlit_area_cm2`` and ``shaded_area_cm2`` [cm2] (leaf area
+            in and out of the direct beam), and for PAR ``absorbed_umol_s`` [umol s-1]
+            (4.57 umol per J of PAR).
+        canopy : Canopy, optional
+            The canopy the light was traced on; needed by leaf and plant.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row, or one per lit leaf or plant.
+
+        Raises
+        ------
+        MaizevizError
+            Another ``by``, or a leaf or plant table without the canopy.
         """
         import pandas as pd
 
-        if by == "balance":
+        kind = table_kind(by, "balance", canopy)
+        if kind == "balance":
             return pd.DataFrame([{"band": self.band, **self.balance.as_dict()}])
-        if by not in ("leaf", "plant"):
-            from maizeviz.errors import MaizevizError
-
-            raise MaizevizError(f"absorbed light is tabled by 'leaf', 'plant' or 'balance', not "
-                                f"'{by}'", quantity="table")
-        if canopy is None:
-            from maizeviz.errors import MaizevizError
-
-            raise MaizevizError("give the canopy the light was traced on to table it by "
-                                f"{by}", quantity="table")
+        assert canopy is not None
         from maizeviz.light.sources.irradiance import PAR_UMOL_PER_J_PAR
 
         rows = leaf_sums(canopy, {"absorbed_w": self.triangle_absorbed_w,
@@ -137,8 +186,13 @@ class AbsorbedLight:
         if frame.empty:
             return frame
         frame["sunlit_area_cm2"] = np.minimum(frame["sunlit_area_cm2"], frame["leaf_area_cm2"])
-        if by == "plant":
+        if kind == "plant":
             frame = _per_plant(frame, ("absorbed_w", "sunlit_area_cm2"))
+        if self.batches is not None:
+            se = errors_by(canopy, self.batches.absorbed, "absorbed_w", self.rect,
+                           self.periodic, kind)
+            keys = frame["instance"] if kind == "plant" else zip(frame["instance"], frame["leaf"])
+            frame["absorbed_w_se"] = [se.get(k, 0.0) for k in keys]
         frame["shaded_area_cm2"] = frame["leaf_area_cm2"] - frame["sunlit_area_cm2"]
         frame["absorbed_w_m2_leaf"] = frame["absorbed_w"] / (frame["leaf_area_cm2"] * 1e-4)
         if self.band == "par":
@@ -152,8 +206,12 @@ class AbsorbedLight:
         rows = leaf_sums(canopy, {"absorbed_w": self.triangle_absorbed_w,
                                   "absorbed_sunlit_area_cm2": self.triangle_sunlit_cm2},
                          self.rect, self.periodic)
+        se = {} if self.batches is None else errors_by(
+            canopy, self.batches.absorbed, "absorbed_w", self.rect, self.periodic, "leaf")
         for r in rows:
             r["absorbed_w_m2_leaf"] = float(r["absorbed_w"]) / (float(r["leaf_area_cm2"]) * 1e-4)
+            if self.batches is not None:
+                r["absorbed_w_se"] = se.get((r["instance"], r["leaf"]), 0.0)
         return rows
 
 
@@ -173,6 +231,10 @@ class AbsorbedPeriod:
     step_incident_w_m2 : (n,) float64 the band's irradiance on a horizontal plane at each step
     rect, rays, depth, seed, periodic, level : as traced; seconds : "trace", "scatter",
         "build"
+    batches : per-batch shares of ``triangle_absorbed_j`` (``absorbed`` only), for standard
+        errors
+    assimilation : PeriodAssimilation (:mod:`maizeviz.light.results.assimilation`) when a
+        leaf model was given, else None
     stands : identity of the stands traced on, None where not known
     """
 
@@ -190,9 +252,29 @@ class AbsorbedPeriod:
     periodic: bool
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
+    batches: Batches | None = None
+    assimilation: Any = None
     stands: dict | None = None
 
     fraction_absorbed = property(_fraction_absorbed)
+
+    @property
+    def absorbed_leaves_error(self) -> float | None:
+        """Monte Carlo standard error of ``balance.absorbed_leaves`` (MJ/m2 of ground)."""
+        total = float(self.triangle_absorbed_j.sum())
+        if self.batches is None or total <= 0:
+            return None if self.batches is None else 0.0
+        return self.batches.error() * self.balance.absorbed_leaves / total
+
+    @property
+    def balance_errors(self) -> dict[str, float] | None:
+        """Monte Carlo standard errors of the energy balance's parts, in its units:
+        ``absorbed_leaves`` (:attr:`absorbed_leaves_error`), ``absorbed_ground``,
+        ``reflected_top``, ``escaped_sides``, ``unresolved``; None without batches."""
+        if self.batches is None or self.batches.parts is None:
+            return None
+        return {"absorbed_leaves": float(self.absorbed_leaves_error or 0.0),
+                **(self.batches.balance_errors(1.0) or {})}
 
     @property
     def absorbed_leaves_mol_m2(self) -> float | None:
@@ -202,21 +284,35 @@ class AbsorbedPeriod:
         return self.balance.absorbed_leaves * PAR_UMOL_PER_J_PAR if self.band == "par" \
             else None                           # MJ x umol/J = mol
 
-    def table(self, by: str = "plant", canopy=None):
-        """Absorbed light per leaf or per plant over the period as a pandas DataFrame:
-        ``absorbed_mj`` (MJ), ``absorbed_mj_m2_leaf``, and for PAR ``absorbed_mol``;
-        ``by="balance"``: the balance (MJ/m2 of ground) as one row."""
+    def table(self, by: TableBy | None = None, canopy: Canopy | None = None) -> pd.DataFrame:
+        """Absorbed light over the period as a table: the balance, or per leaf or per plant.
+
+        Parameters
+        ----------
+        by : {None, "balance", "leaf", "plant"}
+            None (the default) or "balance": the balance [MJ m-2 of ground] as one row.
+            "leaf" or "plant": ``absorbed_mj`` [MJ], ``absorbed_mj_m2_leaf`` [MJ m-2 of leaf],
+            and for PAR ``absorbed_mol`` [mol].
+        canopy : Canopy, optional
+            The canopy the light was traced on; needed by leaf and plant.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row, or one per lit leaf or plant.
+
+        Raises
+        ------
+        MaizevizError
+            Another ``by``, or a leaf or plant table without the canopy.
+        """
         import pandas as pd
 
-        from maizeviz.errors import MaizevizError
-
-        if by == "balance":
+        kind = table_kind(by, "balance", canopy)
+        if kind == "balance":
             return pd.DataFrame([{"band": self.band, "unit": "MJ/m2",
                                   **self.balance.as_dict()}])
-        if by not in ("leaf", "plant") or canopy is None:
-            raise MaizevizError("absorbed light over a period is tabled by 'leaf' or 'plant' "
-                                "(with the canopy it was traced on) or 'balance'",
-                                quantity="table")
+        assert canopy is not None
         from maizeviz.light.sources.irradiance import PAR_UMOL_PER_J_PAR
 
         rows = leaf_sums(canopy, {"absorbed_mj": self.triangle_absorbed_j * 1e-6}, self.rect,
@@ -224,9 +320,23 @@ class AbsorbedPeriod:
         frame = pd.DataFrame(rows)
         if frame.empty:
             return frame
-        if by == "plant":
+        if kind == "plant":
             frame = _per_plant(frame, ("absorbed_mj",))
+        if self.batches is not None:
+            se = errors_by(canopy, self.batches.absorbed * 1e-6, "absorbed_mj", self.rect,
+                           self.periodic, kind)
+            keys = frame["instance"] if kind == "plant" else zip(frame["instance"], frame["leaf"])
+            frame["absorbed_mj_se"] = [se.get(k, 0.0) for k in keys]
         frame["absorbed_mj_m2_leaf"] = frame["absorbed_mj"] / (frame["leaf_area_cm2"] * 1e-4)
         if self.band == "par":
             frame["absorbed_mol"] = frame["absorbed_mj"] * PAR_UMOL_PER_J_PAR
         return frame
+
+    def leaf_rows(self, canopy: Canopy) -> list[LightRow]:
+        """Per lit leaf: ``absorbed_mj`` [MJ] over the period and ``absorbed_mj_m2_leaf``
+        [MJ m-2 of leaf] (:func:`maizeviz.light.results.per_leaf.leaf_sums`)."""
+        rows = leaf_sums(canopy, {"absorbed_mj": self.triangle_absorbed_j * 1e-6}, self.rect,
+                         self.periodic)
+        for r in rows:
+            r["absorbed_mj_m2_leaf"] = float(r["absorbed_mj"]) / (float(r["leaf_area_cm2"]) * 1e-4)
+        return rows
