@@ -10,7 +10,7 @@ from pathlib import Path
 from PySide6.QtWidgets import QFileDialog, QInputDialog, QMessageBox, QWidget
 
 PROJECT_FILTER = "maizeviz project (*.maizeviz)"
-POINTS_FILTER = "Points CSV (*.csv);;All files (*)"
+POINTS_FILTER = "Points (*.csv *.parquet *.pq);;All files (*)"
 CANOPY_MESH_FILTER = "Canopy mesh with plant and leaf ids (*.ply *.obj);;All files (*)"
 #: Units and up axis a mesh file may be written in (what the open dialog offers).
 MESH_FRAMES = {"cm, z up": ("cm", "z"), "m, z up": ("m", "z"), "mm, z up": ("mm", "z"),

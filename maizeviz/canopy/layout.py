@@ -603,7 +603,15 @@ def layout_for(leaves: list[Leaf], tile: tuple[int, int] = (1, 1), row_spacing: 
                plant_spacing: float = 30.0, block: tuple[int, int] | None = None,
                layout_file: str | Path | None = None) -> CanopyLayout:
     """Where the digitized plants of ``leaves`` stand: a layout file if given, else the
-    digitized block tiled ``tile`` times (the paper's 3 x 3)."""
+    digitized block tiled ``tile`` times (the paper's 3 x 3). ``leaves``: fitted leaves, or a
+    field's (:class:`~maizeviz.canopy.field.FieldLeaves`, which knows its plants' bases)."""
+    field_bases = getattr(leaves, "bases", None)
+    if field_bases is not None:
+        if not field_bases:
+            raise LayoutError("no leaf could be reconstructed; the canopy is empty")
+        if layout_file is not None:
+            return load_layout(layout_file, set(field_bases))
+        return tiled_layout(field_bases, tile, row_spacing, plant_spacing, block)
     plants = {lf.grid.plant for lf in leaves}
     if not plants:
         raise LayoutError("no leaf could be reconstructed; the canopy is empty")

@@ -17,8 +17,9 @@ from typing import Any
 
 import numpy as np
 
+from maizeviz.canopy.field import canopy_of
 from maizeviz.canopy.from_mesh import MESH_LEVEL
-from maizeviz.canopy.scene import Canopy, build_canopy
+from maizeviz.canopy.scene import Canopy
 from maizeviz.cli.common import (
     NUMBER_ARG,
     WHOLE_ARG,
@@ -409,7 +410,7 @@ def run(args: argparse.Namespace) -> int:
         if level is None:
             canopy, canopy_s = mesh_canopy, read_s
         else:
-            canopy = build_canopy(leaves, layout, level, args.preserve_area,
+            canopy = canopy_of(leaves, layout, level, args.preserve_area,
                                   Progress(f"building {level}"))
             canopy_s = time.perf_counter() - t0
         label = canopy.level

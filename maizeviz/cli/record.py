@@ -13,6 +13,7 @@ from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import DEFAULT_COLS, Session
 from maizeviz.errors import MaizevizError, check_range
 from maizeviz.io.outputs import check_run_paths
+from maizeviz.io.points import is_parquet_name
 
 #: The subcommand.
 NAME = "record"
@@ -43,6 +44,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     check_range(args.answer_timeout, "the answer timeout", 0.01, 600, "answer_timeout", unit="s")
     check_range(args.baud, "the baud rate", 300, 4_000_000, "baud", whole=True)
+    if is_parquet_name(args.out):
+        raise MaizevizError(f"{args.out}: a recording is a CSV journal, written point by point; "
+                            "record to a .csv file (maizeviz convert then writes it as Parquet)")
     check_run_paths([], [("the serial port", args.port)], appended=[("the recording", args.out)])
     session = Session(args.out, args.cols, args.resume, args.reference_station)
     for message in session.messages:

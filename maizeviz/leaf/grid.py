@@ -72,7 +72,11 @@ class LeafGrid:
 def stalk_base(grids) -> tuple[float, float]:
     """(x, y) cm of a plant's stalk base: the median of its leaves' collar points seen from
     above (``grids``: the plant's LeafGrids, at least one)."""
-    collars = np.array([g.collar[:2] for g in grids])
+    return base_of_collars(np.array([g.collar[:2] for g in grids]))
+
+
+def base_of_collars(collars: np.ndarray) -> tuple[float, float]:
+    """(x, y) cm: the median of collar points (k, 2) cm seen from above (:func:`stalk_base`)."""
     return float(np.median(collars[:, 0])), float(np.median(collars[:, 1]))
 
 

@@ -11,7 +11,7 @@ a canopy's 1,500 leaves are fitted with a few dozen numpy calls, not 1,500 Pytho
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -235,14 +235,50 @@ class NurbsSurfaces:
     weights: np.ndarray
     params_u: np.ndarray
     params_v: np.ndarray
+    #: (batch, index) of a surface taken from a batch by :meth:`__getitem__`, for :meth:`join`
+    _origin: tuple[NurbsSurfaces, int] | None = field(default=None, compare=False, repr=False)
 
     def __len__(self) -> int:
         return len(self.control)
 
     def __getitem__(self, i) -> NurbsSurfaces:
+        """Surface ``i`` (an int: a batch of one whose arrays are views of this batch's, and
+        which :meth:`join` puts back together without a copy), or the surfaces ``i`` picks (a
+        slice, indices, a mask: copies)."""
+        if isinstance(i, (int, np.integer)):
+            k = range(len(self))[i]
+            one = slice(k, k + 1)
+            origin = (self, k) if self._origin is None else (self._origin[0],
+                                                              self._origin[1] + k)
+            return NurbsSurfaces(self.degree_u, self.degree_v, self.knots_u[one],
+                                 self.knots_v[one], self.control[one], self.weights[one],
+                                 self.params_u[one], self.params_v[one], origin)
         i = np.atleast_1d(np.arange(len(self))[i])
         return NurbsSurfaces(self.degree_u, self.degree_v, self.knots_u[i], self.knots_v[i],
                              self.control[i], self.weights[i], self.params_u[i], self.params_v[i])
+
+    @classmethod
+    def join(cls, surfaces: list[NurbsSurfaces]) -> NurbsSurfaces:
+        """One batch of ``surfaces`` (equal degrees and shapes), in order: the batch they were
+        taken from, sliced, where they are consecutive surfaces of one batch (leaves fitted
+        together and meshed together), else their arrays concatenated."""
+        if len(surfaces) == 1:
+            return surfaces[0]
+        first = surfaces[0]._origin
+        if first is not None and all(
+                s._origin is not None and s._origin[0] is first[0]
+                and s._origin[1] == first[1] + k for k, s in enumerate(surfaces)):
+            batch, start = first
+            part = slice(start, start + len(surfaces))
+            return cls(batch.degree_u, batch.degree_v, batch.knots_u[part], batch.knots_v[part],
+                       batch.control[part], batch.weights[part], batch.params_u[part],
+                       batch.params_v[part])
+        s0 = surfaces[0]
+        knots_u, knots_v, control, weights, params_u, params_v = (
+            np.concatenate([getattr(s, f) for s in surfaces])
+            for f in ("knots_u", "knots_v", "control", "weights", "params_u", "params_v"))
+        return cls(s0.degree_u, s0.degree_v, knots_u, knots_v, control, weights, params_u,
+                   params_v)
 
     def _homogeneous(self) -> np.ndarray:
         w = self.weights[..., None]

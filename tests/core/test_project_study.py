@@ -225,7 +225,7 @@ leaves = read_leaves(opened.points_path).leaves
 layout = study.project_layout(opened, leaves)
 print(len(layout.placements), layout.warnings[-1])
 try:
-    study.check_canopy_fits(leaves, layout, parse_level("36"), opened.path)
+    study.check_canopy_fits(leaves, layout, parse_level("K1"), opened.path)
 except ProjectError as exc:
     print(exc.quantity, exc)
 """

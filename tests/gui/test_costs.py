@@ -18,7 +18,7 @@ def test_a_canopy_too_big_for_memory_is_refused_and_the_slider_goes_back(window,
                                                                          monkeypatch):
     w = shown(qtbot, window(small_points, tile=1))
     level, canopy = w.model.settings.canopy.level, w.model.canopy
-    monkeypatch.setattr(cost, "memory_available", lambda: 2**20)      # a 1 MiB machine
+    monkeypatch.setattr(cost, "memory_available", lambda: 2**18)      # a 256 KiB machine
     w.step_level(-1)                                                   # finer
     qtbot.waitUntil(lambda: "memory" in w.messages.toPlainText(), timeout=5000)
     text = w.messages.toPlainText()
