@@ -59,7 +59,7 @@ def _project_read(study: StudyModel, out) -> None:
                                    "preserve_area": preserve})
     with study.quietly():
         study.settings.apply_light_doc(light)
-    study.colour.update_from_doc(opened.view, opened.path)
+        study.colour.update_from_doc(opened.view, opened.path)
     study.project_layout = opened.project.layout is not None
     study.pending_runs = list(runs)
     study.points_loaded(loaded, opened.project.points_csv, opened.path,

@@ -28,6 +28,10 @@ from maizeviz_app.settings import field_names
 #: Settings groups whose edits are undoable (the digitizer's connection is not an edit of the
 #: study).
 UNDOABLE = ("canopy", "light", "sun", "sampling", "sky", "day", "optics")
+#: The colour settings' groups (:class:`maizeviz_app.colour.ColourSettings`): the 3D view's
+#: scale, the heatmaps' and the rest; undoable too (as ParaView's colour map edits), though
+#: they change no result.
+COLOUR_GROUPS = ("view colours", "heatmap colours", "colours")
 #: Edits of one field closer than this (s) are one step.
 MERGE_S = 1.5
 #: Merge ids of settings edits and of layout edits.
@@ -45,7 +49,10 @@ NAMES = {"level": "mesh level", "preserve_area": "area preservation", "mode": "l
          "enabled": "leaf optics", "band": "band", "reflectance": "leaf reflectance",
          "transmittance": "leaf transmittance", "ground_reflectance": "soil reflectance",
          "direct_w_m2": "direct irradiance", "diffuse_w_m2": "diffuse irradiance",
-         "depth": "scattering depth", "tile": "tiling"}
+         "depth": "scattering depth", "tile": "tiling", "range": "colour range",
+         "vmin": "colour min", "vmax": "colour max", "clip": "colour clip",
+         "cmap": "colour map", "log": "log scale", "shared": "one heatmap scale",
+         "painting": "sun painted"}
 
 
 def _shown(value: Any) -> str:
@@ -72,10 +79,11 @@ class SettingsEdit(QUndoCommand):
     def _name(self) -> None:
         (group, name), (_old, new) = next(reversed(self.changes.items()))
         names = {NAMES.get(f, f) for _g, f in self.changes}
+        where = {"view colours": "3D view ", "heatmap colours": "heatmap "}.get(group, "")
         if len(names) == 1:
-            self.setText(f"{NAMES.get(name, name)} {_shown(new)}")
+            self.setText(f"{where}{NAMES.get(name, name)} {_shown(new)}")
         else:
-            self.setText(f"{NAMES.get(name, name)} {_shown(new)} and "
+            self.setText(f"{where}{NAMES.get(name, name)} {_shown(new)} and "
                          f"{len(names) - 1} more")
 
     def id(self) -> int:  # noqa: A003 - Qt's name
@@ -161,6 +169,8 @@ class UndoRecorder(QObject):
         for name in UNDOABLE:
             group = study.settings.groups[name]
             group.events.connect(lambda info, name=name: self._changed(name, info))
+        for name, group in self._colour_groups().items():
+            group.events.connect(lambda info, name=name: self._changed(name, info))
         study.points_changed.connect(self._clear)
         study.mesh_opened.connect(self._clear)
 
@@ -204,5 +214,14 @@ class UndoRecorder(QObject):
                     order = field_names(settings.groups[group])
                     settings.set(group, dict(sorted(values.items(),
                                                     key=lambda kv: order.index(kv[0]))))
+            for name, colours in self._colour_groups().items():
+                values = {f: v[which] for (g, f), v in changes.items() if g == name}
+                with colours.events.paused():          # a range and its limits at once
+                    for f, value in values.items():
+                        setattr(colours, f, value)
         finally:
             self._replaying = False
+
+    def _colour_groups(self) -> dict[str, Any]:
+        c = self.study.colour
+        return dict(zip(COLOUR_GROUPS, (c.view, c.heatmap, c)))

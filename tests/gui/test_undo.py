@@ -31,12 +31,19 @@ VALUES = {("canopy", "level"): ["36", "8", "K4"],
           ("day", "tz"): ["UTC", "Asia/Shanghai"],
           ("optics", "band"): ["par", "nir"],
           ("optics", "reflectance"): [0.1, 0.25]}
+#: Colour settings the machine edits too: (group of the recorder, field) -> values.
+COLOURS = {("view colours", "cmap"): ["inferno", "greys"],
+           ("view colours", "range"): ["auto", "fixed"],
+           ("heatmap colours", "vmax"): [1.0, 0.5],
+           ("heatmap colours", "log"): [False, True],
+           ("colours", "shared"): [False, True],
+           ("colours", "painting"): ["auto", "leaves"]}
 
 
 def _state(model):
     s = model.settings
     groups = ("canopy", "light", "sun", "sampling", "sky", "day", "optics")
-    return ({g: s.snapshot(g) for g in groups}, model.draft.snapshot())
+    return ({g: s.snapshot(g) for g in groups}, model.draft.snapshot(), model.colour.to_doc())
 
 
 class UndoMachine(RuleBasedStateMachine):
@@ -68,6 +75,15 @@ class UndoMachine(RuleBasedStateMachine):
         value = data.draw(st.sampled_from(VALUES[key]))
         made = getattr(self.model.settings.groups[group], name) != value
         setattr(self.model.settings.groups[group], name, value)
+        self._edited(made)
+
+    @rule(key=st.sampled_from(sorted(COLOURS)), data=st.data())
+    def set_a_colour(self, key, data):
+        group, name = key
+        target = dict(self.recorder._colour_groups())[group]
+        value = data.draw(st.sampled_from(COLOURS[key]))
+        made = getattr(target, name) != value
+        setattr(target, name, value)
         self._edited(made)
 
     @rule(i=st.integers(0, 5), dx=st.sampled_from([-7.5, 0.0, 12.25]))
@@ -227,3 +243,30 @@ def test_undoing_a_layout_edit_rebuilds_the_layout_before_it(window, qtbot, two_
         w.menu_actions["undo"].trigger()
     assert w.model.loaded.layout.placements == before
     assert panel.rows.data(panel.rows.index(0, 0)) == f"{before[0].x:.1f}"
+
+
+def test_a_colour_edit_is_one_step_and_undoing_it_repaints(window, qtbot, small_points):
+    w = shown(qtbot, window(small_points, tile=1))
+    small_light(w.light_panel, "sky")
+    compute(qtbot, w)
+    view, panel, stack = w.viewport, w.colour_panel, w.undo.stack
+    before = stack.count()
+    table = view.canopy_mesh.cell_data["light_rgb"].copy()
+    panel.view_editor.cmap.setCurrentText("greys")          # the panel, as a person would
+    qtbot.waitUntil(lambda: stack.count() == before + 1, timeout=5000)
+    assert stack.text(stack.count() - 1) == "3D view colour map greys"
+    greys = view.canopy_mesh.cell_data["light_rgb"].copy()
+    assert (greys != table).any()
+    stack.undo()
+    assert w.model.colour.view.cmap == "inferno"
+    assert panel.view_editor.cmap.currentText() == "inferno"
+    assert (view.canopy_mesh.cell_data["light_rgb"] == table).all()
+    stack.redo()
+    assert (view.canopy_mesh.cell_data["light_rgb"] == greys).all()
+    # a typed range is one step: the range and its limits together
+    w.undo._next_turn()
+    panel.view_editor.show_limits(0.02, 0.5)
+    panel.view_editor.range.setCurrentIndex(panel.view_editor.range.findData("fixed"))
+    qtbot.waitUntil(lambda: stack.count() == before + 2, timeout=5000)
+    stack.undo()
+    assert w.model.colour.view.range == "auto" and w.model.colour.view.vmax == 1.0
