@@ -1344,20 +1344,7 @@ class MainWindow(QMainWindow):
         if self.built is None or self.canopy is None:
             return
         here, canopy = self.signature(self.built.label), self.canopy
-        n = canopy.n_triangles
-        todo = []
-        for run in self.runs.runs.values():
-            if run.signature != here:
-                continue
-            r = run.result
-            if run.kind == "sun" and (run.classes is None or run.extra is not None
-                                      and run.extra.leaf_value is None):
-                if r.first_hits is not None and len(r.first_hits) >= n:
-                    todo.append(run)
-            elif run.kind != "sun" and run.extra is None:
-                per_triangle = r.triangle_share if run.kind == "sky" else r.triangle_direct_mol
-                if len(per_triangle) >= n:
-                    todo.append(run)
+        todo = _runs_to_complete(self.runs.runs.values(), here, canopy.n_triangles)
         if not todo:
             return
 
@@ -1487,3 +1474,24 @@ def about_text() -> str:
             "meshes of chosen complexity, canopies and direct light.</p>"
             f"<p>It implements the method of: {PAPER}</p>"
             "<p>See docs/method.md for what is computed and how far it follows the paper.</p>")
+
+
+def _runs_to_complete(runs, here, n: int) -> list:
+    """The runs traced on the canopy of signature ``here`` (of ``n`` leaf triangles) that
+    lack what the window shows of them: a sun's light classes (or its absorbed light's per
+    leaf), a sky's or a day's light per leaf; runs holding light for fewer triangles than
+    the canopy are left alone."""
+    todo = []
+    for run in runs:
+        if run.signature != here:
+            continue
+        r = run.result
+        if run.kind == "sun" and (run.classes is None or run.extra is not None
+                                  and run.extra.leaf_value is None):
+            if r.first_hits is not None and len(r.first_hits) >= n:
+                todo.append(run)
+        elif run.kind != "sun" and run.extra is None:
+            per_triangle = r.triangle_share if run.kind == "sky" else r.triangle_direct_mol
+            if len(per_triangle) >= n:
+                todo.append(run)
+    return todo
