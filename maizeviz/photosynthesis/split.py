@@ -73,7 +73,7 @@ def leaf_model(name: str = "c4", **params) -> LeafModel:
         An unknown model or parameter, or a value out of range.
     """
     key = str(name).strip().lower()
-    classes: dict[str, type[C4Leaf] | type[WofostLeaf]] = {"c4": C4Leaf, "wofost": WofostLeaf}
+    classes: dict[str, type[C4Leaf | WofostLeaf]] = {"c4": C4Leaf, "wofost": WofostLeaf}
     if key not in classes:
         raise MaizevizError(f"unknown photosynthesis model '{name}' (known: "
                             f"{', '.join(MODELS)})", quantity="photosynthesis")

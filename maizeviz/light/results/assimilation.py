@@ -165,7 +165,7 @@ class Assimilation:
             standard error [umol m-2 s-1, kg CO2 ha-1 h-1], net assimilation, LAI and warnings.
         """
         se = self.canopy_gross_error_umol_m2_s
-        return {**{"model": self.model["model"]},
+        return {"model": self.model["model"],
                 "parameters": {k: v for k, v in self.model.items() if k != "model"},
                 "temperature_c": self.temp_c,
                 "canopy_gross_umol_m2_s": self.canopy_gross_umol_m2_s,
