@@ -60,6 +60,7 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import Self
 
 from anchors import matmul_anchor
 
@@ -84,7 +85,7 @@ class GilProbe:
             self.worst = max(self.worst, now - last)
             last = now
 
-    def __enter__(self) -> GilProbe:
+    def __enter__(self) -> Self:
         self._thread.start()
         return self
 
@@ -546,9 +547,10 @@ def main() -> None:
                       "stop_event_loop_max_gap_ms": 50, "stop_event_loop_max_gap_ms_demo": 50}
     if args.json:
         print(json.dumps(out, indent=1))
-        return
+        return None
     for k, v in out.items():
         print(f"{k}: {v}")
+    return None
 
 
 if __name__ == "__main__":

@@ -37,14 +37,26 @@ def bind(widget: QWidget, group: Any, name: str, label: str = "") -> None:
     group boxes (checked), combo boxes (the item whose data is the value), date edits
     (``YYYY-MM-DD``). ``label``: the accessible name, if the widget has none.
     """
+    setter = _attach(widget, group, name)
+
+    def follow(value: Any, *_old: Any) -> None:
+        with QSignalBlocker(widget):
+            setter(value)
+
+    getattr(group.events, name).connect(follow)
+    widget.destroyed.connect(lambda *_: _disconnect(group, name, follow))
+    if label and not widget.accessibleName():
+        widget.setAccessibleName(label)
+    if isinstance(widget, QAbstractSpinBox):
+        widget.setKeyboardTracking(True)
+
+
+def _attach(widget: QWidget, group: Any, name: str) -> Callable[[Any], None]:
+    """Show ``group.<name>`` in ``widget`` and send the user's edits to it; returns the
+    widget's setter (the model's changes shown)."""
     setter: Callable[[Any], None]
     if isinstance(widget, (QDoubleSpinBox, QSpinBox)):
-        low_high = field_range(group, name)
-        if low_high is not None:
-            if isinstance(widget, QSpinBox):
-                widget.setRange(int(low_high[0]), int(low_high[1]))
-            else:
-                widget.setRange(float(low_high[0]), float(low_high[1]))
+        _set_range(widget, group, name)
         widget.setValue(getattr(group, name))
         setter = widget.setValue
         widget.valueChanged.connect(lambda v: _set(group, name, v))
@@ -80,17 +92,18 @@ def bind(widget: QWidget, group: Any, name: str, label: str = "") -> None:
         widget.dateChanged.connect(lambda d: _set(group, name, d.toString("yyyy-MM-dd")))
     else:
         raise TypeError(f"cannot bind a {type(widget).__name__}")
+    return setter
 
-    def follow(value: Any, *_old: Any) -> None:
-        with QSignalBlocker(widget):
-            setter(value)
 
-    getattr(group.events, name).connect(follow)
-    widget.destroyed.connect(lambda *_: _disconnect(group, name, follow))
-    if label and not widget.accessibleName():
-        widget.setAccessibleName(label)
-    if isinstance(widget, QAbstractSpinBox):
-        widget.setKeyboardTracking(True)
+def _set_range(widget: QDoubleSpinBox | QSpinBox, group: Any, name: str) -> None:
+    """A spin box's range, the setting's own."""
+    low_high = field_range(group, name)
+    if low_high is None:
+        return
+    if isinstance(widget, QSpinBox):
+        widget.setRange(int(low_high[0]), int(low_high[1]))
+    else:
+        widget.setRange(float(low_high[0]), float(low_high[1]))
 
 
 def bind_text(box: QComboBox, group: Any, name: str) -> None:

@@ -295,20 +295,7 @@ def complete_runs(study: StudyModel) -> None:
     if study.built is None or study.canopy is None:
         return
     here, canopy = study.shown_signature, study.canopy
-    n = canopy.n_triangles
-    todo = []
-    for run in study.runs.runs.values():
-        if run.signature != here:
-            continue
-        r = run.result
-        if run.kind == "sun" and (run.classes is None or run.extra is not None
-                                  and run.extra.leaf_value is None):
-            if r.first_hits is not None and len(r.first_hits) >= n:
-                todo.append(run)
-        elif run.kind != "sun" and run.extra is None:
-            per_triangle = r.triangle_share if run.kind == "sky" else r.triangle_direct_mol
-            if len(per_triangle) >= n:
-                todo.append(run)
+    todo = runs_to_complete(study.runs.runs.values(), here, canopy.n_triangles)
     if not todo:
         return
 
@@ -344,3 +331,24 @@ def complete_runs(study: StudyModel) -> None:
 
     study.runner.run("complete", "light per leaf of the project's results", work,
                     on_done=adopt, on_error=lambda e: study.fail(e, "light"))
+
+
+def runs_to_complete(runs, here, n: int) -> list:
+    """The runs traced on the canopy of signature ``here`` (of ``n`` leaf triangles) that
+    lack what the window shows of them: a sun's light classes (or its absorbed light's per
+    leaf), a sky's or a day's light per leaf; runs holding light for fewer triangles than
+    the canopy are left alone."""
+    todo = []
+    for run in runs:
+        if run.signature != here:
+            continue
+        r = run.result
+        if run.kind == "sun" and (run.classes is None or run.extra is not None
+                                  and run.extra.leaf_value is None):
+            if r.first_hits is not None and len(r.first_hits) >= n:
+                todo.append(run)
+        elif run.kind != "sun" and run.extra is None:
+            per_triangle = r.triangle_share if run.kind == "sky" else r.triangle_direct_mol
+            if len(per_triangle) >= n:
+                todo.append(run)
+    return todo

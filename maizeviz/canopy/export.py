@@ -41,5 +41,21 @@ def canopy_cells(canopy: Canopy, cell_data: dict[str, np.ndarray] | None = None,
 
 def export_canopy(path: str | Path, canopy: Canopy,
                   cell_data: dict[str, np.ndarray] | None = None) -> Path:
-    """Write a canopy with its stalks (see :func:`canopy_cells`); format by extension."""
+    """Write a canopy with its stalks as a mesh file, the format chosen by the extension.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write (.ply, .obj, .vtp, .vtu, .vtk, .stl...), atomically.
+    canopy : Canopy
+        The canopy (its leaves, then its stalks).
+    cell_data : dict of str to numpy.ndarray, optional
+        Per-triangle values to carry, each (F,) over the canopy's leaf triangles (stalks get 0,
+        or NaN for floats), beside ``plant`` and ``leaf`` (:func:`canopy_cells`).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
     return write_mesh(path, *canopy_cells(canopy, cell_data))

@@ -313,8 +313,33 @@ def read_mesh_canopy(path: str | Path, unit: str | None = None, up: str = "z",
                      field: tuple[float, float, float, float] | None = None,
                      plant_property: str | None = None,
                      leaf_property: str | None = None) -> tuple[Canopy, MeshData, list[str]]:
-    """Read a mesh file (:func:`maizeviz.io.mesh_canopy.read_mesh`) as a canopy
-    (:func:`canopy_from_mesh`): the canopy, the file's mesh, and notes."""
+    """Read a mesh file as a canopy.
+
+    The file's triangles with plant and leaf ids (:func:`maizeviz.io.mesh_canopy.read_mesh`)
+    become a canopy (:func:`canopy_from_mesh`).
+
+    Parameters
+    ----------
+    path : str or Path
+        A PLY or OBJ file with plant and leaf ids.
+    unit : {"m", "cm", "mm"}, optional
+        The file's length unit; None: cm, refusing a height that suggests another unit.
+    up : {"z", "y"}
+        The file's up axis.
+    field : (x0, y0, x1, y1) tuple of float, optional
+        The plot [cm]; None: the mesh's bounding box seen from above.
+    plant_property, leaf_property : str, optional
+        Names of the per-face plant and leaf id properties, where not the usual ones.
+
+    Returns
+    -------
+    canopy : Canopy
+        The canopy of the mesh's triangles.
+    mesh : MeshData
+        The file's mesh as read.
+    notes : list of str
+        What was decided (one line each).
+    """
     mesh = read_mesh(path, plant_property, leaf_property)
     canopy, notes = canopy_from_mesh(mesh, unit, up, field, str(path))
     return canopy, mesh, notes

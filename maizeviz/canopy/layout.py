@@ -463,6 +463,45 @@ def load_layout(path: str | Path, plants: set[int] | None = None) -> CanopyLayou
     return layout_from_dict(data, plants, str(path))
 
 
+def _field(data: dict, source: str) -> tuple[float, float, float, float]:
+    """A layout document's ``field`` {x0, y0, x1, y1} [cm], each side at least
+    :data:`MIN_LENGTH_CM`."""
+    coord = {"low": -MAX_COORD_CM, "high": MAX_COORD_CM}
+    fld = data.get("field")
+    if not isinstance(fld, dict):
+        raise LayoutError(f"{source}: 'field' must be an object {{x0, y0, x1, y1}} in cm")
+    x0, y0, x1, y1 = (_number(fld, k, f"{source}: field", **coord) for k in ("x0", "y0", "x1", "y1"))
+    if x1 <= x0 or y1 <= y0:
+        raise LayoutError(f"{source}: field must have x1 > x0 and y1 > y0")
+    if x1 - x0 < MIN_LENGTH_CM or y1 - y0 < MIN_LENGTH_CM:
+        raise LayoutError(f"{source}: field is {x1 - x0:g} x {y1 - y0:g} cm; each side must be "
+                          f"at least {MIN_LENGTH_CM:g} cm")
+    return x0, y0, x1, y1
+
+
+def _stand(pos, x: float, w: str, plants: set[int] | None,
+           rng: np.random.Generator) -> tuple[Placement, float]:
+    """One plant of a row at ``x`` [cm]: its placement (moved by its jitter, drawn from
+    ``rng``) and the y [cm] it was given at."""
+    coord = {"low": -MAX_COORD_CM, "high": MAX_COORD_CM}
+    if not isinstance(pos, dict):
+        raise LayoutError(f"{w} must be an object {{y, plant}}")
+    y = _number(pos, "y", w, **coord)
+    pid = _plant_id(pos, w, plants)
+    az = _number(pos, "azimuth_deg", w, default=0.0, low=-MAX_ANGLE_DEG,
+                 high=MAX_ANGLE_DEG, unit=" degrees")
+    jitter = _number(pos, "jitter_cm", w, default=0.0)
+    if not 0 <= jitter <= MAX_JITTER_CM:
+        raise LayoutError(f"{w}: 'jitter_cm' is {jitter:g} cm; it must be from 0 to "
+                          f"{MAX_JITTER_CM:g} cm (farther, the plant has another place: "
+                          "give that position)")
+    px, py = x, y
+    if jitter > 0:
+        r, t = jitter * np.sqrt(rng.random()), 2 * np.pi * rng.random()
+        px, py = x + r * np.cos(t), y + r * np.sin(t)
+    return Placement(pid, px, py, az, (0, 0)), y
+
+
 def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout") -> CanopyLayout:
     """Validate a layout document (already parsed JSON); see :func:`load_layout`.
 
@@ -484,15 +523,7 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
     ps = _number(data, "plant_spacing", source, positive=True, **length)
     north = _number(data, "north_deg", source, default=0.0, low=-MAX_ANGLE_DEG,
                     high=MAX_ANGLE_DEG, unit=" degrees")
-    fld = data.get("field")
-    if not isinstance(fld, dict):
-        raise LayoutError(f"{source}: 'field' must be an object {{x0, y0, x1, y1}} in cm")
-    x0, y0, x1, y1 = (_number(fld, k, f"{source}: field", **coord) for k in ("x0", "y0", "x1", "y1"))
-    if x1 <= x0 or y1 <= y0:
-        raise LayoutError(f"{source}: field must have x1 > x0 and y1 > y0")
-    if x1 - x0 < MIN_LENGTH_CM or y1 - y0 < MIN_LENGTH_CM:
-        raise LayoutError(f"{source}: field is {x1 - x0:g} x {y1 - y0:g} cm; each side must be "
-                          f"at least {MIN_LENGTH_CM:g} cm")
+    x0, y0, x1, y1 = _field(data, source)
     rows = data.get("rows")
     if not isinstance(rows, list) or not rows:
         raise LayoutError(f"{source}: 'rows' must be a non-empty list")
@@ -513,24 +544,10 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
             raise LayoutError(f"{where}: 'plants' must be a list")
         for j, pos in enumerate(plist):
             w = f"{where}.plants[{j}]"
-            if not isinstance(pos, dict):
-                raise LayoutError(f"{w} must be an object {{y, plant}}")
-            y = _number(pos, "y", w, **coord)
-            pid = _plant_id(pos, w, plants)
-            az = _number(pos, "azimuth_deg", w, default=0.0, low=-MAX_ANGLE_DEG,
-                         high=MAX_ANGLE_DEG, unit=" degrees")
-            jitter = _number(pos, "jitter_cm", w, default=0.0)
-            if not 0 <= jitter <= MAX_JITTER_CM:
-                raise LayoutError(f"{w}: 'jitter_cm' is {jitter:g} cm; it must be from 0 to "
-                                  f"{MAX_JITTER_CM:g} cm (farther, the plant has another place: "
-                                  "give that position)")
-            px, py = x, y
-            if jitter > 0:
-                r, t = jitter * np.sqrt(rng.random()), 2 * np.pi * rng.random()
-                px, py = x + r * np.cos(t), y + r * np.sin(t)
-            if not (x0 <= px <= x1 and y0 <= py <= y1):
-                outside.append(f"{w}: plant at ({px:.1f}, {py:.1f}) cm")
-            placements.append(Placement(pid, px, py, az, (0, 0)))
+            place, y = _stand(pos, x, w, plants, rng)
+            if not (x0 <= place.x <= x1 and y0 <= place.y <= y1):
+                outside.append(f"{w}: plant at ({place.x:.1f}, {place.y:.1f}) cm")
+            placements.append(place)
             cells.append(_cell(x, y, rs, ps))
     if not placements:
         raise LayoutError(f"{source}: no plant stands in the layout: every row's 'plants' "

@@ -136,7 +136,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
     except BrokenPipeError:
         return EXIT_OK
-    except Exception as exc:  # a bug: say so in one line unless asked for the traceback
+    except Exception as exc:  # noqa: BLE001 - a bug: one line unless asked for the traceback
         if debug:
             traceback.print_exc()
         else:

@@ -265,12 +265,7 @@ def _ply_header(head: bytes, src: str) -> tuple[str, list[_Element], int]:
         where = f"{src}: header line {no}"
         key = words[0]
         if key == "format":
-            if len(words) != 3 or words[1] not in _FORMATS:
-                raise MeshFileError(f"{where}: '{text[:60]}': the format must be ascii, "
-                                    "binary_little_endian or binary_big_endian")
-            if words[2] not in ("1.0", "1"):
-                raise MeshFileError(f"{where}: PLY version {words[2][:20]}, only 1.0 is known")
-            fmt = _FORMATS[words[1]]
+            fmt = _ply_format(words, text, where)
         elif key == "element":
             if len(words) != 3 or not (words[2].isascii() and words[2].isdigit()):
                 raise MeshFileError(f"{where}: '{text[:60]}': an element needs a name and a "
@@ -279,30 +274,52 @@ def _ply_header(head: bytes, src: str) -> tuple[str, list[_Element], int]:
                 raise MeshFileError(f"{where}: element '{words[1][:40]}' declared twice")
             elements.append(_Element(words[1], int(words[2]), no, []))
         elif key == "property":
-            if not elements:
-                raise MeshFileError(f"{where}: a property before any element")
-            el = elements[-1]
-            if len(words) == 3 and words[1] in _PLY_TYPES:
-                prop = _Prop(words[2], _PLY_TYPES[words[1]])
-            elif len(words) == 5 and words[1] == "list" and words[2] in _PLY_TYPES \
-                    and words[3] in _PLY_TYPES:
-                if _PLY_TYPES[words[2]][0] == "f":
-                    raise MeshFileError(f"{where}: a list count must be of an integer type, "
-                                        f"got {words[2]}")
-                prop = _Prop(words[4], _PLY_TYPES[words[3]], _PLY_TYPES[words[2]])
-            else:
-                raise MeshFileError(f"{where}: '{text[:60]}': not a property of a known type "
-                                    f"({', '.join(sorted(set(_PLY_TYPES)))})")
-            if any(p.name == prop.name for p in el.props):
-                raise MeshFileError(f"{where}: property '{prop.name[:40]}' declared twice in "
-                                    f"element {el.name[:40]}")
-            el.props.append(prop)
+            _ply_property(words, text, where, elements)
         elif key == "end_header":
             break
         else:
             raise MeshFileError(f"{where}: '{text[:60]}' is not a PLY header line")
     if fmt is None:
         raise MeshFileError(f"{src}: the PLY header has no format line")
+    _check_ply_elements(elements, src)
+    return fmt, elements, len(lines)
+
+
+def _ply_format(words: list[str], text: str, where: str) -> str:
+    """The byte order of a ``format`` line ("" ascii, "<" or ">"), version 1.0."""
+    if len(words) != 3 or words[1] not in _FORMATS:
+        raise MeshFileError(f"{where}: '{text[:60]}': the format must be ascii, "
+                            "binary_little_endian or binary_big_endian")
+    if words[2] not in ("1.0", "1"):
+        raise MeshFileError(f"{where}: PLY version {words[2][:20]}, only 1.0 is known")
+    return _FORMATS[words[1]]
+
+
+def _ply_property(words: list[str], text: str, where: str, elements: list[_Element]) -> None:
+    """A ``property`` line added to the last element: a scalar or a list of a known type,
+    not declared twice."""
+    if not elements:
+        raise MeshFileError(f"{where}: a property before any element")
+    el = elements[-1]
+    if len(words) == 3 and words[1] in _PLY_TYPES:
+        prop = _Prop(words[2], _PLY_TYPES[words[1]])
+    elif len(words) == 5 and words[1] == "list" and words[2] in _PLY_TYPES \
+            and words[3] in _PLY_TYPES:
+        if _PLY_TYPES[words[2]][0] == "f":
+            raise MeshFileError(f"{where}: a list count must be of an integer type, "
+                                f"got {words[2]}")
+        prop = _Prop(words[4], _PLY_TYPES[words[3]], _PLY_TYPES[words[2]])
+    else:
+        raise MeshFileError(f"{where}: '{text[:60]}': not a property of a known type "
+                            f"({', '.join(sorted(set(_PLY_TYPES)))})")
+    if any(p.name == prop.name for p in el.props):
+        raise MeshFileError(f"{where}: property '{prop.name[:40]}' declared twice in "
+                            f"element {el.name[:40]}")
+    el.props.append(prop)
+
+
+def _check_ply_elements(elements: list[_Element], src: str) -> None:
+    """A vertex element with x, y and z, and a face element with its vertex indices."""
     vertex = next((e for e in elements if e.name == "vertex"), None)
     face = next((e for e in elements if e.name == "face"), None)
     if vertex is None:
@@ -318,7 +335,6 @@ def _ply_header(head: bytes, src: str) -> tuple[str, list[_Element], int]:
     if _index_prop(face) is None:
         raise MeshFileError(f"{src}: header line {face.line}: the face element has no "
                             "'vertex_indices' list")
-    return fmt, elements, len(lines)
 
 
 def _index_prop(face: _Element) -> _Prop | None:
@@ -509,6 +525,9 @@ def _numbers(tokens: list[bytes], counts: np.ndarray, line_no: np.ndarray, src: 
     raise MeshFileError(f"{src}: a value is not a number")            # pragma: no cover
 
 
+_Lists = dict[str, tuple[np.ndarray, np.ndarray]]
+
+
 def _ascii_element(lines: list[bytes], line_no: np.ndarray, el: _Element, src: str) -> _Values:
     n = len(lines)
     split = [ln.split() for ln in lines]
@@ -516,85 +535,117 @@ def _ascii_element(lines: list[bytes], line_no: np.ndarray, el: _Element, src: s
     tokens = [t for s in split for t in s]
     vals = _numbers(tokens, counts, line_no, src)
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
-    props = el.props
-    n_list = sum(p.is_list for p in props)
-    scalars: dict[str, np.ndarray] = {}
-    lists: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    n_list = sum(p.is_list for p in el.props)
+    lists: _Lists = {}
     if n_list == 0:
-        bad = np.flatnonzero(counts != len(props))
-        if len(bad):
-            i = int(bad[0])
-            raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i} has "
-                                f"{int(counts[i])} values, the header declares {len(props)}")
-        for j, p in enumerate(props):
-            scalars[p.name] = _typed(vals[starts + j], p.code, el, p.name, line_no, src)
+        scalars = _ascii_scalars(vals, counts, starts, line_no, el, src)
     elif n_list == 1:
-        pos = next(j for j, p in enumerate(props) if p.is_list)
-        lp = props[pos]
-        fixed = len(props) - 1
-        if n and np.any(counts <= pos):
-            i = int(np.flatnonzero(counts <= pos)[0])
-            raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i} has "
-                                f"{int(counts[i])} values, too few for its properties")
-        length = _typed(vals[starts + pos], lp.count_code or "u4", el, f"{lp.name} count",
-                        line_no, src).astype(np.int64) if n else np.zeros(0, np.int64)
-        bad = np.flatnonzero(counts != fixed + 1 + length)
-        if len(bad):
-            i = int(bad[0])
-            raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i} has "
-                                f"{int(counts[i])} values; its list of {int(length[i])} and "
-                                f"{fixed} other properties make {fixed + 1 + int(length[i])}")
-        first = starts + pos + 1
-        total = int(length.sum())
-        ends = np.cumsum(length)
-        take = np.repeat(first - (ends - length), length) + np.arange(total)
-        lists[lp.name] = (length, _typed(vals[take], lp.code, el, lp.name, line_no, src,
-                                         np.repeat(np.arange(n), length)))
-        for j, p in enumerate(props):
-            if j < pos:
-                scalars[p.name] = _typed(vals[starts + j], p.code, el, p.name, line_no, src)
-            elif j > pos:
-                scalars[p.name] = _typed(vals[first + length + (j - pos - 1)], p.code, el,
-                                         p.name, line_no, src)
+        scalars, lists = _ascii_one_list(vals, counts, starts, line_no, el, src)
     else:
-        scal_l: dict[str, list[float]] = {p.name: [] for p in props if not p.is_list}
-        lens: dict[str, list[int]] = {p.name: [] for p in props if p.is_list}
-        flat: dict[str, list[float]] = {p.name: [] for p in props if p.is_list}
-        item_of: dict[str, list[int]] = {p.name: [] for p in props if p.is_list}
-        for i in range(n):
-            k, end = int(starts[i]), int(starts[i] + counts[i])
-            for p in props:
-                if k >= end:
-                    raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i} has "
-                                        "too few values for its properties")
-                if p.is_list:
-                    c = vals[k]
-                    if not (c >= 0 and float(c).is_integer()):
-                        raise MeshFileError(f"{src}: line {int(line_no[i])}: a list count of "
-                                            f"{c:g}")
-                    c = int(c)
-                    if k + 1 + c > end:
-                        raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i} has "
-                                            "too few values for its properties")
-                    lens[p.name].append(c)
-                    flat[p.name].extend(vals[k + 1:k + 1 + c].tolist())
-                    item_of[p.name].extend([i] * c)
-                    k += 1 + c
-                else:
-                    scal_l[p.name].append(float(vals[k]))
-                    k += 1
-            if k != end:
-                raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i} has "
-                                    f"{int(counts[i])} values, more than its properties take")
-        for p in props:
-            if p.is_list:
-                lists[p.name] = (np.array(lens[p.name], np.int64),
-                                 _typed(np.array(flat[p.name], np.float64), p.code, el, p.name,
-                                        line_no, src, np.array(item_of[p.name], np.int64)))
-            else:
-                scalars[p.name] = _typed(np.array(scal_l[p.name], np.float64), p.code, el,
-                                         p.name, line_no, src)
+        scalars, lists = _ascii_lists(vals, counts, starts, line_no, el, src)
     return _Values(scalars, lists, line_no)
+
+
+
+def _ascii_scalars(vals: np.ndarray, counts: np.ndarray, starts: np.ndarray,
+                   line_no: np.ndarray, el: _Element, src: str) -> dict[str, np.ndarray]:
+    """An ASCII element of scalar properties only: every line holds one value each."""
+    props = el.props
+    bad = np.flatnonzero(counts != len(props))
+    if len(bad):
+        i = int(bad[0])
+        raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i} has "
+                            f"{int(counts[i])} values, the header declares {len(props)}")
+    return {p.name: _typed(vals[starts + j], p.code, el, p.name, line_no, src)
+            for j, p in enumerate(props)}
+
+
+def _ascii_one_list(vals: np.ndarray, counts: np.ndarray, starts: np.ndarray,
+                    line_no: np.ndarray, el: _Element, src: str
+                    ) -> tuple[dict[str, np.ndarray], _Lists]:
+    """An ASCII element with one list property (a face's vertex indices), read whole."""
+    props = el.props
+    n = len(counts)
+    scalars: dict[str, np.ndarray] = {}
+    pos = next(j for j, p in enumerate(props) if p.is_list)
+    lp = props[pos]
+    fixed = len(props) - 1
+    if n and np.any(counts <= pos):
+        i = int(np.flatnonzero(counts <= pos)[0])
+        raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i} has "
+                            f"{int(counts[i])} values, too few for its properties")
+    length = _typed(vals[starts + pos], lp.count_code or "u4", el, f"{lp.name} count",
+                    line_no, src).astype(np.int64) if n else np.zeros(0, np.int64)
+    bad = np.flatnonzero(counts != fixed + 1 + length)
+    if len(bad):
+        i = int(bad[0])
+        raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i} has "
+                            f"{int(counts[i])} values; its list of {int(length[i])} and "
+                            f"{fixed} other properties make {fixed + 1 + int(length[i])}")
+    first = starts + pos + 1
+    total = int(length.sum())
+    ends = np.cumsum(length)
+    take = np.repeat(first - (ends - length), length) + np.arange(total)
+    lists = {lp.name: (length, _typed(vals[take], lp.code, el, lp.name, line_no, src,
+                                      np.repeat(np.arange(n), length)))}
+    for j, p in enumerate(props):
+        if j < pos:
+            scalars[p.name] = _typed(vals[starts + j], p.code, el, p.name, line_no, src)
+        elif j > pos:
+            scalars[p.name] = _typed(vals[first + length + (j - pos - 1)], p.code, el,
+                                     p.name, line_no, src)
+    return scalars, lists
+
+
+def _ascii_lists(vals: np.ndarray, counts: np.ndarray, starts: np.ndarray,
+                 line_no: np.ndarray, el: _Element, src: str
+                 ) -> tuple[dict[str, np.ndarray], _Lists]:
+    """An ASCII element with several list properties, read line by line."""
+    props = el.props
+    scal_l: dict[str, list[float]] = {p.name: [] for p in props if not p.is_list}
+    lens: dict[str, list[int]] = {p.name: [] for p in props if p.is_list}
+    flat: dict[str, list[float]] = {p.name: [] for p in props if p.is_list}
+    item_of: dict[str, list[int]] = {p.name: [] for p in props if p.is_list}
+    for i in range(len(counts)):
+        k, end = int(starts[i]), int(starts[i] + counts[i])
+        for p in props:
+            if k >= end:
+                raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i} has "
+                                    "too few values for its properties")
+            if p.is_list:
+                c = _list_count(vals[k], k, end, i, line_no, el, src)
+                lens[p.name].append(c)
+                flat[p.name].extend(vals[k + 1:k + 1 + c].tolist())
+                item_of[p.name].extend([i] * c)
+                k += 1 + c
+            else:
+                scal_l[p.name].append(float(vals[k]))
+                k += 1
+        if k != end:
+            raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i} has "
+                                f"{int(counts[i])} values, more than its properties take")
+    scalars: dict[str, np.ndarray] = {}
+    lists: _Lists = {}
+    for p in props:                                 # in the header's order
+        if p.is_list:
+            lists[p.name] = (np.array(lens[p.name], np.int64),
+                             _typed(np.array(flat[p.name], np.float64), p.code, el, p.name,
+                                    line_no, src, np.array(item_of[p.name], np.int64)))
+        else:
+            scalars[p.name] = _typed(np.array(scal_l[p.name], np.float64), p.code, el,
+                                     p.name, line_no, src)
+    return scalars, lists
+
+
+def _list_count(c: float, k: int, end: int, i: int, line_no: np.ndarray, el: _Element,
+                src: str) -> int:
+    """A list's count on line ``i``: a whole number >= 0 whose values fit the line."""
+    if not (c >= 0 and float(c).is_integer()):
+        raise MeshFileError(f"{src}: line {int(line_no[i])}: a list count of {c:g}")
+    if k + 1 + int(c) > end:
+        raise MeshFileError(f"{src}: line {int(line_no[i])}: {el.name} {i} has "
+                            "too few values for its properties")
+    return int(c)
 
 
 def _typed(v: np.ndarray, code: str, el: _Element, name: str, line_no: np.ndarray, src: str,
@@ -773,6 +824,44 @@ def _read_obj(data: bytes, src: str) -> MeshData:
     return _obj_mesh(*_obj_statements(lines, src), src)
 
 
+def _obj_vertex(words: list[str], line: str, no: int, src: str) -> list[float]:
+    """A ``v`` statement's x, y and z."""
+    try:
+        if len(words) < 4:
+            raise ValueError
+        return list(map(number, words[1:4]))
+    except ValueError:
+        raise MeshFileError(f"{src}: line {no}: a vertex needs x, y and z numbers, got "
+                            f"'{line.strip()[:60]}'") from None
+
+
+def _obj_face(words: list[str], line: str, no: int, nv: int, src: str) -> list[int]:
+    """An ``f`` statement's vertex indices from 0 (negative ones counted back from the
+    ``nv`` vertices defined so far), at least 3."""
+    try:
+        if "/" in line:
+            if not _F_LINE.fullmatch(line.strip()):
+                raise ValueError
+            idx = [whole(w.partition("/")[0]) for w in words[1:]]
+        else:
+            idx = list(map(whole, words[1:]))
+        if 0 in idx:
+            raise ValueError
+    except ValueError:
+        raise MeshFileError(f"{src}: line {no}: '{line.strip()[:60]}' is not a face: "
+                            "f then vertices v, v/vt, v//vn or v/vt/vn (whole numbers, "
+                            "not 0)") from None
+    if len(idx) < 3:
+        raise MeshFileError(f"{src}: line {no}: a face has {len(idx)} vertices; a face "
+                            "needs at least 3")
+    if min(idx) < 0:
+        if min(idx) < -nv:
+            raise MeshFileError(f"{src}: line {no}: vertex index {min(idx)} reaches "
+                                f"before the first vertex ({nv:,} defined so far)")
+        return [i + nv if i < 0 else i - 1 for i in idx]
+    return [i - 1 for i in idx]
+
+
 def _obj_statements(lines: list[str], src: str) -> tuple[
         np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
         dict[str, int], dict[str, int], int]:
@@ -805,40 +894,11 @@ def _obj_statements(lines: list[str], src: str) -> tuple[
             continue
         key = words[0]
         if key == "v":
-            try:
-                if len(words) < 4:
-                    raise ValueError
-                coords.extend(map(number, words[1:4]))
-            except ValueError:
-                raise MeshFileError(f"{src}: line {no}: a vertex needs x, y and z numbers, got "
-                                    f"'{line.strip()[:60]}'") from None
+            coords.extend(_obj_vertex(words, line, no, src))
             vlines.append(no)
         elif key == "f":
-            nv = len(vlines)
-            try:
-                if "/" in line:
-                    if not _F_LINE.fullmatch(line.strip()):
-                        raise ValueError
-                    idx = [whole(w.partition("/")[0]) for w in words[1:]]
-                else:
-                    idx = list(map(whole, words[1:]))
-                if 0 in idx:
-                    raise ValueError
-            except ValueError:
-                raise MeshFileError(f"{src}: line {no}: '{line.strip()[:60]}' is not a face: "
-                                    "f then vertices v, v/vt, v//vn or v/vt/vn (whole numbers, "
-                                    "not 0)") from None
-            if len(idx) < 3:
-                raise MeshFileError(f"{src}: line {no}: a face has {len(idx)} vertices; a face "
-                                    "needs at least 3")
-            if min(idx) < 0:
-                if min(idx) < -nv:
-                    raise MeshFileError(f"{src}: line {no}: vertex index {min(idx)} reaches "
-                                        f"before the first vertex ({nv:,} defined so far)")
-                idx = [i + nv if i < 0 else i - 1 for i in idx]
-                flat.extend(idx)
-            else:
-                flat.extend(i - 1 for i in idx)
+            idx = _obj_face(words, line, no, len(vlines), src)
+            flat.extend(idx)
             lengths.append(len(idx))
             flines.append(no)
             if current < 0 and (obj_name is not None or grp_name is not None):

@@ -347,16 +347,10 @@ class LineParser:
         # a quoted field may run over line ends, except in a recording: the recorder never
         # writes one, and a torn line's open quote must not swallow the lines after it
         if self.carry or (text.count('"') % 2 and terminated and not self.journal):
-            if not self.carry:
-                self.carry_start = lineno
-            self.carry += text
-            if len(self.carry) > MAX_LINE_BYTES:
-                raise PointsFileError(
-                    f"{self.source}: line {self.carry_start}: a quoted field runs over more "
-                    f"than {MAX_LINE_BYTES:,} bytes; not a readable CSV file of points")
-            if self.carry.count('"') % 2 and terminated:
+            joined = self._carried(lineno, text, terminated)
+            if joined is None:
                 return                              # the quoted field goes on
-            text, lineno, self.carry = self.carry, self.carry_start, ""
+            lineno, text = joined
         if not terminated:
             self.torn = (lineno, text)
         if self.header is None:
@@ -387,6 +381,22 @@ class LineParser:
             self._note(outcome[1])                  # a repair mark cut short: wait for the next
         else:
             self._settle(outcome)
+
+    def _carried(self, lineno: int, text: str, terminated: bool) -> tuple[int, str] | None:
+        """Add a line to a quoted field running over line ends: the whole record (its first
+        line's number and text) once the field closes, else None."""
+        if not self.carry:
+            self.carry_start = lineno
+        self.carry += text
+        if len(self.carry) > MAX_LINE_BYTES:
+            raise PointsFileError(
+                f"{self.source}: line {self.carry_start}: a quoted field runs over more "
+                f"than {MAX_LINE_BYTES:,} bytes; not a readable CSV file of points")
+        if self.carry.count('"') % 2 and terminated:
+            return None
+        joined = (self.carry_start, self.carry)
+        self.carry = ""
+        return joined
 
     def _settle(self, outcome) -> None:
         """Commit the line before, then hold this one until the next line is seen."""

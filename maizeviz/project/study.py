@@ -297,19 +297,22 @@ class Study:
 
 def read_study(path: str | Path, cache: str | Path | None = None,
                progress: Any = None) -> Study:
-    """Read a ``.maizeviz`` project: its points fitted, its layout, its canopy settings and
-    the light results that belong to them.
+    """Read a ``.maizeviz`` project: its points fitted, its layout, its settings and results.
 
     Parameters
     ----------
-    path : the project file
-    cache : folder for the project's checked copy of its points when the original file moved
-        or changed (default: the system's temporary folder)
-    progress : ``progress(done, total)`` over the leaves; returning False cancels
+    path : str or Path
+        The project file.
+    cache : str or Path, optional
+        Folder for the project's checked copy of its points when the original file moved or
+        changed (default: the system's temporary folder).
+    progress : callable, optional
+        ``progress(done, total)`` over the leaves; returning False cancels.
 
     Returns
     -------
     Study
+        The leaves, the layout, the canopy's level and the light results that belong to them.
 
     Raises
     ------
@@ -342,16 +345,24 @@ def save_study(path: str | Path, points: str | Path, layout: CanopyLayout,
 
     Parameters
     ----------
-    path : the project file to write (atomically: an existing one stays whole on failure)
-    points : the points file the plants were read from (its bytes go into the project)
-    layout : the stands of the canopy, stored with the project
-    results : light results traced on ``layout`` (``LightResult``, ``SkyLight`` or
-        ``PeriodLight``), each stored under its own mesh level
-    level : mesh level the project opens at; preserve_area : area-preserving triangle budgets
+    path : str or Path
+        The project file to write (atomically: an existing one stays whole on failure).
+    points : str or Path
+        The points file the plants were read from (its bytes go into the project).
+    layout : CanopyLayout
+        The stands of the canopy, stored with the project.
+    results : sequence of light results
+        Results traced on ``layout`` (``LightResult``, ``SkyLight``, ``PeriodLight``...), each
+        stored under its own mesh level.
+    level : str
+        The mesh level the project opens at.
+    preserve_area : bool
+        Area-preserving triangle budgets.
 
     Returns
     -------
     pathlib.Path
+        The project written.
 
     Raises
     ------

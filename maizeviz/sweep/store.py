@@ -72,7 +72,7 @@ def now_iso() -> str:
 def scenario_rows(s, result: dict, worker: str | None, finished_at: str) -> list[dict]:
     """Result rows of a scenario, one per height, every column of :data:`COLUMNS`."""
     ok = result.get("status") == "ok"
-    base: dict[str, Any] = {c: None for c in COLUMN_NAMES}
+    base: dict[str, Any] = dict.fromkeys(COLUMN_NAMES)
     base.update(s.axes())
     base.update(scenario=s.key, status=result["status"], error=result.get("error"),
                 worker=worker, maizeviz_version=maizeviz.__version__, finished_at=finished_at)

@@ -127,6 +127,22 @@ def test_lint_is_clean():
     assert proc.returncode == 0, proc.stdout[-5000:] + proc.stderr[-2000:]
 
 
+def test_no_function_is_too_complex():
+    """ruff's C901 (McCabe complexity) is on at 15 over the core, the app, the tests and the
+    benchmarks, and a function of 16 branches is caught (cli/light.py's run was 45)."""
+    import tomllib
+
+    lint = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["ruff"]["lint"]
+    assert "C90" in lint["select"] and lint["mccabe"]["max-complexity"] == 15
+    branches = "".join(f"    if x == {i}:\n        return {i}\n" for i in range(16))
+    ruff = Path(sys.executable).with_name("ruff")
+    proc = subprocess.run([str(ruff), "check", "--no-cache", "--select", "C901", "--config",
+                           "lint.mccabe.max-complexity=15", "--stdin-filename", "x.py", "-"],
+                          input=f"def f(x):\n{branches}    return -1\n", capture_output=True,
+                          text=True, cwd=ROOT, timeout=60)
+    assert proc.returncode == 1 and "`f` is too complex (17 > 15)" in proc.stdout
+
+
 def test_no_reference_to_documents_outside_the_repository():
     outside = re.compile(r"SCIENCE\.md|FASTRAK\.md|PAPER\.md|STYLE\.md|\.\./shared|shared\/data")
     docs = re.compile(r"docs/[A-Za-z0-9_./-]+\.md")

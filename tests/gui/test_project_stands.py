@@ -80,6 +80,6 @@ def test_results_of_other_stands_are_left_out_with_one_line(window, qtbot, small
     w = window(path)
     qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait()
     text = w.messages.toPlainText()
-    assert f"note: the sky result on {level.label} was traced on other stands (18 plants) " \
-           "than the project's layout (2); left out (compute it again)" in text
+    assert (f"note: the sky result on {level.label} was traced on other stands (18 plants) "
+            "than the project's layout (2); left out (compute it again)") in text
     assert not w.model.runs.runs and w.viewport.colouring != "light"

@@ -74,19 +74,39 @@ def _fold(values: np.ndarray, slot: np.ndarray | None, n_slots: int) -> np.ndarr
 class Assimilation:
     """Gross CO2 assimilation of the leaves under one traced light.
 
-    Attributes
+    Parameters
     ----------
-    model : dict, the leaf model's name and parameters (:meth:`LeafModel.as_dict`)
-    temp_c : leaf (air) temperature, C
-    triangle_gross_umol_s : (F,) float64 umol CO2/s per leaf triangle (in a tile-periodic
-        field, on the copy inside the sample rectangle; its other copies 0)
-    triangle_batches : (BATCHES, F) float64 the same from each batch of rays alone (rows sum
-        to ``triangle_gross_umol_s`` up to the non-linearity), or None
-    ground_m2 : m2 of ground the canopy figure is per (the sample rectangle)
-    respiration_umol_m2_leaf : the model's leaf respiration at ``temp_c``, umol/m2 leaf/s
-    leaf_area_m2 : m2 of leaf the triangles stand for (one copy in a tile-periodic field)
-    rect, periodic : as traced
-    warnings : what the user should know (leaves partly out of the rays' reach)
+    model : dict
+        The leaf model's name and parameters (``LeafModel.as_dict``).
+    temp_c : float
+        Leaf (air) temperature [degC].
+    triangle_gross_umol_s : numpy.ndarray
+        (F,) float64 gross assimilation of each leaf triangle [umol CO2 s-1] (in a
+        tile-periodic field on the copy inside the sample rectangle; its other copies 0).
+    triangle_batches : numpy.ndarray or None
+        (BATCHES, F) float64 the same from each batch of rays alone, or None.
+    ground_m2 : float
+        Ground the canopy figure is per (the sample rectangle) [m2].
+    respiration_umol_m2_leaf : float
+        The model's leaf respiration at ``temp_c`` [umol CO2 m-2 of leaf s-1].
+    leaf_area_m2 : float
+        Leaf the triangles stand for (one copy in a tile-periodic field) [m2].
+    rect : (x0, y0, x1, y1) tuple of float
+        The sample rectangle [cm].
+    periodic : bool
+        Rays wrapped across the plot.
+    warnings : tuple of str
+        What the user should know (leaves partly out of the rays' reach).
+
+    References
+    ----------
+    Collatz, G. J., Ribas-Carbo, M. & Berry, J. A. (1992). Coupled photosynthesis-stomatal
+    conductance model for leaves of C4 plants. Australian Journal of Plant Physiology 19,
+    519-538. https://doi.org/10.1071/PP9920519
+    Spitters, C. J. T., Toussaint, H. A. J. M. & Goudriaan, J. (1986). Separating the
+    diffuse and direct component of global radiation and its implications for modeling canopy
+    photosynthesis. Part II. Calculation of canopy photosynthesis. Agricultural and Forest
+    Meteorology 38, 231-242. https://doi.org/10.1016/0168-1923(86)90061-4
     """
 
     model: dict
@@ -126,12 +146,26 @@ class Assimilation:
             self.respiration_umol_m2_leaf * self.leaf_area_m2 / self.ground_m2
 
     def leaf_model(self) -> LeafModel:
+        """The leaf model it was computed with.
+
+        Returns
+        -------
+        LeafModel
+            Rebuilt from ``model``.
+        """
         return model_from_dict(self.model)
 
     def as_dict(self) -> dict[str, Any]:
-        """The figures the command line's JSON carries (``photosynthesis``)."""
+        """The figures the command line's JSON carries (``photosynthesis``).
+
+        Returns
+        -------
+        dict
+            The model, its parameters, the temperature, the canopy's gross assimilation with its
+            standard error [umol m-2 s-1, kg CO2 ha-1 h-1], net assimilation, LAI and warnings.
+        """
         se = self.canopy_gross_error_umol_m2_s
-        return {**{"model": self.model["model"]},
+        return {"model": self.model["model"],
                 "parameters": {k: v for k, v in self.model.items() if k != "model"},
                 "temperature_c": self.temp_c,
                 "canopy_gross_umol_m2_s": self.canopy_gross_umol_m2_s,
@@ -166,20 +200,35 @@ class Assimilation:
 
 @dataclass(frozen=True)
 class PeriodAssimilation:
-    """Gross CO2 assimilation of the leaves over a period (a day, a weather file): each time
-    step's light through the leaf model at that step's temperature, times the step.
+    """Gross CO2 assimilation of the leaves over a period (a day, a weather file).
 
-    Attributes
+    Each time step's light through the leaf model at that step's temperature, times the step.
+
+    Parameters
     ----------
-    model : dict, the leaf model (:meth:`LeafModel.as_dict`)
-    temperature_c : (n,) float64, air (leaf) temperature of each step, C
-    triangle_gross_mol : (F,) float64 mol CO2 per leaf triangle over the period (tile-periodic
-        fields: on the copy inside the sample rectangle)
-    triangle_batches : (BATCHES, F) float64 the same from each batch of rays alone
-    ground_m2 : m2 of ground (the sample rectangle)
-    step_gross_umol_m2_s : (n,) float64 canopy gross assimilation at each step, umol/m2 of
-        ground/s
-    rect, periodic : as traced
+    model : dict
+        The leaf model (``LeafModel.as_dict``).
+    temperature_c : numpy.ndarray
+        (n,) float64 air (leaf) temperature of each step [degC].
+    triangle_gross_mol : numpy.ndarray
+        (F,) float64 gross assimilation of each leaf triangle over the period [mol CO2]
+        (tile-periodic fields: on the copy inside the sample rectangle).
+    triangle_batches : numpy.ndarray or None
+        (BATCHES, F) float64 the same from each batch of rays alone.
+    ground_m2 : float
+        Ground (the sample rectangle) [m2].
+    step_gross_umol_m2_s : numpy.ndarray
+        (n,) float64 the canopy's gross assimilation at each step [umol m-2 of ground s-1].
+    rect : (x0, y0, x1, y1) tuple of float
+        The sample rectangle [cm].
+    periodic : bool
+        Rays wrapped across the plot.
+
+    References
+    ----------
+    Collatz, G. J., Ribas-Carbo, M. & Berry, J. A. (1992). Coupled photosynthesis-stomatal
+    conductance model for leaves of C4 plants. Australian Journal of Plant Physiology 19,
+    519-538. https://doi.org/10.1071/PP9920519
     """
 
     model: dict
@@ -193,16 +242,35 @@ class PeriodAssimilation:
 
     @property
     def canopy_gross_mol_m2(self) -> float:
-        """mol CO2 per m2 of ground over the period."""
+        """Gross CO2 assimilation over the period per m2 of ground.
+
+        Returns
+        -------
+        float
+            [mol CO2 m-2].
+        """
         return float(self.triangle_gross_mol.sum()) / self.ground_m2
 
     @property
     def canopy_gross_g_m2(self) -> float:
-        """g CO2 per m2 of ground over the period."""
+        """Gross CO2 assimilation over the period per m2 of ground.
+
+        Returns
+        -------
+        float
+            [g CO2 m-2].
+        """
         return self.canopy_gross_mol_m2 * CO2_G_PER_MOL
 
     @property
     def canopy_gross_error_mol_m2(self) -> float | None:
+        """Monte Carlo standard error of :attr:`canopy_gross_mol_m2`.
+
+        Returns
+        -------
+        float or None
+            [mol CO2 m-2]; None without batches.
+        """
         if self.triangle_batches is None:
             return None
         from maizeviz.light.results.uncertainty import batch_error
@@ -210,6 +278,14 @@ class PeriodAssimilation:
         return float(batch_error(self.triangle_batches.sum(axis=1))) / self.ground_m2
 
     def as_dict(self) -> dict[str, Any]:
+        """The figures the command line's JSON carries.
+
+        Returns
+        -------
+        dict
+            The model, its parameters, the temperatures, the canopy's gross assimilation with its
+            standard error [mol m-2, g CO2 m-2] and per step [umol m-2 s-1].
+        """
         se = self.canopy_gross_error_mol_m2
         return {"model": self.model["model"],
                 "parameters": {k: v for k, v in self.model.items() if k != "model"},

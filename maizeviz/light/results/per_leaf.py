@@ -214,7 +214,7 @@ def plant_light(rows: list[LightRow]) -> list[LightRow]:
         d = per.setdefault(int(r["instance"]), {
             "instance": r["instance"], "plant": r["plant"], "x_cm": r["x_cm"], "y_cm": r["y_cm"],
             **({"level": r["level"]} if "level" in r else {}), "leaves_lit": 0,
-            **{k: 0.0 for k in sums}})
+            **dict.fromkeys(sums, 0.0)})
         d["leaves_lit"] = int(d["leaves_lit"]) + 1
         for k in sums:
             d[k] = float(d[k]) + float(r[k])

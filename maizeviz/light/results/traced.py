@@ -95,12 +95,34 @@ class TracedLight:
 
     @property
     def rect_area_cm2(self) -> float:
-        """Area of the sample rectangle, cm2."""
+        """Area of the sample rectangle.
+
+        Returns
+        -------
+        float
+            [cm2].
+        """
         x0, y0, x1, y1 = self.rect
         return (x1 - x0) * (y1 - y0)
 
     def height_index(self, height: float) -> int:
-        """Index of ``height`` (cm) among the traced heights; MaizevizError if not traced."""
+        """Index of a height among the traced heights.
+
+        Parameters
+        ----------
+        height : float
+            A traced height [cm].
+
+        Returns
+        -------
+        int
+            Its index in ``heights_cm``.
+
+        Raises
+        ------
+        MaizevizError
+            The height was not traced.
+        """
         k = np.flatnonzero(np.isclose(self.heights_cm, height, rtol=0, atol=1e-9))
         if not len(k):
             raise MaizevizError(f"height {height:g} cm was not traced (traced: "
@@ -145,9 +167,23 @@ class TracedLight:
         raise NotImplementedError
 
     def leaf_rows(self, canopy: Canopy) -> list[LightRow]:
-        """One row per leaf that received light: its plant, place, area and the light it
-        received (:mod:`maizeviz.light.results.per_leaf`); ``table("leaf", canopy)`` as
-        dicts."""
+        """One row per leaf that received light.
+
+        Its plant, place, area and the light it received
+        (:mod:`maizeviz.light.results.per_leaf`).
+
+        Parameters
+        ----------
+        canopy : Canopy
+            The canopy the light was traced on.
+
+        Returns
+        -------
+        list of dict
+            One row per leaf that received light: ``instance``, ``plant``, ``leaf``, ``x_cm``,
+            ``y_cm``, ``leaf_area_cm2`` and the light (copies of a plant in a tile-periodic field
+            reported as one); ``table("leaf", canopy)`` as dicts.
+        """
         raise NotImplementedError
 
 

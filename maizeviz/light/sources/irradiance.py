@@ -502,7 +502,40 @@ def clear_sky_period(date, lat: float, lon: float, tz: str, step_min: float = 30
                      start: str | None = None, end: str | None = None, altitude: float = 0.0,
                      linke_turbidity: float = DEFAULT_LINKE_TURBIDITY,
                      par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J) -> Period:
-    """``clear_sky(sun_track(...))``: a clear day (or part of it) at a place; see both."""
+    """A clear day (or part of it) at a place: ``clear_sky(sun_track(...))``.
+
+    Parameters
+    ----------
+    date : str
+        The local date, "YYYY-MM-DD".
+    lat : float
+        Latitude [deg north].
+    lon : float
+        Longitude [deg east].
+    tz : str
+        IANA time zone of the day.
+    step_min : float
+        Time between steps [min].
+    start, end : str, optional
+        Local clock times "HH:MM" bounding the period (None: the whole day).
+    altitude : float
+        Height of the place above sea level [m].
+    linke_turbidity : float
+        Linke turbidity of the clear sky [-].
+    par_umol_per_j : float
+        PAR photons per joule of shortwave [umol J-1].
+
+    Returns
+    -------
+    Period
+        The steps with the sun up: their times, sun, irradiance and PAR doses.
+
+    References
+    ----------
+    Ineichen, P. & Perez, R. (2002). A new airmass independent formulation for the Linke
+    turbidity coefficient. Solar Energy 73(3), 151-157.
+    https://doi.org/10.1016/S0038-092X(02)00045-2
+    """
     return clear_sky(sun_track(date, lat, lon, tz, step_min=step_min, start=start, end=end,
                                altitude=altitude),
                      linke_turbidity=linke_turbidity, par_umol_per_j=par_umol_per_j)
@@ -733,28 +766,39 @@ def read_weather(path, tz: str | None = None, label: str = "center",
     Format: comma-separated, a header line, blank lines and lines starting with '#' ignored.
     Columns (any order and case): ``time`` (ISO 8601 with a UTC offset such as
     2005-08-01T12:00+08:00 or a trailing Z; without an offset only when ``tz`` is given, the
-    times are then local clock times in ``tz``), ``ghi`` W/m2 (required), ``dni``, ``dhi`` W/m2
-    (optional); no other column.
+    times are then local clock times in ``tz``), ``ghi`` [W m-2] (required), ``dni``,
+    ``dhi`` [W m-2] (optional); no other column.
 
-    Rules: at least 2 rows; times strictly increasing; a step longer than GAP_FACTOR (1.5) x the
-    median step is a gap and refused; values must be numbers in [0, MAX_IRRADIANCE_W_M2]
-    (no NaN, no empty cell); files over ``max_bytes`` are refused before reading.
+    Rules: at least 2 rows; times strictly increasing; a step longer than GAP_FACTOR (1.5) x
+    the median step is a gap and refused; values must be numbers in [0,
+    MAX_IRRADIANCE_W_M2] (no NaN, no empty cell); files over ``max_bytes`` are refused before
+    reading.
 
-    Each row stands for an interval (the midpoint rule of this module): with ``label`` "center"
-    (default) the row's time is the middle of an interval reaching halfway to the neighbouring
-    rows; "start" means the interval begins at the row's time and ends at the next row's;
-    "end" means it ends at the row's time (hourly means stamped at the end of the hour).
+    Each row stands for an interval (the midpoint rule of this module): with ``label``
+    "center" (default) the row's time is the middle of an interval reaching halfway to the
+    neighbouring rows; "start" means the interval begins at the row's time and ends at the
+    next row's; "end" means it ends at the row's time (hourly means stamped at the end of
+    the hour).
 
     Parameters
     ----------
     path : str or Path
-    tz : IANA time zone, or None: times must then carry their offset
-    label : "center", "start" or "end"
-    max_bytes : int, largest file accepted
+        The weather file.
+    tz : str, optional
+        IANA time zone of times without an offset; None: times must carry their offset.
+    label : {"center", "start", "end"}
+        Where each row's time sits in its interval.
+    max_bytes : int
+        Largest file accepted [bytes].
+
+    Returns
+    -------
+    Weather
+        Its times, steps and irradiance columns.
 
     Raises
     ------
-    WeatherFileError (a MaizevizError)
+    WeatherFileError
         One line naming the file, the line, the time and the column at fault.
     """
     path = Path(path)
@@ -822,21 +866,38 @@ def _split_direct_diffuse(weather: Weather, up: np.ndarray, zen: np.ndarray,
 
 def weather_period(weather: Weather, lat: float, lon: float, altitude: float = 0.0,
                    par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J) -> Period:
-    """Period of a weather file at a place: sun positions, direct and diffuse parts.
+    """The period of a weather file at a place: sun positions, direct and diffuse parts.
 
-    The direct and diffuse parts keep the file's ghi: with ``dhi`` given, direct_horizontal =
-    ghi - dhi (dhi above ghi is cut to ghi, said in a note naming the first such row; a
-    ``dni`` column is then not used); with only ``dni``, direct_horizontal = dni
-    cos(zenith) (cut to ghi) and dhi the rest; with ghi alone, the Erbs et al. (1982)
-    diffuse fraction (pvlib; geometric zenith, day of year) gives dhi. ``dni`` is then
-    direct_horizontal / cos(zenith). Rows whose middle has the sun below the horizon are
-    dropped; their energy (twilight, sensor offsets) is stated in the notes.
+    The direct and diffuse parts keep the file's ghi: with ``dhi`` given,
+    direct_horizontal = ghi - dhi (dhi above ghi is cut to ghi); with only ``dni``,
+    direct_horizontal = dni cos(zenith) (cut to ghi) and dhi the rest; with ghi alone, the
+    Erbs et al. (1982) diffuse fraction (pvlib; geometric zenith, day of year) gives dhi.
+    ``dni`` is then direct_horizontal / cos(zenith). Rows whose middle has the sun below the
+    horizon are dropped; their energy (twilight, sensor offsets) is stated in the notes.
 
     Parameters
     ----------
-    weather : Weather from :func:`read_weather`
-    lat, lon : float, deg; altitude : float, m
-    par_umol_per_j : float, umol of PAR per J of shortwave
+    weather : Weather
+        From :func:`read_weather`.
+    lat : float
+        Latitude [deg north].
+    lon : float
+        Longitude [deg east].
+    altitude : float
+        Height of the place above sea level [m].
+    par_umol_per_j : float
+        PAR photons per joule of shortwave [umol J-1].
+
+    Returns
+    -------
+    Period
+        The rows with the sun up: their times, sun, irradiance and PAR doses.
+
+    References
+    ----------
+    Erbs, D. G., Klein, S. A. & Duffie, J. A. (1982). Estimation of the diffuse radiation
+    fraction for hourly, daily and monthly-average global radiation. Solar Energy 28(4),
+    293-302. https://doi.org/10.1016/0038-092X(82)90302-4
     """
     lat, lon = _check_place(lat, lon)
     altitude = _check_altitude(altitude)
