@@ -23,14 +23,18 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
             raise MaizevizError("no canopy to export yet")
         canopy = model.canopy
         signature = model.signature(model.built.label)
+        # the names of `maizeviz light --export` (maizeviz.light.mesh_export.LIGHT_ARRAYS)
         cells = {}
         run = model.runs.for_signature(signature)
         if run is not None and run.classes is not None:
-            cells["light"] = run.classes.astype("int32")
-        for kind, name in (("sky", "diffuse_per_m2_leaf"), ("day", "par_mol_per_m2_leaf")):
+            cells["sun_class"] = run.classes.astype("int32")
+        if run is not None and getattr(run.extra, "leaf_value", None) is not None:
+            cells["absorbed_w_per_m2_leaf"] = run.extra.leaf_value.astype("float64")
+        for kind, name in (("sky", "diffuse_cm2_per_cm2_leaf"),
+                           ("day", "par_mol_per_m2_leaf")):
             run = model.runs.for_signature(signature, kind)
-            if run is not None and run.extra is not None:
-                cells[name] = run.extra.leaf_value.astype("float32")
+            if run is not None and run.extra is not None and run.extra.leaf_value is not None:
+                cells[name] = run.extra.leaf_value.astype("float64")
 
         def work(job):
             from maizeviz.canopy.export import export_canopy

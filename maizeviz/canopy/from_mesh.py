@@ -18,8 +18,15 @@ What is taken from the file, and nothing else changed:
   seen from above (only the tables' ``x_cm, y_cm`` and which plants a sample rectangle holds
   depend on it);
 - **field** (the ground: LAI, ground cover, the periodic field's tile, the default sample
-  rectangle): a rectangle x0, y0, x1, y1 in cm if given, else the mesh's bounding box seen
-  from above.
+  rectangle): a rectangle x0, y0, x1, y1 in cm if given, else the one the file carries (a
+  ``maizeviz field_cm`` comment, as maizeviz's exports write it), else the mesh's bounding
+  box seen from above;
+- **period**: a file that carries its field may also carry the block its periodic field
+  repeats (``maizeviz period_cm``: a tiled canopy's central tile). With the file's field it
+  is the default sample rectangle and, once the light has checked that the triangles do
+  repeat with it, the period the periodic field's sensors are read over, as for the tiled
+  canopy the file came from (:func:`maizeviz.light.tiling.carried_period`). A field given
+  wins over the file's, and then the file's period is not used.
 """
 
 from __future__ import annotations
@@ -32,7 +39,7 @@ import numpy as np
 from maizeviz.canopy.layout import MAX_COORD_CM, CanopyLayout, Placement
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
-from maizeviz.io.mesh_canopy import MAX_LEAF_ID, MeshData, read_mesh
+from maizeviz.io.mesh_canopy import CARRIED, MAX_LEAF_ID, MeshData, read_mesh
 
 #: cm per unit of a mesh file.
 UNITS = {"m": 100.0, "cm": 1.0, "mm": 0.1}
@@ -79,6 +86,50 @@ def check_field(field: tuple[float, float, float, float] | list[float] | str
                             f"less than {MIN_FIELD_CM:g} cm across: is it in cm?",
                             quantity="field")
     return vals
+
+
+def _carried(mesh: MeshData, unit: str | None, up: str, source: str, notes: list[str]
+             ) -> tuple[tuple[float, ...] | None, tuple[float, ...] | None]:
+    """The plot and period the file carries (``field_cm``, ``period_cm`` comments or field
+    data: :data:`maizeviz.io.mesh_data.CARRIED`) in cm, or None."""
+    if not mesh.carried:
+        return None, None
+    if up != "z":
+        notes.append(f"{source}: the file's field and period are written for z up: not used "
+                     "with the y axis up")
+        return None, None
+    scale = UNITS[unit or "cm"]
+    out: list[tuple[float, ...] | None] = []
+    for key in CARRIED:
+        if key not in mesh.carried:
+            out.append(None)
+            continue
+        where, text = mesh.carried[key]
+        try:
+            rect = check_field(text)
+        except MaizevizError as exc:
+            raise MaizevizError(f"{source}: {where}: the {key} the file carries: {exc}",
+                                quantity="field") from None
+        out.append(tuple(v * scale for v in rect))
+    return out[0], out[1]
+
+
+def _period_in(period: tuple[float, ...] | None, field: tuple[float, ...], source: str,
+               notes: list[str]) -> tuple[float, float, float, float] | None:
+    """The carried period if the field holds a whole number of it (more than one), else
+    None with a note."""
+    if period is None:
+        return None
+    x0, y0, x1, y1 = field
+    px0, py0, px1, py1 = period
+    counts = ((x1 - x0) / (px1 - px0), (y1 - y0) / (py1 - py0))
+    whole = all(abs(c - round(c)) <= 1e-9 * c for c in counts)
+    inside = x0 - 1e-6 <= px0 and px1 <= x1 + 1e-6 and y0 - 1e-6 <= py0 and py1 <= y1 + 1e-6
+    if not (whole and inside) or round(counts[0]) * round(counts[1]) < 2:
+        notes.append(f"{source}: the file's period x {px0:g}..{px1:g}, y {py0:g}..{py1:g} cm is "
+                     "not a block the field holds a whole number of times: not used")
+        return None
+    return (float(px0), float(py0), float(px1), float(py1))
 
 
 def _field_coordinates(mesh: MeshData, unit: str | None, up: str, src: str) -> np.ndarray:
@@ -212,7 +263,7 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
     mesh : as :func:`maizeviz.io.mesh_canopy.read_mesh` reads it
     unit : "m", "cm" or "mm"; None: cm, refusing a height that suggests another unit
     up : "z" or "y", the file's up axis
-    field : x0, y0, x1, y1 cm; None: the mesh's bounding box seen from above
+    field : x0, y0, x1, y1 cm; None: the file's, else the mesh's bounding box seen from above
     source : the file, for messages
 
     Raises
@@ -224,6 +275,15 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
     notes = list(mesh.notes)
     if field is not None:
         field = check_field(field)                                    # type: ignore[assignment]
+    carried_field, period = _carried(mesh, unit, up, source, notes)
+    if field is None and carried_field is not None:
+        field, fsrc = carried_field, "the file's"                     # type: ignore[assignment]
+    elif field is not None:
+        fsrc = "given"
+    if period is not None and field != carried_field:
+        notes.append(f"{source}: the file's period is for its own field, not the one given: "
+                     "not used")
+        period = None
     verts = _field_coordinates(mesh, unit, up, source)
     is_leaf = mesh.leaf != 0
     n_leaf = int(is_leaf.sum())
@@ -260,7 +320,6 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
         field = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
         fsrc = "the mesh's bounding box"
     else:
-        fsrc = "given"
         x0, y0, x1, y1 = field
         outside = [p.plant for p in placements if not (x0 <= p.x <= x1 and y0 <= p.y <= y1)]
         if len(outside) == len(placements):
@@ -280,9 +339,15 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
                      "z = 0 (sensor heights count from it)")
     x0, y0, x1, y1 = field
     cells = np.array([field], np.float64)
-    layout = CanopyLayout(placements, cells, x1 - x0, y1 - y0, 0.0, cells.copy(),
-                          (f"the field is {fsrc}: x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f} "
-                           "cm",), (x1 - x0) * (y1 - y0), "mesh")
+    period = _period_in(period, field, source, notes)
+    said = f"the field is {fsrc}: x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f} cm"
+    if period is not None:
+        px0, py0, px1, py1 = period
+        said += (f", repeating every {px1 - px0:.1f} x {py1 - py0:.1f} cm in a periodic field "
+                 "(the file's period; its block is the default sample rectangle)")
+    layout = CanopyLayout(placements, cells, x1 - x0, y1 - y0, 0.0,
+                          np.array([period], np.float64) if period else cells.copy(),
+                          (said,), (x1 - x0) * (y1 - y0), "mesh", period)
     canopy = Canopy(leaf_v, leaf_f, leaf_inst, mesh.plant[is_leaf].astype(np.int32), leaf_ids,
                     layout, MESH_LEVEL, stalk_v, stalk_f, leaves_per,
                     stalk_instance=stalk_inst)

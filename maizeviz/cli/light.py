@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from maizeviz.canopy.export import export_canopy
 from maizeviz.canopy.from_mesh import MESH_LEVEL
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.cli.common import (
@@ -25,6 +26,7 @@ from maizeviz.cli.common import (
     add_level_options,
     canopy_setup,
     check_canopy_costs,
+    check_export,
     check_input_options,
     floats,
     fmt_table,
@@ -55,6 +57,7 @@ from maizeviz.light.irradiance import (
     weather_period,
 )
 from maizeviz.light.leaf_light import leaf_light, merge_rows, plant_light
+from maizeviz.light.mesh_export import light_cells
 from maizeviz.light.optics import BANDS, optics_for, read_optics_table
 from maizeviz.light.perez import PEREZ_MODELS, split_summary
 from maizeviz.light.reports import period_leaf_rows, sky_leaf_rows, write_steps
@@ -143,6 +146,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--leaf-light", metavar="CSV",
                    help="write the light intercepted by every lit leaf")
     p.add_argument("--plant-light", metavar="CSV", help="the same summed per plant")
+    p.add_argument("--export", metavar="PATH",
+                   help="write the canopy mesh of one level with each triangle's light (its "
+                        "leaf's, as --leaf-light): .vtu .vtp .vtk .ply .obj .stl")
     ab = p.add_argument_group(
         "absorbed light with scattering (any of these turns it on; needs a sun)")
     ab.add_argument("--band", choices=BANDS, default=None,
@@ -278,6 +284,7 @@ def run(args: argparse.Namespace) -> int:
     mesh = is_mesh(args.points)
     levels = levels_from(args)
     labels = [MESH_LEVEL] if mesh else [level.label for level in levels]
+    check_export(args.export, [] if mesh else levels)
     sun = sun_from(args)
     heights = tuple(floats(args.heights, "heights", "heights"))
     absorbed_optics = None
@@ -362,9 +369,9 @@ def run(args: argparse.Namespace) -> int:
                                "seconds": {"canopy": canopy_s, "scene": scene_s}}
         warnings: list[str] = []
         tables: list[list[dict]] = []
-        res = sky_res = per_res = None
+        res = sky_res = per_res = ab = None
         if sun is not None:
-            res = engine.sun(sun, classes=want_rows or len(labels) == 1,
+            res = engine.sun(sun, classes=want_rows or len(labels) == 1 or bool(args.export),
                              progress=Progress(f"tracing {label}"))
             warnings += res.warnings
             rec.update(_sun_record(res, sun, canopy, args, heights))
@@ -430,6 +437,11 @@ def run(args: argparse.Namespace) -> int:
             rec.update(sun=None, transmission=None, rays=rays, rect_cm=[x0, y0, x1, y1],
                        density_per_cm2=rays / ((x1 - x0) * (y1 - y0)))
         _write_outputs(args, canopy, label, len(labels), res, sky_res, per_res, tables)
+        if args.export:
+            path = export_canopy(args.export, canopy,
+                                 light_cells(canopy, res, sky_res, per_res, ab))
+            say(f"wrote {canopy.n_triangles:,} leaf triangles of {canopy.n_plants} plants with "
+                f"their light (and their stalks) to {path}")
         records.append(rec)
 
     if args.json:
@@ -575,7 +587,7 @@ def _check_paths(args: argparse.Namespace, labels: list[str], sun: bool,
     """Refuse, before any work, outputs (every per-level file and every file of the heatmap
     and plot folders) that would overwrite an input or each other."""
     period = _period_asked(args)
-    tables = [("the leaf light table", args.leaf_light),
+    tables = [("the mesh export", args.export), ("the leaf light table", args.leaf_light),
               ("the plant light table", args.plant_light),
               ("the time-step table", args.steps if period else None)]
     kinds = [kind for kind, asked in (("sun", sun), ("sky", args.sky is not None or period),
