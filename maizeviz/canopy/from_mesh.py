@@ -88,10 +88,11 @@ def check_field(field: tuple[float, float, float, float] | list[float] | str
     return vals
 
 
-def _carried(mesh: MeshData, unit: str | None, up: str, source: str, notes: list[str]
-             ) -> tuple[tuple[float, ...] | None, tuple[float, ...] | None]:
+def _carried(mesh: MeshData, unit: str | None, up: str, source: str, notes: list[str],
+             strict: bool) -> tuple[tuple[float, ...] | None, tuple[float, ...] | None]:
     """The plot and period the file carries (``field_cm``, ``period_cm`` comments or field
-    data: :data:`maizeviz.io.mesh_data.CARRIED`) in cm, or None."""
+    data: :data:`maizeviz.io.mesh_data.CARRIED`) in cm, or None; a broken one is refused
+    when ``strict`` (no field given), else said in a note."""
     if not mesh.carried:
         return None, None
     if up != "z":
@@ -108,6 +109,10 @@ def _carried(mesh: MeshData, unit: str | None, up: str, source: str, notes: list
         try:
             rect = check_field(text)
         except MaizevizError as exc:
+            if not strict:                          # a field given: the file's is not needed
+                notes.append(f"{source}: {where}: the {key} the file carries is not read: "
+                             f"{exc}")
+                return None, None
             raise MaizevizError(f"{source}: {where}: the {key} the file carries: {exc}",
                                 quantity="field") from None
         out.append(tuple(v * scale for v in rect))
@@ -275,7 +280,7 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
     notes = list(mesh.notes)
     if field is not None:
         field = check_field(field)                                    # type: ignore[assignment]
-    carried_field, period = _carried(mesh, unit, up, source, notes)
+    carried_field, period = _carried(mesh, unit, up, source, notes, strict=field is None)
     if field is None and carried_field is not None:
         field, fsrc = carried_field, "the file's"                     # type: ignore[assignment]
     elif field is not None:

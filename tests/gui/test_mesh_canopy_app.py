@@ -81,3 +81,30 @@ def test_a_mesh_canopy_takes_the_field_given(window, qtbot, small_points, tmp_pa
             w.open_mesh(ply, "cm", "z", field=bad)
         assert says in sig.args[0] and "\n" not in sig.args[0]
         assert np.allclose(w.canopy.layout.bounds, wider, atol=1e-6)    # the canopy stays
+
+
+def test_an_exported_canopy_opens_with_its_plot_and_period(window, qtbot, small_points,
+                                                           tmp_path):
+    """File > Open canopy mesh with the field left empty: a canopy the app exported comes
+    back on its own plot, with its tiling's period, and a periodic sun gives the same
+    transmission as the canopy it came from (issue 27)."""
+    from maizeviz.canopy.export import export_canopy
+
+    w = shown(qtbot, window(small_points, tile=3))
+    layout = w.canopy.layout
+    w.light_panel.set_mode("sun")
+    small_light(w.light_panel, "sun")
+    w.light_panel.periodic.setChecked(True)
+    compute(qtbot, w)
+    before = list(w.runs.last.transmission)
+    ply = tmp_path / "exported.ply"
+    export_canopy(str(ply), w.canopy)
+    with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
+        w.open_mesh(ply, "cm", "z")
+    assert w.canopy.layout.bounds == layout.bounds
+    assert w.canopy.layout.period == layout.centre_bounds == w.canopy.layout.centre_bounds
+    assert "the field is the file's" in w.messages.toPlainText()
+    small_light(w.light_panel, "sun")
+    w.light_panel.periodic.setChecked(True)
+    compute(qtbot, w)
+    assert list(w.runs.last.transmission) == before
