@@ -111,9 +111,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     per.add_argument("--to", metavar="HH:MM", help="end of the period on --date")
     per.add_argument("--step", type=float, default=None, metavar="MIN",
                      help="time step, minutes (default 30)")
-    per.add_argument("--weather", metavar="CSV",
-                     help="irradiance from a weather file (time with zone, ghi W/m2, optional "
-                          "dni, dhi) instead of the clear sky; the file sets the period")
+    per.add_argument("--weather", metavar="FILE",
+                     help="irradiance from a weather file instead of the clear sky: maizeviz's "
+                          "CSV (time with zone, ghi W/m2, optional dni, dhi, par umol/m2/s, "
+                          "temp_air), an EPW, TMY3 or NSRDB PSM3/PSM4 file; the file sets the "
+                          "period (and, EPW/TMY3/PSM, the time zone and the place)")
     per.add_argument("--linke-turbidity", type=float, default=None, metavar="T",
                      help=f"Linke turbidity of the clear sky (default {DEFAULT_LINKE_TURBIDITY:g})")
     per.add_argument("--altitude", type=float, default=0.0, metavar="M",
@@ -210,8 +212,9 @@ def _check_options(args: argparse.Namespace) -> None:
                                     "--day, --from, --to or --step with --weather")
             if args.linke_turbidity is not None:
                 raise MaizevizError("--linke-turbidity is for the clear sky, not for --weather")
-            if args.lat is None or args.lon is None:
-                raise MaizevizError("a weather file needs the place: give --lat and --lon")
+            if (args.lat is None) != (args.lon is None):
+                raise MaizevizError("give both --lat and --lon (or neither, with a weather file "
+                                    "whose header gives the place: EPW, TMY3, PSM)")
         else:
             if args.date is None or args.lat is None or args.lon is None:
                 raise MaizevizError(f"{what} needs --date, --lat and --lon (and --tz)")
@@ -262,7 +265,15 @@ def period_from(args: argparse.Namespace) -> Period | None:
     par = DEFAULT_PAR_UMOL_PER_J if args.par_factor is None else args.par_factor
     if args.weather:
         weather = read_weather(args.weather, tz=args.tz)
-        return weather_period(weather, args.lat, args.lon, args.altitude, par)
+        lat, lon = args.lat, args.lon
+        if lat is None:
+            lat, lon = weather.place.get("latitude"), weather.place.get("longitude")
+            if lat is None or lon is None:
+                raise MaizevizError("a weather CSV file needs the place: give --lat and --lon",
+                                    quantity="weather")
+            say(f"place: latitude {lat:g}, longitude {lon:g} (the header of "
+                f"{os.path.basename(args.weather)})")
+        return weather_period(weather, lat, lon, args.altitude, par)
     linke = DEFAULT_LINKE_TURBIDITY if args.linke_turbidity is None else args.linke_turbidity
     return clear_sky_period(args.date, args.lat, args.lon, args.tz or "UTC",
                             30.0 if args.step is None else args.step, args.from_, args.to,
