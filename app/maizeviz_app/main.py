@@ -94,12 +94,14 @@ def _screenshot_flow(app, window, path: str, code: dict) -> None:
     def shoot() -> None:
         window.grab().save(path)
         print(f"saved {path}")
+        window.confirm_unsaved = False     # the light it computed is no work to save: no box
         window.close()
         app.quit()
 
     def fail(msg: str) -> None:
         print(f"error: {msg}", file=sys.stderr)
         code["value"] = 1
+        window.confirm_unsaved = False
         window.close()
         app.quit()
 
