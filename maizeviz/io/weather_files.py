@@ -119,7 +119,12 @@ def _first_bad_row(text: str, kind: str) -> tuple[int, str] | None:
     """(line, what) of the first data row that is not a row of numbers where the format has
     them, for a file pvlib could not read."""
     skip = _header_lines(kind)
-    rows = list(csv.reader(io.StringIO(text)))
+    rows = []
+    for no, line in enumerate(text.splitlines(), 1):
+        try:
+            rows.append(next(csv.reader([line]), []))
+        except csv.Error:
+            return no, "not readable as CSV"
     header = rows[skip - 1] if kind != "epw" and len(rows) >= skip else []
     width = len([c for c in header if c.strip()]) if header else None
     texts = _text_columns(kind, header)
@@ -142,8 +147,11 @@ def _first_bad_row(text: str, kind: str) -> tuple[int, str] | None:
 
 def _read(kind: str, text: str, coerce: int | None):
     """pvlib's reader of ``kind`` on the file's text: (DataFrame, metadata)."""
+    import warnings
+
     import pvlib.iotools as iot
 
+    warnings.filterwarnings("ignore", module=r"pvlib\.iotools")  # pandas' deprecations there
     buf = io.StringIO(text)
     if kind == "epw":
         return iot.read_epw(buf, coerce_year=coerce)

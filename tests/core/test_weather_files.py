@@ -233,3 +233,37 @@ def test_a_csv_without_a_place_is_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert code == EXIT_FAIL and "needs the place: give --lat and --lon" in err
     assert os.path.exists(path)
+
+
+# ------------------------------------------------------------------------------ damaged
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+from maizeviz.errors import MaizevizError  # noqa: E402
+
+
+@settings(max_examples=40, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.data(), path=st.sampled_from([EPW, TMY3, PSM3]))
+def test_damaged_weather_files_give_only_weather_errors(tmp_path, data, path):
+    """Bytes cut, flipped or inserted anywhere in a real sample: a Weather or one line
+    naming the file."""
+    raw = bytearray(path.read_bytes())
+    for _ in range(data.draw(st.integers(1, 3))):
+        op = data.draw(st.sampled_from(["cut", "flip", "insert"]))
+        at = data.draw(st.integers(0, len(raw) - 1))
+        if op == "cut":
+            del raw[at:at + data.draw(st.integers(1, 200))]
+        elif op == "flip":
+            raw[at] = data.draw(st.integers(0, 255))
+        else:
+            raw[at:at] = data.draw(st.binary(min_size=1, max_size=12))
+    bad = tmp_path / path.name
+    bad.write_bytes(bytes(raw))
+    try:
+        w = read_weather(bad)
+    except MaizevizError as exc:
+        assert "\n" not in str(exc) and str(bad) in str(exc), str(exc)
+    else:
+        assert len(w.times) >= 2 and np.all(np.diff(w.times.asi8) > 0)
+        assert np.all(np.isfinite(w.ghi)) and np.all(w.ghi >= 0)
