@@ -32,12 +32,13 @@ from maizeviz.canopy.scene import build_canopy
 from maizeviz.io.points import read_points
 from maizeviz.leaf.fit import fit_leaves
 from maizeviz.leaf.grid import build_grids
-from maizeviz.light.daylight import trace_period
-from maizeviz.light.irradiance import clear_sky_period
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.sky import make_sky
-from maizeviz.light.sun import sun_at
-from maizeviz.light.transmission import light_scene, trace_light
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.scene.scenes import light_scene
+from maizeviz.light.sources.irradiance import clear_sky_period
+from maizeviz.light.sources.sky import make_sky
+from maizeviz.light.sources.sun import sun_at
+from maizeviz.light.trace.diffuse import trace_period
+from maizeviz.light.trace.direct import trace_light
 from maizeviz.mesh.levels import parse_level
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -15,7 +15,7 @@ Fresh processes of the command line (``maizeviz light``, the bundled 3 x 3 block
 - *_seconds: the JSON's own split (canopy, scene, trace, second hits)
 - cli_*_single_rays_s: the same with MAIZEVIZ_PACKETS=0 (embreex's single rays)
 
-In one process (``LightEngine``), the block scene (maizeviz.light.tiling) against the whole
+In one process (``LightEngine``), the block scene (maizeviz.light.scene.tiling) against the whole
 tiled canopy, same engine otherwise:
 
 - build_block_s / build_whole_s: the periodic scene's build
@@ -42,8 +42,8 @@ from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.sun import sun_at
-from maizeviz.light.transmission import light_scene
+from maizeviz.light.scene.scenes import light_scene
+from maizeviz.light.sources.sun import sun_at
 from maizeviz.mesh.levels import parse_level
 from maizeviz.resources import example_points
 

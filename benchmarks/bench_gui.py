@@ -83,9 +83,8 @@ def gil_part() -> dict:
     from maizeviz_app import jobs
     from maizeviz_app.process import CoreProcess
 
-    from maizeviz.light.leaf_light import triangle_light
-    from maizeviz.light.request import LightRequest, Sampling
-    from maizeviz.light.sun import Sun
+    from maizeviz.light.scene.request import LightRequest, Sampling
+    from maizeviz.light.sources.sun import Sun
     from maizeviz.resources import example_points
 
     cover, light = CoreProcess("cover"), CoreProcess("light")
@@ -116,7 +115,7 @@ def gil_part() -> dict:
         req = LightRequest(Sun(22.34, 166.95),
                            Sampling((0, 50, 100, 150, 200, 225), 2.0, None, True, 2), classes=True)
         result = light.call("light", 1, canopy, (req,), Ticket())
-        triangle_light(canopy, result)
+        result.triangle_light(canopy)
         t2 = time.perf_counter()
     gc.callbacks.remove(gc_timer)
     cover.close()

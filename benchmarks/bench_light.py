@@ -32,10 +32,10 @@ from maizeviz.canopy.scene import build_canopy
 from maizeviz.io.points import read_points
 from maizeviz.leaf.fit import fit_leaves
 from maizeviz.leaf.grid import build_grids
-from maizeviz.light.rays import ray_grid
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.sun import Sun
-from maizeviz.light.transmission import trace_light
+from maizeviz.light.scene.rays import ray_grid
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.sources.sun import Sun
+from maizeviz.light.trace.direct import trace_light
 from maizeviz.mesh.levels import parse_level
 from maizeviz.mesh.raytrace import RayScene
 

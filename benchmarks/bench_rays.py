@@ -14,7 +14,7 @@ of them, in Mrays/s:
 - *_nearest: the nearest hit (triangle and distance); *_occluded: any hit (Embree's cheaper
   occlusion query)
 - open: the whole canopy's scene in an open field; periodic_block: the periodic field traced
-  through the block's scene (maizeviz.light.tiling), segments wrapped in C
+  through the block's scene (maizeviz.light.scene.tiling), segments wrapped in C
 - bare_embree_occluded_*: bare Embree's ceiling for packets_occluded: the same packets (the
   same rays, 2 x 4 tiles) laid out in memory beforehand and traced by a C loop that only calls
   ``rtcOccluded8`` (``benchmarks/_bare_embree.c``, compiled here; skipped without a C
@@ -50,9 +50,10 @@ from anchors import best, report
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
-from maizeviz.light.rays import Tracer, ray_grid
-from maizeviz.light.sun import sun_at
-from maizeviz.light.transmission import light_scene, sampler, trace_direction
+from maizeviz.light.scene.rays import Tracer, ray_grid
+from maizeviz.light.scene.scenes import light_scene
+from maizeviz.light.sources.sun import sun_at
+from maizeviz.light.trace.direct import sampler, trace_direction
 from maizeviz.mesh import packets
 from maizeviz.mesh.levels import parse_level
 from maizeviz.mesh.raytrace import RayScene

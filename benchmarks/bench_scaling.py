@@ -34,10 +34,10 @@ from anchors import best
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
-from maizeviz.light.daylight import trace_sky
-from maizeviz.light.request import Sampling
-from maizeviz.light.sky import Sky, make_sky
-from maizeviz.light.transmission import light_scene
+from maizeviz.light.scene.request import Sampling
+from maizeviz.light.scene.scenes import light_scene
+from maizeviz.light.sources.sky import Sky, make_sky
+from maizeviz.light.trace.diffuse import trace_sky
 from maizeviz.mesh.levels import parse_level
 from maizeviz.resources import example_points
 

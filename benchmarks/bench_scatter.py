@@ -27,7 +27,7 @@ from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.optics import DEFAULT_OPTICS, Optics
+from maizeviz.light.trace.optics import DEFAULT_OPTICS, Optics
 from maizeviz.mesh.levels import parse_level
 from maizeviz.resources import example_points
 

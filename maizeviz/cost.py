@@ -22,7 +22,7 @@ from maizeviz.canopy.layout import CanopyLayout
 from maizeviz.canopy.measures import check_cover_resolution
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import Leaf
-from maizeviz.light.rays import Rect, ray_count
+from maizeviz.light.scene.rays import Rect, ray_count
 from maizeviz.mesh.levels import Level
 
 #: Peak bytes per canopy triangle: the canopy arrays, its Embree scene, the ground-cover scene

@@ -23,7 +23,7 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
             raise MaizevizError("no canopy to export yet")
         canopy = model.canopy
         signature = model.signature(model.built.label)
-        # the names of `maizeviz light --export` (maizeviz.light.mesh_export.LIGHT_ARRAYS)
+        # the names of `maizeviz light --export` (maizeviz.light.report.mesh_export.LIGHT_ARRAYS)
         cells = {}
         run = model.runs.for_signature(signature)
         if run is not None and run.classes is not None:
@@ -79,7 +79,7 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
         result = run.result
 
         def work(job):
-            from maizeviz.light.heatmap import save_figure
+            from maizeviz.light.report.heatmap import save_figure
             from maizeviz_app.plots import heatmap_figure_of
 
             save_figure(heatmap_figure_of(result, height, kind), path)
@@ -92,7 +92,7 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
         title = plot_title(model.runs)
 
         def work(job):
-            from maizeviz.light.heatmap import save_figure
+            from maizeviz.light.report.heatmap import save_figure
 
             save_figure(plots.transmission_figure(curves, title, width_in=7, dpi=110), path)
             return path
@@ -113,7 +113,7 @@ def _diffuse_job(what: str, path: str, model: StudyModel):
     light, extra, label = run.result, run.extra, run.label
     if what == "steps":
         def work(job):
-            from maizeviz.light.reports import write_steps
+            from maizeviz.light.report.tables import write_steps
 
             write_steps(path, light)
             return path
@@ -122,8 +122,8 @@ def _diffuse_job(what: str, path: str, model: StudyModel):
         title = day_title(light, label)
 
         def work(job):
-            from maizeviz.light.heatmap import save_figure
-            from maizeviz.light.plots import day_figure
+            from maizeviz.light.report.heatmap import save_figure
+            from maizeviz.light.report.plots import day_figure
 
             save_figure(day_figure(light, title), path)
             return path
@@ -135,7 +135,7 @@ def _diffuse_job(what: str, path: str, model: StudyModel):
 
     def write_table(job):
         from maizeviz.io.atomic import write_rows
-        from maizeviz.light.leaf_light import plant_light
+        from maizeviz.light.results.per_leaf import plant_light
 
         write_rows(path, rows if what == "leaves" else plant_light(rows))
         return path

@@ -21,9 +21,9 @@ from maizeviz.canopy.measures import CanopyMeasures, measure_canopy
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.request import LightRequest
+from maizeviz.light.results.direct import LightResult
+from maizeviz.light.scene.request import LightRequest
 from maizeviz.light.specs import DaySpec, OpticsSpec, SkySpec  # noqa: F401 - the app's names
-from maizeviz.light.transmission import LightResult
 from maizeviz.mesh.levels import parse_level
 from maizeviz.progress import ProgressCallback
 
@@ -133,10 +133,8 @@ def op_absorbed(state: dict, progress: ProgressCallback, request: LightRequest,
 def absorbed_of(canopy, light) -> Absorbed:
     """What the window shows of absorbed light (an ``AbsorbedLight``) on the canopy it was
     traced on (also for a result read from a project)."""
-    from maizeviz.light.reports import leaf_values
-    from maizeviz.light.scatter import absorbed_leaf_rows
-
-    values = leaf_values(canopy, absorbed_leaf_rows(canopy, light), "absorbed_w", light.rect,
+    from maizeviz.light.report.tables import leaf_values
+    values = leaf_values(canopy, light.leaf_rows(canopy), "absorbed_w", light.rect,
                          light.periodic)
     plants = light.table("plant", canopy).to_dict("records")
     return Absorbed(light, values.astype(np.float32), plants)
@@ -144,7 +142,7 @@ def absorbed_of(canopy, light) -> Absorbed:
 
 @dataclass(frozen=True)
 class Absorbed:
-    """Absorbed light (:class:`maizeviz.light.scatter.AbsorbedLight`) with what the window
+    """Absorbed light (:class:`maizeviz.light.results.absorbed.AbsorbedLight`) with what the window
     shows of it: ``leaf_value`` (F,) float32 W absorbed per m2 of leaf on each leaf triangle
     (its leaf's), and ``plant_rows`` (the result's ``table("plant")`` as records); both None
     for a result read from a project until computed against its canopy."""
@@ -172,8 +170,8 @@ class Diffuse:
 def _diffuse(state: dict, light, rows: list, column: str, build_s: float) -> Diffuse:
     import numpy as np
 
-    from maizeviz.light.leaf_light import plant_light
-    from maizeviz.light.reports import leaf_values
+    from maizeviz.light.report.tables import leaf_values
+    from maizeviz.light.results.per_leaf import plant_light
 
     values = leaf_values(state["canopy"], rows, column, light.rect, light.periodic)
     if column == "diffuse_intercepted_cm2":
@@ -185,35 +183,29 @@ def diffuse_of(canopy, light, kind: str) -> Diffuse:
     """What the window shows of a sky (``kind`` "sky") or day ("day") result on the canopy it
     was traced on, as :func:`op_sky` and :func:`op_period` make it (for a result read from a
     project)."""
-    from maizeviz.light.reports import period_leaf_rows, sky_leaf_rows
-
     state = {"canopy": canopy}
     build_s = float(light.seconds.get("build", 0.0))
     if kind == "sky":
-        return _diffuse(state, light, sky_leaf_rows(canopy, light), "diffuse_intercepted_cm2",
+        return _diffuse(state, light, light.leaf_rows(canopy), "diffuse_intercepted_cm2",
                         build_s)
-    return _diffuse(state, light, period_leaf_rows(canopy, light), "par_intercepted_mol",
+    return _diffuse(state, light, light.leaf_rows(canopy), "par_intercepted_mol",
                     build_s)
 
 
 def op_sky(state: dict, progress, sampling, spec: SkySpec) -> Diffuse:
     """Diffuse light under a sky (one scene, every direction traced like the sun); the engine
     keeps the result, so a day on the same canopy, sampling and sky reuses it."""
-    from maizeviz.light.reports import sky_leaf_rows
-
     def steps(done: int, total: int):
         return progress(done, total, f"sky direction {done} of {total}")
 
     light = _engine(state).sky(spec.sky(), sampling=sampling, progress=steps)
-    return _diffuse(state, light, sky_leaf_rows(state["canopy"], light),
+    return _diffuse(state, light, light.leaf_rows(state["canopy"]),
                     "diffuse_intercepted_cm2", light.seconds["build"])
 
 
 def op_period(state: dict, progress, sampling, sky: SkySpec, day: DaySpec) -> Diffuse:
     """Light over a day: the sun traced at every step, the sky once (or the sky light the
     engine kept from a sky run with the same settings)."""
-    from maizeviz.light.reports import period_leaf_rows
-
     period = day.period()
     engine = _engine(state)
     perez = day.diffuse == "perez"             # the sky's directions, as a uniform sky
@@ -227,7 +219,7 @@ def op_period(state: dict, progress, sampling, sky: SkySpec, day: DaySpec) -> Di
 
     light = engine.day(period, sky="perez" if perez else sky_obj, directions=sky_obj.n,
                        sampling=sampling, progress=steps)
-    return _diffuse(state, light, period_leaf_rows(state["canopy"], light),
+    return _diffuse(state, light, light.leaf_rows(state["canopy"]),
                     "par_intercepted_mol", light.seconds["build"])
 
 

@@ -91,11 +91,11 @@ PAPER = ("Xinyu Guo, Chunjiang Zhao, Boxiang Xiao, Shenglian Lu, Changfeng Li. <
 #: Modules the warm-up thread imports while the window is already on screen, in three stages:
 #: the core (then the points file opens), the 3D view (then the view is made), the rest.
 WARM_STAGES = (
-    ("core", ("maizeviz_app.jobs", "maizeviz.light.leaf_light")),
+    ("core", ("maizeviz_app.jobs", "maizeviz.light.results.per_leaf")),
     ("view", ("pyvista", "pyvistaqt", "maizeviz_app.viewport", "maizeviz_app.panels.layout",
               "maizeviz_app.panels.digitizer")),
     ("rest", ("matplotlib.figure", "matplotlib.backends.backend_agg", "maizeviz_app.plots",
-              "maizeviz.light.heatmap", "maizeviz.canopy.export", "maizeviz_app.project")))
+              "maizeviz.light.report.heatmap", "maizeviz.canopy.export", "maizeviz_app.project")))
 
 
 def _count(n: int, one: str, many: str | None = None) -> str:
@@ -825,14 +825,12 @@ class MainWindow(QMainWindow):
             out = runner.light_process.call(op, key, canopy, args, job)
             job.check()
             if mode == "sun":
-                from maizeviz.light.leaf_light import triangle_light
-
                 absorbed = None
                 if optics is not None:              # leaves with optics: absorbed light too
                     absorbed = runner.light_process.call("absorbed", key, canopy,
                                                          (args[0], optics), job)
                     job.check()
-                run = Run(label, signature, out, triangle_light(canopy, out), extra=absorbed)
+                run = Run(label, signature, out, out.triangle_light(canopy), extra=absorbed)
             else:
                 run = Run(label, signature, out.light, None, mode, out)
             maps = plots.heatmap_images(run.result, first=shown_height, check=job.check,
@@ -961,7 +959,7 @@ class MainWindow(QMainWindow):
         text = self.light_panel.place.text()
 
         def work(job, t):
-            from maizeviz.light.sun import sun_at
+            from maizeviz.light.sources.sun import sun_at
 
             parts = t.split()
             if len(parts) != 5:
@@ -1275,7 +1273,6 @@ class MainWindow(QMainWindow):
             return
 
         def work(job):
-            from maizeviz.light.leaf_light import triangle_light
             from maizeviz_app import jobs
 
             done: list[Any] = []
@@ -1284,7 +1281,7 @@ class MainWindow(QMainWindow):
                 if run.kind == "sun":
                     absorbed = None if run.extra is None else \
                         jobs.absorbed_of(canopy, run.extra.light)
-                    done.append((triangle_light(canopy, run.result), absorbed))
+                    done.append((run.result.triangle_light(canopy), absorbed))
                 else:
                     done.append(jobs.diffuse_of(canopy, run.result, run.kind))
             return done

@@ -6,7 +6,7 @@ COLOURINGS = {"plant": "plant", "leaf": "leaf rank", "light": "light received"}
 CAMERAS = {"top": "Top", "along": "Along the rows", "across": "Across the rows",
            "perspective": "Perspective"}
 #: Light class of a triangle in the view: value -> (label, colour). The leaf classes are the
-#: paper's (maizeviz.light.leaf_light.triangle_light): 2 direct, 1 second class, 0 none.
+#: paper's (maizeviz.light.results.per_leaf.triangle_light): 2 direct, 1 second class, 0 none.
 LIGHT_CLASSES = {-2: ("stalk", "#b0875a"), -1: ("not traced", "#c8c8c8"),
                  0: ("no direct light", "#2e5130"), 1: ("second class", "#e39b2d"),
                  2: ("direct", "#fbe54b")}

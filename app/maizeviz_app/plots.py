@@ -1,6 +1,6 @@
 """Light figures drawn off the GUI thread (matplotlib's Agg canvas; no Qt here).
 
-The heatmaps are the core's own figures (:func:`maizeviz.light.heatmap.result_figure`, the
+The heatmaps are the core's own figures (:func:`maizeviz.light.report.heatmap.result_figure`, the
 same as ``maizeviz light --heatmaps``) for a sun, a sky or a day; the transmission-vs-height
 plot compares the mesh levels and lights traced with the same sampling (the paper's Table 3 as
 a plot, with the diffuse sky and the day's PAR beside it). Figures are drawn to RGBA arrays in
@@ -91,8 +91,9 @@ def heatmap_figure_of(result, height: float, kind: str = "sun", width_in: float 
                       dpi: int = 110, bin_cm: float = HEATMAP_BIN_CM):
     """The core's heatmap figure of one height of a light result (a sun's ``LightResult``, a
     ``SkyLight`` or a ``PeriodLight``; ``kind`` sun, sky or day), a sun's in ``bin_cm`` bins
-    (:func:`maizeviz.light.heatmap.result_figure`, titled as ``maizeviz light --heatmaps``)."""
-    from maizeviz.light.heatmap import result_figure
+    (:func:`maizeviz.light.report.heatmap.result_figure`, titled as
+    ``maizeviz light --heatmaps``)."""
+    from maizeviz.light.report.heatmap import result_figure
 
     return result_figure(result, float(height), kind, bin_cm, width_in=width_in, dpi=dpi)
 

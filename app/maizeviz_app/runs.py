@@ -60,8 +60,8 @@ class Run:
 
     @property
     def balance(self) -> Any:
-        """The energy balance (:class:`maizeviz.light.scatter.Balance`, W/m2 of ground) of a
-        sun traced with leaf optics, else None."""
+        """The energy balance (:class:`maizeviz.light.results.absorbed.Balance`, W/m2 of
+        ground) of a sun traced with leaf optics, else None."""
         light = getattr(self.extra, "light", None) if self.kind == "sun" else None
         return getattr(light, "balance", None)
 

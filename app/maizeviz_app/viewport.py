@@ -288,7 +288,7 @@ class Viewport(QtInteractor):
         return bool(np.any(self.canopy_mesh.cell_data["light"] >= 0))
 
     def set_light(self, classes: np.ndarray | None) -> None:
-        """Light class of every leaf triangle (F,) (see ``maizeviz.light.leaf_light.
+        """Light class of every leaf triangle (F,) (see ``maizeviz.light.results.per_leaf.
         triangle_light``), or None to forget it; the view follows if coloured by light."""
         if self.canopy_mesh is None:
             return

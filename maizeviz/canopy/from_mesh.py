@@ -25,7 +25,7 @@ What is taken from the file, and nothing else changed:
   repeats (``maizeviz period_cm``: a tiled canopy's central tile). With the file's field it
   is the default sample rectangle and, once the light has checked that the triangles do
   repeat with it, the period the periodic field's sensors are read over, as for the tiled
-  canopy the file came from (:func:`maizeviz.light.tiling.carried_period`). A field given
+  canopy the file came from (:func:`maizeviz.light.scene.tiling.carried_period`). A field given
   wins over the file's, and then the file's period is not used.
 """
 

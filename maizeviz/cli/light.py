@@ -43,11 +43,17 @@ from maizeviz.errors import LeafError, MaizevizError, check_range
 from maizeviz.io.atomic import file_tag, make_folder, write_rows
 from maizeviz.io.outputs import OutputFolder, check_run_paths
 from maizeviz.leaf.fit import Leaf
-from maizeviz.light.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping
-from maizeviz.light.daylight import PeriodLight, SkyLight
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.heatmap import map_stems, save_figure, write_heatmaps
-from maizeviz.light.irradiance import (
+from maizeviz.light.report.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping
+from maizeviz.light.report.heatmap import map_stems, save_figure, write_heatmaps
+from maizeviz.light.report.mesh_export import light_cells
+from maizeviz.light.report.tables import write_steps
+from maizeviz.light.results.absorbed import AbsorbedLight
+from maizeviz.light.results.diffuse import PeriodLight, SkyLight
+from maizeviz.light.results.direct import LightResult
+from maizeviz.light.results.per_leaf import merge_rows, plant_light
+from maizeviz.light.scene.request import Sampling
+from maizeviz.light.sources.irradiance import (
     DEFAULT_LINKE_TURBIDITY,
     DEFAULT_PAR_UMOL_PER_J,
     PAR_UMOL_PER_J_PAR,
@@ -56,16 +62,11 @@ from maizeviz.light.irradiance import (
     read_weather,
     weather_period,
 )
-from maizeviz.light.leaf_light import leaf_light, merge_rows, plant_light
-from maizeviz.light.mesh_export import light_cells
-from maizeviz.light.optics import BANDS, optics_for, read_optics_table
-from maizeviz.light.perez import PEREZ_MODELS, split_summary
-from maizeviz.light.reports import period_leaf_rows, sky_leaf_rows, write_steps
-from maizeviz.light.request import Sampling
-from maizeviz.light.scatter import DEFAULT_DEPTH, AbsorbedLight, absorbed_leaf_rows
-from maizeviz.light.sky import SKY_KINDS, Sky, make_sky
-from maizeviz.light.sun import Sun, sun_at
-from maizeviz.light.transmission import LightResult
+from maizeviz.light.sources.perez import PEREZ_MODELS, split_summary
+from maizeviz.light.sources.sky import SKY_KINDS, Sky, make_sky
+from maizeviz.light.sources.sun import Sun, sun_at
+from maizeviz.light.trace.optics import BANDS, optics_for, read_optics_table
+from maizeviz.light.trace.scatter import DEFAULT_DEPTH
 from maizeviz.mesh.levels import CANOPY_LEVELS
 
 #: The subcommand.
@@ -389,7 +390,7 @@ def run(args: argparse.Namespace) -> int:
             rec["seconds"].update(trace=res.seconds["trace"],
                                   second_hits=res.seconds.get("second", 0.0))
             if want_rows:
-                tables.append(leaf_light(canopy, res))
+                tables.append(res.leaf_rows(canopy))
         if period is not None:
             per_res = engine.day(period, sky=PEREZ if args.sky == PEREZ else sky,
                                  directions=sky.n if sky is not None else 46,
@@ -409,13 +410,13 @@ def run(args: argparse.Namespace) -> int:
                 rec["diffuse"]["part"] = "isotropic part of the Perez sky"
 
             if want_rows:
-                tables.append(sky_leaf_rows(canopy, sky_res))
+                tables.append(sky_res.leaf_rows(canopy))
         elif sky is not None and period is not None:
             rec["diffuse"] = None                   # the sun never rose: no sky traced
         if per_res is not None:
             rec["period"] = _period_record(per_res, args)
             if want_rows:
-                tables.append(period_leaf_rows(canopy, per_res))
+                tables.append(per_res.leaf_rows(canopy))
         for w in warnings:
             if w not in said:
                 said.add(w)
@@ -441,7 +442,7 @@ def run(args: argparse.Namespace) -> int:
             rec["absorbed"] = _absorbed_record(ab, canopy)
             rec["seconds"]["scatter"] = ab.seconds["trace"] + ab.seconds["scatter"]
             if want_rows:
-                tables.append(absorbed_leaf_rows(canopy, ab))
+                tables.append(ab.leaf_rows(canopy))
         if sun is None:
             rays = per_res.rays if per_res else sky_res.rays if sky_res else 0
             x0, y0, x1, y1 = per_res.rect if per_res else sky_res.rect if sky_res else (0, 0, 1, 1)
@@ -631,7 +632,7 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
     if pl is not None and args.steps:
         write_steps(level_path(args.steps, label, n_levels), pl)
     if pl is not None and args.plots:
-        from maizeviz.light.plots import day_figure
+        from maizeviz.light.report.plots import day_figure
 
         folder = make_folder(args.plots)
         p = pl.period

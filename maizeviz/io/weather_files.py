@@ -1,7 +1,7 @@
 """Weather files researchers hold, read through pvlib.iotools: EnergyPlus EPW, NREL TMY3 and
-NSRDB PSM3/PSM4 CSV (maizeviz's own CSV is read by :func:`maizeviz.light.irradiance.
-read_weather`, which also turns these tables into a :class:`~maizeviz.light.irradiance.
-Weather`).
+NSRDB PSM3/PSM4 CSV. maizeviz's own CSV is read by
+:func:`maizeviz.light.sources.irradiance.read_weather`, which also turns these tables into a
+``Weather``.
 
 Each format is recognised by its first lines (an ``.epw`` starts ``LOCATION,``; a TMY3 file's
 second line starts ``Date (MM/DD/YYYY)``; a PSM file's first ``Source,`` and its third

@@ -1,7 +1,7 @@
 """One light engine over a canopy: its Embree scenes built once, every sun, sky and day traced
 on them.
 
-A scene (:func:`~maizeviz.light.transmission.light_scene`) costs about as much as tracing one
+A scene (:func:`~maizeviz.light.scene.scenes.light_scene`) costs about as much as tracing one
 sun, and is the same for every direction traced through the canopy; an engine builds it when a
 request first needs it (one for an open field, one with the overhanging leaves copied for a
 periodic field) and keeps it. The command line, the sweep's workers and the app's core process
@@ -27,24 +27,26 @@ from dataclasses import fields, replace
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.light.daylight import PeriodLight, SkyLight, trace_period, trace_sky
-from maizeviz.light.irradiance import DEFAULT_LINKE_TURBIDITY, DEFAULT_PAR_UMOL_PER_J, Period
-from maizeviz.light.optics import SHORTWAVE_SHARE, Optics, optics_for
-from maizeviz.light.perez import PEREZ_MODELS, perez_split
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.scatter import (
-    DEFAULT_DEPTH,
-    DEFAULT_THRESHOLD,
-    AbsorbedLight,
-    AbsorbedPeriod,
-    Balance,
-    scatter_beam,
+from maizeviz.light.results.absorbed import AbsorbedLight, AbsorbedPeriod
+from maizeviz.light.results.diffuse import PeriodLight, SkyLight
+from maizeviz.light.results.direct import LightResult
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.scene.scenes import light_scene
+from maizeviz.light.sources.irradiance import (
+    DEFAULT_LINKE_TURBIDITY,
+    DEFAULT_PAR_UMOL_PER_J,
+    Period,
 )
-from maizeviz.light.sky import Sky, make_sky
-from maizeviz.light.sun import Sun, sun_at
-from maizeviz.light.transmission import LightResult, light_scene, trace_light
+from maizeviz.light.sources.perez import PEREZ_MODELS, perez_split
+from maizeviz.light.sources.sky import Sky, make_sky
+from maizeviz.light.sources.sun import Sun, sun_at
+from maizeviz.light.trace.absorbed import absorbed_light, absorbed_period, check_absorbed
+from maizeviz.light.trace.diffuse import trace_period, trace_sky
+from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.optics import SHORTWAVE_SHARE, Optics, optics_for
+from maizeviz.light.trace.scatter import DEFAULT_DEPTH, DEFAULT_THRESHOLD
 from maizeviz.mesh.raytrace import RayScene
-from maizeviz.progress import ProgressCallback, report
+from maizeviz.progress import ProgressCallback
 
 
 class LightEngine:
@@ -62,7 +64,7 @@ class LightEngine:
         Stalks intercept light too (their triangles follow the leaves' in per-triangle
         results).
     **fields
-        Any field of :class:`~maizeviz.light.request.Sampling`: ``heights_cm``, ``density``,
+        Any field of :class:`~maizeviz.light.scene.request.Sampling`: ``heights_cm``, ``density``,
         ``rect``, ``periodic``, ``threads``.
 
     Attributes
@@ -133,7 +135,7 @@ class LightEngine:
         sun : Sun, optional
             The sun's angles; else ``zenith`` and ``azimuth`` (deg), or a place and time.
         date, time : str
-            "YYYY-MM-DD" and local clock time "HH:MM" (:mod:`maizeviz.light.clock`).
+            "YYYY-MM-DD" and local clock time "HH:MM" (:mod:`maizeviz.light.sources.clock`).
         lat, lon : float
             deg north and east. ``tz``: IANA time zone. ``solar_noon``: the day's true solar
             noon instead of ``time``. ``altitude``: m above sea level.
@@ -180,7 +182,7 @@ class LightEngine:
         Parameters
         ----------
         sky : Sky or str
-            A :class:`~maizeviz.light.sky.Sky`, or its kind: "soc" (standard overcast) or
+            A :class:`~maizeviz.light.sources.sky.Sky`, or its kind: "soc" (standard overcast) or
             "uoc" (uniform overcast), split into ``directions`` directions (``split``: "auto",
             "turtle", "tregenza", "equal").
         sampling, progress, **fields_ : as :meth:`sun` (``progress`` after each direction).
@@ -218,8 +220,8 @@ class LightEngine:
         Parameters
         ----------
         period : Period, optional
-            From :func:`~maizeviz.light.irradiance.clear_sky_period` or
-            :func:`~maizeviz.light.irradiance.weather_period`; else a clear day from ``date``
+            From :func:`~maizeviz.light.sources.irradiance.clear_sky_period` or
+            :func:`~maizeviz.light.sources.irradiance.weather_period`; else a clear day from ``date``
             ("YYYY-MM-DD"), ``lat``, ``lon`` (deg), ``tz`` (IANA), ``step_min`` (min),
             ``start``/``end`` (local "HH:MM"), ``altitude`` (m), ``linke`` (Linke turbidity)
             and ``par_factor`` (umol of PAR per J of shortwave).
@@ -227,7 +229,7 @@ class LightEngine:
             The sky of the diffuse part (default: standard overcast, 46 directions); the sky
             light this engine last traced is reused when its sky, sampling and bins match.
             "perez" (or "perez-driesse") splits each step's diffuse light by Perez's
-            anisotropic model (:mod:`maizeviz.light.perez`): its circumsolar part traced with
+            anisotropic model (:mod:`maizeviz.light.sources.perez`): its circumsolar part traced with
             the sun, its isotropic part over a uniform sky of ``directions`` directions.
         directions : int
             Directions of a sky given by its kind (default 46, den Dulk's turtle).
@@ -245,7 +247,7 @@ class LightEngine:
         Ineichen, P. & Perez, R. (2002). A new airmass independent formulation for the Linke
         turbidity coefficient. Solar Energy 73(3), 151-157 (the clear sky).
         """
-        from maizeviz.light.irradiance import clear_sky_period
+        from maizeviz.light.sources.irradiance import clear_sky_period
 
         if period is None:
             if date is None or lat is None or lon is None:
@@ -286,14 +288,14 @@ class LightEngine:
                  time: str | None = None, lat: float | None = None, lon: float | None = None,
                  tz: str | None = None, **fields_) -> AbsorbedLight:
         """Light absorbed by leaves and ground in one band, with scattering
-        (:mod:`maizeviz.light.scatter`): the sun's direct beam and, when ``diffuse_w_m2`` > 0,
-        the diffuse light of a sky.
+        (:func:`maizeviz.light.trace.absorbed.absorbed_light`): the sun's direct beam and,
+        when ``diffuse_w_m2`` > 0, the diffuse light of a sky.
 
         Parameters
         ----------
         sun, zenith, azimuth, date, time, lat, lon, tz : the sun, as :meth:`sun`
         band : "par" or "nir"; optics : the band's Optics (default
-            :data:`maizeviz.light.optics.DEFAULT_OPTICS`)
+            :data:`maizeviz.light.trace.optics.DEFAULT_OPTICS`)
         direct_w_m2 : the band's direct irradiance on a horizontal plane above the canopy,
             W/m2 (default: the band's share of 1000 W/m2 of shortwave, 480 in PAR)
         diffuse_w_m2 : the band's diffuse irradiance on a horizontal plane, W/m2, spread over
@@ -311,11 +313,8 @@ class LightEngine:
         ----------
         Bailey, B. N. (2018). Ecological Modelling 368, 233-245 (Helios' radiation model).
         """
-        import numpy as np
-
-        from maizeviz.errors import check_range
-        from maizeviz.light.request import check_sampling
-        from maizeviz.light.transmission import sampler
+        from maizeviz.light.scene.request import check_sampling
+        from maizeviz.light.trace.direct import sampler
 
         opt = optics if optics is not None else optics_for(band)
         if sun is None:
@@ -324,10 +323,7 @@ class LightEngine:
             elif date is not None and lat is not None and lon is not None:
                 sun = sun_at(date, time, lat, lon, tz)
         direct = 1000.0 * SHORTWAVE_SHARE[opt.band] if direct_w_m2 is None else direct_w_m2
-        check_range(direct, "the direct irradiance (W/m2)", 0, 5000, "irradiance")
-        check_range(diffuse_w_m2, "the diffuse irradiance (W/m2)", 0, 5000, "irradiance")
-        check_range(depth, "the scattering depth", 0, 10_000, "depth", whole=True)
-        check_range(threshold, "the scattering threshold", 0, 1, "threshold")
+        check_absorbed(direct, diffuse_w_m2, depth, threshold)
         if sun is None and (direct > 0 or diffuse_w_m2 == 0):
             raise TypeError("give a Sun, zenith and azimuth, or date, time, lat and lon; or "
                             "direct_w_m2=0 with a diffuse irradiance")
@@ -336,54 +332,12 @@ class LightEngine:
         scene, build_s = self._scene_and_build(smp_req.periodic)
         smp = sampler(self.canopy, scene, rect, smp_req.density, smp_req.heights_cm,
                       smp_req.periodic, self.with_stalks)
-        normals = self._normals()
-        beams: list[tuple[np.ndarray, float]] = []
-        if sun is not None and direct > 0:
-            beams.append((sun.direction(self.canopy.layout.north_deg), direct))
+        sky_obj = None
         if diffuse_w_m2 > 0:
             sky_obj = sky if isinstance(sky, Sky) else make_sky(sky, directions)
-            for toward, weight in zip(sky_obj.directions, sky_obj.weights):
-                beams.append((np.asarray(toward, np.float64), diffuse_w_m2 * float(weight)))
-        area_m2 = smp.ray_area_cm2 * 1e-4 * smp.n
-        nf = len(normals)
-        leaf_optics, kept = None, 1.0 - opt.scattering
-        if opt.ranks:                                # leaves differ by rank (stalks: 0)
-            rank = np.zeros(nf, np.int64)
-            rank[:self.canopy.n_triangles] = self.canopy.face_leaf
-            leaf_optics = opt.per_triangle(rank)
-            kept = 1.0 - (leaf_optics[0] + leaf_optics[1])
-        absorbed, sunlit = np.zeros(nf), np.zeros(nf)
-        parts = dict.fromkeys(("ground", "top", "sides", "unresolved"), 0.0)
-        events, seconds = 0, {"build": build_s, "trace": 0.0, "scatter": 0.0}
-        for k, (toward, irradiance) in enumerate(beams):
-            tally, secs = scatter_beam(smp, toward, opt, normals, depth, threshold,
-                                       seed + 7919 * k, smp_req.threads,
-                                       leaf_optics=leaf_optics)
-            per_ray = irradiance * smp.ray_area_cm2 * 1e-4       # W carried by one ray
-            absorbed += tally.per_triangle(nf, kept * per_ray)
-            if k == 0 and sun is not None and direct > 0:
-                # cm2 of leaf a ray's beam covers: its footprint across the beam over the
-                # cosine of the leaf's tilt to it
-                first = (np.concatenate(tally.first_hits) if tally.first_hits
-                         else np.zeros(0, dtype=np.int64))
-                lit = np.unique(first)
-                factor = np.zeros(nf)
-                factor[lit] = smp.ray_area_cm2 * toward[2] / np.maximum(
-                    np.abs(normals[lit] @ toward), 1e-6)
-                sunlit = tally.sunlit(nf, factor)
-            for name in parts:
-                parts[name] += getattr(tally, name) * per_ray
-            events += tally.events
-            seconds["trace"] += secs["trace"]
-            seconds["scatter"] += secs["scatter"]
-            report(progress, k + 1, len(beams), "absorbed light")
-        incident = direct * (sun is not None) + diffuse_w_m2
-        balance = Balance(float(incident), float(absorbed.sum()) / area_m2,
-                          *(float(parts[k]) / area_m2 for k in ("ground", "top", "sides",
-                                                                 "unresolved")))
-        return AbsorbedLight(opt.band, opt, incident, balance, absorbed, sunlit, rect, smp.n,
-                             len(beams), depth, threshold, seed, events, smp_req.periodic,
-                             self.canopy.level, seconds)
+        return absorbed_light(self.canopy, smp, self._normals(), opt, sun, direct,
+                              diffuse_w_m2, sky_obj, depth, threshold, seed, smp_req.threads,
+                              progress, build_s)
 
     def absorbed_day(self, period: Period | None = None, *, band: str = "par",
                      optics: Optics | None = None, sky: Sky | str = "soc",
@@ -393,20 +347,26 @@ class LightEngine:
                      progress: ProgressCallback | None = None, date: str | None = None,
                      lat: float | None = None, lon: float | None = None, tz: str = "UTC",
                      step_min: float = 30.0, start: str | None = None,
-                     end: str | None = None, linke: float = DEFAULT_LINKE_TURBIDITY,
-                     **fields_) -> AbsorbedPeriod:
+                     end: str | None = None, altitude: float = 0.0,
+                     linke: float = DEFAULT_LINKE_TURBIDITY,
+                     par_factor: float = DEFAULT_PAR_UMOL_PER_J, **fields_) -> AbsorbedPeriod:
         """Light absorbed with scattering over a period (a day), in one band: each step's
         sun with the band's share of its direct irradiance, and the diffuse part spread over
         ``sky``, traced once per W/m2 and scaled by each step's diffuse irradiance (the
-        transport is linear in the light put in).
+        transport is linear in the light put in;
+        :func:`maizeviz.light.trace.absorbed.absorbed_period`).
 
         Parameters
         ----------
-        period, date, lat, lon, tz, step_min, start, end, linke : the period, as :meth:`day`
+        period, date, lat, lon, tz, step_min, start, end, altitude, linke, par_factor : the
+            period, as :meth:`day`; the period's PAR factor (umol of PAR per J of shortwave)
+            also sets the band's share of the shortwave
+            (:func:`~maizeviz.light.trace.optics.band_share`: 0.48 for PAR by default), so that
+            black leaves absorb exactly the PAR the same day intercepts
         band, optics, depth, threshold, seed, sampling, **fields_ : as :meth:`absorbed`
         sky, directions : the diffuse light's sky (default: standard overcast, 46); "perez"
             (or "perez-driesse") splits each step's diffuse light by Perez's model
-            (:mod:`maizeviz.light.perez`): its circumsolar part added to that step's direct
+            (:mod:`maizeviz.light.sources.perez`): its circumsolar part added to that step's direct
             beam, the rest from a uniform sky
         progress : after the sky and after each step
 
@@ -416,57 +376,19 @@ class LightEngine:
             ``balance`` in MJ/m2 of ground, J per triangle, ``absorbed_leaves_mol_m2`` (PAR),
             ``table("plant", canopy)``.
         """
-        from maizeviz.light.irradiance import clear_sky_period
+        from functools import partial
+
+        from maizeviz.light.sources.irradiance import clear_sky_period
 
         if period is None:
             if date is None or lat is None or lon is None:
                 raise TypeError("give a Period, or date, lat and lon")
-            period = clear_sky_period(date, lat, lon, tz, step_min, start, end, 0.0, linke)
+            period = clear_sky_period(date, lat, lon, tz, step_min, start, end, altitude,
+                                      linke, par_factor)
         opt = optics if optics is not None else optics_for(band)
-        share = SHORTWAVE_SHARE[opt.band]
-        common = dict(band=opt.band, optics=opt, depth=depth, threshold=threshold, seed=seed,
-                      sampling=sampling, **fields_)
-        steps = len(period.step_s)
-        model = str(sky).strip().lower() if isinstance(sky, str) else ""
-        split = perez_split(period, model) if model in PEREZ_MODELS else None
-        unit = self.absorbed(direct_w_m2=0.0, diffuse_w_m2=1.0,
-                             sky="uoc" if split is not None else sky,
-                             directions=directions, **common)
-        report(progress, 1, steps + 1, "absorbed light: the sky")
-        diffuse_w = np.asarray(period.dhi, np.float64) * share
-        circumsolar_w = np.zeros(steps)
-        if split is not None:                   # the circumsolar part comes with the sun
-            circumsolar_w = np.asarray(split.circumsolar_w_m2, np.float64) * share
-            diffuse_w = np.asarray(split.isotropic_w_m2, np.float64) * share
-        step_s = np.asarray(period.step_s, np.float64)
-        joules = unit.triangle_absorbed_w * float(np.sum(diffuse_w * step_s))
-        ub = unit.balance
-        parts = {k: getattr(ub, k) * float(np.sum(diffuse_w * step_s))
-                 for k in ("absorbed_leaves", "absorbed_ground", "reflected_top",
-                           "escaped_sides", "unresolved")}
-        leaves_w = ub.absorbed_leaves * diffuse_w
-        seconds = dict(unit.seconds)
-        direct_w = np.asarray(period.direct_horizontal, np.float64) * share + circumsolar_w
-        for k in range(steps):
-            z = float(period.zenith_deg[k])
-            if direct_w[k] > 0 and z < 90.0:
-                light = self.absorbed(Sun(z, float(period.azimuth_deg[k])),
-                                      direct_w_m2=float(direct_w[k]), **common)
-                joules += light.triangle_absorbed_w * step_s[k]
-                for name in parts:
-                    parts[name] += getattr(light.balance, name) * step_s[k]
-                leaves_w[k] += light.balance.absorbed_leaves
-                for name in ("trace", "scatter"):
-                    seconds[name] = seconds.get(name, 0.0) + light.seconds.get(name, 0.0)
-            report(progress, k + 2, steps + 1, f"absorbed light: time step {k + 1} of {steps}")
-        incident_w = diffuse_w + direct_w
-        balance = Balance(float(np.sum(incident_w * step_s)) * 1e-6,
-                          *(float(parts[k]) * 1e-6 for k in ("absorbed_leaves", "absorbed_ground",
-                                                       "reflected_top", "escaped_sides",
-                                                       "unresolved")))
-        return AbsorbedPeriod(opt.band, opt, period, balance, joules, leaves_w, incident_w,
-                              unit.rect, unit.rays, depth, seed, unit.periodic,
-                              self.canopy.level, seconds)
+        one = partial(self.absorbed, band=opt.band, optics=opt, directions=directions,
+                      depth=depth, threshold=threshold, seed=seed, sampling=sampling, **fields_)
+        return absorbed_period(period, opt, sky, one, progress)
 
     def _normals(self):
         """Unit normals (F, 3) of the scene's leaf triangles, then its stalks' if traced

@@ -1,6 +1,6 @@
 """A sky and a day as a user chooses them (the app's light panel, a project's stored
-settings, a notebook): small frozen records that make the core's :class:`~maizeviz.light.sky.Sky`
-and :class:`~maizeviz.light.irradiance.Period` on demand, and compare equal when they would
+settings, a notebook): small frozen records that make the core's :class:`~maizeviz.light.sources.sky.Sky`
+and :class:`~maizeviz.light.sources.irradiance.Period` on demand, and compare equal when they would
 make the same ones.
 
 Example
@@ -14,14 +14,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from maizeviz.light.irradiance import DEFAULT_PAR_UMOL_PER_J
-from maizeviz.light.scatter import DEFAULT_DEPTH
+from maizeviz.light.sources.irradiance import DEFAULT_PAR_UMOL_PER_J
+from maizeviz.light.trace.scatter import DEFAULT_DEPTH
 
 
 @dataclass(frozen=True)
 class SkySpec:
     """A discretised sky: ``kind`` "soc" or "uoc", ``directions`` (16, 46, 145 or any n for
-    an equal-area split), ``split`` "auto" or "equal" (see :func:`maizeviz.light.sky.make_sky`,
+    an equal-area split), ``split`` "auto" or "equal" (see :func:`maizeviz.light.sources.sky.make_sky`,
     which :meth:`sky` calls)."""
 
     kind: str = "soc"
@@ -29,7 +29,7 @@ class SkySpec:
     split: str = "auto"
 
     def sky(self):
-        from maizeviz.light.sky import make_sky
+        from maizeviz.light.sources.sky import make_sky
 
         return make_sky(self.kind, self.directions, self.split)
 
@@ -61,7 +61,7 @@ class DaySpec:
         How each step's diffuse light comes from the sky: ``"sky"`` (the sky chosen, one
         shape all day) or ``"perez"`` (Perez's anisotropic split per step: its circumsolar
         part with the sun, the rest from a uniform sky of the sky's directions; see
-        :mod:`maizeviz.light.perez`).
+        :mod:`maizeviz.light.sources.perez`).
     """
 
     date: str = "2005-08-01"
@@ -77,10 +77,10 @@ class DaySpec:
     diffuse: str = "sky"
 
     def period(self):
-        """The Period (maizeviz.light.irradiance) the spec describes; refused with a
+        """The Period (maizeviz.light.sources.irradiance) the spec describes; refused with a
         MaizevizError naming the quantity (date, tz, step, period, weather...)."""
         from maizeviz.errors import MaizevizError
-        from maizeviz.light import irradiance as irr
+        from maizeviz.light.sources import irradiance as irr
 
         if self.weather:
             weather = irr.read_weather(self.weather, tz=self.tz or None)
@@ -103,7 +103,7 @@ class DaySpec:
         import os
 
         from maizeviz.errors import MaizevizError
-        from maizeviz.light.clock import parse_clock
+        from maizeviz.light.sources.clock import parse_clock
 
         if self.weather:
             try:
@@ -131,7 +131,7 @@ class OpticsSpec:
         ``"par"`` or ``"nir"``.
     reflectance, transmittance, ground_reflectance : float or None
         Leaf and soil fractions in [0, 1] (None: the band's default,
-        :data:`maizeviz.light.optics.DEFAULT_OPTICS`).
+        :data:`maizeviz.light.trace.optics.DEFAULT_OPTICS`).
     direct_w_m2 : float or None
         The band's direct irradiance on a horizontal plane above the canopy, W/m2 (None: the
         band's share of 1000 W/m2 of shortwave).
@@ -140,12 +140,12 @@ class OpticsSpec:
         sky of 46 directions (0: the direct beam only).
     depth : int
         Most scatterings followed per ray (0: first hits only; default
-        :data:`maizeviz.light.scatter.DEFAULT_DEPTH`, as the command line; Russian roulette
+        :data:`maizeviz.light.trace.scatter.DEFAULT_DEPTH`, as the command line; Russian roulette
         and the energy threshold end most paths long before).
     seed : int
         Random seed of the Monte Carlo scattering (the same seed gives the same result).
     ranks : tuple of (rank, reflectance, transmittance)
-        Leaf optics of the ranks that differ (see :class:`maizeviz.light.optics.Optics`).
+        Leaf optics of the ranks that differ (see :class:`maizeviz.light.trace.optics.Optics`).
     """
 
     band: str = "par"
@@ -159,11 +159,11 @@ class OpticsSpec:
     ranks: tuple = ()
 
     def optics(self):
-        """The :class:`~maizeviz.light.optics.Optics` of the band (checked: MaizevizError
+        """The :class:`~maizeviz.light.trace.optics.Optics` of the band (checked: MaizevizError
         naming the value out of range)."""
         from dataclasses import replace
 
-        from maizeviz.light.optics import optics_for
+        from maizeviz.light.trace.optics import optics_for
 
         base = optics_for(self.band, self.reflectance, self.transmittance,
                           self.ground_reflectance)

@@ -221,7 +221,7 @@ int mz_occluded(void *fn_addr, int width, void *scene, int64_t n, const float *o
 }
 
 /* ----------------------------------------------------------------------------------------
- * Rays through a periodic field (maizeviz/light/periodic.py, trace_wrapped, is the same
+ * Rays through a periodic field (maizeviz/light/scene/periodic.py, trace_wrapped, is the same
  * algorithm in numpy, operation for operation in float64, so both give the same answers):
  * the scene repeats with period (w, h) from (x0, y0); each ray is traced, cell by cell, from
  * its own origin moved by whole periods (x, y on the grid of step q), with tfar the end of the
@@ -273,7 +273,7 @@ typedef struct {
 } segment;
 
 /* How far (cm) before a segment's start its query begins: more than a cell edge's rounding
- * and than the margin of the copies (maizeviz.light.periodic.COPY_MARGIN_CM). */
+ * and than the margin of the copies (maizeviz.light.scene.periodic.COPY_MARGIN_CM). */
 #define TNEAR_MARGIN_CM 0.02
 
 static void lane_segment(const lane *L, const double *wrap, segment *S) {

@@ -1,9 +1,9 @@
 """A scene of translated copies (Embree instances) of one built scene: Embree's two-level BVH.
 
 One block of a tiled canopy, built once, placed at each tile of the plot: the plot's scene for
-the price of the block's BVH (:mod:`maizeviz.light.tiling`). An instance moves a ray into the
+the price of the block's BVH (:mod:`maizeviz.light.scene.tiling`). An instance moves a ray into the
 block's frame by ``org - offset`` (a pure translation: Embree's inverse of the transform is
-exact), so with the coordinates on a common grid (:mod:`maizeviz.light.periodic`) an instance
+exact), so with the coordinates on a common grid (:mod:`maizeviz.light.scene.periodic`) an instance
 gives the float32 hits of the triangles it stands for, moved, exactly.
 
 Made through the Embree library embreex loads (:func:`maizeviz.mesh.embree_fill._embree`, the

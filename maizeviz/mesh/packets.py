@@ -202,7 +202,7 @@ def wrapped(k: Kernel, scene_handle: int, origins: np.ndarray, directions: np.nd
             any_hit: bool = False, coherent: bool = True, width: int | None = None,
             row: int = 0, inst_cells: np.ndarray | None = None,
             frame_cells: tuple[int, int] = (1, 1)):
-    """Rays through a periodic field, in C: :func:`maizeviz.light.periodic.trace_wrapped`'s
+    """Rays through a periodic field, in C: :func:`maizeviz.light.scene.periodic.trace_wrapped`'s
     algorithm, the same float64 steps, the same queries.
 
     Parameters

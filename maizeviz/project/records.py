@@ -1,12 +1,12 @@
 """Light results to and from project records (:mod:`maizeviz.io.project`).
 
-A sun result (:class:`~maizeviz.light.transmission.LightResult`) is stored as a ``light``
-record (the only kind of maizeviz 0.2's projects), a sky result (:class:`~maizeviz.light.daylight.SkyLight`) is stored as a ``light_sky`` record,
-a day (:class:`~maizeviz.light.daylight.PeriodLight`, its :class:`~maizeviz.light.irradiance.
+A sun result (:class:`~maizeviz.light.results.direct.LightResult`) is stored as a ``light``
+record (the only kind of maizeviz 0.2's projects), a sky result (:class:`~maizeviz.light.results.diffuse.SkyLight`) is stored as a ``light_sky`` record,
+a day (:class:`~maizeviz.light.results.diffuse.PeriodLight`, its :class:`~maizeviz.light.sources.irradiance.
 Period` and the sky light of its diffuse part) as a ``light_day`` record: JSON metadata
 (numbers, text, times as ISO 8601 with their UTC offset, the time zone's name) and numeric
 arrays; no pickle. Reading checks every size, type and value before the objects are made
-through their constructors (so :class:`~maizeviz.light.sky.Sky` and ``Period`` validate
+through their constructors (so :class:`~maizeviz.light.sources.sky.Sky` and ``Period`` validate
 themselves too); anything wrong is a :class:`~maizeviz.io.project.ProjectError` naming it.
 
 Each record may also hold the settings of that light as JSON (``settings``: the sky chosen, the
@@ -30,8 +30,8 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.io.project import ProjectError, Record, get, get_numbers
-from maizeviz.light.clock import zone as iana_zone
-from maizeviz.light.request import MAX_RAYS
+from maizeviz.light.scene.request import MAX_RAYS
+from maizeviz.light.sources.clock import zone as iana_zone
 
 #: Record kinds of a sun, a sky and a day result (a sun's is the only kind of maizeviz 0.2),
 #: and of the light a sun's leaves absorbed with scattering (kept beside that sun's record).
@@ -135,7 +135,7 @@ def sky_record(label: str, light, settings: dict | None = None) -> Record:
 def day_record(label: str, light, settings: dict | None = None) -> Record:
     """A day result (``PeriodLight`` traced on the canopy labelled ``label``); ``settings``
     as :func:`sky_record`."""
-    from maizeviz.light.perez import SPLIT_ARRAYS
+    from maizeviz.light.sources.perez import SPLIT_ARRAYS
 
     p = light.period
     meta = _common_meta(label, light)
@@ -222,8 +222,8 @@ def run_record(label: str, result, settings: dict | None = None,
     ``PeriodLight`` or an ``AbsorbedLight``; ``settings``: the settings of a sky, day or
     absorbed run as JSON (kept for reopening); ``stands``: the identity of the stands it was
     traced on (:func:`maizeviz.project.stands.stands_identity`)."""
-    from maizeviz.light.daylight import PeriodLight, SkyLight
-    from maizeviz.light.scatter import AbsorbedLight
+    from maizeviz.light.results.absorbed import AbsorbedLight
+    from maizeviz.light.results.diffuse import PeriodLight, SkyLight
 
     if isinstance(result, AbsorbedLight):
         rec = absorbed_record(label, result, settings)
@@ -319,8 +319,8 @@ def _maps(rec: Record, prefix: str, n_heights: int, where: str, what: str) -> di
 
 def _sky_light(rec: Record, m: dict, prefix: str, where: str, what: str):
     """A SkyLight from its metadata ``m`` and the record's arrays named with ``prefix``."""
-    from maizeviz.light.daylight import SkyLight
-    from maizeviz.light.sky import Sky
+    from maizeviz.light.results.diffuse import SkyLight
+    from maizeviz.light.sources.sky import Sky
 
     at = f"{where}: {what}"
     c = _common(m, where, what)
@@ -396,7 +396,7 @@ def _time(text: Any, where: str, what: str):
 def _period(rec: Record, m: dict, where: str):
     import pandas as pd
 
-    from maizeviz.light.irradiance import Period
+    from maizeviz.light.sources.irradiance import Period
 
     at = f"{where}: a day result's period"
     p = get(m, "period", dict, where=f"{where}: a day result")
@@ -434,8 +434,8 @@ def _period(rec: Record, m: dict, where: str):
 def day_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None]:
     """(label, PeriodLight, stored settings or None) from a ``light_day`` record; refused with
     ProjectError if malformed."""
-    from maizeviz.light.daylight import PeriodLight
-    from maizeviz.light.perez import SPLIT_ARRAYS, DiffuseSplit
+    from maizeviz.light.results.diffuse import PeriodLight
+    from maizeviz.light.sources.perez import SPLIT_ARRAYS, DiffuseSplit
 
     m = rec.meta
     what = "a day result"
@@ -478,8 +478,8 @@ def day_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None]:
 
 def sun_from_record(rec: Record, where: str) -> tuple[str, Any]:
     """(label, LightResult) from a ``light`` record; refused with ProjectError if malformed."""
-    from maizeviz.light.sun import Sun
-    from maizeviz.light.transmission import LightResult
+    from maizeviz.light.results.direct import LightResult
+    from maizeviz.light.sources.sun import Sun
 
     m = rec.meta
     what = "a sun result"
@@ -538,8 +538,8 @@ def sun_from_record(rec: Record, where: str) -> tuple[str, Any]:
 def absorbed_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None]:
     """(label, AbsorbedLight, stored settings) from a ``light_absorbed`` record; refused
     with ProjectError if malformed."""
-    from maizeviz.light.optics import Optics
-    from maizeviz.light.scatter import AbsorbedLight, Balance
+    from maizeviz.light.results.absorbed import AbsorbedLight, Balance
+    from maizeviz.light.trace.optics import Optics
 
     m = rec.meta
     what = "an absorbed-light result"

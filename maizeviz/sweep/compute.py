@@ -38,8 +38,8 @@ from maizeviz.errors import MaizevizError
 from maizeviz.io.hashing import sha256_stream
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.request import Sampling
-from maizeviz.light.sun import Sun, sun_at
+from maizeviz.light.scene.request import Sampling
+from maizeviz.light.sources.sun import Sun, sun_at
 from maizeviz.mesh.levels import parse_level
 from maizeviz.sweep.errors import WorkerInputError
 

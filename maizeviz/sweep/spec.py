@@ -222,7 +222,7 @@ def optics_label(optics: OpticsSpec | None) -> str:
     ranks)."""
     if optics is None:
         return "black"
-    from maizeviz.light.scatter import DEFAULT_DEPTH
+    from maizeviz.light.trace.scatter import DEFAULT_DEPTH
 
     o = optics.optics()
     text = (f"{o.band} rho {o.reflectance:g} tau {o.transmittance:g} soil "

@@ -3,11 +3,13 @@ PAR the day intercepts, the balance closes, and the command line reports MJ/m2 a
 
 import json
 
+import numpy as np
 import pytest
 
 import maizeviz as mv
 from maizeviz.cli import main as cli_main
-from maizeviz.light.optics import Optics
+from maizeviz.errors import MaizevizError
+from maizeviz.light.trace.optics import Optics
 
 DAY = dict(date="2005-08-01", lat=39.9, lon=116.4, tz="Asia/Shanghai", step_min=60)
 
@@ -43,6 +45,33 @@ def test_the_days_balance_closes_and_tables_add_up(engine):
     assert got.table("balance")["unit"][0] == "MJ/m2"
     nir = engine.absorbed_day(band="nir", **DAY)
     assert nir.absorbed_leaves_mol_m2 is None and nir.fraction_absorbed < got.fraction_absorbed
+
+
+def test_a_day_at_altitude_with_its_par_factor_absorbs_what_it_intercepts(engine):
+    """absorbed_day takes the period's altitude and PAR factor as day does: black leaves
+    absorb exactly the PAR the same day intercepts, PAR and NIR together are the shortwave,
+    and the higher site brings more light."""
+    high = dict(DAY, altitude=1500.0, par_factor=2.0)
+    day = engine.day(**high)
+    black = engine.absorbed_day(optics=Optics(0, 0, 0), **high)
+    assert dict(black.period.parameters)["altitude_m"] == 1500.0
+    assert black.period.par_umol_per_j == 2.0
+    np.testing.assert_array_equal(black.period.ghi, day.period.ghi)
+    assert black.absorbed_leaves_mol_m2 == pytest.approx(day.par_intercepted_mol_m2, rel=1e-12)
+    assert black.balance.incident * 4.57 == pytest.approx(day.par_incident_mol_m2, rel=1e-12)
+    nir = engine.absorbed_day(band="nir", optics=Optics(0, 0, 0, "nir"), **high)
+    shortwave_mj = float(np.sum(day.period.ghi * day.period.step_s)) * 1e-6
+    assert black.balance.incident + nir.balance.incident == pytest.approx(shortwave_mj,
+                                                                          rel=1e-12)
+    assert black.balance.incident / shortwave_mj == pytest.approx(2.0 / 4.57, rel=1e-12)
+    low = engine.absorbed_day(optics=Optics(0, 0, 0), **DAY)
+    assert np.sum(low.period.ghi) < np.sum(black.period.ghi)      # thinner air at 1500 m
+
+
+def test_a_par_factor_beyond_the_whole_shortwave_is_refused(engine):
+    with pytest.raises(MaizevizError, match="more than the whole shortwave") as info:
+        engine.absorbed_day(band="nir", par_factor=5.0, **DAY)
+    assert info.value.quantity == "par_factor"
 
 
 def test_the_cli_reports_a_days_absorbed_par(capsys):

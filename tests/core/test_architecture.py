@@ -47,6 +47,68 @@ def test_layers_only_point_down():
     assert "0 broken" in proc.stdout
 
 
+def _import_cycles(package: str) -> list[list[str]]:
+    """The import cycles among the modules of ``package`` (strongly connected components of
+    more than one module, every import counted: module level, in functions, for type checks)."""
+    import grimp
+
+    graph = grimp.build_graph(package.split(".")[0], include_external_packages=False)
+    mods = sorted(m for m in graph.modules if m.startswith(package + "."))
+    edges = {m: sorted(d for d in graph.find_modules_directly_imported_by(m)
+                       if d.startswith(package + ".")) for m in mods}
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    cycles: list[list[str]] = []
+
+    def visit(v: str) -> None:                       # Tarjan's strongly connected components
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        for w in edges[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            part = stack[stack.index(v):]
+            del stack[stack.index(v):]
+            if len(part) > 1:
+                cycles.append(sorted(part))
+
+    for m in mods:
+        if m not in index:
+            visit(m)
+    return cycles
+
+
+def test_light_has_no_import_cycle_and_its_layers_are_a_contract():
+    """maizeviz.light's modules import each other without a cycle (results take arrays, not
+    result types: per_leaf no longer imports the sun's result, the diffuse results no longer
+    import the report tables), and pyproject.toml holds its layers as a contract."""
+    import tomllib
+
+    assert _import_cycles("maizeviz.light") == []
+    contracts = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]
+    light = [c for c in contracts["contracts"] if c.get("containers") == ["maizeviz.light"]]
+    assert len(light) == 1 and light[0]["type"] == "layers"
+    layers = [[name.strip() for name in layer.split("|")] for layer in light[0]["layers"]]
+    assert layers == [["engine", "specs"], ["report", "trace"], ["results"], ["scene"],
+                      ["sources"]]
+
+
+def test_an_import_cycle_is_found(tmp_path, monkeypatch):
+    """The cycle finder above finds a cycle closed by an import inside a function."""
+    pkg = tmp_path / "cyclic"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "a.py").write_text("from cyclic import b\n")
+    (pkg / "b.py").write_text("def f():\n    from cyclic import a\n")
+    (pkg / "c.py").write_text("from cyclic import a\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert _import_cycles("cyclic") == [["cyclic.a", "cyclic.b"]]
+
+
 def test_core_and_app_type_check():
     """mypy over the core and the app (pyproject's [tool.mypy] files)."""
     from mypy import api

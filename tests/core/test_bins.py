@@ -5,8 +5,8 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from maizeviz.light.bins import bin_edges, binned, binned_grid
-from maizeviz.light.rays import grid_shape, ray_grid
+from maizeviz.light.results.maps import bin_edges, binned, binned_grid
+from maizeviz.light.scene.rays import grid_shape, ray_grid
 
 
 @settings(max_examples=60, deadline=None)

@@ -5,9 +5,9 @@ import datetime as dt
 import pytest
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.clock import local_time, parse_clock, zone
-from maizeviz.light.irradiance import sun_track
-from maizeviz.light.sun import sun_at
+from maizeviz.light.sources.clock import local_time, parse_clock, zone
+from maizeviz.light.sources.irradiance import sun_track
+from maizeviz.light.sources.sun import sun_at
 
 DAY = dt.date(2005, 8, 1)
 

@@ -8,9 +8,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from maizeviz.light.dates import FIRST_YEAR, LAST_YEAR
-from maizeviz.light.irradiance import WeatherFileError, read_weather, sun_track
-from maizeviz.light.sun import sun_at
+from maizeviz.light.sources.dates import FIRST_YEAR, LAST_YEAR
+from maizeviz.light.sources.irradiance import WeatherFileError, read_weather, sun_track
+from maizeviz.light.sources.sun import sun_at
 
 #: Whole minutes, years 1..9999 (a day short of the end: the file's second row and the
 #: interval after it must stay inside the calendar).

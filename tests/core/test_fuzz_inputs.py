@@ -12,7 +12,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.irradiance import read_weather
+from maizeviz.light.sources.irradiance import read_weather
 from maizeviz.resources import example_points
 
 _LONG = int(os.environ.get("MAIZEVIZ_FUZZ_EXAMPLES", "0"))

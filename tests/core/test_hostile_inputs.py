@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 
 from maizeviz.cli import EXIT_FAIL, main
 from maizeviz.errors import MaizevizError
-from maizeviz.light.irradiance import clear_sky_period, read_weather
-from maizeviz.light.sun import sun_at
+from maizeviz.light.sources.irradiance import clear_sky_period, read_weather
+from maizeviz.light.sources.sun import sun_at
 from maizeviz.resources import example_points
 
 B = str(example_points())

@@ -9,7 +9,7 @@ import pvlib
 import pytest
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.irradiance import (
+from maizeviz.light.sources.irradiance import (
     DEFAULT_PAR_UMOL_PER_J,
     MAX_IRRADIANCE_W_M2,
     WeatherFileError,
@@ -19,7 +19,7 @@ from maizeviz.light.irradiance import (
     sun_track,
     weather_period,
 )
-from maizeviz.light.sun import sun_at
+from maizeviz.light.sources.sun import sun_at
 
 BEIJING = dict(lat=39.9, lon=116.4, tz="Asia/Shanghai")
 DAY = "2005-08-01"

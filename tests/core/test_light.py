@@ -13,13 +13,12 @@ from maizeviz.canopy.layout import layout_from_dict
 from maizeviz.canopy.scene import Canopy
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
-from maizeviz.light.beer_lambert import beer_lambert
-from maizeviz.light.heatmap import transmission_map
-from maizeviz.light.leaf_light import leaf_light
-from maizeviz.light.rays import ray_grid
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.sun import Sun, sun_at
-from maizeviz.light.transmission import trace_light
+from maizeviz.light.report.beer_lambert import beer_lambert
+from maizeviz.light.report.heatmap import transmission_map
+from maizeviz.light.scene.rays import ray_grid
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.sources.sun import Sun, sun_at
+from maizeviz.light.trace.direct import trace_light
 
 BLOCK = str(Path(__file__).resolve().parents[2] / "maizeviz/resources/block3x3.csv")
 
@@ -56,7 +55,7 @@ def test_vertical_sun_shades_exactly_the_overlap():
     assert r.transmission[0] == pytest.approx(expect, abs=1e-12)
     assert r.transmission[:3] == pytest.approx([expect] * 3, abs=1e-12)
     assert list(r.transmission[3:]) == [1.0, 1.0]
-    rows = leaf_light(c, r)
+    rows = r.leaf_rows(c)
     assert rows[0]["sunlit_area_cm2"] == pytest.approx(400, rel=1e-9)
     assert rows[0]["second_class_area_cm2"] == 0
 
@@ -78,7 +77,7 @@ def test_stacked_leaves_direct_and_second_class_areas():
     c = canopy_of([(20, 20, 40, 100), (30, 30, 40, 60), (10, 10, 10, 20)])
     r = trace_light(c, LightRequest(Sun(0, 0),
                                     Sampling(heights_cm=(0,), density=4, rect=(0, 0, 100, 100))))
-    rows = {row["leaf"]: row for row in leaf_light(c, r)}
+    rows = {row["leaf"]: row for row in r.leaf_rows(c)}
     assert rows[1]["sunlit_area_cm2"] == pytest.approx(1600, rel=1e-9)        # top: all direct
     assert rows[1]["second_class_area_cm2"] == 0
     # middle: 30..70 overlaps the top 20..60 over 30 x 30 -> 900 second class, 700 direct
@@ -96,7 +95,7 @@ def test_tilted_leaf_sunlit_area_is_its_surface_area():
     c = Canopy.from_triangles(v, np.array([[0, 1, 2], [0, 2, 3]]), plot(), np.array([1, 1]))
     r = trace_light(c, LightRequest(Sun(0, 0),
                                     Sampling(heights_cm=(0,), density=25, rect=(30, 30, 70, 70))))
-    row = leaf_light(c, r)[0]
+    row = r.leaf_rows(c)[0]
     assert row["sunlit_area_cm2"] == pytest.approx(400, rel=0.02)
     assert row["sunlit_intercepted_cm2"] == pytest.approx(200, rel=0.02)   # its shadow
 
@@ -279,7 +278,7 @@ def test_heights_above_canopy_fine_and_empty_canopy_refused():
 
 
 def test_threads_give_the_same_answer_and_cancel_works(monkeypatch):
-    import maizeviz.light.transmission as tr
+    import maizeviz.light.trace.direct as tr
     monkeypatch.setattr(tr, "CHUNK", 1000)
     rng = np.random.default_rng(1)
     c = canopy_of([(x, y, 10, h) for x, y, h in zip(rng.uniform(0, 90, 80), rng.uniform(0, 90, 80),
@@ -358,8 +357,8 @@ def test_cli_light_bad_input(capsys, argv, says):
 def test_occlusion_queries_agree_with_nearest_hits(periodic):
     """The tracer's occlusion mode (sensor planes) and its nearest-hit mode (ground rays) see
     the same triangles along the same paths, wrapped or not."""
-    from maizeviz.light.rays import Tracer
-    from maizeviz.light.transmission import light_scene
+    from maizeviz.light.scene.rays import Tracer
+    from maizeviz.light.scene.scenes import light_scene
 
     c = _random_squares(7, n=120)
     scene = light_scene(c)
@@ -380,7 +379,7 @@ def test_occlusion_queries_agree_with_nearest_hits(periodic):
 def test_sensor_planes_by_occlusion_and_by_the_ray_family_agree(monkeypatch, periodic):
     """A sensor's path to the sun is asked either as an occlusion query or as the first hit of
     the ray of the same family through it; both give the same planes."""
-    import maizeviz.light.transmission as tr
+    import maizeviz.light.trace.direct as tr
 
     c = _random_squares(9, n=150)
     heights = (0.0, 20.0, 55.5, 100.0, 140.0, 400.0)
@@ -402,7 +401,7 @@ def test_a_rectangle_of_whole_periods_answers_every_plane_by_its_ground_rays(mon
     for any sensor: the family ray through a sensor is one of the rectangle's ground rays
     moved by whole periods. The same sensors, ray for ray, as the family's box; within 2 rays
     of a query per sensor (a path asked from its two ends); the same first and second hits."""
-    import maizeviz.light.transmission as tr
+    import maizeviz.light.trace.direct as tr
 
     calls = {"occluded": 0}
     occluded = tr.Tracer.occluded
@@ -438,7 +437,7 @@ def test_a_rectangle_of_whole_periods_answers_every_plane_by_its_ground_rays(mon
 def test_a_leaf_overhanging_a_periodic_plot_shades_the_opposite_edge():
     """A leaf hanging 20 cm over the east edge of a periodic 100 cm plot stands, in the
     infinite field, 20 cm inside its west edge too: its light is counted on the leaf itself."""
-    from maizeviz.light.transmission import light_scene
+    from maizeviz.light.scene.scenes import light_scene
 
     c = canopy_of([(90, 40, 30, 50)])                       # x 90..120 over the edge at 100
     req = LightRequest(Sun(0, 0), Sampling((0, 60), 4, (0, 0, 100, 100), periodic=True))
@@ -447,7 +446,7 @@ def test_a_leaf_overhanging_a_periodic_plot_shades_the_opposite_edge():
     m = transmission_map(r, 0.0, 10.0)
     assert np.all(m.transmission[[0, 1, 9], 4:7] == 0)      # x 0..20 and 90..100 shaded
     assert len(r.first_hits) == c.n_triangles
-    rows = leaf_light(c, r)
+    rows = r.leaf_rows(c)
     assert rows[0]["sunlit_area_cm2"] == pytest.approx(900, rel=1e-9)
     # an open field has no such copy; a scene built for one is said to miss the overhang
     assert trace_light(c, LightRequest(Sun(0, 0),

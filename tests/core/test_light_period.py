@@ -11,12 +11,13 @@ from test_light_sky import random_leaves
 
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
-from maizeviz.light.daylight import trace_period, trace_sky
-from maizeviz.light.irradiance import clear_sky_period
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.sky import make_sky
-from maizeviz.light.sun import Sun
-from maizeviz.light.transmission import light_scene, trace_light
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.scene.scenes import light_scene
+from maizeviz.light.sources.irradiance import clear_sky_period
+from maizeviz.light.sources.sky import make_sky
+from maizeviz.light.sources.sun import Sun
+from maizeviz.light.trace.diffuse import trace_period, trace_sky
+from maizeviz.light.trace.direct import trace_light
 
 BEIJING = dict(lat=39.9, lon=116.4, tz="Asia/Shanghai")
 HEIGHTS = (0.0, 60.0, 200.0)

@@ -1,4 +1,4 @@
-"""Per-leaf light for colouring and tables (maizeviz.light.reports), and a period that crosses
+"""Per-leaf light for colouring and tables (maizeviz.light.report.tables), and a period that crosses
 process boundaries (pickled) and a weather-file error that names its quantity."""
 
 import pickle
@@ -12,12 +12,12 @@ from maizeviz.io.atomic import write_rows
 from maizeviz.io.points import write_points
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.leaf.synth import block_grids
-from maizeviz.light.daylight import trace_period
-from maizeviz.light.irradiance import WeatherFileError, clear_sky_period, read_weather
-from maizeviz.light.leaf_light import plant_light
-from maizeviz.light.reports import leaf_values, period_leaf_rows, write_steps
-from maizeviz.light.request import Sampling
-from maizeviz.light.sky import make_sky
+from maizeviz.light.report.tables import leaf_values, write_steps
+from maizeviz.light.results.per_leaf import plant_light
+from maizeviz.light.scene.request import Sampling
+from maizeviz.light.sources.irradiance import WeatherFileError, clear_sky_period, read_weather
+from maizeviz.light.sources.sky import make_sky
+from maizeviz.light.trace.diffuse import trace_period
 from maizeviz.mesh.levels import parse_level
 
 
@@ -38,7 +38,7 @@ def day(tiled):
 
 
 def test_leaf_values_put_each_leafs_light_on_all_its_triangles_and_copies(tiled, day):
-    rows = period_leaf_rows(tiled, day)
+    rows = day.leaf_rows(tiled)
     assert {r["instance"] for r in rows} <= {p + 1 for p in range(18)}
     assert len({r["plant"] for r in rows}) == 2 and len({r["instance"] for r in rows}) == 2
     values = leaf_values(tiled, rows, "par_intercepted_mol", day.rect, True)
@@ -55,7 +55,7 @@ def test_leaf_values_put_each_leafs_light_on_all_its_triangles_and_copies(tiled,
 
 
 def test_an_open_field_marks_plants_outside_the_rectangle_not_traced(tiled, day):
-    rows = period_leaf_rows(tiled, day)
+    rows = day.leaf_rows(tiled)
     open_field = leaf_values(tiled, rows, "par_intercepted_mol", day.rect, False)
     assert np.isnan(open_field).any() and np.isfinite(open_field).any()
 
@@ -64,7 +64,7 @@ def test_steps_and_rows_files(tiled, day, tmp_path):
     write_steps(tmp_path / "steps.csv", day)
     lines = (tmp_path / "steps.csv").read_text().splitlines()
     assert len(lines) == day.n_steps + 1 and lines[0].startswith("time,step_s,zenith_deg")
-    write_rows(tmp_path / "leaves.csv", period_leaf_rows(tiled, day))
+    write_rows(tmp_path / "leaves.csv", day.leaf_rows(tiled))
     assert (tmp_path / "leaves.csv").read_text().startswith("instance,plant,leaf")
 
 

@@ -22,12 +22,13 @@ import pytest
 from maizeviz.canopy.layout import layout_from_dict
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
-from maizeviz.light.beer_lambert import beer_lambert_sky
-from maizeviz.light.daylight import trace_sky
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.sky import analytic_diffuse_transmission, make_sky
-from maizeviz.light.sun import Sun
-from maizeviz.light.transmission import light_scene, trace_light
+from maizeviz.light.report.beer_lambert import beer_lambert_sky
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.scene.scenes import light_scene
+from maizeviz.light.sources.sky import analytic_diffuse_transmission, make_sky
+from maizeviz.light.sources.sun import Sun
+from maizeviz.light.trace.diffuse import trace_sky
+from maizeviz.light.trace.direct import trace_light
 
 SIDE = 200.0
 

@@ -595,7 +595,7 @@ def test_light_of_the_exported_canopy_is_the_same(tmp_path, capsys, periodic):
         # rectangle; the mesh's plants are all different, so add its copies up
         found = read_leaves(B)
         layout = layout_for(found.leaves, (3, 3))
-        from maizeviz.light.leaf_light import tile_representatives
+        from maizeviz.light.results.per_leaf import tile_representatives
 
         rep = tile_representatives(layout, tuple(orig["rect_cm"]), True)
         sums: dict = {}

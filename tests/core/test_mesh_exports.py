@@ -22,7 +22,7 @@ from maizeviz.canopy.from_mesh import read_mesh_canopy
 from maizeviz.canopy.layout import layout_for
 from maizeviz.cli import EXIT_OK, main
 from maizeviz.leaf.fit import read_leaves
-from maizeviz.light.leaf_light import tile_representatives
+from maizeviz.light.results.per_leaf import tile_representatives
 from maizeviz.resources import example_points
 
 B = str(example_points())

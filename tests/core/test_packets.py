@@ -10,11 +10,12 @@ import maizeviz.mesh.raytrace as raytrace
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
-from maizeviz.light.daylight import trace_sky
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.sky import make_sky
-from maizeviz.light.sun import Sun
-from maizeviz.light.transmission import light_scene, trace_light
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.scene.scenes import light_scene
+from maizeviz.light.sources.sky import make_sky
+from maizeviz.light.sources.sun import Sun
+from maizeviz.light.trace.diffuse import trace_sky
+from maizeviz.light.trace.direct import trace_light
 from maizeviz.mesh import packets
 from maizeviz.mesh.levels import parse_level
 from maizeviz.mesh.raytrace import RayScene

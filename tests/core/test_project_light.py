@@ -18,13 +18,13 @@ from maizeviz.io.points import write_points
 from maizeviz.io.project import ProjectError, Record, load_project, save_project
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.leaf.synth import block_grids
-from maizeviz.light.daylight import trace_period, trace_sky
-from maizeviz.light.irradiance import clear_sky_period
-from maizeviz.light.reports import leaf_values, period_leaf_rows, sky_leaf_rows, write_steps
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.sky import make_sky
-from maizeviz.light.sun import Sun
-from maizeviz.light.transmission import trace_light
+from maizeviz.light.report.tables import leaf_values, write_steps
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.sources.irradiance import clear_sky_period
+from maizeviz.light.sources.sky import make_sky
+from maizeviz.light.sources.sun import Sun
+from maizeviz.light.trace.diffuse import trace_period, trace_sky
+from maizeviz.light.trace.direct import trace_light
 from maizeviz.mesh.levels import parse_level
 from maizeviz.project import study
 from maizeviz.project.records import DAY_KIND, SKY_KIND, run_from_record, run_record
@@ -145,7 +145,7 @@ def test_a_sky_comes_back_with_every_output_and_its_settings(reopened, sky, cano
     assert (label, kind, settings) == ("16", "sky", SKY_SPEC)
     same_sky_light(sky, back)
     # the leaves' and plants' light, and the colours of the canopy
-    rows, rows_back = sky_leaf_rows(canopy, sky), sky_leaf_rows(canopy, back)
+    rows, rows_back = sky.leaf_rows(canopy), back.leaf_rows(canopy)
     assert rows == rows_back
     np.testing.assert_array_equal(
         leaf_values(canopy, rows, "diffuse_intercepted_cm2", sky.rect, sky.periodic),
@@ -178,7 +178,7 @@ def test_a_day_comes_back_with_every_output_and_its_settings(reopened, day, cano
     for h in HEIGHTS:
         same_map(day, back, h)
     same_sky_light(day.sky, back.sky)
-    assert period_leaf_rows(canopy, day) == period_leaf_rows(canopy, back)
+    assert day.leaf_rows(canopy) == back.leaf_rows(canopy)
     write_steps(tmp_path / "a.csv", day)
     write_steps(tmp_path / "b.csv", back)
     assert (tmp_path / "a.csv").read_text() == (tmp_path / "b.csv").read_text()

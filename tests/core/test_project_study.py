@@ -22,9 +22,9 @@ from maizeviz.io.points import write_points
 from maizeviz.io.project import Project, ProjectError, load_project, save_project
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.leaf.synth import block_grids
-from maizeviz.light.daylight import trace_sky
-from maizeviz.light.request import Sampling
-from maizeviz.light.sky import make_sky
+from maizeviz.light.scene.request import Sampling
+from maizeviz.light.sources.sky import make_sky
+from maizeviz.light.trace.diffuse import trace_sky
 from maizeviz.mesh.levels import parse_level
 from maizeviz.project import study
 

@@ -1,4 +1,4 @@
-"""Absorbed light with scattering (maizeviz.light.scatter), through real Embree, against
+"""Absorbed light with scattering (maizeviz.light.trace.scatter), through real Embree, against
 references we did not write: exact interception with black leaves, the Beer-Lambert law of a
 random spherical canopy (the values Helios' homogeneous-canopy test uses), a leaf's
 transmittance, two parallel plates in closed form, de Pury & Farquhar's scattered-beam
@@ -13,7 +13,7 @@ from maizeviz.canopy.layout import layout_from_dict
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.optics import DEFAULT_OPTICS, Optics, optics_for
+from maizeviz.light.trace.optics import DEFAULT_OPTICS, Optics, optics_for
 
 
 def plot(x0=0.0, y0=0.0, x1=100.0, y1=100.0):

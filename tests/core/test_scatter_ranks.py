@@ -9,7 +9,7 @@ from test_scatter import plates
 from maizeviz.cli import main as cli_main
 from maizeviz.errors import MaizevizError
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.optics import Optics, read_optics_table
+from maizeviz.light.trace.optics import Optics, read_optics_table
 
 
 def test_each_triangle_takes_its_ranks_values():

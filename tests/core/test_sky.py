@@ -11,7 +11,7 @@ from scipy.spatial import cKDTree
 from scipy.special import expn
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.sky import (
+from maizeviz.light.sources.sky import (
     MAX_SKY_DIRECTIONS,
     Sky,
     analytic_diffuse_transmission,
@@ -19,7 +19,7 @@ from maizeviz.light.sky import (
     make_sky,
     turtle_directions,
 )
-from maizeviz.light.sun import Sun
+from maizeviz.light.sources.sun import Sun
 
 KINDS = ("soc", "uoc")
 SKIES = [(6, "turtle"), (16, "turtle"), (46, "turtle"), (145, "tregenza"), (1, "equal"),

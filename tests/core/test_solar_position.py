@@ -14,9 +14,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light import solar_position
-from maizeviz.light.clock import local_datetime, local_time, zone
-from maizeviz.light.sun import sun_at
+from maizeviz.light.sources import solar_position
+from maizeviz.light.sources.clock import local_datetime, local_time, zone
+from maizeviz.light.sources.sun import sun_at
 
 ZONES = st.sampled_from([None, "UTC", "Asia/Shanghai", "America/New_York", "Europe/Paris",
                          "Australia/Lord_Howe", "Pacific/Kiritimati", "America/St_Johns"])
@@ -84,7 +84,7 @@ def test_pvlibs_spa_file_alone_computes_what_the_package_does():
 def test_a_sun_from_a_date_imports_neither_pandas_nor_pvlib():
     """pandas and pvlib take 1 to 2 s to import: more than tracing a K = 4 sun (issue 20)."""
     code = ("import sys\n"
-            "from maizeviz.light.sun import sun_at\n"
+            "from maizeviz.light.sources.sun import sun_at\n"
             "s = sun_at('2005-08-01', '12:00', 39.9, 116.4, 'Asia/Shanghai')\n"
             "n = sun_at('2005-08-01', None, 39.9, 116.4, 'Asia/Shanghai', solar_noon=True)\n"
             "print(s.zenith_deg, n.when, sorted(m for m in sys.modules "

@@ -1,4 +1,4 @@
-"""A tiled canopy in a periodic field traced through its block (maizeviz.light.tiling) gives
+"""A tiled canopy in a periodic field traced through its block (maizeviz.light.scene.tiling) gives
 what the whole tiled canopy gives, ray for ray, through real Embree: the same first and second
 hits on the same tile's triangles, the same hit heights, sensor planes, transmission, heatmaps,
 per-leaf and per-plant light, sky and day; and a canopy that does not tile its block exactly
@@ -10,17 +10,17 @@ import pytest
 from maizeviz.canopy.layout import layout_for, layout_from_dict, layout_to_dict
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
-from maizeviz.light.daylight import trace_period, trace_sky
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.heatmap import transmission_map
-from maizeviz.light.irradiance import clear_sky_period
-from maizeviz.light.leaf_light import leaf_light
-from maizeviz.light.periodic import Wrap, trace_wrapped
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.sky import make_sky
-from maizeviz.light.sun import Sun
-from maizeviz.light.tiling import block_tiling
-from maizeviz.light.transmission import BlockScene, CanopyScene, light_scene, trace_light
+from maizeviz.light.report.heatmap import transmission_map
+from maizeviz.light.scene.periodic import Wrap, trace_wrapped
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.scene.scenes import BlockScene, CanopyScene, light_scene
+from maizeviz.light.scene.tiling import block_tiling
+from maizeviz.light.sources.irradiance import clear_sky_period
+from maizeviz.light.sources.sky import make_sky
+from maizeviz.light.sources.sun import Sun
+from maizeviz.light.trace.diffuse import trace_period, trace_sky
+from maizeviz.light.trace.direct import trace_light
 from maizeviz.mesh.levels import parse_level
 from maizeviz.resources import example_points
 
@@ -66,7 +66,7 @@ def test_sun_through_the_block_is_the_tiled_canopy_ray_for_ray(tiled, zenith, az
     _same(a.transmission, b.transmission)
     for h in (0.0, 100.0):
         _same(transmission_map(a, h, 5.0).transmission, transmission_map(b, h, 5.0).transmission)
-    assert leaf_light(c, a) == leaf_light(c, b)
+    assert a.leaf_rows(c) == b.leaf_rows(c)
     assert a.table("plant", c).equals(b.table("plant", c))
 
 

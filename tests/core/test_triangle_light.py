@@ -6,10 +6,10 @@ import pytest
 from maizeviz.canopy.layout import layout_for, layout_from_dict
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.leaf.fit import read_leaves
-from maizeviz.light.leaf_light import NOT_TRACED, triangle_light
-from maizeviz.light.request import LightRequest, Sampling
-from maizeviz.light.sun import Sun
-from maizeviz.light.transmission import trace_light
+from maizeviz.light.results.per_leaf import NOT_TRACED
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.sources.sun import Sun
+from maizeviz.light.trace.direct import trace_light
 from maizeviz.mesh.levels import Level
 from maizeviz.resources import example_points
 
@@ -31,7 +31,7 @@ def test_stacked_leaves_direct_second_and_untraced():
     # two stacked squares above the sample rectangle, one square far outside it
     c = squares([(20, 20, 20, 80), (20, 20, 20, 40), (70, 70, 10, 50)])
     r = trace_light(c, LightRequest(Sun(0, 0), Sampling((0,), 4, (10, 10, 50, 50))))
-    classes = triangle_light(c, r)
+    classes = r.triangle_light(c)
     assert list(classes) == [2, 2, 1, 1, NOT_TRACED, NOT_TRACED]
 
 
@@ -43,7 +43,7 @@ def tiled():
 
 def test_every_copy_of_a_plant_is_classified_like_the_others_in_a_periodic_tiling(tiled):
     r = trace_light(tiled, LightRequest(Sun(22.3, 167), Sampling((0,), 1, None, periodic=True)))
-    classes = triangle_light(tiled, r)
+    classes = r.triangle_light(tiled)
     assert (classes >= 0).all(), "a tile-periodic field is classified everywhere"
     inst = tiled.face_instance
     by_plant = {}
@@ -56,7 +56,7 @@ def test_every_copy_of_a_plant_is_classified_like_the_others_in_a_periodic_tilin
 
 def test_an_open_field_marks_what_no_ray_reached(tiled):
     r = trace_light(tiled, LightRequest(Sun(22.3, 167), Sampling((0,), 1, None, periodic=False)))
-    classes = triangle_light(tiled, r)
+    classes = r.triangle_light(tiled)
     centre = np.array([pl.tile == (0, 0) for pl in tiled.layout.placements])[tiled.face_instance]
     unreached = classes == NOT_TRACED
     assert unreached[~centre].mean() > 0.5                    # outer tiles: mostly unreached

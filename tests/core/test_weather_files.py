@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
-from maizeviz.light.irradiance import (
+from maizeviz.light.sources.irradiance import (
     DEFAULT_PAR_UMOL_PER_J,
     WeatherFileError,
     read_weather,

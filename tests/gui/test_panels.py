@@ -120,9 +120,9 @@ def test_plots_switch_heights(qtbot):
 def test_figures_are_the_core_heatmap_and_a_level_comparison(small_canopy):
     from maizeviz_app.plots import Curve, heatmap_images, rgba, transmission_figure
 
-    from maizeviz.light.request import LightRequest, Sampling
-    from maizeviz.light.sun import Sun
-    from maizeviz.light.transmission import trace_light
+    from maizeviz.light.scene.request import LightRequest, Sampling
+    from maizeviz.light.sources.sun import Sun
+    from maizeviz.light.trace.direct import trace_light
 
     result = trace_light(small_canopy, LightRequest(Sun(22.3, 167.0), Sampling((0.0, 100.0), 0.5),
                                                     classes=True))

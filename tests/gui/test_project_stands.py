@@ -62,9 +62,9 @@ def test_results_of_other_stands_are_left_out_with_one_line(window, qtbot, small
     from maizeviz.canopy.scene import build_canopy
     from maizeviz.io.project import save_project
     from maizeviz.leaf.fit import read_leaves
-    from maizeviz.light.daylight import trace_sky
-    from maizeviz.light.request import Sampling
-    from maizeviz.light.sky import make_sky
+    from maizeviz.light.scene.request import Sampling
+    from maizeviz.light.sources.sky import make_sky
+    from maizeviz.light.trace.diffuse import trace_sky
     from maizeviz.mesh.levels import parse_level
     from maizeviz.project.study import make_project
 

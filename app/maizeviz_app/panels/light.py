@@ -47,7 +47,11 @@ from PySide6.QtWidgets import (
 )
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.irradiance import DEFAULT_PAR_UMOL_PER_J, PAR_FRACTION, PAR_UMOL_PER_J_PAR
+from maizeviz.light.sources.irradiance import (
+    DEFAULT_PAR_UMOL_PER_J,
+    PAR_FRACTION,
+    PAR_UMOL_PER_J_PAR,
+)
 from maizeviz_app.runs import MODES, SKIES, LightRuns, Run, level_order  # noqa: F401 - re-exported
 
 DEFAULT_PLACE = "2005-08-01 12:00 39.9 116.4 Asia/Shanghai"
@@ -304,7 +308,7 @@ class LightPanel(QWidget):
 
     def _optics_group(self) -> QGroupBox:
         """Leaf optics: absorbed light with scattering (off: black leaves, interception)."""
-        from maizeviz.light.optics import DEFAULT_OPTICS, SHORTWAVE_SHARE
+        from maizeviz.light.trace.optics import DEFAULT_OPTICS, SHORTWAVE_SHARE
 
         box = QGroupBox("leaf optics: absorbed light with scattering")
         box.setCheckable(True)
@@ -347,7 +351,7 @@ class LightPanel(QWidget):
                                   "standard overcast sky of 46 directions (0: direct only)")
         form.addRow("direct", self.direct_w)
         form.addRow("diffuse", self.diffuse_w)
-        from maizeviz.light.scatter import DEFAULT_DEPTH
+        from maizeviz.light.trace.scatter import DEFAULT_DEPTH
 
         self.scatter_depth = QSpinBox(minimum=0, maximum=50, value=DEFAULT_DEPTH)
         self.scatter_depth.setToolTip("most scatterings followed per ray (0: first hits only; "
@@ -652,8 +656,8 @@ class LightPanel(QWidget):
         InputProblem, MaizevizError
             Naming the field (``quantity``).
         """
-        from maizeviz.light.request import LightRequest
-        from maizeviz.light.sun import Sun
+        from maizeviz.light.scene.request import LightRequest
+        from maizeviz.light.sources.sun import Sun
 
         sampling = self.sampling()
         sun = Sun(self.zenith.value(), self.azimuth.value())
@@ -661,7 +665,7 @@ class LightPanel(QWidget):
 
     def sampling(self):
         """Heights, density and field of a sky or a day (a ``Sampling``; 2 tracing threads)."""
-        from maizeviz.light.request import Sampling
+        from maizeviz.light.scene.request import Sampling
 
         return Sampling(parse_heights(self.heights.text()), self.density.value(), None,
                         self.periodic.isChecked(), 2)

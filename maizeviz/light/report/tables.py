@@ -1,9 +1,9 @@
-"""Tables of diffuse and period light, per leaf, per plant and per time step, and the files they
-are written to (atomically): what ``maizeviz light`` writes and the desktop app exports.
+"""Tables of light per leaf and per time step, and the files they are written to (atomically):
+what ``maizeviz light`` writes and the desktop app exports.
 
-Per-leaf rows come from :func:`maizeviz.light.leaf_light.leaf_sums` (copies of a plant in a
-tile-periodic field reported as one); per-plant rows from
-:func:`~maizeviz.light.leaf_light.plant_light`.
+Per-leaf rows come from each result's ``leaf_rows(canopy)`` (sums over the leaf's triangles by
+:func:`maizeviz.light.results.per_leaf.leaf_sums`: copies of a plant in a tile-periodic field
+reported as one); per-plant rows from :func:`~maizeviz.light.results.per_leaf.plant_light`.
 """
 
 from __future__ import annotations
@@ -15,28 +15,8 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.io.atomic import atomic_open
-from maizeviz.light.daylight import PeriodLight, SkyLight
-from maizeviz.light.leaf_light import LightRow, leaf_sums, tile_representatives
-
-
-def sky_leaf_rows(canopy: Canopy, sky: SkyLight) -> list[LightRow]:
-    """Per leaf: ``diffuse_intercepted_cm2``, the horizontal area whose diffuse light the leaf
-    intercepts (its share of the rectangle's sky light times the rectangle's area)."""
-    return leaf_sums(canopy, {"diffuse_intercepted_cm2": sky.triangle_intercepted_cm2},
-                     sky.rect, sky.periodic)
-
-
-def period_leaf_rows(canopy: Canopy, pl: PeriodLight) -> list[LightRow]:
-    """Per leaf: PAR intercepted over the period in mol (``par_intercepted_mol``, its
-    ``direct_`` and ``diffuse_`` parts) and per m2 of leaf (``par_mol_per_m2_leaf``)."""
-    rows = leaf_sums(canopy, {"par_intercepted_mol": pl.triangle_mol,
-                              "direct_par_intercepted_mol": pl.triangle_direct_mol,
-                              "diffuse_par_intercepted_mol": pl.triangle_diffuse_mol},
-                     pl.rect, pl.periodic)
-    for r in rows:
-        r["par_mol_per_m2_leaf"] = float(r["par_intercepted_mol"]) / \
-            (float(r["leaf_area_cm2"]) * 1e-4)
-    return rows
+from maizeviz.light.results.diffuse import PeriodLight
+from maizeviz.light.results.per_leaf import LightRow, tile_representatives
 
 
 def leaf_values(canopy: Canopy, rows: list[LightRow], column: str, rect=None,
@@ -46,7 +26,7 @@ def leaf_values(canopy: Canopy, rows: list[LightRow], column: str, rect=None,
     Parameters
     ----------
     rows : leaf rows (``instance``, ``leaf``, ``leaf_area_cm2`` and ``column``), as
-        :func:`sky_leaf_rows` or :func:`period_leaf_rows` give
+        a result's ``leaf_rows(canopy)`` gives
     column : the value; divided by the leaf's area in m2 when ``per_m2_leaf``
     rect, periodic : the sample rectangle and field the rows were summed with (copies of a
         plant in a tile-periodic field take the value of the copy that stands for them)

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.light.sky import Sky
-from maizeviz.light.sun import Sun
+from maizeviz.light.sources.sky import Sky
+from maizeviz.light.sources.sun import Sun
 from maizeviz.mesh.tessellate import triangle_areas_normals
 
 

@@ -1,8 +1,8 @@
 """What every traced light result shares: where it was sampled, how, and what it says.
 
-:class:`~maizeviz.light.transmission.LightResult` (one sun),
-:class:`~maizeviz.light.daylight.SkyLight` (a sky) and
-:class:`~maizeviz.light.daylight.PeriodLight` (a day) are :class:`TracedLight`; the last two
+:class:`~maizeviz.light.results.direct.LightResult` (one sun),
+:class:`~maizeviz.light.results.diffuse.SkyLight` (a sky) and
+:class:`~maizeviz.light.results.diffuse.PeriodLight` (a day) are :class:`TracedLight`; the last two
 also carry binned maps (:class:`MappedLight`). Every result gives its numbers as a pandas
 DataFrame with :meth:`TracedLight.table`: per height, or per leaf or plant of the canopy it was
 traced on.
@@ -16,8 +16,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.bins import TransmissionMap
-from maizeviz.light.rays import Rect
+from maizeviz.light.results.maps import TransmissionMap
+from maizeviz.light.results.per_leaf import LightRow, plant_light
+from maizeviz.light.scene.rays import Rect
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -92,17 +93,17 @@ class TracedLight:
         if canopy is None:
             raise MaizevizError(f"a table by {by} needs the canopy the light was traced on: "
                                 f"table('{by}', canopy)", quantity="canopy")
-        from maizeviz.light.leaf_light import plant_light
-
-        rows = self._leaf_rows(canopy)
+        rows = self.leaf_rows(canopy)
         return pd.DataFrame(plant_light(rows) if by == "plant" else rows)
 
     def _height_columns(self) -> dict[str, Any]:
         """The per-height columns of :meth:`table`, each (H,)."""
         raise NotImplementedError
 
-    def _leaf_rows(self, canopy: Canopy) -> list[dict]:
-        """One row per leaf (:mod:`maizeviz.light.leaf_light`)."""
+    def leaf_rows(self, canopy: Canopy) -> list[LightRow]:
+        """One row per leaf that received light: its plant, place, area and the light it
+        received (:mod:`maizeviz.light.results.per_leaf`); ``table("leaf", canopy)`` as
+        dicts."""
         raise NotImplementedError
 
 

@@ -1,13 +1,13 @@
 """Diffuse light from the sky and light over a day or a period, on one Embree scene.
 
 Every direction, a sky element or the sun at a time step, is traced exactly like the sun of
-:func:`~maizeviz.light.transmission.trace_light`: parallel rays landing on the ground rectangle
+:func:`~maizeviz.light.trace.direct.trace_light`: parallel rays landing on the ground rectangle
 (first hits: light intercepted per triangle) and sensor planes at each height (transmission),
 with the same periodic wrap. The scene is built once and shared by every direction; directions
 run in parallel on ``threads`` threads (Embree releases the GIL), and ``progress(done, total)``
 is called after each direction, in order (returning ``False`` cancels with InterruptedError).
 
-Diffuse light (:func:`trace_sky`): a :class:`~maizeviz.light.sky.Sky` of n directions with
+Diffuse light (:func:`trace_sky`): a :class:`~maizeviz.light.sources.sky.Sky` of n directions with
 weights w_i (each direction's share of the horizontal diffuse irradiance, summing to 1) gives
 
     T_diffuse(h) = sum_i w_i T_i(h),   share of triangle t = sum_i w_i hits_i(t) / N,
@@ -16,7 +16,7 @@ where N is the number of rays per direction: the share is the fraction of the re
 horizontal diffuse light that the triangle intercepts (first hits; light scattered by leaves is
 not followed).
 
-A period (:func:`trace_period`, a :class:`~maizeviz.light.irradiance.Period`): step j carries a
+A period (:func:`trace_period`, a :class:`~maizeviz.light.sources.irradiance.Period`): step j carries a
 direct PAR dose D_j and a diffuse dose S_j (mol/m2 of ground, midpoint rule); the sun is traced
 at each step, the sky once for the whole period. Per step,
 
@@ -26,7 +26,7 @@ at each step, the sky once for the whole period. Per step,
 and the period's totals are the exactly rounded sums (math.fsum) of its steps. Intercepted PAR
 per triangle in mol is its share times the dose times the rectangle's area.
 
-An anisotropic diffuse sky (``diffuse``, a :class:`~maizeviz.light.perez.DiffuseSplit` from
+An anisotropic diffuse sky (``diffuse``, a :class:`~maizeviz.light.sources.perez.DiffuseSplit` from
 Perez's model): the diffuse dose of step j is split into a circumsolar part C_j, traced with the
 sun of that step, and an isotropic part I_j = S_j - C_j, spread over the directions of a uniform
 sky traced once (the horizon band brings nothing through a horizontal plane). Sky direction i
@@ -46,25 +46,24 @@ import threading
 import time
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
-from maizeviz.light.bins import TransmissionMap, bin_edges, binned, binned_grid
-from maizeviz.light.irradiance import Period
-from maizeviz.light.perez import DiffuseSplit
-from maizeviz.light.request import (
+from maizeviz.light.results.diffuse import PeriodLight, SkyLight
+from maizeviz.light.results.maps import bin_edges, binned, binned_grid
+from maizeviz.light.scene.request import (
     LightRequest,
     Sampling,
     canopy_top,
     check_sampling,
     edge_reach,
 )
-from maizeviz.light.result import MappedLight
-from maizeviz.light.sky import Sky
-from maizeviz.light.transmission import Sampler, sampler, scene_for, trace_direction
+from maizeviz.light.sources.irradiance import Period
+from maizeviz.light.sources.perez import DiffuseSplit
+from maizeviz.light.sources.sky import Sky
+from maizeviz.light.trace.direct import Sampler, sampler, scene_for, trace_direction
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, ordered_map, report
 
@@ -117,7 +116,7 @@ def _beams(smp: Sampler, towards: Sequence[np.ndarray], threads: int,
            what: str) -> Iterator[_Beam]:
     """Trace ``towards`` (each (3,), toward the light) on ``threads`` threads; yields the beams
     in order, calling ``progress(done, total)`` after each."""
-    from maizeviz.light.rays import grid_shape, ray_grid
+    from maizeviz.light.scene.rays import grid_shape, ray_grid
 
     grid = ray_grid(smp.rect, smp.density)[0]
     nx, ny = grid_shape(smp.rect, smp.density)
@@ -125,226 +124,6 @@ def _beams(smp: Sampler, towards: Sequence[np.ndarray], threads: int,
     stop = threading.Event()
     return ordered_map(lambda s: _beam(smp, s, edges, ground_xy, stop), towards, threads,
                        lambda k: report(progress, k, len(towards), what), stop)
-
-
-# --------------------------------------------------------------------------- results
-
-
-@dataclass(frozen=True, eq=False, kw_only=True)
-class SkyLight(MappedLight):
-    """Diffuse light under a sky, from :func:`trace_sky` (with the shared fields of
-    :class:`~maizeviz.light.result.MappedLight`: heights_cm, rect, rays, maps, map_edges,
-    map_rays, level, warnings, seconds, periodic).
-
-    Attributes
-    ----------
-    sky : Sky
-    transmission : (H,) float64 in [0, 1]: sum_i w_i T_i(h), the fraction of the horizontal
-        diffuse irradiance reaching each sensor plane
-    per_direction : (n, H) float64: T_i(h) of each sky direction
-    intercepted_fraction : float: share of the rectangle's diffuse light whose first hit is a
-        leaf
-    per_direction_intercepted : (n,) float64: the same per direction (leaves' share of its beam)
-    triangle_share : (F,) float64: share of the rectangle's diffuse light each scene triangle
-        intercepts (leaf triangles first, then stalks)
-    density : rays per cm2 asked for
-
-    ``maps`` hold the diffuse transmission per bin; ``seconds`` "build", "trace" (wall
-    clock), s.
-    """
-
-    sky: Sky
-    transmission: np.ndarray
-    per_direction: np.ndarray
-    intercepted_fraction: float
-    per_direction_intercepted: np.ndarray
-    triangle_share: np.ndarray
-    density: float
-
-    @property
-    def triangle_intercepted_cm2(self) -> np.ndarray:
-        """(F,) float64 cm2: each triangle's share times the rectangle's area (the horizontal
-        area whose diffuse light it takes)."""
-        return self.triangle_share * self.rect_area_cm2
-
-    def transmission_map(self, height: float) -> TransmissionMap:
-        """Diffuse transmission binned over the sensor plane at ``height`` (a traced height)."""
-        return self._map_at(height, self.transmission)
-
-    def _height_columns(self) -> dict[str, np.ndarray]:
-        return {"diffuse_transmission": self.transmission}
-
-    def _leaf_rows(self, canopy: Canopy) -> list[dict]:
-        from maizeviz.light.reports import sky_leaf_rows
-
-        return sky_leaf_rows(canopy, self)
-
-
-@dataclass(frozen=True, eq=False, kw_only=True)
-class PeriodLight(MappedLight):
-    """Light over a period, from :func:`trace_period`. PAR doses are mol/m2 of ground. With the
-    shared fields of :class:`~maizeviz.light.result.MappedLight` (heights_cm, rect, rays, maps:
-    fraction of the period's PAR reaching each bin, map_edges, map_rays, level, warnings,
-    seconds "build" and "trace", periodic).
-
-    Attributes
-    ----------
-    period : Period (times, sun, irradiance, PAR factor)
-    sky : SkyLight used for the diffuse part (None when the sun never rises)
-    step_transmission : (n, H) float64: direct-sun transmission at each step
-    step_intercepted_fraction : (n,) float64: leaves' share of the direct beam at each step
-    triangle_direct_mol, triangle_diffuse_mol : (F,) float64 mol: PAR intercepted by each scene
-        triangle over the period (leaf triangles first, then stalks)
-    diffuse : DiffuseSplit or None: each step's diffuse light split by Perez's model (its
-        circumsolar part traced with the sun, the rest over the uniform ``sky``); None when the
-        whole diffuse part is spread over ``sky``
-    """
-
-    period: Period
-    sky: SkyLight | None
-    step_transmission: np.ndarray
-    step_intercepted_fraction: np.ndarray
-    triangle_direct_mol: np.ndarray
-    triangle_diffuse_mol: np.ndarray
-    diffuse: DiffuseSplit | None = None
-
-    @property
-    def n_steps(self) -> int:
-        return self.period.n_steps
-
-    @property
-    def rect_area_m2(self) -> float:
-        return self.rect_area_cm2 * 1e-4
-
-    # ---- per step, mol/m2 of ground
-    @cached_property
-    def step_direct_mol_m2(self) -> np.ndarray:
-        """(n,) direct PAR incident at each step."""
-        return np.asarray(self.period.step_direct_par_mol_m2, dtype=np.float64)
-
-    @cached_property
-    def step_diffuse_mol_m2(self) -> np.ndarray:
-        """(n,) diffuse PAR incident at each step."""
-        return np.asarray(self.period.step_diffuse_par_mol_m2, dtype=np.float64)
-
-    @cached_property
-    def step_circumsolar_mol_m2(self) -> np.ndarray:
-        """(n,) the part of each step's diffuse PAR traced with the sun (Perez's circumsolar
-        part; zeros without a diffuse split)."""
-        if self.diffuse is None:
-            return np.zeros(self.n_steps)
-        return self.step_diffuse_mol_m2 * self.diffuse.circumsolar_share
-
-    @cached_property
-    def step_sky_mol_m2(self) -> np.ndarray:
-        """(n,) the part of each step's diffuse PAR spread over the sky's directions."""
-        return self.step_diffuse_mol_m2 - self.step_circumsolar_mol_m2
-
-    @cached_property
-    def step_incident_mol_m2(self) -> np.ndarray:
-        """(n,) PAR incident at each step (direct + diffuse)."""
-        return self.step_direct_mol_m2 + self.step_diffuse_mol_m2
-
-    @cached_property
-    def step_diffuse_intercepted_mol_m2(self) -> np.ndarray:
-        """(n,) diffuse PAR intercepted by the leaves at each step."""
-        fd = self.sky.intercepted_fraction if self.sky is not None else 0.0
-        return (self.step_circumsolar_mol_m2 * self.step_intercepted_fraction
-                + self.step_sky_mol_m2 * fd)
-
-    @cached_property
-    def step_intercepted_mol_m2(self) -> np.ndarray:
-        """(n,) PAR intercepted by the leaves at each step."""
-        return (self.step_direct_mol_m2 * self.step_intercepted_fraction
-                + self.step_diffuse_intercepted_mol_m2)
-
-    @cached_property
-    def step_diffuse_transmitted_mol_m2(self) -> np.ndarray:
-        """(n, H) diffuse PAR reaching each sensor plane at each step."""
-        td = self.sky.transmission if self.sky is not None else np.zeros(len(self.heights_cm))
-        return (self.step_circumsolar_mol_m2[:, None] * self.step_transmission
-                + self.step_sky_mol_m2[:, None] * td[None, :])
-
-    @cached_property
-    def step_transmitted_mol_m2(self) -> np.ndarray:
-        """(n, H) PAR reaching each sensor plane at each step."""
-        return (self.step_direct_mol_m2[:, None] * self.step_transmission
-                + self.step_diffuse_transmitted_mol_m2)
-
-    @cached_property
-    def step_fraction_intercepted(self) -> np.ndarray:
-        """(n,) share of each step's incident PAR intercepted by the leaves (NaN without light)."""
-        with np.errstate(invalid="ignore", divide="ignore"):
-            return np.where(self.step_incident_mol_m2 > 0,
-                            self.step_intercepted_mol_m2 / self.step_incident_mol_m2, np.nan)
-
-    # ---- the period: sums of the steps
-    @property
-    def par_incident_mol_m2(self) -> float:
-        return math.fsum(self.step_incident_mol_m2)
-
-    @property
-    def par_direct_mol_m2(self) -> float:
-        return math.fsum(self.step_direct_mol_m2)
-
-    @property
-    def par_diffuse_mol_m2(self) -> float:
-        return math.fsum(self.step_diffuse_mol_m2)
-
-    @property
-    def par_intercepted_mol_m2(self) -> float:
-        return math.fsum(self.step_intercepted_mol_m2)
-
-    @property
-    def par_diffuse_intercepted_mol_m2(self) -> float:
-        """Diffuse PAR intercepted by the leaves over the period, mol/m2 of ground."""
-        return math.fsum(self.step_diffuse_intercepted_mol_m2)
-
-    @property
-    def diffuse_transmission_by_height(self) -> np.ndarray:
-        """(H,) transmitted / incident diffuse PAR over the period (the sky's transmission
-        without a diffuse split; NaN when no diffuse light came)."""
-        inc = self.par_diffuse_mol_m2
-        if not inc > 0:
-            return np.full(len(self.heights_cm), np.nan)
-        return np.array([math.fsum(c) for c in self.step_diffuse_transmitted_mol_m2.T]) / inc
-
-    @property
-    def par_transmitted_mol_m2(self) -> np.ndarray:
-        """(H,) PAR reaching each sensor plane over the period."""
-        return np.array([math.fsum(c) for c in self.step_transmitted_mol_m2.T]) \
-            if self.n_steps else np.zeros(len(self.heights_cm))
-
-    @property
-    def fraction_intercepted(self) -> float | None:
-        """Intercepted / incident PAR over the period; None when no light came."""
-        inc = self.par_incident_mol_m2
-        return self.par_intercepted_mol_m2 / inc if inc > 0 else None
-
-    @property
-    def transmission_by_height(self) -> np.ndarray:
-        """(H,) transmitted / incident PAR over the period (NaN when no light came)."""
-        inc = self.par_incident_mol_m2
-        return self.par_transmitted_mol_m2 / inc if inc > 0 else \
-            np.full(len(self.heights_cm), np.nan)
-
-    @property
-    def triangle_mol(self) -> np.ndarray:
-        """(F,) float64 mol: PAR intercepted by each scene triangle over the period."""
-        return self.triangle_direct_mol + self.triangle_diffuse_mol
-
-    def transmission_map(self, height: float) -> TransmissionMap:
-        """Fraction of the period's PAR reaching each bin of the sensor plane at ``height``."""
-        return self._map_at(height, self.transmission_by_height)
-
-    def _height_columns(self) -> dict[str, np.ndarray]:
-        return {"par_transmitted_mol_m2": self.par_transmitted_mol_m2,
-                "transmission": self.transmission_by_height}
-
-    def _leaf_rows(self, canopy: Canopy) -> list[dict]:
-        from maizeviz.light.reports import period_leaf_rows
-
-        return period_leaf_rows(canopy, self)
 
 
 # --------------------------------------------------------------------------- entry points
@@ -358,7 +137,7 @@ class _Bins:
 
 def _prepare(canopy: Canopy, sampling: Sampling | LightRequest, with_stalks: bool,
              scene: RayScene | None, bin_cm: float) -> tuple[Sampler, list[str], float, _Bins]:
-    from maizeviz.light.rays import ray_grid
+    from maizeviz.light.scene.rays import ray_grid
 
     if isinstance(sampling, LightRequest):
         sampling = sampling.sampling
@@ -419,19 +198,19 @@ def trace_sky(canopy: Canopy, sky: Sky, sampling: Sampling | LightRequest,
     Parameters
     ----------
     canopy : Canopy
-    sky : Sky from :func:`maizeviz.light.sky.make_sky`
+    sky : Sky from :func:`maizeviz.light.sources.sky.make_sky`
     sampling : heights, density, rectangle, periodic field and threads (a :class:`Sampling`, or
         a :class:`LightRequest` whose sun is ignored)
     progress : ``progress(done, total)`` after each direction; returning ``False`` cancels
         with InterruptedError
-    scene : the canopy's scene from :func:`~maizeviz.light.transmission.light_scene` (same
+    scene : the canopy's scene from :func:`~maizeviz.light.scene.scenes.light_scene` (same
         ``with_stalks`` and ``periodic``); built here when not given
     bin_cm : bin edge of the maps, cm
 
     Raises
     ------
     MaizevizError
-        A bad request (as :func:`maizeviz.light.request.check_sampling`), naming the quantity.
+        A bad request (as :func:`maizeviz.light.scene.request.check_sampling`), naming the quantity.
     """
     smp, warnings, build_s, bins = _prepare(canopy, sampling, with_stalks, scene, bin_cm)
     towards = sky.field_directions(canopy.layout.north_deg)
@@ -454,8 +233,8 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
     Parameters
     ----------
     canopy : Canopy
-    period : Period from :func:`maizeviz.light.irradiance.clear_sky_period` or
-        :func:`~maizeviz.light.irradiance.weather_period`
+    period : Period from :func:`maizeviz.light.sources.irradiance.clear_sky_period` or
+        :func:`~maizeviz.light.sources.irradiance.weather_period`
     sampling : heights, density, rectangle, periodic field and threads
     sky : the Sky for the diffuse part (traced here, its directions and the sun steps sharing
         the threads), or a SkyLight already traced on this canopy with the same sampling
@@ -466,7 +245,7 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
     scene : the canopy's scene (same ``with_stalks`` and ``periodic``); built here when not given
     bin_cm : bin edge of the maps, cm
     diffuse : each step's diffuse light split by Perez's model
-        (:func:`maizeviz.light.perez.perez_split` of ``period``): its circumsolar part is traced
+        (:func:`maizeviz.light.sources.perez.perez_split` of ``period``): its circumsolar part is traced
         with the sun of the step, the rest spread over ``sky``, which must then be a uniform
         sky ("uoc"; default: the uniform turtle of 46 directions); None spreads the whole
         diffuse part over ``sky``
@@ -476,7 +255,7 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
     PeriodLight; a period without sun (polar night) traces nothing and gives zeros (its
     ``period.notes`` say so).
     """
-    from maizeviz.light.sky import make_sky
+    from maizeviz.light.sources.sky import make_sky
 
     if diffuse is not None and (diffuse.n_steps != period.n_steps or not np.allclose(
             diffuse.dhi_w_m2, period.dhi, rtol=1e-9, atol=1e-9)):

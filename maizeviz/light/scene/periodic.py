@@ -23,7 +23,7 @@ the scene's vertices, of the periods and of the ray origins are rounded to multi
   nearest its line, so that its moved origins stay within float32's exact range.
 
 So a field traced through its plot (the whole tiled canopy, overhangs copied across the plot
-edge) and the same field traced through one block of it (:mod:`maizeviz.light.tiling`) make the
+edge) and the same field traced through one block of it (:mod:`maizeviz.light.scene.tiling`) make the
 same float32 queries up to exact translations, and give the same hits, ray for ray
 (``tests/core/test_tiling.py``).
 """

@@ -1,9 +1,9 @@
 """The Embree scenes light is traced on: a canopy's (open field), the same with the overhangs
 copied across the plot edge (periodic field), or one block of a tiled canopy (periodic field,
-:mod:`maizeviz.light.tiling`); :func:`light_scene` picks it.
+:mod:`maizeviz.light.scene.tiling`); :func:`light_scene` picks it.
 
 A scene reports hits in the canopy's triangle ids (leaves, then stalks): ``resolve`` maps a
-scene triangle hit in a field cell to them (:mod:`maizeviz.light.periodic`).
+scene triangle hit in a field cell to them (:mod:`maizeviz.light.scene.periodic`).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.light.periodic import (
+from maizeviz.light.scene.periodic import (
     ANCHOR_CM,
     COPY_MARGIN_CM,
     Rect,
@@ -19,7 +19,7 @@ from maizeviz.light.periodic import (
     overhang_copies,
     snap,
 )
-from maizeviz.light.tiling import (
+from maizeviz.light.scene.tiling import (
     BlockTiling,
     block_mesh,
     block_tiling,
@@ -38,7 +38,7 @@ class CanopyScene(RayScene):
     In a periodic field a ray that leaves the plot re-enters on the opposite side, so a leaf
     part hanging over the edge (3.7 % of the leaf area of the bundled block tiled 3 x 3) must
     also stand just inside the opposite edge, where the next tile's plants would put it. A
-    periodic scene's x, y are on the field's grid (:mod:`maizeviz.light.periodic`).
+    periodic scene's x, y are on the field's grid (:mod:`maizeviz.light.scene.periodic`).
 
     Attributes
     ----------
@@ -47,8 +47,8 @@ class CanopyScene(RayScene):
     wrapped : (x0, y0, x1, y1) cm, the plot whose overhangs were copied, or None
     wrap : Wrap of the periodic field this scene repeats in (the plot), or None
     period : Wrap of the field's smallest known period: the block of a tiled canopy (which
-        the field repeats exactly, :func:`~maizeviz.light.tiling.block_tiling`), or the one a
-        mesh file carries once checked (:func:`~maizeviz.light.tiling.carried_period`), else
+        the field repeats exactly, :func:`~maizeviz.light.scene.tiling.block_tiling`), or the one a
+        mesh file carries once checked (:func:`~maizeviz.light.scene.tiling.carried_period`), else
         ``wrap``
     """
 
@@ -70,7 +70,7 @@ class CanopyScene(RayScene):
 
 class BlockScene(CanopyScene):
     """The scene of one block of a tiled canopy in a periodic field
-    (:mod:`maizeviz.light.tiling`); hits are reported as the tiled canopy's triangles
+    (:mod:`maizeviz.light.scene.tiling`); hits are reported as the tiled canopy's triangles
     (``n_original`` of them).
 
     The scene holds what reaches into the block's cell: the block's triangles there and copies
@@ -116,7 +116,7 @@ class BlockScene(CanopyScene):
 
     def trace_field(self, org: np.ndarray, dirs: np.ndarray, length: np.ndarray,
                     any_hit: bool, row: int, native: bool):
-        """:func:`~maizeviz.light.periodic.trace_wrapped` for this scene: blocked (N,) bool
+        """:func:`~maizeviz.light.scene.periodic.trace_wrapped` for this scene: blocked (N,) bool
         (``any_hit``), else the block triangles hit (N,) int32 (-1: none; leaves, then
         stalks), the tile keys (N, 2) int64 of the block copies they belong to and the
         distances (N,) float64 cm (inf: none); :meth:`resolve` names the canopy's triangles.
@@ -125,7 +125,7 @@ class BlockScene(CanopyScene):
         traced over the plot's period (the whole canopy's segments); otherwise (or
         ``native=False``) it is traced over the block's own period: more segments, the same
         hits."""
-        from maizeviz.light.periodic import wrap_segments
+        from maizeviz.light.scene.periodic import wrap_segments
 
         if native and self.instanced is not None and self._kernel is not None:
             pw = self.tiling.plot_wrap
@@ -166,7 +166,7 @@ def light_scene(canopy: Canopy, with_stalks: bool = False, periodic: bool = Fals
     periodic : for a periodic field (``--periodic``): leaf parts overhanging the plot edges are
         copied to the opposite side; such a scene traces periodic requests only
     block : for a periodic field, the scene of the canopy's block alone when the canopy tiles
-        it exactly (:mod:`maizeviz.light.tiling`: the same hits, A x B times fewer triangles);
+        it exactly (:mod:`maizeviz.light.scene.tiling`: the same hits, A x B times fewer triangles);
         False: always the whole canopy
     """
     verts, faces = canopy.vertices, canopy.faces

@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from maizeviz.light.daylight import PeriodLight
+from maizeviz.light.results.diffuse import PeriodLight
 
 if TYPE_CHECKING:                                   # matplotlib is imported when drawing
     from matplotlib.figure import Figure

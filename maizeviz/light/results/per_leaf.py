@@ -8,8 +8,7 @@ import numpy as np
 from maizeviz.canopy.layout import CanopyLayout
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
-from maizeviz.light.request import Rect
-from maizeviz.light.transmission import LightResult
+from maizeviz.light.scene.rays import Rect
 from maizeviz.mesh.tessellate import triangle_areas_normals
 
 #: Per-leaf sums that :func:`plant_light` adds up per plant (those present in the rows).
@@ -75,7 +74,9 @@ def tile_representatives(layout: CanopyLayout, rect: Rect | None, periodic: bool
     return rep
 
 
-def leaf_light(canopy: Canopy, result: LightResult) -> list[LightRow]:
+def leaf_light(canopy: Canopy, first_hits: np.ndarray | None, second_hits: np.ndarray | None,
+               direction: np.ndarray, ray_area_cm2: float, rect: Rect,
+               periodic: bool) -> list[LightRow]:
     """Per leaf of the canopy that received rays: sunlit and second-class areas (cm2).
 
     In a tile-periodic field the copies of a plant are reported as one
@@ -85,21 +86,37 @@ def leaf_light(canopy: Canopy, result: LightResult) -> list[LightRow]:
     the sample rectangle's sunlight the leaf takes); ``*_area_cm2`` is the leaf surface lit,
     count x footprint x cos(zenith) / |n . s| summed over the leaf's triangles, capped at the
     leaf's area (one ray on a grazing triangle stands for more than the triangle).
+
+    Parameters
+    ----------
+    canopy : Canopy
+        The canopy the sun was traced on.
+    first_hits, second_hits : (F',) int64
+        Rays whose first and second hit is each scene triangle (leaves first, then stalks);
+        None when hit classes were not traced (refused).
+    direction : (3,) float64
+        Unit vector toward the sun, field coordinates.
+    ray_area_cm2 : float
+        Horizontal footprint of one ray [cm2].
+    rect : (x0, y0, x1, y1) float
+        The sample rectangle [cm].
+    periodic : bool
+        Rays wrapped across the plot.
     """
-    if result.first_hits is None or result.second_hits is None:
+    if first_hits is None or second_hits is None:
         raise MaizevizError("hit classes were not traced")
     _, normals = triangle_areas_normals(canopy.vertices, canopy.faces)
-    s = result.direction
+    s = direction
     # a ray on a grazing triangle stands for more than the triangle: capped per leaf below
-    lit = result.ray_area_cm2 * s[2] / np.maximum(np.abs(normals @ s), 1e-6)
+    lit = ray_area_cm2 * s[2] / np.maximum(np.abs(normals @ s), 1e-6)
     nf = canopy.n_triangles
-    first = result.first_hits[:nf].astype(np.float64)
-    second = result.second_hits[:nf].astype(np.float64)
+    first = first_hits[:nf].astype(np.float64)
+    second = second_hits[:nf].astype(np.float64)
     rows = leaf_sums(canopy, {"sunlit_area_cm2": first * lit,
                               "second_class_area_cm2": second * lit,
-                              "sunlit_intercepted_cm2": first * result.ray_area_cm2,
-                              "second_class_intercepted_cm2": second * result.ray_area_cm2},
-                     result.rect, result.periodic)
+                              "sunlit_intercepted_cm2": first * ray_area_cm2,
+                              "second_class_intercepted_cm2": second * ray_area_cm2},
+                     rect, periodic)
     for r in rows:
         for k in ("sunlit_area_cm2", "second_class_area_cm2"):
             r[k] = min(float(r[k]), float(r["leaf_area_cm2"]))
@@ -189,7 +206,9 @@ def plant_light(rows: list[LightRow]) -> list[LightRow]:
 NOT_TRACED = -1
 
 
-def triangle_light(canopy: Canopy, result: LightResult) -> np.ndarray:
+def triangle_light(canopy: Canopy, first_hits: np.ndarray | None,
+                   second_hits: np.ndarray | None, direction: np.ndarray, rect: Rect,
+                   periodic: bool) -> np.ndarray:
     """Light class of every leaf triangle (F,) int8, for colouring the canopy and exporting it:
     2 direct (some ray's first hit), 1 second class only, 0 none, and :data:`NOT_TRACED` (-1)
     where no traced ray could reach the triangle (it stands outside the sample rectangle seen
@@ -198,12 +217,25 @@ def triangle_light(canopy: Canopy, result: LightResult) -> np.ndarray:
     In a tile-periodic field (see :func:`tile_representatives`) every copy of a plant receives
     what the copies receive together, so each copy gets the classes of its plant's triangles
     summed over the copies: the whole field is classified, not only the sampled tile.
+
+    Parameters
+    ----------
+    canopy : Canopy
+        The canopy the sun was traced on.
+    first_hits, second_hits : (F',) int64
+        Rays whose first and second hit is each scene triangle; None: refused (no hit classes).
+    direction : (3,) float64
+        Unit vector toward the sun, field coordinates.
+    rect : (x0, y0, x1, y1) float
+        The sample rectangle [cm].
+    periodic : bool
+        Rays wrapped across the plot.
     """
-    if result.first_hits is None or result.second_hits is None:
+    if first_hits is None or second_hits is None:
         raise MaizevizError("hit classes were not traced")
     nf = canopy.n_triangles
-    first, second = result.first_hits[:nf], result.second_hits[:nf]
-    rep = tile_representatives(canopy.layout, result.rect, result.periodic)
+    first, second = first_hits[:nf], second_hits[:nf]
+    rep = tile_representatives(canopy.layout, rect, periodic)
     inst = canopy.face_instance.astype(np.int64)
     if nf and (rep != np.arange(len(rep))).any() and np.all(np.diff(inst) >= 0):
         # copies of a plant have the same triangles in the same order: fold hits by
@@ -216,13 +248,13 @@ def triangle_light(canopy: Canopy, result: LightResult) -> np.ndarray:
         traced = np.ones(nf, bool)
     else:
         centroid = canopy.vertices[canopy.faces].mean(axis=1)                       # (F, 3)
-        s = result.direction
+        s = direction
         ground = centroid[:, :2] - centroid[:, 2:3] / s[2] * s[:2]      # along the sun ray
-        if result.periodic:
+        if periodic:
             px0, py0, px1, py1 = canopy.layout.bounds
             ground = np.column_stack([px0 + np.mod(ground[:, 0] - px0, px1 - px0),
                                       py0 + np.mod(ground[:, 1] - py0, py1 - py0)])
-        x0, y0, x1, y1 = result.rect
+        x0, y0, x1, y1 = rect
         traced = ((ground[:, 0] >= x0) & (ground[:, 0] <= x1) &
                   (ground[:, 1] >= y0) & (ground[:, 1] <= y1))
     out = np.where(traced, 0, NOT_TRACED).astype(np.int8)

@@ -13,7 +13,7 @@ from functools import cached_property
 
 import numpy as np
 
-from maizeviz.light.rays import Rect, Tracer, grid_shape, ray_grid
+from maizeviz.light.scene.rays import Rect, Tracer, grid_shape, ray_grid
 
 #: Distance (cm) past a first hit where the second-hit ray starts (Embree starts at t = 0).
 SECOND_HIT_EPS = 0.01

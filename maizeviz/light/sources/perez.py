@@ -71,7 +71,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.irradiance import Period
+from maizeviz.light.sources.irradiance import Period
 
 #: Diffuse models that split each step's diffuse light: name -> description.
 PEREZ_MODELS = {

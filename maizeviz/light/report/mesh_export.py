@@ -12,8 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.light.leaf_light import triangle_light
-from maizeviz.light.reports import leaf_values, period_leaf_rows, sky_leaf_rows
+from maizeviz.light.report.tables import leaf_values
 
 #: The arrays a light export may hold: name -> what it is, with its unit.
 LIGHT_ARRAYS = {
@@ -30,25 +29,18 @@ LIGHT_ARRAYS = {
 def light_cells(canopy: Canopy, sun=None, sky=None, period=None, absorbed=None
                 ) -> dict[str, np.ndarray]:
     """Per leaf triangle (F,) arrays of the light computed on ``canopy``: ``sun`` a
-    :class:`~maizeviz.light.result.LightResult` traced with its hit classes, ``sky`` a
-    :class:`~maizeviz.light.daylight.SkyLight`, ``period`` a
-    :class:`~maizeviz.light.daylight.PeriodLight`, ``absorbed`` an
-    :class:`~maizeviz.light.scatter.AbsorbedLight` (see :data:`LIGHT_ARRAYS`)."""
+    :class:`~maizeviz.light.results.direct.LightResult` traced with its hit classes, ``sky``
+    a :class:`~maizeviz.light.results.diffuse.SkyLight`, ``period`` a
+    :class:`~maizeviz.light.results.diffuse.PeriodLight`, ``absorbed`` an
+    :class:`~maizeviz.light.results.absorbed.AbsorbedLight` (see :data:`LIGHT_ARRAYS`)."""
     out: dict[str, np.ndarray] = {}
     if sun is not None and sun.first_hits is not None:
-        out["sun_class"] = triangle_light(canopy, sun).astype(np.int32)
-    if sky is not None:
-        out["diffuse_cm2_per_cm2_leaf"] = 1e-4 * leaf_values(
-            canopy, sky_leaf_rows(canopy, sky), "diffuse_intercepted_cm2", sky.rect,
-            sky.periodic)
-    if period is not None:
-        out["par_mol_per_m2_leaf"] = leaf_values(
-            canopy, period_leaf_rows(canopy, period), "par_intercepted_mol", period.rect,
-            period.periodic)
-    if absorbed is not None:
-        from maizeviz.light.scatter import absorbed_leaf_rows
-
-        out["absorbed_w_per_m2_leaf"] = leaf_values(
-            canopy, absorbed_leaf_rows(canopy, absorbed), "absorbed_w", absorbed.rect,
-            absorbed.periodic)
+        out["sun_class"] = sun.triangle_light(canopy).astype(np.int32)
+    for name, light, column, scale in (
+            ("diffuse_cm2_per_cm2_leaf", sky, "diffuse_intercepted_cm2", 1e-4),
+            ("par_mol_per_m2_leaf", period, "par_intercepted_mol", 1.0),
+            ("absorbed_w_per_m2_leaf", absorbed, "absorbed_w", 1.0)):
+        if light is not None:
+            out[name] = scale * leaf_values(canopy, light.leaf_rows(canopy), column, light.rect,
+                                            light.periodic)
     return out

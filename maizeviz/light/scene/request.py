@@ -14,8 +14,8 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError, check_range
-from maizeviz.light.rays import Rect, check_density, check_rect, ray_count
-from maizeviz.light.sun import Sun
+from maizeviz.light.scene.rays import Rect, check_density, check_rect, ray_count
+from maizeviz.light.sources.sun import Sun
 
 #: Highest sensor plane, cm (100 m: far above any crop; float32 tracing stays exact).
 MAX_HEIGHT_CM = 10_000.0

@@ -114,7 +114,7 @@ def sensor_offsets(heights_cm: np.ndarray, toward_sun: np.ndarray, rect: Rect,
 
 class Tracer:
     """Follows rays along one direction through a scene, wrapping them across the plot when
-    periodic (:func:`maizeviz.light.periodic.trace_wrapped`).
+    periodic (:func:`maizeviz.light.scene.periodic.trace_wrapped`).
 
     Parameters
     ----------
@@ -129,7 +129,7 @@ class Tracer:
 
     def __init__(self, scene: RayScene, direction: np.ndarray, bounds: Rect, periodic: bool,
                  size: int = 0):
-        from maizeviz.light.periodic import Wrap
+        from maizeviz.light.scene.periodic import Wrap
 
         self.scene = scene
         self.down = np.asarray(direction, dtype=np.float64)
@@ -145,7 +145,7 @@ class Tracer:
         (N,) bool. Embree's occlusion query (any hit, not the nearest), wrapped like
         :meth:`trace` in a periodic field. ``row``: rays per row of a grid laid out row by row
         (coherent packets), else 0."""
-        from maizeviz.light.periodic import trace_wrapped
+        from maizeviz.light.scene.periodic import trace_wrapped
 
         if self.wrap is None:
             return self.scene.occluded(org, self.dirs, length, row=row)
@@ -159,7 +159,7 @@ class Tracer:
         Returns triangle ids (N,) int32, -1 where none (None unless ``ids``), and hit distances
         (N,) float64 cm (inf where none). ``row`` as :meth:`occluded`.
         """
-        from maizeviz.light.periodic import trace_wrapped
+        from maizeviz.light.scene.periodic import trace_wrapped
 
         length = np.asarray(length)
         if self.wrap is None:

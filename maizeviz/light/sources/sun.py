@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.clock import check_altitude, check_place, local_datetime, zone
+from maizeviz.light.sources.clock import check_altitude, check_place, local_datetime, zone
 
 
 @dataclass(frozen=True)
@@ -49,7 +49,7 @@ def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None =
     Parameters
     ----------
     date : "YYYY-MM-DD"; time : "HH:MM" or "HH:MM:SS" local clock time in ``tz`` (or with
-        its own offset, "12:00+08:00"), read by :func:`maizeviz.light.clock.local_datetime`
+        its own offset, "12:00+08:00"), read by :func:`maizeviz.light.sources.clock.local_datetime`
     lat, lon : degrees (north, east positive); tz : IANA zone such as "Asia/Shanghai" (UTC
         when neither the time nor ``tz`` says)
     solar_noon : bool, the day's true solar noon (sun transit) instead of ``time``
@@ -72,9 +72,9 @@ def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None =
     Reda, I. & Andreas, A. (2004). Solar position algorithm for solar radiation
     applications. Solar Energy 76(5), 577-589: pvlib's implementation, run as its
     ``get_solarposition`` and ``sun_rise_set_transit_spa`` run it but without importing pandas
-    (:mod:`maizeviz.light.solar_position`).
+    (:mod:`maizeviz.light.sources.solar_position`).
     """
-    from maizeviz.light import solar_position as spa
+    from maizeviz.light.sources import solar_position as spa
 
     lat, lon = check_place(lat, lon)
     altitude = check_altitude(altitude)

@@ -11,14 +11,14 @@ from typing import TYPE_CHECKING, TypeAlias, cast
 import numpy as np
 
 from maizeviz.io.atomic import atomic_open, atomic_path, file_tag, make_folder
-from maizeviz.light.bins import TransmissionMap, bin_edges, binned
-from maizeviz.light.sky import SKY_KINDS
-from maizeviz.light.transmission import LightResult
+from maizeviz.light.results.direct import LightResult
+from maizeviz.light.results.maps import TransmissionMap, bin_edges, binned
+from maizeviz.light.sources.sky import SKY_KINDS
 
 if TYPE_CHECKING:                                   # matplotlib is imported when drawing
     from matplotlib.figure import Figure
 
-    from maizeviz.light.daylight import PeriodLight, SkyLight
+    from maizeviz.light.results.diffuse import PeriodLight, SkyLight
 
     AnyLight: TypeAlias = LightResult | SkyLight | PeriodLight
 

@@ -39,7 +39,7 @@ Discretisations (``split``)
 and the equal split otherwise.
 
 Angles are in degrees, zenith from the vertical, azimuth clockwise from north; vectors have
-x = east, y = north, z = up, as :meth:`maizeviz.light.sun.Sun.direction`.
+x = east, y = north, z = up, as :meth:`maizeviz.light.sources.sun.Sun.direction`.
 
 References
 ----------

@@ -25,7 +25,7 @@ shortwave, by default 0.48 (PAR share of global radiation) x 4.57 umol/J (photon
 daylight PAR, McCree 1972) = 2.1936 umol/J.
 
 Angles in degrees: zenith from the vertical, azimuth clockwise from north (as
-:class:`maizeviz.light.sun.Sun`).
+:class:`maizeviz.light.sources.sun.Sun`).
 
 References
 ----------
@@ -65,11 +65,11 @@ from maizeviz.io.weather_files import (
     detect_format,
     read_pvlib_file,
 )
-from maizeviz.light.clock import check_altitude as _check_altitude
-from maizeviz.light.clock import check_place as _check_place
-from maizeviz.light.clock import local_time
-from maizeviz.light.clock import zone as _time_zone
-from maizeviz.light.dates import FIRST_YEAR, LAST_YEAR, TIME_UNIT, check_year
+from maizeviz.light.sources.clock import check_altitude as _check_altitude
+from maizeviz.light.sources.clock import check_place as _check_place
+from maizeviz.light.sources.clock import local_time
+from maizeviz.light.sources.clock import zone as _time_zone
+from maizeviz.light.sources.dates import FIRST_YEAR, LAST_YEAR, TIME_UNIT, check_year
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -133,7 +133,7 @@ def _check_par_factor(par_umol_per_j) -> float:
 
 def _localize(day: _dt.date, clock: str, tz, what: str):
     """Local clock time ``clock`` on ``day`` in zone ``tz``, a tz-aware Timestamp
-    (:func:`maizeviz.light.clock.local_time`)."""
+    (:func:`maizeviz.light.sources.clock.local_time`)."""
     return local_time(day, clock, tz, what, quantity="period")
 
 
@@ -470,8 +470,8 @@ class Period:
         return replace(self, par_umol_per_j=_check_par_factor(par_umol_per_j))
 
     def suns(self) -> list:
-        """One :class:`maizeviz.light.sun.Sun` per step, for tracing the direct light."""
-        from maizeviz.light.sun import Sun
+        """One :class:`maizeviz.light.sources.sun.Sun` per step, for tracing the direct light."""
+        from maizeviz.light.sources.sun import Sun
 
         return [Sun(float(z), float(a), t.isoformat())
                 for z, a, t in zip(self.zenith_deg, self.azimuth_deg, self.times, strict=True)]
@@ -648,7 +648,7 @@ def _header(line: int, fields: list, path: Path) -> dict:
 
 def _parse_times(texts: list, lines: list, path: Path, tz):
     """Time texts -> tz-aware DatetimeIndex in microseconds (in ``tz``, or the first row's
-    offset); every local date in the years :func:`~maizeviz.light.dates.check_year` allows."""
+    offset); every local date in the years :func:`~maizeviz.light.sources.dates.check_year` allows."""
     import pandas as pd
 
     zoned = np.array([bool(_ZONE_SUFFIX.search(t)) for t in texts])

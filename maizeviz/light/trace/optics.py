@@ -34,12 +34,48 @@ import math
 from dataclasses import dataclass
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.irradiance import PAR_FRACTION
+from maizeviz.light.sources.irradiance import (
+    DEFAULT_PAR_UMOL_PER_J,
+    PAR_FRACTION,
+    PAR_UMOL_PER_J_PAR,
+)
 
 #: Wavebands traced: photosynthetically active radiation and near infrared.
 BANDS = ("par", "nir")
 #: Share of global shortwave irradiance in each band.
 SHORTWAVE_SHARE = {"par": PAR_FRACTION, "nir": 1.0 - PAR_FRACTION}
+
+
+def band_share(band: str, par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J) -> float:
+    """Share of global shortwave irradiance in ``band`` when PAR brings ``par_umol_per_j``
+    umol of photons per J of shortwave: PAR's share is that factor over the photons per J of
+    PAR (4.57), the near infrared the rest. With the default factor these are
+    :data:`SHORTWAVE_SHARE`, exactly (0.48 and 0.52).
+
+    Parameters
+    ----------
+    band : {"par", "nir"}
+        The waveband.
+    par_umol_per_j : float
+        PAR photons per joule of shortwave [umol J-1] (a period's ``par_umol_per_j``).
+
+    Returns
+    -------
+    float
+        The band's share of shortwave irradiance, in [0, 1].
+
+    Raises
+    ------
+    MaizevizError
+        A factor above 4.57 umol/J: PAR would carry more than the whole shortwave.
+    """
+    par = par_umol_per_j / PAR_UMOL_PER_J_PAR
+    if not 0.0 < par <= 1.0:
+        raise MaizevizError(f"a PAR factor of {par_umol_per_j:g} umol per J of shortwave puts "
+                            f"more than the whole shortwave in PAR (at most "
+                            f"{PAR_UMOL_PER_J_PAR:g}, the photons in a J of PAR)",
+                            quantity="par_factor")
+    return par if band == "par" else 1.0 - par
 
 
 @dataclass(frozen=True)

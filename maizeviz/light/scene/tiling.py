@@ -5,7 +5,7 @@ from 9). In a periodic field the tiled plot repeats forever, and so does the blo
 is the block repeated with the block's period. Its Embree scene can then be the block alone
 (with its neighbours' overhangs copied in): A x B times fewer triangles to build a BVH over
 (0.35 s instead of 3.1 s at K = 4 for the bundled 3 x 3 tiling), rays wrapped over the block's
-period instead of the plot's (:mod:`maizeviz.light.periodic`).
+period instead of the plot's (:mod:`maizeviz.light.scene.periodic`).
 
 Hits still name the tiled canopy's triangles: a hit in the copy of the block under cell (i, j)
 of the field (cell (0, 0) is the tile (0, 0), the digitized block) lies on the plant of tile
@@ -14,7 +14,7 @@ and per-plant light, heatmaps and transmission are the tiled scene's.
 
 Where it applies (:func:`block_tiling`): the canopy's placements form whole tiles, each tile
 the same plants in the same order, every tile's triangles the block's moved by a whole number
-of block periods once on the field's grid (:func:`maizeviz.light.periodic.snap`), exactly, and
+of block periods once on the field's grid (:func:`maizeviz.light.scene.periodic.snap`), exactly, and
 the plot exactly A x B periods. Then the block scene gives the same hits as the tiled scene,
 ray for ray (``tests/core/test_tiling.py``). Otherwise (a layout file, an edited layout, a
 spacing that is not a multiple of the grid step, 2^-12 cm here) :func:`block_tiling` returns None
@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.light.periodic import Wrap, overhang_copies, snap
+from maizeviz.light.scene.periodic import Wrap, overhang_copies, snap
 
 
 @dataclass(frozen=True)
@@ -182,7 +182,7 @@ def carried_period(canopy: Canopy, verts: np.ndarray, faces: np.ndarray,
     :class:`Wrap` on the plot's grid, when its triangles do repeat with it; else None.
 
     The claim is checked on the scene's triangles ``faces`` (F, 3) of ``verts`` (V, 3) cm on
-    the grid of ``plot_wrap`` (:func:`maizeviz.light.periodic.snap`): the plot must be a whole
+    the grid of ``plot_wrap`` (:func:`maizeviz.light.scene.periodic.snap`): the plot must be a whole
     number A x B (> 1) of periods, and each triangle, moved back by whole periods to the cell
     its first vertex stands in, must be found exactly A x B times, once from every cell of
     the plot folded modulo A, B. Then the periodic field of the plot is that of the block,

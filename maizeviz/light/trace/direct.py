@@ -2,14 +2,14 @@
 
 Transmission at height h is measured on the sample rectangle raised to h: the same x, y
 rectangle, as a row of light sensors held at that height. The rectangle at h carries a regular
-grid of ``density`` sensors per cm2 (:func:`~maizeviz.light.rays.sensor_offsets`), and Embree is
+grid of ``density`` sensors per cm2 (:func:`~maizeviz.light.scene.rays.sensor_offsets`), and Embree is
 asked whether the path from each sensor toward the sun is blocked (an occlusion query, cheaper
 than a nearest-hit query); T(h) is the fraction of sensors whose path is clear.
 
 The paper's hit classes come from parallel rays landing on the ground rectangle
-(:class:`~maizeviz.light.hits.SunRays`): each is followed from above the canopy down toward the
+(:class:`~maizeviz.light.trace.hits.SunRays`): each is followed from above the canopy down toward the
 ground against the sun direction; its first leaf hit receives direct light, its second hit
-second-class light (:mod:`maizeviz.light.hits`). The ground's sensors are these rays' landing
+second-class light (:mod:`maizeviz.light.trace.hits`). The ground's sensors are these rays' landing
 points, so T(0) comes from them without another query.
 
 With ``periodic`` every ray and every sensor path that leaves the plot sideways re-enters on the
@@ -37,17 +37,17 @@ from typing import TypeVar
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
-from maizeviz.light.hits import SunRays, first_hits, hit_counts, lattice_first_hits, second_hits
-from maizeviz.light.rays import Rect, Tracer, ray_grid, sensor_offsets
-from maizeviz.light.request import LightRequest, canopy_top, check_request
-from maizeviz.light.result import TracedLight
-
-# the scenes lived here before maizeviz.light.scenes: kept importable from here
-from maizeviz.light.scenes import BlockScene as BlockScene
-from maizeviz.light.scenes import CanopyScene as CanopyScene
-from maizeviz.light.scenes import light_scene as light_scene
-from maizeviz.light.scenes import scene_for
-from maizeviz.light.sun import Sun
+from maizeviz.light.results.direct import LightResult
+from maizeviz.light.scene.rays import Rect, Tracer, ray_grid, sensor_offsets
+from maizeviz.light.scene.request import LightRequest, canopy_top, check_request
+from maizeviz.light.scene.scenes import scene_for
+from maizeviz.light.trace.hits import (
+    SunRays,
+    first_hits,
+    hit_counts,
+    lattice_first_hits,
+    second_hits,
+)
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, ordered_map, report
 
@@ -56,81 +56,6 @@ from maizeviz.progress import ProgressCallback, ordered_map, report
 CHUNK = 1 << 18
 
 T = TypeVar("T")
-
-
-@dataclass(frozen=True, kw_only=True)
-class LightResult(TracedLight):
-    """Output of :func:`trace_light` (and the shared fields of
-    :class:`~maizeviz.light.result.TracedLight`: heights_cm, rect, rays, level, warnings,
-    seconds, periodic).
-
-    Attributes
-    ----------
-    sun : Sun
-    transmission : (H,) float64 in [0, 1], on the sensor planes at ``heights_cm`` (H,) cm
-    ray_area_cm2 : horizontal footprint of a ray (and of a sensor)
-    first_z : (N,) float32, height (cm) of each ground ray's first hit, -inf where none
-    first_hits, second_hits : (F,) int64, rays whose first / second hit is each triangle
-        (None unless the request asked for hit classes)
-    direction : (3,) unit vector toward the sun in field coordinates
-    density : rays per cm2 asked for
-    sensor_lit : (H, ceil(N / 8)) uint8, the sensors of each plane whose path to the sun is
-        clear, bits packed in ray grid order (:meth:`lit`); None for results made elsewhere
-    sensor_offset_cm : (H, 2) float64 cm, where each plane's grid sits relative to the ground
-        grid's cell centres (:meth:`sensor_xy`)
-
-    ``seconds`` has "build" and "trace" (and "second" for second hits), s.
-    """
-
-    sun: Sun
-    transmission: np.ndarray
-    ray_area_cm2: float
-    first_z: np.ndarray
-    first_hits: np.ndarray | None
-    second_hits: np.ndarray | None
-    direction: np.ndarray
-    density: float = 0.0
-    sensor_lit: np.ndarray | None = None
-    sensor_offset_cm: np.ndarray | None = None
-
-    @property
-    def density_per_cm2(self) -> float:
-        """Rays actually traced per cm2 of the rectangle (the grid rounds the asked density)."""
-        return self.rays / self.rect_area_cm2
-
-    @property
-    def sunlit_intercepted_fraction(self) -> float | None:
-        """Share of the rectangle's direct sunlight whose first hit is a leaf (None without
-        hit classes)."""
-        if self.first_hits is None:
-            return None
-        return float(self.first_hits.sum() * self.ray_area_cm2 / self.rect_area_cm2)
-
-    @cached_property
-    def ground_xy(self) -> np.ndarray:
-        """Where each ray meets the ground (N, 2) cm, in ray grid order."""
-        return ray_grid(self.rect, self.density)[0]
-
-    def sensor_xy(self, k: int) -> np.ndarray:
-        """Sensor positions (N, 2) cm of the plane of height index ``k``, in ray grid order."""
-        off = np.zeros(2) if self.sensor_offset_cm is None else self.sensor_offset_cm[k]
-        return self.ground_xy + off
-
-    def lit(self, k: int) -> np.ndarray:
-        """(N,) bool: the sensors of the plane of height index ``k`` that see the sun."""
-        if self.sensor_lit is None:
-            from maizeviz.errors import MaizevizError
-
-            raise MaizevizError("this result carries no sensor planes")
-        return np.unpackbits(self.sensor_lit[k], count=self.rays).astype(bool)
-
-    def _height_columns(self) -> dict[str, np.ndarray]:
-        return {"transmission": self.transmission}
-
-    def _leaf_rows(self, canopy: Canopy) -> list[dict]:
-        from maizeviz.light.leaf_light import leaf_light
-
-        return leaf_light(canopy, self)
 
 
 def _chunks(n: int) -> list[tuple[int, int]]:
@@ -239,7 +164,7 @@ class _Family:
 def _lattice_shifts(smp: Sampler, s: np.ndarray, planes: list[int]) -> np.ndarray:
     """(H, 2) int64: r_k, the ground lattice cells from a sensor of plane k to the ray of its
     family (zero for the planes not in ``planes``); see :func:`sensor_offsets`."""
-    from maizeviz.light.rays import grid_shape
+    from maizeviz.light.scene.rays import grid_shape
 
     nx, ny = grid_shape(smp.rect, smp.density)
     x0, y0, x1, y1 = smp.rect
@@ -261,7 +186,7 @@ def _spans_periods(smp: Sampler) -> bool:
 
     Then the family ray through any sensor is a ground ray of the rectangle moved by whole
     periods: the same ray of the field, with the same hits (the field repeats exactly, on its
-    grid: :mod:`maizeviz.light.periodic`). The ground rays answer every plane, whatever the
+    grid: :mod:`maizeviz.light.scene.periodic`). The ground rays answer every plane, whatever the
     sun's elevation, and no sensor needs a query of its own.
     """
     wrap = getattr(smp.scene, "period", None)
@@ -276,7 +201,7 @@ def _spans_periods(smp: Sampler) -> bool:
 def _family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family | None:
     """The ray family through the planes ``planes`` and the ground, or None when per-plane
     occlusion queries cost less (low suns: the shifted grids hardly overlap)."""
-    from maizeviz.light.rays import grid_shape
+    from maizeviz.light.scene.rays import grid_shape
 
     nx, ny = grid_shape(smp.rect, smp.density)
     shifts = _lattice_shifts(smp, s, planes)
@@ -304,7 +229,7 @@ def _family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family | None:
 def _period_family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family:
     """The ray family of a rectangle spanning whole periods (:func:`_spans_periods`): its own
     ground rays, read modulo the grid."""
-    from maizeviz.light.rays import grid_shape
+    from maizeviz.light.scene.rays import grid_shape
 
     nx, ny = grid_shape(smp.rect, smp.density)
     cells = np.arange(nx * ny, dtype=np.int64)
@@ -460,8 +385,9 @@ def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | 
     ----------
     progress : called after each chunk of rays; returning ``False`` cancels with
         :class:`InterruptedError`
-    scene : the canopy's scene from :func:`light_scene` (same ``with_stalks`` and ``periodic``),
-        to trace several suns on one scene; built here when not given
+    scene : the canopy's scene from :func:`~maizeviz.light.scene.scenes.light_scene` (same
+        ``with_stalks`` and ``periodic``), to trace several suns on one scene; built here when
+        not given
     """
     rect, warnings = check_request(canopy, req)
     t0 = time.perf_counter()

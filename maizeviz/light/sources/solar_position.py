@@ -7,7 +7,7 @@ trace. For one sun this module runs pvlib's own ``spa`` file on its own (the pac
 imported) with the inputs pvlib's wrappers give it, so the angles are pvlib's to the last bit
 (``tests/core/test_solar_position.py`` compares them with ``get_solarposition`` and
 ``sun_rise_set_transit_spa``). Sun tracks over a period still go through pvlib's wrappers
-(:mod:`maizeviz.light.irradiance`), which need pandas anyway.
+(:mod:`maizeviz.light.sources.irradiance`), which need pandas anyway.
 
 References
 ----------

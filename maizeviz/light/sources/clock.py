@@ -9,8 +9,8 @@ A *clock time* is ``HH:MM`` or ``HH:MM:SS``, optionally followed by a UTC offset
   or repeats is refused rather than guessed;
 - with neither, the time is UTC.
 
-The single sun (:func:`maizeviz.light.sun.sun_at`) and the sun track of a period
-(:func:`maizeviz.light.irradiance.sun_track`) both read their times here.
+The single sun (:func:`maizeviz.light.sources.sun.sun_at`) and the sun track of a period
+(:func:`maizeviz.light.sources.irradiance.sun_track`) both read their times here.
 
 References
 ----------
@@ -25,7 +25,7 @@ import math
 import numbers
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.dates import TIME_UNIT
+from maizeviz.light.sources.dates import TIME_UNIT
 
 
 def zone(tz) -> _dt.tzinfo:

@@ -1,0 +1,227 @@
+"""Light absorbed by the leaves and the ground, with scattering, as traced by
+:mod:`maizeviz.light.trace.absorbed`: the energy balance (:class:`Balance`), the power or
+energy each triangle absorbed, and tables per leaf and per plant.
+
+Units: W and W/m2 of sample ground for one instant (:class:`AbsorbedLight`), J and MJ/m2 over a
+period (:class:`AbsorbedPeriod`); PAR also in photons, 4.57 umol per J of PAR
+(:data:`maizeviz.light.sources.irradiance.PAR_UMOL_PER_J_PAR`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from maizeviz.canopy.scene import Canopy
+from maizeviz.light.results.per_leaf import LightRow, leaf_sums
+
+if TYPE_CHECKING:                       # the optics live with the tracing that uses them
+    from maizeviz.light.trace.optics import Optics
+
+
+@dataclass(frozen=True)
+class Balance:
+    """Where the incident light went, W/m2 of sample ground (or, for a period, MJ/m2 or mol/m2
+    as the result says).
+
+    incident = absorbed_leaves + absorbed_ground + reflected_top + escaped_sides + unresolved,
+    within Monte Carlo noise (``closure``).
+    """
+
+    incident: float
+    absorbed_leaves: float
+    absorbed_ground: float
+    reflected_top: float
+    escaped_sides: float = 0.0
+    unresolved: float = 0.0
+
+    @property
+    def closure(self) -> float:
+        """(sum of the parts) / incident - 1: 0 up to Monte Carlo noise."""
+        parts = (self.absorbed_leaves + self.absorbed_ground + self.reflected_top
+                 + self.escaped_sides + self.unresolved)
+        return parts / self.incident - 1.0 if self.incident else 0.0
+
+    def as_dict(self) -> dict[str, float]:
+        return {"incident": self.incident, "absorbed_leaves": self.absorbed_leaves,
+                "absorbed_ground": self.absorbed_ground, "reflected_top": self.reflected_top,
+                "escaped_sides": self.escaped_sides, "unresolved": self.unresolved,
+                "closure": self.closure}
+
+
+def _fraction_absorbed(self) -> float:
+    """Share of the incident light the leaves absorb."""
+    b = self.balance
+    return b.absorbed_leaves / b.incident if b.incident else 0.0
+
+
+def _per_plant(frame, sums: tuple[str, ...]):
+    """Leaf rows (a DataFrame of :func:`maizeviz.light.results.per_leaf.leaf_sums` rows) summed per
+    plant standing in the canopy: its digitized plant, place, leaves, leaf area and ``sums``."""
+    return frame.groupby("instance", as_index=False).agg(
+        plant=("plant", "first"), x_cm=("x_cm", "first"), y_cm=("y_cm", "first"),
+        leaves=("leaf", "size"), leaf_area_cm2=("leaf_area_cm2", "sum"),
+        **{name: (name, "sum") for name in sums})
+
+
+@dataclass(frozen=True)
+class AbsorbedLight:
+    """Light absorbed by the leaves (and the ground) in one band, with scattering.
+
+    Attributes
+    ----------
+    band : "par" or "nir"; optics : Optics
+    irradiance_w_m2 : float, the band's irradiance on a horizontal plane above the canopy
+        (direct plus diffuse as traced), W/m2
+    balance : Balance, W/m2 of sample ground
+    triangle_absorbed_w : (F,) float64 W absorbed by each triangle of the scene (leaves, then
+        stalks), from the light falling on the sample rectangle
+    triangle_sunlit_cm2 : (F,) float64 cm2 of each triangle in the direct beam (0 for a sky)
+    rect : (x0, y0, x1, y1) cm; rays : primary rays per direction; directions : beams traced
+    depth, threshold, seed : as traced; events : scatterings followed; periodic : bool
+    level : the canopy's mesh level; seconds : "trace" (primary beams), "scatter", "build"
+    """
+
+    band: str
+    optics: Optics
+    irradiance_w_m2: float
+    balance: Balance
+    triangle_absorbed_w: np.ndarray
+    triangle_sunlit_cm2: np.ndarray
+    rect: tuple[float, float, float, float]
+    rays: int
+    directions: int
+    depth: int
+    threshold: float
+    seed: int
+    events: int
+    periodic: bool
+    level: str = ""
+    seconds: dict[str, float] = field(default_factory=dict)
+
+    fraction_absorbed = property(_fraction_absorbed)
+
+    def table(self, by: str = "plant", canopy=None):
+        """Absorbed light per leaf or per plant as a pandas DataFrame.
+
+        Columns: ``absorbed_w`` (W), ``absorbed_w_m2_leaf`` (W per m2 of one-sided leaf area),
+        ``sunlit_area_cm2`` and ``shaded_area_cm2`` (leaf area in and out of the direct beam),
+        and for PAR ``absorbed_umol_s`` (umol/s: 4.57 umol per J of PAR). ``by="balance"``:
+        the energy balance (W/m2 of ground) as one row.
+        """
+        import pandas as pd
+
+        if by == "balance":
+            return pd.DataFrame([{"band": self.band, **self.balance.as_dict()}])
+        if by not in ("leaf", "plant"):
+            from maizeviz.errors import MaizevizError
+
+            raise MaizevizError(f"absorbed light is tabled by 'leaf', 'plant' or 'balance', not "
+                                f"'{by}'", quantity="table")
+        if canopy is None:
+            from maizeviz.errors import MaizevizError
+
+            raise MaizevizError("give the canopy the light was traced on to table it by "
+                                f"{by}", quantity="table")
+        from maizeviz.light.sources.irradiance import PAR_UMOL_PER_J_PAR
+
+        rows = leaf_sums(canopy, {"absorbed_w": self.triangle_absorbed_w,
+                                  "sunlit_area_cm2": self.triangle_sunlit_cm2},
+                         self.rect, self.periodic)
+        frame = pd.DataFrame(rows)
+        if frame.empty:
+            return frame
+        frame["sunlit_area_cm2"] = np.minimum(frame["sunlit_area_cm2"], frame["leaf_area_cm2"])
+        if by == "plant":
+            frame = _per_plant(frame, ("absorbed_w", "sunlit_area_cm2"))
+        frame["shaded_area_cm2"] = frame["leaf_area_cm2"] - frame["sunlit_area_cm2"]
+        frame["absorbed_w_m2_leaf"] = frame["absorbed_w"] / (frame["leaf_area_cm2"] * 1e-4)
+        if self.band == "par":
+            frame["absorbed_umol_s"] = frame["absorbed_w"] * PAR_UMOL_PER_J_PAR
+        return frame
+
+    def leaf_rows(self, canopy: Canopy) -> list[LightRow]:
+        """Per lit leaf: ``absorbed_w`` (W), ``absorbed_w_m2_leaf`` and
+        ``absorbed_sunlit_area_cm2``, as the light tables of the command line
+        (:func:`maizeviz.light.results.per_leaf.leaf_sums`)."""
+        rows = leaf_sums(canopy, {"absorbed_w": self.triangle_absorbed_w,
+                                  "absorbed_sunlit_area_cm2": self.triangle_sunlit_cm2},
+                         self.rect, self.periodic)
+        for r in rows:
+            r["absorbed_w_m2_leaf"] = float(r["absorbed_w"]) / (float(r["leaf_area_cm2"]) * 1e-4)
+        return rows
+
+
+@dataclass(frozen=True)
+class AbsorbedPeriod:
+    """Light absorbed by the leaves (and the ground) in one band over a period (a day), with
+    scattering: each time step's sun traced with its direct irradiance, the diffuse part
+    traced once per unit of diffuse irradiance and scaled by each step's (it is linear).
+
+    Attributes
+    ----------
+    band : "par" or "nir"; optics : Optics
+    period : Period (:mod:`maizeviz.light.sources.irradiance`): its steps, sun and irradiance
+    balance : Balance in MJ/m2 of sample ground over the period
+    triangle_absorbed_j : (F,) float64 J absorbed by each scene triangle over the period
+    step_absorbed_leaves_w_m2 : (n,) float64 W/m2 of ground the leaves absorb at each step
+    step_incident_w_m2 : (n,) float64 the band's irradiance on a horizontal plane at each step
+    rect, rays, depth, seed, periodic, level : as traced; seconds : "trace", "scatter",
+        "build"
+    """
+
+    band: str
+    optics: Optics
+    period: Any
+    balance: Balance
+    triangle_absorbed_j: np.ndarray
+    step_absorbed_leaves_w_m2: np.ndarray
+    step_incident_w_m2: np.ndarray
+    rect: tuple[float, float, float, float]
+    rays: int
+    depth: int
+    seed: int
+    periodic: bool
+    level: str = ""
+    seconds: dict[str, float] = field(default_factory=dict)
+
+    fraction_absorbed = property(_fraction_absorbed)
+
+    @property
+    def absorbed_leaves_mol_m2(self) -> float | None:
+        """PAR the leaves absorbed over the period, mol per m2 of ground (None for NIR)."""
+        from maizeviz.light.sources.irradiance import PAR_UMOL_PER_J_PAR
+
+        return self.balance.absorbed_leaves * PAR_UMOL_PER_J_PAR if self.band == "par" \
+            else None                           # MJ x umol/J = mol
+
+    def table(self, by: str = "plant", canopy=None):
+        """Absorbed light per leaf or per plant over the period as a pandas DataFrame:
+        ``absorbed_mj`` (MJ), ``absorbed_mj_m2_leaf``, and for PAR ``absorbed_mol``;
+        ``by="balance"``: the balance (MJ/m2 of ground) as one row."""
+        import pandas as pd
+
+        from maizeviz.errors import MaizevizError
+
+        if by == "balance":
+            return pd.DataFrame([{"band": self.band, "unit": "MJ/m2",
+                                  **self.balance.as_dict()}])
+        if by not in ("leaf", "plant") or canopy is None:
+            raise MaizevizError("absorbed light over a period is tabled by 'leaf' or 'plant' "
+                                "(with the canopy it was traced on) or 'balance'",
+                                quantity="table")
+        from maizeviz.light.sources.irradiance import PAR_UMOL_PER_J_PAR
+
+        rows = leaf_sums(canopy, {"absorbed_mj": self.triangle_absorbed_j * 1e-6}, self.rect,
+                         self.periodic)
+        frame = pd.DataFrame(rows)
+        if frame.empty:
+            return frame
+        if by == "plant":
+            frame = _per_plant(frame, ("absorbed_mj",))
+        frame["absorbed_mj_m2_leaf"] = frame["absorbed_mj"] / (frame["leaf_area_cm2"] * 1e-4)
+        if self.band == "par":
+            frame["absorbed_mol"] = frame["absorbed_mj"] * PAR_UMOL_PER_J_PAR
+        return frame

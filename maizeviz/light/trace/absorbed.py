@@ -1,0 +1,207 @@
+"""Light absorbed with scattering by the leaves and the ground: the sun's direct beam and the
+directions of a sky, each followed through the canopy by :func:`~.scatter.scatter_beam`, summed
+into an energy balance and the power each triangle absorbs (:func:`absorbed_light`); and over a
+period (:func:`absorbed_period`), the sky traced once per W/m2 and scaled by each step's
+diffuse irradiance (the transport is linear in the light put in), each step's sun traced with
+its direct irradiance.
+
+Every beam of an instant carries its irradiance over the sample rectangle's rays: a ray of a
+beam of ``E`` W/m2 carries ``E x ray area`` W, and deposits ``1 - scattering`` of what it
+carries at each leaf it reaches (:mod:`.scatter`).
+
+References
+----------
+Bailey, B. N. (2018). A reverse ray-tracing method for modelling the net radiative flux in
+leaf-resolving plant canopy simulations. Ecological Modelling 368, 233-245.
+https://doi.org/10.1016/j.ecolmodel.2017.11.022
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from maizeviz.canopy.scene import Canopy
+from maizeviz.errors import check_range
+from maizeviz.light.results.absorbed import AbsorbedLight, AbsorbedPeriod, Balance
+from maizeviz.light.sources.irradiance import Period
+from maizeviz.light.sources.perez import PEREZ_MODELS, perez_split
+from maizeviz.light.sources.sky import Sky
+from maizeviz.light.sources.sun import Sun
+from maizeviz.light.trace.direct import Sampler
+from maizeviz.light.trace.optics import Optics, band_share
+from maizeviz.light.trace.scatter import scatter_beam
+from maizeviz.progress import ProgressCallback, report
+
+
+def check_absorbed(direct_w_m2: float, diffuse_w_m2: float, depth: int,
+                   threshold: float) -> None:
+    """Refuse, naming the quantity, an irradiance outside 0-5000 W/m2, a depth that is not a
+    whole number in 0-10,000 or a threshold outside [0, 1] (MaizevizError)."""
+    check_range(direct_w_m2, "the direct irradiance (W/m2)", 0, 5000, "irradiance")
+    check_range(diffuse_w_m2, "the diffuse irradiance (W/m2)", 0, 5000, "irradiance")
+    check_range(depth, "the scattering depth", 0, 10_000, "depth", whole=True)
+    check_range(threshold, "the scattering threshold", 0, 1, "threshold")
+
+
+def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Optics,
+                   sun: Sun | None, direct_w_m2: float, diffuse_w_m2: float, sky: Sky | None,
+                   depth: int, threshold: float, seed: int, threads: int = 1,
+                   progress: ProgressCallback | None = None,
+                   build_s: float = 0.0) -> AbsorbedLight:
+    """Light absorbed in one band at one instant: the sun's beam and a sky's directions.
+
+    Parameters
+    ----------
+    canopy : Canopy
+        The canopy of the scene (its north, leaf ranks and mesh level).
+    smp : Sampler
+        The scene, sample rectangle, density and field (:func:`~.direct.sampler`).
+    normals : (F, 3) float64
+        Unit normals of the scene's leaf triangles, then its stalks' if traced.
+    optics : Optics
+        The band's leaf and soil optics.
+    sun : Sun or None
+        The sun's angles; None: no direct beam.
+    direct_w_m2, diffuse_w_m2 : float
+        The band's direct and diffuse irradiance on a horizontal plane above the canopy
+        [W m-2]; the diffuse part is spread over ``sky`` (needed when it is > 0).
+    sky : Sky or None
+        The sky of the diffuse part.
+    depth, threshold, seed : int, float, int
+        Scatterings followed, share of the incident power left travelling where tracing stops,
+        random seed (beam ``k`` uses ``seed + 7919 k``).
+    threads : int
+        Threads over chunks of rays.
+    progress : callable, optional
+        ``progress(done, total, what)`` after each beam.
+    build_s : float
+        Seconds spent building the scene for this call [s] (reported as ``seconds["build"]``).
+
+    Returns
+    -------
+    AbsorbedLight
+        Its balance in W/m2 of sample ground and the W absorbed by each scene triangle.
+    """
+    opt = optics
+    beams: list[tuple[np.ndarray, float]] = []
+    if sun is not None and direct_w_m2 > 0:
+        beams.append((sun.direction(canopy.layout.north_deg), direct_w_m2))
+    if diffuse_w_m2 > 0:
+        assert sky is not None
+        for toward, weight in zip(sky.directions, sky.weights):
+            beams.append((np.asarray(toward, np.float64), diffuse_w_m2 * float(weight)))
+    area_m2 = smp.ray_area_cm2 * 1e-4 * smp.n
+    nf = len(normals)
+    leaf_optics, kept = None, 1.0 - opt.scattering
+    if opt.ranks:                                # leaves differ by rank (stalks: 0)
+        rank = np.zeros(nf, np.int64)
+        rank[:canopy.n_triangles] = canopy.face_leaf
+        leaf_optics = opt.per_triangle(rank)
+        kept = 1.0 - (leaf_optics[0] + leaf_optics[1])
+    absorbed, sunlit = np.zeros(nf), np.zeros(nf)
+    parts = dict.fromkeys(("ground", "top", "sides", "unresolved"), 0.0)
+    events, seconds = 0, {"build": build_s, "trace": 0.0, "scatter": 0.0}
+    for k, (toward, irradiance) in enumerate(beams):
+        tally, secs = scatter_beam(smp, toward, opt, normals, depth, threshold,
+                                   seed + 7919 * k, threads,
+                                   leaf_optics=leaf_optics)
+        per_ray = irradiance * smp.ray_area_cm2 * 1e-4       # W carried by one ray
+        absorbed += tally.per_triangle(nf, kept * per_ray)
+        if k == 0 and sun is not None and direct_w_m2 > 0:
+            # cm2 of leaf a ray's beam covers: its footprint across the beam over the
+            # cosine of the leaf's tilt to it
+            first = (np.concatenate(tally.first_hits) if tally.first_hits
+                     else np.zeros(0, dtype=np.int64))
+            lit = np.unique(first)
+            factor = np.zeros(nf)
+            factor[lit] = smp.ray_area_cm2 * toward[2] / np.maximum(
+                np.abs(normals[lit] @ toward), 1e-6)
+            sunlit = tally.sunlit(nf, factor)
+        for name in parts:
+            parts[name] += getattr(tally, name) * per_ray
+        events += tally.events
+        seconds["trace"] += secs["trace"]
+        seconds["scatter"] += secs["scatter"]
+        report(progress, k + 1, len(beams), "absorbed light")
+    incident = direct_w_m2 * (sun is not None) + diffuse_w_m2
+    balance = Balance(float(incident), float(absorbed.sum()) / area_m2,
+                      *(float(parts[k]) / area_m2 for k in ("ground", "top", "sides",
+                                                             "unresolved")))
+    return AbsorbedLight(opt.band, opt, incident, balance, absorbed, sunlit, smp.rect, smp.n,
+                         len(beams), depth, threshold, seed, events, smp.periodic,
+                         canopy.level, seconds)
+
+
+def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
+                    absorbed: Callable[..., AbsorbedLight],
+                    progress: ProgressCallback | None = None) -> AbsorbedPeriod:
+    """Light absorbed in one band over a period: the diffuse part traced once per W/m2 over
+    ``sky`` and scaled by each step's diffuse irradiance, each step's sun with the band's share
+    of its direct irradiance.
+
+    Parameters
+    ----------
+    period : Period
+        Its steps, sun and irradiance; its PAR factor sets the band's share of shortwave
+        (:func:`~.optics.band_share`).
+    optics : Optics
+        The band's leaf and soil optics.
+    sky : Sky or str
+        The diffuse light's sky (kind or Sky); "perez" (or "perez-driesse") splits each step's
+        diffuse light by Perez's model (:mod:`maizeviz.light.sources.perez`): its circumsolar
+        part added to that step's direct beam, the rest from a uniform sky.
+    absorbed : callable
+        ``absorbed(sun, direct_w_m2=..., diffuse_w_m2=..., sky=...)`` -> AbsorbedLight of one
+        instant on the canopy (``LightEngine.absorbed`` with the band, optics, sampling and
+        scattering settings bound).
+    progress : callable, optional
+        Called after the sky and after each step.
+
+    Returns
+    -------
+    AbsorbedPeriod
+        Its balance in MJ/m2 of sample ground, the J absorbed by each scene triangle.
+    """
+    share = band_share(optics.band, period.par_umol_per_j)
+    steps = len(period.step_s)
+    model = str(sky).strip().lower() if isinstance(sky, str) else ""
+    split = perez_split(period, model) if model in PEREZ_MODELS else None
+    unit = absorbed(None, direct_w_m2=0.0, diffuse_w_m2=1.0,
+                    sky="uoc" if split is not None else sky)
+    report(progress, 1, steps + 1, "absorbed light: the sky")
+    diffuse_w = np.asarray(period.dhi, np.float64) * share
+    circumsolar_w = np.zeros(steps)
+    if split is not None:                   # the circumsolar part comes with the sun
+        circumsolar_w = np.asarray(split.circumsolar_w_m2, np.float64) * share
+        diffuse_w = np.asarray(split.isotropic_w_m2, np.float64) * share
+    step_s = np.asarray(period.step_s, np.float64)
+    joules = unit.triangle_absorbed_w * float(np.sum(diffuse_w * step_s))
+    ub = unit.balance
+    parts = {k: getattr(ub, k) * float(np.sum(diffuse_w * step_s))
+             for k in ("absorbed_leaves", "absorbed_ground", "reflected_top",
+                       "escaped_sides", "unresolved")}
+    leaves_w = ub.absorbed_leaves * diffuse_w
+    seconds = dict(unit.seconds)
+    direct_w = np.asarray(period.direct_horizontal, np.float64) * share + circumsolar_w
+    for k in range(steps):
+        z = float(period.zenith_deg[k])
+        if direct_w[k] > 0 and z < 90.0:
+            light = absorbed(Sun(z, float(period.azimuth_deg[k])),
+                             direct_w_m2=float(direct_w[k]))
+            joules += light.triangle_absorbed_w * step_s[k]
+            for name in parts:
+                parts[name] += getattr(light.balance, name) * step_s[k]
+            leaves_w[k] += light.balance.absorbed_leaves
+            for name in ("trace", "scatter"):
+                seconds[name] = seconds.get(name, 0.0) + light.seconds.get(name, 0.0)
+        report(progress, k + 2, steps + 1, f"absorbed light: time step {k + 1} of {steps}")
+    incident_w = diffuse_w + direct_w
+    balance = Balance(float(np.sum(incident_w * step_s)) * 1e-6,
+                      *(float(parts[k]) * 1e-6 for k in ("absorbed_leaves", "absorbed_ground",
+                                                   "reflected_top", "escaped_sides",
+                                                   "unresolved")))
+    return AbsorbedPeriod(optics.band, optics, period, balance, joules, leaves_w, incident_w,
+                          unit.rect, unit.rays, unit.depth, unit.seed, unit.periodic,
+                          unit.level, seconds)
