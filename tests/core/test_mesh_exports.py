@@ -220,3 +220,28 @@ def test_a_broken_carried_field_is_one_line_naming_the_comment(tmp_path):
     # a field given does not read the comment
     assert read_mesh_canopy(path, field=(-100, -100, 200, 200))[0].layout.bounds == \
         (-100, -100, 200, 200)
+
+
+def test_the_carried_period_is_used_only_when_the_triangles_repeat_with_it(tmp_path):
+    """The light reads the sensors over a carried period only after checking it: a mesh one
+    of whose leaves moved by a millimetre in one tile keeps the plot as its period."""
+    from maizeviz.io.mesh_canopy import read_mesh
+    from maizeviz.io.meshfile import write_mesh
+    from maizeviz.light.scene.scenes import light_scene
+
+    path = tmp_path / "c.ply"
+    assert main(["canopy", B, "--tile", "3x3", "--triangles", "8", "--export",
+                 str(path)]) == EXIT_OK
+    canopy, mesh, _ = read_mesh_canopy(path)
+    scene = light_scene(canopy, periodic=True)
+    assert (scene.period.w, scene.period.h) == (180.0, 90.0)          # the block, checked
+    assert (scene.wrap.w, scene.wrap.h) == (540.0, 270.0)             # the plot
+    v = mesh.vertices.copy()
+    v[mesh.faces[len(mesh.faces) // 2, 0], 0] += 0.1                  # one vertex, 1 mm
+    moved = tmp_path / "moved.ply"
+    write_mesh(moved, v, mesh.faces, {"plant": mesh.plant, "leaf": mesh.leaf},
+               field_cm=canopy.layout.bounds, period_cm=canopy.layout.period)
+    bent, _, _ = read_mesh_canopy(moved)
+    assert bent.layout.period == canopy.layout.period                  # claimed...
+    scene = light_scene(bent, periodic=True)
+    assert (scene.period.w, scene.period.h) == (540.0, 270.0)          # ...not believed
