@@ -225,7 +225,6 @@ def test_a_broken_carried_field_is_one_line_naming_the_comment(tmp_path):
 def test_the_carried_period_is_used_only_when_the_triangles_repeat_with_it(tmp_path):
     """The light reads the sensors over a carried period only after checking it: a mesh one
     of whose leaves moved by a millimetre in one tile keeps the plot as its period."""
-    from maizeviz.io.mesh_canopy import read_mesh
     from maizeviz.io.meshfile import write_mesh
     from maizeviz.light.scene.scenes import light_scene
 
