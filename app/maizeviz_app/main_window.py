@@ -460,7 +460,8 @@ class MainWindow(QMainWindow):
         field, ok = QInputDialog.getText(
             self, "Field of the mesh", "The ground plot x0, y0, x1, y1 in cm, in field "
             "coordinates (it sets leaf area index, ground cover and the periodic field's tile; "
-            "leave empty for the mesh's extent seen from above):")
+            "leave empty for the plot the file carries, as maizeviz's exports do, else the "
+            "mesh's extent seen from above):")
         if ok:
             self.open_mesh(path, *MESH_FRAMES[frame], field=field.strip() or None)
 
