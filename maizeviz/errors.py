@@ -127,4 +127,5 @@ QUANTITIES = {
     "up": "up axis of a mesh file (z, y)",
     "field": "field rectangle of a mesh canopy x0, y0, x1, y1, cm",
     "mesh_ids": "face properties holding a mesh's plant and leaf ids",
+    "connect_timeout": "seconds to wait for a Dask scheduler",
 }

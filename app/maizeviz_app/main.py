@@ -6,7 +6,8 @@ the core follow in a warm-up thread (see :mod:`maizeviz_app.main_window`).
 
 ``--screenshot PNG`` builds the canopy, computes light once, colours the leaves by light,
 saves a picture of the window (canopy, heatmap and transmission plot) and quits: the way to look
-at the app on a machine without a screen (under ``xvfb-run``).
+at the app on a machine without a screen (under ``xvfb-run``). With ``--workspace digitize`` it
+pictures the Digitize workspace instead, during a Demo session (a simulated FASTRAK).
 """
 
 from __future__ import annotations
@@ -56,6 +57,8 @@ def run(argv: Sequence[str] | None = None) -> int:
     ap.add_argument("--screenshot", metavar="PNG", help="save the window and quit")
     ap.add_argument("--size", default="1366x768", metavar="WxH",
                     help="window size for --screenshot (default 1366x768, a laptop screen)")
+    ap.add_argument("--workspace", choices=("analyse", "digitize"),
+                    help="start in this workspace (default: the one the app was closed in)")
     args = ap.parse_args(argv)
     os.environ.setdefault("QT_API", "pyside6")
     from PySide6.QtWidgets import QApplication
@@ -72,6 +75,8 @@ def run(argv: Sequence[str] | None = None) -> int:
 
         points = str(example_points())
     window = MainWindow(points, args.tile)
+    if args.workspace:
+        window.workspaces.show(args.workspace)
     code = {"value": 0}
     if args.screenshot:
         try:
@@ -79,7 +84,13 @@ def run(argv: Sequence[str] | None = None) -> int:
         except ValueError:
             ap.error(f"--size must look like 1366x768, got {args.size}")
         window.resize(w, h)
-        _screenshot_flow(app, window, args.screenshot, code)
+        # nothing to save: without this the unsaved-results question waited, unanswered,
+        # until the flow's 300 s timeout (and the exit code was 1)
+        window.confirm_unsaved = False
+        if args.workspace == "digitize":
+            _digitize_screenshot_flow(app, window, args.screenshot, code)
+        else:
+            _screenshot_flow(app, window, args.screenshot, code)
     window.show()
     app.exec()
     return code["value"]
@@ -94,14 +105,12 @@ def _screenshot_flow(app, window, path: str, code: dict) -> None:
     def shoot() -> None:
         window.grab().save(path)
         print(f"saved {path}")
-        window.confirm_unsaved = False     # the light it computed is no work to save: no box
         window.close()
         app.quit()
 
     def fail(msg: str) -> None:
         print(f"error: {msg}", file=sys.stderr)
         code["value"] = 1
-        window.confirm_unsaved = False
         window.close()
         app.quit()
 
@@ -113,6 +122,52 @@ def _screenshot_flow(app, window, path: str, code: dict) -> None:
     window.canopy_shown.connect(on_canopy)
     window.light_shown.connect(lambda: QTimer.singleShot(800, shoot))
     window.failed.connect(fail)
+    QTimer.singleShot(300_000, lambda: fail("timed out"))
+
+
+def _digitize_screenshot_flow(app, window, path: str, code: dict, points: int = 26) -> None:
+    """The Demo records ``points`` presses into a temporary file, a press comes while paused,
+    the leaves are meshed -> grab -> quit."""
+    import tempfile
+
+    from PySide6.QtCore import QTimer
+
+    folder = tempfile.mkdtemp(prefix="maizeviz-screenshot-")
+
+    def shoot() -> None:
+        window.grab().save(path)
+        print(f"saved {path}")
+        window.digitizer.stopped.disconnect(stopped)
+        window.digitizer.stop("screenshot", wait=True)
+        window.close()
+        app.quit()
+
+    def fail(msg: str) -> None:
+        print(f"error: {msg}", file=sys.stderr)
+        code["value"] = 1
+        window.close()
+        app.quit()
+
+    def recorded(n: int) -> None:
+        panel = window.digitizer
+        if n == points:
+            panel.toggle_pause()
+            panel.plant.wait()
+            QTimer.singleShot(1500, shoot)
+
+    def start() -> None:
+        panel = window.digitizer
+        panel.out_edit.setText(f"{folder}/session.csv")
+        panel.cols.setValue(5)
+        panel.demo_pace = 0.1
+        panel.recorded.connect(recorded)
+        panel.stopped.connect(stopped)
+        panel.start(demo=True)
+
+    def stopped(why: str) -> None:
+        fail(f"the demo stopped ({why})")
+
+    window.ready.connect(start)
     QTimer.singleShot(300_000, lambda: fail("timed out"))
 
 

@@ -177,6 +177,14 @@ class MainWindow(QMainWindow):
         self._build_panels()
         self._build_status()
         from maizeviz_app.menus import build_menus
+        from maizeviz_app.workspaces import Workspaces
+
+        self.workspaces = Workspaces(self, self._settings, STATE_VERSION,
+                                     sizes=self._apply_default_sizes)
+        self.workspaces.changed.connect(self._workspace_changed)
+        self._canopy_away = False         # the digitizer has the view (until Analyse)
+        self.light_shown.connect(lambda: None if self.digitizing else
+                                 self.workspaces.show("analyse"))
 
         self.menu_actions = build_menus(self)
         self._default_state: QByteArray | None = None   # taken at the first show, docks sized
@@ -289,6 +297,7 @@ class MainWindow(QMainWindow):
         self._default_state = self.saveState(STATE_VERSION)
         if self._state_restored:
             self.restoreState(restored, STATE_VERSION)
+        self.workspaces.settle(self._state_restored)
 
     def _apply_default_sizes(self) -> None:
         w, h = self.width(), self.height()
@@ -307,6 +316,7 @@ class MainWindow(QMainWindow):
             dock.show()
         self.docks["canopy"].raise_()
         self.docks["results"].raise_()
+        self.workspaces.reset()
 
     # ------------------------------------------------------------------ start-up
     def _warm_up(self) -> None:
@@ -377,6 +387,7 @@ class MainWindow(QMainWindow):
         self.digitizer = DigitizerPanel(self.viewport)
         self.digitizer.alert.connect(lambda text: self.say(text, error=True, status_only=True))
         self.digitizer.stopped.connect(self._digitizing_stopped)
+        self.digitizer.started.connect(self._digitizing_started)
         self.docks["layout"].setWidget(_scrolled(self.layout_panel))
         self.docks["digitizer"].setWidget(_scrolled(self.digitizer))
 
@@ -725,10 +736,10 @@ class MainWindow(QMainWindow):
         if self.viewport is None or not self.model.show_built(built):
             return
         self._canopy_id += 1
-        if self.digitizing:
+        if self.digitizing or self._canopy_away:
             self._view_pending = (built.canopy, mesh)
-            self.say(f"{built.label} is ready; it shows when the digitizing session stops",
-                     status_only=True)
+            self.say(f"{built.label} is ready; it shows in the Analyse workspace once the "
+                     "digitizing session stops", status_only=True)
         else:
             self._view_pending = None
             self.viewport.show_canopy(built.canopy, mesh)
@@ -756,7 +767,7 @@ class MainWindow(QMainWindow):
         sky's or day's light per leaf), unless the view is busy with the digitizer;
         ``colour``: switch the colouring to light."""
         if self.viewport is None or self.built is None or self.digitizing or \
-                self._view_pending is not None:
+                self._canopy_away or self._view_pending is not None:
             return
         run = self.runs.latest(self.signature(self.built.label))
         if run is not None and run.kind == "sun" and run.classes is not None and \
@@ -1004,8 +1015,27 @@ class MainWindow(QMainWindow):
             if act is not None:
                 act.setChecked(self.viewport.colouring == name)
 
+    def _digitizing_started(self) -> None:
+        self._canopy_away = True
+        self.workspaces.show("digitize")
+
     def _digitizing_stopped(self, _why: str) -> None:
-        """The canopy comes back after a session: the one built meanwhile if any."""
+        """In Digitize the plant just digitized stays in the view (no canopy frame on Stop);
+        in Analyse the canopy comes back at once."""
+        if self.workspaces.current == "analyse":
+            self._canopy_back()
+
+    def _workspace_changed(self, name: str) -> None:
+        if name == "analyse" and not self.digitizing:
+            self._canopy_back()
+
+    def _canopy_back(self) -> None:
+        """The canopy back in the view after a session: the one built meanwhile if any."""
+        if not self._canopy_away:
+            return
+        self._canopy_away = False
+        if self.digitizer is not None:
+            self.digitizer.release_view()
         if self.viewport is None or self.canopy is None:
             return
         pending, self._view_pending = self._view_pending, None
@@ -1368,18 +1398,23 @@ class MainWindow(QMainWindow):
         """Stop the reader, cancel and wait for the jobs, kill the core processes, save the
         window's geometry and docks, close the 3D view explicitly. Unsaved work is asked
         about first (:meth:`keep_unsaved`)."""
+        if not self._closing and self.digitizer is not None and \
+                not self.digitizer.may_close(self):
+            event.ignore()
+            return
         if not self._closing and not self.keep_unsaved(self.close):
             event.ignore()
             return
         self._closing = True
         try:
             if self.digitizer is not None:
-                self.digitizer.stop("window closed")
+                self.digitizer.stop("window closed", wait=True)
         except Exception as exc:  # noqa: BLE001 - closing must go on
             print(f"maizeviz: the digitizer did not stop cleanly: {exc}", file=sys.stderr)
         self.runner.shutdown(10.0)
         self._settings.setValue("geometry", self.saveGeometry())
         self._settings.setValue("window_state", self.saveState(STATE_VERSION))
+        self.workspaces.save()
         self._settings.sync()
         if self.viewport is not None:
             self.viewport.close()

@@ -93,6 +93,7 @@ def build_menus(w) -> dict[str, QAction]:
     w.docks_menu = v.addMenu("&Panels")
     for dock in w.docks.values():
         w.docks_menu.addAction(dock.toggleViewAction())
+    acts.update(w.workspaces.fill_menu(v))
 
     r = bar.addMenu("&Light")
     acts["compute"] = _action(w, r, "&Compute light (sun, sky or day, as chosen)",

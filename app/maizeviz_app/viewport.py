@@ -29,6 +29,7 @@ from PySide6.QtGui import QColor, QFont, QImage, QLinearGradient, QPainter, QPen
 from PySide6.QtWidgets import QWidget
 from pyvistaqt import QtInteractor
 
+from maizeviz.ids import groups
 from maizeviz_app.options import CAMERAS, COLOURINGS, LIGHT_CLASSES, NOT_TRACED, STALK
 
 #: Text alignments of the painted axes and legends.
@@ -96,16 +97,14 @@ def _point_values(points: np.ndarray, faces: np.ndarray, plant: np.ndarray, leaf
     if all(np.array_equal(p[faces], v[:, None].repeat(3, axis=1))
            for p, v in zip(per_point, (plant, leaf))):
         return points, faces, tuple(per_point)
-    # one vertex per (vertex, plant and leaf) pair, by 1-D keys (fast for millions)
-    by_plant = plant.astype(np.int64) - plant.min()
-    by_leaf = leaf.astype(np.int64) - leaf.min()
-    _, first, pair = np.unique(by_plant * (by_leaf.max() + 1) + by_leaf, return_index=True,
-                               return_inverse=True)
-    n_pairs = len(first)
-    keys, inverse = np.unique(flat.astype(np.int64) * n_pairs + np.repeat(pair, 3),
-                              return_inverse=True)
-    leaf_of = first[keys % n_pairs]                 # a triangle of each new vertex's leaf
-    return (points[keys // n_pairs], inverse.reshape(faces.shape).astype(faces.dtype),
+    # one vertex per (vertex, plant and leaf), grouped by the id columns themselves (ids of
+    # any width: no packing into one number)
+    pairs, pair = groups(plant, leaf)
+    first = np.empty(len(pairs), np.intp)
+    first[pair[::-1]] = np.arange(len(pair))[::-1]  # the first triangle of each (plant, leaf)
+    keys, inverse = groups(flat, np.repeat(pair, 3))
+    leaf_of = first[keys[:, 1]]                     # a triangle of each new vertex's leaf
+    return (points[keys[:, 0]], inverse.reshape(faces.shape).astype(faces.dtype),
             (plant[leaf_of].astype(np.int32), leaf[leaf_of].astype(np.int32)))
 
 
@@ -161,13 +160,19 @@ def display_polydata(canopy, coarse) -> pv.PolyData:
     poly.field_data["source"] = np.concatenate([fine, np.full(len(rough), -1)]).astype(np.int64)
     # the leaves of the canopy, and for each coarse triangle drawn its leaf among them (-1: a
     # leaf the canopy does not have), worked out here so that colouring is cheap
-    keys = canopy.face_instance.astype(np.int64) * 10_000 + canopy.face_leaf
-    uniq, first, inv = np.unique(keys, return_index=True, return_inverse=True)
-    want = coarse.face_instance[rough].astype(np.int64) * 10_000 + coarse.face_leaf[rough]
-    pos = np.clip(np.searchsorted(uniq, want), 0, len(uniq) - 1)
+    nf = canopy.n_triangles
+    _, label = groups(np.concatenate([canopy.face_instance, coarse.face_instance[rough]]),
+                      np.concatenate([canopy.face_leaf, coarse.face_leaf[rough]]))
+    present = np.zeros(int(label.max()) + 1 if len(label) else 0, bool)
+    present[label[:nf]] = True
+    rank = np.cumsum(present) - 1                   # leaf of the canopy, in (instance, leaf) order
+    inv = rank[label[:nf]]
+    first = np.empty(int(present.sum()), np.int64)
+    first[inv[::-1]] = np.arange(nf)[::-1]          # the first triangle of each leaf
+    want = label[nf:]
     poly.field_data["canopy_leaf"] = inv.astype(np.int32)
-    poly.field_data["leaf_first"] = first.astype(np.int64)
-    poly.field_data["drawn_leaf"] = np.where(uniq[pos] == want, pos, -1).astype(np.int64)
+    poly.field_data["leaf_first"] = first
+    poly.field_data["drawn_leaf"] = np.where(present[want], rank[want], -1).astype(np.int64)
     return _settle(poly)
 
 

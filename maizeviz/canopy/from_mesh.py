@@ -32,6 +32,7 @@ What is taken from the file, and nothing else changed:
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -39,7 +40,9 @@ import numpy as np
 from maizeviz.canopy.layout import MAX_COORD_CM, CanopyLayout, Placement
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
-from maizeviz.io.mesh_canopy import CARRIED, MAX_LEAF_ID, MeshData, read_mesh
+from maizeviz.ids import groups
+from maizeviz.io.mesh_canopy import CARRIED, MeshData, read_mesh
+from maizeviz.numbers import number
 
 #: cm per unit of a mesh file.
 UNITS = {"m": 100.0, "cm": 1.0, "mm": 0.1}
@@ -65,12 +68,12 @@ def check_field(field: tuple[float, float, float, float] | list[float] | str
     if isinstance(field, str):
         words = field.replace(",", " ").split()
         try:
-            vals = tuple(float(w) for w in words)
+            vals = tuple(number(w) for w in words)
         except ValueError:
             raise MaizevizError(f"the field needs 4 numbers x0, y0, x1, y1 (cm), got "
                                 f"'{field[:60]}'", quantity="field") from None
     else:
-        vals = tuple(float(v) for v in field)
+        vals = tuple(number(v) if isinstance(v, (str, bytes)) else float(v) for v in field)
     if len(vals) != 4:
         raise MaizevizError(f"the field needs 4 numbers x0, y0, x1, y1 (cm), got {len(vals)}",
                             quantity="field")
@@ -185,6 +188,41 @@ def _distinct(a: np.ndarray) -> np.ndarray:
     return np.unique(a[starts])
 
 
+def repeated_triangles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(T,) bool: the triangles whose three corners (by position, in any order and either
+    orientation) are those of an earlier triangle.
+
+    vertices : (V, 3) float64; faces : (T, 3) int64. A surface written twice (a file
+    concatenated with itself, a double-sided export) would otherwise count its area, and
+    intercept its light, twice.
+    """
+    out = np.zeros(len(faces), dtype=bool)
+    if len(faces) < 2:
+        return out
+    _, same = np.unique(vertices, axis=0, return_inverse=True)
+    corners = np.sort(same.reshape(-1)[faces], axis=1)
+    order = np.lexsort(corners.T[::-1])                # stable: the first of equals first
+    ranked = corners[order]
+    out[order[1:][np.all(ranked[1:] == ranked[:-1], axis=1)]] = True
+    return out
+
+
+def _without_repeats(mesh: MeshData, source: str) -> tuple[MeshData, list[str]]:
+    """The mesh with each repeated triangle (:func:`repeated_triangles`) left out, and the
+    note saying so."""
+    repeat = repeated_triangles(mesh.vertices, mesh.faces)
+    n = int(repeat.sum())
+    if not n:
+        return mesh, []
+    t = int(np.flatnonzero(repeat)[0])
+    keep = ~repeat
+    note = (f"{source}: {n:,} of the {mesh.n_triangles:,} triangles repeat an earlier triangle "
+            f"(the same three corners; first: {mesh.where_triangle(t)}): each surface is "
+            "counted once")
+    return replace(mesh, faces=mesh.faces[keep], triangle_face=mesh.triangle_face[keep],
+                   plant=mesh.plant[keep], leaf=mesh.leaf[keep]), [note]
+
+
 def _split(vertices: np.ndarray, faces: np.ndarray, is_leaf: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Leaf vertices and faces, stalk vertices and faces, each renumbered, vertices in file
@@ -248,8 +286,8 @@ def _positions(n: int, centre: np.ndarray, area: np.ndarray, leaf_inst: np.ndarr
                              plain / np.maximum(count, 1))
     if len(stalk_f):
         # each stalk vertex once per plant that uses it
-        vi = np.unique(stalk_inst.astype(np.int64)[:, None] * len(stalk_v) + stalk_f)
-        owner, vert = vi // len(stalk_v), vi % len(stalk_v)
+        used, _ = groups(np.repeat(stalk_inst, 3), stalk_f.ravel())
+        owner, vert = used[:, 0], used[:, 1]
         has = np.bincount(owner, minlength=n) > 0
         for k in range(2):
             mean = np.bincount(owner, stalk_v[vert, k], n) / np.maximum(
@@ -280,6 +318,8 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
     notes = list(mesh.notes)
     if field is not None:
         field = check_field(field)                                    # type: ignore[assignment]
+    mesh, said = _without_repeats(mesh, source)
+    notes += said
     carried_field, period = _carried(mesh, unit, up, source, notes, strict=field is None)
     if field is None and carried_field is not None:
         field, fsrc = carried_field, "the file's"                     # type: ignore[assignment]
@@ -309,8 +349,8 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
     inst = np.searchsorted(plants, mesh.plant).astype(np.int32)
     leaf_inst, stalk_inst = inst[is_leaf], inst[~is_leaf]
     leaf_ids = mesh.leaf[is_leaf].astype(np.int32)
-    pairs = _distinct(leaf_inst.astype(np.int64) * (MAX_LEAF_ID + 1) + leaf_ids)
-    leaves_per = np.bincount(pairs // (MAX_LEAF_ID + 1), minlength=len(plants)).astype(np.int32)
+    pairs, _ = groups(leaf_inst, leaf_ids)
+    leaves_per = np.bincount(pairs[:, 0], minlength=len(plants)).astype(np.int32)
     xy = _positions(len(plants), centre, area, leaf_inst, stalk_v, stalk_f, stalk_inst)
     del centre
     placements = tuple(Placement(int(p), float(x), float(y)) for p, (x, y) in zip(plants, xy))
@@ -345,14 +385,14 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
     x0, y0, x1, y1 = field
     cells = np.array([field], np.float64)
     period = _period_in(period, field, source, notes)
-    said = f"the field is {fsrc}: x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f} cm"
+    field_said = f"the field is {fsrc}: x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f} cm"
     if period is not None:
         px0, py0, px1, py1 = period
-        said += (f", repeating every {px1 - px0:.1f} x {py1 - py0:.1f} cm in a periodic field "
+        field_said += (f", repeating every {px1 - px0:.1f} x {py1 - py0:.1f} cm in a periodic field "
                  "(the file's period; its block is the default sample rectangle)")
     layout = CanopyLayout(placements, cells, x1 - x0, y1 - y0, 0.0,
                           np.array([period], np.float64) if period else cells.copy(),
-                          (said,), (x1 - x0) * (y1 - y0), "mesh", period)
+                          (field_said,), (x1 - x0) * (y1 - y0), "mesh", period)
     canopy = Canopy(leaf_v, leaf_f, leaf_inst, mesh.plant[is_leaf].astype(np.int32), leaf_ids,
                     layout, MESH_LEVEL, stalk_v, stalk_f, leaves_per,
                     stalk_instance=stalk_inst)

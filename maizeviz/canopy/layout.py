@@ -9,11 +9,13 @@ its cells (tiling) or the field rectangle (layout file).
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 from collections import defaultdict
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -23,6 +25,7 @@ from maizeviz.io.inputs import read_input
 from maizeviz.io.points import MAX_ID as MAX_PLANT_ID  # plant ids as in points files
 from maizeviz.leaf.fit import Leaf
 from maizeviz.leaf.grid import stalk_base
+from maizeviz.numbers import whole
 
 LAYOUT_SCHEMA = 1
 #: Plants a layout may hold (a hectare at 60 x 30 cm is about 55,000).
@@ -134,6 +137,27 @@ def field_period(layout: CanopyLayout) -> tuple[float, float, float, float] | No
     return None
 
 
+#: Columns of :func:`placements_array`.
+PLACEMENT_COLUMNS = ("plant", "x_cm", "y_cm", "azimuth_deg", "tile_i", "tile_j")
+
+
+def placements_array(layout: CanopyLayout) -> np.ndarray:
+    """(n, 6) float64: plant, x, y (cm), azimuth (degrees), tile i, tile j of each stand, in
+    the layout's order."""
+    rows = [(p.plant, p.x, p.y, p.azimuth_deg, p.tile[0], p.tile[1]) for p in layout.placements]
+    return np.array(rows, np.float64).reshape(-1, len(PLACEMENT_COLUMNS))
+
+
+def stands_identity(layout: CanopyLayout) -> dict[str, Any]:
+    """``{"n": stands, "sha256": hex}``: what identifies the stands of a canopy, in order (the
+    digitized plant of each, where it stands to 1e-6 cm, its rotation to 1e-6 degrees and its
+    tile). Every traced light result carries that of the canopy it was traced on, so that it
+    is never stored or shown on other stands."""
+    a = placements_array(layout)
+    key = np.round(a, 6) + 0.0             # + 0.0 turns -0.0 into 0.0
+    return {"n": int(len(a)), "sha256": hashlib.sha256(key.tobytes()).hexdigest()}
+
+
 def union_area(rects: np.ndarray) -> float:
     """Exact area of the union of axis-aligned rectangles (k, 4) x0, y0, x1, y1 (cm2).
 
@@ -190,7 +214,7 @@ def parse_shape(text: str, quantity: str = "tile") -> tuple[int, int]:
     what = quantity.replace("_", " ")
     parts = str(text).lower().replace(" ", "").split("x")
     try:
-        a, b = (int(p) for p in parts)
+        a, b = (whole(p) for p in parts)
     except ValueError:
         raise LayoutError(f"{what} must look like 3x3, got '{text}'", quantity=quantity) from None
     if a < 1 or b < 1:

@@ -17,6 +17,7 @@ from maizeviz.canopy.measures import (
 )
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.cli.common import (
+    NUMBER_ARG,
     Progress,
     add_canopy_options,
     add_level_options,
@@ -49,7 +50,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     add_level_options(p, CANOPY_LEVELS)
     p.add_argument("--with-stalks", action="store_true",
                    help="count stalk cylinders in the measures (they are always in exports)")
-    p.add_argument("--cover-resolution", type=float, default=0.5, metavar="CM",
+    p.add_argument("--cover-resolution", type=NUMBER_ARG, default=0.5, metavar="CM",
                    help="pixel edge of the vertical-ray grid measuring ground cover (default 0.5)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--export", metavar="PATH",

@@ -15,12 +15,18 @@ from maizeviz.errors import LeafError, MaizevizError
 from maizeviz.io.atomic import file_tag
 from maizeviz.io.mesh_canopy import is_mesh_path
 from maizeviz.io.meshfile import check_mesh_path
+from maizeviz.io.points import shown
 from maizeviz.io.project import SUFFIX as PROJECT_SUFFIX
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.mesh.levels import Level, parse_levels
+from maizeviz.numbers import NUMBER_ARG as NUMBER_ARG
+from maizeviz.numbers import WHOLE_ARG as WHOLE_ARG
+from maizeviz.numbers import number
 from maizeviz.progress import ProgressCallback
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_PARTIAL = 0, 1, 2, 3
+#: Most numbers one list option takes (``--heights``): counted before any is read.
+MAX_LIST_ITEMS = 1_000
 
 #: The flag (or flags) through which each quantity of :data:`maizeviz.errors.QUANTITIES`
 #: reaches the core: errors about a quantity name it.
@@ -91,10 +97,10 @@ class Progress:
 # ------------------------------------------------------------------------------ options
 def add_level_options(p: argparse.ArgumentParser, default_levels: str) -> None:
     lv = p.add_mutually_exclusive_group()
-    lv.add_argument("--interp", type=int, metavar="K",
+    lv.add_argument("--interp", type=WHOLE_ARG, metavar="K",
                     help="K points interpolated between data points (0 = standard mesh; "
                          "default 4, the paper's reference mesh)")
-    lv.add_argument("--triangles", type=int, metavar="N",
+    lv.add_argument("--triangles", type=WHOLE_ARG, metavar="N",
                     help="at most N triangles per leaf (inverse multi-line segment splitting)")
     lv.add_argument("--levels", nargs="?", const=default_levels, metavar="LIST",
                     help=f"compare levels (default {default_levels})")
@@ -131,9 +137,9 @@ def add_canopy_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--block", metavar="RxP",
                    help="rows x plants per row of the digitized block (default: inferred from "
                         "the stalk positions)")
-    p.add_argument("--row-spacing", type=float, default=60.0, metavar="CM",
+    p.add_argument("--row-spacing", type=NUMBER_ARG, default=60.0, metavar="CM",
                    help="distance between rows along x, cm (default 60)")
-    p.add_argument("--plant-spacing", type=float, default=30.0, metavar="CM",
+    p.add_argument("--plant-spacing", type=NUMBER_ARG, default=30.0, metavar="CM",
                    help="distance between plants in a row along y, cm (default 30)")
     p.add_argument("--layout", metavar="JSON", help="a layout file instead of tiling")
     p.add_argument("--strict", action="store_true",
@@ -276,15 +282,34 @@ def _project_setup(args: argparse.Namespace) -> tuple[list[Leaf], list[LeafError
     return list(study.plants.leaves), list(study.plants.skipped), study.layout
 
 
-def floats(text: str, what: str, quantity: str, count: int | None = None) -> list[float]:
-    """Numbers separated by commas (``"0,50,100"``)."""
-    try:
-        vals = [float(v) for v in str(text).split(",") if v.strip()]
-    except ValueError:
-        raise MaizevizError(f"{what} must be numbers separated by commas, got '{text}'",
-                            quantity=quantity) from None
+def floats(text: str, what: str, quantity: str, count: int | None = None,
+           most: int = MAX_LIST_ITEMS) -> list[float]:
+    """Numbers separated by commas (``"0,50,100"``), at most ``most`` of them.
+
+    An empty item (``0,,50``, a trailing comma) is refused rather than dropped: a number left
+    out by a slip should not pass unseen. So are underscores (``1_000``) and anything else
+    :func:`maizeviz.numbers.number` does not read.
+    """
+    text = str(text)
+    if text.count(",") >= most:
+        raise MaizevizError(f"{what}: {text.count(',') + 1:,} values; at most {most:,} are "
+                            "taken", quantity=quantity)
+    items = text.split(",")
+    vals = []
+    for k, item in enumerate(items, 1):
+        if not item.strip():
+            if len(items) == 1:
+                raise MaizevizError(f"{what}: no number given", quantity=quantity)
+            raise MaizevizError(f"{what}: item {k} of {len(items)} is empty in '{shown(text)}'; "
+                                "write numbers separated by single commas", quantity=quantity)
+        try:
+            vals.append(number(item))
+        except ValueError:
+            raise MaizevizError(f"{what} must be numbers separated by commas, got "
+                                f"'{shown(item)}' in '{shown(text)}'", quantity=quantity) from None
     if count is not None and len(vals) != count:
-        raise MaizevizError(f"{what} needs {count} numbers, got '{text}'", quantity=quantity)
+        raise MaizevizError(f"{what} needs {count} numbers, got '{shown(text)}'",
+                            quantity=quantity)
     return vals
 
 

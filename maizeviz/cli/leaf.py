@@ -6,6 +6,7 @@ import argparse
 import json
 
 from maizeviz.cli.common import (
+    WHOLE_ARG,
     Progress,
     add_level_options,
     check_export,
@@ -50,7 +51,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--export", metavar="PATH",
                    help="write the meshes: .ply .obj .vtk .vtu .vtp .stl (plant/leaf ids kept "
                         "as cell data where the format allows)")
-    p.add_argument("--degree", type=int, default=3, help="NURBS degree in u and v (default 3)")
+    p.add_argument("--degree", type=WHOLE_ARG, default=3, help="NURBS degree in u and v (default 3)")
     p.add_argument("--params", choices=("chord", "centripetal"), default="chord",
                    help="data parameters (default chord length)")
     p.add_argument("--strict", action="store_true",

@@ -21,6 +21,8 @@ from maizeviz.canopy.export import export_canopy
 from maizeviz.canopy.from_mesh import MESH_LEVEL
 from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.cli.common import (
+    NUMBER_ARG,
+    WHOLE_ARG,
     Progress,
     add_canopy_options,
     add_level_options,
@@ -85,14 +87,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     add_canopy_options(p)
     add_level_options(p, CANOPY_LEVELS)
     sun = p.add_argument_group("sun (explicit angles, or place + date + time through pvlib)")
-    sun.add_argument("--sun-zenith", type=float, metavar="DEG", help="zenith angle, degrees")
-    sun.add_argument("--sun-azimuth", type=float, metavar="DEG",
+    sun.add_argument("--sun-zenith", type=NUMBER_ARG, metavar="DEG", help="zenith angle, degrees")
+    sun.add_argument("--sun-azimuth", type=NUMBER_ARG, metavar="DEG",
                      help="azimuth, degrees clockwise from north (field y = north by default)")
     sun.add_argument("--date", help="YYYY-MM-DD")
     sun.add_argument("--time", help="local clock time HH:MM (or HH:MM+08:00 with its offset)")
     sun.add_argument("--solar-noon", action="store_true", help="the true solar noon of --date")
-    sun.add_argument("--lat", type=float, help="latitude, degrees north")
-    sun.add_argument("--lon", type=float, help="longitude, degrees east")
+    sun.add_argument("--lat", type=NUMBER_ARG, help="latitude, degrees north")
+    sun.add_argument("--lon", type=NUMBER_ARG, help="longitude, degrees east")
     sun.add_argument("--tz", default=None,
                      help="time zone, e.g. Asia/Shanghai (default UTC, or the offset of --time)")
     sky = p.add_argument_group("diffuse sky")
@@ -102,7 +104,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                           "each time step's diffuse light split by Perez's anisotropic model "
                           "(pvlib), its circumsolar part traced with the sun, the rest over a "
                           "uniform sky")
-    sky.add_argument("--sky-directions", type=int, default=None, metavar="N",
+    sky.add_argument("--sky-directions", type=WHOLE_ARG, default=None, metavar="N",
                      help="directions of the sky: 6, 16, 46 (den Dulk's turtle), 145 (Tregenza) "
                           "or any N >= 1 (equal solid angles); default 46")
     per = p.add_argument_group("a day or a period (sun every --step, sky once)")
@@ -110,18 +112,18 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     per.add_argument("--from", dest="from_", metavar="HH:MM",
                      help="start of the period on --date (local clock time)")
     per.add_argument("--to", metavar="HH:MM", help="end of the period on --date")
-    per.add_argument("--step", type=float, default=None, metavar="MIN",
+    per.add_argument("--step", type=NUMBER_ARG, default=None, metavar="MIN",
                      help="time step, minutes (default 30)")
     per.add_argument("--weather", metavar="FILE",
                      help="irradiance from a weather file instead of the clear sky: maizeviz's "
                           "CSV (time with zone, ghi W/m2, optional dni, dhi, par umol/m2/s, "
                           "temp_air), an EPW, TMY3 or NSRDB PSM3/PSM4 file; the file sets the "
                           "period (and, EPW/TMY3/PSM, the time zone and the place)")
-    per.add_argument("--linke-turbidity", type=float, default=None, metavar="T",
+    per.add_argument("--linke-turbidity", type=NUMBER_ARG, default=None, metavar="T",
                      help=f"Linke turbidity of the clear sky (default {DEFAULT_LINKE_TURBIDITY:g})")
-    per.add_argument("--altitude", type=float, default=0.0, metavar="M",
+    per.add_argument("--altitude", type=NUMBER_ARG, default=0.0, metavar="M",
                      help="site altitude, m (clear sky and sun positions; default 0)")
-    per.add_argument("--par-factor", type=float, default=None, metavar="UMOL_PER_J",
+    per.add_argument("--par-factor", type=NUMBER_ARG, default=None, metavar="UMOL_PER_J",
                      help=f"umol of PAR per J of shortwave (default 0.48 x 4.57 = "
                           f"{DEFAULT_PAR_UMOL_PER_J:.4g})")
     per.add_argument("--steps", metavar="CSV", help="write one line per time step")
@@ -129,13 +131,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                      help="write PNGs of the period: PAR through the day, transmission profile")
     p.add_argument("--heights", default="0,50,100,150,200,225", metavar="CM,...",
                    help="heights of the sensor planes, cm (default 0,50,100,150,200,225)")
-    p.add_argument("--density", type=float, default=4.0,
+    p.add_argument("--density", type=NUMBER_ARG, default=4.0,
                    help="rays (and sensors) per cm2 of the sample rectangle (default 4)")
     p.add_argument("--rect", metavar="X0,Y0,X1,Y1",
                    help="sample rectangle, cm (default: the central tile)")
     p.add_argument("--periodic", action="store_true",
                    help="rays leaving the plot sideways re-enter on the other side (infinite field)")
-    p.add_argument("--threads", type=int, default=os.cpu_count() or 1,
+    p.add_argument("--threads", type=WHOLE_ARG, default=os.cpu_count() or 1,
                    help="tracing threads (default: all cores)")
     p.add_argument("--with-stalks", action="store_true", help="stalks intercept light too")
     p.add_argument("--check", action="store_true",
@@ -144,7 +146,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--verbose", action="store_true",
                    help="print the sky's directions and weights on stderr")
     p.add_argument("--heatmaps", metavar="DIR", help="write a transmission map PNG + CSV per height")
-    p.add_argument("--heatmap-bin", type=float, default=5.0, metavar="CM",
+    p.add_argument("--heatmap-bin", type=NUMBER_ARG, default=5.0, metavar="CM",
                    help="heatmap bin size, cm (default 5)")
     p.add_argument("--leaf-light", metavar="CSV",
                    help="write the light intercepted by every lit leaf")
@@ -156,25 +158,25 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "absorbed light with scattering (any of these turns it on; needs a sun)")
     ab.add_argument("--band", choices=BANDS, default=None,
                     help="waveband: par (default) or nir, with its default optics")
-    ab.add_argument("--reflectance", type=float, default=None, metavar="R",
+    ab.add_argument("--reflectance", type=NUMBER_ARG, default=None, metavar="R",
                     help="leaf reflectance in the band (PAR default 0.10, NIR 0.45)")
-    ab.add_argument("--transmittance", type=float, default=None, metavar="T",
+    ab.add_argument("--transmittance", type=NUMBER_ARG, default=None, metavar="T",
                     help="leaf transmittance in the band (PAR default 0.05, NIR 0.40)")
-    ab.add_argument("--ground-reflectance", type=float, default=None, metavar="G",
+    ab.add_argument("--ground-reflectance", type=NUMBER_ARG, default=None, metavar="G",
                     help="soil reflectance in the band (PAR default 0.10, NIR 0.25)")
     ab.add_argument("--optics-table", metavar="CSV",
                     help="leaf optics per leaf rank: a CSV with rank,reflectance,transmittance "
                          "(and optionally band); ranks it does not name take --reflectance and "
                          "--transmittance (or the band's defaults)")
-    ab.add_argument("--irradiance", type=float, default=None, metavar="W_M2",
+    ab.add_argument("--irradiance", type=NUMBER_ARG, default=None, metavar="W_M2",
                     help="the band's direct irradiance on a horizontal plane, W/m2 (default "
                          "its share of 1000 W/m2: PAR 480, NIR 520)")
-    ab.add_argument("--diffuse", type=float, default=0.0, metavar="W_M2",
+    ab.add_argument("--diffuse", type=NUMBER_ARG, default=0.0, metavar="W_M2",
                     help="the band's diffuse irradiance on a horizontal plane, W/m2, spread "
                          "over --sky (default soc) (default 0)")
-    ab.add_argument("--depth", type=int, default=None, metavar="N",
+    ab.add_argument("--depth", type=WHOLE_ARG, default=None, metavar="N",
                     help=f"most scatterings followed per ray (default {DEFAULT_DEPTH})")
-    ab.add_argument("--seed", type=int, default=None, help="random seed (default 0)")
+    ab.add_argument("--seed", type=WHOLE_ARG, default=None, help="random seed (default 0)")
     p.set_defaults(run=run)
 
 

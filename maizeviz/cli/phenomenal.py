@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from maizeviz.cli.common import EXIT_OK, floats, say
+from maizeviz.cli.common import EXIT_OK, WHOLE_ARG, floats, say
 from maizeviz.errors import check_range
 from maizeviz.io.outputs import check_run_paths
 from maizeviz.io.phenomenal import load_phenomenal
@@ -23,7 +23,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                     "surface voxels become cross-sections of 5 points.")
     p.add_argument("file", help="Phenomenal plant, .json or .json.gz")
     p.add_argument("--out", required=True, help="points CSV to write")
-    p.add_argument("--plant", type=int, default=1, help="plant id to give it (default 1)")
+    p.add_argument("--plant", type=WHOLE_ARG, default=1, help="plant id to give it (default 1)")
     p.add_argument("--at", metavar="X,Y", help="move the stalk base to x,y (cm)")
     p.set_defaults(run=run)
 

@@ -7,7 +7,7 @@ import signal
 import sys
 import threading
 
-from maizeviz.cli.common import EXIT_OK, say
+from maizeviz.cli.common import EXIT_OK, NUMBER_ARG, WHOLE_ARG, say
 from maizeviz.digitizer.port import FastrakPort
 from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import DEFAULT_COLS, Session
@@ -27,14 +27,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                     "r end the row early (tip), u undo the last point, q finish.")
     p.add_argument("--port", required=True, help="serial port, e.g. /dev/ttyUSB0")
     p.add_argument("--out", required=True, help="points CSV to append to")
-    p.add_argument("--cols", type=int, default=None,
+    p.add_argument("--cols", type=WHOLE_ARG, default=None,
                    help=f"points per cross-section, margin to margin (default {DEFAULT_COLS}; "
                         "with --resume, the recording's own: a different value is refused)")
     p.add_argument("--resume", action="store_true", help="continue --out where it stopped")
-    p.add_argument("--baud", type=int, default=115200, help="baud rate (default 115200)")
-    p.add_argument("--reference-station", type=int, choices=(2, 3, 4), metavar="N",
+    p.add_argument("--baud", type=WHOLE_ARG, default=115200, help="baud rate (default 115200)")
+    p.add_argument("--reference-station", type=WHOLE_ARG, choices=(2, 3, 4), metavar="N",
                    help="a receiver fixed to the stalk: points are re-expressed in its frame")
-    p.add_argument("--answer-timeout", type=float, default=1.0, metavar="S",
+    p.add_argument("--answer-timeout", type=NUMBER_ARG, default=1.0, metavar="S",
                    help="seconds to wait for each reply of the unit (default 1)")
     p.set_defaults(run=run)
 

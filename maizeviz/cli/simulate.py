@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import time
 
-from maizeviz.cli.common import EXIT_OK
+from maizeviz.cli.common import EXIT_OK, NUMBER_ARG, WHOLE_ARG
 from maizeviz.digitizer.replay import replay_points
 from maizeviz.digitizer.simulator import FastrakSimulator
 from maizeviz.errors import check_range
@@ -21,15 +21,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                     "press the stylus at every point of a points file once a recorder has "
                     "configured it.")
     p.add_argument("--replay", metavar="CSV", help="points file to replay as stylus presses")
-    p.add_argument("--pace", type=float, default=1.0, metavar="S",
+    p.add_argument("--pace", type=NUMBER_ARG, default=1.0, metavar="S",
                    help="seconds between presses (default 1.0; the unit ignores < 0.333)")
     p.add_argument("--reference", action="store_true",
                    help="a second receiver on the stalk (station 2) that sways while replaying")
     p.add_argument("--faults", action="store_true",
                    help="inject garbled bytes, truncated records, BIT errors and finally pull "
                         "the port")
-    p.add_argument("--noise", type=float, default=0.08, help="position noise, cm (default 0.08)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--noise", type=NUMBER_ARG, default=0.08, help="position noise, cm (default 0.08)")
+    p.add_argument("--seed", type=WHOLE_ARG, default=0)
     p.set_defaults(run=run)
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from maizeviz.canopy.layout import parse_shape
-from maizeviz.cli.common import EXIT_OK, say
+from maizeviz.cli.common import EXIT_OK, NUMBER_ARG, WHOLE_ARG, say
 from maizeviz.io.outputs import check_run_paths
 from maizeviz.io.points import write_points
 from maizeviz.leaf.synth import block_grids
@@ -22,12 +22,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                     "technician would, with 0.08 cm digitizer noise.")
     p.add_argument("--plants", default="3x3", metavar="RxP",
                    help="rows x plants per row (default 3x3)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.add_argument("--row-spacing", type=float, default=60.0, metavar="CM")
-    p.add_argument("--plant-spacing", type=float, default=30.0, metavar="CM")
-    p.add_argument("--sections", type=int, default=13,
+    p.add_argument("--seed", type=WHOLE_ARG, default=0, help="random seed (default 0)")
+    p.add_argument("--row-spacing", type=NUMBER_ARG, default=60.0, metavar="CM")
+    p.add_argument("--plant-spacing", type=NUMBER_ARG, default=30.0, metavar="CM")
+    p.add_argument("--sections", type=WHOLE_ARG, default=13,
                    help="cross-sections of a long leaf (default 13)")
-    p.add_argument("--points-across", type=int, default=5,
+    p.add_argument("--points-across", type=WHOLE_ARG, default=5,
                    help="points per cross-section, margin to margin (default 5)")
     p.add_argument("--out", required=True, help="points CSV to write")
     p.set_defaults(run=run)

@@ -29,6 +29,7 @@ import os
 import shutil
 import stat
 import time
+from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -47,6 +48,7 @@ from maizeviz.io.points import (
     refuse_binary,
     shown,
     text_of,
+    zero_tail,
 )
 
 COLUMNS = JOURNAL_COLUMNS
@@ -177,65 +179,94 @@ def release_lock(fd: int, lp: Path) -> None:
 
 # ------------------------------------------------------------------------- the replay
 class JournalReplay(LineParser):
-    """Replays a recording with the points reader's rules: the position the next point
-    goes to, the points still recorded (undo pops the last one), and any torn last line.
+    """Replays a recording with the points reader's rules: the points it keeps, where the
+    next point goes, and any torn last line.
+
+    A line the reader skips (an unknown status, a line of the wrong length, an id out of
+    range, an undo of a point that is not recorded) changes nothing here either: the next
+    point goes where it went before that line. An undo takes back the latest recording of
+    its point, as the reader's does, and the next point goes there (as after the recorder's
+    own undo).
 
     Attributes
     ----------
-    history : list of (Position, (x, y, z) cm), points recorded and not undone, in order
-    pos : Position, where the next point goes (with ``cols`` None, after a point: its next col;
-        :meth:`pos_after` gives it for a width)
+    history : list of (Position, (x, y, z) cm), points recorded and not undone, in order: the
+        points :func:`maizeviz.io.points.read_points` keeps, in the same order
     problems : lines that were skipped, with the reason (the points reader says the same)
     width : points per cross-section the recording shows, or None: the last row that ended
-        by itself (a point at col 0 right after the previous row's last point, no control or
-        undo in between) had ``width`` points
+        by itself (a point at col 0 right after the previous row's last point, no other line
+        in between) had ``width`` points
     least_width : points per cross-section the recording needs at least (largest col + 1)
-    last_point : Position of the last line when it was a point (the next position depends on
-        the width), else None
+    bad_leaf_lines : {(plant, leaf): first message}: leaves with a line the reader cannot
+        read (every point of such a leaf is refused when the file is read)
     """
 
     def __init__(self, source: str, cols: int | None):
         super().__init__(source, max_points=MAX_JOURNAL_LINES, max_lines=MAX_JOURNAL_LINES)
         self.cols = cols
         self.history: list[tuple] = []
-        self.pos = Position()
         self.controls = 0
         self.width: int | None = None
         self.least_width = 0
-        self.last_point: Position | None = None
+        self.bad_leaf_lines: dict[tuple[int, int], str] = {}
+        self._moved_to: Position | None = None   # where a control or an undo leads
+        self._after: Position | None = None      # else: the next point follows this one
+        self._previous: Position | None = None   # the line just before was this point
+
+    @property
+    def pos(self) -> Position:
+        """Where the next point goes for :attr:`cols` (after a point with ``cols`` None: its
+        next col; :meth:`pos_after` gives it for a width)."""
+        if self._moved_to is None and self._after is not None and not self.cols:
+            p = self._after
+            return Position(p.plant, p.leaf, p.row, p.col + 1)
+        return self.pos_after(self.cols or DEFAULT_COLS)
 
     def pos_after(self, cols: int) -> Position:
         """Where the next point goes in a recording of ``cols`` points per cross-section."""
-        return self.pos if self.last_point is None else _after(self.last_point, cols)
+        if self._moved_to is not None:
+            return self._moved_to
+        if self._after is not None:
+            return _after(self._after, cols)
+        return Position()
 
     def _discard(self, lineno: int) -> None:
         """A torn line marked when an earlier session resumed: skipped without a word."""
         self.pending = None
 
     def commit(self, outcome) -> None:
-        kind, payload, _ = outcome
-        last, self.last_point = self.last_point, None
+        kind, payload, lineno = outcome
+        previous, self._previous = self._previous, None
         if kind == "point":
             plant, leaf, row, col, coords, _ = payload
             p = Position(plant, leaf, row, col)
-            if last is not None and col == 0 and (last.plant, last.leaf, last.row + 1) == \
-                    (plant, leaf, row):
-                self.width = last.col + 1                 # the row ended by itself
+            if previous is not None and col == 0 and (previous.plant, previous.leaf,
+                                                      previous.row + 1) == (plant, leaf, row):
+                self.width = previous.col + 1             # the row ended by itself
             self.least_width = max(self.least_width, col + 1)
             self.history.append((p, tuple(coords)))
-            self.last_point = p
-            self.pos = _after(p, self.cols) if self.cols else Position(plant, leaf, row, col + 1)
+            self._after, self._moved_to, self._previous = p, None, p
         elif kind == "undo":
-            if self.history:
-                last, _ = self.history.pop()
-                self.pos = Position(last.plant, last.leaf, last.row, last.col)
+            key = Position(*payload)
+            for k in range(len(self.history) - 1, -1, -1):
+                if self.history[k][0] == key:          # the latest recording of that point
+                    del self.history[k]
+                    self._moved_to = key
+                    break
+            else:
+                self._note(f"line {lineno}: undoes plant {key.plant} leaf {key.leaf} row "
+                           f"{key.row} col {key.col}, which is not recorded; skipped")
         elif kind == "control":
             self.controls += 1
-            _, key = payload
-            if key is not None:
-                self.pos = Position(*key)
+            status, key = payload
+            if key is None:
+                self._note(f"line {lineno}: unreadable '{status}' line; skipped")
+            else:
+                self._moved_to = Position(*key)
         elif kind == "bad":
-            self._note(f"plant {payload[0][0]}, leaf {payload[0][1]}: {payload[1]}; skipped")
+            (plant, leaf), message = payload
+            self.bad_leaf_lines.setdefault((plant, leaf), message)
+            self._note(f"plant {plant}, leaf {leaf}: {message}; skipped")
         elif kind == "problem":
             self._note(payload)
         # "torn": the session reports and repairs it itself
@@ -247,6 +278,10 @@ class JournalReplay(LineParser):
             self.pending = None
         if self.dropped:
             self.problems.append(f"... and {self.dropped:,} more lines skipped")
+
+
+def _key(p: Position) -> tuple[int, int, int, int]:
+    return (p.plant, p.leaf, p.row, p.col)
 
 
 def _after(p: Position, cols: int) -> Position:
@@ -302,6 +337,7 @@ class Session:
         self.pos = start or Position()
         self.count = Counters()
         self.history: list[tuple] = []          # (position, xyz) of recorded, not undone points
+        self._held: Counter = Counter()         # how often each position is in the history
         self._pending: Record | None = None     # a stylus record waiting for its reference
         self.messages: list[str] = []
         self.fd: int | None = None
@@ -309,6 +345,8 @@ class Session:
         self._tail = ""                         # what follows the file's last line end
         self._unmarked = False                  # a torn line is ended but not yet marked
         self._torn_line: tuple | None = None    # (line number, text) found when opening
+        self._zeros = 0                         # zero bytes ending the file (a power cut)
+        self._size = 0                          # the file's bytes before them
         self._open(resume)
 
     # ---------------------------------------------------------------------- journal
@@ -355,9 +393,19 @@ class Session:
                 self.fd = os.open(self.path, flags, 0o644)
                 if state in ("new", "rewrite"):
                     self._append(HEADER)
+                elif self._zeros:                  # nothing in them: appending must follow
+                    os.ftruncate(self.fd, self._size)  # the last line, not a run of zeros
+                    os.fsync(self.fd)
             except OSError as exc:
                 raise SessionError(f"{self.path}: cannot write ({exc.strerror or exc}); nothing "
                                    "was recorded") from None
+            if self._zeros:
+                self.messages.append(
+                    f"the file ended in {self._zeros:,} zero bytes (as a power cut leaves a file "
+                    "being written); they held nothing and are removed, every line before them "
+                    "is kept")
+            if self.cols is None:                  # resuming a recording that holds no line
+                self.cols = DEFAULT_COLS
             if self._tail or self._unmarked:
                 try:
                     self._repair(announce=True)
@@ -383,9 +431,15 @@ class Session:
             size = os.stat(p).st_size
         except FileNotFoundError:
             return "new", None
-        if size <= len(HEADER) + 1:
+        try:
             with open_regular(p, SessionError, "recording")[0] as fh:
-                head = fh.read(len(HEADER) + 2)
+                self._zeros = zero_tail(fh, size)
+                size -= self._zeros
+                head = fh.read(min(size, len(HEADER) + 2))
+        except OSError as exc:
+            raise SessionError(f"{p}: cannot be read ({exc.strerror or exc})") from None
+        self._size = size
+        if size <= len(HEADER) + 1:
             core = head.strip(b" \t\r\n")
             if not core:
                 return "rewrite", None
@@ -409,10 +463,29 @@ class Session:
             for q, _ in self.history:
                 self.count.leaves.add((q.plant, q.leaf))
                 self.count.plants.add(q.plant)
+                self._held[_key(q)] += 1
+            self._check_next(replay)
         self.messages.extend(replay.problems)
         if replay.torn is not None:
             self._tail = replay.torn[1]
             self._torn_line = replay.torn
+
+    def _check_next(self, replay: JournalReplay) -> None:
+        """Refuse to resume where the next press would lose points: on a point the recording
+        already holds (the leaf would then be refused as a whole), or on a leaf the reader
+        refuses for an unreadable line."""
+        q = self.pos
+        where = f"plant {q.plant} leaf {q.leaf} row {q.row} col {q.col}"
+        if self._held[_key(q)]:
+            raise SessionError(f"cannot resume {self.path}: the next point would be {where}, "
+                               "which the recording already holds, and a point recorded twice "
+                               "makes its whole leaf unreadable; record into another file",
+                               quantity="resume")
+        bad = replay.bad_leaf_lines.get((q.plant, q.leaf))
+        if bad is not None:
+            raise SessionError(f"cannot resume {self.path}: the next point would be {where}, "
+                               f"on a leaf the file already makes unreadable ({bad}); correct "
+                               "that line, or record into another file", quantity="resume")
 
     def _width(self, replay: JournalReplay) -> int:
         """The points per cross-section of a resumed recording: the one it shows, or the one
@@ -448,8 +521,9 @@ class Session:
         try:
             fh, _ = open_regular(p, SessionError, "recording")
             with fh:
-                refuse_binary(fh, str(p))
-                for lineno, (text, terminated) in enumerate(file_lines(fh, str(p)), 1):
+                refuse_binary(fh, str(p), self._size)
+                lines = file_lines(fh, str(p), limit=self._size)
+                for lineno, (text, terminated) in enumerate(lines, 1):
                     replay.feed(lineno, text, terminated)
                     if replay.header is not None and not replay.journal:
                         break
@@ -573,6 +647,11 @@ class Session:
             self.count.refused += 1
             return "refused: the record has no usable position"
         p = self.pos
+        if self._held[_key(p)]:           # only after a hand-edited recording was resumed
+            self.count.refused += 1
+            return (f"refused: plant {p.plant} leaf {p.leaf} row {p.row} col {p.col} is already "
+                    "recorded, and a point recorded twice makes its leaf unreadable; press n "
+                    "or p to move on, or u to take the last point back")
         try:
             self._write_line([p.plant, p.leaf, p.row, p.col, *(f"{v:.3f}" for v in xyz),
                               "recorded", f"{time.time():.3f}", rec.station, rec.error.strip()])
@@ -581,6 +660,7 @@ class Session:
                                f"point was NOT recorded; {self.count.points} points are safe "
                                "on disk") from None
         self.history.append((p, tuple(xyz)))
+        self._held[_key(p)] += 1
         self.count.points += 1
         self.count.leaves.add((p.plant, p.leaf))
         self.count.plants.add(p.plant)
@@ -611,6 +691,7 @@ class Session:
                                  *(f"{v:.3f}" for v in xyz), "undone", f"{time.time():.3f}",
                                  "", ""], "the undo")
             self.history.pop()
+            self._held[_key(last)] -= 1
             self.count.points -= 1
             self.count.undone += 1
             self.pos = Position(last.plant, last.leaf, last.row, last.col)

@@ -50,17 +50,21 @@ class FastrakSimulator:
     silent : never answer (a unit switched off, or the wrong port)
     ignore_units, ignore_format : keep inches / ASCII whatever the driver asks
     start_binary : power up in binary output
+    garbage : answer every command with unreadable bytes (another device on the port, or a
+        baud rate that differs from the unit's)
     """
 
     def __init__(self, stations=(1,), noise_cm: float = 0.08, seed: int = 0,
                  silent: bool = False, ignore_units: bool = False, ignore_format: bool = False,
-                 start_binary: bool = False, press_gap_s: float = PRESS_GAP_S):
+                 start_binary: bool = False, press_gap_s: float = PRESS_GAP_S,
+                 garbage: bool = False):
         self.master, self.slave = os.openpty()
         tty.setraw(self.slave)
         self.path = os.ttyname(self.slave)
         self.rng = np.random.default_rng(seed)
         self.noise = noise_cm
         self.silent = silent
+        self.garbage = garbage
         self.ignore_units = ignore_units
         self.ignore_format = ignore_format
         self.binary = start_binary
@@ -89,8 +93,9 @@ class FastrakSimulator:
         """Move the reference receiver (station 2, fixed to the stalk)."""
         self.reference = Pose(np.asarray(position_cm, float), np.asarray(angles_deg, float))
 
-    def press(self, point_cm=None, plant_frame: bool = False) -> bool:
-        """Press the stylus button (optionally at ``point_cm``).
+    def press(self, point_cm=None, plant_frame: bool = False, hold_s: float = 0.0) -> bool:
+        """Press the stylus button (optionally at ``point_cm``) and hold it ``hold_s`` seconds
+        (records asked for meanwhile, by ``P`` or the stream, show the switch down).
 
         With ``plant_frame`` the point is given in the reference receiver's frame and placed in
         the world through the reference's current pose. Returns False when the unit ignores
@@ -107,6 +112,7 @@ class FastrakSimulator:
         self.last_press = now
         self.presses += 1
         if self.point_mode:
+            self.stylus_down_until = now + hold_s
             if self.continuous:
                 self.streaming = not self.streaming     # a press toggles the stream
             else:
@@ -242,6 +248,9 @@ class FastrakSimulator:
     def _handle(self, cmd: str) -> None:
         self.commands.append(cmd)
         if self.silent:
+            return
+        if self.garbage:
+            self._write(bytes(self.rng.integers(0x80, 0x100, 40, dtype=np.uint8)) + b"\r\n")
             return
         c, args = cmd[0], cmd[1:].rstrip("\r")
         if c == "P":

@@ -8,6 +8,7 @@ the same for both, and every refusal is one line naming the file and the place.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -28,8 +29,8 @@ MAX_HEADER_BYTES = 2**20
 PLANT_PROPERTIES = ("plant", "plant_id", "plantid")
 #: Face property names read as the leaf id, in order of preference (any case).
 LEAF_PROPERTIES = ("leaf", "leaf_id", "leafid", "organ", "organ_id", "label", "object_label")
-#: Largest leaf id (light tables number leaves within a plant below 10,000); 0 is not a leaf.
-MAX_LEAF_ID = 9999
+#: Largest leaf id, as in points files; 0 is not a leaf.
+MAX_LEAF_ID = MAX_ID
 #: Largest plant id (absolute value), as in points files.
 MAX_PLANT_ID = MAX_ID
 #: Most vertices of one polygon face.
@@ -168,6 +169,12 @@ def fan(length: np.ndarray, flat: np.ndarray, n_vertices: int, at: Callable[[int
     return faces.astype(np.int64), face_of, int((length > 3).sum())
 
 
+def shown_number(x: float) -> str:
+    """A value for a message: whole numbers written out (2147483648, not 2.14748e+09)."""
+    x = float(x)
+    return f"{int(x)}" if math.isfinite(x) and x == round(x) and abs(x) < 1e18 else f"{x:g}"
+
+
 def whole_ids(v: np.ndarray, name: str, what: str, low: int, high: int,
               at: Callable[[int], str], src: str) -> np.ndarray:
     """Ids ``v`` (n,) as int64, refusing the first that is not whole or outside [low, high]
@@ -180,13 +187,13 @@ def whole_ids(v: np.ndarray, name: str, what: str, low: int, high: int,
             bad = np.flatnonzero(~(v == np.round(v)))
         if len(bad):
             i = int(bad[0])
-            raise MeshFileError(f"{src}: {at(i)}: the {what} id ('{name}') is {v[i]:g}, not a "
-                                "whole number")
+            raise MeshFileError(f"{src}: {at(i)}: the {what} id ('{name}') is "
+                                f"{shown_number(v[i])}, not a whole number")
     if len(v) and (v.min() < low or v.max() > high):
         i = int(np.flatnonzero((v < low) | (v > high))[0])
         rule = "0 (not a leaf: a stalk) to" if what == "leaf" else f"{low:,} to"
-        raise MeshFileError(f"{src}: {at(i)}: the {what} id ('{name}') is {v[i]:g}; {what} "
-                            f"ids go from {rule} {high:,}")
+        raise MeshFileError(f"{src}: {at(i)}: the {what} id ('{name}') is "
+                            f"{shown_number(v[i])}; {what} ids go from {rule} {high:,}")
     return v.astype(np.int64)
 
 

@@ -33,6 +33,7 @@ from maizeviz.io.mesh_data import (
     check_finite,
     fan,
 )
+from maizeviz.numbers import number, whole
 
 _IGNORED = {b"vt", b"vn", b"vp", b"s", b"usemtl", b"mtllib", b"l", b"p", b"mg", b"lod",
             b"shadow_obj", b"trace_obj", b"bevel", b"c_interp", b"d_interp", b"maplib",
@@ -199,7 +200,7 @@ def _vertices(lines: list[bytes], rows: np.ndarray, numbers: np.ndarray,
         try:
             if len(words) < 3 or max(map(len, words)) > MAX_VALUE_CHARS:
                 raise ValueError
-            coords[k] = [float(w) for w in words]
+            coords[k] = [number(w) for w in words]
         except ValueError:
             raise MeshFileError(f"{src}: line {numbers[i]}: a vertex needs x, y and z "
                                 f"numbers, got '{_shown(lines[i])}'") from None
@@ -238,7 +239,7 @@ def _face_lists(lines: list[bytes], rows: np.ndarray, numbers: np.ndarray,
                 words = [w.partition(b"/")[0] for w in words]
             if max(map(len, words), default=0) > 18:          # no file has 10^18 vertices
                 raise ValueError
-            flat.extend(map(int, words))
+            flat.extend(map(whole, words))
         except ValueError:
             raise _not_a_face(src, int(numbers[i]), lines[i]) from None
         counts[k] = len(words)

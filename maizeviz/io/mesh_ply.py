@@ -16,6 +16,7 @@ item (binary).
 from __future__ import annotations
 
 import io
+import math
 import re
 import warnings
 from typing import Any, BinaryIO
@@ -34,7 +35,9 @@ from maizeviz.io.mesh_data import (
     check_finite,
     fan,
     ids_of_faces,
+    shown_number,
 )
+from maizeviz.numbers import number
 
 #: Names of the face list holding vertex indices, in order of preference.
 INDEX_NAMES = ("vertex_indices", "vertex_index")
@@ -79,6 +82,11 @@ def _header(head: bytes, size: int, src: str):
         words = raw.decode("ascii").split(None, 1)
         if len(words) == 2 and words[0] == "comment":
             comments.append((f"header line {no}", words[1].strip()))
+        elif words and words[0] == "element":
+            parts = raw.decode("ascii").split()
+            if len(parts) != 3 or not parts[2].isdigit():     # plyfile's int() reads 1_000
+                raise MeshFileError(f"{src}: header line {no}: '{raw.decode()[:60]}': an "
+                                    "element needs a name and a count (a whole number >= 0)")
     try:
         ply = plyfile.PlyData._parse_header(io.BytesIO(head[:end]))
     except plyfile.PlyHeaderParseError as exc:
@@ -220,15 +228,18 @@ def _ascii_problem(tokens: list[bytes], el) -> str:
                 text = tokens[k].decode("ascii")
                 k += 1
                 try:
-                    value = float(text)
+                    value = number(text)
                 except ValueError:
                     return f"'{text[:30]}' is not a number"
                 dt = np.dtype(code)
                 if dt.kind in "iu" or role == "count":
                     info = np.iinfo(dt)
-                    if not (value == round(value) and info.min <= value <= info.max):
+                    if not (math.isfinite(value) and value == round(value)):
                         return (f"{p.name} is {text[:30]}, not a whole number of type "
                                 f"{dt.name}")
+                    if not info.min <= value <= info.max:
+                        return (f"{p.name} is {shown_number(value)}, beyond the range of its "
+                                f"type {dt.name} ({info.min:,} to {info.max:,})")
                 if role == "count":
                     n = int(value)
     if k < len(tokens):
@@ -259,6 +270,11 @@ def _read_ascii(fh: BinaryIO, end: int, size: int, head, header_lines: int, src:
                             "ascii PLY holds numbers")
     if b"\r" in body:
         body = body.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
+    if b"_" in body:                          # plyfile's float() and int() read 1_000
+        line_no = header_lines + body.count(b"\n", 0, body.index(b"_")) + 1
+        underscored = re.search(rb"[^ \t\r\n]*_[^ \t\r\n]*", body)
+        token = (underscored.group(0) if underscored else b"_")[:30].decode("ascii")
+        raise MeshFileError(f"{src}: line {line_no}: '{token}' is not a number")
     long = _LONG_VALUE.search(body)
     if long is not None:
         line = header_lines + body.count(b"\n", 0, long.start()) + 1

@@ -107,8 +107,8 @@ def _write_obj(path: Path, pts: np.ndarray, faces: np.ndarray, cells: CellData,
         fh.write("".join(f"v {x!r} {y!r} {z!r}\n" for x, y, z in pts.tolist()))
         if "plant" in cells and "leaf" in cells:
             plant, leaf = cells["plant"], cells["leaf"]
-            key = plant.astype(np.int64) * (1 << 32) + leaf
-            starts = np.flatnonzero(np.concatenate([[True], key[1:] != key[:-1]]))
+            changes = (plant[1:] != plant[:-1]) | (leaf[1:] != leaf[:-1])
+            starts = np.flatnonzero(np.concatenate([[True], changes]))
             ends = np.concatenate([starts[1:], [len(faces)]])
             for a, b in zip(starts, ends):
                 fh.write(f"g plant{plant[a]}_leaf{leaf[a]}\n")

@@ -40,6 +40,7 @@ import numpy as np
 from maizeviz.errors import PointsFileError
 from maizeviz.io.atomic import atomic_open
 from maizeviz.io.inputs import open_input
+from maizeviz.numbers import number, whole
 
 REQUIRED = ("plant", "leaf", "row", "col", "x", "y", "z")
 ID_COLUMNS = ("plant", "leaf", "row", "col")
@@ -50,6 +51,8 @@ JOURNAL_COLUMNS = ("plant", "leaf", "row", "col", "x", "y", "z", "status", "time
 #: cut-off line.
 RECORDED, UNDONE, DISCARDED = "recorded", "undone", "discarded"
 CONTROL_STATUSES = ("next_leaf", "next_plant", "end_row")
+#: Statuses of a point line, in a recording as in any file with a status column (docs/cli.md).
+POINT_STATUSES = ("", RECORDED, "ok")
 
 #: Longest line read (bytes). A points line is under 100 bytes; 10,000 leaves room for long
 #: extra columns and stops a file without line ends (binary data, one huge field) early.
@@ -60,8 +63,10 @@ MAX_POINTS = 20_000_000
 #: Most lines read from one file (blank, skipped and control lines count): 50 million lines
 #: take a few minutes to read.
 MAX_LINES = 50_000_000
-#: Largest plant or leaf id (absolute value); larger ones are typing mistakes.
-MAX_ID = 1_000_000_000
+#: Largest plant or leaf id (absolute value): the largest 32-bit integer, the width the canopy
+#: keeps ids in (segmenters number organs with such ids; ids are never packed together, see
+#: :mod:`maizeviz.ids`).
+MAX_ID = 2**31 - 1
 #: Largest row or col index: a leaf has at most a few hundred cross-sections.
 MAX_INDEX = 10_000
 #: Problem lines and bad-leaf messages kept for the report; the rest are counted.
@@ -115,12 +120,13 @@ class _BadValue(ValueError):
 
 
 def _parse_int(text: str) -> int:
-    """A whole number written as ``3``, ``3.0`` or `` 3 ``; ValueError otherwise."""
+    """A whole number written as ``3``, ``3.0`` or `` 3 ``; ValueError otherwise (``1_000``
+    too: :mod:`maizeviz.numbers`)."""
     try:
-        return int(text)
+        return whole(text)
     except ValueError:
         pass
-    value = float(text)
+    value = number(text)
     if not math.isfinite(value) or value != int(value):
         raise ValueError
     return int(value)
@@ -149,11 +155,47 @@ def _looks_binary(head: bytes) -> bool:
     return controls > len(head) // 10
 
 
-def refuse_binary(fh, source: str) -> None:
+def refuse_binary(fh, source: str, size: int | None = None) -> None:
     """Raise :class:`PointsFileError` when the first bytes of a binary file (opened by
-    :func:`open_regular`) are not text; reads nothing away."""
-    if _looks_binary(fh.peek(_BINARY_SNIFF)[:_BINARY_SNIFF]):
+    :func:`open_regular`), of its first ``size`` bytes if given, are not text; reads nothing
+    away."""
+    head = fh.peek(_BINARY_SNIFF)[:_BINARY_SNIFF if size is None else min(size, _BINARY_SNIFF)]
+    if _looks_binary(head):
         raise PointsFileError(f"{source}: not a CSV text file (binary content)")
+
+
+def zero_tail(fh, size: int) -> int:
+    """How many NUL bytes end the file (``size`` bytes long, opened by :func:`open_regular`);
+    the file is left at its start.
+
+    A power cut while a file grows can leave its new length on disk without its data: the
+    file then ends in zero bytes, its lines before them intact. Readers read up to the zeros
+    and say how many bytes they leave; the recorder removes them before it appends.
+    """
+    n, pos = 0, size
+    while pos > 0:
+        k = min(1 << 16, pos)
+        fh.seek(pos - k)
+        block = fh.read(k)
+        kept = block.rstrip(b"\x00")
+        n += len(block) - len(kept)
+        if kept or len(block) < k:
+            break
+        pos -= k
+    fh.seek(0)
+    return n
+
+
+def zero_tail_note(zeros: int) -> str:
+    """The note a reader gives for a file ending in ``zeros`` NUL bytes."""
+    return (f"the file ends in {zeros:,} zero bytes (as a power cut leaves a file being "
+            "written): read up to them, the lines before them are kept")
+
+
+def check_not_only_zeros(source: str, size: int, zeros: int) -> None:
+    """A file of nothing but zero bytes is no text file at all."""
+    if size and zeros == size:
+        raise PointsFileError(f"{source}: not a CSV text file (only zero bytes)")
 
 
 def _decode(raw: bytes) -> str:
@@ -163,19 +205,27 @@ def _decode(raw: bytes) -> str:
         return raw.decode("latin-1")              # decodes every byte
 
 
-def file_blocks(fh, max_line: int = MAX_LINE_BYTES, size: int | None = None):
-    """Blocks of whole lines of a binary file, about ``size`` bytes each.
+def file_blocks(fh, max_line: int = MAX_LINE_BYTES, size: int | None = None,
+                limit: int | None = None):
+    """Blocks of whole lines of a binary file, about ``size`` bytes each, from its first
+    ``limit`` bytes (all of it when None).
 
-    A block ends with a line end, or with the file, or with a line longer than ``max_line``
-    (whose first ``max_line + 1`` bytes the block holds: the line checks refuse it).
+    A block ends with a line end, or with the file (or its limit), or with a line longer than
+    ``max_line`` (whose first ``max_line + 1`` bytes the block holds: the line checks refuse
+    it).
     """
     size = size or BLOCK_BYTES
-    while True:
-        block = fh.read(size)
+    left = -1 if limit is None else limit
+    while left:
+        block = fh.read(size if left < 0 else min(size, left))
         if not block:
             return
         if not block.endswith(b"\n"):
-            block += fh.readline(max_line + 1)
+            more = max_line + 1 if left < 0 else min(max_line + 1, left - len(block))
+            if more:
+                block += fh.readline(more)
+        if left > 0:
+            left -= len(block)
         yield block
 
 
@@ -194,10 +244,11 @@ def raw_line_text(raw: bytes, lineno: int, source: str, max_line: int = MAX_LINE
     return _decode(raw)
 
 
-def file_lines(fh, source: str, max_line: int = MAX_LINE_BYTES):
-    """(text, terminated) for each physical line of a binary file, bounded in length."""
+def file_lines(fh, source: str, max_line: int = MAX_LINE_BYTES, limit: int | None = None):
+    """(text, terminated) for each physical line of a binary file (of its first ``limit``
+    bytes), bounded in length."""
     lineno = 0
-    for block in file_blocks(fh, max_line):
+    for block in file_blocks(fh, max_line, limit=limit):
         for raw in io.BytesIO(block):
             lineno += 1
             yield raw_line_text(raw, lineno, source, max_line), raw.endswith(b"\n")
@@ -374,12 +425,12 @@ class LineParser:
                 if key is None:
                     return ("problem", f"line {lineno}: unreadable undo line; skipped", lineno)
                 return ("undo", key, lineno)
-            if self.journal and status != RECORDED:
+            if self.journal and status not in POINT_STATUSES:
                 if status in CONTROL_STATUSES:
                     return self._control(lineno, fields, status)
                 return ("problem", f"line {lineno}: unknown status '{shown(status, 20)}'; skipped",
                         lineno)
-            if status not in ("", RECORDED, "ok"):
+            if status not in POINT_STATUSES:
                 return self._control(lineno, fields, status)   # controls carry no point
         return self._point(lineno, fields)
 
@@ -419,7 +470,7 @@ class LineParser:
         coords = []
         for axis, value in zip("xyz", (x, y, z)):
             try:
-                coords.append(float(value))
+                coords.append(number(value))
             except ValueError:
                 return ("bad", ((plant, leaf), f"row {row}, col {col} (line {lineno}): {axis} is "
                         f"not a number ('{shown(value)}')"), lineno)
@@ -615,15 +666,20 @@ def read_points(path: str | Path, max_points: int = MAX_POINTS,
     """
     path = Path(path)
     source = str(path)
-    fh, _ = open_regular(path)
+    fh, size = open_regular(path)
     with fh:
         try:
-            refuse_binary(fh, source)
+            zeros = zero_tail(fh, size)
+            check_not_only_zeros(source, size, zeros)
+            refuse_binary(fh, source, size - zeros)
             parser = LineParser(source, max_points, max_lines)
             lineno = 0
-            for block in file_blocks(fh):
+            for block in file_blocks(fh, limit=size - zeros):
                 lineno = parser.feed_block(block, lineno)
-            return parser.finish()
+            table = parser.finish()
+            if zeros:
+                table.problems.append(zero_tail_note(zeros))
+            return table
         except OSError as exc:
             raise PointsFileError(f"{path}: cannot be read ({exc.strerror or exc})") from None
 

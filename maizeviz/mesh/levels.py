@@ -88,16 +88,20 @@ class Level:
         return self.label
 
 
+#: Most mesh levels compared in one run (the paper compares 7).
+MAX_LEVELS = 64
+
+
 def parse_level(text: str) -> Level:
     """``"K4"``/``"K=4"``/``"k4"`` -> 4 interpolated points, ``"standard"``/``"std"`` -> K=0,
     ``"36"``/``"36t"`` -> a budget of 36 triangles."""
     t = str(text).strip().lower().replace(" ", "")
     if t in ("standard", "std", "s"):
         return Level(interp=0)
-    m = re.fullmatch(r"k=?(\d{1,9})", t)
+    m = re.fullmatch(r"k=?(\d{1,9})", t, re.ASCII)
     if m:
         return Level(interp=int(m.group(1)))
-    m = re.fullmatch(r"(\d{1,9})(t|tri|triangles)?", t)
+    m = re.fullmatch(r"(\d{1,9})(t|tri|triangles)?", t, re.ASCII)
     if m:
         return Level(triangles=int(m.group(1)))
     raise MaizevizError(f"'{text}' is not a mesh level: use K4 (4 points between data points), "
@@ -105,10 +109,26 @@ def parse_level(text: str) -> Level:
 
 
 def parse_levels(text: str) -> list[Level]:
-    """Comma-separated levels, e.g. ``"K4,K1,standard,36,8,4,3"``."""
-    levels = [parse_level(p) for p in str(text).split(",") if p.strip()]
-    if not levels:
+    """Comma-separated levels, e.g. ``"K4,K1,standard,36,8,4,3"``: at most
+    :data:`MAX_LEVELS`, none empty (``K4,,8``), none twice (``K4,K=4``): each is refused in one
+    line rather than dropped or traced twice."""
+    text = str(text)
+    if not text.strip():
         raise MaizevizError("give at least one mesh level", quantity="level")
+    if text.count(",") >= MAX_LEVELS:
+        raise MaizevizError(f"{text.count(',') + 1:,} mesh levels; at most {MAX_LEVELS} are "
+                            "compared in one run", quantity="level")
+    levels: list[Level] = []
+    items = text.split(",")
+    for k, item in enumerate(items, 1):
+        if not item.strip():
+            raise MaizevizError(f"mesh level {k} of {len(items)} is empty; write levels "
+                                "separated by single commas", quantity="level")
+        level = parse_level(item)
+        if level in levels:
+            raise MaizevizError(f"mesh level {level.label} is given twice (items "
+                                f"{levels.index(level) + 1} and {k})", quantity="level")
+        levels.append(level)
     return levels
 
 

@@ -24,6 +24,7 @@ import datetime as _dt
 import json
 import math
 import re
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -593,19 +594,21 @@ def run_from_record(rec: Record, where: str) -> tuple[str, Any, str, dict | None
     ProjectError
         A malformed record (one line naming what is wrong).
     """
+    stored: dict | None = None
     if rec.kind == SUN_KIND:
         label, result = sun_from_record(rec, where)
-        return label, result, "sun", None
-    if rec.kind == SKY_KIND:
+    elif rec.kind == SKY_KIND:
         label, result, stored = sky_from_record(rec, where)
-        return label, result, "sky", stored
-    if rec.kind == DAY_KIND:
+    elif rec.kind == DAY_KIND:
         label, result, stored = day_from_record(rec, where)
-        return label, result, "day", stored
-    if rec.kind == ABSORBED_KIND:
+    elif rec.kind == ABSORBED_KIND:
         label, result, stored = absorbed_from_record(rec, where)
-        return label, result, "absorbed", stored
-    return None
+    else:
+        return None
+    stands = rec.meta.get("stands")
+    if isinstance(stands, dict):             # the result says which stands it belongs to
+        result = replace(result, stands=dict(stands))
+    return label, result, KINDS[rec.kind], stored
 
 
 #: Arrays of a record that hold one value per canopy triangle (stalks included).

@@ -18,7 +18,6 @@ never shown on other plants.
 
 from __future__ import annotations
 
-import hashlib
 from collections import Counter
 from collections.abc import Mapping
 from dataclasses import replace
@@ -26,27 +25,16 @@ from typing import Any
 
 import numpy as np
 
-from maizeviz.canopy.layout import CanopyLayout, Placement, layout_from_dict, layout_to_dict
+from maizeviz.canopy.layout import (
+    PLACEMENT_COLUMNS,
+    CanopyLayout,
+    Placement,
+    layout_from_dict,
+    layout_to_dict,
+    placements_array,
+)
+from maizeviz.canopy.layout import stands_identity as stands_identity
 from maizeviz.io.project import ProjectError
-
-#: Columns of ``layout_placements``.
-PLACEMENT_COLUMNS = ("plant", "x_cm", "y_cm", "azimuth_deg", "tile_i", "tile_j")
-
-
-def placements_array(layout: CanopyLayout) -> np.ndarray:
-    """(n, 6) float64: plant, x, y (cm), azimuth (degrees), tile i, tile j of each stand, in
-    the layout's order."""
-    rows = [(p.plant, p.x, p.y, p.azimuth_deg, p.tile[0], p.tile[1]) for p in layout.placements]
-    return np.array(rows, np.float64).reshape(-1, len(PLACEMENT_COLUMNS))
-
-
-def stands_identity(layout: CanopyLayout) -> dict[str, Any]:
-    """``{"n": stands, "sha256": hex}``: what identifies the stands of a canopy, in order (the
-    digitized plant of each, where it stands to 1e-6 cm, its rotation to 1e-6 degrees and its
-    tile)."""
-    a = placements_array(layout)
-    key = np.round(a, 6) + 0.0             # + 0.0 turns -0.0 into 0.0
-    return {"n": int(len(a)), "sha256": hashlib.sha256(key.tobytes()).hexdigest()}
 
 
 def layout_parts(layout: CanopyLayout) -> tuple[dict, dict[str, np.ndarray]]:

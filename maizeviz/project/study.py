@@ -93,14 +93,15 @@ def make_project(points_path: str, points_bytes: bytes, layout: CanopyLayout | N
     points_path, points_bytes : the points file and its content (embedded in the project)
     layout : the layout to store, or None when it is the tiling given by ``canopy["tile"]``
     stands : the layout the ``runs`` were traced on (the one shown): each result is tagged
-        with its stands' identity
+        with the identity of the stands it says it was traced on, else with this layout's
     canopy, light : settings (JSON objects)
     runs : (label, result) or (label, result, settings) tuples, results of any light
     """
     doc, arrays = layout_parts(layout) if layout is not None else (None, {})
     identity = stands_identity(stands)
     records = tuple(run_record(run[0], run[1], run[2] if len(run) > 2 else None,
-                               stands=identity) for run in runs)
+                               stands=getattr(run[1], "stands", None) or identity)
+                    for run in runs)
     return Project(points_bytes, str(points_path), doc, {CANOPY: canopy, LIGHT: light}, arrays,
                    records)
 
@@ -347,10 +348,24 @@ def save_study(path: str | Path, points: str | Path, layout: CanopyLayout,
     Returns
     -------
     pathlib.Path
+
+    Raises
+    ------
+    MaizevizError
+        A result traced on other stands than ``layout``'s (its per-plant light would be read
+        back on other plants), before anything is written.
     """
     from maizeviz.io.inputs import read_input
     from maizeviz.io.project import MAX_MEMBER_BYTES, save_project
 
+    here = stands_identity(layout)
+    for k, r in enumerate(results):
+        traced = getattr(r, "stands", None)
+        if traced is not None and traced != here:
+            raise MaizevizError(
+                f"result {k + 1} ({r.level or 'light'}) was traced on other stands "
+                f"({traced.get('n')} plants) than the layout given ({here['n']} plants): save "
+                "it with the layout of the canopy it was traced on", quantity="results")
     chosen = parse_level(str(level))
     data = read_input(points, "points file", MAX_MEMBER_BYTES["points.csv"], ProjectError)
     stop = (str(chosen.triangles) if chosen.triangles is not None else

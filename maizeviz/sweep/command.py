@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 from maizeviz.errors import MaizevizError
+from maizeviz.numbers import NUMBER_ARG, WHOLE_ARG
 
 EXIT_OK, EXIT_FAIL, EXIT_USAGE, EXIT_PARTIAL, EXIT_INTERRUPTED = 0, 1, 2, 3, 130
 #: The subcommand (``maizeviz.cli`` lists this module among its commands).
@@ -31,12 +32,12 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("spec", metavar="SPEC", help="sweep file (TOML): canopy, level and sun axes")
     p.add_argument("--out", metavar="DIR",
                    help="results folder: results.parquet, results.csv, summary.csv, sweep.json")
-    p.add_argument("--workers", type=int, metavar="N",
+    p.add_argument("--workers", type=WHOLE_ARG, metavar="N",
                    help="worker processes of the local Dask cluster (default: one per core)")
     p.add_argument("--scheduler", metavar="ADDR",
                    help="use a running Dask scheduler, e.g. tcp://10.0.0.5:8786, instead of a "
                         "local cluster (workers need maizeviz and the points files)")
-    p.add_argument("--connect-timeout", type=float, default=CONNECT_TIMEOUT_S, metavar="S",
+    p.add_argument("--connect-timeout", type=NUMBER_ARG, default=CONNECT_TIMEOUT_S, metavar="S",
                    help=f"seconds to wait for --scheduler (default {CONNECT_TIMEOUT_S:g})")
     p.add_argument("--dry-run", action="store_true",
                    help="list the scenarios and estimate the work; compute nothing")
@@ -47,7 +48,7 @@ def _add_arguments(p: argparse.ArgumentParser) -> None:
                    help="use --out even when it holds another sweep or other files")
     p.add_argument("--yes", action="store_true",
                    help=f"run more than {MAX_SCENARIOS:,} scenarios")
-    p.add_argument("--tolerance", type=float, default=DEFAULT_TOLERANCE, metavar="T",
+    p.add_argument("--tolerance", type=NUMBER_ARG, default=DEFAULT_TOLERANCE, metavar="T",
                    help="summary: largest transmission difference from the finest level "
                         f"(default {DEFAULT_TOLERANCE:g})")
     p.add_argument("--no-progress", dest="progress", action="store_false", default=None,
@@ -83,6 +84,13 @@ def run_sweep(args) -> int:
         return EXIT_USAGE
     if not (args.tolerance >= 0):
         _say(f"error: --tolerance must be >= 0, got {args.tolerance}")
+        return EXIT_USAGE
+    from maizeviz.sweep.run import check_connect_timeout
+
+    try:
+        check_connect_timeout(args.connect_timeout)
+    except MaizevizError as exc:
+        _say(f"error: --connect-timeout: {exc}")
         return EXIT_USAGE
     if args.workers is not None and args.scheduler:
         _say("error: --workers sizes the local cluster; with --scheduler the cluster has its own")

@@ -36,6 +36,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from maizeviz.errors import MaizevizError
 from maizeviz.sweep import compute
 from maizeviz.sweep.errors import SchedulerError
 from maizeviz.sweep.store import ResultStore, now_iso
@@ -47,6 +48,21 @@ RETRIES = 2
 FLUSH_EVERY_S = 30.0
 #: Seconds to wait for an external scheduler before giving up.
 CONNECT_TIMEOUT_S = 10.0
+#: The longest wait for a scheduler, s: past an hour a scheduler that does not answer will not.
+MAX_CONNECT_TIMEOUT_S = 3600.0
+
+
+def check_connect_timeout(seconds: float) -> float:
+    """Refuse a scheduler timeout that is not a number of seconds from 0.1 to
+    :data:`MAX_CONNECT_TIMEOUT_S` (1e308 waited forever; NaN and -1 gave Dask's own
+    messages)."""
+    ok = isinstance(seconds, (int, float)) and not isinstance(seconds, bool) and \
+        math.isfinite(seconds) and 0.1 <= seconds <= MAX_CONNECT_TIMEOUT_S
+    if not ok:
+        raise MaizevizError(f"the scheduler timeout must be from 0.1 to "
+                            f"{MAX_CONNECT_TIMEOUT_S:g} s, got {seconds}",
+                            quantity="connect_timeout")
+    return float(seconds)
 #: Dask settings of the local cluster. Our tasks are few and long, so the statistical profiler
 #: (a thread sampling every worker's stack every 10 ms) and work stealing (tasks are queued on
 #: the scheduler and handed out as workers free up) cost CPU for nothing, and the event-loop
@@ -190,6 +206,7 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
                              "'dask[distributed]' pyarrow tqdm") from None
     cluster = None
     if scheduler:
+        connect_timeout = check_connect_timeout(connect_timeout)
         try:
             client = Client(scheduler, timeout=connect_timeout)
         except Exception as exc:                                # noqa: BLE001 - one line

@@ -63,6 +63,7 @@ else:  # pragma: no cover - Python 3.10: the tomli backport (the sweep extra ins
 import maizeviz
 from maizeviz.errors import MaizevizError
 from maizeviz.io.inputs import read_input
+from maizeviz.light.scene.request import MAX_HEIGHTS
 from maizeviz.light.specs import OpticsSpec
 from maizeviz.sweep import compute
 from maizeviz.sweep.errors import SweepSpecError
@@ -502,7 +503,8 @@ def read_toml(path) -> tuple[dict, str]:
     not TOML."""
     raw = read_input(path, "sweep file", MAX_SPEC_BYTES, SweepSpecError)
     try:
-        text = raw.decode("utf-8")
+        # a byte order mark (Windows editors write one) is read past, as in points files
+        text = raw.decode("utf-8").removeprefix("\ufeff")
     except UnicodeDecodeError:
         raise SweepSpecError(f"{path}: not a TOML text file (not UTF-8)") from None
     try:
@@ -586,8 +588,13 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
             ck.fail("light.heights", "must be a list of heights in cm, such as [0, 50, 100]")
         if not raw:
             ck.fail("light.heights", "is empty: give at least one height")
+        if len(raw) > MAX_HEIGHTS:
+            ck.fail("light.heights", f"holds {len(raw):,} heights; at most {MAX_HEIGHTS:,}")
         heights = tuple(ck.number(h, f"light.heights[{i}]", positive=False, minimum=0)
                         for i, h in enumerate(raw))
+        for i, h in enumerate(heights):
+            if h in heights[:i]:
+                ck.fail(f"light.heights[{i}]", f"height {h + 0.0:g} cm is given twice")
     rect = None
     if "rect" in light:
         raw = light["rect"]

@@ -8,6 +8,7 @@ import argparse
 import pytest
 
 from maizeviz.cli import build_parser, main
+from maizeviz.numbers import NUMBER_ARG, WHOLE_ARG
 
 FLOATS = ("nan", "inf", "-inf", "1e308", "-1e308", "1e-308", "-5")
 INTS = ("-99999999999999999999", "99999999999999999999", "0", "-1")
@@ -32,10 +33,10 @@ def _cases():
     sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     for name in BASE:
         for action in sub.choices[name]._actions:
-            if action.type not in (int, float) or not action.option_strings:
+            if action.type not in (NUMBER_ARG, WHOLE_ARG) or not action.option_strings:
                 continue
             flag = action.option_strings[0]
-            for value in FLOATS if action.type is float else INTS:
+            for value in FLOATS if action.type is NUMBER_ARG else INTS:
                 yield pytest.param(name, flag, value, id=f"{name}{flag}={value}")
 
 

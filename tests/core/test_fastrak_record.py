@@ -172,7 +172,8 @@ def test_port_vanishing_mid_session(sim, tmp_path):
     sim.vanish()
     code = rec.proc.wait(timeout=10)
     err = rec.proc.stderr.read()
-    assert code == 1 and "vanished" in err and "on disk" in err and "Traceback" not in err
+    assert code == 1 and "was lost (the device disconnected)" in err and "on disk (3)" in err
+    assert "Traceback" not in err and err.count("\n") == 1
     assert len(read_points(out)) == 3
 
 
@@ -282,8 +283,6 @@ def test_silent_device_clear_message(tmp_path):
         with pytest.raises(DeviceError, match="no answer from a FASTRAK.*DIP switches"):
             port.configure()
         port.close()
-    with pytest.raises(DeviceError, match="cannot open"):
-        FastrakPort("/dev/does-not-exist").configure()
 
 
 @pytest.mark.parametrize("kind", ["inches", "binary"])
@@ -310,7 +309,7 @@ def test_reader_reports_a_vanished_port():
         sim.vanish()
         ev = q.get(timeout=5)
         port.close()
-    assert isinstance(ev, PortLost) and "vanished" in ev.message
+    assert isinstance(ev, PortLost) and "was lost" in ev.message and "plugged in" in ev.message
 
 
 def test_motion_compensation_with_a_swaying_plant(tmp_path):

@@ -308,7 +308,7 @@ def test_wrong_port_then_right_port_without_resume(sim, tmp_path):
     bad = subprocess.run([sys.executable, "-m", "maizeviz", "record", "--port",
                           str(tmp_path / "no-such-port"), "--out", str(out), "--cols", "3"],
                          capture_output=True, text=True, timeout=30)
-    assert bad.returncode == 1 and "cannot open" in bad.stderr
+    assert bad.returncode == 1 and "no serial port" in bad.stderr
     assert out.read_bytes() == HEADER                   # the failed start left its header
     assert not lock_path(out).exists()
     r = Recorder(sim.path, out)                          # no --resume, no fight

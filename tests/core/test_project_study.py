@@ -411,3 +411,50 @@ def test_results_at_other_levels_are_sized_against_their_own_level(points, leave
     save_project(path, replace(proj, results=(odd,)))
     results, notes = study.results_on(study.open_project(path, tmp_path), layout, leaves)
     assert results == [] and "its mesh level 'K=999999' is not one this maizeviz knows" in notes[0]
+
+
+# ------------------------------------------------------------------ results and their stands
+def test_save_study_refuses_a_result_traced_on_other_stands(points, leaves, tmp_path):
+    """Issue 25 case 4: ``save_study`` stored a result traced on another layout and
+    ``read_study`` gave it back on the wrong stands, with no note. Every traced result now
+    carries the identity of its stands, and saving it with other stands is one line, nothing
+    written."""
+    from maizeviz.canopy.layout import stands_identity
+    from maizeviz.errors import MaizevizError
+    from maizeviz.light.scene.request import LightRequest
+    from maizeviz.light.sources.sun import Sun
+    from maizeviz.light.trace.direct import trace_light
+
+    shown = layout_for(leaves, (2, 2))
+    other = edited(leaves, (2, 2), 3, 0, 2)              # the same 16 plants, two turned
+    canopy = build_canopy(leaves, other, LEVEL)
+    sun = trace_light(canopy, LightRequest(Sun(30, 180), SAMPLING))
+    sky = trace_sky(canopy, make_sky("soc", 16), SAMPLING)
+    assert sun.stands == sky.stands == stands_identity(other) != stands_identity(shown)
+    path = tmp_path / "wrong.maizeviz"
+    for result in (sun, sky):
+        with pytest.raises(MaizevizError, match="result 1 .* was traced on other stands"):
+            study.save_study(path, points, shown, [result], level=LEVEL.label)
+        assert not path.exists()
+    # on its own stands it is saved, read back with them, and saved again unchanged
+    study.save_study(path, points, other, [sun, sky], level=LEVEL.label)
+    back = study.read_study(path, tmp_path / "cache")
+    assert [r.result.stands for r in back.results] == [stands_identity(other)] * 2
+    study.save_study(tmp_path / "again.maizeviz", points, back.layout,
+                     [r.result for r in back.results], level=LEVEL.label)
+    assert len(study.read_study(tmp_path / "again.maizeviz", tmp_path / "cache").results) == 2
+
+
+def test_a_day_refuses_a_sky_traced_on_other_stands(points, leaves):
+    """A day reuses a sky traced with the same sampling; traced on other stands, its shares
+    per triangle belong to other plants."""
+    from maizeviz.errors import MaizevizError
+    from maizeviz.light.sources.irradiance import clear_sky_period
+    from maizeviz.light.trace.diffuse import trace_period
+
+    sky = trace_sky(build_canopy(leaves, edited(leaves, (2, 2), 3, 0, 2), LEVEL),
+                    make_sky("soc", 16), SAMPLING)
+    period = clear_sky_period("2024-07-01", 43.6, 1.4, "Europe/Paris", step_min=180)
+    with pytest.raises(MaizevizError, match="traced on other stands"):
+        trace_period(build_canopy(leaves, layout_for(leaves, (2, 2)), LEVEL), period, SAMPLING,
+                     sky=sky)

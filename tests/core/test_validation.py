@@ -144,7 +144,7 @@ def flat(m=4, n=3):
 
 @pytest.mark.parametrize("line, says", [
     ("1e300,1,0,0,1,2,3", "line 14: plant id 1e300 is beyond the range "
-                          "-1,000,000,000..1,000,000,000; line skipped"),
+                          "-2,147,483,647..2,147,483,647; line skipped"),
     ("1,-1e300,0,0,1,2,3", "line 14: leaf id -1e300 is beyond the range"),
     ("1," + "9" * 400 + ",0,0,1,2,3", "leaf id 999999999999999999999999999999... is beyond"),
     ("inf,1,0,0,1,2,3", "plant/leaf id is not an integer ('inf', '1')"),

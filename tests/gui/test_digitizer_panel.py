@@ -43,7 +43,7 @@ def make_panel(qtbot):
 
     yield make
     for panel in made:
-        panel.stop("test over")
+        panel.stop("test over", wait=True)
 
 
 @pytest.fixture
@@ -60,7 +60,7 @@ def _press(x, y=0.0, z=0.0):
 
 
 def _connect(qtbot, panel, sim, out, cols=3):
-    panel.port_edit.setText(sim.path)
+    panel.ports.set_port(sim.path)
     panel.out_edit.setText(str(out))
     panel.cols.setValue(cols)
     with qtbot.waitSignal(panel.started, timeout=TIMEOUT):
@@ -124,7 +124,9 @@ def test_q_in_the_same_tick_as_a_point(qtbot, make_panel, sim, tmp_path):
     _connect(qtbot, panel, sim, out)
     panel.timer.stop()                                    # hold the tick
     assert sim.press((1.0, 2.0, 3.0))
-    qtbot.waitUntil(lambda: panel.recorder.events.qsize() >= 1, timeout=TIMEOUT)
+    # (the queue also holds the live position's answers: wait for the press itself)
+    qtbot.waitUntil(lambda: any(isinstance(e, Record) for e in list(panel.recorder.events.queue)),
+                    timeout=TIMEOUT)
     panel.recorder.control("q")
     with qtbot.waitSignal(panel.stopped, timeout=TIMEOUT) as stopped:
         panel.timer.start()                               # one tick sees the point and the q
@@ -179,12 +181,12 @@ def test_unwritable_output_and_missing_port_are_said(qtbot, make_panel, tmp_path
     assert "no such folder" in panel.log.item(panel.log.count() - 1).text()
     assert panel.band.state == "error" and panel.connect_button.isEnabled()
     panel.out_edit.setText(str(tmp_path / "ok.csv"))
-    panel.port_edit.setText("/dev/does-not-exist")
+    panel.ports.set_port("/dev/does-not-exist")
     with qtbot.waitSignal(panel.stopped, timeout=TIMEOUT) as stopped:
         panel.connect_button.click()
     assert stopped.args == ["could not connect"]
     texts = [panel.log.item(i).text() for i in range(panel.log.count())]
-    assert any("cannot open /dev/does-not-exist" in t for t in texts)
+    assert any("no serial port /dev/does-not-exist: nothing is plugged in" in t for t in texts)
     assert panel.connect_button.isEnabled() and panel.session is None
 
 
@@ -251,6 +253,9 @@ def test_camera_follows_the_current_plant_and_the_canopy_comes_back(qtbot, make_
     panel.plant.wait()
     with qtbot.waitSignal(panel.stopped, timeout=TIMEOUT):
         panel.stop()
+    # the plant just digitized stays in view until the canopy comes back
+    assert [n for n in viewport.actors if str(n).startswith(("leafsurf", "digitized"))]
+    panel.release_view()
     assert not [n for n in viewport.actors if str(n).startswith(("leafsurf", "digitized"))]
 
 
@@ -292,7 +297,10 @@ def test_canopy_returns_in_the_window_after_a_session(window, two_plants, qtbot,
     rec.events.put(Record(1, "x", (1.0, 2.0, 3.0), (0.0, 0.0, 0.0), 1))
     w.digitizer._drain()
     assert any("refused" in a for a in alerts)            # the status bar says it too
-    w.digitizer.stop()
+    with qtbot.waitSignal(w.digitizer.stopped, timeout=TIMEOUT):
+        w.digitizer.stop()
+    assert "canopy" not in w.viewport.actors              # Digitize: the plant keeps the view
+    w.workspaces.show("analyse")
     assert "canopy" in w.viewport.actors
 
 
@@ -304,7 +312,7 @@ def test_stop_while_connecting_lets_go_of_the_file(qtbot, make_panel, tmp_path):
     with FastrakSimulator(silent=True) as silent:
         panel = make_panel()
         out = tmp_path / "s.csv"
-        panel.port_edit.setText(silent.path)
+        panel.ports.set_port(silent.path)
         panel.out_edit.setText(str(out))
         panel.connect_button.click()
         assert panel.band.state == "busy" and panel.stop_button.isEnabled()
@@ -333,7 +341,10 @@ def test_a_canopy_built_while_digitizing_waits_for_the_session(window, two_plant
     assert w.built.label == "16 triangles"
     assert "canopy" not in w.viewport.actors                 # the plant keeps the view
     assert "digitized" in w.viewport.actors
-    w.digitizer.stop()
+    with qtbot.waitSignal(w.digitizer.stopped, timeout=TIMEOUT):
+        w.digitizer.stop()
+    assert "digitized" in w.viewport.actors                  # still, until Analyse
+    w.workspaces.show("analyse")
     assert "canopy" in w.viewport.actors and "digitized" not in w.viewport.actors
     n_stalk = len(w.canopy.stalk_faces)
     assert w.viewport.canopy_mesh.n_cells == w.canopy.n_triangles + n_stalk   # the new one

@@ -52,6 +52,7 @@ from maizeviz.light.sources.irradiance import (
     PAR_FRACTION,
     PAR_UMOL_PER_J_PAR,
 )
+from maizeviz.numbers import number
 from maizeviz_app.runs import MODES, SKIES, LightRuns, Run, level_order  # noqa: F401 - re-exported
 
 DEFAULT_PLACE = "2005-08-01 12:00 39.9 116.4 Asia/Shanghai"
@@ -85,7 +86,7 @@ def parse_heights(text: str) -> tuple[float, ...]:
         if not part:
             continue
         try:
-            h = float(part.removesuffix("cm").strip())
+            h = number(part.removesuffix("cm").strip())
         except ValueError:
             raise InputProblem(f"heights: '{part}' is not a number of centimetres; write them "
                                "separated by commas, e.g. 0, 50, 100", "heights") from None

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
+from maizeviz.ids import groups
 from maizeviz.io.atomic import atomic_open
 from maizeviz.light.results.diffuse import PeriodLight
 from maizeviz.light.results.per_leaf import LightRow, tile_representatives
@@ -39,18 +40,14 @@ def leaf_values(canopy: Canopy, rows: list[LightRow], column: str, rect=None,
     nf = canopy.n_triangles
     rep = tile_representatives(canopy.layout, rect, periodic)
     inst = canopy.face_instance.astype(np.int64)
-    keys = rep[inst] * 10_000 + canopy.face_leaf.astype(np.int64)
     out = np.zeros(nf, np.float64)
     if rows:
-        row_keys = np.array([(int(r["instance"]) - 1) * 10_000 + int(r["leaf"]) for r in rows],
-                            np.int64)
-        vals = np.array([float(r[column]) / (float(r["leaf_area_cm2"]) * 1e-4
-                                              if per_m2_leaf else 1.0) for r in rows])
-        order = np.argsort(row_keys)
-        sk = row_keys[order]
-        pos = np.clip(np.searchsorted(sk, keys), 0, len(sk) - 1)
-        hit = sk[pos] == keys
-        out[hit] = vals[order][pos[hit]]
+        value = {(int(r["instance"]) - 1, int(r["leaf"])):
+                 float(r[column]) / (float(r["leaf_area_cm2"]) * 1e-4 if per_m2_leaf else 1.0)
+                 for r in rows}
+        keys, leaf_of = groups(rep[inst], canopy.face_leaf)
+        per_leaf = np.array([value.get((int(i), int(lf)), 0.0) for i, lf in keys], np.float64)
+        out = per_leaf[leaf_of]
     if rect is not None and (rep == np.arange(len(rep))).all():
         x0, y0, x1, y1 = rect
         outside = np.array([not (x0 <= p.x <= x1 and y0 <= p.y <= y1)

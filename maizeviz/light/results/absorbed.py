@@ -82,6 +82,8 @@ class AbsorbedLight:
     rect : (x0, y0, x1, y1) cm; rays : primary rays per direction; directions : beams traced
     depth, threshold, seed : as traced; events : scatterings followed; periodic : bool
     level : the canopy's mesh level; seconds : "trace" (primary beams), "scatter", "build"
+    stands : identity of the stands traced on (:func:`maizeviz.canopy.layout.stands_identity`),
+        None where not known
     """
 
     band: str
@@ -100,6 +102,7 @@ class AbsorbedLight:
     periodic: bool
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
+    stands: dict | None = None
 
     fraction_absorbed = property(_fraction_absorbed)
 
@@ -170,6 +173,7 @@ class AbsorbedPeriod:
     step_incident_w_m2 : (n,) float64 the band's irradiance on a horizontal plane at each step
     rect, rays, depth, seed, periodic, level : as traced; seconds : "trace", "scatter",
         "build"
+    stands : identity of the stands traced on, None where not known
     """
 
     band: str
@@ -186,6 +190,7 @@ class AbsorbedPeriod:
     periodic: bool
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
+    stands: dict | None = None
 
     fraction_absorbed = property(_fraction_absorbed)
 

@@ -8,6 +8,7 @@ import numpy as np
 from maizeviz.canopy.layout import CanopyLayout
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
+from maizeviz.ids import group_rows, groups
 from maizeviz.light.scene.rays import Rect
 from maizeviz.mesh.tessellate import triangle_areas_normals
 
@@ -143,21 +144,19 @@ def leaf_sums(canopy: Canopy, columns: dict[str, np.ndarray], rect: Rect | None 
     nf = canopy.n_triangles
     cols = {k: np.asarray(v, dtype=np.float64)[:nf] for k, v in columns.items()}
     rep = tile_representatives(canopy.layout, rect, periodic)
-    keys = rep[canopy.face_instance] * 10_000 + canopy.face_leaf
+    keys, leaf_of = groups(rep[canopy.face_instance], canopy.face_leaf)
     any_light = np.zeros(nf, dtype=bool)
     for v in cols.values():
         any_light |= v != 0
-    touched = np.unique(keys[any_light])
-    order = np.argsort(keys, kind="stable")
-    sk = keys[order]
+    touched = np.unique(leaf_of[any_light])
+    order, starts = group_rows(leaf_of, len(keys))
     rows: list[LightRow] = []
-    for key in touched:
-        a, b = np.searchsorted(sk, key, "left"), np.searchsorted(sk, key, "right")
-        idx = order[a:b]
-        inst = int(key // 10_000)
+    for k in touched:
+        idx = order[starts[k]:starts[k + 1]]
+        inst, leaf = (int(v) for v in keys[k])
         copies = len(np.unique(canopy.face_instance[idx]))
         row: LightRow = {"instance": inst + 1, "plant": int(canopy.face_plant[idx[0]]),
-                         "leaf": int(key % 10_000), "x_cm": canopy.layout.placements[inst].x,
+                         "leaf": leaf, "x_cm": canopy.layout.placements[inst].x,
                          "y_cm": canopy.layout.placements[inst].y,
                          "leaf_area_cm2": float(area[idx].sum()) / copies}
         for k, v in cols.items():
@@ -242,7 +241,7 @@ def triangle_light(canopy: Canopy, first_hits: np.ndarray | None,
         # (representative placement, triangle index within the placement)
         starts = np.searchsorted(inst, np.arange(len(rep)))
         local = np.arange(nf) - starts[inst]
-        _, slot = np.unique(rep[inst] * (int(local.max()) + 1) + local, return_inverse=True)
+        _, slot = groups(rep[inst], local)
         first = np.bincount(slot, weights=first)[slot]
         second = np.bincount(slot, weights=second)[slot]
         traced = np.ones(nf, bool)

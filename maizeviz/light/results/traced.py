@@ -42,6 +42,8 @@ class TracedLight:
     warnings : tuple of str, what the user should know about this result
     seconds : dict, "build" (the scene), "trace", ..., s
     periodic : bool, rays and sensor paths wrapped across the plot
+    stands : ``{"n", "sha256"}``, the identity of the stands of the canopy it was traced on
+        (:func:`maizeviz.canopy.layout.stands_identity`), or None where not known
     """
 
     heights_cm: np.ndarray
@@ -51,6 +53,7 @@ class TracedLight:
     warnings: tuple[str, ...] = ()
     seconds: dict[str, float] = field(default_factory=dict)
     periodic: bool = False
+    stands: dict | None = None
 
     @property
     def rect_area_cm2(self) -> float:

@@ -59,10 +59,25 @@ def check_rect(rect: Rect) -> Rect:
 
 def grid_shape(rect: Rect, density: float) -> tuple[int, int]:
     """Rays across x and along y of a regular grid of ``density`` rays per cm2 over ``rect``
-    (both checked: every grid is sized here)."""
+    (both checked: every grid is sized here).
+
+    Raises
+    ------
+    MaizevizError
+        The density puts less than half a ray step across a side of the rectangle: the grid
+        would be one ray there whatever density was asked (``--density 1e-308`` gave a single
+        ray for the whole plot, unsaid).
+    """
     x0, y0, x1, y1 = check_rect(rect)
     step = 1.0 / math.sqrt(check_density(density))
-    return max(1, int(round((x1 - x0) / step))), max(1, int(round((y1 - y0) / step)))
+    nx, ny = int(round((x1 - x0) / step)), int(round((y1 - y0) / step))
+    if nx < 1 or ny < 1:
+        side = min(x1 - x0, y1 - y0)
+        raise MaizevizError(f"a density of {density:g} rays per cm2 (a ray every {step:.3g} cm) "
+                            f"puts no ray across the sample rectangle's {side:g} cm side; the "
+                            f"lowest density for it is {1.0 / (2.0 * side) ** 2:.3g} rays per "
+                            "cm2", quantity="density")
+    return nx, ny
 
 
 def ray_count(rect: Rect, density: float) -> int:

@@ -19,6 +19,8 @@ from maizeviz.light.sources.sun import Sun
 
 #: Highest sensor plane, cm (100 m: far above any crop; float32 tracing stays exact).
 MAX_HEIGHT_CM = 10_000.0
+#: Most sensor planes in one computation.
+MAX_HEIGHTS = 1_000
 #: More rays than this are refused (minutes of tracing and GiB of results).
 MAX_RAYS = 400_000_000
 #: More tracing threads than this are refused (Embree gains nothing past the cores).
@@ -152,10 +154,18 @@ def check_sampling(canopy: Canopy, req: Sampling) -> tuple[Rect, list[str]]:
         raise MaizevizError("the canopy is empty: no leaf triangle to intercept light")
     if not req.heights_cm:
         raise MaizevizError("give at least one height", quantity="heights")
-    for h in req.heights_cm:
+    if len(req.heights_cm) > MAX_HEIGHTS:
+        raise MaizevizError(f"{len(req.heights_cm):,} heights; at most {MAX_HEIGHTS:,} sensor "
+                            "planes are traced (one every cm over 10 m)", quantity="heights")
+    seen: dict[float, int] = {}
+    for k, h in enumerate(req.heights_cm):
         if not math.isfinite(h) or not 0 <= h <= MAX_HEIGHT_CM:
             raise MaizevizError(f"heights must be from 0 to {MAX_HEIGHT_CM:,.0f} cm, got {h:g}",
                                 quantity="heights")
+        if h in seen:
+            raise MaizevizError(f"height {h + 0.0:g} cm is given twice (heights {seen[h] + 1} and "
+                                f"{k + 1})", quantity="heights")
+        seen[h] = k
     check_density(req.density)
     check_range(req.threads, "tracing threads", 1, MAX_THREADS, "threads", whole=True)
     px0, py0, px1, py1 = canopy.layout.bounds

@@ -70,6 +70,7 @@ from maizeviz.light.sources.clock import check_place as _check_place
 from maizeviz.light.sources.clock import local_time
 from maizeviz.light.sources.clock import zone as _time_zone
 from maizeviz.light.sources.dates import FIRST_YEAR, LAST_YEAR, TIME_UNIT, check_year
+from maizeviz.numbers import NUMBER, first_unplain, number
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -721,7 +722,7 @@ def _value_problem(text: str, column: str = "ghi") -> str | None:
     if text == "":
         return "missing value"
     try:
-        value = float(text)
+        value = number(text)
     except ValueError:
         return f"'{text}' is not a number"
     if math.isnan(value):
@@ -744,6 +745,8 @@ def _parse_values(texts: list, lines: list, times: list, column: str, path: Path
     try:
         values = np.array(texts, dtype=np.float64)
         ok = np.isfinite(values) & (values >= lo) & (values <= hi)
+        if first_unplain(texts) is not None:          # numpy reads 1_000 as float does
+            ok &= np.array([NUMBER.fullmatch(t) is not None for t in texts], bool)
         bad = np.flatnonzero(~ok)
     except ValueError:                              # an empty or non-numeric cell somewhere
         values, bad = None, np.arange(len(texts))
@@ -753,7 +756,7 @@ def _parse_values(texts: list, lines: list, times: list, column: str, path: Path
             raise WeatherFileError(f"{path}, line {lines[k]} ({times[k]}), column {column}: "
                                    f"{problem}")
     if values is None:                              # forms float() reads and numpy does not
-        values = np.array([float(t) for t in texts])
+        values = np.array([number(t) for t in texts])
     return values
 
 

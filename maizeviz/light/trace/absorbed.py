@@ -22,6 +22,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from maizeviz.canopy.layout import stands_identity
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import check_range
 from maizeviz.light.results.absorbed import AbsorbedLight, AbsorbedPeriod, Balance
@@ -131,7 +132,7 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
                                                              "unresolved")))
     return AbsorbedLight(opt.band, opt, incident, balance, absorbed, sunlit, smp.rect, smp.n,
                          len(beams), depth, threshold, seed, events, smp.periodic,
-                         canopy.level, seconds)
+                         canopy.level, seconds, stands_identity(canopy.layout))
 
 
 def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
@@ -204,4 +205,4 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
                                                    "unresolved")))
     return AbsorbedPeriod(optics.band, optics, period, balance, joules, leaves_w, incident_w,
                           unit.rect, unit.rays, unit.depth, unit.seed, unit.periodic,
-                          unit.level, seconds)
+                          unit.level, seconds, unit.stands)

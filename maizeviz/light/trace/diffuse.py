@@ -49,6 +49,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from maizeviz.canopy.layout import stands_identity
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.light.results.diffuse import PeriodLight, SkyLight
@@ -171,7 +172,7 @@ def _edge_warning(canopy: Canopy, smp: Sampler, zenith: np.ndarray, towards: np.
 
 
 def _sky_light(sky: Sky, smp: Sampler, beams: list[_Beam], bins: _Bins, level: str,
-               warnings: list[str], seconds: dict[str, float]) -> SkyLight:
+               warnings: list[str], seconds: dict[str, float], stands: dict) -> SkyLight:
     edges = bins.edges
     w = np.asarray(sky.weights, dtype=np.float64)
     per_dir = np.array([b.transmission for b in beams]).reshape(sky.n, len(smp.heights_cm))
@@ -187,7 +188,7 @@ def _sky_light(sky: Sky, smp: Sampler, beams: list[_Beam], bins: _Bins, level: s
                     per_direction_intercepted=per_int, triangle_share=share, rect=smp.rect,
                     rays=smp.n, density=smp.density, maps=maps, map_edges=edges,
                     map_rays=bins.rays, level=level, warnings=tuple(warnings), seconds=seconds,
-                    periodic=smp.periodic)
+                    periodic=smp.periodic, stands=stands)
 
 
 def trace_sky(canopy: Canopy, sky: Sky, sampling: Sampling | LightRequest,
@@ -221,7 +222,8 @@ def trace_sky(canopy: Canopy, sky: Sky, sampling: Sampling | LightRequest,
     beams = list(_beams(smp, list(towards), sampling.threads, progress, bins.edges,
                         "sky tracing"))
     seconds = {"build": build_s, "trace": time.perf_counter() - t0}
-    return _sky_light(sky, smp, beams, bins, canopy.level, warnings, seconds)
+    return _sky_light(sky, smp, beams, bins, canopy.level, warnings, seconds,
+                      stands_identity(canopy.layout))
 
 
 def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightRequest,
@@ -262,6 +264,7 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
         raise MaizevizError("the diffuse split is not this period's: its steps or its diffuse "
                             "irradiance differ (split the period itself)", quantity="sky")
     smp, warnings, build_s, bins = _prepare(canopy, sampling, with_stalks, scene, bin_cm)
+    stands = stands_identity(canopy.layout)
     edges = bins.edges
     warnings += list(period.notes)
     n_h = len(smp.heights_cm)
@@ -275,13 +278,17 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
                            maps=np.full(shape, np.nan), map_edges=edges, map_rays=bins.rays,
                            level=canopy.level, warnings=tuple(warnings),
                            seconds={"build": build_s, "trace": 0.0}, periodic=smp.periodic,
-                           diffuse=diffuse)
+                           diffuse=diffuse, stands=stands)
     sky_light = sky if isinstance(sky, SkyLight) else None
     if sky_light is not None:
         if not (np.array_equal(sky_light.heights_cm, smp.heights_cm)
                 and sky_light.rect == smp.rect and sky_light.rays == smp.n):
             raise MaizevizError("the sky light was traced with other heights, rectangle or "
                                 "density than this period", quantity="sky")
+        if sky_light.stands is not None and sky_light.stands != stands:
+            raise MaizevizError("the sky light was traced on other stands than this canopy's "
+                                f"({sky_light.stands.get('n')} plants, this canopy "
+                                f"{stands['n']}): trace the sky on this canopy", quantity="sky")
     sky_obj = sky_light.sky if sky_light is not None else \
         (sky if isinstance(sky, Sky) else make_sky("soc" if diffuse is None else "uoc", 46))
     if diffuse is not None and sky_obj.kind != "uoc":
@@ -305,7 +312,7 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
     trace_s = time.perf_counter() - t0
     if sky_light is None:
         sky_light = _sky_light(sky_obj, smp, beams[:len(sky_dirs)], bins, canopy.level, [],
-                               {"build": 0.0, "trace": trace_s})
+                               {"build": 0.0, "trace": trace_s}, stands)
     steps = beams[len(sky_dirs):]
     direct_mol = np.asarray(period.step_direct_par_mol_m2, dtype=np.float64)
     step_diffuse = np.asarray(period.step_diffuse_par_mol_m2, dtype=np.float64)
@@ -332,4 +339,4 @@ def trace_period(canopy: Canopy, period: Period, sampling: Sampling | LightReque
         triangle_direct_mol=tri_direct, triangle_diffuse_mol=tri_diffuse, rect=smp.rect,
         rays=smp.n, maps=maps, map_edges=edges, map_rays=bins.rays, level=canopy.level,
         warnings=tuple(warnings), seconds={"build": build_s, "trace": trace_s},
-        periodic=smp.periodic, diffuse=diffuse)
+        periodic=smp.periodic, diffuse=diffuse, stands=stands)

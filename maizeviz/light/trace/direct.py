@@ -36,6 +36,7 @@ from typing import TypeVar
 
 import numpy as np
 
+from maizeviz.canopy.layout import stands_identity
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.results.direct import LightResult
 from maizeviz.light.scene.rays import Rect, Tracer, ray_grid, sensor_offsets
@@ -205,8 +206,7 @@ def _family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family | None:
 
     nx, ny = grid_shape(smp.rect, smp.density)
     shifts = _lattice_shifts(smp, s, planes)
-    used = np.array([0, *planes])
-    r = np.vstack([np.zeros((1, 2), np.int64), shifts[planes]])
+    r = np.vstack([np.zeros((1, 2), np.int64), shifts[planes]])   # the ground, then planes
     lo = (-r).min(axis=0)
     hi = (np.array([nx, ny]) - r).max(axis=0)
     bw, bh = (hi - lo).tolist()
@@ -215,8 +215,8 @@ def _family(smp: Sampler, s: np.ndarray, planes: list[int]) -> _Family | None:
     if bw * bh > 8 * n and bw * bh > budget:
         return None                                 # too spread out to be worth a box
     mask = np.zeros((bw, bh), dtype=bool)
-    for k in used:
-        ox, oy = -shifts[k] - lo
+    for rk in r:             # by shift, not by height index: index 0 need not be the ground
+        ox, oy = -rk - lo
         mask[ox:ox + nx, oy:oy + ny] = True
     cells = np.flatnonzero(mask)
     if len(cells) > budget:
@@ -409,4 +409,5 @@ def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | 
                        first_hits=counts[0], second_hits=counts[1], direction=s,
                        seconds=seconds, warnings=tuple(warnings), level=canopy.level,
                        density=req.density, sensor_lit=tr.sensor_lit,
-                       sensor_offset_cm=tr.sensor_offset_cm, periodic=req.periodic)
+                       sensor_offset_cm=tr.sensor_offset_cm, periodic=req.periodic,
+                       stands=stands_identity(canopy.layout))

@@ -39,6 +39,7 @@ from maizeviz.light.sources.irradiance import (
     PAR_FRACTION,
     PAR_UMOL_PER_J_PAR,
 )
+from maizeviz.numbers import number, whole
 
 #: Wavebands traced: photosynthetically active radiation and near infrared.
 BANDS = ("par", "nir")
@@ -218,8 +219,8 @@ def read_optics_table(path, band: str) -> tuple[tuple[int, float, float], ...]:
         if "band" in col and row[col["band"]].strip().lower() != band:
             continue
         try:
-            rank = int(row[col["rank"]])
-            rho, tau = float(row[col["reflectance"]]), float(row[col["transmittance"]])
+            rank = whole(row[col["rank"]])
+            rho, tau = number(row[col["reflectance"]]), number(row[col["transmittance"]])
         except ValueError:
             raise MaizevizError(f"{path}, line {line}: rank, reflectance and transmittance "
                                 f"must be numbers, got {', '.join(c[:20] for c in row)}",

@@ -1,0 +1,210 @@
+"""Metamorphic tests: the oracle is the data itself.
+
+A result may not depend on how its inputs are ordered (heights, levels, plants, rows of a
+file) nor on a duplicate entry (refused in one line, or counted once and reported): each test
+runs one computation twice, on inputs that mean the same thing, and compares the numbers.
+"""
+
+import contextlib
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from maizeviz.canopy.layout import layout_from_dict
+from maizeviz.canopy.scene import Canopy
+from maizeviz.cli import main
+from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.sources.irradiance import clear_sky_period
+from maizeviz.light.sources.sky import make_sky
+from maizeviz.light.sources.sun import Sun
+from maizeviz.light.trace.diffuse import trace_period, trace_sky
+from maizeviz.light.trace.direct import trace_light
+
+BLOCK = str(Path(__file__).resolve().parents[2] / "maizeviz/resources/block3x3.csv")
+
+
+def _plot():
+    return layout_from_dict({"maizeviz_layout": 1, "row_spacing": 60, "plant_spacing": 30,
+                             "field": {"x0": 0, "y0": 0, "x1": 100, "y1": 100},
+                             "rows": [{"x": 50, "plants": [{"y": 50, "plant": 1}]}]})
+
+
+def _squares(seed: int, n: int = 60) -> Canopy:
+    """n horizontal squares at random places and heights (5 to 150 cm) in a 100 cm plot."""
+    rng = np.random.default_rng(seed)
+    v, f = [], []
+    for k, (x, y, a, z) in enumerate(zip(rng.uniform(0, 90, n), rng.uniform(0, 90, n),
+                                         rng.uniform(2, 15, n), rng.uniform(5, 150, n))):
+        v += [[x, y, z], [x + a, y, z], [x + a, y + a, z], [x, y + a, z]]
+        f += [[4 * k, 4 * k + 1, 4 * k + 2], [4 * k, 4 * k + 2, 4 * k + 3]]
+    return Canopy.from_triangles(np.array(v, float), np.array(f), _plot(),
+                                 np.repeat(np.arange(1, n + 1), 2))
+
+
+HEIGHTS = (0.0, 20.0, 60.0, 100.0, 140.0, 200.0)
+
+
+def _permutation(draw_seed: int, n: int) -> np.ndarray:
+    return np.random.default_rng(draw_seed).permutation(n)
+
+
+# ------------------------------------------------------------------ order of heights
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 2**31), st.integers(0, 2**31), st.floats(0, 70), st.floats(0, 360),
+       st.booleans())
+def test_sun_transmission_follows_its_height_whatever_the_order(seed, order, zenith, azimuth,
+                                                                periodic):
+    """T at each height is the same number, whichever place the height has in the list (issue
+    25 case 1: T(0) was wrong whenever 0 was not the first height, the ground's rays then
+    read from outside the traced family)."""
+    canopy = _squares(seed)
+    perm = _permutation(order, len(HEIGHTS))
+    heights = tuple(HEIGHTS[i] for i in perm)
+    rect = (10, 10, 90, 90) if not periodic else (0, 0, 100, 100)
+    a = trace_light(canopy, LightRequest(Sun(zenith, azimuth),
+                                         Sampling(HEIGHTS, 1.0, rect, periodic)))
+    b = trace_light(canopy, LightRequest(Sun(zenith, azimuth),
+                                         Sampling(heights, 1.0, rect, periodic)))
+    assert list(b.transmission) == list(a.transmission[perm])
+    assert np.array_equal(b.first_z, a.first_z)
+    assert np.array_equal(b.first_hits, a.first_hits)
+    for k, i in enumerate(perm):
+        assert np.array_equal(b.lit(k), a.lit(int(i)))
+
+
+def test_ground_transmission_of_the_bundled_block_with_zero_last():
+    """The issue's own case: the 3x3 tiled example, sun at 30 deg zenith from the south,
+    heights 100,0 against 0,100 (T(0) was 0.0342 against 0.1059)."""
+    def run(heights):
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            assert main(["light", BLOCK, "--tile", "3x3", "--triangles", "36", "--sun-zenith",
+                         "30", "--sun-azimuth", "180", "--density", "1", "--heights", heights,
+                         "--json"]) == 0
+        return json.loads(out.getvalue())["transmission"]
+
+    assert run("100,0") == run("0,100")[::-1]
+
+
+@settings(max_examples=6, deadline=None)
+@given(st.integers(0, 2**31), st.integers(0, 2**31), st.booleans())
+def test_sky_transmission_follows_its_height_whatever_the_order(seed, order, periodic):
+    canopy = _squares(seed)
+    perm = _permutation(order, len(HEIGHTS))
+    heights = tuple(HEIGHTS[i] for i in perm)
+    rect = (10, 10, 90, 90) if not periodic else (0, 0, 100, 100)
+    sky = make_sky("soc", 16)
+    a = trace_sky(canopy, sky, Sampling(HEIGHTS, 1.0, rect, periodic), bin_cm=10.0)
+    b = trace_sky(canopy, sky, Sampling(heights, 1.0, rect, periodic), bin_cm=10.0)
+    assert list(b.transmission) == list(a.transmission[perm])
+    np.testing.assert_array_equal(b.per_direction, a.per_direction[:, perm])
+    np.testing.assert_array_equal(b.maps, a.maps[perm])
+    np.testing.assert_array_equal(b.triangle_share, a.triangle_share)
+
+
+def test_day_transmission_follows_its_height_whatever_the_order():
+    canopy = _squares(7)
+    perm = np.array([3, 0, 5, 1, 4, 2])
+    heights = tuple(HEIGHTS[i] for i in perm)
+    period = clear_sky_period("2024-07-01", 43.6, 1.4, "Europe/Paris", step_min=120)
+    sky = make_sky("uoc", 16)
+    a = trace_period(canopy, period, Sampling(HEIGHTS, 1.0, (10, 10, 90, 90)), sky=sky,
+                     bin_cm=10.0)
+    b = trace_period(canopy, period, Sampling(heights, 1.0, (10, 10, 90, 90)), sky=sky,
+                     bin_cm=10.0)
+    np.testing.assert_array_equal(b.step_transmission, a.step_transmission[:, perm])
+    np.testing.assert_array_equal(b.maps, a.maps[perm])
+    np.testing.assert_array_equal(b.triangle_direct_mol, a.triangle_direct_mol)
+    np.testing.assert_array_equal(b.triangle_diffuse_mol, a.triangle_diffuse_mol)
+
+
+# ------------------------------------------------------------------ mesh files: faces
+
+
+@pytest.fixture(scope="module")
+def block_mesh(tmp_path_factory):
+    """The bundled block's canopy at 36 triangles a leaf, exported as PLY and read back:
+    (vertices (V, 3) cm, faces (T, 3), plant (T,), leaf (T,))."""
+    from maizeviz.canopy.export import export_canopy
+    from maizeviz.canopy.layout import layout_for
+    from maizeviz.canopy.scene import build_canopy
+    from maizeviz.io.mesh_canopy import read_mesh
+    from maizeviz.leaf.fit import read_leaves
+    from maizeviz.mesh.levels import Level
+
+    found = read_leaves(BLOCK)
+    canopy = build_canopy(found.leaves, layout_for(found.leaves, (1, 1)), Level(triangles=36))
+    mesh = read_mesh(export_canopy(tmp_path_factory.mktemp("mesh") / "c.ply", canopy))
+    return mesh.vertices, mesh.faces, mesh.plant, mesh.leaf
+
+
+def _canopy_json(capsys, path, *extra):
+    capsys.readouterr()
+    assert main(["canopy", str(path), "--mesh-unit", "cm", "--json", *extra]) == 0
+    out, err = capsys.readouterr()
+    return json.loads(out), err
+
+
+def _measures(doc):
+    """The canopy measures of `maizeviz canopy --json` (one level), without timings."""
+    return {k: v for k, v in doc.items() if not k.endswith("_s")}
+
+
+@pytest.mark.parametrize("how", ["same order", "reversed corners", "new vertices"])
+def test_a_mesh_written_twice_measures_as_once(tmp_path, capsys, block_mesh, how):
+    """Issue 25 case 3: every face written twice gave twice the leaf area and LAI, no word.
+    A repeated triangle (the same three corners, by position, in any order) counts once, and
+    a note says how many were left out."""
+    from tests.core.test_mesh_canopy import write_ply
+
+    v, f, plant, leaf = block_mesh
+    once = write_ply(tmp_path / "once.ply", v, f, {"plant": plant, "leaf": leaf},
+                     fmt="binary_little_endian")
+    second = {"same order": f, "reversed corners": f[:, ::-1], "new vertices": f + len(v)}[how]
+    verts = np.vstack([v, v]) if how == "new vertices" else v
+    twice = write_ply(tmp_path / "twice.ply", verts, np.vstack([f, second]),
+                      {"plant": np.concatenate([plant, plant]),
+                       "leaf": np.concatenate([leaf, leaf])}, fmt="binary_little_endian")
+    a, _ = _canopy_json(capsys, once)
+    b, said = _canopy_json(capsys, twice)
+    assert _measures(b) == _measures(a)
+    assert f"{len(f):,} of the {2 * len(f):,} triangles repeat an earlier triangle" in said
+
+
+
+# ------------------------------------------------------------------ sweep files
+
+
+def test_a_sweep_file_with_a_byte_order_mark_lists_the_same_scenarios(tmp_path):
+    """A sweep TOML saved by a Windows editor begins with a byte order mark; it was refused
+    as invalid TOML at line 1. It reads as the same file without it."""
+    from maizeviz.sweep.spec import load_spec
+
+    text = (Path(BLOCK).with_name("sweep-example.toml").read_text()
+            .replace('"block3x3.csv"', json.dumps(BLOCK)))
+    plain, marked = tmp_path / "plain.toml", tmp_path / "marked.toml"
+    plain.write_text(text)
+    marked.write_bytes(b"\xef\xbb\xbf" + text.encode())
+    a, b = load_spec(plain, yes=True), load_spec(marked, yes=True)
+    assert len(a.scenarios) > 1
+    assert [s.key for s in b.scenarios] == [s.key for s in a.scenarios]
+
+
+def test_a_sweep_height_given_twice_is_refused_naming_it(tmp_path):
+    from maizeviz.errors import MaizevizError
+    from maizeviz.sweep.spec import load_spec
+
+    text = (Path(BLOCK).with_name("sweep-example.toml").read_text()
+            .replace('"block3x3.csv"', json.dumps(BLOCK)))
+    assert "heights = [0, 50, 100, 150" in text
+    path = tmp_path / "twice.toml"
+    path.write_text(text.replace("heights = [0, 50, 100, 150", "heights = [0, 50, 50.0, 100, 150"))
+    with pytest.raises(MaizevizError, match=r"light.heights\[2\]: height 50 cm is given twice"):
+        load_spec(path, yes=True)
