@@ -14,7 +14,20 @@ the central tile, on the engine's kept scene (its build is not counted on either
 - rays_per_s: primary and scattered rays traced per second with scattering
 - closure: the energy balance's closure (0 up to Monte Carlo noise)
 
+and the diffuse light of a ``--sky-directions`` uniform overcast sky (``--sky-density`` rays
+per cm2, default 1), for PAR and NIR at the default depth (20):
+
+- sky_black_s: the black-leaf sky (``LightEngine.sky``: every direction over the whole grid):
+  the anchor of the sky
+- sky_par_s, sky_nir_s: absorbed diffuse light with the maize optics, the sky's directions
+  drawn per ray (4 rays per cell); sky_par_ratio, sky_nir_ratio: against the anchor (target
+  <= 2)
+- sky_par_all_s, sky_nir_all_s: the same traced direction by direction over the whole grid
+  (``sky_passes=0``, before); the answers of both ways, with their standard errors
+  (``*_absorbed``, ``*_se``, fractions of the diffuse light), agree within them
+
     python benchmarks/bench_scatter.py [--json] [--level K4] [--density 4] [--depth 3]
+        [--sky-directions 145] [--sky-density 1]
 """
 
 from __future__ import annotations
@@ -50,6 +63,9 @@ def main() -> None:
     ap.add_argument("--depth", type=int, default=3)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--sky-directions", type=int, default=145)
+    ap.add_argument("--sky-density", type=float, default=1.0)
+    ap.add_argument("--no-sky", action="store_true", help="leave the sky part out")
     args = ap.parse_args()
 
     leaves = read_leaves(example_points()).leaves
@@ -73,11 +89,36 @@ def main() -> None:
            "fraction_absorbed": round(lit.fraction_absorbed, 4),
            "reflected_top": round(lit.balance.reflected_top / lit.balance.incident, 4),
            "closure": round(lit.balance.closure, 5)}
+    if not args.no_sky:
+        out.update(sky_part(canopy, args))
     if args.json:
         print(json.dumps(out, indent=1))
     else:
         for k, v in out.items():
             print(f"{k:>24}: {v}")
+
+
+def sky_part(canopy, args) -> dict:
+    """The sky: black leaves against absorbed PAR and NIR, per ray and direction by
+    direction (each timed once: the direction-by-direction NIR sky takes about a minute)."""
+    from maizeviz.light.sources.sky import make_sky
+
+    sky = make_sky("uoc", args.sky_directions)
+    eng = LightEngine(canopy, periodic=True, density=args.sky_density, heights_cm=(0.0,),
+                      threads=args.threads)
+    eng.scene()
+    black_s, _ = best(lambda: eng.sky(sky), 1)
+    out: dict = {"sky_directions": sky.n, "sky_density": args.sky_density,
+                 "sky_black_s": round(black_s, 3)}
+    for band in ("par", "nir"):
+        for label, passes in ((band, 4), (f"{band}_all", 0)):
+            secs, got = best(lambda p=passes, b=band: eng.absorbed(
+                direct_w_m2=0.0, diffuse_w_m2=1.0, sky=sky, band=b, sky_passes=p), 1)
+            out[f"sky_{label}_s"] = round(secs, 3)
+            out[f"sky_{label}_absorbed"] = round(got.balance.absorbed_leaves, 5)
+            out[f"sky_{label}_se"] = round(got.absorbed_leaves_error, 5)
+        out[f"sky_{band}_ratio"] = round(out[f"sky_{band}_s"] / black_s, 2)
+    return out
 
 
 if __name__ == "__main__":

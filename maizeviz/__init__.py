@@ -50,6 +50,12 @@ _EXPORTS = {
     "PeriodLight": "maizeviz.light.results.diffuse",
     "AbsorbedLight": "maizeviz.light.results.absorbed",
     "AbsorbedPeriod": "maizeviz.light.results.absorbed",
+    "Assimilation": "maizeviz.light.results.assimilation",
+    "PeriodAssimilation": "maizeviz.light.results.assimilation",
+    # photosynthesis
+    "leaf_model": "maizeviz.photosynthesis.split",
+    "C4Leaf": "maizeviz.photosynthesis.c4",
+    "WofostLeaf": "maizeviz.photosynthesis.wofost",
     "MaizevizError": "maizeviz.errors",
 }
 

@@ -23,7 +23,7 @@ from maizeviz.canopy.measures import check_cover_resolution
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import Leaf
 from maizeviz.light.scene.rays import Rect, ray_count
-from maizeviz.mesh.levels import Level
+from maizeviz.mesh.levels import DEVIATION_K, Level
 
 #: Peak bytes per canopy triangle: the canopy arrays, its Embree scene, the ground-cover scene
 #: and the transients of building them (measured: 345 B at K = 4 on the bundled example).
@@ -31,6 +31,9 @@ BYTES_PER_TRIANGLE = 400
 #: Peak bytes per leaf triangle meshed and measured by ``maizeviz leaf`` (measured on the
 #: bundled example: 272 B from K = 4 to K = 16, 3.2 million more triangles).
 BYTES_PER_LEAF_TRIANGLE = 300
+#: Peak bytes per surface point of the largest leaf's deviation measure (its sample and the
+#: bounds of each point; measured: 46 B on a leaf of 10,000 x 3 points, 1.7 million of them).
+BYTES_PER_DEVIATION_POINT = 64
 #: Leaf triangles meshed and measured per second (measured there: about 1 million).
 LEAF_TRIANGLES_PER_S = 1_000_000
 #: Bytes per traced ray: origins, hits, heights, ground positions (measured: 48-55 B).
@@ -145,8 +148,18 @@ def leaves_cost(leaves: Sequence[Leaf], level: Level, quantity: str, batch: int,
     tris = [leaf_triangles(*lf.grid.shape, lf.grid.tip_collapsed, level) for lf in leaves]
     held = sum(tris) if keep else max((sum(tris[s:s + batch])
                                        for s in range(0, len(tris), batch)), default=0)
+    # a leaf is measured whole, however many surface points it has (most leaves, a few
+    # thousand, go MEASURE_POINTS at a time): the largest one's points add to the meshes
+    points = max((deviation_points(*lf.grid.shape) for lf in leaves), default=0)
     return Cost(f"meshing {len(tris):,} leaves at {level}", quantity, sum(tris), "triangles",
-                held * BYTES_PER_LEAF_TRIANGLE, sum(tris) / LEAF_TRIANGLES_PER_S)
+                held * BYTES_PER_LEAF_TRIANGLE + points * BYTES_PER_DEVIATION_POINT,
+                sum(tris) / LEAF_TRIANGLES_PER_S)
+
+
+def deviation_points(rows: int, cols: int) -> int:
+    """Surface points of an m x n leaf grid its deviation is measured at (K = 8, as
+    :func:`maizeviz.mesh.levels.measure_leaves` samples it)."""
+    return ((rows - 1) * (DEVIATION_K + 1) + 1) * ((cols - 1) * (DEVIATION_K + 1) + 1)
 
 
 def layout_cost(leaves: Iterable[Leaf], layout: CanopyLayout, level: Level) -> Cost:

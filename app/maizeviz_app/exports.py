@@ -77,12 +77,15 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
         if height is None:
             height = float(run.result.heights_cm[0])
         result = run.result
+        from maizeviz_app.plots import Look
+
+        look = Look.of(model.colour, shown_runs or {kind: run})    # as shown
 
         def work(job):
             from maizeviz.light.report.heatmap import save_figure
             from maizeviz_app.plots import heatmap_figure_of
 
-            save_figure(heatmap_figure_of(result, height, kind), path)
+            save_figure(heatmap_figure_of(result, height, kind, look=look), path)
             return path
         return work, ()
     if what == "plot":

@@ -127,17 +127,31 @@ def op_absorbed(state: dict, progress: ProgressCallback, request: LightRequest,
     of a plant in a periodic field take their representative's; NaN on plants outside the
     sample rectangle of an open field) and the plants' rows."""
     light = spec.absorbed(_engine(state), request.sun, request.sampling, progress)
-    return absorbed_of(state["canopy"], light)
+    return absorbed_of(state["canopy"], light, spec)
 
 
-def absorbed_of(canopy, light) -> Absorbed:
+def absorbed_of(canopy, light, spec: OpticsSpec | None = None) -> Absorbed:
     """What the window shows of absorbed light (an ``AbsorbedLight``) on the canopy it was
-    traced on (also for a result read from a project)."""
+    traced on (also for a result read from a project); with a leaf model in ``spec``
+    (``OpticsSpec.photosynthesis``), also the leaves' gross CO2 assimilation: each leaf's
+    umol CO2 per m2 of leaf per s on its triangles (``gross_value``) and the plants' rows
+    gaining ``gross_umol_s`` and its standard error ``gross_umol_s_se``."""
     from maizeviz.light.report.tables import leaf_values
     values = leaf_values(canopy, light.leaf_rows(canopy), "absorbed_w", light.rect,
                          light.periodic)
-    plants = light.table("plant", canopy).to_dict("records")
-    return Absorbed(light, values.astype(np.float32), plants)
+    frame = light.table("plant", canopy)
+    assimilation = spec.assimilation(canopy, light) if spec is not None else None
+    gross = None
+    if assimilation is not None:
+        leaves = assimilation.table("leaf", canopy)
+        gross = leaf_values(canopy, leaves.to_dict("records"), "gross_umol_s", light.rect,
+                            light.periodic).astype(np.float32)
+        plants = assimilation.table("plant", canopy)[["instance", "gross_umol_s",
+                                                      "gross_umol_s_se"]]
+        frame = frame.merge(plants, on="instance", how="left").fillna(
+            {"gross_umol_s": 0.0, "gross_umol_s_se": 0.0})
+    return Absorbed(light, values.astype(np.float32), frame.to_dict("records"), assimilation,
+                    gross)
 
 
 @dataclass(frozen=True)
@@ -145,11 +159,16 @@ class Absorbed:
     """Absorbed light (:class:`maizeviz.light.results.absorbed.AbsorbedLight`) with what the window
     shows of it: ``leaf_value`` (F,) float32 W absorbed per m2 of leaf on each leaf triangle
     (its leaf's), and ``plant_rows`` (the result's ``table("plant")`` as records); both None
-    for a result read from a project until computed against its canopy."""
+    for a result read from a project until computed against its canopy. With a leaf model:
+    ``assimilation`` (:class:`maizeviz.light.results.assimilation.Assimilation`) and
+    ``gross_value`` (F,) float32, each leaf's gross umol CO2 per m2 of leaf per s on its
+    triangles."""
 
     light: Any
     leaf_value: np.ndarray | None
     plant_rows: list | None
+    assimilation: Any = None
+    gross_value: np.ndarray | None = None
 
 
 @dataclass(frozen=True)

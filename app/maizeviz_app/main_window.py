@@ -227,15 +227,23 @@ class MainWindow(QMainWindow):
         self.digitizer: DigitizerPanel | None = None
         self.plots = LightPlots()
         self.plots.heatmap_needed.connect(self._draw_heatmap)
+        self.model.colour.heatmap.events.connect(lambda _info: self.plots.redraw())
+        self.model.colour.events.shared.connect(lambda _on: self.plots.redraw())
+        self.model.colour.events.painting.connect(lambda _p: self._light_to_view())
         self.messages = QPlainTextEdit(readOnly=True)
         self.messages.setMaximumBlockCount(1000)
+        from maizeviz_app.panels.colour import ColourPanel
+
+        self.colour_panel = ColourPanel(self.model.colour)
+        self.plots.heatmap.limits_shown.connect(self.colour_panel.heatmap_editor.show_limits)
 
         right = Qt.DockWidgetArea.RightDockWidgetArea
         canopy = self._dock("canopy", "Canopy", self.canopy_panel, right)
         light = self._dock("light", "Light", self.light_panel, right)
         layout = self._dock("layout", "Layout", QLabel("starting…"), right)
         digitizer = self._dock("digitizer", "Digitizer", QLabel("starting…"), right)
-        for d in (light, layout, digitizer):
+        colour = self._dock("colour", "Colour", self.colour_panel, right)
+        for d in (light, layout, digitizer, colour):
             self.tabifyDockWidget(canopy, d)
         canopy.raise_()
         bottom = Qt.DockWidgetArea.BottomDockWidgetArea
@@ -367,6 +375,12 @@ class MainWindow(QMainWindow):
             # Qt compose the whole window again (see _own_window), and re-laying it out then
             # gives the docks all the room but the view's minimum height
             self.viewport = Viewport(self._centre)
+            self.viewport.set_colour_scale(self.model.colour.view)
+            self.viewport.limits_shown.connect(self.colour_panel.view_editor.show_limits)
+            from maizeviz_app.linked import LinkedSelection
+
+            self.linked = LinkedSelection(self.model, self.viewport, self.light_panel.plants,
+                                          lambda text: self.say(text, status_only=True))
             # the central widget stays (a new one would make the docks take its room)
             self._centre.addWidget(self.viewport)
             self._centre.setCurrentWidget(self.viewport)
@@ -513,10 +527,10 @@ class MainWindow(QMainWindow):
             measure_s = time.perf_counter() - t0
             while not view_ready.wait(0.05):
                 job.check()
-            from maizeviz_app.viewport import canopy_polydata
+            from maizeviz_app.mesh_view import mesh_polydata
 
             row = table2_row(m, read_s, MESH_LEVEL)
-            return notes, (canopy, m, read_s, measure_s, canopy_polydata(canopy),
+            return notes, (canopy, m, read_s, measure_s, mesh_polydata(canopy),
                            tuple(TABLE2_COLUMNS), row)
 
         self.runner.run("load", f"reading {Path(path).name}", work,
@@ -747,7 +761,10 @@ class MainWindow(QMainWindow):
         self._complete_runs()
         self._light_to_view()
         m = built.measures
-        if "source" in mesh.field_data:
+        if "view_note" in mesh.field_data:
+            self.say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
+                     f"responsive {mesh.field_data['view_note'][0]}")
+        elif "source" in mesh.field_data:
             self.say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
                      "responsive the view draws the plants around the sampled tile at 36 "
                      "triangles a leaf (light, tables and exports use every triangle)")
@@ -772,7 +789,8 @@ class MainWindow(QMainWindow):
         run = self.runs.latest(self.signature(self.built.label))
         if run is not None and run.kind == "sun" and run.classes is not None and \
                 (run.extra is None or run.extra.leaf_value is None):
-            self.viewport.set_light(run.classes)
+            self.viewport.set_sun(run.painting, self.model.colour.painting, run.classes)
+            self.colour_panel.show_painting(self.viewport.painting_note)
         elif run is not None and run.extra is not None and \
                 getattr(run.extra, "leaf_value", None) is not None:
             title, unit = value_legend(run)
@@ -832,21 +850,26 @@ class MainWindow(QMainWindow):
         key = self._canopy_id
         runner = self.runner
         shown_height = max(self.plots.height_box.currentIndex(), 0)
+        look = plots.Look.of(self.model.colour, self._heatmaps_for)
 
         def work(job):
             out = runner.light_process.call(op, key, canopy, args, job)
             job.check()
             if mode == "sun":
+                from maizeviz.light.results.painting import sun_painting
+
                 absorbed = None
                 if optics is not None:              # leaves with optics: absorbed light too
                     absorbed = runner.light_process.call("absorbed", key, canopy,
                                                          (args[0], optics), job)
                     job.check()
-                run = Run(label, signature, out, out.triangle_light(canopy), extra=absorbed)
+                painting = sun_painting(canopy, out)
+                run = Run(label, signature, out, painting.classes, extra=absorbed,
+                          painting=painting)
             else:
                 run = Run(label, signature, out.light, None, mode, out)
             maps = plots.heatmap_images(run.result, first=shown_height, check=job.check,
-                                        kind=mode)
+                                        kind=mode, look=look.sharing(mode, run.result))
             runs.add(run, settings, sampling_key)
             plot = plots.rgba(plots.transmission_figure(runs.curves(), plot_title(runs)))
             return run, settings, sampling_key, maps, plot
@@ -934,11 +957,15 @@ class MainWindow(QMainWindow):
         self._heatmaps_for[run.kind] = run
         self.plots.keep_only(set(self._heatmaps_for))
         self.plots.set_heatmaps(maps, run.kind)
+        if self.model.colour.shared:                  # the others' scale includes this run
+            self.plots.redraw(keep=run.kind)
         self.plots.set_transmission(plot)
         for w in r.warnings:
             self.say(f"{'note' if 'sun never rises' in w else 'warning'}: {w}")
         if self.built is not None and self.signature(self.built.label) == run.signature:
             self._light_to_view(colour=True)
+            if run.painting is not None and self.viewport is not None:
+                self.say(f"note: the view shows {self.viewport.painting_note}")
         self.docks["results"].raise_()
         if run.kind == "day":
             self.say(summary.replace("\n", "; "), status_only=True)
@@ -957,13 +984,14 @@ class MainWindow(QMainWindow):
 
         result = run.result
         height = float(result.heights_cm[index])
+        look = plots.Look.of(self.model.colour, self._heatmaps_for)
 
         def done(rgba):
             if self._heatmaps_for.get(kind) is run:
                 self.plots.set_heatmap(index, rgba, kind)
 
         self.runner.run("heatmap", f"drawing the heatmap at {height:g} cm",
-                        lambda job: plots.heatmap_image(result, height, kind=kind),
+                        lambda job: plots.heatmap_image(result, height, kind=kind, look=look),
                         on_done=done, on_error=lambda e: self._fail(e, "light"))
 
     def sun_from_place(self) -> None:
@@ -995,6 +1023,31 @@ class MainWindow(QMainWindow):
                  f"{sun.azimuth_deg:.2f}°")
 
     # ------------------------------------------------------------------ view
+    def choose_view_image(self) -> None:
+        """File > Save view as image: ask the width and the file, then save."""
+        if self.viewport is None:
+            return
+        from maizeviz_app.snapshot import ask_view_image
+
+        chosen = ask_view_image(self, self.viewport, self._folder())
+        if chosen is not None:
+            self.save_view_image(*chosen)
+
+    def save_view_image(self, path: str | Path, width: int | None = None) -> None:
+        """The 3D view as a PNG ``width`` pixels wide (None: the view's), with its colour key
+        (:mod:`maizeviz_app.snapshot`)."""
+        if self.viewport is None:
+            return
+        from maizeviz_app.snapshot import save_view_image
+
+        try:
+            written = save_view_image(self.viewport, path, width)
+        except (MaizevizError, OSError, ValueError) as exc:
+            self._fail(exc, "export")
+            return
+        self.say(f"saved the view as {written}")
+        self.saved.emit(str(written))
+
     def camera(self, name: str) -> None:
         if self.viewport is not None:
             self.viewport.camera_preset(name)
@@ -1022,7 +1075,7 @@ class MainWindow(QMainWindow):
     def _digitizing_stopped(self, _why: str) -> None:
         """In Digitize the plant just digitized stays in the view (no canopy frame on Stop);
         in Analyse the canopy comes back at once."""
-        if self.workspaces.current == "analyse":
+        if not self._closing and self.workspaces.current == "analyse":
             self._canopy_back()
 
     def _workspace_changed(self, name: str) -> None:
@@ -1041,7 +1094,7 @@ class MainWindow(QMainWindow):
         pending, self._view_pending = self._view_pending, None
         if pending is not None:
             self.viewport.show_canopy(*pending)
-            self.viewport.camera_preset("perspective")
+            self.viewport.camera_preset("reset")
         else:
             self.viewport.restore_canopy()
         self._light_to_view()
@@ -1115,6 +1168,7 @@ class MainWindow(QMainWindow):
         canopy = {"tile": self.tile_n, "level": self.level,
                   "preserve_area": self.canopy_panel.preserve.isChecked()}
         light = self.light_panel.settings()
+        view = self.model.colour.to_doc()
         runs = []
         sun_settings = self.runs.settings.get("sun")
         optics = sun_settings[2] if isinstance(sun_settings, tuple) and \
@@ -1132,7 +1186,8 @@ class MainWindow(QMainWindow):
             from maizeviz.project.study import make_project
 
             # the runs were all traced on the layout shown (a layout edit clears them)
-            proj = make_project(origin, data, layout, loaded.layout, canopy, light, runs)
+            proj = make_project(origin, data, layout, loaded.layout, canopy, light, runs,
+                                view)
             save_project(path, proj)
             return path
 
@@ -1170,6 +1225,7 @@ class MainWindow(QMainWindow):
             opened = study.open_project(path, cache)
             tile, level, preserve = project.canopy_settings(opened)
             light = project.light_settings(opened)
+            project.view_settings(opened)
             found = jobs.load_points(opened.points_path, (tile, tile),
                                      shown_name=opened.shown_name)
             layout = study.restore_layout(opened, found.plants) or found.layout
@@ -1199,6 +1255,7 @@ class MainWindow(QMainWindow):
         self.canopy_panel.preserve.setChecked(preserve)
         self.canopy_panel.preserve.blockSignals(False)
         self.light_panel.apply_settings(light)
+        self.model.colour.update_from_doc(opened.view, opened.path)
         self._project_layout = opened.project.layout is not None
         self._on_loaded(loaded, opened.project.points_csv, opened.path,
                         opened.project.points_path)
@@ -1253,9 +1310,11 @@ class MainWindow(QMainWindow):
         title = plot_title(self.runs)
         self._heatmaps_for = dict(shown)
         results = [(k, shown[k].result) for k in order]
+        look = plots.Look.of(self.model.colour, shown)
 
         def work(job):
-            maps = [(k, plots.heatmap_images(r, check=job.check, kind=k)) for k, r in results]
+            maps = [(k, plots.heatmap_images(r, check=job.check, kind=k, look=look))
+                    for k, r in results]
             plot = plots.rgba(plots.transmission_figure(curves, title))
             return maps, plot
 
@@ -1304,6 +1363,7 @@ class MainWindow(QMainWindow):
             return
 
         def work(job):
+            from maizeviz.light.results.painting import sun_painting
             from maizeviz_app import jobs
 
             done: list[Any] = []
@@ -1312,7 +1372,7 @@ class MainWindow(QMainWindow):
                 if run.kind == "sun":
                     absorbed = None if run.extra is None else \
                         jobs.absorbed_of(canopy, run.extra.light)
-                    done.append((run.result.triangle_light(canopy), absorbed))
+                    done.append((sun_painting(canopy, run.result), absorbed))
                 else:
                     done.append(jobs.diffuse_of(canopy, run.result, run.kind))
             return done
@@ -1320,7 +1380,8 @@ class MainWindow(QMainWindow):
         def adopt(done):
             for run, value in zip(todo, done):
                 if run.kind == "sun":
-                    run.classes, absorbed = value
+                    run.painting, absorbed = value
+                    run.classes = run.painting.classes
                     if absorbed is not None:
                         run.extra = absorbed
                 else:

@@ -67,14 +67,19 @@ def build_menus(w) -> dict[str, QAction]:
                                     lambda: w.choose_export("plants"))
     acts["export_day"] = _action(w, results, "Day figure (PNG)…",
                                  lambda: w.choose_export("day"))
+    acts["view_image"] = _action(w, f, "Save view as &image…", w.choose_view_image,
+                                 "Ctrl+Alt+S", "the 3D view as a PNG of a chosen width, with "
+                                               "its colour key")
     f.addSeparator()
     acts["quit"] = _action(w, f, "&Quit", w.close, QKeySequence.StandardKey.Quit)
 
     v = bar.addMenu("&View")
     cam = v.addMenu("&Camera")
     for k, (name, text) in enumerate(CAMERAS.items(), start=1):
+        if name == "reset":
+            cam.addSeparator()
         acts[f"camera_{name}"] = _action(w, cam, text, lambda n=name: w.camera(n),
-                                         f"Ctrl+{k}")
+                                         "Ctrl+0" if name == "reset" else f"Ctrl+{k}")
     colour = v.addMenu("C&olour by")
     group = QActionGroup(w)
     for k, (name, text) in enumerate(COLOURINGS.items(), start=1):

@@ -25,7 +25,9 @@ from typing import Any
 
 from psygnal import Signal
 
+from maizeviz_app.colour import ColourSettings
 from maizeviz_app.runs import LightRuns, Run
+from maizeviz_app.selection import Selection
 
 
 class StudyModel:
@@ -60,6 +62,10 @@ class StudyModel:
         the serial it was made for, and one made for an older serial is dropped.
     modified : bool
         There is work a project does not hold yet (see the module docstring).
+    colour : ColourSettings
+        How the 3D view and the heatmaps colour light (evented; saved in a project).
+    selection : Selection
+        The plant or leaf selected (evented; the 3D view and the plants table follow it).
 
     Signals
     -------
@@ -94,6 +100,8 @@ class StudyModel:
         self.layout_edited = False
         self.serial = 0
         self.modified = False
+        self.colour = ColourSettings()
+        self.selection = Selection()
 
     # ------------------------------------------------------------------ reading
     @property

@@ -49,6 +49,8 @@ FLAGS = {
     "irradiance": "--irradiance/--diffuse", "depth": "--depth",
     "mesh_unit": "--mesh-unit", "up": "--up", "field": "--field",
     "mesh_ids": "--mesh-plant/--mesh-leaf",
+    "photosynthesis": "--photosynthesis", "temperature": "--temperature", "co2": "--co2",
+    "precision": "--precision",
 }
 
 

@@ -51,6 +51,7 @@ from maizeviz.light.report.heatmap import map_stems, save_figure, write_heatmaps
 from maizeviz.light.report.mesh_export import light_cells
 from maizeviz.light.report.tables import write_steps
 from maizeviz.light.results.absorbed import AbsorbedLight
+from maizeviz.light.results.assimilation import assimilate
 from maizeviz.light.results.diffuse import PeriodLight, SkyLight
 from maizeviz.light.results.direct import LightResult
 from maizeviz.light.results.per_leaf import merge_rows, plant_light
@@ -68,8 +69,10 @@ from maizeviz.light.sources.perez import PEREZ_MODELS, split_summary
 from maizeviz.light.sources.sky import SKY_KINDS, Sky, make_sky
 from maizeviz.light.sources.sun import Sun, sun_at
 from maizeviz.light.trace.optics import BANDS, optics_for, read_optics_table
+from maizeviz.light.trace.precision import check_precision, trace_until
 from maizeviz.light.trace.scatter import DEFAULT_DEPTH
 from maizeviz.mesh.levels import CANOPY_LEVELS
+from maizeviz.photosynthesis.split import MODELS, LeafModel, leaf_model
 
 #: The subcommand.
 NAME = "light"
@@ -177,14 +180,64 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ab.add_argument("--depth", type=WHOLE_ARG, default=None, metavar="N",
                     help=f"most scatterings followed per ray (default {DEFAULT_DEPTH})")
     ab.add_argument("--seed", type=WHOLE_ARG, default=None, help="random seed (default 0)")
+    ab.add_argument("--precision", type=NUMBER_ARG, default=None, metavar="REL_SE",
+                    help="trace denser until the relative Monte Carlo standard error of the "
+                         "leaves' absorbed light (of the canopy's assimilation with "
+                         "--photosynthesis) is at most this (0.005: 0.5 %%)")
+    ph = p.add_argument_group(
+        "photosynthesis from the absorbed PAR (turns absorbed light on; the sun, or a period)")
+    ph.add_argument("--photosynthesis", choices=MODELS, default=None,
+                    help="leaf model: c4 (Collatz et al. 1992, maize) or wofost (negative "
+                         "exponential)")
+    ph.add_argument("--amax", type=NUMBER_ARG, default=None, metavar="KG_HA_H",
+                    help="wofost: gross assimilation at light saturation, kg CO2/ha leaf/h "
+                         "(default 70)")
+    ph.add_argument("--eff", type=NUMBER_ARG, default=None, metavar="KG_HA_H_PER_W_M2",
+                    help="wofost: initial light use efficiency, kg CO2/ha/h per J/m2/s of "
+                         "absorbed PAR (default 0.45)")
+    ph.add_argument("--vmax", type=NUMBER_ARG, default=None, metavar="UMOL_M2_S",
+                    help="c4: Rubisco capacity at 25 C, umol/m2/s (default 39)")
+    ph.add_argument("--alpha", type=NUMBER_ARG, default=None, metavar="MOL_MOL",
+                    help="c4: quantum yield, mol CO2 per mol of absorbed photons "
+                         "(default 0.04)")
+    ph.add_argument("--co2", type=NUMBER_ARG, default=None, metavar="PPM",
+                    help="c4: ambient CO2, umol/mol (default 400; intercellular 0.4 of it)")
+    ph.add_argument("--temperature", type=NUMBER_ARG, default=None, metavar="C",
+                    help="air (leaf) temperature, C (default 25; a weather file's own air "
+                         "temperature when it has one)")
     p.set_defaults(run=run)
 
 
 def _absorbed_asked(args: argparse.Namespace) -> bool:
     return any(v is not None for v in (args.band, args.reflectance, args.transmittance,
                                         args.ground_reflectance, args.irradiance,
-                                        args.optics_table, args.depth, args.seed)) or \
+                                        args.optics_table, args.depth, args.seed,
+                                        args.photosynthesis, args.precision)) or \
         bool(args.diffuse)
+
+
+def _leaf_model_from(args: argparse.Namespace) -> LeafModel | None:
+    """The leaf model ``--photosynthesis`` names, with its flags; refuses another model's
+    flags and photosynthesis from NIR."""
+    own = {"c4": ("vmax", "alpha", "co2"), "wofost": ("amax", "eff")}
+    given = [k for k in ("vmax", "alpha", "co2", "amax", "eff", "temperature")
+             if getattr(args, k) is not None]
+    if args.photosynthesis is None:
+        if given:
+            raise MaizevizError(f"--{given[0]} is a parameter of leaf photosynthesis: add "
+                                "--photosynthesis c4 or wofost", quantity="photosynthesis")
+        return None
+    other = [k for k in given if k != "temperature" and k not in own[args.photosynthesis]]
+    if other:
+        raise MaizevizError(f"--{other[0]} is not a parameter of the {args.photosynthesis} "
+                            "model", quantity="photosynthesis")
+    if args.band == "nir":
+        raise MaizevizError("photosynthesis works from absorbed PAR: give no --band nir",
+                            quantity="band")
+    if args.temperature is not None:
+        check_range(args.temperature, "the air temperature (C)", -50, 70, "temperature")
+    return leaf_model(args.photosynthesis, vmax=args.vmax, alpha=args.alpha,
+                      co2_ppm=args.co2, amax=args.amax, eff=args.eff)
 
 
 # ------------------------------------------------------------------------------ what is asked
@@ -313,6 +366,9 @@ def run(args: argparse.Namespace) -> int:
                                 quantity="irradiance")
         absorbed_optics = optics_for(args.band or "par", args.reflectance, args.transmittance,
                                      args.ground_reflectance)
+    leaf_model_ = _leaf_model_from(args)
+    temp_c = 25.0 if args.temperature is None else args.temperature
+    if absorbed_optics is not None:
         if args.optics_table is not None:
             absorbed_optics = replace(absorbed_optics, ranks=read_optics_table(
                 args.optics_table, absorbed_optics.band))
@@ -323,6 +379,8 @@ def run(args: argparse.Namespace) -> int:
         args.seed = 0 if args.seed is None else args.seed
         check_range(args.depth, "the scattering depth", 0, 10_000, "depth", whole=True)
         check_range(args.seed, "the random seed", 0, 2**32 - 1, "seed", whole=True)
+        if args.precision is not None:
+            check_precision(args.precision)
     rect = tuple(floats(args.rect, "the sample rectangle", "rect", 4)) if args.rect else None
     if not args.heatmap_bin > 0:
         raise MaizevizError(f"the heatmap bin must be > 0 cm, got {args.heatmap_bin}",
@@ -383,6 +441,7 @@ def run(args: argparse.Namespace) -> int:
                                "seconds": {"canopy": canopy_s, "scene": scene_s}}
         warnings: list[str] = []
         tables: list[list[dict]] = []
+        plant_extra: dict[int, dict[str, float]] = {}
         res = sky_res = per_res = ab = None
         if sun is not None:
             res = engine.sun(sun, classes=want_rows or len(labels) == 1 or bool(args.export),
@@ -425,32 +484,72 @@ def run(args: argparse.Namespace) -> int:
                 say(f"{'note' if w in (period.notes if period else ()) else 'warning'}: {w}")
         rec["warnings"] = list(dict.fromkeys(warnings))
         if absorbed_optics is not None and sun is None and period is not None:
-            abd = engine.absorbed_day(period, optics=absorbed_optics,
-                                      sky=args.sky or "soc",
-                                      directions=args.sky_directions or 46, depth=args.depth,
-                                      seed=args.seed,
-                                      progress=Progress(f"absorbed light over the period, "
-                                                        f"{label}"))
+            def trace_day(density: float, engine=engine, label=label):
+                d = engine.absorbed_day(period, optics=absorbed_optics,
+                                        sky=args.sky or "soc",
+                                        directions=args.sky_directions or 46,
+                                        depth=args.depth, seed=args.seed,
+                                        photosynthesis=leaf_model_, temperature_c=temp_c,
+                                        density=density,
+                                        progress=Progress(f"absorbed light over the period, "
+                                                          f"{label}"))
+                if d.assimilation is not None:
+                    return (d, d.assimilation.canopy_gross_mol_m2,
+                            d.assimilation.canopy_gross_error_mol_m2 or 0.0)
+                return d, d.balance.absorbed_leaves, d.absorbed_leaves_error or 0.0
+
+            abd = _traced(trace_day, args, rec, said)
+            _warn_unresolved(abd.balance, abd.depth, rec, said)
             rec["balance"] = dict(abd.balance.as_dict(), units="MJ/m2 of ground")
+            rec["balance_se"] = abd.balance_errors
             rec["absorbed"] = _absorbed_period_record(abd)
+            if abd.assimilation is not None:
+                rec["photosynthesis"] = abd.assimilation.as_dict()
+                if want_rows:
+                    tables.append(_assimilation_rows(canopy, abd.assimilation))
+                    _merge(plant_extra, _plant_errors(canopy, abd.assimilation))
+            if want_rows:
+                tables.append(_assimilation_rows(canopy, abd))
+                _merge(plant_extra, _plant_errors(canopy, abd))
             rec["seconds"]["scatter"] = abd.seconds.get("trace", 0.0) + \
                 abd.seconds.get("scatter", 0.0)
         elif absorbed_optics is not None:
-            ab = engine.absorbed(sun, optics=absorbed_optics, direct_w_m2=args.irradiance,
-                                 diffuse_w_m2=args.diffuse, sky=args.sky or "soc",
-                                 directions=args.sky_directions or 46, depth=args.depth,
-                                 seed=args.seed)
+            def trace_sun(density: float, engine=engine, canopy=canopy):
+                a = engine.absorbed(sun, optics=absorbed_optics, direct_w_m2=args.irradiance,
+                                    diffuse_w_m2=args.diffuse, sky=args.sky or "soc",
+                                    directions=args.sky_directions or 46, depth=args.depth,
+                                    seed=args.seed, density=density)
+                if leaf_model_ is not None:
+                    g = assimilate(canopy, a, leaf_model_, temp_c)
+                    return a, g.canopy_gross_umol_m2_s, g.canopy_gross_error_umol_m2_s or 0.0
+                return a, a.balance.absorbed_leaves, a.absorbed_leaves_error or 0.0
+
+            ab = _traced(trace_sun, args, rec, said)
+            _warn_unresolved(ab.balance, ab.depth, rec, said)
             rec["balance"] = ab.balance.as_dict()
+            rec["balance_se"] = ab.balance_errors
             rec["absorbed"] = _absorbed_record(ab, canopy)
             rec["seconds"]["scatter"] = ab.seconds["trace"] + ab.seconds["scatter"]
             if want_rows:
                 tables.append(ab.leaf_rows(canopy))
+                _merge(plant_extra, _plant_errors(canopy, ab))
+            if leaf_model_ is not None:
+                asm = assimilate(canopy, ab, leaf_model_, temp_c)
+                rec["photosynthesis"] = asm.as_dict()
+                for w in asm.warnings:
+                    if w not in said:
+                        said.add(w)
+                        say(f"warning: {w}")
+                if want_rows:
+                    tables.append(_assimilation_rows(canopy, asm))
+                    _merge(plant_extra, _plant_errors(canopy, asm))
         if sun is None:
             rays = per_res.rays if per_res else sky_res.rays if sky_res else 0
             x0, y0, x1, y1 = per_res.rect if per_res else sky_res.rect if sky_res else (0, 0, 1, 1)
             rec.update(sun=None, transmission=None, rays=rays, rect_cm=[x0, y0, x1, y1],
                        density_per_cm2=rays / ((x1 - x0) * (y1 - y0)))
-        _write_outputs(args, canopy, label, len(labels), res, sky_res, per_res, tables)
+        _write_outputs(args, canopy, label, len(labels), res, sky_res, per_res, tables,
+                       plant_extra)
         if args.export:
             path = export_canopy(args.export, canopy,
                                  light_cells(canopy, res, sky_res, per_res, ab))
@@ -478,8 +577,11 @@ def _absorbed_record(ab: AbsorbedLight, canopy: Canopy) -> dict[str, Any]:
         "sunlit_lai": _sunlit_m2(ab, canopy),
         "rays": ab.rays, "directions": ab.directions, "depth": ab.depth, "seed": ab.seed,
         "scatterings": ab.events}
+    se = ab.absorbed_leaves_error
+    out["absorbed_leaves_se"] = se
     if ab.band == "par":
         out["absorbed_leaves_umol_m2_s"] = ab.balance.absorbed_leaves * PAR_UMOL_PER_J_PAR
+        out["absorbed_leaves_umol_m2_s_se"] = None if se is None else se * PAR_UMOL_PER_J_PAR
     return out
 
 
@@ -494,9 +596,63 @@ def _absorbed_period_record(ab) -> dict[str, Any]:
         "seed": ab.seed,
         "step_absorbed_leaves_w_m2": [float(w) for w in ab.step_absorbed_leaves_w_m2],
         "step_incident_w_m2": [float(w) for w in ab.step_incident_w_m2]}
+    se = ab.absorbed_leaves_error
+    out["absorbed_leaves_se"] = se
     if ab.band == "par":
         out["absorbed_leaves_mol_m2"] = ab.absorbed_leaves_mol_m2
+        out["absorbed_leaves_mol_m2_se"] = None if se is None else se * PAR_UMOL_PER_J_PAR
     return out
+
+
+def _warn_unresolved(balance, depth: int, rec: dict[str, Any], said: set[str]) -> None:
+    """Warn when more than 1 % of the incident light was left unresolved."""
+    from maizeviz.light.results.absorbed import UNRESOLVED_WARN, unresolved_warning
+
+    if balance.incident and balance.unresolved > UNRESOLVED_WARN * balance.incident:
+        w = unresolved_warning(balance.unresolved / balance.incident, depth)
+        rec["warnings"].append(w)
+        if w not in said:
+            said.add(w)
+            say(f"warning: {w}")
+
+
+def _traced(trace, args: argparse.Namespace, rec: dict[str, Any], said: set[str]) -> Any:
+    """``trace(density)``'s result at ``--density``, or with ``--precision`` at the density
+    that meets it (recorded in ``rec["precision"]``, a warning when it cannot be)."""
+    if args.precision is None:
+        return trace(args.density)[0]
+    result, prec = trace_until(trace, args.density, args.precision)
+    rec["precision"] = prec.as_dict()
+    say(f"precision: relative standard error {prec.achieved:.2%} at {prec.density:g} rays "
+        f"per cm2 after {prec.passes} trace{'s' if prec.passes > 1 else ''}")
+    if not prec.met:
+        w = (f"the relative standard error {prec.achieved:.2%} is above the {prec.target:.2%} "
+             f"asked for at the densest tracing allowed ({prec.density:g} rays per cm2)")
+        said.add(w)
+        say(f"warning: {w}")
+        rec["warnings"].append(w)
+    return result
+
+
+def _assimilation_rows(canopy: Canopy, asm: Any) -> list[dict]:
+    """Leaf rows of a result's leaf table (an Assimilation, PeriodAssimilation or
+    AbsorbedPeriod) for the command line's leaf table."""
+    frame = asm.table("leaf", canopy)
+    return [] if frame.empty else frame.to_dict("records")
+
+
+def _merge(into: dict[int, dict[str, float]], more: dict[int, dict[str, float]]) -> None:
+    for k, v in more.items():
+        into.setdefault(k, {}).update(v)
+
+
+def _plant_errors(canopy: Canopy, result: Any) -> dict[int, dict[str, float]]:
+    """Standard errors per plant (instance): columns ending ``_se`` of ``result``'s plant
+    table (absorbed light or assimilation)."""
+    frame = result.table("plant", canopy)
+    cols = [c for c in frame.columns if c.endswith("_se")]
+    return {int(r["instance"]): {c: float(r[c]) for c in cols}
+            for r in frame.to_dict("records")}
 
 
 def _sunlit_m2(ab: AbsorbedLight, canopy: Canopy) -> float:
@@ -620,7 +776,8 @@ def _check_paths(args: argparse.Namespace, labels: list[str], sun: bool,
 
 def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_levels: int,
                    res: LightResult | None, sky: SkyLight | None, pl: PeriodLight | None,
-                   tables: list[list[dict]]) -> None:
+                   tables: list[list[dict]],
+                   plant_extra: dict[int, dict[str, float]] | None = None) -> None:
     if args.heatmaps:
         folder = make_folder(args.heatmaps)
         n = 0
@@ -650,7 +807,10 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
         if args.leaf_light:
             write_rows(level_path(args.leaf_light, label, n_levels), rows)
         if args.plant_light:
-            write_rows(level_path(args.plant_light, label, n_levels), plant_light(rows))
+            plants = plant_light(rows)
+            for r in plants:            # standard errors do not add: computed per plant
+                r.update((plant_extra or {}).get(int(r["instance"]), {}))
+            write_rows(level_path(args.plant_light, label, n_levels), plants)
 
 
 # ------------------------------------------------------------------------------ tables
@@ -666,6 +826,8 @@ def _print_tables(records: list[dict], sun: Sun | None, heights: tuple[float, ..
             _print_period(r, len(records) > 1)
     if "balance" in r0:
         _print_balance(records)
+    if r0.get("photosynthesis"):
+        _print_photosynthesis(records)
     print()
     t_ref = _cost(r0)
     cols = ["level", "triangles", "canopy s", "scene s"]
@@ -784,6 +946,30 @@ def _print_period(r: dict, label: bool) -> None:
                      for i, (h, v, f) in enumerate(zip(tb["heights_cm"], tb["par_mol_m2"],
                                                        tb["fraction"]))]))
     print()
+
+
+def _print_photosynthesis(records: list[dict]) -> None:
+    """Canopy gross assimilation per level, with its Monte Carlo standard error."""
+    ph = records[0]["photosynthesis"]
+    period = "canopy_gross_mol_m2" in ph
+    params = ", ".join(f"{k} {v:g}" for k, v in ph["parameters"].items()
+                       if k in ("vmax", "alpha", "co2_ppm", "amax", "eff"))
+    print(f"\ngross CO2 assimilation, {ph['model']} leaf model ({params}), per m2 of ground"
+          + ("" if period else f", leaves at {ph['temperature_c']:g} C") + ":")
+    rows = []
+    for r in records:
+        p = r["photosynthesis"]
+        if period:
+            se = p["canopy_gross_mol_m2_se"] or 0.0
+            rows.append([r["level"], f"{p['canopy_gross_mol_m2']:.4f} +- {se:.4f}",
+                         f"{p['canopy_gross_g_co2_m2']:.2f} +- {se * 44.0095:.2f}"])
+        else:
+            se = p["canopy_gross_umol_m2_s_se"] or 0.0
+            rows.append([r["level"], f"{p['canopy_gross_umol_m2_s']:.2f} +- {se:.2f}",
+                         f"{p['canopy_gross_kg_co2_ha_h']:.2f} +- "
+                         f"{p['canopy_gross_kg_co2_ha_h_se'] or 0.0:.2f}"])
+    print(fmt_table(["level", "mol CO2/m2" if period else "umol CO2/m2/s",
+                     "g CO2/m2" if period else "kg CO2/ha/h"], rows))
 
 
 def _print_balance(records: list[dict]) -> None:

@@ -24,7 +24,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description="Record stylus presses from a FASTRAK as points of plants, leaves and "
                     "cross-sections. Every point is on disk (fsync) before it is reported. "
                     "Controls, one per line on standard input: n next leaf, p next plant, "
-                    "r end the row early (tip), u undo the last point, q finish.")
+                    "r end the row early (tip), u undo the last point, s pause or resume "
+                    "(presses while paused are said and not recorded), q finish.")
     p.add_argument("--port", required=True, help="serial port, e.g. /dev/ttyUSB0")
     p.add_argument("--out", required=True, help="points CSV to append to")
     p.add_argument("--cols", type=WHOLE_ARG, default=None,
@@ -74,14 +75,15 @@ def run(args: argparse.Namespace) -> int:
     if sys.stdin is not None and not sys.stdin.closed:
         threading.Thread(target=read_stdin, daemon=True, name="controls").start()
     old = signal.signal(signal.SIGTERM, lambda signum, _frame: recorder.signal(signum))
-    print(f"ready on {args.port}: press the stylus; controls n, p, r, u, q + Enter", flush=True)
+    print(f"ready on {args.port}: press the stylus; controls n, p, r, u, s, q + Enter", flush=True)
     code = EXIT_OK
     try:
         while not recorder.finished:
             for update in recorder.poll(timeout=0.5):
                 if update.kind in ("lost", "failed"):
                     say(f"error: {update.message}")
-                elif update.kind in ("recorded", "refused", "control", "said"):
+                elif update.kind in ("recorded", "refused", "control", "said", "paused",
+                                     "resumed", "ignored"):
                     print(update.message, flush=True)
                 code = update.code or code
     except KeyboardInterrupt:

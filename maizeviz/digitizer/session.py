@@ -678,7 +678,8 @@ class Session:
         """
         key = key.strip().lower()
         if key not in CONTROLS:
-            return f"unknown control '{key[:20]}': n next leaf, p next plant, r end row, u undo, q quit"
+            return (f"unknown control '{key[:20]}': n next leaf, p next plant, r end row, u undo, "
+                    "s pause or resume, q quit")
         action = CONTROLS[key]
         p = self.pos
         if action == "quit":

@@ -68,11 +68,15 @@ def make_folder(path: str | Path) -> Path:
 def check_output(path: str | Path) -> Path:
     """Refuse, before any work, an output whose folder is missing or that is a folder."""
     path = Path(path)
-    if path.is_dir():
+    try:
+        is_dir, folder_there = path.is_dir(), path.parent.is_dir()
+    except (OSError, ValueError) as exc:       # a name too long, a NUL: not a lookup failure
+        why = getattr(exc, "strerror", None) or str(exc)
+        raise MaizevizError(f"{path}: cannot be looked up ({why})") from None
+    if is_dir:
         raise MaizevizError(f"{path} is a folder; give a file name")
-    folder = path.parent
-    if not folder.is_dir():
-        raise MaizevizError(f"{path}: the folder {folder} does not exist")
+    if not folder_there:
+        raise MaizevizError(f"{path}: the folder {path.parent} does not exist")
     return path
 
 

@@ -40,7 +40,12 @@ from maizeviz.light.sources.irradiance import (
 from maizeviz.light.sources.perez import PEREZ_MODELS, perez_split
 from maizeviz.light.sources.sky import Sky, make_sky
 from maizeviz.light.sources.sun import Sun, sun_at
-from maizeviz.light.trace.absorbed import absorbed_light, absorbed_period, check_absorbed
+from maizeviz.light.trace.absorbed import (
+    SKY_PASSES,
+    absorbed_light,
+    absorbed_period,
+    check_absorbed,
+)
 from maizeviz.light.trace.diffuse import trace_period, trace_sky
 from maizeviz.light.trace.direct import trace_light
 from maizeviz.light.trace.optics import SHORTWAVE_SHARE, Optics, optics_for
@@ -286,7 +291,8 @@ class LightEngine:
                  progress: ProgressCallback | None = None, zenith: float | None = None,
                  azimuth: float | None = None, date: str | None = None,
                  time: str | None = None, lat: float | None = None, lon: float | None = None,
-                 tz: str | None = None, **fields_) -> AbsorbedLight:
+                 tz: str | None = None, sky_passes: int = SKY_PASSES,
+                 **fields_) -> AbsorbedLight:
         """Light absorbed by leaves and ground in one band, with scattering
         (:func:`maizeviz.light.trace.absorbed.absorbed_light`): the sun's direct beam and,
         when ``diffuse_w_m2`` > 0, the diffuse light of a sky.
@@ -302,12 +308,18 @@ class LightEngine:
             ``sky`` (kind or Sky) split into ``directions`` directions
         depth, threshold, seed : scatterings followed, share of the incident power left
             travelling where tracing stops, random seed
+        sky_passes : with leaves or soil that scatter, in a periodic field, the diffuse light
+            is traced as one beam whose rays each take a sky direction of their own
+            (:func:`~maizeviz.light.trace.scatter.scatter_sky`), this many rays per grid cell
+            (default 4; 0: every sky direction traced over the whole grid, as black leaves
+            are)
         sampling, progress, **fields_ : as :meth:`sun` (``progress`` after each beam)
 
         Returns
         -------
         AbsorbedLight
-            ``balance`` (W/m2 of ground), absorbed W per triangle, ``table("plant", canopy)``.
+            ``balance`` (W/m2 of ground), absorbed W per triangle, ``table("plant", canopy)``,
+            ``absorbed_leaves_error`` (the Monte Carlo standard error).
 
         References
         ----------
@@ -337,7 +349,39 @@ class LightEngine:
             sky_obj = sky if isinstance(sky, Sky) else make_sky(sky, directions)
         return absorbed_light(self.canopy, smp, self._normals(), opt, sun, direct,
                               diffuse_w_m2, sky_obj, depth, threshold, seed, smp_req.threads,
-                              progress, build_s)
+                              progress, build_s, sky_passes)
+
+    def photosynthesis(self, sun: Sun | None = None, *, model="c4",
+                       temperature_c: float = 25.0, **absorbed):
+        """Gross CO2 assimilation of the leaves under one sun (and sky): absorbed PAR
+        (:meth:`absorbed`, same keywords) through a leaf model, each triangle's sunlit and
+        shaded parts at their own light (:mod:`maizeviz.light.results.assimilation`).
+
+        Parameters
+        ----------
+        sun, **absorbed : as :meth:`absorbed` (``zenith=``, ``diffuse_w_m2=``, ``optics=``...)
+        model : "c4", "wofost" or a leaf model
+            (:func:`maizeviz.photosynthesis.split.leaf_model` for other parameters)
+        temperature_c : air (leaf) temperature, C
+
+        Returns
+        -------
+        Assimilation
+            ``canopy_gross_umol_m2_s`` (per m2 of ground), ``canopy_gross_kg_co2_ha_h``, their
+            standard errors; ``table("plant", canopy)`` as a DataFrame.
+
+        References
+        ----------
+        Collatz, G. J., Ribas-Carbo, M. & Berry, J. A. (1992). Australian Journal of Plant
+        Physiology 19, 519-538. Spitters, C. J. T. (1986). Agricultural and Forest
+        Meteorology 38, 231-242.
+        """
+        from maizeviz.light.results.assimilation import assimilate
+        from maizeviz.photosynthesis.split import leaf_model
+
+        leaf = leaf_model(model) if isinstance(model, str) else model
+        light = self.absorbed(sun, band="par", **absorbed)
+        return assimilate(self.canopy, light, leaf, temperature_c)
 
     def absorbed_day(self, period: Period | None = None, *, band: str = "par",
                      optics: Optics | None = None, sky: Sky | str = "soc",
@@ -349,7 +393,8 @@ class LightEngine:
                      step_min: float = 30.0, start: str | None = None,
                      end: str | None = None, altitude: float = 0.0,
                      linke: float = DEFAULT_LINKE_TURBIDITY,
-                     par_factor: float = DEFAULT_PAR_UMOL_PER_J, **fields_) -> AbsorbedPeriod:
+                     par_factor: float = DEFAULT_PAR_UMOL_PER_J, photosynthesis=None,
+                     temperature_c=25.0, **fields_) -> AbsorbedPeriod:
         """Light absorbed with scattering over a period (a day), in one band: each step's
         sun with the band's share of its direct irradiance, and the diffuse part spread over
         ``sky``, traced once per W/m2 and scaled by each step's diffuse irradiance (the
@@ -369,6 +414,14 @@ class LightEngine:
             (:mod:`maizeviz.light.sources.perez`): its circumsolar part added to that step's direct
             beam, the rest from a uniform sky
         progress : after the sky and after each step
+        photosynthesis : LeafModel, optional
+            Also the leaves' gross CO2 assimilation at every step (PAR only,
+            :func:`maizeviz.light.results.assimilation.assimilate`), added up over the period
+            (``AbsorbedPeriod.assimilation``).
+        temperature_c : float or (n,) float64
+            Air (leaf) temperature at each step, C (default 25); a period read from a weather
+            file with an air temperature column (``Period.temp_air``) gives its own, these
+            filling the steps it lacks (NaN).
 
         Returns
         -------
@@ -388,7 +441,8 @@ class LightEngine:
         opt = optics if optics is not None else optics_for(band)
         one = partial(self.absorbed, band=opt.band, optics=opt, directions=directions,
                       depth=depth, threshold=threshold, seed=seed, sampling=sampling, **fields_)
-        return absorbed_period(period, opt, sky, one, progress)
+        return absorbed_period(period, opt, sky, one, progress, self.canopy, photosynthesis,
+                               temperature_c)
 
     def _normals(self):
         """Unit normals (F, 3) of the scene's leaf triangles, then its stalks' if traced

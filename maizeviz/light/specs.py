@@ -146,6 +146,13 @@ class OpticsSpec:
         Random seed of the Monte Carlo scattering (the same seed gives the same result).
     ranks : tuple of (rank, reflectance, transmittance)
         Leaf optics of the ranks that differ (see :class:`maizeviz.light.trace.optics.Optics`).
+    photosynthesis : str
+        A leaf model turning the absorbed PAR into gross CO2 assimilation: "c4", "wofost",
+        or "" (none; :mod:`maizeviz.photosynthesis`).
+    temperature_c : float
+        Air (leaf) temperature for the leaf model, C.
+    photosynthesis_params : tuple of (name, value)
+        The leaf model's parameters that differ from its defaults (``vmax``, ``amax``...).
     """
 
     band: str = "par"
@@ -157,6 +164,33 @@ class OpticsSpec:
     depth: int = DEFAULT_DEPTH
     seed: int = 0
     ranks: tuple = ()
+    photosynthesis: str = ""
+    temperature_c: float = 25.0
+    photosynthesis_params: tuple = ()
+
+    def leaf_model(self):
+        """The leaf model chosen (checked: MaizevizError naming what is wrong), or None."""
+        if not self.photosynthesis:
+            return None
+        from maizeviz.errors import MaizevizError, check_range
+        from maizeviz.photosynthesis.split import leaf_model
+
+        if self.band != "par":
+            raise MaizevizError("photosynthesis works from absorbed PAR, not "
+                                f"{self.band.upper()}", quantity="band")
+        check_range(self.temperature_c, "the air temperature (C)", -50, 70, "temperature")
+        return leaf_model(self.photosynthesis, **dict(self.photosynthesis_params))
+
+    def assimilation(self, canopy, light):
+        """Gross CO2 assimilation of ``light`` (this spec's AbsorbedLight, traced on
+        ``canopy``) through the chosen leaf model (an
+        :class:`~maizeviz.light.results.assimilation.Assimilation`), or None without one."""
+        model = self.leaf_model()
+        if model is None:
+            return None
+        from maizeviz.light.results.assimilation import assimilate
+
+        return assimilate(canopy, light, model, self.temperature_c)
 
     def optics(self):
         """The :class:`~maizeviz.light.trace.optics.Optics` of the band (checked: MaizevizError

@@ -214,7 +214,38 @@ def absorbed_record(label: str, light, settings: dict | None = None) -> Record:
         meta["settings"] = _jsonable(settings)
     arrays = {"triangle_absorbed_w": np.asarray(light.triangle_absorbed_w, np.float64),
               "triangle_sunlit_cm2": np.asarray(light.triangle_sunlit_cm2, np.float64)}
+    # what photosynthesis and standard errors need (maizeviz 0.2): the direct-beam part, the
+    # sun, and each batch's shares as (3, nnz) rows of (batch, triangle, value)
+    if light.triangle_direct_w is not None:
+        arrays["triangle_direct_w"] = np.asarray(light.triangle_direct_w, np.float64)
+    if light.sun_direction is not None:
+        meta["sun_direction"] = [float(c) for c in light.sun_direction]
+    if light.batches is not None:
+        for name in ("absorbed", "direct", "sunlit_cm2"):
+            m = getattr(light.batches, name).tocoo()
+            arrays[f"batches_{name}"] = np.vstack([m.row, m.col, m.data]).astype(np.float64)
     return Record(ABSORBED_KIND, meta, arrays)
+
+
+def _batches_from(rec: Record, where: str, what: str, n_tri: int):
+    """The per-batch shares of an absorbed-light record (None when it has none)."""
+    from scipy.sparse import csr_array
+
+    from maizeviz.light.results.uncertainty import BATCHES, Batches
+
+    if "batches_absorbed" not in rec.arrays:
+        return None
+    parts = []
+    for name in ("absorbed", "direct", "sunlit_cm2"):
+        a = _array(rec, f"batches_{name}", where, what, (3, None))
+        rows, cols = a[0], a[1]
+        if np.any(rows != np.round(rows)) or np.any(cols != np.round(cols)) or \
+                np.any((rows < 0) | (rows >= BATCHES)) or np.any((cols < 0) | (cols >= n_tri)):
+            raise ProjectError(f"{where}: {what}: array 'batches_{name}' names batches or "
+                               "triangles that do not exist; the project is damaged")
+        parts.append(csr_array((a[2], (rows.astype(np.int64), cols.astype(np.int64))),
+                               shape=(BATCHES, n_tri)))
+    return Batches(*parts)
 
 
 def run_record(label: str, result, settings: dict | None = None,
@@ -506,6 +537,11 @@ def sun_from_record(rec: Record, where: str) -> tuple[str, Any]:
     for name in ("first_hits", "second_hits"):
         hits[name] = None if name not in rec.arrays else \
             _array(rec, name, where, what, (None,), counts=True, lo=0)
+    if (hits["first_hits"] is None) != (hits["second_hits"] is None) or (
+            hits["first_hits"] is not None
+            and len(hits["first_hits"]) != len(hits["second_hits"])):
+        raise ProjectError(f"{at}: its first and second hits per triangle do not match "
+                           "(one missing, or of other lengths); the project is damaged")
     planes: dict[str, Any] = {}
     if "sensor_lit" in rec.arrays:
         lit = rec.arrays["sensor_lit"]
@@ -556,6 +592,12 @@ def absorbed_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None
     absorbed = _array(rec, "triangle_absorbed_w", where, what, (n_tri,), lo=0)
     sunlit = _array(rec, "triangle_sunlit_cm2", where, what, (n_tri,), lo=0)
     settings = get(m, "settings", dict, None, at)
+    direct = _array(rec, "triangle_direct_w", where, what, (n_tri,), lo=0) \
+        if "triangle_direct_w" in rec.arrays else None
+    batches = _batches_from(rec, where, what, n_tri)
+    sun_dir = get_numbers(m, "sun_direction", where=at) if "sun_direction" in m else None
+    if sun_dir is not None and len(sun_dir) != 3:
+        raise ProjectError(f"{at} has inconsistent sizes; the project is damaged")
     try:
         light = AbsorbedLight(
             band, Optics(_number(optics, "reflectance", where, what, 0, 1),
@@ -570,7 +612,9 @@ def absorbed_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None
             get(m, "seed", int, where=at), get(m, "events", int, where=at),
             bool(get(m, "periodic", bool, False, at)), str(get(m, "level", str, "", at)),
             {str(k): float(v) for k, v in get(m, "seconds", dict, {}, at).items()
-             if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)})
+             if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)},
+            triangle_direct_w=direct, batches=batches,
+            sun_direction=None if sun_dir is None else (sun_dir[0], sun_dir[1], sun_dir[2]))
     except (ValueError, TypeError, MaizevizError) as exc:
         raise ProjectError(f"{at} cannot be used ({exc})") from None
     return str(get(m, "label", str, light.level, at)), light, settings

@@ -93,9 +93,16 @@ def _optics_spec(stored: dict | None, light, where: str) -> OpticsSpec:
                       float(get(doc, "diffuse_w_m2", (int, float), 0.0, at)),
                       get(doc, "depth", int, 3, at), get(doc, "seed", int, 0, at),
                       tuple(tuple(r) for r in get(doc, "ranks", list, [], at)
-                            if isinstance(r, list)))
+                            if isinstance(r, list)),
+                      get(doc, "photosynthesis", str, "", at),
+                      float(get(doc, "temperature_c", (int, float), 25.0, at)),
+                      tuple((str(r[0]), float(r[1])) for r in
+                            get(doc, "photosynthesis_params", list, [], at)
+                            if isinstance(r, list) and len(r) == 2 and isinstance(r[0], str)
+                            and isinstance(r[1], (int, float)) and not isinstance(r[1], bool)))
     try:
         spec.optics()
+        spec.leaf_model()
     except (MaizevizError, TypeError, ValueError) as exc:
         raise ProjectError(f"{at}: {exc}") from None
     return spec

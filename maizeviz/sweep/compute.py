@@ -254,7 +254,26 @@ def _light(state: _GroupState, s) -> dict:
         b = light.balance
         absorbed = {"incident_w_m2": b.incident, "absorbed_leaves_w_m2": b.absorbed_leaves,
                     "absorbed_ground_w_m2": b.absorbed_ground,
-                    "reflected_top_w_m2": b.reflected_top, "balance_closure": b.closure}
+                    "reflected_top_w_m2": b.reflected_top, "balance_closure": b.closure,
+                    "absorbed_leaves_se_w_m2": light.absorbed_leaves_error,
+                    "unresolved_w_m2": b.unresolved}
+        from maizeviz.light.results.absorbed import UNRESOLVED_WARN, unresolved_warning
+
+        if b.incident and b.unresolved > UNRESOLVED_WARN * b.incident:
+            state_warnings = [unresolved_warning(b.unresolved / b.incident, light.depth)]
+        else:
+            state_warnings = []
+        if s.photosynthesis is not None:
+            from maizeviz.light.results.assimilation import assimilate
+            from maizeviz.photosynthesis.split import model_from_dict
+
+            ph = dict(s.photosynthesis)
+            temp = float(ph.pop("temperature"))
+            a = assimilate(state.engine.canopy, light, model_from_dict(ph), temp)
+            absorbed.update(canopy_gross_umol_m2_s=a.canopy_gross_umol_m2_s,
+                            canopy_gross_umol_m2_s_se=a.canopy_gross_error_umol_m2_s,
+                            canopy_gross_kg_co2_ha_h=a.canopy_gross_kg_co2_ha_h)
+        absorbed["warnings_scatter"] = state_warnings
     m = state.measures
     return {**absorbed,"key": s.key, "status": "ok", "error": None, "triangles": m["triangles"],
             "plants": m["plants"], "leaves": m["leaves"],
@@ -264,7 +283,8 @@ def _light(state: _GroupState, s) -> dict:
             "lai": m["lai"], "rays": int(res.rays),
             "heights_cm": [float(h) for h in res.heights_cm],
             "transmission": [float(t) for t in res.transmission],
-            "warnings": list(state.warnings) + list(res.warnings), "seconds": seconds}
+            "warnings": list(state.warnings) + list(res.warnings)
+            + absorbed.pop("warnings_scatter", []), "seconds": seconds}
 
 
 def compute_scenarios(scenarios) -> list[dict]:

@@ -52,6 +52,10 @@ COLUMNS = (
     ("scatter_depth", "int64"), ("incident_w_m2", "float64"), ("absorbed_leaves_w_m2", "float64"),
     ("absorbed_ground_w_m2", "float64"), ("reflected_top_w_m2", "float64"),
     ("balance_closure", "float64"), ("seconds_scatter", "float64"),
+    ("absorbed_leaves_se_w_m2", "float64"), ("unresolved_w_m2", "float64"),
+    # photosynthesis (PAR optics only): the axis, then gross assimilation per m2 of ground
+    ("photosynthesis", "string"), ("canopy_gross_umol_m2_s", "float64"),
+    ("canopy_gross_umol_m2_s_se", "float64"), ("canopy_gross_kg_co2_ha_h", "float64"),
     ("worker", "string"), ("maizeviz_version", "string"), ("finished_at", "string"),
 )
 COLUMN_NAMES = tuple(c for c, _ in COLUMNS)
@@ -77,7 +81,9 @@ def scenario_rows(s, result: dict, worker: str | None, finished_at: str) -> list
                   "projected_area_m2", "ground_cover_m2", "ground_area_m2", "lai"):
             base[k] = result[k]
         for k in ("incident_w_m2", "absorbed_leaves_w_m2", "absorbed_ground_w_m2",
-                  "reflected_top_w_m2", "balance_closure"):
+                  "reflected_top_w_m2", "balance_closure", "absorbed_leaves_se_w_m2",
+                  "unresolved_w_m2", "canopy_gross_umol_m2_s", "canopy_gross_umol_m2_s_se",
+                  "canopy_gross_kg_co2_ha_h"):
             base[k] = result.get(k)
         warnings = result.get("warnings") or []
         base["warnings"] = "; ".join(warnings[:5]) + (

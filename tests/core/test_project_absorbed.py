@@ -60,6 +60,45 @@ def test_absorbed_light_round_trips_with_its_optics(traced, tmp_path):
         (light.rect, light.rays, light.depth, light.seed, light.periodic)
     # tables from the record equal the traced result's
     assert back.table("plant", canopy).equals(light.table("plant", canopy))
+    # what photosynthesis needs comes back too: its figures and errors bit for bit
+    np.testing.assert_array_equal(back.triangle_direct_w, light.triangle_direct_w)
+    assert back.sun_direction == light.sun_direction
+    for name in ("absorbed", "direct", "sunlit_cm2"):
+        assert (getattr(back.batches, name) != getattr(light.batches, name)).nnz == 0
+
+
+def test_a_par_records_photosynthesis_comes_back_the_same(traced, tmp_path):
+    from maizeviz.light.results.assimilation import assimilate
+    from maizeviz.photosynthesis.split import leaf_model
+
+    path, leaves, layout, canopy, _ = traced
+    engine = LightEngine(canopy, density=0.3, heights_cm=(0.0,), periodic=True, threads=1)
+    par = OpticsSpec("par", 0.1, 0.05, 0.1, 480.0, 60.0, 20, 3, photosynthesis="c4",
+                     temperature_c=30.0, photosynthesis_params=(("vmax", 45.0),))
+    light = par.absorbed(engine, engine.sun(zenith=30, azimuth=180).sun)
+    proj = study.make_project(str(path), path.read_bytes(), None, layout,
+                              {"tile": 1, "level": "16"}, {},
+                              [("16 triangles", light, settings_doc("absorbed", par))])
+    target = tmp_path / "p.maizeviz"
+    save_project(target, proj)
+    got = study.results_on(study.open_project(target), layout, leaves)[0][0]
+    back = got.result
+    assert got.specs() == par                   # the leaf model chosen is kept with the result
+    model = leaf_model("c4", vmax=45.0)
+    a, b = assimilate(canopy, light, model, 30.0), assimilate(canopy, back, model, 30.0)
+    assert a.as_dict() == b.as_dict() and a.canopy_gross_umol_m2_s > 0
+    assert a.table("leaf", canopy).equals(b.table("leaf", canopy))
+    assert got.specs().assimilation(canopy, back).as_dict() == a.as_dict()
+    # a stored leaf model that is not one is refused in one line naming the project
+    import json
+
+    from maizeviz.project.settings import run_settings
+
+    doc = json.loads(json.dumps(settings_doc("absorbed", par)))     # as a project stores it
+    doc["optics"]["photosynthesis"] = "c3"
+    with pytest.raises(ProjectError, match="unknown photosynthesis model 'c3'") as err:
+        run_settings("absorbed", back, doc, "p.maizeviz")
+    assert "p.maizeviz" in str(err.value) and "\n" not in str(err.value)
 
 
 def _damaged(rec: Record, **change) -> Record:

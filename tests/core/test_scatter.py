@@ -279,3 +279,46 @@ def test_per_plant_tables_add_up_to_the_balance(homogeneous):
     assert list(got.table("balance").columns[:2]) == ["band", "incident"]
     with pytest.raises(MaizevizError, match="give the canopy"):
         got.table("leaf")
+
+
+# ----------------------------------------------------------------------------- the sky per ray
+@pytest.mark.parametrize("band", ["par", "nir"])
+def test_a_sky_drawn_per_ray_gives_the_directions_answers_within_their_errors(homogeneous,
+                                                                               band):
+    """Leaves that scatter, in a periodic field: the sky's directions drawn per ray (4 rays a
+    cell, one beam's work) give what tracing every direction over the whole grid gives, within
+    their standard errors (batches); black leaves and open fields keep the exact
+    direction-by-direction tracing."""
+    eng = LightEngine(homogeneous, periodic=True, density=2.0, heights_cm=(0.0,))
+    kw = dict(direct_w_m2=0.0, diffuse_w_m2=100.0, sky="uoc", directions=46, band=band)
+    per_ray = eng.absorbed(**kw, seed=1)
+    every = eng.absorbed(**kw, seed=2, sky_passes=0)
+    assert per_ray.directions == every.directions == 46
+    se = math.hypot(per_ray.absorbed_leaves_error, every.absorbed_leaves_error)
+    assert abs(per_ray.balance.absorbed_leaves - every.balance.absorbed_leaves) < 4 * se
+    assert se < 0.005 * every.balance.absorbed_leaves
+    assert abs(per_ray.balance.closure) < 5 / math.sqrt(4 * per_ray.rays)
+    # per plant too (one plant here), and the events are a fraction of the directions'
+    assert per_ray.events < every.events / 4
+    black = Optics(0, 0, 0)
+    a = eng.absorbed(**{**kw, "band": "par"}, optics=black)
+    b = eng.absorbed(**{**kw, "band": "par"}, optics=black, sky_passes=0)
+    np.testing.assert_array_equal(a.triangle_absorbed_w, b.triangle_absorbed_w)
+
+
+def test_the_balances_errors_shrink_with_the_rays_and_cover_two_seeds(homogeneous):
+    """Each part of the energy balance has a standard error from the batches: they shrink
+    with the rays, and two seeds' parts differ by no more than their errors allow."""
+    out = {}
+    for density in (0.5, 4.0):
+        eng = LightEngine(homogeneous, periodic=True, density=density, heights_cm=(0.0,))
+        out[density] = [eng.absorbed(zenith=35, azimuth=60, diffuse_w_m2=80.0, directions=16,
+                                     seed=seed) for seed in (1, 2)]
+    for name in ("absorbed_leaves", "absorbed_ground", "reflected_top", "unresolved"):
+        coarse = out[0.5][0].balance_errors[name]
+        fine = out[4.0][0].balance_errors[name]
+        assert fine <= coarse or coarse == 0.0, name
+    a, b = out[4.0]
+    for name in ("absorbed_leaves", "absorbed_ground", "reflected_top"):
+        se = math.hypot(a.balance_errors[name], b.balance_errors[name])
+        assert abs(getattr(a.balance, name) - getattr(b.balance, name)) < 5 * se + 1e-12, name

@@ -277,9 +277,73 @@ def test_optics_axis_rows_equal_the_single_run_cli(blocks, client, tmp_path, cap
                                               "par rho 0.1 tau 0.05 soil 0.1 seed 3"}
 
 
+def test_photosynthesis_axis_rows_equal_the_cli_and_the_summary_names_the_carbon_level(
+        blocks, client, tmp_path, capsys):
+    """Photosynthesis as an axis of PAR scenarios (black and NIR ones take only "none"): each
+    row carries ``maizeviz light --photosynthesis ... --json``'s canopy assimilation, and the
+    summary names the cheapest level within 1 % of the finest level's assimilation."""
+    text = SPEC.replace('points = ["b*.csv"]', 'points = ["b0.csv"]').replace(
+        "periodic = true", 'periodic = true\noptics = ["black", {band = "par"}, '
+        '{band = "nir"}]\nphotosynthesis = ["none", {model = "c4", temperature = 30}, '
+        '{model = "wofost", amax = 60}]').replace(
+        "sun = [{zenith = 30, azimuth = 180}, {zenith = 45, azimuth = 90}, "
+        "{zenith = 60, azimuth = 225}]", "sun = [{zenith = 30, azimuth = 180}]")
+    spec = load_spec(spec_file(blocks, text, "carbon.toml"))
+    # 2 levels x (black none, par x 3, nir none)
+    assert len(spec.scenarios) == 2 * 5
+    out = tmp_path / "r"
+    outcome = run_sweep(spec, out, client=client, progress=False)
+    assert outcome.complete and outcome.errors == 0
+    rows = [r for r in read_results(out) if r["height_cm"] == 0.0]
+    capsys.readouterr()
+    carbon = [r for r in rows if r["photosynthesis"] != "none"]
+    assert {r["photosynthesis"] for r in carbon} == {"c4 30 C", "wofost 25 C amax 60"}
+    assert all(r["optics_band"] == "par" for r in carbon)
+    for r in carbon:
+        model = r["photosynthesis"].split()[0]
+        args = ["light", str(blocks / "b0.csv"), "--triangles", r["level"].split()[0]
+                if r["level"] != "standard" else "72", "--sun-zenith", "30", "--sun-azimuth",
+                "180", "--density", "0.5", "--periodic", "--heights",
+                ",".join(map(str, HEIGHTS)), "--json", "--photosynthesis", model,
+                "--temperature", "30" if model == "c4" else "25"]
+        if r["level"] == "standard":
+            args[2:4] = ["--levels", "standard"]
+        if model == "wofost":
+            args += ["--amax", "60"]
+        assert cli_main(args) == 0
+        ph = json.loads(capsys.readouterr().out)["photosynthesis"]
+        assert r["canopy_gross_umol_m2_s"] == pytest.approx(ph["canopy_gross_umol_m2_s"],
+                                                            rel=1e-9)
+        assert r["canopy_gross_umol_m2_s_se"] > 0 and r["absorbed_leaves_se_w_m2"] > 0
+    summary = [s for s in summarize(read_results(out), 0.02) if s["photosynthesis"] != "none"]
+    assert len(summary) == 2
+    for s in summary:
+        assert s["assimilation_cheapest_level"] in ("standard", "8 triangles")
+        assert s["assimilation_max_rel_difference"] <= 0.01
+        assert s["assimilation_tolerance"] == 0.01
+
+
+def test_the_carbon_example_asks_the_mesh_question_for_carbon():
+    from maizeviz.resources import example_points
+
+    spec = load_spec(Path(example_points()).parent / "sweep-carbon.toml")
+    assert len(spec.scenarios) == 8
+    assert {s.level for s in spec.scenarios} == {"K=4", "standard", "36 triangles",
+                                                  "8 triangles"}
+    assert all(s.optics is not None and s.optics.band == "par" and s.photosynthesis
+               for s in spec.scenarios)
+    assert {dict(s.photosynthesis)["model"] for s in spec.scenarios} == {"c4", "wofost"}
+
+
 @pytest.mark.parametrize("text, says", [
     ("[canopy\npoints = 1", r"not valid TOML.*line 1"),
     (SPEC.replace("tile =", "tiles ="), r"unknown key 'canopy.tiles' \(known in canopy: points, "),
+    (SPEC + 'optics = [{band = "par"}]\nphotosynthesis = [{model = "c3"}]',
+     r"light.photosynthesis\[0\]: unknown photosynthesis model 'c3'"),
+    (SPEC + 'photosynthesis = [{model = "c4", temperature = 99}]',
+     r"light.photosynthesis\[0\].temperature: must be from -50 to 70 C, got 99"),
+    (SPEC + 'photosynthesis = [{model = "wofost", vmax = 3}]',
+     r"light.photosynthesis\[0\]: the wofost model has no parameter vmax"),
     (SPEC + "[sky]\n", r"unknown key 'sky' \(known: canopy, light, exclude\)"),
     (SPEC.replace('level = ["standard", "8"]', "level = []"), r"canopy.level: is empty"),
     (SPEC.replace("density = [0.5]", 'density = ["a"]'), r"light.density\[0\]: must be a number"),

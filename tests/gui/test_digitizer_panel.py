@@ -9,6 +9,7 @@ from PySide6.QtWidgets import QLineEdit
 from maizeviz.digitizer.protocol import Record
 from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import Session
+from maizeviz.digitizer.simulator import FastrakSimulator
 from maizeviz.io.points import read_points
 
 TIMEOUT = 20_000
@@ -172,6 +173,14 @@ def test_lost_port_is_loud_and_every_point_is_on_disk(qtbot, make_panel, sim, tm
     assert any("on disk" in a for a in alerts) and panel.beeps >= 1
     assert len(read_points(out)) == 4
     assert panel.connect_button.isEnabled() and not panel.out_edit.isReadOnly()
+    # plugged back in, Connect continues the same file where it stopped
+    assert panel.resume.isChecked()
+    with FastrakSimulator(press_gap_s=0.0, noise_cm=0.0) as again:
+        _connect(qtbot, panel, again, out)
+        assert panel.session.count.points == 4
+        _press_and_wait(qtbot, panel, again, [(9.0, 0.0, 0.0)])
+        panel.stop(wait=True)
+    assert read_points(out).xyz[:, 0].tolist() == [0, 1, 2, 3, 9]
 
 
 def test_unwritable_output_and_missing_port_are_said(qtbot, make_panel, tmp_path):

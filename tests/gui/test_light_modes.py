@@ -64,7 +64,7 @@ def test_sky_mode_adds_a_diffuse_curve_maps_and_colours(window, qtbot, small_poi
     assert w.plots.transmission.image() is not None
     # the leaves coloured by the diffuse light they take, with a colour bar
     assert w.viewport.colouring == "light" and w.viewport.light_variant == "values"
-    assert w.viewport.actors["canopy"].mapper.GetArrayName() == "light_value"
+    assert w.viewport.actors["canopy"].mapper.GetArrayName() == "light_rgb"
     assert "diffuse light per leaf" in w.viewport.key.text()
     values = w.viewport.canopy_mesh.cell_data["light_value"][:w.canopy.n_triangles]
     assert np.all(np.isfinite(values)) and values.max() > 0.2

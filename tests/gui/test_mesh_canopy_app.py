@@ -83,6 +83,53 @@ def test_a_mesh_canopy_takes_the_field_given(window, qtbot, small_points, tmp_pa
         assert np.allclose(w.canopy.layout.bounds, wider, atol=1e-6)    # the canopy stays
 
 
+def test_a_large_mesh_file_is_drawn_within_the_budget(window, qtbot, small_points, tmp_path,
+                                                      monkeypatch):
+    """A mesh file over the view's budget: the plants nearest the centre drawn with the
+    file's triangles, the others simplified per leaf, each drawn triangle keeping its leaf;
+    a sun's light per leaf paints them all."""
+    import maizeviz_app.mesh_view as mesh_view
+    import maizeviz_app.viewport as viewport_mod
+
+    from maizeviz.canopy.export import export_canopy
+    from maizeviz.mesh.levels import COMPLEXITY_STOPS
+
+    w = shown(qtbot, window(small_points, tile=3))
+    with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
+        w.slider.setValue(COMPLEXITY_STOPS.index("standard"))
+    ply = tmp_path / "field.ply"
+    export_canopy(str(ply), w.canopy)
+    monkeypatch.setattr(viewport_mod, "VIEW_BUDGET", 20_000)
+    monkeypatch.setattr(mesh_view, "DRAWN", 12_000)
+    with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
+        w.open_mesh(ply, "cm", "z")
+    c, mesh = w.canopy, w.viewport.canopy_mesh
+    n_leaf = int(mesh.field_data["leaf_triangles"][0])
+    assert c.n_triangles > 20_000 and n_leaf + len(c.stalk_faces) <= 1.1 * 12_000
+    assert "simplified" in w.messages.toPlainText()
+    source = np.asarray(mesh.field_data["source"])
+    inst = np.asarray(mesh.cell_data["instance"])[:n_leaf] - 1
+    leaf = np.asarray(mesh.cell_data["leaf"])[:n_leaf]
+    fine = np.unique(inst[source >= 0])
+    assert 0 < len(fine) < len(c.layout.placements)
+    # the fine plants are the file's own triangles, all of them
+    np.testing.assert_array_equal(np.sort(source[source >= 0]),
+                                  np.flatnonzero(np.isin(c.face_instance, fine)))
+    # every leaf of the other plants is drawn, simplified, with its own ids
+    keys = set(zip(c.face_instance.tolist(), c.face_leaf.tolist()))
+    drawn = set(zip(inst.tolist(), leaf.tolist()))
+    assert drawn == keys
+    # a sun per leaf: each drawn triangle takes its leaf's share
+    small_light(w.light_panel, "sun", density=0.5)
+    w.model.colour.painting = "leaves"
+    compute(qtbot, w)
+    share = w.runs.last.painting.share
+    values = np.asarray(mesh.cell_data["light_value"])[:n_leaf]
+    for k in np.flatnonzero(source < 0)[::53]:
+        mine = (c.face_instance == inst[k]) & (c.face_leaf == leaf[k])
+        np.testing.assert_allclose(values[k], share[mine][0], equal_nan=True)
+
+
 def test_an_exported_canopy_opens_with_its_plot_and_period(window, qtbot, small_points,
                                                            tmp_path):
     """File > Open canopy mesh with the field left empty: a canopy the app exported comes

@@ -129,7 +129,8 @@ def test_figures_are_the_core_heatmap_and_a_level_comparison(small_canopy):
     maps = heatmap_images(result, all_heights=True)
     assert heatmap_images(result, first=1)[0][1] is None      # drawn when asked for
     assert [h for h, _ in maps] == [0.0, 100.0]
-    assert all(img.ndim == 3 and img.shape[2] == 4 and img.shape[1] > 300 for _, img in maps)
+    assert all(m.rgba.ndim == 3 and m.rgba.shape[2] == 4 and m.rgba.shape[1] > 300
+               for _, m in maps)
     fig = transmission_figure([Curve("K=4", (0.0, 100.0), (0.1, 0.5)),
                                Curve("36 triangles", (0.0, 100.0), (0.11, 0.5))])
     assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()] == \

@@ -36,6 +36,7 @@ def test_a_large_canopy_is_drawn_within_the_budget_and_coloured_by_its_light(
     np.testing.assert_allclose(np.asarray(mesh.points)[faces[mine]],
                                c.vertices[c.faces[source[mine]]], rtol=1e-6)
     small_light(w.light_panel, "sun")
+    w.model.colour.painting = "triangles"               # each triangle's class, asked for
     compute(qtbot, w)
     classes = w.runs.last.classes
     light = np.asarray(mesh.cell_data["light"])[:n_leaf]

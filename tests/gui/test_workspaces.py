@@ -7,7 +7,7 @@ from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import Session
 
 TIMEOUT = 120_000
-ANALYSE = {"canopy", "light", "layout", "results", "messages"}
+ANALYSE = {"canopy", "light", "layout", "colour", "results", "messages"}
 
 
 def _open(w):

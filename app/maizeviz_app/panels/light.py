@@ -920,8 +920,15 @@ class LightPlots(QWidget):
         top.addWidget(self.height_box)
         top.addStretch(1)
         left.addLayout(top)
-        self.heatmap = ImageView("compute light to see where it reaches each height")
+        from maizeviz_app.panels.heatmap_view import HeatmapView
+
+        self.heatmap = HeatmapView("compute light to see where it reaches each height")
         left.addWidget(self.heatmap, 1)
+        # the value under the mouse (always in place: showing a widget relayouts the dock)
+        self.hover = QLabel(" ")
+        self.hover.setToolTip("the value of the heatmap's bin under the mouse")
+        self.heatmap.hovered.connect(lambda text: self.hover.setText(text or " "))
+        left.addWidget(self.hover)
         lay.addLayout(left, 1)
         self.transmission = ImageView("transmission by height appears here")
         lay.addWidget(self.transmission, 1)
@@ -973,6 +980,14 @@ class LightPlots(QWidget):
             del self._maps[k]
         if gone:
             self._fill_sources(None)
+
+    def redraw(self, keep: str | None = None) -> None:
+        """The colours changed: every map (but those of the light ``keep``) is drawn again
+        when shown (the one shown now is asked for at once, by ``heatmap_needed``)."""
+        for kind, maps in self._maps.items():
+            if kind != keep:
+                self._maps[kind] = [(h, None) for h, _ in maps]
+        self._show_height(self.height_box.currentIndex())
 
     def set_heatmap(self, index: int, rgba: np.ndarray, kind: str = "sun") -> None:
         """A height's figure, drawn after it was asked for."""

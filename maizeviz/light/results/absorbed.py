@@ -16,9 +16,21 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.results.per_leaf import LightRow, leaf_sums
+from maizeviz.light.results.uncertainty import Batches, errors_by
 
 if TYPE_CHECKING:                       # the optics live with the tracing that uses them
     from maizeviz.light.trace.optics import Optics
+
+
+#: Share of the incident light left unresolved (still travelling when scattering stopped)
+#: above which a result says so.
+UNRESOLVED_WARN = 0.01
+
+
+def unresolved_warning(share: float, depth: int) -> str:
+    """The warning for a result that left ``share`` of its light unresolved."""
+    return (f"{share:.1%} of the incident light was still travelling after {depth} "
+            "scatterings and is not in the absorbed figures: raise the depth")
 
 
 @dataclass(frozen=True)
@@ -79,6 +91,10 @@ class AbsorbedLight:
     triangle_absorbed_w : (F,) float64 W absorbed by each triangle of the scene (leaves, then
         stalks), from the light falling on the sample rectangle
     triangle_sunlit_cm2 : (F,) float64 cm2 of each triangle in the direct beam (0 for a sky)
+    triangle_direct_w : (F,) float64 the part of ``triangle_absorbed_w`` the sun's direct beam
+        deposited (on the sunlit area), or None (a record older than photosynthesis)
+    batches : Batches, the per-batch shares the standard errors come from, or None
+    sun_direction : (3,) unit vector toward the sun, or None (no direct beam)
     rect : (x0, y0, x1, y1) cm; rays : primary rays per direction; directions : beams traced
     depth, threshold, seed : as traced; events : scatterings followed; periodic : bool
     level : the canopy's mesh level; seconds : "trace" (primary beams), "scatter", "build"
@@ -102,9 +118,31 @@ class AbsorbedLight:
     periodic: bool
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
+    triangle_direct_w: np.ndarray | None = None
+    batches: Batches | None = None
+    sun_direction: tuple[float, float, float] | None = None
     stands: dict | None = None
 
     fraction_absorbed = property(_fraction_absorbed)
+
+    @property
+    def absorbed_leaves_error(self) -> float | None:
+        """Monte Carlo standard error of ``balance.absorbed_leaves`` (W/m2 of ground), from
+        independent batches of rays; None when the result was not traced in batches."""
+        total = float(self.triangle_absorbed_w.sum())
+        if self.batches is None or total <= 0:
+            return None if self.batches is None else 0.0
+        return self.batches.error() * self.balance.absorbed_leaves / total
+
+    @property
+    def balance_errors(self) -> dict[str, float] | None:
+        """Monte Carlo standard errors of the energy balance's parts, in its units:
+        ``absorbed_leaves`` (:attr:`absorbed_leaves_error`), ``absorbed_ground``,
+        ``reflected_top``, ``escaped_sides``, ``unresolved``; None without batches."""
+        if self.batches is None or self.batches.parts is None:
+            return None
+        return {"absorbed_leaves": float(self.absorbed_leaves_error or 0.0),
+                **(self.batches.balance_errors(1.0) or {})}
 
     def table(self, by: str = "plant", canopy=None):
         """Absorbed light per leaf or per plant as a pandas DataFrame.
@@ -139,6 +177,11 @@ class AbsorbedLight:
         frame["sunlit_area_cm2"] = np.minimum(frame["sunlit_area_cm2"], frame["leaf_area_cm2"])
         if by == "plant":
             frame = _per_plant(frame, ("absorbed_w", "sunlit_area_cm2"))
+        if self.batches is not None:
+            se = errors_by(canopy, self.batches.absorbed, "absorbed_w", self.rect,
+                           self.periodic, by)
+            keys = frame["instance"] if by == "plant" else zip(frame["instance"], frame["leaf"])
+            frame["absorbed_w_se"] = [se.get(k, 0.0) for k in keys]
         frame["shaded_area_cm2"] = frame["leaf_area_cm2"] - frame["sunlit_area_cm2"]
         frame["absorbed_w_m2_leaf"] = frame["absorbed_w"] / (frame["leaf_area_cm2"] * 1e-4)
         if self.band == "par":
@@ -152,8 +195,12 @@ class AbsorbedLight:
         rows = leaf_sums(canopy, {"absorbed_w": self.triangle_absorbed_w,
                                   "absorbed_sunlit_area_cm2": self.triangle_sunlit_cm2},
                          self.rect, self.periodic)
+        se = {} if self.batches is None else errors_by(
+            canopy, self.batches.absorbed, "absorbed_w", self.rect, self.periodic, "leaf")
         for r in rows:
             r["absorbed_w_m2_leaf"] = float(r["absorbed_w"]) / (float(r["leaf_area_cm2"]) * 1e-4)
+            if self.batches is not None:
+                r["absorbed_w_se"] = se.get((r["instance"], r["leaf"]), 0.0)
         return rows
 
 
@@ -173,6 +220,10 @@ class AbsorbedPeriod:
     step_incident_w_m2 : (n,) float64 the band's irradiance on a horizontal plane at each step
     rect, rays, depth, seed, periodic, level : as traced; seconds : "trace", "scatter",
         "build"
+    batches : per-batch shares of ``triangle_absorbed_j`` (``absorbed`` only), for standard
+        errors
+    assimilation : PeriodAssimilation (:mod:`maizeviz.light.results.assimilation`) when a
+        leaf model was given, else None
     stands : identity of the stands traced on, None where not known
     """
 
@@ -190,9 +241,29 @@ class AbsorbedPeriod:
     periodic: bool
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
+    batches: Batches | None = None
+    assimilation: Any = None
     stands: dict | None = None
 
     fraction_absorbed = property(_fraction_absorbed)
+
+    @property
+    def absorbed_leaves_error(self) -> float | None:
+        """Monte Carlo standard error of ``balance.absorbed_leaves`` (MJ/m2 of ground)."""
+        total = float(self.triangle_absorbed_j.sum())
+        if self.batches is None or total <= 0:
+            return None if self.batches is None else 0.0
+        return self.batches.error() * self.balance.absorbed_leaves / total
+
+    @property
+    def balance_errors(self) -> dict[str, float] | None:
+        """Monte Carlo standard errors of the energy balance's parts, in its units:
+        ``absorbed_leaves`` (:attr:`absorbed_leaves_error`), ``absorbed_ground``,
+        ``reflected_top``, ``escaped_sides``, ``unresolved``; None without batches."""
+        if self.batches is None or self.batches.parts is None:
+            return None
+        return {"absorbed_leaves": float(self.absorbed_leaves_error or 0.0),
+                **(self.batches.balance_errors(1.0) or {})}
 
     @property
     def absorbed_leaves_mol_m2(self) -> float | None:
@@ -226,6 +297,11 @@ class AbsorbedPeriod:
             return frame
         if by == "plant":
             frame = _per_plant(frame, ("absorbed_mj",))
+        if self.batches is not None:
+            se = errors_by(canopy, self.batches.absorbed * 1e-6, "absorbed_mj", self.rect,
+                           self.periodic, by)
+            keys = frame["instance"] if by == "plant" else zip(frame["instance"], frame["leaf"])
+            frame["absorbed_mj_se"] = [se.get(k, 0.0) for k in keys]
         frame["absorbed_mj_m2_leaf"] = frame["absorbed_mj"] / (frame["leaf_area_cm2"] * 1e-4)
         if self.band == "par":
             frame["absorbed_mol"] = frame["absorbed_mj"] * PAR_UMOL_PER_J_PAR

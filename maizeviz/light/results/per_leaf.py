@@ -15,7 +15,8 @@ from maizeviz.mesh.tessellate import triangle_areas_normals
 #: Per-leaf sums that :func:`plant_light` adds up per plant (those present in the rows).
 LIGHT_SUMS = ("sunlit_area_cm2", "second_class_area_cm2", "sunlit_intercepted_cm2",
               "second_class_intercepted_cm2", "diffuse_intercepted_cm2", "par_intercepted_mol",
-              "direct_par_intercepted_mol", "diffuse_par_intercepted_mol", "absorbed_w")
+              "direct_par_intercepted_mol", "diffuse_par_intercepted_mol", "absorbed_w",
+              "absorbed_mj", "absorbed_mol", "gross_umol_s", "gross_mol", "gross_g_co2")
 #: Columns that identify a leaf row.
 LEAF_KEYS = ("instance", "plant", "leaf", "x_cm", "y_cm", "leaf_area_cm2")
 
@@ -75,6 +76,25 @@ def tile_representatives(layout: CanopyLayout, rect: Rect | None, periodic: bool
     return rep
 
 
+def leaf_part(canopy: Canopy, values: np.ndarray, what: str) -> np.ndarray:
+    """The leaf triangles' part (F,) of light given per scene triangle (F,) or (F + G,): the
+    canopy's F leaf triangles, then its G stalk triangles when they were traced.
+
+    Raises
+    ------
+    MaizevizError
+        ``values`` has another length: it was traced on another canopy (or read damaged), and
+        its light would be summed on other leaves (or fail to broadcast).
+    """
+    nf, ns = canopy.n_triangles, len(canopy.stalk_faces)
+    values = np.asarray(values)
+    if values.ndim != 1 or len(values) not in (nf, nf + ns):
+        raise MaizevizError(f"{what} holds light for {len(values):,} triangles, but the canopy "
+                            f"has {nf:,} leaf triangles ({nf + ns:,} with its stalks): it was "
+                            "traced on another canopy")
+    return values[:nf]
+
+
 def leaf_light(canopy: Canopy, first_hits: np.ndarray | None, second_hits: np.ndarray | None,
                direction: np.ndarray, ray_area_cm2: float, rect: Rect,
                periodic: bool) -> list[LightRow]:
@@ -110,9 +130,8 @@ def leaf_light(canopy: Canopy, first_hits: np.ndarray | None, second_hits: np.nd
     s = direction
     # a ray on a grazing triangle stands for more than the triangle: capped per leaf below
     lit = ray_area_cm2 * s[2] / np.maximum(np.abs(normals @ s), 1e-6)
-    nf = canopy.n_triangles
-    first = first_hits[:nf].astype(np.float64)
-    second = second_hits[:nf].astype(np.float64)
+    first = leaf_part(canopy, first_hits, "the first hits").astype(np.float64)
+    second = leaf_part(canopy, second_hits, "the second hits").astype(np.float64)
     rows = leaf_sums(canopy, {"sunlit_area_cm2": first * lit,
                               "second_class_area_cm2": second * lit,
                               "sunlit_intercepted_cm2": first * ray_area_cm2,
@@ -142,7 +161,8 @@ def leaf_sums(canopy: Canopy, columns: dict[str, np.ndarray], rect: Rect | None 
     """
     area, _ = triangle_areas_normals(canopy.vertices, canopy.faces)
     nf = canopy.n_triangles
-    cols = {k: np.asarray(v, dtype=np.float64)[:nf] for k, v in columns.items()}
+    cols = {k: leaf_part(canopy, v, f"the column {k}").astype(np.float64)
+            for k, v in columns.items()}
     rep = tile_representatives(canopy.layout, rect, periodic)
     keys, leaf_of = groups(rep[canopy.face_instance], canopy.face_leaf)
     any_light = np.zeros(nf, dtype=bool)
@@ -233,7 +253,8 @@ def triangle_light(canopy: Canopy, first_hits: np.ndarray | None,
     if first_hits is None or second_hits is None:
         raise MaizevizError("hit classes were not traced")
     nf = canopy.n_triangles
-    first, second = first_hits[:nf], second_hits[:nf]
+    first = leaf_part(canopy, first_hits, "the first hits")
+    second = leaf_part(canopy, second_hits, "the second hits")
     rep = tile_representatives(canopy.layout, rect, periodic)
     inst = canopy.face_instance.astype(np.int64)
     if nf and (rep != np.arange(len(rep))).any() and np.all(np.diff(inst) >= 0):

@@ -959,7 +959,8 @@ def weather_period(weather: Weather, lat: float, lon: float, altitude: float = 0
     A measured PAR column is the period's PAR (split into direct and diffuse as the
     shortwave is); the air temperature travels with the steps (:attr:`Period.temp_air`).
     The direct and diffuse parts keep the file's ghi: with ``dhi`` given, direct_horizontal =
-    ghi - dhi (dhi above ghi is cut to ghi); with only ``dni``, direct_horizontal = dni
+    ghi - dhi (dhi above ghi is cut to ghi, said in a note naming the first such row; a
+    ``dni`` column is then not used); with only ``dni``, direct_horizontal = dni
     cos(zenith) (cut to ghi) and dhi the rest; with ghi alone, the Erbs et al. (1982)
     diffuse fraction (pvlib; geometric zenith, day of year) gives dhi. ``dni`` is then
     direct_horizontal / cos(zenith). Rows whose middle has the sun below the horizon are
@@ -980,6 +981,16 @@ def weather_period(weather: Weather, lat: float, lon: float, altitude: float = 0
     ghi = direct + dhi
     dni = direct / np.cos(np.radians(zen[up]))
     notes = list(weather.notes)
+    if weather.dhi is not None:
+        over = np.flatnonzero(weather.dhi[up] > weather.ghi[up])
+        if len(over):                  # a sensor's offset at low sun, or columns swapped
+            first = weather.times[up][int(over[0])]
+            unused = " (its dni is not used: ghi - dhi gives the direct part)" \
+                if weather.dni is not None else ""
+            rows = f"{len(over)} rows" if len(over) > 1 else "1 row"
+            notes.append(f"{rows} of {Path(weather.path).name} with the sun up "
+                         f"{'have' if len(over) > 1 else 'has'} dhi above ghi (first: "
+                         f"{first.isoformat()}): diffuse cut to ghi, no direct light{unused}")
     if not up.any():
         notes.append(_no_sun_note(weather.start, weather.end, lat, lon))
     night = ~up

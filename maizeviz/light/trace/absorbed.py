@@ -19,21 +19,32 @@ https://doi.org/10.1016/j.ecolmodel.2017.11.022
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
+from typing import TYPE_CHECKING
 
 import numpy as np
+from scipy.sparse import csr_array
 
 from maizeviz.canopy.layout import stands_identity
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import check_range
 from maizeviz.light.results.absorbed import AbsorbedLight, AbsorbedPeriod, Balance
+from maizeviz.light.results.uncertainty import BATCHES, Batches
 from maizeviz.light.sources.irradiance import Period
 from maizeviz.light.sources.perez import PEREZ_MODELS, perez_split
 from maizeviz.light.sources.sky import Sky
 from maizeviz.light.sources.sun import Sun
 from maizeviz.light.trace.direct import Sampler
 from maizeviz.light.trace.optics import Optics, band_share
-from maizeviz.light.trace.scatter import scatter_beam
+from maizeviz.light.trace.scatter import scatter_beam, scatter_sky
 from maizeviz.progress import ProgressCallback, report
+
+if TYPE_CHECKING:
+    from maizeviz.photosynthesis.split import LeafModel
+
+
+#: Primary rays per grid cell of a sky traced with its directions drawn per ray.
+SKY_PASSES = 4
 
 
 def check_absorbed(direct_w_m2: float, diffuse_w_m2: float, depth: int,
@@ -50,7 +61,7 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
                    sun: Sun | None, direct_w_m2: float, diffuse_w_m2: float, sky: Sky | None,
                    depth: int, threshold: float, seed: int, threads: int = 1,
                    progress: ProgressCallback | None = None,
-                   build_s: float = 0.0) -> AbsorbedLight:
+                   build_s: float = 0.0, sky_passes: int = SKY_PASSES) -> AbsorbedLight:
     """Light absorbed in one band at one instant: the sun's beam and a sky's directions.
 
     Parameters
@@ -79,20 +90,33 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
         ``progress(done, total, what)`` after each beam.
     build_s : float
         Seconds spent building the scene for this call [s] (reported as ``seconds["build"]``).
+    sky_passes : int
+        With leaves or soil that scatter, in a periodic field, the diffuse light is traced as
+        one beam whose rays each take a sky direction of their own
+        (:func:`~.scatter.scatter_sky`), this many rays per grid cell (0: every sky direction
+        traced over the whole grid, as black leaves are).
 
     Returns
     -------
     AbsorbedLight
-        Its balance in W/m2 of sample ground and the W absorbed by each scene triangle.
+        Its balance in W/m2 of sample ground, the W absorbed by each scene triangle (and the
+        part the direct beam deposited), the per-batch shares the standard errors come from.
     """
     opt = optics
     beams: list[tuple[np.ndarray, float]] = []
     if sun is not None and direct_w_m2 > 0:
         beams.append((sun.direction(canopy.layout.north_deg), direct_w_m2))
+    # leaves that scatter, in a periodic field: the sky's directions are drawn per ray
+    # (one beam's rays, ``sky_passes`` per cell) instead of each traced over the grid
+    sky_per_ray = diffuse_w_m2 > 0 and smp.periodic and sky_passes > 0 and (
+        opt.scattering > 0 or opt.ground_reflectance > 0 or bool(opt.ranks))
+    n_sky = 0
     if diffuse_w_m2 > 0:
         assert sky is not None
-        for toward, weight in zip(sky.directions, sky.weights):
-            beams.append((np.asarray(toward, np.float64), diffuse_w_m2 * float(weight)))
+        n_sky = len(sky.weights)
+        if not sky_per_ray:
+            for toward, weight in zip(sky.directions, sky.weights):
+                beams.append((np.asarray(toward, np.float64), diffuse_w_m2 * float(weight)))
     area_m2 = smp.ray_area_cm2 * 1e-4 * smp.n
     nf = len(normals)
     leaf_optics, kept = None, 1.0 - opt.scattering
@@ -101,7 +125,11 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
         rank[:canopy.n_triangles] = canopy.face_leaf
         leaf_optics = opt.per_triangle(rank)
         kept = 1.0 - (leaf_optics[0] + leaf_optics[1])
-    absorbed, sunlit = np.zeros(nf), np.zeros(nf)
+    absorbed, sunlit, direct_t = np.zeros(nf), np.zeros(nf), np.zeros(nf)
+    empty = csr_array((BATCHES, nf))
+    absorbed_b, direct_b, sunlit_b = empty, empty, empty
+    sun_dir = None
+    parts_b = np.zeros((4, BATCHES))
     parts = dict.fromkeys(("ground", "top", "sides", "unresolved"), 0.0)
     events, seconds = 0, {"build": build_s, "trace": 0.0, "scatter": 0.0}
     for k, (toward, irradiance) in enumerate(beams):
@@ -110,6 +138,7 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
                                    leaf_optics=leaf_optics)
         per_ray = irradiance * smp.ray_area_cm2 * 1e-4       # W carried by one ray
         absorbed += tally.per_triangle(nf, kept * per_ray)
+        absorbed_b = absorbed_b + tally.per_batch(nf, kept * per_ray)
         if k == 0 and sun is not None and direct_w_m2 > 0:
             # cm2 of leaf a ray's beam covers: its footprint across the beam over the
             # cosine of the leaf's tilt to it
@@ -120,27 +149,72 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
             factor[lit] = smp.ray_area_cm2 * toward[2] / np.maximum(
                 np.abs(normals[lit] @ toward), 1e-6)
             sunlit = tally.sunlit(nf, factor)
+            direct_b = tally.per_batch(nf, kept * per_ray, first=True)
+            direct_t = np.asarray(direct_b.sum(axis=0)).ravel()
+            sunlit_b = tally.per_batch(nf, factor, first=True)
+            sun_dir = (float(toward[0]), float(toward[1]), float(toward[2]))
         for name in parts:
             parts[name] += getattr(tally, name) * per_ray
+        parts_b += tally.parts_batch * per_ray
         events += tally.events
         seconds["trace"] += secs["trace"]
         seconds["scatter"] += secs["scatter"]
-        report(progress, k + 1, len(beams), "absorbed light")
+        report(progress, k + 1, len(beams) + sky_per_ray, "absorbed light")
+    if sky_per_ray:
+        assert sky is not None
+        tally, secs = scatter_sky(smp, np.asarray(sky.directions, np.float64),
+                                  np.asarray(sky.weights, np.float64), opt, normals, depth,
+                                  threshold, seed + 7919 * len(beams), threads, sky_passes,
+                                  leaf_optics=leaf_optics)
+        per_ray = diffuse_w_m2 * smp.ray_area_cm2 * 1e-4 / sky_passes
+        absorbed += tally.per_triangle(nf, kept * per_ray)
+        absorbed_b = absorbed_b + tally.per_batch(nf, kept * per_ray)
+        for name in parts:
+            parts[name] += getattr(tally, name) * per_ray
+        parts_b += tally.parts_batch * per_ray
+        events += tally.events
+        seconds["scatter"] += secs["scatter"]
+        report(progress, len(beams) + 1, len(beams) + 1, "absorbed light")
     incident = direct_w_m2 * (sun is not None) + diffuse_w_m2
     balance = Balance(float(incident), float(absorbed.sum()) / area_m2,
                       *(float(parts[k]) / area_m2 for k in ("ground", "top", "sides",
                                                              "unresolved")))
     return AbsorbedLight(opt.band, opt, incident, balance, absorbed, sunlit, smp.rect, smp.n,
-                         len(beams), depth, threshold, seed, events, smp.periodic,
-                         canopy.level, seconds, stands_identity(canopy.layout))
+                         len(beams) + (n_sky if sky_per_ray else 0), depth, threshold, seed,
+                         events, smp.periodic, canopy.level, seconds,
+                         triangle_direct_w=direct_t,
+                         batches=Batches(absorbed_b, direct_b, sunlit_b, parts_b / area_m2),
+                         sun_direction=sun_dir, stands=stands_identity(canopy.layout))
+
+
+def period_temperatures(period: Period, temperature_c) -> np.ndarray:
+    """Air (leaf) temperature of each step of ``period``, C (n,): a weather file's own
+    (``Period.temp_air``, where finite), else ``temperature_c`` (one, or one per step);
+    MaizevizError naming the temperature when they do not fit."""
+    from maizeviz.errors import MaizevizError
+
+    steps = len(period.step_s)
+    temps = np.asarray(temperature_c, np.float64)
+    if temps.ndim > 1 or temps.size not in (1, steps) or not np.all(np.isfinite(temps)):
+        raise MaizevizError(f"give one air temperature or one for each of the period's "
+                            f"{steps} steps (finite, C), got {temps.size}",
+                            quantity="temperature")
+    temps = np.broadcast_to(temps.reshape(-1), (steps,)) if temps.size == 1 else temps
+    given = getattr(period, "temp_air", None)          # a weather file's air temperature
+    if given is not None and len(given) == steps:
+        temps = np.where(np.isfinite(given), np.asarray(given, np.float64), temps)
+    return np.array(temps, dtype=np.float64)
 
 
 def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
                     absorbed: Callable[..., AbsorbedLight],
-                    progress: ProgressCallback | None = None) -> AbsorbedPeriod:
+                    progress: ProgressCallback | None = None, canopy: Canopy | None = None,
+                    photosynthesis: LeafModel | None = None,
+                    temperature_c=25.0) -> AbsorbedPeriod:
     """Light absorbed in one band over a period: the diffuse part traced once per W/m2 over
     ``sky`` and scaled by each step's diffuse irradiance, each step's sun with the band's share
-    of its direct irradiance.
+    of its direct irradiance; with a leaf model, the leaves' gross CO2 assimilation at every
+    step (each step's light through the model at that step's temperature).
 
     Parameters
     ----------
@@ -159,14 +233,24 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
         scattering settings bound).
     progress : callable, optional
         Called after the sky and after each step.
+    canopy : Canopy
+        The canopy traced (needed with ``photosynthesis``).
+    photosynthesis : LeafModel, optional
+        A leaf model (:mod:`maizeviz.photosynthesis`); PAR only.
+    temperature_c : float or (n,) float64
+        Air (leaf) temperature, C: one, or one per step (:func:`period_temperatures`).
 
     Returns
     -------
     AbsorbedPeriod
-        Its balance in MJ/m2 of sample ground, the J absorbed by each scene triangle.
+        Its balance in MJ/m2 of sample ground, the J absorbed by each scene triangle, the
+        per-batch shares of those, and ``assimilation`` (a
+        :class:`~maizeviz.light.results.assimilation.PeriodAssimilation`) with a leaf model.
     """
     share = band_share(optics.band, period.par_umol_per_j)
     steps = len(period.step_s)
+    temps = period_temperatures(period, temperature_c) if photosynthesis is not None \
+        else np.zeros(steps)
     model = str(sky).strip().lower() if isinstance(sky, str) else ""
     split = perez_split(period, model) if model in PEREZ_MODELS else None
     unit = absorbed(None, direct_w_m2=0.0, diffuse_w_m2=1.0,
@@ -179,6 +263,12 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
         diffuse_w = np.asarray(split.isotropic_w_m2, np.float64) * share
     step_s = np.asarray(period.step_s, np.float64)
     joules = unit.triangle_absorbed_w * float(np.sum(diffuse_w * step_s))
+    ub_ = unit.batches
+    assert ub_ is not None
+    joules_b = ub_.absorbed * float(np.sum(diffuse_w * step_s))
+    parts_b = (ub_.parts if ub_.parts is not None else np.zeros((4, BATCHES))) * float(
+        np.sum(diffuse_w * step_s))
+    carbon = _Carbon(canopy, photosynthesis, unit, diffuse_w, step_s, temps)
     ub = unit.balance
     parts = {k: getattr(ub, k) * float(np.sum(diffuse_w * step_s))
              for k in ("absorbed_leaves", "absorbed_ground", "reflected_top",
@@ -192,11 +282,18 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
             light = absorbed(Sun(z, float(period.azimuth_deg[k])),
                              direct_w_m2=float(direct_w[k]))
             joules += light.triangle_absorbed_w * step_s[k]
+            assert light.batches is not None
+            joules_b = joules_b + light.batches.absorbed * step_s[k]
+            if light.batches.parts is not None:
+                parts_b = parts_b + light.batches.parts * step_s[k]
+            carbon.add(k, light)
             for name in parts:
                 parts[name] += getattr(light.balance, name) * step_s[k]
             leaves_w[k] += light.balance.absorbed_leaves
             for name in ("trace", "scatter"):
                 seconds[name] = seconds.get(name, 0.0) + light.seconds.get(name, 0.0)
+        elif diffuse_w[k] > 0:
+            carbon.add(k, None)
         report(progress, k + 2, steps + 1, f"absorbed light: time step {k + 1} of {steps}")
     incident_w = diffuse_w + direct_w
     balance = Balance(float(np.sum(incident_w * step_s)) * 1e-6,
@@ -205,4 +302,55 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
                                                    "unresolved")))
     return AbsorbedPeriod(optics.band, optics, period, balance, joules, leaves_w, incident_w,
                           unit.rect, unit.rays, unit.depth, unit.seed, unit.periodic,
-                          unit.level, seconds, unit.stands)
+                          unit.level, seconds,
+                          batches=Batches(joules_b, None, None, parts_b * 1e-6),
+                          assimilation=carbon.result(), stands=unit.stands)
+
+
+class _Carbon:
+    """A period's gross assimilation, step by step: each step's light (its sun, if any, and
+    the sky's unit light scaled by its diffuse irradiance) through the leaf model."""
+
+    def __init__(self, canopy, model, unit: AbsorbedLight, diffuse_w, step_s, temps):
+        self.canopy, self.model, self.unit = canopy, model, unit
+        self.diffuse_w, self.step_s, self.temps = diffuse_w, step_s, temps
+        self.step_gross = np.zeros(len(step_s))
+        if model is not None:
+            if canopy is None:
+                raise TypeError("photosynthesis over a period needs the canopy")
+            n = canopy.n_triangles
+            self.mol, self.mol_b = np.zeros(n), np.zeros((BATCHES, n))
+
+    def add(self, k: int, light: AbsorbedLight | None) -> None:
+        if self.model is None:
+            return
+        from maizeviz.light.results.assimilation import assimilate
+
+        unit, dw = self.unit, float(self.diffuse_w[k])
+        ub = unit.batches
+        assert ub is not None
+        if light is None:
+            step = replace(unit, triangle_absorbed_w=unit.triangle_absorbed_w * dw,
+                           batches=Batches(ub.absorbed * dw, ub.direct, ub.sunlit_cm2))
+        else:
+            lb = light.batches
+            assert lb is not None
+            step = replace(light, triangle_absorbed_w=light.triangle_absorbed_w
+                           + unit.triangle_absorbed_w * dw,
+                           batches=Batches(lb.absorbed + ub.absorbed * dw, lb.direct,
+                                           lb.sunlit_cm2))
+        a = assimilate(self.canopy, step, self.model, float(self.temps[k]))
+        self.mol += a.triangle_gross_umol_s * self.step_s[k] * 1e-6
+        if a.triangle_batches is not None:
+            self.mol_b += a.triangle_batches * self.step_s[k] * 1e-6
+        self.step_gross[k] = a.canopy_gross_umol_m2_s
+
+    def result(self):
+        if self.model is None:
+            return None
+        from maizeviz.light.results.assimilation import PeriodAssimilation
+
+        x0, y0, x1, y1 = self.unit.rect
+        return PeriodAssimilation(self.model.as_dict(), self.temps.copy(), self.mol,
+                                  self.mol_b, (x1 - x0) * (y1 - y0) * 1e-4, self.step_gross,
+                                  self.unit.rect, self.unit.periodic)

@@ -44,6 +44,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from maizeviz.light.results.uncertainty import BATCHES
 from maizeviz.light.scene.rays import ray_grid
 from maizeviz.light.trace.direct import Sampler, trace_direction
 from maizeviz.light.trace.optics import Optics
@@ -71,10 +72,16 @@ class Tally:
     ground, top, sides, unresolved : float, absorbed by the ground, reflected out of the
         canopy top, escaped sideways (open field), still travelling when tracing stopped
     rays : primary rays; events : scatterings followed
+    leaf_batch, first_batch : int8 arrays beside ``leaf_hits`` and ``first_hits``: the batch
+        of the primary ray each arrival descends from
     """
 
     leaf_hits: list = field(default_factory=list)
     first_hits: list = field(default_factory=list)
+    leaf_batch: list = field(default_factory=list)
+    first_batch: list = field(default_factory=list)
+    #: ground, top, sides, unresolved by batch: (4, BATCHES) float64
+    parts_batch: np.ndarray = field(default_factory=lambda: np.zeros((4, BATCHES)))
     ground: float = 0.0
     top: float = 0.0
     sides: float = 0.0
@@ -85,6 +92,9 @@ class Tally:
     def add(self, other: Tally) -> None:
         self.leaf_hits += other.leaf_hits
         self.first_hits += other.first_hits
+        self.leaf_batch += other.leaf_batch
+        self.first_batch += other.first_batch
+        self.parts_batch = self.parts_batch + other.parts_batch
         for name in ("ground", "top", "sides", "unresolved", "rays", "events"):
             setattr(self, name, getattr(self, name) + getattr(other, name))
 
@@ -92,6 +102,22 @@ class Tally:
         """(F,) float64: what each triangle absorbed (``absorbed_share`` of each arrival)."""
         ids = np.concatenate(self.leaf_hits) if self.leaf_hits else np.empty(0, np.int64)
         return np.bincount(ids, minlength=n_triangles) * absorbed_share
+
+    def per_batch(self, n_triangles: int, weight: float | np.ndarray, first: bool = False):
+        """(BATCHES, F) scipy.sparse CSR array: what each batch's rays deposited on each
+        triangle, ``weight`` per arrival (a number, or (F,) per triangle); ``first``: the
+        primary hits only. Rows sum to :meth:`per_triangle`'s (for the same weight)."""
+        from scipy.sparse import csr_array
+
+        hits, batch = (self.first_hits, self.first_batch) if first else \
+            (self.leaf_hits, self.leaf_batch)
+        ids = np.concatenate(hits) if hits else np.empty(0, np.int64)
+        bat = np.concatenate(batch).astype(np.int64) if batch else np.empty(0, np.int64)
+        w = np.broadcast_to(np.asarray(weight, np.float64), (n_triangles,))[ids] \
+            if np.ndim(weight) else np.full(len(ids), float(weight))
+        out = csr_array((w, (bat, ids)), shape=(BATCHES, n_triangles))
+        out.sum_duplicates()
+        return out
 
     def sunlit(self, n_triangles: int, area_factor: np.ndarray) -> np.ndarray:
         """(F,) float64 cm2 in the direct beam: primary hits times each triangle's
@@ -115,10 +141,12 @@ def lambertian(normals: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 
 @dataclass
 class _Rays:
-    """Rays travelling: origins (k, 3) cm, unit directions (k, 3)."""
+    """Rays travelling: origins (k, 3) cm, unit directions (k, 3), the batch (k,) int8 of
+    the primary ray each descends from."""
 
     org: np.ndarray
     dirs: np.ndarray
+    batch: np.ndarray
 
 
 LEAF, GROUND, TOP, SIDES, LOST = range(5)
@@ -184,22 +212,26 @@ def follow(smp: Sampler, rays: _Rays, max_crossings: int = 1000
 
 def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng,
             kind: np.ndarray, prim: np.ndarray, end: np.ndarray, dirs: np.ndarray,
-            leaf_optics: tuple | None = None) -> _Rays:
+            batch: np.ndarray, leaf_optics: tuple | None = None) -> _Rays:
     """Deposit what rays ending at leaves and the ground absorb, count those leaving, and draw
     the rays that go on (Russian roulette on the scattering coefficient); ``leaf_optics``:
     (reflectance, transmittance) per triangle (F,) when leaves differ by rank."""
     leaf = kind == LEAF
     sc = optics.scattering
-    if leaf_optics is not None:
+    if leaf_optics is not None or sc < 1.0:
         tally.leaf_hits.append(prim[leaf])
-    elif sc < 1.0:
-        tally.leaf_hits.append(prim[leaf])
+        tally.leaf_batch.append(batch[leaf])
     ground = kind == GROUND
     tally.ground += np.count_nonzero(ground) * (1.0 - optics.ground_reflectance)
     tally.top += np.count_nonzero(kind == TOP)
     tally.sides += np.count_nonzero(kind == SIDES)
     tally.unresolved += np.count_nonzero(kind == LOST)
-    parts_o, parts_d = [], []
+    for row, (what, share) in enumerate(((ground, 1.0 - optics.ground_reflectance),
+                                         (kind == TOP, 1.0), (kind == SIDES, 1.0),
+                                         (kind == LOST, 1.0))):
+        if what.any():
+            tally.parts_batch[row] += np.bincount(batch[what], minlength=BATCHES) * share
+    parts_o, parts_d, parts_b = [], [], []
     go = np.flatnonzero(leaf)
     if leaf_optics is not None:
         rho_t, tau_t = leaf_optics[0][prim[go]], leaf_optics[1][prim[go]]
@@ -217,6 +249,7 @@ def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng
         side = np.where(reflect[:, None], back, -back)
         parts_o.append(end[go] + EPS_CM * side)
         parts_d.append(lambertian(side, rng))
+        parts_b.append(batch[go])
     up = np.flatnonzero(ground)
     rg = optics.ground_reflectance
     up = up[rng.random(len(up)) < rg] if rg > 0 else up[:0]
@@ -226,9 +259,26 @@ def _bounce(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng
         o[:, 2] = EPS_CM
         parts_o.append(o)
         parts_d.append(lambertian(zplus, rng))
+        parts_b.append(batch[up])
     if not parts_o:
-        return _Rays(np.empty((0, 3)), np.empty((0, 3)))
-    return _Rays(np.vstack(parts_o), np.vstack(parts_d))
+        return _Rays(np.empty((0, 3)), np.empty((0, 3)), np.empty(0, np.int8))
+    return _Rays(np.vstack(parts_o), np.vstack(parts_d), np.concatenate(parts_b))
+
+
+def _scatter_on(smp: Sampler, optics: Optics, normals: np.ndarray, tally: Tally, rng,
+                rays: _Rays, depth: int, least: float, leaf_optics: tuple | None) -> None:
+    """Follow scattered ``rays`` for up to ``depth`` more scatterings, or until no more than
+    ``least`` are still travelling; what is left is unresolved."""
+    for _ in range(depth):
+        if len(rays.org) <= least:
+            break
+        tally.events += len(rays.org)
+        kind, prim, end = follow(smp, rays)
+        rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, rays.dirs,
+                       rays.batch, leaf_optics)
+    tally.unresolved += len(rays.org)
+    if len(rays.org):
+        tally.parts_batch[3] += np.bincount(rays.batch, minlength=BATCHES)
 
 
 def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.ndarray,
@@ -264,6 +314,8 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
     chunks = [(a, min(a + CHUNK_RAYS, n)) for a in range(0, n, CHUNK_RAYS)]
     first_prim = primary.first_prim
     assert first_prim is not None
+    # primary rays dealt into equal batches at random (the same whatever ``threads``)
+    batches = (np.random.default_rng([seed, 0xBA7C]).permutation(n) % BATCHES).astype(np.int8)
 
     def chunk(k_ab: tuple[int, tuple[int, int]]) -> Tally:
         k, (a, b) = k_ab
@@ -279,16 +331,13 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
         end[:, :2] = g + s[:2] * (height / s[2])[:, None]
         end[:, 2] = height
         tally.first_hits.append(prim[hit])
+        batch = batches[a:b]
+        tally.first_batch.append(batch[hit])
         dirs = np.broadcast_to(-s, (b - a, 3))
-        rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, dirs, leaf_optics)
-        for _ in range(depth):
-            if len(rays.org) <= threshold * (b - a):
-                break
-            tally.events += len(rays.org)
-            kind, prim, end = follow(smp, rays)
-            rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, rays.dirs,
-                           leaf_optics)
-        tally.unresolved += len(rays.org)
+        rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, dirs, batch,
+                       leaf_optics)
+        _scatter_on(smp, optics, normals, tally, rng, rays, depth, threshold * (b - a),
+                    leaf_optics)
         return tally
 
     total = Tally()
@@ -299,3 +348,77 @@ def scatter_beam(smp: Sampler, toward: np.ndarray, optics: Optics, normals: np.n
     for part in ordered_map(chunk, list(enumerate(chunks)), threads, done, stop):
         total.add(part)
     return total, {"trace": t1 - t0, "scatter": time.perf_counter() - t1}
+
+
+def scatter_sky(smp: Sampler, directions: np.ndarray, weights: np.ndarray, optics: Optics,
+                normals: np.ndarray, depth: int = DEFAULT_DEPTH,
+                threshold: float = DEFAULT_THRESHOLD, seed: int = 0, threads: int = 1,
+                passes: int = 1, stop: threading.Event | None = None,
+                leaf_optics: tuple | None = None) -> tuple[Tally, dict[str, float]]:
+    """Follow a whole sky's diffuse light through a periodic canopy, each primary ray in a
+    sky direction of its own: ``passes`` rays per cell of the sample grid, their directions
+    dealt in proportion to the sky's ``weights`` (stratified, then shuffled over the cells).
+
+    Each ray carries the same power (the sky's horizontal irradiance over its footprint, over
+    ``passes``): drawing a direction with probability ``weight`` makes that unbiased. Tracing
+    every direction over the whole grid (:func:`scatter_beam` per direction) costs as many
+    times more primary rays as the sky has directions; this costs one beam's, for a Monte Carlo
+    error the batches report.
+
+    Parameters
+    ----------
+    smp : Sampler of a periodic field; directions : (K, 3) unit vectors toward the sky
+    weights : (K,) shares of the horizontal diffuse irradiance (sum 1)
+    optics, normals, depth, threshold, seed, threads, stop, leaf_optics : as
+        :func:`scatter_beam`
+    passes : primary rays per grid cell
+
+    Returns
+    -------
+    Tally in units of one primary ray's power, and seconds ("trace": 0, "scatter": all).
+    """
+    if not smp.periodic:
+        raise ValueError("a sky sampled per ray needs a periodic field")
+    t0 = time.perf_counter()
+    dirs_k = np.asarray(directions, dtype=np.float64)
+    w = np.asarray(weights, dtype=np.float64)
+    n_cells = smp.n
+    n = n_cells * passes
+    rng0 = np.random.default_rng([seed, 0x5C1])
+    # stratified: each direction gets its share of the rays (largest remainders), shuffled
+    want = w / w.sum() * n
+    counts = np.floor(want).astype(np.int64)
+    rest = n - int(counts.sum())
+    if rest:
+        counts[np.argsort(want - counts)[::-1][:rest]] += 1
+    which = rng0.permutation(np.repeat(np.arange(len(w)), counts))
+    batches = (rng0.permutation(n) % BATCHES).astype(np.int8)
+    chunks = [(a, min(a + CHUNK_RAYS, n)) for a in range(0, n, CHUNK_RAYS)]
+    grid = ray_grid(smp.rect, smp.density)[0]
+
+    def chunk(k_ab: tuple[int, tuple[int, int]]) -> Tally:
+        k, (a, b) = k_ab
+        rng = np.random.default_rng([seed, k, 0x5C1])
+        tally = Tally(rays=b - a)
+        g = grid[np.arange(a, b) % n_cells]
+        s = dirs_k[which[a:b]]
+        # start on the plane above the canopy, on the line through the grid point toward the
+        # sky direction, going down along it
+        org = np.empty((b - a, 3))
+        org[:, :2] = g + s[:, :2] * (smp.top / s[:, 2])[:, None]
+        org[:, 2] = smp.top
+        batch = batches[a:b]
+        kind, prim, end = follow(smp, _Rays(org, -s, batch))
+        hit = kind == LEAF
+        tally.first_hits.append(prim[hit])
+        tally.first_batch.append(batch[hit])
+        rays = _bounce(smp, optics, normals, tally, rng, kind, prim, end, -s, batch,
+                       leaf_optics)
+        _scatter_on(smp, optics, normals, tally, rng, rays, depth, threshold * (b - a),
+                    leaf_optics)
+        return tally
+
+    total = Tally()
+    for part in ordered_map(chunk, list(enumerate(chunks)), threads, None, stop):
+        total.add(part)
+    return total, {"trace": 0.0, "scatter": time.perf_counter() - t0}
