@@ -376,6 +376,9 @@ def stop_gaps(window, gaps: GapTimer, spin, repeat: int = 1) -> dict:
             spin(1.0)
     out: dict = {name: statistics.median(v) for name, v in samples.items()}
     out.update({name + "_samples": v for name, v in samples.items()})
+    return out
+
+
 def _leaf_pixels(view, n: int):
     """Widget points over ``n`` leaf triangles of the view's mesh that a click picks."""
     import numpy as np

@@ -15,7 +15,8 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
     in a worker as ``work(job, *args)``: returns ``(work, args)``. ``heatmap``: the light
     whose map is shown, the run shown for each light, the height shown (cm).
 
-    ``what``: canopy (mesh with each triangle's light), table (transmission by height),
+    ``what``: canopy (mesh with each triangle's light: its class and its leaf's sunlit share
+    for a sun, its leaf's light per m2 of leaf for a sky or a day), table (transmission by height),
     measures (Table 2), heatmap, plot; steps, leaves, plants, day (of a sky or a day). Nothing
     to export yet: MaizevizError saying what to do first."""
     if what == "canopy":
@@ -28,6 +29,8 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
         run = model.runs.for_signature(signature)
         if run is not None and run.classes is not None:
             cells["sun_class"] = run.classes.astype("int32")
+        if run is not None and run.painting is not None:   # honest where triangles are small
+            cells["sunlit_share"] = run.painting.share.astype("float32")
         if run is not None and getattr(run.extra, "leaf_value", None) is not None:
             cells["absorbed_w_per_m2_leaf"] = run.extra.leaf_value.astype("float64")
         for kind, name in (("sky", "diffuse_cm2_per_cm2_leaf"),

@@ -795,6 +795,7 @@ class MainWindow(QMainWindow):
                 getattr(run.extra, "leaf_value", None) is not None:
             title, unit = value_legend(run)
             self.viewport.set_light_values(run.extra.leaf_value, title, unit)
+            self.colour_panel.show_painting("")          # a sun's painting is not shown
         if colour and run is not None:
             self.colour_by("light")
         self._sync_colour_actions()

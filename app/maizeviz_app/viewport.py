@@ -325,6 +325,7 @@ class Viewport(QtInteractor):
         else:
             self._canopy_actor.mapper.SetInputData(poly)
         self._canopy_actor.SetVisibility(True)
+        self._highlight_actor()
         self._set_ground(canopy.layout)
         if "light_value" not in poly.cell_data:
             self.light_variant = "classes"
@@ -720,17 +721,26 @@ class Viewport(QtInteractor):
                 actor.SetVisibility(False)
                 self.render()
             return False
+        actor = self._highlight_actor()
+        actor.mapper.dataset = part
+        actor.SetVisibility(True)
+        self.render()
+        return True
+
+    def _highlight_actor(self):
+        """The actor that draws the selection (made once, hidden; show_canopy makes it, so
+        that the first click does not pay for it)."""
+        actor = self.actors.get("selection")
         if actor is None:
-            actor = self.add_mesh(part, name="selection", color=self.HIGHLIGHT, render=False,
+            dummy = pv.PolyData.from_regular_faces(np.eye(3, dtype=np.float32),
+                                                   np.array([[0, 1, 2]]))
+            actor = self.add_mesh(dummy, name="selection", color=self.HIGHLIGHT, render=False,
                                   reset_camera=False, pickable=False, lighting=True)
             # drawn over the canopy's same triangles, not fighting them for the pixels
             actor.mapper.SetResolveCoincidentTopologyToPolygonOffset()
             actor.mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(-2.0, -2.0)
-        else:
-            actor.mapper.dataset = part
-        actor.SetVisibility(True)
-        self.render()
-        return True
+            actor.SetVisibility(False)
+        return actor
 
     def frame_part(self, instance: int, leaf: int = -1) -> bool:
         """Point the camera at placement ``instance`` (its leaf ``leaf``), keeping its
@@ -749,6 +759,18 @@ class Viewport(QtInteractor):
         except AttributeError:
             pass
         super().close()
+
+
+def _card(widget: QWidget) -> QPainter:
+    """A painter on ``widget`` after its card: a rounded, nearly opaque white rectangle (the
+    view shows through a little); the pen set for dark text."""
+    p = QPainter(widget)
+    p.setRenderHint(QPainter.RenderHint.Antialiasing)
+    p.setPen(Qt.PenStyle.NoPen)
+    p.setBrush(QColor(255, 255, 255, 220))
+    p.drawRoundedRect(QRectF(widget.rect()), 6, 6)
+    p.setPen(QColor("#222222"))
+    return p
 
 
 class InfoCard(QWidget):
@@ -781,12 +803,7 @@ class InfoCard(QWidget):
         return "\n".join(self._lines)
 
     def paintEvent(self, _event) -> None:  # noqa: N802 - Qt's name
-        p = QPainter(self)
-        p.setRenderHint(QPainter.RenderHint.Antialiasing)
-        p.setPen(Qt.PenStyle.NoPen)
-        p.setBrush(QColor(255, 255, 255, 225))
-        p.drawRoundedRect(QRectF(self.rect()), 6, 6)
-        p.setPen(QColor("#222222"))
+        p = _card(self)
         fm = self.fontMetrics()
         y = 6
         for k, line in enumerate(self._lines):
@@ -946,14 +963,9 @@ class Legend(QWidget):
         self.update()
 
     def paintEvent(self, _event) -> None:  # noqa: N802 - Qt's name
-        p = QPainter(self)
-        p.setRenderHint(QPainter.RenderHint.Antialiasing)
-        p.setPen(Qt.PenStyle.NoPen)
-        p.setBrush(QColor(255, 255, 255, 215))
-        p.drawRoundedRect(QRectF(self.rect()), 6, 6)
+        p = _card(self)
         fm = self.fontMetrics()
         line = fm.height() + 4
-        p.setPen(QColor("#222222"))
         y = 6
         p.drawText(QRectF(8, y, self.width() - 16, line), LEFT, self._title)
         y += line

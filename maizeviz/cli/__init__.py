@@ -15,6 +15,7 @@ import importlib
 import os
 import sys
 import traceback
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -43,6 +44,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         description="Digitized maize plants: leaf surfaces, mesh complexity, canopies, light. "
                     "Without a subcommand, opens the desktop app.")
     parser.add_argument("--version", action="version", version=f"maizeviz {__version__}")
+    parser.add_argument("--info", action="store_true",
+                        help="print versions, the Embree library, the ray kernel in use and "
+                             "why, and threads (for bug reports), then exit")
     parser.add_argument("--debug", action="store_true", help="show tracebacks")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, module in COMMANDS.items():
@@ -102,15 +106,27 @@ def _no_command(argv: list[str]) -> int:
     return main(["canopy", str(example_points()), "--tile", "3x3", "--levels"])
 
 
+def _say_warnings(message, category, filename, lineno, file=None, line=None) -> None:
+    """Python warnings (maizeviz's fallbacks, a library's deprecation) as one line each."""
+    say(f"warning: {message}")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     tokens = list(sys.argv[1:] if argv is None else argv)
     first = next((t for t in tokens if t != "--debug"), None)
+    if first == "--info":
+        from maizeviz.info import report
+
+        print(report())
+        return EXIT_OK
     if first not in COMMANDS and first not in ("-h", "--help", "--version"):
         return _no_command(tokens)                 # the app, with its own options
     args = build_parser(first if first in COMMANDS else None).parse_args(tokens)
     debug = args.debug or bool(os.environ.get("MAIZEVIZ_DEBUG"))
     try:
-        return int(args.run(args))
+        with warnings.catch_warnings():
+            warnings.showwarning = _say_warnings
+            return int(args.run(args))
     except MaizevizError as exc:
         say(error_line(exc))
         return EXIT_FAIL

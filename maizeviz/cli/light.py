@@ -438,6 +438,7 @@ def run(args: argparse.Namespace) -> int:
         rec: dict[str, Any] = {"level": label, "triangles": canopy.n_triangles,
                                "heights_cm": [float(h) for h in heights],
                                "periodic": args.periodic, "threads": args.threads,
+                               "kernel": "packets" if engine.scene().packets else "embreex",
                                "seconds": {"canopy": canopy_s, "scene": scene_s}}
         warnings: list[str] = []
         tables: list[list[dict]] = []

@@ -24,10 +24,31 @@ from typing import IO, Any
 from maizeviz.errors import MaizevizError
 
 
-def _umask_mode() -> int:
-    mask = os.umask(0)
+def read_umask() -> int:
+    """The process's umask, without a moment where it is 0.
+
+    Linux tells it in /proc/self/status; elsewhere ``os.umask`` can only read it by setting
+    it, so it is set to 0o077 for that instant: a file another thread creates meanwhile is
+    private, never world-writable (setting 0, as before, gave such a file mode 0o666).
+    """
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o077)
     os.umask(mask)
-    return 0o666 & ~mask
+    return mask
+
+
+#: The umask, read once when maizeviz.io.atomic is imported (before any thread of maizeviz
+#: writes): never set again while files are written.
+UMASK = read_umask()
+#: Mode of the files written here: what ``open`` would give a new file under :data:`UMASK`
+#: (0o644 under the usual 0o022; mkstemp's temporary file is 0o600).
+FILE_MODE = 0o666 & ~UMASK
 
 
 def _fsync_folder(folder: Path) -> None:
@@ -150,7 +171,7 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     os.close(fd)
     tmp = Path(tmp_name)
     try:
-        os.chmod(tmp, _umask_mode())
+        os.chmod(tmp, FILE_MODE)
         yield tmp
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import io
 import re
-from typing import Any
 
 import numpy as np
 
@@ -175,13 +174,10 @@ def _table(text: bytes, n: int, columns: int, dtype) -> np.ndarray | None:
     grouped = spaces.reshape(n, columns)
     if (grouped[1:, 0] < ends).any() or (grouped[:-1, -1] > ends).any():
         return None
-    # pandas 3 reads floats exactly by default (and deprecates the option)
-    exact: dict[str, Any] = {} if int(pd.__version__.split(".")[0]) >= 3 else \
-        {"float_precision": "round_trip"}
-    try:
+    try:                                    # pandas 3 reads floats to the nearest double
         table = pd.read_csv(io.BytesIO(text), sep=" ", header=None,
                             names=range(columns + 1), usecols=range(1, columns + 1),
-                            dtype=dtype, na_filter=False, engine="c", **exact)
+                            dtype=dtype, na_filter=False, engine="c")
     except (ValueError, TypeError, OverflowError, pd.errors.ParserError):
         return None
     if len(table) != n:                                                # pragma: no cover

@@ -157,8 +157,7 @@ def _read(kind: str, text: str, coerce: int | None):
         return iot.read_epw(buf, coerce_year=coerce)
     if kind == "tmy3":
         return iot.read_tmy3(buf, coerce_year=coerce, map_variables=True)
-    reader = getattr(iot, "read_nsrdb_psm4", None) or iot.read_psm3   # pvlib < 0.12
-    return reader(buf, map_variables=True)
+    return iot.read_nsrdb_psm4(buf, map_variables=True)           # reads PSM3 files too
 
 
 def _typical_year(times) -> bool:

@@ -10,13 +10,21 @@ device and geometry are one Embree). ctypes rather than a compiled extension: em
 ships its Cython declarations but not Embree's C headers, and a compiler is then not needed on
 the user's machine.
 
+The library is the one embreex loaded, found where the process mapped it (Linux, macOS,
+Windows), else where embreex's wheels vendor it: ``embreex.libs/libembree4*.so*`` (manylinux,
+auditwheel), ``embreex/.dylibs/libembree4*.dylib`` (macOS, delocate) and
+``embreex.libs/embree4*.dll`` (Windows, delvewheel); :data:`WHEEL_LAYOUTS` was checked
+against the embreex 4.4.0.post1 wheels of the three platforms.
+
 The geometry is attached to the scene of an embreex ``EmbreeScene``, whose queries
-(``run``, GIL released) stay embreex's. The scene handle is a private field of that object:
-its place is checked on every new scene against what the object says publicly (its
-``is_committed`` flag beside it, the type of its device after it) and against Embree (the
-scene's device); where anything differs, or the library is not found, :func:`fill` returns
-False and the caller falls back to embreex's own fill. ``tests/core/test_embree_fill.py`` checks
-that both fills give the same hits, triangle by triangle.
+(``run``, GIL released) stay embreex's. The scene handle is a private field of that object,
+read only for the embreex releases whose layout is known (:data:`KNOWN_EMBREEX`); its place is
+also checked on every new scene against what the object says publicly (its ``is_committed``
+flag beside it, the type of its device after it) and against Embree (the scene's device).
+Where anything differs, or the library is not found, :func:`fill` returns False and the
+caller falls back to embreex's own fill, and :func:`embree` says why (``maizeviz --info``).
+``tests/core/test_embree_fill.py`` checks that both fills give the same hits, triangle by
+triangle.
 
 References
 ----------
@@ -30,6 +38,8 @@ from __future__ import annotations
 
 import ctypes
 import functools
+import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -47,21 +57,123 @@ _PTR = ctypes.sizeof(ctypes.c_void_p)
 _SCENE_AT, _COMMITTED_AT, _DEVICE_AT = 2 * _PTR, 3 * _PTR, 4 * _PTR
 
 
+#: Where embreex's wheels keep the Embree library, relative to the folder holding the
+#: ``embreex`` package (site-packages): Linux (auditwheel), macOS (delocate), Windows
+#: (delvewheel).
+WHEEL_LAYOUTS = (("embreex.libs", "libembree4*.so*"), ("embreex/.dylibs", "libembree4*.dylib"),
+                 ("embreex.libs", "embree4*.dll"))
+#: embreex releases (major, minor) whose ``EmbreeScene`` keeps the scene handle where
+#: ``_SCENE_AT`` says (read in their Cython declarations: 4.4.0 and 4.4.0.post1).
+KNOWN_EMBREEX = ((4, 4),)
+
+
+def wheel_library(site: Path) -> Path | None:
+    """The Embree library of an embreex wheel installed in ``site`` (its site-packages), in
+    any of the three layouts, or None (none, or more than one: not knowing which is loaded)."""
+    found = [p for folder, pattern in WHEEL_LAYOUTS for p in sorted((site / folder).glob(pattern))]
+    return found[0] if len(found) == 1 else None
+
+
+def loaded_library() -> Path | None:
+    """The Embree 4 library mapped into this process (embreex's, once it is imported): from
+    /proc/self/maps on Linux, dyld's image list on macOS, the loaded module on Windows."""
+    names: list[str] = []
+    try:
+        if sys.platform.startswith("linux"):
+            with open("/proc/self/maps") as fh:
+                names = [line.split(None, 5)[-1].strip() for line in fh if "/" in line]
+        elif sys.platform == "darwin":  # pragma: no cover - macOS only
+            dyld = ctypes.CDLL(None)
+            dyld._dyld_get_image_name.restype = ctypes.c_char_p
+            names = [dyld._dyld_get_image_name(i).decode()
+                     for i in range(dyld._dyld_image_count())]
+        elif sys.platform == "win32":  # pragma: no cover - Windows only
+            k32 = ctypes.WinDLL("kernel32", use_last_error=True)
+            k32.GetModuleHandleW.restype = ctypes.c_void_p
+            k32.GetModuleHandleW.argtypes = [ctypes.c_wchar_p]
+            k32.GetModuleFileNameW.argtypes = [ctypes.c_void_p, ctypes.c_wchar_p,
+                                               ctypes.c_uint32]
+            handle = k32.GetModuleHandleW("embree4.dll")
+            if handle:
+                buf = ctypes.create_unicode_buffer(32768)
+                if k32.GetModuleFileNameW(handle, buf, len(buf)):
+                    names = [buf.value]
+    except (OSError, AttributeError, ValueError):
+        return None
+    hits = sorted({n for n in names if Path(n).name.lower().startswith(("libembree4", "embree4"))})
+    return Path(hits[0]) if len(hits) == 1 else None
+
+
+def _version_tuple(text: str) -> tuple[int, ...]:
+    import re
+
+    return tuple(int(x) for x in re.findall(r"\d+", text)[:2])
+
+
+@dataclass(frozen=True)
+class Embree:
+    """The Embree library embreex loaded, as maizeviz reaches it.
+
+    Attributes
+    ----------
+    lib : ctypes.CDLL or None
+        The library with the prototypes used here; None where it was not found.
+    path : Path or None
+        Its file.
+    embreex : str
+        embreex's version ("" when it does not import).
+    scene_field : bool
+        Whether an ``EmbreeScene``'s private scene handle may be read (a known embreex).
+    why : str
+        Why the copy fill, instances and ray packets cannot be used ("" when they can).
+    """
+
+    lib: ctypes.CDLL | None
+    path: Path | None
+    embreex: str
+    scene_field: bool
+    why: str
+
+    @property
+    def version(self) -> str:
+        """Embree's own version ("4.4.0"), asked of a device; "" without the library."""
+        if self.lib is None:
+            return ""
+        device = self.lib.rtcNewDevice(b"verbose=0")
+        if not device:  # pragma: no cover - Embree refusing a device
+            return ""
+        try:
+            v = int(self.lib.rtcGetDeviceProperty(device, 0))    # RTC_DEVICE_PROPERTY_VERSION
+        finally:
+            self.lib.rtcReleaseDevice(device)
+        return f"{v // 10000}.{v // 100 % 100}.{v % 100}"
+
+
 @functools.cache
-def _embree():
-    """The Embree library embreex loaded, with the prototypes used here; None if not found."""
+def embree() -> Embree:
+    """What :func:`fill`, the instances and the ray packets use: the library embreex loaded,
+    found once (:func:`loaded_library`, else :func:`wheel_library`)."""
     try:
         import embreex
-    except ImportError:
-        return None
-    folder = Path(embreex.__file__).resolve().parent.parent / "embreex.libs"
-    found = sorted(folder.glob("libembree4*.so*"))
-    if len(found) != 1:
-        return None
+        from embreex import rtcore_scene  # noqa: F401 - loads Embree
+    except ImportError as exc:
+        return Embree(None, None, "", False, f"embreex does not import ({exc})")
+    from importlib.metadata import PackageNotFoundError, version
+
     try:
-        lib = ctypes.CDLL(str(found[0]))
-    except OSError:
-        return None
+        release = version("embreex")
+    except PackageNotFoundError:  # pragma: no cover - embreex without its metadata
+        release = "unknown"
+    site = Path(embreex.__file__).resolve().parent.parent
+    path = loaded_library() or wheel_library(site)
+    if path is None:
+        return Embree(None, None, release, False,
+                      f"the Embree library embreex {release} loads was not found (not mapped "
+                      f"in this process, nor in {site} as embreex's wheels keep it)")
+    try:
+        lib = ctypes.CDLL(str(path))
+    except OSError as exc:
+        return Embree(None, path, release, False, f"{path} does not load ({exc})")
     p, u = ctypes.c_void_p, ctypes.c_uint
     for name, res, args in (
             ("rtcNewGeometry", p, [p, ctypes.c_int]),
@@ -71,6 +183,8 @@ def _embree():
             ("rtcAttachGeometry", u, [p, p]),
             ("rtcReleaseGeometry", None, [p]),
             ("rtcGetSceneDevice", p, [p]),
+            ("rtcNewDevice", p, [ctypes.c_char_p]),
+            ("rtcGetDeviceProperty", ctypes.c_ssize_t, [p, ctypes.c_int]),
             ("rtcReleaseDevice", None, [p]),
             # scenes of instances (maizeviz.mesh.instances)
             ("rtcNewScene", p, [p]),
@@ -80,9 +194,21 @@ def _embree():
             ("rtcSetGeometryTransform", None, [p, u, ctypes.c_int, p])):
         fn = getattr(lib, name, None)
         if fn is None:
-            return None
+            return Embree(None, path, release, False, f"{path} has no {name}: not Embree 4")
         fn.restype, fn.argtypes = res, args
-    return lib
+    if _version_tuple(release) not in KNOWN_EMBREEX:
+        known = ", ".join(".".join(map(str, v)) + ".x" for v in KNOWN_EMBREEX)
+        return Embree(lib, path, release, False,
+                      f"embreex {release} is not a release whose scene layout maizeviz knows "
+                      f"({known}): its scenes' private handle is not read")
+    return Embree(lib, path, release, True, "")
+
+
+def _embree():
+    """The Embree library embreex loaded, with the prototypes used here; None where it was
+    not found or embreex's scenes cannot be reached (:func:`embree` says why)."""
+    e = embree()
+    return e.lib if e.scene_field else None
 
 
 def _handles(scene) -> tuple[int, int] | None:

@@ -16,13 +16,28 @@ import numpy as np
 try:  # optional native piece: fail only when ray tracing is used
     from embreex.mesh_construction import TriangleMesh
     from embreex.rtcore_scene import EmbreeScene
-except ImportError as _exc:  # pragma: no cover - exercised only without embreex
+except ImportError as _exc:  # exercised by tests/core/test_packets.py in a subprocess
     EmbreeScene = None
     _IMPORT_ERROR = _exc
 
 from maizeviz.errors import MaizevizError
 from maizeviz.mesh import packets as _packets
-from maizeviz.mesh.embree_fill import _handles, fill
+from maizeviz.mesh.embree_fill import _handles, embree, fill
+
+#: Why the fast paths are off when embreex's scene object is not laid out as expected.
+_UNREAD = "embreex's EmbreeScene is not laid out as maizeviz reads it (its scene handle)"
+
+
+def no_embreex(exc: BaseException) -> str:
+    """One line for light asked where embreex does not import: its wheels' platforms, and this
+    one."""
+    import platform
+    import sys
+
+    return (f"light is traced by Embree through embreex, which does not import here ({exc}): "
+            f"embreex has wheels for Linux x86-64, Windows x86-64 and macOS 13 or later, this "
+            f"is {sys.platform} {platform.machine()} (pip install embreex, or build it against "
+            "an Embree 4 of the system)")
 
 
 def _writable(a) -> np.ndarray:
@@ -53,8 +68,8 @@ class RayScene:
         ``TriangleMesh`` (the same scene: ``filled_by_copy`` says which was used).
         ``packets``: trace through Embree's ray packets where the kernel is available
         (``self.packets`` says whether it is used), else embreex's single rays."""
-        if EmbreeScene is None:  # pragma: no cover
-            raise MaizevizError(f"ray tracing needs embreex, which failed to import: {_IMPORT_ERROR}")
+        if EmbreeScene is None:
+            raise MaizevizError(no_embreex(_IMPORT_ERROR), quantity="embreex")
         if len(faces) == 0:
             raise MaizevizError("the scene is empty: no triangle to trace against")
         self.n_triangles = len(faces)
@@ -63,13 +78,17 @@ class RayScene:
         tris = np.ascontiguousarray(faces, dtype=np.int32)
         self.filled_by_copy = by_copy and fill(self._scene, verts, tris)
         if not self.filled_by_copy:
+            if by_copy:
+                _packets.warn_once(embree().why or _UNREAD, "filling Embree's scenes through "
+                                   "embreex (the same scene, about 3x slower to build)")
             self._mesh = TriangleMesh(self._scene, verts, tris)
         # commit now: the lazy first build is not thread-safe
         self._scene.run(np.zeros((1, 3), np.float32), np.array([[0, 0, 1]], np.float32))
         self._kernel = _packets.kernel() if packets else None
         handles = _handles(self._scene) if self._kernel is not None else None
         self._handle = handles[0] if handles else 0
-        if not self._handle:
+        if packets and not self._handle:
+            _packets.warn_once(_packets.status().why if self._kernel is None else _UNREAD)
             self._kernel = None
 
     @property

@@ -414,6 +414,7 @@ def _time(text: Any, where: str, what: str):
             text is None else "something else"
         raise ProjectError(f"{where}: {what} must be an ISO 8601 time with its UTC offset "
                            f"(2005-08-01T12:00:00+08:00), got {shown}")
+    t: pd.Timestamp | None
     try:
         t = pd.Timestamp(text.strip())
         t = None if t is pd.NaT or t.tz is None else t.as_unit("ns")   # years 1678-2261

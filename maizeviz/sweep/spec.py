@@ -52,18 +52,13 @@ import itertools
 import json
 import math
 import os
-import sys
+import tomllib
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from datetime import date, datetime
 from datetime import time as dtime
 from pathlib import Path
 from typing import Any, NoReturn
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10: the tomli backport (the sweep extra installs it)
-    import tomli as tomllib
 
 import maizeviz
 from maizeviz.errors import MaizevizError

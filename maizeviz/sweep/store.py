@@ -66,7 +66,7 @@ OWN_FILES = {"sweep.json", "parts", "results.parquet", "results.csv", "summary.c
 
 
 def now_iso() -> str:
-    return dt.datetime.now(dt.timezone.utc).astimezone().isoformat(timespec="seconds")
+    return dt.datetime.now(dt.UTC).astimezone().isoformat(timespec="seconds")
 
 
 def scenario_rows(s, result: dict, worker: str | None, finished_at: str) -> list[dict]:

@@ -76,3 +76,21 @@ def test_a_small_cell_keeps_the_mesh_and_a_larger_one_thins_it_by_its_area():
     assert 0.3 * target < len(coarse) < 3 * target
     with pytest.raises(ValueError, match="cell size"):
         cluster_triangles(v, f, g, 0.0)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.integers(2, 40))
+def test_repeated_triangles_are_those_with_the_corners_of_an_earlier_one(seed, n):
+    """Against numpy's unique rows: the same corners by position (-0.0 is 0.0), in any order
+    and orientation, repeat an earlier triangle."""
+    from maizeviz.canopy.from_mesh import repeated_triangles
+
+    rng = np.random.default_rng(seed)
+    vertices = rng.integers(-2, 3, (n, 3)).astype(np.float64) * 0.5
+    vertices[rng.random(n) < 0.3] *= -1.0                  # -0.0 where 0.0 was
+    faces = rng.integers(0, n, (3 * n, 3))
+    got = repeated_triangles(vertices, faces)
+    _, same = np.unique(vertices, axis=0, return_inverse=True)
+    corners = [tuple(sorted(same.reshape(-1)[f])) for f in faces]
+    want = [c in corners[:k] for k, c in enumerate(corners)]
+    np.testing.assert_array_equal(got, want)

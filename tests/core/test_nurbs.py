@@ -171,7 +171,11 @@ def test_banded_fit_and_evaluation_equal_the_dense_ones(m, n, seed):
                   - pts).max() <= 1e-9 * scale          # still through every point
     k = rng.uniform(0, 1, (2, 50))
     want = _old_derivatives(dense, k[0], k[1])
-    got = dense._at(k[0], k[1], derivative=True)
+    try:
+        nurbs.BANDED_FROM = 2                       # points and derivatives, banded
+        got = dense._at(k[0], k[1], derivative=True)
+    finally:
+        nurbs.BANDED_FROM = old
     for g, w in zip(got, want):
         assert np.abs(g - w).max() <= 1e-9 * max(1.0, np.abs(w).max())
 

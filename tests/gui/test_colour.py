@@ -281,3 +281,35 @@ def test_a_project_keeps_the_colours(window, qtbot, tmp_path):
     assert w.model.colour.view.range == "percentile" and w.model.colour.view.clip == 5.0
     assert w.model.colour.view.cmap == "cividis" and w.model.colour.heatmap.log
     assert w.colour_panel.view_editor.cmap.currentText() == "cividis"
+
+
+def test_the_window_redraws_its_heatmaps_when_their_colours_change(window, qtbot, small_points):
+    from test_light_modes import compute, shown, small_light
+
+    from maizeviz.light.report.heatmap import result_map
+
+    w = shown(qtbot, window(small_points, tile=1))
+    small_light(w.light_panel, "sun")
+    compute(qtbot, w)
+    heat = w.plots.heatmap
+    qtbot.waitUntil(lambda: heat.heatmap is not None, timeout=120_000)
+    result = w.runs.last.result
+    maps = [result_map(result, float(h), "sun").transmission for h in result.heights_cm]
+    own = maps[0]
+    assert heat.heatmap.limits == (np.nanmin(own), np.nanmax(own))
+    # typed: redrawn with the typed range, its note saying it
+    w.model.colour.heatmap.update_from_doc({"range": "fixed", "vmin": 0.1, "vmax": 0.6,
+                                            "cmap": "greys"})
+    qtbot.waitUntil(lambda: heat.heatmap is not None and heat.heatmap.limits == (0.1, 0.6),
+                    timeout=120_000)
+    assert "0.1 to 0.6" in w.colour_panel.heatmap_editor.note.text()
+    # one scale for every height: the same range at each, that of all the maps
+    w.model.colour.heatmap.range = "auto"
+    w.model.colour.shared = True
+    both = (min(np.nanmin(m) for m in maps), max(np.nanmax(m) for m in maps))
+    for index in range(len(maps)):
+        w.plots.height_box.setCurrentIndex(index)
+        want = float(result.heights_cm[index])
+        qtbot.waitUntil(lambda want=want: heat.heatmap is not None and
+                        heat.heatmap.height_cm == want, timeout=120_000)
+        assert heat.heatmap.limits == pytest.approx(both)

@@ -10,7 +10,7 @@ from test_light_modes import TIMEOUT, compute, shown, small_light
 from maizeviz.mesh.levels import COMPLEXITY_STOPS
 
 
-def test_k4_sun_paints_each_leaf_with_its_sunlit_share(window, qtbot, small_points):
+def test_k4_sun_paints_each_leaf_with_its_sunlit_share(window, qtbot, small_points, tmp_path):
     w = shown(qtbot, window(small_points, tile=1))
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
         w.slider.setValue(COMPLEXITY_STOPS.index("K4"))
@@ -47,6 +47,16 @@ def test_k4_sun_paints_each_leaf_with_its_sunlit_share(window, qtbot, small_poin
     assert "many sunlit triangles get no ray" in w.colour_panel.painting_note.text()
     w.model.colour.painting = "auto"
     assert view.light_variant == "values"
+    # the exported canopy carries the leaves' share beside the classes
+    import pyvista as pv
+
+    out = tmp_path / "k4.vtu"
+    with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
+        w.export("canopy", out)
+    mesh = pv.read(out)
+    np.testing.assert_array_equal(np.asarray(mesh.cell_data["light"])[:n], run.classes)
+    np.testing.assert_allclose(np.asarray(mesh.cell_data["sunlit_share"])[:n],
+                               run.painting.share, equal_nan=True)
 
 
 def test_36_triangles_a_leaf_are_painted_one_by_one(window, qtbot, small_points):

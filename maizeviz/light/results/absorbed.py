@@ -16,10 +16,13 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.results.per_leaf import LightRow, leaf_sums
+from maizeviz.light.results.traced import TableBy, table_kind
 from maizeviz.light.results.uncertainty import Batches, errors_by
 
-if TYPE_CHECKING:                       # the optics live with the tracing that uses them
-    from maizeviz.light.trace.optics import Optics
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from maizeviz.light.trace.optics import Optics  # with the tracing that uses them
 
 
 #: Share of the incident light left unresolved (still travelling when scattering stopped)
@@ -144,28 +147,36 @@ class AbsorbedLight:
         return {"absorbed_leaves": float(self.absorbed_leaves_error or 0.0),
                 **(self.batches.balance_errors(1.0) or {})}
 
-    def table(self, by: str = "plant", canopy=None):
-        """Absorbed light per leaf or per plant as a pandas DataFrame.
+    def table(self, by: TableBy | None = None, canopy: Canopy | None = None) -> pd.DataFrame:
+        """Absorbed light as a table: the energy balance, or per leaf or per plant.
 
-        Columns: ``absorbed_w`` (W), ``absorbed_w_m2_leaf`` (W per m2 of one-sided leaf area),
-        ``sunlit_area_cm2`` and ``shaded_area_cm2`` (leaf area in and out of the direct beam),
-        and for PAR ``absorbed_umol_s`` (umol/s: 4.57 umol per J of PAR). ``by="balance"``:
-        the energy balance (W/m2 of ground) as one row.
+        Parameters
+        ----------
+        by : {None, "balance", "leaf", "plant"}
+            None (the default) or "balance": the energy balance [W m-2 of ground] as one
+            row. "leaf" or "plant": ``absorbed_w`` [W], ``absorbed_w_m2_leaf`` [W m-2 of
+            one-sided leaf area], ``sunlit_area_cm2`` and ``shaded_area_cm2`` [cm2] (leaf area
+            in and out of the direct beam), and for PAR ``absorbed_umol_s`` [umol s-1]
+            (4.57 umol per J of PAR).
+        canopy : Canopy, optional
+            The canopy the light was traced on; needed by leaf and plant.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row, or one per lit leaf or plant.
+
+        Raises
+        ------
+        MaizevizError
+            Another ``by``, or a leaf or plant table without the canopy.
         """
         import pandas as pd
 
-        if by == "balance":
+        kind = table_kind(by, "balance", canopy)
+        if kind == "balance":
             return pd.DataFrame([{"band": self.band, **self.balance.as_dict()}])
-        if by not in ("leaf", "plant"):
-            from maizeviz.errors import MaizevizError
-
-            raise MaizevizError(f"absorbed light is tabled by 'leaf', 'plant' or 'balance', not "
-                                f"'{by}'", quantity="table")
-        if canopy is None:
-            from maizeviz.errors import MaizevizError
-
-            raise MaizevizError("give the canopy the light was traced on to table it by "
-                                f"{by}", quantity="table")
+        assert canopy is not None
         from maizeviz.light.sources.irradiance import PAR_UMOL_PER_J_PAR
 
         rows = leaf_sums(canopy, {"absorbed_w": self.triangle_absorbed_w,
@@ -175,12 +186,12 @@ class AbsorbedLight:
         if frame.empty:
             return frame
         frame["sunlit_area_cm2"] = np.minimum(frame["sunlit_area_cm2"], frame["leaf_area_cm2"])
-        if by == "plant":
+        if kind == "plant":
             frame = _per_plant(frame, ("absorbed_w", "sunlit_area_cm2"))
         if self.batches is not None:
             se = errors_by(canopy, self.batches.absorbed, "absorbed_w", self.rect,
-                           self.periodic, by)
-            keys = frame["instance"] if by == "plant" else zip(frame["instance"], frame["leaf"])
+                           self.periodic, kind)
+            keys = frame["instance"] if kind == "plant" else zip(frame["instance"], frame["leaf"])
             frame["absorbed_w_se"] = [se.get(k, 0.0) for k in keys]
         frame["shaded_area_cm2"] = frame["leaf_area_cm2"] - frame["sunlit_area_cm2"]
         frame["absorbed_w_m2_leaf"] = frame["absorbed_w"] / (frame["leaf_area_cm2"] * 1e-4)
@@ -273,21 +284,35 @@ class AbsorbedPeriod:
         return self.balance.absorbed_leaves * PAR_UMOL_PER_J_PAR if self.band == "par" \
             else None                           # MJ x umol/J = mol
 
-    def table(self, by: str = "plant", canopy=None):
-        """Absorbed light per leaf or per plant over the period as a pandas DataFrame:
-        ``absorbed_mj`` (MJ), ``absorbed_mj_m2_leaf``, and for PAR ``absorbed_mol``;
-        ``by="balance"``: the balance (MJ/m2 of ground) as one row."""
+    def table(self, by: TableBy | None = None, canopy: Canopy | None = None) -> pd.DataFrame:
+        """Absorbed light over the period as a table: the balance, or per leaf or per plant.
+
+        Parameters
+        ----------
+        by : {None, "balance", "leaf", "plant"}
+            None (the default) or "balance": the balance [MJ m-2 of ground] as one row.
+            "leaf" or "plant": ``absorbed_mj`` [MJ], ``absorbed_mj_m2_leaf`` [MJ m-2 of leaf],
+            and for PAR ``absorbed_mol`` [mol].
+        canopy : Canopy, optional
+            The canopy the light was traced on; needed by leaf and plant.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row, or one per lit leaf or plant.
+
+        Raises
+        ------
+        MaizevizError
+            Another ``by``, or a leaf or plant table without the canopy.
+        """
         import pandas as pd
 
-        from maizeviz.errors import MaizevizError
-
-        if by == "balance":
+        kind = table_kind(by, "balance", canopy)
+        if kind == "balance":
             return pd.DataFrame([{"band": self.band, "unit": "MJ/m2",
                                   **self.balance.as_dict()}])
-        if by not in ("leaf", "plant") or canopy is None:
-            raise MaizevizError("absorbed light over a period is tabled by 'leaf' or 'plant' "
-                                "(with the canopy it was traced on) or 'balance'",
-                                quantity="table")
+        assert canopy is not None
         from maizeviz.light.sources.irradiance import PAR_UMOL_PER_J_PAR
 
         rows = leaf_sums(canopy, {"absorbed_mj": self.triangle_absorbed_j * 1e-6}, self.rect,
@@ -295,14 +320,23 @@ class AbsorbedPeriod:
         frame = pd.DataFrame(rows)
         if frame.empty:
             return frame
-        if by == "plant":
+        if kind == "plant":
             frame = _per_plant(frame, ("absorbed_mj",))
         if self.batches is not None:
             se = errors_by(canopy, self.batches.absorbed * 1e-6, "absorbed_mj", self.rect,
-                           self.periodic, by)
-            keys = frame["instance"] if by == "plant" else zip(frame["instance"], frame["leaf"])
+                           self.periodic, kind)
+            keys = frame["instance"] if kind == "plant" else zip(frame["instance"], frame["leaf"])
             frame["absorbed_mj_se"] = [se.get(k, 0.0) for k in keys]
         frame["absorbed_mj_m2_leaf"] = frame["absorbed_mj"] / (frame["leaf_area_cm2"] * 1e-4)
         if self.band == "par":
             frame["absorbed_mol"] = frame["absorbed_mj"] * PAR_UMOL_PER_J_PAR
         return frame
+
+    def leaf_rows(self, canopy: Canopy) -> list[LightRow]:
+        """Per lit leaf: ``absorbed_mj`` [MJ] over the period and ``absorbed_mj_m2_leaf``
+        [MJ m-2 of leaf] (:func:`maizeviz.light.results.per_leaf.leaf_sums`)."""
+        rows = leaf_sums(canopy, {"absorbed_mj": self.triangle_absorbed_j * 1e-6}, self.rect,
+                         self.periodic)
+        for r in rows:
+            r["absorbed_mj_m2_leaf"] = float(r["absorbed_mj"]) / (float(r["leaf_area_cm2"]) * 1e-4)
+        return rows

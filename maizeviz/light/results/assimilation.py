@@ -41,6 +41,7 @@ if TYPE_CHECKING:
 
     from maizeviz.canopy.scene import Canopy
     from maizeviz.light.results.absorbed import AbsorbedLight
+    from maizeviz.light.results.traced import TableBy
 
 
 #: Height band (cm) over which the background light of a leaf's triangles is pooled.
@@ -142,10 +143,24 @@ class Assimilation:
                 "leaf_area_index": self.leaf_area_m2 / self.ground_m2,
                 "warnings": list(self.warnings)}
 
-    def table(self, by: str = "plant", canopy: Canopy | None = None) -> pd.DataFrame:
-        """Gross assimilation per leaf or plant: ``gross_umol_s`` (umol CO2/s), its standard
-        error ``gross_umol_s_se``, ``gross_umol_m2_leaf_s`` (per m2 of leaf)."""
-        return _table(self.triangle_gross_umol_s, self.triangle_batches, "gross_umol_s",
+    def table(self, by: TableBy | None = None, canopy: Canopy | None = None) -> pd.DataFrame:
+        """Gross assimilation as a table: the canopy's, or per leaf or plant.
+
+        Parameters
+        ----------
+        by : {None, "canopy", "leaf", "plant"}
+            None (the default) or "canopy": the canopy's figures as one row (:meth:`as_dict`'s
+            numbers). "leaf" or "plant": ``gross_umol_s`` [umol CO2 s-1], its standard error
+            ``gross_umol_s_se``, ``gross_umol_m2_leaf_s`` [umol CO2 m-2 of leaf s-1].
+        canopy : Canopy, optional
+            The canopy the light was traced on; needed by leaf and plant.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row, or one per leaf or plant.
+        """
+        return _table(self, self.triangle_gross_umol_s, self.triangle_batches, "gross_umol_s",
                       "gross_umol_m2_leaf_s", self.rect, self.periodic, by, canopy)
 
 
@@ -205,28 +220,47 @@ class PeriodAssimilation:
                 "canopy_gross_g_co2_m2_se": None if se is None else se * CO2_G_PER_MOL,
                 "step_gross_umol_m2_s": [float(v) for v in self.step_gross_umol_m2_s]}
 
-    def table(self, by: str = "plant", canopy: Canopy | None = None) -> pd.DataFrame:
-        """Per leaf or plant: ``gross_mol`` (mol CO2 over the period), ``gross_mol_se``,
-        ``gross_g_co2`` (g), ``gross_mol_m2_leaf``."""
-        frame = _table(self.triangle_gross_mol, self.triangle_batches, "gross_mol",
+    def table(self, by: TableBy | None = None, canopy: Canopy | None = None) -> pd.DataFrame:
+        """Gross assimilation over the period as a table: the canopy's, or per leaf or plant.
+
+        Parameters
+        ----------
+        by : {None, "canopy", "leaf", "plant"}
+            None (the default) or "canopy": the canopy's figures as one row (:meth:`as_dict`'s
+            numbers). "leaf" or "plant": ``gross_mol`` [mol CO2] over the period,
+            ``gross_mol_se``, ``gross_g_co2`` [g], ``gross_mol_m2_leaf`` [mol m-2 of leaf].
+        canopy : Canopy, optional
+            The canopy the light was traced on; needed by leaf and plant.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row, or one per leaf or plant.
+        """
+        frame = _table(self, self.triangle_gross_mol, self.triangle_batches, "gross_mol",
                        "gross_mol_m2_leaf", self.rect, self.periodic, by, canopy)
-        if not frame.empty:
+        if by is not None and by != "canopy" and not frame.empty:
             frame["gross_g_co2"] = frame["gross_mol"] * CO2_G_PER_MOL
         return frame
 
 
-def _table(values: np.ndarray, batches: np.ndarray | None, col: str, per_leaf_col: str,
-           rect, periodic: bool, by: str, canopy: Canopy | None) -> pd.DataFrame:
-    """Per-leaf or per-plant sums of per-triangle ``values`` (column ``col``), their standard
-    errors from ``batches`` (column ``col + "_se"``), and ``per_leaf_col``: per m2 of leaf."""
+def _table(result, values: np.ndarray, batches: np.ndarray | None, col: str,
+           per_leaf_col: str, rect, periodic: bool, by: str | None,
+           canopy: Canopy | None) -> pd.DataFrame:
+    """The canopy's figures as one row (``by`` None or "canopy"), or per-leaf or per-plant
+    sums of per-triangle ``values`` (column ``col``), their standard errors from ``batches``
+    (column ``col + "_se"``), and ``per_leaf_col``: per m2 of leaf."""
     import pandas as pd
 
     from maizeviz.light.results.per_leaf import leaf_sums
+    from maizeviz.light.results.traced import table_kind
     from maizeviz.light.results.uncertainty import errors_by
 
-    if by not in ("leaf", "plant") or canopy is None:
-        raise MaizevizError("assimilation is tabled by 'leaf' or 'plant', with the canopy it "
-                            "was computed on", quantity="table")
+    by = table_kind(by, "canopy", canopy)
+    if by == "canopy":
+        return pd.DataFrame([{k: v for k, v in result.as_dict().items()
+                              if isinstance(v, (str, int, float)) or v is None}])
+    assert canopy is not None
     frame = pd.DataFrame(leaf_sums(canopy, {col: values}, rect, periodic))
     if frame.empty:
         return frame

@@ -83,7 +83,7 @@ def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None =
     except (TypeError, ValueError):
         raise MaizevizError(f"the date must be YYYY-MM-DD, got '{date}'", quantity="date") from None
     if solar_noon:
-        where = zone(tz) if tz is not None else _dt.timezone.utc
+        where = zone(tz) if tz is not None else _dt.UTC
         ns = spa.transit_ns(day, lat, lon)
         unixtime, when = ns / 1e9, spa.iso_ns(ns, where)
     else:
