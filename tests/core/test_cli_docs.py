@@ -66,9 +66,15 @@ def argv_of(line: str) -> list[str]:
     return words[1:]
 
 
+#: What the command line answers itself, without the app: ``maizeviz --info`` and friends.
+CORE_OPTIONS = ("--info", "--version", "-h", "--help")
+
+
 def kind_of(line: str) -> str:
     """"app" (no subcommand), "serial" (the digitizer) or "headless"."""
     args = argv_of(line)
+    if args and args[0] in CORE_OPTIONS:
+        return "headless"
     if not args or args[0] not in COMMANDS:
         return "app"
     return "serial" if args[0] in SERIAL else "headless"
@@ -141,6 +147,7 @@ def test_the_page_has_commands_of_every_kind():
     assert kinds.count("headless") >= 25 and "app" in kinds and "serial" in kinds
     # every subcommand of maizeviz is shown on the page
     shown = {argv_of(line)[0] for line in doc_commands() if kind_of(line) != "app"}
+    shown -= set(CORE_OPTIONS)
     assert shown >= set(COMMANDS) - {"sweep"}
 
 
