@@ -129,7 +129,7 @@ def _screenshot_flow(app, window, path: str, code: dict) -> None:
     def on_canopy(_label: str) -> None:
         if not state["lit"]:
             state["lit"] = True
-            window.compute_light()
+            window.model.compute_light()
 
     window.canopy_shown.connect(on_canopy)
     window.light_shown.connect(lambda: QTimer.singleShot(800, shoot))

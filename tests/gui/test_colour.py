@@ -260,7 +260,7 @@ def test_the_heatmap_pixels_follow_the_colour_map():
 
 def test_a_project_keeps_the_colours(window, qtbot, tmp_path):
     w = window()
-    qtbot.waitUntil(lambda: w.built is not None, timeout=120_000)
+    qtbot.waitUntil(lambda: w.model.built is not None, timeout=120_000)
     w.model.colour.update_from_doc({"view": {"range": "percentile", "clip": 5.0,
                                              "cmap": "cividis"},
                                     "heatmap": {"log": True}, "shared": True})
@@ -269,7 +269,7 @@ def test_a_project_keeps_the_colours(window, qtbot, tmp_path):
     assert w.colour_panel.shared.isChecked()
     path = tmp_path / "colours.maizeviz"
     with qtbot.waitSignal(w.saved, timeout=120_000):
-        w.save_project(path)
+        w.model.save_project(path)
     with zipfile.ZipFile(path) as zf:
         names = [n for n in zf.namelist() if n.endswith(".json")]
         docs = [json.loads(zf.read(n)) for n in names]
@@ -293,7 +293,7 @@ def test_the_window_redraws_its_heatmaps_when_their_colours_change(window, qtbot
     compute(qtbot, w)
     heat = w.plots.heatmap
     qtbot.waitUntil(lambda: heat.heatmap is not None, timeout=120_000)
-    result = w.runs.last.result
+    result = w.model.runs.last.result
     maps = [result_map(result, float(h), "sun").transmission for h in result.heights_cm]
     own = maps[0]
     assert heat.heatmap.limits == (np.nanmin(own), np.nanmax(own))

@@ -346,8 +346,8 @@ def test_a_canopy_built_while_digitizing_waits_for_the_session(window, two_plant
     w.digitizer._drain()
     qtbot.waitUntil(lambda: "digitized" in w.viewport.actors, timeout=TIMEOUT)
     with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
-        w.slider.setValue(w.slider.value() + 1)             # a rebuild finishes meanwhile
-    assert w.built.label == "16 triangles"
+        w.canopy_panel.slider.setValue(w.canopy_panel.slider.value() + 1)             # a rebuild finishes meanwhile
+    assert w.model.built.label == "16 triangles"
     assert "canopy" not in w.viewport.actors                 # the plant keeps the view
     assert "digitized" in w.viewport.actors
     with qtbot.waitSignal(w.digitizer.stopped, timeout=TIMEOUT):
@@ -355,5 +355,5 @@ def test_a_canopy_built_while_digitizing_waits_for_the_session(window, two_plant
     assert "digitized" in w.viewport.actors                  # still, until Analyse
     w.workspaces.show("analyse")
     assert "canopy" in w.viewport.actors and "digitized" not in w.viewport.actors
-    n_stalk = len(w.canopy.stalk_faces)
-    assert w.viewport.canopy_mesh.n_cells == w.canopy.n_triangles + n_stalk   # the new one
+    n_stalk = len(w.model.canopy.stalk_faces)
+    assert w.viewport.canopy_mesh.n_cells == w.model.canopy.n_triangles + n_stalk   # the new one

@@ -13,10 +13,10 @@ from maizeviz.mesh.levels import COMPLEXITY_STOPS
 def test_k4_sun_paints_each_leaf_with_its_sunlit_share(window, qtbot, small_points, tmp_path):
     w = shown(qtbot, window(small_points, tile=1))
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
-        w.slider.setValue(COMPLEXITY_STOPS.index("K4"))
+        w.canopy_panel.slider.setValue(COMPLEXITY_STOPS.index("K4"))
     small_light(w.light_panel, "sun", density=2.0)
     compute(qtbot, w)
-    run, view, c = w.runs.last, w.viewport, w.canopy
+    run, view, c = w.model.runs.last, w.viewport, w.model.canopy
     assert run.painting.per == "leaves" and run.painting.rays_per_triangle < 1
     assert view.colouring == "light" and view.light_variant == "values"
     n = c.n_triangles
@@ -52,7 +52,7 @@ def test_k4_sun_paints_each_leaf_with_its_sunlit_share(window, qtbot, small_poin
 
     out = tmp_path / "k4.vtu"
     with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
-        w.export("canopy", out)
+        w.model.export("canopy", out)
     mesh = pv.read(out)
     np.testing.assert_array_equal(np.asarray(mesh.cell_data["sun_class"])[:n], run.classes)
     np.testing.assert_allclose(np.asarray(mesh.cell_data["sunlit_share"])[:n],
@@ -63,9 +63,9 @@ def test_36_triangles_a_leaf_are_painted_one_by_one(window, qtbot, small_points)
     w = shown(qtbot, window(small_points, tile=1))
     small_light(w.light_panel, "sun", density=2.0)
     compute(qtbot, w)
-    assert w.runs.last.painting.per == "triangles"
+    assert w.model.runs.last.painting.per == "triangles"
     assert w.viewport.light_variant == "classes"
     np.testing.assert_array_equal(
-        np.asarray(w.viewport.canopy_mesh.cell_data["light"])[:w.canopy.n_triangles],
-        w.runs.last.classes)
+        np.asarray(w.viewport.canopy_mesh.cell_data["light"])[:w.model.canopy.n_triangles],
+        w.model.runs.last.classes)
     assert "light class" in w.colour_panel.painting_note.text()

@@ -77,7 +77,7 @@ def test_a_click_picks_the_first_triangle_under_the_mouse_and_tells_its_leaf(
         assert p is not None and p.cell == want
         assert (model.selection.placement, model.selection.leaf) == (p.instance, p.leaf)
         if p.leaf > 0:
-            c = w.canopy
+            c = w.model.canopy
             mine = (c.face_instance == p.instance) & (c.face_leaf == p.leaf)
             area, _ = triangle_areas_normals(c.vertices, c.faces[mine])
             text = view.info.text()
@@ -124,7 +124,7 @@ def test_plants_table_and_view_select_each_other_with_the_light_of_the_selection
     stand = int(table.item(row, 0).text())
     table.selectRow(row)
     assert (model.selection.placement, model.selection.leaf) == (stand - 1, -1)
-    c = w.canopy
+    c = w.model.canopy
     mine = c.face_instance == stand - 1
     drawn = np.asarray(view.canopy_mesh.cell_data["instance"]) == stand
     assert view.actors["selection"].mapper.dataset.n_cells == drawn.sum()
@@ -135,7 +135,7 @@ def test_plants_table_and_view_select_each_other_with_the_light_of_the_selection
     assert not np.allclose(now, focal) and np.all(now >= lo - 1) and np.all(now <= hi + 1)
     # the card: the plant's sky light, the area-weighted mean of its leaves' values
     area, _ = triangle_areas_normals(c.vertices, c.faces[mine])
-    value = w.runs.last.extra.leaf_value[mine]
+    value = w.model.runs.last.extra.leaf_value[mine]
     ok = np.isfinite(value)
     mean = np.sum(value[ok] * area[ok]) / area[ok].sum()
     assert f"sky: {mean:.3f} of the open sky's diffuse light per leaf area" in view.info.text()
@@ -157,7 +157,7 @@ def test_plants_table_and_view_select_each_other_with_the_light_of_the_selection
     from maizeviz.mesh.levels import COMPLEXITY_STOPS
 
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
-        w.slider.setValue(COMPLEXITY_STOPS.index("16"))
+        w.canopy_panel.slider.setValue(COMPLEXITY_STOPS.index("16"))
     qtbot.waitUntil(lambda: "level 16 triangles" in view.info.text(), timeout=5000)
     drawn = (np.asarray(view.canopy_mesh.cell_data["instance"]) == p.instance + 1) & \
         (np.asarray(view.canopy_mesh.cell_data["leaf"]) == p.leaf)

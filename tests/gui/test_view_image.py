@@ -58,7 +58,7 @@ def test_the_view_saved_as_an_image_is_the_view_with_its_colour_key(window, qtbo
     rw, rh = render_size(view)
     one = tmp_path / "view.png"
     with qtbot.waitSignal(w.saved, timeout=30_000):
-        w.save_view_image(one)
+        w.view_link.save_image(one)
     image = _array(QImage(str(one)))
     assert image.shape[:2] == (rh, rw) == on_screen.shape[:2]
     # the 3D part is what the screen shows
@@ -75,13 +75,13 @@ def test_the_view_saved_as_an_image_is_the_view_with_its_colour_key(window, qtbo
     assert np.abs(bar[2] - table[0].astype(int)).max() < 25
     # twice as wide: the same picture, sharper
     two = tmp_path / "view2x.png"
-    w.save_view_image(two, 2 * rw)
+    w.view_link.save_image(two, 2 * rw)
     big = _array(QImage(str(two)))
     assert big.shape[:2] == (2 * rh, 2 * rw)
     halved = big.reshape(rh, 2, rw, 2, 3).mean(axis=(1, 3))
     assert np.abs(halved - image)[outside].mean() < 12.0
     # a width it cannot make: said, nothing written
-    w.save_view_image(tmp_path / "tiny.png", 5)
+    w.view_link.save_image(tmp_path / "tiny.png", 5)
     assert not (tmp_path / "tiny.png").exists()
     assert "image width 5 px" in w.messages.toPlainText()
 
@@ -92,6 +92,6 @@ def test_a_chosen_width_keeps_the_views_shape(window, qtbot, small_points, tmp_p
 
     w = shown(qtbot, window(small_points, tile=1))
     path = tmp_path / "v.png"
-    w.save_view_image(path, width)
+    w.view_link.save_image(path, width)
     image = QImage(str(path))
     assert (image.width(), image.height()) == (width, height_for(w.viewport, width))

@@ -72,9 +72,9 @@ class ScaleEditor(QGroupBox):
         self.clip.setDecimals(1)
         self.clip.setSuffix(" %")
         self.clip.setKeyboardTracking(False)
-        _named(self.clip, f"{title} clip", "percent of the values left out at each end "
-                                           "(percentile clip): a few bright or dark bins do "
-                                           "not flatten the rest")
+        _named(self.clip, f"{title} clip each end",
+               "percent of the values left out at each end (percentile clip): a few bright "
+               "or dark bins do not flatten the rest")
         form.addRow("Clip each end", self.clip)
         self.cmap = QComboBox()
         self.cmap.addItems(list(CMAPS))

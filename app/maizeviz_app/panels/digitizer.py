@@ -285,6 +285,7 @@ class DigitizerPanel(QWidget):
         lay.addWidget(self.counts)
         self.log = QListWidget()
         self.log.setAccessibleName("digitizer log")
+        self.log.setToolTip("what the session did, newest last: presses, refusals, the port")
         self.log.setUniformItemSizes(True)          # scrolling 400 lines stays instant
         self.log.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
         # the band shows the whole last line
