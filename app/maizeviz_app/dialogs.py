@@ -57,7 +57,8 @@ def choose_mesh(window) -> tuple[str, str, str, str | None] | None:
     field, ok = QInputDialog.getText(
         window, "Field of the mesh", "The ground plot x0, y0, x1, y1 in cm, in field "
         "coordinates (it sets leaf area index, ground cover and the periodic field's tile; "
-        "leave empty for the mesh's extent seen from above):")
+        "leave empty for the plot the file carries, as maizeviz's exports do, else the "
+        "mesh's extent seen from above):")
     if not ok:
         return None
     unit, up = MESH_FRAMES[frame]

@@ -43,16 +43,19 @@ def _canopy_job(path: str, model: StudyModel):
         raise MaizevizError("no canopy to export yet")
     canopy = model.canopy
     signature = model.signature(model.built.label)
+    # the names of `maizeviz light --export` (maizeviz.light.report.mesh_export.LIGHT_ARRAYS)
     cells = {}
     run = model.runs.for_signature(signature)
     if run is not None and run.classes is not None:
-        cells["light"] = run.classes.astype("int32")
+        cells["sun_class"] = run.classes.astype("int32")
     if run is not None and run.painting is not None:   # honest where triangles are small
         cells["sunlit_share"] = run.painting.share.astype("float32")
-    for kind, name in (("sky", "diffuse_per_m2_leaf"), ("day", "par_mol_per_m2_leaf")):
+    if run is not None and getattr(run.extra, "leaf_value", None) is not None:
+        cells["absorbed_w_per_m2_leaf"] = run.extra.leaf_value.astype("float64")
+    for kind, name in (("sky", "diffuse_cm2_per_cm2_leaf"), ("day", "par_mol_per_m2_leaf")):
         run = model.runs.for_signature(signature, kind)
-        if run is not None and run.extra is not None:
-            cells[name] = run.extra.leaf_value.astype("float32")
+        if run is not None and run.extra is not None and run.extra.leaf_value is not None:
+            cells[name] = run.extra.leaf_value.astype("float64")
 
     def work(job):
         from maizeviz.canopy.export import export_canopy

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from maizeviz.canopy.layout import field_period
 from maizeviz.canopy.scene import Canopy
 from maizeviz.io.meshfile import write_mesh
 
@@ -53,9 +54,14 @@ def export_canopy(path: str | Path, canopy: Canopy,
         Per-triangle values to carry, each (F,) over the canopy's leaf triangles (stalks get 0,
         or NaN for floats), beside ``plant`` and ``leaf`` (:func:`canopy_cells`).
 
+    The file carries the plot (the layout's bounds) and, for a tiling, the period of its
+    periodic field (:func:`~maizeviz.canopy.layout.field_period`), so that read back without
+    a field it has the same ground, LAI and light (:mod:`maizeviz.canopy.from_mesh`).
+
     Returns
     -------
     pathlib.Path
         The file written.
     """
-    return write_mesh(path, *canopy_cells(canopy, cell_data))
+    return write_mesh(path, *canopy_cells(canopy, cell_data), field_cm=canopy.layout.bounds,
+                      period_cm=field_period(canopy.layout))

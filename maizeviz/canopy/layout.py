@@ -92,6 +92,9 @@ class CanopyLayout:
     ground_area : float, cm2, or None: the union of the cells
     quantity : the input that set the plants (see :data:`maizeviz.errors.QUANTITIES`):
         "tile" for a tiling, "layout" for a layout document; costs name it
+    period : (x0, y0, x1, y1) cm or None: the smallest rectangle the plot repeats, as a mesh
+        file says it (:mod:`maizeviz.canopy.from_mesh`); a claim the light verifies before
+        using it. A tiling's is :func:`field_period`.
     """
 
     placements: tuple[Placement, ...]
@@ -103,6 +106,7 @@ class CanopyLayout:
     warnings: tuple[str, ...] = ()
     ground_area: float | None = None
     quantity: str = "tile"
+    period: tuple[float, float, float, float] | None = None
 
     @property
     def ground_area_cm2(self) -> float:
@@ -120,6 +124,17 @@ class CanopyLayout:
     def centre_bounds(self) -> tuple[float, float, float, float]:
         c = self.centre_cells if len(self.centre_cells) else self.cells
         return float(c[:, 0].min()), float(c[:, 1].min()), float(c[:, 2].max()), float(c[:, 3].max())
+
+
+def field_period(layout: CanopyLayout) -> tuple[float, float, float, float] | None:
+    """The rectangle (x0, y0, x1, y1) cm a periodic field of ``layout``'s plot repeats, when
+    smaller than the plot: a tiling's block (its central tile, the default sample rectangle),
+    or the period a mesh file carried; None otherwise (a layout file, one tile)."""
+    if layout.period is not None:
+        return layout.period
+    if layout.quantity == "tile" and len({p.tile for p in layout.placements}) >= 2:
+        return layout.centre_bounds
+    return None
 
 
 #: Columns of :func:`placements_array`.

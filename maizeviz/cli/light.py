@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from maizeviz.canopy.export import export_canopy
 from maizeviz.canopy.field import canopy_of
 from maizeviz.canopy.from_mesh import MESH_LEVEL
 from maizeviz.canopy.scene import Canopy
@@ -28,6 +29,7 @@ from maizeviz.cli.common import (
     add_level_options,
     canopy_setup,
     check_canopy_costs,
+    check_export,
     check_input_options,
     floats,
     fmt_table,
@@ -47,6 +49,7 @@ from maizeviz.leaf.fit import Leaf
 from maizeviz.light.engine import LightEngine
 from maizeviz.light.report.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping
 from maizeviz.light.report.heatmap import map_stems, save_figure, write_heatmaps
+from maizeviz.light.report.mesh_export import light_cells
 from maizeviz.light.report.tables import write_steps
 from maizeviz.light.results.absorbed import AbsorbedLight
 from maizeviz.light.results.assimilation import assimilate
@@ -115,9 +118,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     per.add_argument("--to", metavar="HH:MM", help="end of the period on --date")
     per.add_argument("--step", type=NUMBER_ARG, default=None, metavar="MIN",
                      help="time step, minutes (default 30)")
-    per.add_argument("--weather", metavar="CSV",
-                     help="irradiance from a weather file (time with zone, ghi W/m2, optional "
-                          "dni, dhi) instead of the clear sky; the file sets the period")
+    per.add_argument("--weather", metavar="FILE",
+                     help="irradiance from a weather file instead of the clear sky: maizeviz's "
+                          "CSV (time with zone, ghi W/m2, optional dni, dhi, par umol/m2/s, "
+                          "temp_air), an EPW, TMY3 or NSRDB PSM3/PSM4 file; the file sets the "
+                          "period (and, EPW/TMY3/PSM, the time zone and the place)")
     per.add_argument("--linke-turbidity", type=NUMBER_ARG, default=None, metavar="T",
                      help=f"Linke turbidity of the clear sky (default {DEFAULT_LINKE_TURBIDITY:g})")
     per.add_argument("--altitude", type=NUMBER_ARG, default=0.0, metavar="M",
@@ -150,6 +155,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--leaf-light", metavar="CSV",
                    help="write the light intercepted by every lit leaf")
     p.add_argument("--plant-light", metavar="CSV", help="the same summed per plant")
+    p.add_argument("--export", metavar="PATH",
+                   help="write the canopy mesh of one level with each triangle's light (its "
+                        "leaf's, as --leaf-light): .vtu .vtp .vtk .ply .obj .stl")
     ab = p.add_argument_group(
         "absorbed light with scattering (any of these turns it on; needs a sun)")
     ab.add_argument("--band", choices=BANDS, default=None,
@@ -261,8 +269,9 @@ def _check_options(args: argparse.Namespace) -> None:
                                     "--day, --from, --to or --step with --weather")
             if args.linke_turbidity is not None:
                 raise MaizevizError("--linke-turbidity is for the clear sky, not for --weather")
-            if args.lat is None or args.lon is None:
-                raise MaizevizError("a weather file needs the place: give --lat and --lon")
+            if (args.lat is None) != (args.lon is None):
+                raise MaizevizError("give both --lat and --lon (or neither, with a weather file "
+                                    "whose header gives the place: EPW, TMY3, PSM)")
         else:
             if args.date is None or args.lat is None or args.lon is None:
                 raise MaizevizError(f"{what} needs --date, --lat and --lon (and --tz)")
@@ -313,7 +322,15 @@ def period_from(args: argparse.Namespace) -> Period | None:
     par = DEFAULT_PAR_UMOL_PER_J if args.par_factor is None else args.par_factor
     if args.weather:
         weather = read_weather(args.weather, tz=args.tz)
-        return weather_period(weather, args.lat, args.lon, args.altitude, par)
+        lat, lon = args.lat, args.lon
+        if lat is None:
+            lat, lon = weather.place.get("latitude"), weather.place.get("longitude")
+            if lat is None or lon is None:
+                raise MaizevizError("a weather CSV file needs the place: give --lat and --lon",
+                                    quantity="weather")
+            say(f"place: latitude {lat:g}, longitude {lon:g} (the header of "
+                f"{os.path.basename(args.weather)})")
+        return weather_period(weather, lat, lon, args.altitude, par)
     linke = DEFAULT_LINKE_TURBIDITY if args.linke_turbidity is None else args.linke_turbidity
     return clear_sky_period(args.date, args.lat, args.lon, args.tz or "UTC",
                             30.0 if args.step is None else args.step, args.from_, args.to,
@@ -362,6 +379,7 @@ class _Level:
     res: LightResult | None = None
     sky_res: SkyLight | None = None
     per_res: PeriodLight | None = None
+    ab: AbsorbedLight | None = None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -373,6 +391,7 @@ def run(args: argparse.Namespace) -> int:
     mesh = is_mesh(args.points)
     levels = levels_from(args)
     labels = [MESH_LEVEL] if mesh else [level.label for level in levels]
+    check_export(args.export, [] if mesh else levels)
     job = _job(args, labels)
     if mesh:
         t0 = time.perf_counter()
@@ -516,13 +535,19 @@ def _trace_level(job: _Job, canopy: Canopy, canopy_s: float) -> dict[str, Any]:
         _without_sun(lv)
     _write_outputs(args, canopy, lv.label, job.n_levels, lv.res, lv.sky_res, lv.per_res,
                    lv.tables, lv.plant_extra)
+    if args.export:
+        path = export_canopy(args.export, canopy,
+                             light_cells(canopy, lv.res, lv.sky_res, lv.per_res, lv.ab))
+        say(f"wrote {canopy.n_triangles:,} leaf triangles of {canopy.n_plants} plants with "
+            f"their light (and their stalks) to {path}")
     return rec
 
 
 def _trace_sun(job: _Job, lv: _Level) -> None:
     """The sun: transmission by height and, for the tables, its hit classes."""
     assert job.sun is not None
-    res = lv.engine.sun(job.sun, classes=job.want_rows or job.n_levels == 1,
+    res = lv.engine.sun(job.sun, classes=job.want_rows or job.n_levels == 1
+                        or bool(job.args.export),
                         progress=Progress(f"tracing {lv.label}"))
     lv.res = res
     lv.warnings += res.warnings
@@ -619,7 +644,7 @@ def _trace_absorbed_sun(job: _Job, lv: _Level) -> None:
             return a, g.canopy_gross_umol_m2_s, g.canopy_gross_error_umol_m2_s or 0.0
         return a, a.balance.absorbed_leaves, a.absorbed_leaves_error or 0.0
 
-    ab = _traced(trace_sun, args, lv.rec, job.said)
+    ab = lv.ab = _traced(trace_sun, args, lv.rec, job.said)
     _warn_unresolved(ab.balance, ab.depth, lv.rec, job.said)
     lv.rec["balance"] = ab.balance.as_dict()
     lv.rec["balance_se"] = ab.balance_errors
@@ -839,7 +864,7 @@ def _check_paths(args: argparse.Namespace, labels: list[str], sun: bool,
     """Refuse, before any work, outputs (every per-level file and every file of the heatmap
     and plot folders) that would overwrite an input or each other."""
     period = _period_asked(args)
-    tables = [("the leaf light table", args.leaf_light),
+    tables = [("the mesh export", args.export), ("the leaf light table", args.leaf_light),
               ("the plant light table", args.plant_light),
               ("the time-step table", args.steps if period else None)]
     kinds = [kind for kind, asked in (("sun", sun), ("sky", args.sky is not None or period),

@@ -48,6 +48,9 @@ _SKY_ARRAYS = ("zenith_deg", "azimuth_deg", "solid_angle_sr", "weights")
 #: Arrays of a Period (each (n,) float64), stored as ``period_<name>``.
 _PERIOD_ARRAYS = ("step_s", "zenith_deg", "azimuth_deg", "ghi", "dni", "dhi",
                   "direct_horizontal")
+#: Arrays a Period may have (a weather file's measured PAR, air temperature; NaN allowed in
+#: the temperature), stored when present.
+_PERIOD_OPTIONAL = {"par_measured": False, "temp_air": True}
 #: Prefix of the arrays of a day's sky light.
 _DIFFUSE = "diffuse_"
 #: Prefix of the arrays of a day's diffuse split by Perez's model.
@@ -144,7 +147,7 @@ def day_record(label: str, light, settings: dict | None = None) -> Record:
                       "par_umol_per_j": float(p.par_umol_per_j),
                       "notes": [str(n) for n in p.notes]}
     arrays = {f"period_{name}": np.asarray(getattr(p, name), np.float64)
-              for name in _PERIOD_ARRAYS}
+              for name in (*_PERIOD_ARRAYS, *_PERIOD_OPTIONAL) if getattr(p, name) is not None}
     arrays.update({"step_transmission": np.asarray(light.step_transmission, np.float64),
                    "step_intercepted_fraction":
                        np.asarray(light.step_intercepted_fraction, np.float64),
@@ -445,6 +448,9 @@ def _period(rec: Record, m: dict, where: str):
     n = len(times)
     arrays = {name: _array(rec, f"period_{name}", where, "a day result's period", (n,))
               for name in _PERIOD_ARRAYS}
+    arrays.update({name: _array(rec, f"period_{name}", where, "a day result's period", (n,),
+                                nan=nan, lo=None if nan else 0.0)
+                   for name, nan in _PERIOD_OPTIONAL.items() if f"period_{name}" in rec.arrays})
     notes = tuple(str(get({"n": v}, "n", str, where=f"{at}: notes"))
                   for v in get(p, "notes", list, [], at))
     try:

@@ -54,7 +54,7 @@ def test_k4_sun_paints_each_leaf_with_its_sunlit_share(window, qtbot, small_poin
     with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
         w.model.export("canopy", out)
     mesh = pv.read(out)
-    np.testing.assert_array_equal(np.asarray(mesh.cell_data["light"])[:n], run.classes)
+    np.testing.assert_array_equal(np.asarray(mesh.cell_data["sun_class"])[:n], run.classes)
     np.testing.assert_allclose(np.asarray(mesh.cell_data["sunlit_share"])[:n],
                                run.painting.share, equal_nan=True)
 

@@ -128,3 +128,30 @@ def test_a_large_mesh_file_is_drawn_within_the_budget(window, qtbot, small_point
     for k in np.flatnonzero(source < 0)[::53]:
         mine = (c.face_instance == inst[k]) & (c.face_leaf == leaf[k])
         np.testing.assert_allclose(values[k], share[mine][0], equal_nan=True)
+
+
+def test_an_exported_canopy_opens_with_its_plot_and_period(window, qtbot, small_points,
+                                                           tmp_path):
+    """File > Open canopy mesh with the field left empty: a canopy the app exported comes
+    back on its own plot, with its tiling's period, and a periodic sun gives the same
+    transmission as the canopy it came from (issue 27)."""
+    from maizeviz.canopy.export import export_canopy
+
+    w = shown(qtbot, window(small_points, tile=3))
+    layout = w.model.canopy.layout
+    w.light_panel.set_mode("sun")
+    small_light(w.light_panel, "sun")
+    w.light_panel.periodic.setChecked(True)
+    compute(qtbot, w)
+    before = list(w.model.runs.last.transmission)
+    ply = tmp_path / "exported.ply"
+    export_canopy(str(ply), w.model.canopy)
+    with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
+        w.open_mesh(ply, "cm", "z")
+    assert w.model.canopy.layout.bounds == layout.bounds
+    assert w.model.canopy.layout.period == layout.centre_bounds == w.model.canopy.layout.centre_bounds
+    assert "the field is the file's" in w.messages.toPlainText()
+    small_light(w.light_panel, "sun")
+    w.light_panel.periodic.setChecked(True)
+    compute(qtbot, w)
+    assert list(w.model.runs.last.transmission) == before

@@ -173,9 +173,11 @@ def test_exports(window, qtbot, small_points, tmp_path):
     for png in ("heatmap", "plot"):
         assert outs[png].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     mesh = meshio.read(outs["canopy"])
-    light = np.concatenate(mesh.cell_data["light"])
+    light = np.concatenate(mesh.cell_data["sun_class"])
     assert set(np.unique(light[:w.model.canopy.n_triangles])) <= {0, 1, 2}
     assert np.any(light == 2)
+    # the plot travels with the mesh (VTK field data), as the canopy's layout has it
+    assert tuple(mesh.field_data["field_cm"]) == w.model.canopy.layout.bounds
 
 
 def test_menus_show_shortcuts_and_about_names_the_paper(window, qtbot):

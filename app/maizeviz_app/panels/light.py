@@ -450,10 +450,12 @@ class LightPanel(QWidget):
         form.addRow(clear_row)
         self.source_weather = QRadioButton("weather file")
         self.source_weather.setToolTip("measured irradiance: a CSV with a time column (with "
-                                       "its time zone) and ghi in W/m², optionally dni and "
-                                       "dhi; it sets the period and its steps")
+                                       "its time zone) and ghi in W/m², optionally dni, dhi, "
+                                       "par (µmol/m²/s, used as the PAR) and temp_air (°C); "
+                                       "or an EPW, TMY3 or NSRDB PSM3/PSM4 file (its own time "
+                                       "zone); it sets the period and its steps")
         self.weather = QLineEdit()
-        self.weather.setPlaceholderText("CSV: time, ghi (W/m²) [, dni, dhi]")
+        self.weather.setPlaceholderText("CSV (time, ghi [, dni, dhi, par]), EPW, TMY3, PSM")
         self.weather.setToolTip(self.source_weather.toolTip())
         bind(self.weather, d, "weather", "weather file path")
         self.weather_button = QPushButton("Weather file…")
@@ -531,7 +533,8 @@ class LightPanel(QWidget):
 
     def choose_weather(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self, "Weather file", self.weather.text(),
-                                              "Weather CSV (*.csv);;All files (*)")
+                                              "Weather files (*.csv *.epw *.CSV *.EPW);;"
+                                              "All files (*)")
         if path:
             self.settings.set("day", {"weather": path, "source": "weather"})
 

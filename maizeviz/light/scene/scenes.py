@@ -18,7 +18,13 @@ from maizeviz.light.scene.periodic import (
     Wrap,
     overhang_copies,
 )
-from maizeviz.light.scene.tiling import BlockTiling, block_mesh, block_tiling, tile_triangles
+from maizeviz.light.scene.tiling import (
+    BlockTiling,
+    block_mesh,
+    block_tiling,
+    carried_period,
+    tile_triangles,
+)
 from maizeviz.mesh import packets as _packets
 from maizeviz.mesh.instances import Instances
 from maizeviz.mesh.raytrace import RayScene
@@ -41,7 +47,9 @@ class CanopyScene(RayScene):
     wrapped : (x0, y0, x1, y1) cm, the plot whose overhangs were copied, or None
     wrap : Wrap of the periodic field this scene repeats in (the plot), or None
     period : Wrap of the field's smallest known period: the block of a tiled canopy (which
-        the field repeats exactly, :func:`~maizeviz.light.scene.tiling.block_tiling`), else ``wrap``
+        the field repeats exactly, :func:`~maizeviz.light.scene.tiling.block_tiling`), or the one a
+        mesh file carries once checked (:func:`~maizeviz.light.scene.tiling.carried_period`), else
+        ``wrap``
     """
 
     def __init__(self, vertices, faces, n_original: int | None = None,
@@ -180,9 +188,10 @@ def light_scene(canopy: Canopy, with_stalks: bool = False, periodic: bool = Fals
     bounds = canopy.layout.bounds
     wrap = Wrap.of(bounds)
     # the canopy on the field's grid as Embree's copy is made, with copies of the overhangs
+    period = tiling.wrap if tiling is not None else carried_period(canopy, verts, faces, wrap)
     cv, cf, src, _ = overhang_copies(verts, faces, wrap, wrap.q)
-    return CanopyScene([verts, cv], [faces, cf + len(verts)], n, src, bounds, wrap,
-                       None if tiling is None else tiling.wrap, snap_q=wrap.q)
+    return CanopyScene([verts, cv], [faces, cf + len(verts)], n, src, bounds, wrap, period,
+                       snap_q=wrap.q)
 
 
 def scene_for(canopy: Canopy, periodic: bool, scene: RayScene | None,
