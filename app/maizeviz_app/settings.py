@@ -26,6 +26,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from psygnal import SignalGroup, evented
 
 from maizeviz.errors import MaizevizError
+from maizeviz.io.points import shown
 from maizeviz.numbers import number
 
 DEFAULT_PLACE = "2005-08-01 12:00 39.9 116.4 Asia/Shanghai"
@@ -52,23 +53,30 @@ class InputProblem(MaizevizError):
 
 
 def parse_heights(text: str) -> tuple[float, ...]:
-    """``"0, 50, 100"`` -> (0.0, 50.0, 100.0) cm; a word that is not a number is named."""
+    """``"0, 50, 100"`` -> (0.0, 50.0, 100.0) cm; a word that is not a number is named.
+
+    Items are separated by commas (or semicolons) and may end in "cm". An empty item (``0,,50``,
+    a trailing comma) is refused as ``maizeviz light --heights`` refuses it, with the same
+    words: a height left out by a slip should not pass unseen.
+    """
+    items = text.replace(";", ",").split(",")
+    if not "".join(items).strip():
+        raise InputProblem("give at least one height in cm, e.g. 0, 50, 100", "heights")
     out = []
-    for part in text.replace(";", ",").split(","):
-        part = part.strip()
+    for k, item in enumerate(items, 1):
+        part = item.strip()
         if not part:
-            continue
+            raise InputProblem(f"heights: item {k} of {len(items)} is empty in '{shown(text)}'; "
+                               "write numbers separated by single commas", "heights")
         try:
             h = number(part.removesuffix("cm").strip())
         except ValueError:
-            raise InputProblem(f"heights: '{part}' is not a number of centimetres; write them "
-                               "separated by commas, e.g. 0, 50, 100", "heights") from None
+            raise InputProblem(f"heights: '{shown(part)}' is not a number of centimetres; write "
+                               "them separated by commas, e.g. 0, 50, 100", "heights") from None
         if not math.isfinite(h) or h < 0:
-            raise InputProblem(f"heights must be finite numbers of 0 cm or more, got {part}",
-                               "heights")
+            raise InputProblem(f"heights must be finite numbers of 0 cm or more, got "
+                               f"{shown(part)}", "heights")
         out.append(h)
-    if not out:
-        raise InputProblem("give at least one height in cm, e.g. 0, 50, 100", "heights")
     return tuple(out)
 
 

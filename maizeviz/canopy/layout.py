@@ -387,7 +387,13 @@ def _overlaps(cells: np.ndarray) -> str:
         return ""
     d = np.abs(centres[pairs[:, 0]] - centres[pairs[:, 1]])
     twice = float(np.sum((1 - d[:, 0]) * (1 - d[:, 1]))) * w * h
-    return f"({len(pairs)} overlapping pairs, about {twice:.0f} cm2 counted twice)"
+    return (f"({len(pairs)} overlapping {_pairs(len(pairs))}, about {twice:.0f} cm2 counted "
+            "twice)")
+
+
+def _pairs(n: int) -> str:
+    """'pair' or 'pairs' after a count of ``n``."""
+    return "pair" if n == 1 else "pairs"
 
 
 # ------------------------------------------------------------------------- layout files

@@ -163,6 +163,14 @@ def test_layout_warnings_overlap_and_outside():
     assert "outside the field" in text and "closer than the spacing" in text
 
 
+@pytest.mark.parametrize("ys, words", [((15, 20), "(1 overlapping pair, about"),
+                                        ((15, 20, 25), "(3 overlapping pairs, about")])
+def test_the_overlap_warning_counts_pairs_in_words(ys, words):
+    doc = _doc(rows=[{"x": 30, "plants": [{"y": y, "plant": 1} for y in ys]}])
+    text = " ".join(layout_from_dict(doc, plants={1, 2}).warnings)
+    assert words in text, text
+
+
 @pytest.mark.parametrize("content, match", [
     ("not json", "not valid JSON"),
     ("[" * 100000 + "]" * 100000, "not valid JSON"),

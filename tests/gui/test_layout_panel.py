@@ -279,6 +279,34 @@ def test_a_plant_put_onto_another_is_red_and_listed_until_moved(panel, qtbot):
     assert panel.rows.rowCount() == 3
 
 
+def test_the_overlap_note_counts_its_pairs_in_words(panel, qtbot):
+    """One pair is "1 overlapping pair", two are "2 overlapping pairs" (issue 25)."""
+    said: list[str] = []
+    panel.problem.connect(said.append)
+    a = panel.model.placements[0]
+    for k in (1, 2):                                  # a copy of plant 1 beside it, twice
+        panel.select(0)
+        panel.duplicate_button.click()
+        row = panel.rows.rowCount() - 1
+        assert panel.rows.setData(panel.rows.index(row, 0), str(a.x + k))
+        assert panel.rows.setData(panel.rows.index(row, 1), str(a.y + 40.0 * (k - 1) + 1.0))
+        said.clear()
+        with qtbot.waitSignal(panel.applied):
+            panel.apply_button.click()
+        notes = [t for t in said if "overlapping" in t]
+        assert len(notes) == 1, said
+        want = "(1 overlapping pair," if k == 1 else "(2 overlapping pairs,"
+        assert want in notes[0] and "1 overlapping pairs" not in notes[0], notes[0]
+
+
+def test_one_plant_is_one_plant_in_the_summary(panel, qtbot):
+    assert panel.info.text().startswith("2 plants on ")
+    panel.select(1)
+    panel.remove_button.click()
+    qtbot.waitUntil(lambda: panel.rows.rowCount() == 1, timeout=2000)
+    qtbot.waitUntil(lambda: panel.info.text().startswith("1 plant on "), timeout=2000)
+
+
 def test_add_rotate_and_snap(panel, qtbot):
     panel.select(1)
     panel.add_button.click()                                  # beyond the end of the row

@@ -34,7 +34,11 @@ def test_bad_heights_and_a_missing_weather_file_are_the_users(window, qtbot, sma
 
     for typed, words in (("abc", "'abc' is not a number"), ("-5", "0 cm or more, got -5"),
                          ("", "give at least one height"), ("0, 1e999", "0 cm or more"),
-                         ("0,,nan", "0 cm or more")):
+                         ("0, nan", "0 cm or more"),
+                         # an empty item, refused as `maizeviz light --heights 0,,50` is
+                         ("0,,50", "heights: item 2 of 3 is empty in '0,,50'; write numbers "
+                                   "separated by single commas"),
+                         ("0, 50,", "item 3 of 3 is empty")):
         panel.heights.setText(typed)
         refused(panel.heights, words)
     panel.heights.setText("0, 100")

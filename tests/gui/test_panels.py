@@ -55,6 +55,20 @@ def test_heights_are_read_or_named():
         parse_heights(" , ")
 
 
+@pytest.mark.parametrize("typed", ["0,,50", "0, 50,", ",0", "0;;50", "0,,"])
+def test_an_empty_height_is_refused_in_the_command_lines_words(typed):
+    """The app decides as ``maizeviz light --heights`` does: an empty item is a slip, named."""
+    from maizeviz.cli.common import floats
+
+    with pytest.raises(InputProblem, match="is empty in") as app:
+        parse_heights(typed)
+    assert app.value.quantity == "heights"
+    if ";" not in typed:                          # the command line takes commas only
+        with pytest.raises(MaizevizError) as cli:
+            floats(typed, "heights", "heights")
+        assert str(app.value) == str(cli.value)
+
+
 def test_light_panel_request_and_problem_marking(qtbot):
     panel = LightPanel()
     qtbot.addWidget(panel)

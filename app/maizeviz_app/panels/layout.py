@@ -68,6 +68,11 @@ def _named(widget: W, name: str, tip: str) -> W:
     return widget
 
 
+def _count(n: int, noun: str) -> str:
+    """``3, "plant"`` -> "3 plants"; one is "1 plant"."""
+    return f"{n:,} {noun}{'' if n == 1 else 's'}"
+
+
 def _tool(text: str) -> QToolButton:
     button = QToolButton()
     button.setText(text)
@@ -351,7 +356,8 @@ class LayoutPanel(QWidget):
             return
         x0, y0, x1, y1 = base.bounds
         self.info.setText(
-            f"{len(self.model.placements)} plants on {fmt(base.ground_area_cm2 / 1e4, 2)} m², "
+            f"{_count(len(self.model.placements), 'plant')} on "
+            f"{fmt(base.ground_area_cm2 / 1e4, 2)} m², "
             f"field x {fmt(x0, 0)}..{fmt(x1, 0)} cm, y {fmt(y0, 0)}..{fmt(y1, 0)} cm; rows "
             f"{base.row_spacing:g} cm apart, plants {base.plant_spacing:g} cm")
         self._show_state()
@@ -379,7 +385,7 @@ class LayoutPanel(QWidget):
             item.setData(Qt.ItemDataRole.UserRole, j)
             self.overlaps.addItem(item)
         if len(pairs) > OVERLAPS_LISTED:
-            self.overlaps.addItem(f"… and {len(pairs) - OVERLAPS_LISTED} more pairs")
+            self.overlaps.addItem(f"… and {_count(len(pairs) - OVERLAPS_LISTED, 'more pair')}")
         if pairs:                               # as tall as its lines, three at most
             rows = min(self.overlaps.count(), 3)
             self.overlaps.setFixedHeight(rows * self.overlaps.sizeHintForRow(0)
