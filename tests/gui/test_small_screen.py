@@ -86,10 +86,19 @@ def laptop(window, qtbot, small_points):
 def test_every_panel_fits_a_laptop_screen(laptop, qtbot):
     w = laptop
     problems = []
-    for name in PANELS:
-        w.docks[name].raise_()
-        qtbot.wait(150)
-        problems += _fits(w, name)
+    checked = set()
+    for workspace in ("digitize", "analyse"):       # each dock as its workspace shows it
+        w.workspaces.show(workspace)
+        qtbot.wait(200)
+        for name in PANELS:
+            if w.docks[name].isHidden():
+                continue
+            w.docks[name].raise_()
+            qtbot.wait(150)
+            assert w.docks[name].widget().isVisible(), name     # else nothing is measured
+            checked.add(name)
+            problems += [f"{workspace}: {p}" for p in _fits(w, name)]
+    assert checked == set(PANELS)
     light = w.light_panel
     for mode in ("sky", "day"):                     # the light's other pages
         w.docks["light"].raise_()

@@ -48,6 +48,7 @@ from PySide6.QtWidgets import (
     QScrollArea,
     QSizePolicy,
     QSpinBox,
+    QToolButton,
     QVBoxLayout,
     QWidget,
 )
@@ -259,16 +260,20 @@ class DigitizerPanel(QWidget):
         stamp = time.strftime("%Y%m%d-%H%M%S")
         self.out_edit = QLineEdit(str(Path.home() / f"maizeviz-session-{stamp}.csv"))
         self.out_edit.setAccessibleName("record to")
-        self.out_edit.setToolTip("the points file every press is appended to (on disk before "
-                                 "it is reported recorded)")
-        self.browse = QPushButton("…")
+        self.out_edit.textChanged.connect(self._show_out_path)
+        self._show_out_path(self.out_edit.text())
+        self.browse = QToolButton()
+        self.browse.setText("…")
         self.browse.setAccessibleName("choose the file to record to")
         self.browse.setToolTip("choose the file to record to")
         self.browse.clicked.connect(self._choose_out)
-        self.browse.setMaximumWidth(40)
         out_row.addWidget(self.out_edit, 1)
         out_row.addWidget(self.browse)
-        form.addRow("record to", out_row)
+        # the path on a row of its own, under its label: the dock's whole width shows it
+        out_label = QLabel("record to")
+        out_label.setBuddy(self.out_edit)
+        form.addRow(out_label)
+        form.addRow(out_row)
         self.resume = QCheckBox("continue this file (resume)")
         self.resume.setAccessibleName("continue this file (resume)")
         self.resume.setToolTip("go on where the file stopped (after a crash, a lost cable or "
@@ -295,6 +300,11 @@ class DigitizerPanel(QWidget):
 
         self.timer = QTimer(self, interval=50)
         self.timer.timeout.connect(self._drain)
+
+    def _show_out_path(self, path: str) -> None:
+        """The tooltip names the whole path, for one too long for the field."""
+        self.out_edit.setToolTip("the points file every press is appended to (on disk before "
+                                 f"it is reported recorded):\n{path}")
 
     def _big_button(self, text: str) -> QPushButton:
         b = QPushButton(text)

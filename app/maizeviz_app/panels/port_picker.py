@@ -11,7 +11,14 @@ from __future__ import annotations
 import threading
 
 from PySide6.QtCore import Qt, QThreadPool, Signal
-from PySide6.QtWidgets import QComboBox, QHBoxLayout, QPushButton, QSizePolicy, QWidget
+from PySide6.QtWidgets import (
+    QComboBox,
+    QHBoxLayout,
+    QPushButton,
+    QSizePolicy,
+    QToolButton,
+    QWidget,
+)
 
 from maizeviz_app.workers import JobRunner
 
@@ -53,11 +60,11 @@ class PortPicker(QWidget):
         self.box.setToolTip("the serial port the FASTRAK is plugged into: choose one the system "
                             "lists, or type its path")
         self.box.setEditText(port)
-        self.refresh_button = QPushButton("↻")
+        self.refresh_button = QToolButton()             # a glyph: as small as a tool button
+        self.refresh_button.setText("↻")
         self.refresh_button.setAccessibleName("refresh ports")
         self.refresh_button.setToolTip("list the serial ports again (after plugging an adapter in)")
         self.refresh_button.clicked.connect(self.refresh)
-        self.refresh_button.setMaximumWidth(40)
         self.find_button = QPushButton("Find FASTRAK")
         self.find_button.setAccessibleName("Find FASTRAK")
         self.find_button.setToolTip("ask each listed port (and the one typed) for a FASTRAK status "
