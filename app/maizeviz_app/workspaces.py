@@ -65,6 +65,8 @@ class Workspaces(QObject):
     def fill_menu(self, menu) -> dict[str, QAction]:
         """Add View > Workspace > Analyse / Digitize; returns the actions by name."""
         sub = menu.addMenu("&Workspace")
+        sub.menuAction().setStatusTip("Digitize (the view and the recorder) or Analyse (the "
+                                      "light results), each arranged as last left")
         group = QActionGroup(self.window)
         for name, (text, shortcut, _docks, _raised, tip) in WORKSPACES.items():
             act = QAction(text, self.window)

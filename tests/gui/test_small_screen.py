@@ -165,3 +165,30 @@ def test_a_light_run_by_the_controls_names(laptop, qtbot):
     assert w.model.runs.of_kind("sky") is not None
     table = find(panel, "transmission table")
     assert table.rowCount() == 2
+
+
+def test_every_menu_entry_says_what_it_does_in_the_status_bar(laptop, qtbot):
+    """Hovering a menu entry tells what it does, as the panels' tooltips do (the recent
+    files' entries name their file instead)."""
+    w = laptop
+    silent, seen = [], 0
+
+    def walk(menu, path):
+        nonlocal seen
+        for act in menu.actions():
+            if act.isSeparator() or menu is w.recent_menu:
+                continue
+            seen += 1
+            name = f"{path} > {act.text().replace('&', '')}"
+            if not act.statusTip().strip():
+                silent.append(name)
+            if act.menu() is not None:
+                walk(act.menu(), name)
+
+    for top in w.menuBar().actions():
+        walk(top.menu(), top.text().replace("&", ""))
+    assert seen > 40 and not silent, silent
+    # the tip is shown where the user looks: the status bar (as Qt's menus do on hover)
+    act = w.menu_actions["view_image"]
+    assert act.showStatusText(w)
+    assert w.statusBar().currentMessage() == act.statusTip()
