@@ -58,7 +58,8 @@ def build_menus(w) -> dict[str, QAction]:
     results.menuAction().setStatusTip("light results and canopy measures as CSV and PNG files")
     acts["export_table"] = _action(w, results, "Transmission table (CSV)…",
                                    lambda: w.choose_export("table"), "Ctrl+Shift+T",
-                                   "the transmission table of the Light panel (by height, level and light)")
+                                   "the Light panel's transmission table (by height, level "
+                                   "and light)")
     acts["export_measures"] = _action(w, results, "Canopy measures, Table 2 (CSV)…",
                                       lambda: w.choose_export("measures"), None,
                                       "triangles, leaf area and cover per mesh level built")

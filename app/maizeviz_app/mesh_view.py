@@ -1,10 +1,11 @@
 """What the 3D view draws of a canopy read from a mesh file, within the view's budget.
 
 A canopy built from digitized points that is larger than
-:data:`~maizeviz_app.viewport.VIEW_BUDGET` is drawn with the plants of its sample tile at the
-level asked and the others at 36 triangles a leaf, built again from their surfaces. A mesh
-file has no surfaces to mesh coarser, so the plants nearest the field's centre are drawn with
-the file's triangles (up to half the budget) and the others with their leaves simplified by
+:data:`~maizeviz_app.viewport.VIEW_BUDGET` is drawn with the plants of its sample tile nearest
+its centre at the level asked (up to :data:`~maizeviz_app.viewport.FINE_BUDGET` triangles) and
+the others at 36 triangles a leaf, built again from their surfaces. A mesh file has no surfaces
+to mesh coarser, so the plants nearest the field's centre are drawn with the file's triangles
+(up to half the budget) and the others with their leaves simplified by
 vertex clustering (:func:`maizeviz.mesh.cluster.cluster_triangles`: each leaf on its own,
 keeping its ids) to fit the rest. Light is traced on every triangle of the file either way;
 the view paints the simplified leaves per leaf, as it does the coarse plants of a built
@@ -23,12 +24,12 @@ from maizeviz.mesh.cluster import cell_for, cluster_triangles
 from maizeviz.mesh.tessellate import triangle_areas_normals
 from maizeviz_app import viewport
 
-#: Triangles drawn of a canopy read from a file above the view's budget: what the view draws
-#: of the built K = 4 canopy of the example (336,400: its sample tile at K = 4, the other
-#: plants at 36 a leaf), whose frame keeps the event loop's gaps under 200 ms on software
-#: OpenGL (779,000 triangles took 660 ms for their first frame, 260 ms for the next).
-DRAWN = 320_000
-#: Share of those the plants drawn with the file's own triangles may take.
+#: Triangles drawn of a canopy read from a file above the view's budget: the view's budget,
+#: as for built canopies (779,000 triangles took 660 ms for their first frame, 260 ms for the
+#: next; 308,000 left gaps of 254 to 395 ms under load).
+DRAWN = viewport.VIEW_BUDGET
+#: Share of those the plants drawn with the file's own triangles may take (the rest keeps
+#: every leaf of the other plants drawn: clustered too coarsely, a small leaf vanishes).
 FINE_SHARE = 0.5
 
 

@@ -53,10 +53,6 @@ class ViewLink:
         if mesh is not None and "view_note" in mesh.field_data:
             say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
                 f"responsive {mesh.field_data['view_note'][0]}")
-        elif mesh is not None and "source" in mesh.field_data:
-            say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
-                "responsive the view draws the plants around the sampled tile at 36 "
-                "triangles a leaf (light, tables and exports use every triangle)")
         if not self.digitizing:
             say(f"{built.label}: {m.triangles:,} triangles, leaf area {m.leaf_area_m2:.2f} "
                 f"m², LAI {m.lai:.2f}; built in {built.build_s:.2f} s, measured in "

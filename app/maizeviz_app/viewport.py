@@ -137,31 +137,37 @@ def _settle(poly: pv.PolyData) -> pv.PolyData:
     return make_pickable(poly)
 
 
-#: Leaf and stalk triangles the view draws at most at the level asked: a frame of 2.7 M
-#: triangles costs 0.6 to 0.7 s on software OpenGL (Mesa llvmpipe), 800,000 about 0.2 s. Above
-#: it, the plants around the sampled tile are drawn at a coarser level (see display_polydata;
-#: the window uses 36 triangles a leaf).
-VIEW_BUDGET = 800_000
+#: Leaf and stalk triangles a canopy may have to be drawn whole. A frame costs about the time
+#: to draw its triangles on software OpenGL (Mesa llvmpipe), and the first frame of a new mesh
+#: about twice that (VTK builds and uploads its buffers on the GUI thread): 2.7 M triangles
+#: 0.6 to 0.7 s a frame; the 336,400 the view used to draw at K = 4 left event-loop gaps of
+#: 201 to 244 ms from the slider to their first frame on a quiet machine, 172,000 half of that.
+#: Above it the view draws part of the canopy at the level asked (:data:`FINE_BUDGET`) and the
+#: rest at a coarser level (see display_polydata; the window uses 36 triangles a leaf).
+VIEW_BUDGET = 200_000
+#: Triangles of the level asked drawn at most above :data:`VIEW_BUDGET`: the plants of the
+#: sample tile nearest its centre whose triangles fit (at K = 4 on the example, 4 of its 9
+#: plants, 132,000 triangles, and the other 77 plants at 36 triangles a leaf, 40,000).
+FINE_BUDGET = 160_000
 
 
 def display_polydata(canopy, coarse, fine: np.ndarray | None = None) -> pv.PolyData:
     """What the view draws of a canopy larger than :data:`VIEW_BUDGET`: the plants standing in
-    the sample tile (the central one, whose light is traced and reported) at the canopy's own
-    level, the others from ``coarse`` (the same plants and layout at a coarser level). Safe
-    off the GUI thread.
+    the sample tile (the central one, whose light is traced and reported) nearest its centre
+    whose triangles fit within :data:`FINE_BUDGET` at the canopy's own level, the others from
+    ``coarse`` (the same plants and layout at a coarser level). Safe off the GUI thread.
 
     The mesh has the cell data of :func:`canopy_polydata`, and in field data ``source``: for
     each drawn leaf triangle, its triangle in ``canopy`` (-1 for a coarse one);
     ``canopy_triangles``; ``canopy_leaf`` (each canopy triangle's leaf), ``leaf_first`` (a
     triangle of each leaf) and ``drawn_leaf`` (each coarse triangle's leaf), so that light
     given per triangle of ``canopy`` colours the coarse plants per leaf
-    (:meth:`Viewport.set_light`). ``fine``: (P,) bool, the placements drawn at the canopy's
-    level, if not those of the sample tile.
+    (:meth:`Viewport.set_light`); ``view_note`` says what is drawn how. ``fine``: (P,) bool,
+    the placements drawn at the canopy's level, if not those chosen as above.
     """
+    note = fine is None
     if fine is None:
-        x0, y0, x1, y1 = canopy.layout.centre_bounds
-        fine = np.array([x0 <= p.x <= x1 and y0 <= p.y <= y1
-                         for p in canopy.layout.placements], bool)
+        fine = sample_plants(canopy, FINE_BUDGET)
     sampled = np.asarray(fine, bool)
     fine = np.flatnonzero(sampled[canopy.face_instance])
     rough = np.flatnonzero(~sampled[coarse.face_instance])
@@ -194,8 +200,34 @@ def display_polydata(canopy, coarse, fine: np.ndarray | None = None) -> pv.PolyD
     poly.field_data["canopy_leaf"] = inv.astype(np.int32)
     poly.field_data["leaf_first"] = first
     poly.field_data["drawn_leaf"] = np.where(present[want], rank[want], -1).astype(np.int64)
+    if note:
+        n, tile = int(sampled.sum()), int(sample_plants(canopy, None).sum())
+        poly.field_data["view_note"] = [
+            f"the view draws {n} of the {tile} plants of the sampled tile (those nearest its "
+            f"centre) at this level, {len(fine):,} triangles, and the other "
+            f"{len(sampled) - n} plants at the display level, {len(rough):,} triangles (light, "
+            "tables and exports use every triangle)"]
     _prepare_ground(canopy.layout)
     return _settle(poly)
+
+
+def sample_plants(canopy, budget: int | None) -> np.ndarray:
+    """(P,) bool: the placements standing in the sample tile (``canopy.layout.centre_bounds``),
+    those nearest its centre whose triangles together fit within ``budget`` (None: all)."""
+    x0, y0, x1, y1 = canopy.layout.centre_bounds
+    xy = np.array([(p.x, p.y) for p in canopy.layout.placements], np.float64).reshape(-1, 2)
+    inside = (x0 <= xy[:, 0]) & (xy[:, 0] <= x1) & (y0 <= xy[:, 1]) & (xy[:, 1] <= y1)
+    if budget is None:
+        return inside
+    order = np.flatnonzero(inside)
+    order = order[np.argsort(np.hypot(xy[order, 0] - (x0 + x1) / 2,
+                                      xy[order, 1] - (y0 + y1) / 2), kind="stable")]
+    per_plant = np.bincount(canopy.face_instance, minlength=len(xy))
+    fits = np.cumsum(per_plant[order]) <= budget
+    fits[:1] = True           # the central plant at least (a single plant over the budget)
+    out = np.zeros(len(xy), bool)
+    out[order[fits]] = True
+    return out
 
 
 def _per_drawn(mesh: pv.PolyData, values: np.ndarray, classes: bool) -> np.ndarray:

@@ -20,7 +20,8 @@ def test_a_large_canopy_is_drawn_within_the_budget_and_coloured_by_its_light(
     mesh = w.viewport.canopy_mesh
     c = w.model.canopy
     assert "source" in mesh.field_data and c.n_triangles > 500
-    assert "around the sampled tile at 36 triangles a leaf" in w.messages.toPlainText()
+    assert "plants of the sampled tile (those nearest its centre) at this level" in \
+        w.messages.toPlainText()
     source = np.asarray(mesh.field_data["source"])
     x0, y0, x1, y1 = c.layout.centre_bounds
     sampled = [i for i, p in enumerate(c.layout.placements) if x0 <= p.x <= x1 and y0 <= p.y <= y1]
@@ -60,3 +61,41 @@ def test_a_large_canopy_is_drawn_within_the_budget_and_coloured_by_its_light(
     mine = (c.face_instance == inst[k]) & (c.face_leaf == leaf[k])
     np.testing.assert_allclose(values[k], leaf_value[mine][0], equal_nan=True)
 
+
+
+def test_a_dense_tile_draws_the_plants_nearest_its_centre_within_the_fine_budget(small_points):
+    """Above the budget the view draws at the level asked only the sample tile's plants
+    nearest its centre whose triangles fit FINE_BUDGET (at least the central one), the
+    others coarse: a K = 4 frame costs what its triangles cost, not the whole tile's."""
+    from maizeviz_app.building import DISPLAY_LEVEL
+    from maizeviz_app.viewport import display_polydata, sample_plants
+
+    from maizeviz.canopy.layout import layout_for
+    from maizeviz.canopy.scene import build_canopy
+    from maizeviz.leaf.fit import read_leaves
+    from maizeviz.mesh.levels import parse_level
+
+    leaves = read_leaves(small_points).leaves
+    layout = layout_for(leaves, (3, 3))
+    canopy = build_canopy(leaves, layout, parse_level("standard"))
+    coarse = build_canopy(leaves, layout, parse_level(DISPLAY_LEVEL))
+    tile = sample_plants(canopy, None)
+    per_plant = np.bincount(canopy.face_instance, minlength=len(tile))
+    assert tile.sum() == 2
+    x0, y0, x1, y1 = canopy.layout.centre_bounds
+    xy = np.array([(p.x, p.y) for p in canopy.layout.placements])
+    near = np.flatnonzero(tile)[np.argmin(np.hypot(*(xy[tile] - [(x0 + x1) / 2,
+                                                                   (y0 + y1) / 2]).T))]
+    for budget, drawn in ((10 ** 9, set(np.flatnonzero(tile))),
+                          (int(per_plant[tile].max()) + int(per_plant[tile].min()) - 1, {near}),
+                          (1, {near})):
+        assert set(np.flatnonzero(sample_plants(canopy, budget))) == drawn, budget
+    viewport_mod.FINE_BUDGET, old = 1, viewport_mod.FINE_BUDGET
+    try:
+        poly = display_polydata(canopy, coarse)
+    finally:
+        viewport_mod.FINE_BUDGET = old
+    source = np.asarray(poly.field_data["source"])
+    np.testing.assert_array_equal(np.sort(source[source >= 0]),
+                                  np.flatnonzero(canopy.face_instance == near))
+    assert "draws 1 of the 2 plants of the sampled tile" in poly.field_data["view_note"][0]
