@@ -5,6 +5,7 @@ size and dock layout remembered between sessions, and the 3D view's native windo
 from __future__ import annotations
 
 from PySide6.QtCore import QByteArray, QSettings, Qt, QTimer
+from PySide6.QtGui import QFont, QFontMetrics
 from PySide6.QtWidgets import (
     QApplication,
     QDockWidget,
@@ -14,6 +15,8 @@ from PySide6.QtWidgets import (
     QPlainTextEdit,
     QPushButton,
     QScrollArea,
+    QSizeGrip,
+    QStatusBar,
     QWidget,
 )
 
@@ -116,6 +119,21 @@ def status_widgets(window: QMainWindow) -> tuple[QLabel, QPushButton]:
     lay.addWidget(cancel)
     window.statusBar().addPermanentWidget(box)
     return label, cancel
+
+
+def status_line(bar: QStatusBar, text: str, bold: bool) -> str:
+    """``text``'s first line as the status bar has room for it: cut in the middle with an
+    ellipsis when too long (Qt clips it at the right edge), the whole line then in the bar's
+    tooltip (and in Messages unless it was a status-only line)."""
+    line = text.splitlines()[0] if text else ""
+    right = [w.geometry().left() for w in bar.findChildren(QWidget)
+             if w.parent() is bar and w.isVisible() and not isinstance(w, QSizeGrip)]
+    room = (min(right) if right else bar.width()) - 16      # the bar's margins and a gap
+    font = QFont(bar.font())
+    font.setBold(bold)
+    shown = QFontMetrics(font).elidedText(line, Qt.TextElideMode.ElideMiddle, max(room, 40))
+    bar.setToolTip(line if shown != line else "")
+    return shown
 
 
 def restore_window(window: QMainWindow, settings: QSettings) -> bool:

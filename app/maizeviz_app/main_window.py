@@ -340,7 +340,7 @@ class MainWindow(QMainWindow):
             self.messages.appendPlainText(text)
         bar = self.statusBar()
         bar.setStyleSheet("QStatusBar { color: #b3261e; font-weight: bold; }" if error else "")
-        bar.showMessage(text.splitlines()[0], 15000 if error else 8000)
+        bar.showMessage(docks.status_line(bar, text, bool(error)), 15000 if error else 8000)
 
     def _on_failed(self, text: str, doing: str, quantity, mode) -> None:
         """An error the study said: a light setting's field is marked, a save that failed

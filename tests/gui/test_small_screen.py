@@ -192,3 +192,26 @@ def test_every_menu_entry_says_what_it_does_in_the_status_bar(laptop, qtbot):
     act = w.menu_actions["view_image"]
     assert act.showStatusText(w)
     assert w.statusBar().currentMessage() == act.statusTip()
+
+
+def test_a_long_status_line_is_shortened_in_the_middle_and_whole_in_its_tooltip(laptop, qtbot):
+    from PySide6.QtGui import QFont, QFontMetrics
+
+    w = laptop
+    bar = w.statusBar()
+    long = ("2005-08-01: PAR incident 61.6 mol/m² (direct 53.3, diffuse 8.3); intercepted 60.0 "
+            "mol/m² (97.3%); transmitted to the ground 1.67 mol/m² (2.7%); clear sky: "
+            "Ineichen-Perez with a Linke turbidity of 3.0, 14 steps of 60 min, end")
+    for error in (False, True):
+        w.say(("error: " if error else "") + long, status_only=True)
+        shown = bar.currentMessage()
+        font = QFont(bar.font())
+        font.setBold(error)
+        box = [c for c in bar.children() if getattr(c, "isVisible", None) and c.isVisible()
+               and c.metaObject().className() == "QWidget"]
+        room = min(c.geometry().left() for c in box)
+        assert "…" in shown and shown.endswith(", end"), shown
+        assert QFontMetrics(font).horizontalAdvance(shown) <= room, (shown, room)
+        assert bar.toolTip().endswith(long)
+    w.say("a short line", status_only=True)
+    assert bar.currentMessage() == "a short line" and bar.toolTip() == ""
