@@ -1,5 +1,5 @@
-"""A canopy above the view's triangle budget: the plants of the sampled tile are drawn at the
-level asked, the others at the standard mesh, and light given per triangle of the canopy
+"""A canopy above the view's triangle budget: the plants of the sampled tile nearest its centre
+(within FINE_BUDGET) are drawn at the level asked, the others at the display level, and light given per triangle of the canopy
 colours the drawn triangles exactly where they are the canopy's and per leaf elsewhere."""
 
 from __future__ import annotations
