@@ -202,9 +202,10 @@ def display_polydata(canopy, coarse, fine: np.ndarray | None = None) -> pv.PolyD
     poly.field_data["drawn_leaf"] = np.where(present[want], rank[want], -1).astype(np.int64)
     if note:
         n, tile = int(sampled.sum()), int(sample_plants(canopy, None).sum())
+        which = (f"the {n} plants of the sampled tile" if n == tile else
+                 f"{n} of the {tile} plants of the sampled tile (those nearest its centre)")
         poly.field_data["view_note"] = [
-            f"the view draws {n} of the {tile} plants of the sampled tile (those nearest its "
-            f"centre) at this level, {len(fine):,} triangles, and the other "
+            f"the view draws {which} at this level, {len(fine):,} triangles, and the other "
             f"{len(sampled) - n} plants at the display level, {len(rough):,} triangles (light, "
             "tables and exports use every triangle)"]
     _prepare_ground(canopy.layout)

@@ -20,8 +20,7 @@ def test_a_large_canopy_is_drawn_within_the_budget_and_coloured_by_its_light(
     mesh = w.viewport.canopy_mesh
     c = w.model.canopy
     assert "source" in mesh.field_data and c.n_triangles > 500
-    assert "plants of the sampled tile (those nearest its centre) at this level" in \
-        w.messages.toPlainText()
+    assert "draws the 2 plants of the sampled tile at this level" in w.messages.toPlainText()
     source = np.asarray(mesh.field_data["source"])
     x0, y0, x1, y1 = c.layout.centre_bounds
     sampled = [i for i, p in enumerate(c.layout.placements) if x0 <= p.x <= x1 and y0 <= p.y <= y1]
