@@ -827,9 +827,10 @@ def _intervals(utc_us: np.ndarray, label: str) -> np.ndarray:
 
 def read_weather(path, tz: str | None = None, label: str | None = None,
                  max_bytes: int = MAX_WEATHER_BYTES) -> Weather:
-    """Read a weather file: maizeviz's CSV, or an EnergyPlus EPW, NREL TMY3 or NSRDB
-    PSM3/PSM4 file through pvlib (:mod:`maizeviz.io.weather_files`, recognised by their
-    first lines).
+    """Read a weather file: maizeviz's CSV, or an EPW, TMY3 or PSM file through pvlib.
+
+    EnergyPlus EPW, NREL TMY3 and NSRDB PSM3/PSM4 files are read through pvlib
+    (:mod:`maizeviz.io.weather_files`), recognised by their first lines.
 
     maizeviz's CSV: comma-separated, a header line, blank lines and lines starting with '#'
     ignored. Columns (any order and case): ``time`` (ISO 8601 with a UTC offset such as
