@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from maizeviz.mesh import native
 from maizeviz.mesh.tessellate import LeafMesh, grid_faces, mesh_grids, triangle_areas_normals
 
 #: Largest distance (cm) of a data point from the chords counted as on them.
@@ -55,6 +56,19 @@ def _segment_distance(p, a, b) -> np.ndarray:
     return np.sqrt(dx * dx + dy * dy + dz * dz)
 
 
+def _chord_errors(coords: Sequence[np.ndarray], leaf: np.ndarray, line: np.ndarray,
+                  lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Largest distance (R,) cm of the points of line ``line[r]`` of grid ``leaf[r]`` from the
+    chords joining its lines ``lo[r]`` and ``hi[r]`` point by point; ``coords`` three
+    (L, m, n) arrays, cm. The compiled loop where built (the same numbers, one pass), else
+    numpy's gathers."""
+    got = native.chord_errors(tuple(coords), leaf, line, lo, hi)
+    if got is not None:
+        return got
+    return _segment_distance([c[leaf, line] for c in coords], [c[leaf, lo] for c in coords],
+                             [c[leaf, hi] for c in coords]).max(axis=1)
+
+
 def _split_errors(coords: Sequence[np.ndarray], kept: np.ndarray) -> np.ndarray:
     """For each leaf (L) and each index along axis 1 of the grids whose x, y, z are
     ``coords`` (three (L, m, n) arrays, cm): the largest distance (cm) of its points from the
@@ -64,12 +78,8 @@ def _split_errors(coords: Sequence[np.ndarray], kept: np.ndarray) -> np.ndarray:
     idx = np.arange(m)
     lo = np.maximum.accumulate(np.where(kept, idx, 0), axis=1)
     hi = np.minimum.accumulate(np.where(kept, idx, m - 1)[:, ::-1], axis=1)[:, ::-1]
-    base = (np.arange(nl) * m)[:, None]
-    lo, hi = (lo + base).ravel(), (hi + base).ravel()          # lines of the (L m, n) arrays
-    flat = [c.reshape(nl * m, -1) for c in coords]
-    a = [c[lo].reshape(coords[0].shape) for c in flat]
-    b = [c[hi].reshape(coords[0].shape) for c in flat]
-    err = _segment_distance(coords, a, b).max(axis=2)
+    leaf = np.repeat(np.arange(nl), m)
+    err = _chord_errors(coords, leaf, np.tile(idx, nl), lo.ravel(), hi.ravel()).reshape(nl, m)
     err[kept] = 0.0
     return err
 
@@ -94,8 +104,7 @@ def _update_errors(coords: Sequence[np.ndarray], kept: np.ndarray, which: np.nda
     at = np.repeat(added, counts)
     a = np.where(line < at, np.repeat(below, counts), at)
     b = np.where(line < at, at, np.repeat(above, counts))
-    err = _segment_distance([c[leaf, line] for c in coords], [c[leaf, a] for c in coords],
-                            [c[leaf, b] for c in coords]).max(axis=1)
+    err = _chord_errors(coords, leaf, line, a, b)
     err[line == at] = 0.0
     errors[leaf, line] = err
 
