@@ -1,12 +1,12 @@
-"""maizeviz's compiled pieces, the ray-packet kernel (maizeviz/mesh/_packets.c) and the meshing
-loops (maizeviz/mesh/_meshing.c), built when maizeviz is installed; everything else is declared
+"""maizeviz's compiled pieces, the ray-packet kernel (maizeviz/mesh/_packets.c) and the compiled
+loops (maizeviz/_loops.c), built when maizeviz is installed; everything else is declared
 in pyproject.toml.
 
 The kernel is an extension module on Python's stable ABI (one wheel per platform for every
 Python from 3.11). It needs no Embree header and no link: it calls Embree through addresses
 taken at run time from the library embreex loads (maizeviz/mesh/packets.py). It is optional:
 where it does not compile, maizeviz installs without it and traces with embreex's single
-rays, saying so once (the same hits, slower). The meshing loops are optional too: without them
+rays, saying so once (the same hits, slower). The compiled loops are optional too: without them
 numpy computes the same numbers, slower.
 """
 
@@ -17,12 +17,12 @@ from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
 SOURCES = {"maizeviz.mesh._packets": "maizeviz/mesh/_packets.c",
-           "maizeviz.mesh._meshing": "maizeviz/mesh/_meshing.c"}
+           "maizeviz._loops": "maizeviz/_loops.c"}
 
 
 class BuildExt(build_ext):
     """Flags by compiler: no fused multiply-add (the kernels' float64 steps must round as
-    numpy's do), symbols hidden but the kernels' own; the meshing loops vectorized (-O3; a
+    numpy's do), symbols hidden but the kernels' own; the compiled loops vectorized (-O3; a
     square root need not set errno nor a comparison trap, so that both run in SIMD lanes:
     the same values, no fast-math)."""
 
@@ -33,7 +33,7 @@ class BuildExt(build_ext):
                 ext.extra_compile_args = ["/O2", "/fp:precise"]
             else:
                 fast = ["-O3", "-fno-math-errno", "-fno-trapping-math"] \
-                    if ext.name.endswith("_meshing") else ["-O2"]
+                    if ext.name.endswith("_loops") else ["-O2"]
                 ext.extra_compile_args = [*fast, "-ffp-contract=off", "-fvisibility=hidden"]
         super().build_extensions()
 

@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from maizeviz import loops
 from maizeviz.leaf.nurbs import count_at_most
-from maizeviz.mesh import native
 from maizeviz.mesh.tessellate import LeafMesh, grid_faces, triangle_areas_normals
 
 #: A triangle whose squared cross product is below this share of |ab|^2 |ac|^2 (its corners
@@ -100,12 +100,12 @@ def grid_areas(vertices: np.ndarray, rel_tol: float = 1e-9) -> np.ndarray:
     nl, a, b = vertices.shape[:3]
     out = np.empty(nl)
     step = max(1, CHUNK_PAIRS // (a * b))              # leaves whose arrays stay in cache
-    if native.available():
+    if loops.available():
         # the same triangles' doubled areas from the compiled loop, summed here as below
         size = min(step, nl) * (a - 1) * (b - 1)
         buf = (np.empty(size), np.empty(size))
         for s in range(0, nl, step):
-            twice = native.grid_twice_areas(vertices[s:s + step], rel_tol, buf)
+            twice = loops.grid_twice_areas(vertices[s:s + step], rel_tol, buf)
             assert twice is not None
             total = np.zeros(len(twice[0]))
             for t in twice:

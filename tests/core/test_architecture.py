@@ -230,7 +230,7 @@ def test_wheel_holds_the_app_and_the_data_under_our_names(wheel_env):
     # a platform wheel carrying the built ray-packet kernel and meshing loops (stable ABI)
     # and their sources
     assert "-cp311-abi3-" in wheel.name and not wheel.name.endswith("-any.whl")
-    assert {f"maizeviz/mesh/_{m}{ext}" for m in ("packets", "meshing")
+    assert {f"maizeviz/{m}{ext}" for m in ("mesh/_packets", "_loops")
             for ext in (".abi3.so", ".pyi", ".c")} <= set(names)
     meta = next(n for n in names if n.endswith("entry_points.txt"))
     text = zipfile.ZipFile(wheel).read(meta).decode()

@@ -1,8 +1,8 @@
-"""The compiled meshing loops (``maizeviz/mesh/_meshing.c``) give numpy's numbers to the bit:
+"""The compiled loops (``maizeviz/_loops.c``) give numpy's numbers to the bit:
 grid areas (the reference areas a triangle budget widens its leaves to) and the splitting's
 chord distances, on hypothesis-drawn grids (leaf-like, random, integer ties, zero-length edges,
 collapsed tips, NaN and infinite points), and whole canopies at triangle budgets built with and
-without them are the same arrays."""
+without them are the same arrays; B-spline bases too, and so surfaces fitted and sampled."""
 
 import os
 
@@ -11,31 +11,33 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from maizeviz import loops
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
+from maizeviz.leaf import nurbs
 from maizeviz.leaf.fit import fit_leaves
 from maizeviz.leaf.synth import LeafShape, block_grids, leaf_points
-from maizeviz.mesh import measures, native, simplify
+from maizeviz.mesh import measures, simplify
 from maizeviz.mesh.levels import Level, reference_areas
 
-pytestmark = pytest.mark.skipif(not native.available(),
-                                reason="the meshing loops were not built at install")
+pytestmark = pytest.mark.skipif(not loops.available(),
+                                reason="the compiled loops were not built at install")
 
 
 def without_loops(fn):
     """``fn()`` run with numpy's passes instead of the compiled loops."""
-    old = os.environ.get("MAIZEVIZ_MESHING")
-    os.environ["MAIZEVIZ_MESHING"] = "0"
-    native._loaded.cache_clear()
+    old = os.environ.get("MAIZEVIZ_LOOPS")
+    os.environ["MAIZEVIZ_LOOPS"] = "0"
+    loops._loaded.cache_clear()
     try:
-        assert not native.available() and "MAIZEVIZ_MESHING=0" in native.why()
+        assert not loops.available() and "MAIZEVIZ_LOOPS=0" in loops.why()
         return fn()
     finally:
         if old is None:
-            del os.environ["MAIZEVIZ_MESHING"]
+            del os.environ["MAIZEVIZ_LOOPS"]
         else:
-            os.environ["MAIZEVIZ_MESHING"] = old
-        native._loaded.cache_clear()
+            os.environ["MAIZEVIZ_LOOPS"] = old
+        loops._loaded.cache_clear()
 
 
 @st.composite
@@ -104,13 +106,12 @@ def test_canopies_at_budgets_are_the_same_arrays(budget):
     """A synthetic field's canopy at a triangle budget, widened to the reference areas, built
     with and without the loops: every vertex, triangle and id the same (the triangles of
     before the loops), and the reference areas the same."""
-    leaves, errors = fit_leaves(block_grids(3, 4, seed=budget))
-    assert not errors
-    layout = layout_for(leaves, (1, 1), 60.0, 30.0, None, None)
+    grids = block_grids(3, 4, seed=budget)
 
-    def build():
-        for lf in leaves:
-            lf.cache.pop("reference_area_cm2", None)
+    def build():                              # fitted, sampled and meshed either way
+        leaves, errors = fit_leaves(grids)
+        assert not errors
+        layout = layout_for(leaves, (1, 1), 60.0, 30.0, None, None)
         return reference_areas(leaves), build_canopy(leaves, layout, Level(triangles=budget))
 
     areas, got = build()
@@ -119,3 +120,33 @@ def test_canopies_at_budgets_are_the_same_arrays(budget):
     for name in ("vertices", "faces", "face_instance", "face_plant", "face_leaf"):
         assert np.array_equal(getattr(got, name), getattr(want, name)), name
     _same(got.vertices, want.vertices)
+
+
+@st.composite
+def knots_and_points(draw):
+    degree = draw(st.integers(0, 5))
+    nl = draw(st.integers(1, 4))
+    inner = draw(st.integers(0, 8))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    # clamped knot vectors, interior knots repeated at times; points on knots, 0 and 1 too
+    interior = np.sort(rng.choice([0.25, 0.5, 0.5, 0.75], inner) if draw(st.booleans())
+                       else rng.uniform(0, 1, (nl, inner)), axis=-1)
+    interior = np.broadcast_to(interior, (nl, inner))
+    knots = np.concatenate([np.zeros((nl, degree + 1)), interior,
+                            np.ones((nl, degree + 1))], axis=1)
+    na = draw(st.integers(1, 30))
+    x = rng.uniform(0, 1, (nl, na))
+    x[:, :min(na, 2)] = [0.0, 1.0][:min(na, 2)]
+    if inner and na > 2:
+        x[:, 2] = interior[:, 0]
+    return x, knots, degree
+
+
+@settings(max_examples=300, deadline=None)
+@given(knots_and_points())
+def test_basis_matrices_are_numpys_to_the_bit(case):
+    x, knots, degree = case
+    with np.errstate(all="ignore"):
+        got = nurbs.basis_matrix(x, knots, degree)
+        want = without_loops(lambda: nurbs.basis_matrix(x, knots, degree))
+    _same(got, want)

@@ -1,16 +1,20 @@
-"""The meshing loops compiled from ``_meshing.c``, called through ctypes.
+"""Loops compiled from ``_loops.c`` (meshing and surface sampling), called through ctypes.
 
 numpy computes a grid's triangle areas in some thirty passes over temporaries (subtract, square,
 add, compare, cross, root...), each a trip through memory: at K = 4, 14,400 leaves' reference
-areas took 0.58 s of CPU, the largest part of a coarse canopy's build. ``_meshing.c`` makes the
+areas took 0.58 s of CPU, the largest part of a coarse canopy's build. ``_loops.c`` makes the
 same floating-point operations element by element in one pass and leaves the sums to numpy
 (pairwise summation, whose order only numpy knows), so the numbers are numpy's to the bit
-(``tests/core/test_meshing_kernel.py``).
+(``tests/core/test_loops.py``).
 
 The loops are built when maizeviz is installed (``setup.py``, the extension module
-``maizeviz.mesh._meshing``). Where they are not (no C compiler at install, a module built from
-another ``_meshing.c``), :func:`grid_twice_areas` returns None and numpy does the work: the same
-numbers, slower. ``MAIZEVIZ_MESHING=0`` in the environment turns them off.
+``maizeviz._loops``). Where they are not (no C compiler at install, a module built from
+another ``_loops.c``), :func:`grid_twice_areas` returns None and numpy does the work: the same
+numbers, slower. ``MAIZEVIZ_LOOPS=0`` in the environment turns them off.
+
+The B-spline basis of every surface fit and sample (The NURBS Book A2.2: a span search and
+the Cox-de Boor recurrence, a dozen numpy passes over (L, A) arrays) is here too, point by
+point, the same divisions, products and sums.
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-SOURCE = Path(__file__).with_name("_meshing.c")
+SOURCE = Path(__file__).with_name("_loops.c")
 
 
 def _lib() -> ctypes.CDLL | None:
@@ -31,21 +35,21 @@ def _lib() -> ctypes.CDLL | None:
 
 
 def why() -> str:
-    """Why numpy does the meshing loops' work ("" when the compiled loops do it)."""
+    """Why numpy does the compiled loops' work ("" when the compiled loops do it)."""
     return _loaded()[1]
 
 
 @functools.cache
 def _loaded() -> tuple[ctypes.CDLL | None, str]:
-    if os.environ.get("MAIZEVIZ_MESHING", "1") == "0":
-        return None, "turned off by MAIZEVIZ_MESHING=0"
+    if os.environ.get("MAIZEVIZ_LOOPS", "1") == "0":
+        return None, "turned off by MAIZEVIZ_LOOPS=0"
     try:
-        from maizeviz.mesh import _meshing as ext
+        from maizeviz import _loops as ext
     except ImportError:
         return None, "not built when maizeviz was installed (no C compiler?)"
     if SOURCE.is_file() and \
             hashlib.sha256(SOURCE.read_bytes()).hexdigest() != ext.source_sha256:
-        return None, ("built from another _meshing.c: rebuild it (pip install -e . or "
+        return None, ("built from another _loops.c: rebuild it (pip install -e . or "
                       "scripts/setup.sh)")
     try:
         lib = ctypes.CDLL(str(ext.__file__))
@@ -56,6 +60,8 @@ def _loaded() -> tuple[ctypes.CDLL | None, str]:
     lib.mz_grid_twice_areas.argtypes = [p, i64, i64, i64, f64, p, p]
     lib.mz_chord_errors.restype = ctypes.c_int
     lib.mz_chord_errors.argtypes = [p, p, p, i64, i64, i64, p, p, p, p, p]
+    lib.mz_basis_matrix.restype = ctypes.c_int
+    lib.mz_basis_matrix.argtypes = [p, p, i64, i64, i64, i64, p]
     return lib, ""
 
 
@@ -121,6 +127,32 @@ def chord_errors(coords: tuple[np.ndarray, ...], leaf: np.ndarray, line: np.ndar
     _, m, n = x.shape
     idx = [np.ascontiguousarray(i, dtype=np.int64) for i in (leaf, line, lo, hi)]
     out = np.empty(len(idx[0]))
-    lib.mz_chord_errors(x.ctypes.data, y.ctypes.data, z.ctypes.data, m, n, len(out),
-                        *(i.ctypes.data for i in idx), out.ctypes.data)
+    if lib.mz_chord_errors(x.ctypes.data, y.ctypes.data, z.ctypes.data, m, n, len(out),
+                           *(i.ctypes.data for i in idx), out.ctypes.data) != 0:
+        raise MemoryError("no memory for a line's distances")  # pragma: no cover - bytes
+    return out
+
+
+def basis_matrix(x: np.ndarray, knots: np.ndarray, degree: int) -> np.ndarray | None:
+    """Dense B-spline basis values, as :func:`maizeviz.leaf.nurbs.basis_matrix` computes them.
+
+    Parameters
+    ----------
+    x : (L, A) float64 in [0, 1]
+    knots : (L, K) float64, clamped, increasing
+    degree : int, 0 to 15
+
+    Returns
+    -------
+    (L, A, K - degree - 1) float64; None where the loops are not built (or past degree 15).
+    """
+    lib = _lib()
+    if lib is None or not 0 <= degree <= 15:
+        return None
+    x = np.ascontiguousarray(x, dtype=np.float64)
+    k = np.ascontiguousarray(knots, dtype=np.float64)
+    nl, na = x.shape
+    out = np.empty((nl, na, k.shape[1] - degree - 1))
+    lib.mz_basis_matrix(x.ctypes.data, k.ctypes.data, nl, na, k.shape[1], degree,
+                        out.ctypes.data)
     return out
