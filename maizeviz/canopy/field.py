@@ -23,6 +23,7 @@ from __future__ import annotations
 import os
 from collections import defaultdict
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +31,13 @@ import numpy as np
 from maizeviz.canopy.layout import CanopyLayout
 from maizeviz.canopy.scene import Canopy, PlantMesh, place_plants, plant_meshes
 from maizeviz.errors import LeafError
-from maizeviz.io.parquet import NotStreamable, is_parquet, parquet_rows, point_chunks
+from maizeviz.io.parquet import (
+    NotStreamable,
+    is_parquet,
+    parquet_rows,
+    plant_chunk_bounds,
+    point_chunks,
+)
 from maizeviz.leaf.fit import fit_leaves
 from maizeviz.leaf.grid import base_of_collars, build_grids
 from maizeviz.mesh.levels import Level
@@ -93,6 +100,30 @@ class FieldLeaves:
         self.workers = workers
         self.strict, self.degree, self.method = strict, degree, method
         self.rows = parquet_rows(path) or 0
+        #: records [start, stop) of each chunk of whole plants, in the file's order
+        self.chunks: list[tuple[int, int]] = []
+        parts: Iterable[_Survey] = ()
+        pool = None
+        if survey and workers > 1 and not strict:
+            # the chunks' bounds from the plant column alone, then each chunk surveyed in a
+            # worker (the same numbers: each chunk's leaves are gridded alone either way)
+            self.chunks = plant_chunk_bounds(path, CHUNK_POINTS)
+            if len(self.chunks) > 1:
+                pool = _pool(min(workers, len(self.chunks)))
+                parts = pool.map(_survey_rows, [str(path)] * len(self.chunks),
+                                 *zip(*self.chunks))
+            else:
+                parts = (_survey_rows(str(path), a, b) for a, b in self.chunks)
+        elif survey:
+            parts = (_survey_table(t, strict) for t in point_chunks(path, CHUNK_POINTS))
+        try:
+            self._gather(parts, progress)
+        finally:
+            if pool is not None:
+                pool.shutdown(cancel_futures=True)
+
+    def _gather(self, parts: Iterable[_Survey], progress: ProgressCallback | None) -> None:
+        """The survey's attributes from each chunk's, in the file's order."""
         plant: list[int] = []
         nrows: list[int] = []
         ncols: list[int] = []
@@ -103,32 +134,25 @@ class FieldLeaves:
         lo: dict[int, np.ndarray] = {}
         hi: dict[int, np.ndarray] = {}
         self.highest = -np.inf
-        #: records [start, stop) of each chunk of whole plants, in the file's order
-        self.chunks: list[tuple[int, int]] = []
+        bounds = []
         done = 0
-        for table in point_chunks(path, CHUNK_POINTS) if survey else ():
-            self.chunks.append((int(table.line[0]) - 2, int(table.line[-1]) - 1))
-            grids, errors = build_grids(table, strict=strict)
-            self.skipped += errors
-            plant += [g.plant for g in grids]
-            nrows += [g.points.shape[0] for g in grids]
-            ncols += [g.points.shape[1] for g in grids]
-            tip += [g.tip_collapsed for g in grids]
-            for g in grids:
-                collars[g.plant].append(g.collar[:2].copy())
-            self.notes += [f"plant {g.plant}, leaf {g.leaf}: {n}" for g in grids if g.notes
-                           for n in g.notes]
-            # each plant's points seen from above (its records lie together in the chunk)
-            ids, xyz = table.ids[:, 0], table.xyz
-            starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
-            for p, a, b in zip(ids[starts].tolist(), np.minimum.reduceat(xyz, starts),
-                               np.maximum.reduceat(xyz, starts)):
+        for part in parts:
+            bounds.append(part.bounds)
+            self.skipped += [LeafError(*e) for e in part.errors]
+            plant += part.plant
+            nrows += part.rows
+            ncols += part.cols
+            tip += part.tip
+            for p, xy in zip(part.plant, part.collars):
+                collars[p].append(xy)
+            self.notes += part.notes
+            for p, a, b in zip(part.extent_plants, part.lo, part.hi):
                 lo[p] = np.minimum(lo[p], a) if p in lo else a
                 hi[p] = np.maximum(hi[p], b) if p in hi else b
-            if len(xyz):
-                self.highest = max(self.highest, float(xyz[:, 2].max()))
-            done += len(table)
+            self.highest = max(self.highest, part.highest)
+            done += part.records
             report(progress, done, max(self.rows, done), "reading the field")
+        self.chunks = bounds
         self.shapes = LeafShapes(np.array(plant, np.int64), np.array(nrows, np.int32),
                                  np.array(ncols, np.int32), np.array(tip, bool))
         self.bases = {p: base_of_collars(np.array(c)) for p, c in collars.items()}
@@ -175,11 +199,7 @@ class FieldLeaves:
             results = (_mesh_rows(*job) for job in jobs)
             pool = None
         else:
-            import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor
-
-            pool = ProcessPoolExecutor(min(n, len(jobs)),
-                                       mp_context=multiprocessing.get_context("forkserver"))
+            pool = _pool(min(n, len(jobs)))
             results = pool.map(_mesh_rows, *zip(*jobs))
         try:
             for k, (meshes, errors) in enumerate(results, start=1):
@@ -198,6 +218,64 @@ class FieldLeaves:
         placed = {p.plant for p in layout.placements}
         meshes = self.plant_meshes(level, preserve_area, placed, progress)
         return place_plants(meshes, layout, level.label)
+
+
+@dataclass
+class _Survey:
+    """What the survey keeps of one chunk of whole plants (pickles: errors as tuples)."""
+
+    bounds: tuple[int, int]
+    records: int
+    errors: list[tuple]
+    plant: list[int]
+    rows: list[int]
+    cols: list[int]
+    tip: list[bool]
+    collars: list[np.ndarray]
+    notes: list[str]
+    extent_plants: list[int]
+    lo: np.ndarray
+    hi: np.ndarray
+    highest: float
+
+
+def _survey_table(table, strict: bool = False) -> _Survey:
+    """The survey of one table of whole plants (:class:`FieldLeaves`)."""
+    grids, errors = build_grids(table, strict=strict)
+    # each plant's points seen from above (its records lie together in the chunk)
+    ids, xyz = table.ids[:, 0], table.xyz
+    starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]]) if len(ids) else \
+        np.zeros(0, np.int64)
+    some = len(xyz) > 0
+    return _Survey(
+        bounds=(int(table.line[0]) - 2, int(table.line[-1]) - 1) if some else (0, 0),
+        records=len(table), errors=[(e.plant, e.leaf, e.detail) for e in errors],
+        plant=[g.plant for g in grids], rows=[g.points.shape[0] for g in grids],
+        cols=[g.points.shape[1] for g in grids], tip=[g.tip_collapsed for g in grids],
+        collars=[g.collar[:2].copy() for g in grids],
+        notes=[f"plant {g.plant}, leaf {g.leaf}: {n}" for g in grids if g.notes
+               for n in g.notes],
+        extent_plants=ids[starts].tolist(),
+        lo=np.minimum.reduceat(xyz, starts) if some else np.zeros((0, 3)),
+        hi=np.maximum.reduceat(xyz, starts) if some else np.zeros((0, 3)),
+        highest=float(xyz[:, 2].max()) if some else -np.inf)
+
+
+def _survey_rows(path: str, start: int, stop: int) -> _Survey:
+    """:func:`_survey_table` of the records [start, stop) of a Parquet points file (in a
+    worker process)."""
+    from maizeviz.io.parquet import read_rows
+
+    return _survey_table(read_rows(path, start, stop))
+
+
+def _pool(n: int):
+    """Processes for a field's chunks (started by forkserver: no copy of this process's
+    memory, nor of its threads' locks)."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("forkserver"))
 
 
 def _mesh_table(table, level: Level, preserve_area: bool, strict: bool, degree: int,
