@@ -40,6 +40,7 @@ from maizeviz.cli.common import (
     levels_from,
     mesh_setup,
     say,
+    say_estimate,
 )
 from maizeviz.cost import check, light_costs, mesh_cost
 from maizeviz.errors import LeafError, MaizevizError, check_range
@@ -404,7 +405,7 @@ def run(args: argparse.Namespace) -> int:
         leaves, skipped, layout = canopy_setup(args)
     work = _costs(job, layout)
     if mesh:
-        check([[mesh_cost(mesh_canopy.n_triangles), *work]], args.force)
+        say_estimate(check([[mesh_cost(mesh_canopy.n_triangles), *work]], args.force))
     else:
         check_canopy_costs(leaves, layout, levels, args.force, work)
     records: list[dict[str, Any]] = []

@@ -131,3 +131,21 @@ def test_scattered_plants_are_found_from_the_plant_column(tmp_path, small_chunks
     with pytest.raises(NotStreamable, match="not together"):
         plant_chunk_bounds(path, 100)
     assert field.read_field(path, workers=2) is None
+
+
+def test_long_work_is_estimated_before_it_starts(points, small_chunks, capsys, monkeypatch):
+    """Work estimated past SAY_SECONDS is told on stderr before the canopy is built: its
+    time and memory, and its largest part."""
+    import maizeviz.cost as cost
+
+    argv = ["light", str(points), "--triangles", "36", "--sun-zenith", "35", "--sun-azimuth",
+            "120", "--density", "1"]
+    assert main(argv) == EXIT_PARTIAL                       # the spoiled leaf
+    assert "estimate:" not in capsys.readouterr().err       # seconds of work: not told
+    monkeypatch.setattr(cost, "SAY_SECONDS", 0.0)
+    assert main(argv) == EXIT_PARTIAL                       # the spoiled leaf
+    err = capsys.readouterr().err
+    line = next(x for x in err.splitlines() if x.startswith("estimate:"))
+    assert "of work and" in line and "of memory (the largest part: " in line
+    assert "36 triangles" in line or "rays" in line
+    assert err.index("read plant by plant") < err.index("estimate:")   # after the survey
