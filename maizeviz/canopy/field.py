@@ -90,6 +90,8 @@ class FieldLeaves:
     rows : records in the file
     extents : {plant: (x0, y0, x1, y1) cm}, the bounding box of its points from above
     highest : cm, the highest point
+    worker_cpu_s : CPU seconds the worker processes spent on its chunks so far (survey and
+        builds; 0 when this process did all the work)
     """
 
     def __init__(self, path: str | Path, strict: bool = False, degree: int = 3,
@@ -100,6 +102,7 @@ class FieldLeaves:
         self.workers = workers
         self.strict, self.degree, self.method = strict, degree, method
         self.rows = parquet_rows(path) or 0
+        self.worker_cpu_s = 0.0
         #: records [start, stop) of each chunk of whole plants, in the file's order
         self.chunks: list[tuple[int, int]] = []
         parts: Iterable[_Survey] = ()
@@ -137,6 +140,7 @@ class FieldLeaves:
         bounds = []
         done = 0
         for part in parts:
+            self.worker_cpu_s += part.cpu_s
             bounds.append(part.bounds)
             self.skipped += [LeafError(*e) for e in part.errors]
             plant += part.plant
@@ -202,7 +206,8 @@ class FieldLeaves:
             pool = _pool(min(n, len(jobs)))
             results = pool.map(_mesh_rows, *zip(*jobs))
         try:
-            for k, (meshes, errors) in enumerate(results, start=1):
+            for k, (meshes, errors, cpu_s) in enumerate(results, start=1):
+                self.worker_cpu_s += cpu_s
                 out.update(meshes)
                 self.skipped += [LeafError(*e) for e in errors]
                 report(progress, k, len(jobs), f"building the field at {level}")
@@ -237,6 +242,7 @@ class _Survey:
     lo: np.ndarray
     hi: np.ndarray
     highest: float
+    cpu_s: float = 0.0                  # CPU seconds a worker process spent on it
 
 
 def _survey_table(table, strict: bool = False) -> _Survey:
@@ -264,9 +270,21 @@ def _survey_table(table, strict: bool = False) -> _Survey:
 def _survey_rows(path: str, start: int, stop: int) -> _Survey:
     """:func:`_survey_table` of the records [start, stop) of a Parquet points file (in a
     worker process)."""
+    import time
+
     from maizeviz.io.parquet import read_rows
 
-    return _survey_table(read_rows(path, start, stop))
+    t = time.process_time()
+    out = _survey_table(read_rows(path, start, stop))
+    out.cpu_s = time.process_time() - t if _in_worker() else 0.0
+    return out
+
+
+def _in_worker() -> bool:
+    """Whether this process is a worker started by :mod:`multiprocessing`."""
+    import multiprocessing
+
+    return multiprocessing.parent_process() is not None
 
 
 def _pool(n: int):
@@ -297,11 +315,15 @@ def _mesh_rows(path: str, start: int, stop: int, level: Level, preserve_area: bo
                strict: bool, degree: int, method: str, only: set[int] | None):
     """:func:`_mesh_table` of the records [start, stop) of a Parquet points file (in a worker
     process: errors as (plant, leaf, detail), which pickle)."""
+    import time
+
     from maizeviz.io.parquet import read_rows
 
+    t = time.process_time()
     meshes, errors = _mesh_table(read_rows(path, start, stop), level, preserve_area, strict,
                                  degree, method, only)
-    return meshes, [(e.plant, e.leaf, e.detail) for e in errors]
+    cpu_s = time.process_time() - t if _in_worker() else 0.0
+    return meshes, [(e.plant, e.leaf, e.detail) for e in errors], cpu_s
 
 
 def canopy_of(leaves, layout: CanopyLayout, level: Level, preserve_area: bool = True,
