@@ -9,6 +9,8 @@ time, whole plants per chunk (:func:`maizeviz.io.parquet.point_chunks`):
 1. the survey (:class:`FieldLeaves`): each chunk's leaf grids are built and only what the
    commands need before any long work is kept: each leaf's plant and grid shape (the cost
    estimates), each plant's stalk base (the layout), the leaves refused and the repairs made;
+   with workers, the chunks' bounds are read from the plant column alone
+   (:func:`~maizeviz.io.parquet.plant_chunk_bounds`) and each chunk surveyed on a process;
 2. the build (:meth:`FieldLeaves.canopy`): each chunk's grids are built again, fitted and
    meshed at the level (:func:`~maizeviz.canopy.scene.plant_meshes`), the chunk's leaves let
    go; the plants' meshes are then placed (:func:`~maizeviz.canopy.scene.place_plants`).
