@@ -89,7 +89,7 @@ def main() -> None:
         secs = doc.get("seconds") or doc.get("day", {}).get("seconds")
         if secs:
             out[f"{name}_seconds"] = {k: round(v, 3) for k, v in secs.items()}
-    out["cli_sun_over_anchor"] = round(out["cli_sun_s"] / out["anchor_s"], 1)   # type: ignore
+    out["cli_sun_over_anchor"] = round(out["cli_sun_s"] / out["anchor_s"], 1)   # type: ignore[operator]
 
     leaves = read_leaves(example_points()).leaves
     canopy = build_canopy(leaves, layout_for(leaves, (3, 3)), parse_level("K4"))
@@ -111,9 +111,9 @@ def main() -> None:
         out[f"sun_{name}_s"] = round(min(sun_s), 3)
         out[f"day_{name}_s"] = round(min(day_s), 3)
     out["block_speedup_first_sun"] = round(
-        (out["build_whole_s"] + out["sun_whole_s"])                            # type: ignore
-        / (out["build_block_s"] + out["sun_block_s"]), 1)                      # type: ignore
-    out["block_speedup_day"] = round(out["day_whole_s"] / out["day_block_s"], 2)  # type: ignore
+        (out["build_whole_s"] + out["sun_whole_s"])                            # type: ignore[operator]
+        / (out["build_block_s"] + out["sun_block_s"]), 1)                      # type: ignore[operator]
+    out["block_speedup_day"] = round(out["day_whole_s"] / out["day_block_s"], 2)  # type: ignore[operator]
     out["targets"] = {"cli_sun_s": 1.5, "cli_day_s": 5.0}
     report(out, args.json)
 

@@ -18,11 +18,30 @@ Run under a display (``xvfb-run -a -s "-screen 0 1366x768x24" python benchmarks/
   draws the sampled tile at K = 4, the other plants coarser), on software OpenGL.
   With ``--repeat N`` every level is visited N times: the medians, and every sample in
   ``..._samples``.
+- ``undo_level_to_canopy_s`` and ``undo_level_event_loop_max_gap_ms``: Edit > Undo of a
+  level (16 back to 36 triangles) to the canopy shown again, and the longest gap meanwhile.
+- ``layout_<edit>_ms`` and ``layout_<edit>_event_loop_max_gap_ms``: the layout editor on a
+  field of 30 x 30 plants (the 3D view not following): laying it out by rows x plants, moving
+  one plant, undoing the move, undoing the whole field (target: an edit or an undo on 900
+  plants leaves no gap over 200 ms; laying out 900 plants where there were 81 makes 819 new
+  items in the top view once: 47 ms on a quiet machine, 0.24 s on a busy one).
+- ``pick_ms``: a click on a leaf of the K = 4 canopy, from the release event's delivery to the
+  leaf picked, highlighted and described (the event loop is held that long; target under 50
+  ms), median and worst of the clicks (``pick_ms_samples``); ``pick_frame_gap_ms``: the
+  longest gap of the 10 ms timer from a click through the frame that shows the highlight
+  (median over the clicks, and the worst).
+- ``mesh_file_event_loop_max_gap_ms``: opening the K = 4 canopy exported as a PLY (File > Open
+  canopy mesh), the longest gap from the open to its first frame (target under 200 ms, as for
+  built canopies); ``mesh_file_frame_gap_ms`` the gap of the frame itself (from the canopy
+  shown), ``mesh_file_drawn`` the triangles the view draws of it, ``mesh_file_s`` the time to
+  the frame.
 - ``stop_event_loop_max_gap_ms``: longest gap of the 10 ms timer from pressing the digitizer's
   Stop to 0.3 s after the session reported stopped (its port closed, its journal closed), for a
   session on a simulated FASTRAK (a real pty) with one leaf meshed, and ``..._demo`` for the
   Demo (its replay thread sleeping between presses), each clicked with no press in flight (a
-  press's own frame is the recording's). Target: under 50 ms.
+  press's own frame is the recording's). Target: under 50 ms. ``stop_idle_max_gap_ms`` is the
+  same timer over the 0.4 s (0.1 s for the Demo) just before each Stop: what the machine's
+  load alone does to the event loop at that moment. Stops are repeated ``max(5, N)`` times.
 - ``view_px``: the 3D view's size in pixels (the window is 1366 x 740, docks as on a first start).
 - ``anchor_s``: a fixed numpy workload timed in the same run (these machines are shared and
   noisy; compare runs through it); ``anchor_end_s`` the same after the GUI part.
@@ -41,6 +60,7 @@ import sys
 import threading
 import time
 from pathlib import Path
+from typing import Self
 
 from anchors import matmul_anchor
 
@@ -65,7 +85,7 @@ class GilProbe:
             self.worst = max(self.worst, now - last)
             last = now
 
-    def __enter__(self) -> GilProbe:
+    def __enter__(self) -> Self:
         self._thread.start()
         return self
 
@@ -197,18 +217,26 @@ class GapTimer:
 
         self.worst = 0.0
         self._last = time.perf_counter()
+        self.spans: list[tuple[float, float]] = []     # (start, end) of gaps over 50 ms
         self.timer = QTimer(interval=10)
         self.timer.timeout.connect(self._tick)
 
     def _tick(self) -> None:
         now = time.perf_counter()
         self.worst = max(self.worst, now - self._last)
+        if now - self._last > 0.05:
+            self.spans.append((self._last, now))
         self._last = now
 
     def start(self) -> None:
         self.worst = 0.0
+        self.spans = []
         self._last = time.perf_counter()
         self.timer.start()
+
+    def worst_after(self, t: float) -> float:
+        """The longest gap (ms) that ended after ``t`` (perf_counter seconds)."""
+        return 1000 * max((b - a for a, b in self.spans if b > t), default=0.0)
 
     def stop(self) -> float:
         self._tick()
@@ -250,10 +278,10 @@ def gui_child(levels: list[str], repeat: int = 1) -> None:
                  "view_px": [view.width(), view.height()]}
     samples: dict = {"slider_to_view_s": {}, "event_loop_max_gap_ms": {}, "renders_per_level": {}}
     gaps = GapTimer()
-    current = window.level
+    current = window.model.settings.canopy.level
     for level in levels * repeat:
         if level == current:
-            window.slider.setValue(COMPLEXITY_STOPS.index("4" if level != "4" else "8"))
+            window.canopy_panel.slider.setValue(COMPLEXITY_STOPS.index("4" if level != "4" else "8"))
             assert spin(TIMEOUT_S, lambda: bool(shown) and window.runner.current("build") is None
                         and not window.canopy_panel.asked_label.text())
             spin(1.0)
@@ -261,7 +289,7 @@ def gui_child(levels: list[str], repeat: int = 1) -> None:
         frames_before = view.render_count
         gaps.start()
         t0 = time.perf_counter()
-        window.slider.setValue(COMPLEXITY_STOPS.index(level))
+        window.canopy_panel.slider.setValue(COMPLEXITY_STOPS.index(level))
         assert spin(TIMEOUT_S, lambda before=before: len(shown) > before), f"no canopy at {level}"
         framed = view.render_count
         spin(TIMEOUT_S, lambda framed=framed: view.render_count > framed)
@@ -278,7 +306,7 @@ def gui_child(levels: list[str], repeat: int = 1) -> None:
     out["renders_per_canopy"] = max(out["renders_per_level"].values(), default=None)
     # a light run at 36 triangles: the event loop while the child traces
     if "36" in levels:
-        window.slider.setValue(COMPLEXITY_STOPS.index("36"))
+        window.canopy_panel.slider.setValue(COMPLEXITY_STOPS.index("36"))
         spin(TIMEOUT_S, lambda: shown[-1] == "36 triangles" and
              window.runner.current("build") is None)
         spin(1.0)
@@ -286,18 +314,64 @@ def gui_child(levels: list[str], repeat: int = 1) -> None:
         window.light_shown.connect(lambda: lit.append(1))
         gaps.start()
         t0 = time.perf_counter()
-        window.compute_light()
+        window.model.compute_light()
         spin(TIMEOUT_S, lambda: bool(lit))
         out["light_36_s"] = time.perf_counter() - t0
         out["light_event_loop_max_gap_ms"] = gaps.stop()
+    out.update(edit_part(window, spin, gaps, shown))
     out.update(stop_gaps(window, gaps, spin, repeat))
+    if "K4" in levels:
+        out.update(pick_and_mesh_file(window, spin, gaps, shown))
     window.close()
     print(json.dumps(out), flush=True)
 
 
+def edit_part(window, spin, gaps, shown: list) -> dict:
+    """Undo and the layout editor on the GUI thread: an undone level (the canopy rebuilt, as
+    the edit did), and on a regular field of 30 x 30 plants (900, the 3D view not following)
+    laying it out, moving one plant, undoing the move and undoing the whole field; each as
+    the time the GUI thread takes and the longest gap of the 10 ms timer until it is drawn
+    (overlaps included)."""
+    out: dict = {}
+    undo = window.menu_actions["undo"]
+    before = len(shown)
+    window.model.settings.canopy.level = "16"
+    spin(TIMEOUT_S, lambda: len(shown) > before and window.runner.current("build") is None)
+    spin(1.0)
+    before = len(shown)
+    gaps.start()
+    t0 = time.perf_counter()
+    undo.trigger()
+    spin(TIMEOUT_S, lambda: len(shown) > before)
+    out["undo_level_to_canopy_s"] = time.perf_counter() - t0
+    out["undo_level_event_loop_max_gap_ms"] = gaps.stop()
+    panel = window.layout_panel
+    window.docks["layout"].raise_()
+    panel.follow.setChecked(False)
+    panel.rows_box.setValue(30)
+    panel.per_row_box.setValue(30)
+    spin(0.5)
+    draft = panel.model
+
+    def timed(name: str, action) -> None:
+        gaps.start()
+        t0 = time.perf_counter()
+        action()
+        out[f"layout_{name}_ms"] = (time.perf_counter() - t0) * 1000
+        spin(0.3)                                # the overlaps (debounced 60 ms) and a paint
+        out[f"layout_{name}_event_loop_max_gap_ms"] = gaps.stop()
+
+    timed("lay_out_900", panel.lay_out)
+    p = draft.placements[450]
+    timed("move_one_of_900", lambda: draft.move(450, p.x + 40.0, p.y + 10.0))
+    timed("undo_move_of_900", undo.trigger)
+    timed("undo_lay_out_900", undo.trigger)
+    return out
+
+
 def stop_gaps(window, gaps: GapTimer, spin, repeat: int = 1) -> dict:
     """The event loop while the digitizer stops: a session on a simulated unit (a leaf's worth
-    of presses, its surface meshed) and a Demo, ``max(3, repeat)`` times each."""
+    of presses, its surface meshed) and a Demo, ``max(5, repeat)`` times each."""
     import tempfile
 
     from maizeviz.digitizer.simulator import FastrakSimulator
@@ -305,8 +379,10 @@ def stop_gaps(window, gaps: GapTimer, spin, repeat: int = 1) -> dict:
     panel = window.digitizer
     folder = Path(tempfile.mkdtemp(prefix="maizeviz-bench-stop-"))
     samples: dict[str, list[float]] = {"stop_event_loop_max_gap_ms": [],
-                                       "stop_event_loop_max_gap_ms_demo": []}
-    for k in range(max(3, repeat)):
+                                       "stop_event_loop_max_gap_ms_demo": [],
+                                       "stop_idle_max_gap_ms": [],
+                                       "stop_idle_max_gap_ms_demo": []}
+    for k in range(max(5, repeat)):
         for demo in (False, True):
             stopped: list[str] = []
             panel.stopped.connect(stopped.append)
@@ -323,6 +399,7 @@ def stop_gaps(window, gaps: GapTimer, spin, repeat: int = 1) -> dict:
                 n = panel.session.count.points
                 assert spin(10, lambda n=n: panel.session.count.points > n)
                 panel.plant.wait()
+                gaps.start()                         # the same loop idle, just before
                 spin(0.1)
             else:
                 sim = FastrakSimulator(press_gap_s=0.0, noise_cm=0.0)
@@ -334,12 +411,17 @@ def stop_gaps(window, gaps: GapTimer, spin, repeat: int = 1) -> dict:
                     sim.press((2.0 * (i % 3), 0.5 * (i // 3), 10.0 + 8.0 * (i // 3)))
                     assert spin(10, lambda n=n: panel.session.count.points > n)
                 panel.plant.wait()
-                spin(0.5)
+                spin(0.1)
+                gaps.start()
+                spin(0.4)
+            idle = gaps.stop()
             gaps.start()
             panel.stop_button.click()
             assert spin(TIMEOUT_S, lambda stopped=stopped: bool(stopped)), "no stop"
             spin(0.3)
-            samples["stop_event_loop_max_gap_ms" + ("_demo" if demo else "")].append(gaps.stop())
+            suffix = "_demo" if demo else ""
+            samples["stop_event_loop_max_gap_ms" + suffix].append(gaps.stop())
+            samples["stop_idle_max_gap_ms" + suffix].append(idle)
             panel.stopped.disconnect(stopped.append)
             if sim is not None:
                 sim.close()
@@ -347,6 +429,82 @@ def stop_gaps(window, gaps: GapTimer, spin, repeat: int = 1) -> dict:
             spin(1.0)
     out: dict = {name: statistics.median(v) for name, v in samples.items()}
     out.update({name + "_samples": v for name, v in samples.items()})
+    return out
+
+
+def _leaf_pixels(view, n: int):
+    """Widget points over ``n`` leaf triangles of the view's mesh that a click picks."""
+    import numpy as np
+
+    mesh = view.canopy_mesh
+    nf = int(mesh.field_data["leaf_triangles"][0])
+    faces, points = mesh.regular_faces[:nf], np.asarray(mesh.points)
+    out = []
+    for cell in np.random.default_rng(7).permutation(nf):
+        x, y = view.display_point(points[faces[cell]].mean(axis=0))
+        if 10 < x < view.width() - 10 and 10 < y < view.height() - 10:
+            p = view.pick_at(round(x), round(y))
+            if p is not None and p.leaf > 0:
+                out.append((round(x), round(y)))
+        if len(out) == n:
+            return out
+    return out
+
+
+def pick_and_mesh_file(window, spin, gaps, shown, clicks: int = 15) -> dict:
+    """Clicks on leaves of the K = 4 canopy, then the K = 4 canopy opened from a PLY."""
+    import tempfile
+
+    from PySide6.QtCore import QPoint, Qt
+    from PySide6.QtTest import QTest
+
+    from maizeviz.canopy.export import export_canopy
+    from maizeviz.mesh.levels import COMPLEXITY_STOPS
+
+    out: dict = {}
+    view = window.viewport
+    if window.model.settings.canopy.level != "K4":
+        before = len(shown)
+        window.canopy_panel.slider.setValue(COMPLEXITY_STOPS.index("K4"))
+        spin(TIMEOUT_S, lambda: len(shown) > before and window.runner.current("build") is None)
+    spin(1.0)
+    picks, frame_gaps = [], []
+    for x, y in _leaf_pixels(view, clicks):
+        frames = view.render_count
+        gaps.start()
+        QTest.mouseClick(view, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier,
+                         QPoint(x, y))
+        picks.append(view.last_pick_ms)
+        spin(5.0, lambda frames=frames: view.render_count > frames)
+        frame_gaps.append(gaps.stop())
+        spin(0.3)
+    if picks:
+        out.update({"pick_ms": statistics.median(picks), "pick_max_ms": max(picks),
+                    "pick_ms_samples": [round(p, 1) for p in picks],
+                    "pick_frame_gap_ms": statistics.median(frame_gaps),
+                    "pick_frame_gap_max_ms": max(frame_gaps),
+                    "pick_drawn": view.canopy_mesh.n_cells})
+    folder = tempfile.mkdtemp(prefix="maizeviz-bench-mesh-")
+    ply = str(Path(folder) / "k4.ply")
+    export_canopy(ply, window.model.canopy)
+    spin(1.0)
+    before = len(shown)
+    when: dict = {}
+    window.canopy_shown.connect(lambda _l: when.setdefault("shown", time.perf_counter()))
+    gaps.start()
+    t0 = time.perf_counter()
+    window.open_mesh(ply, "cm", "z")
+    spin(TIMEOUT_S, lambda: len(shown) > before)
+    spin(3.0)                                   # its frame, and what follows it
+    worst = gaps.stop()
+    out.update({"mesh_file_s": time.perf_counter() - t0,
+                "mesh_file_event_loop_max_gap_ms": worst,
+                "mesh_file_frame_gap_ms": gaps.worst_after(when.get("shown", t0)),
+                "mesh_file_drawn": view.canopy_mesh.n_cells,
+                "mesh_file_triangles": window.model.canopy.n_triangles})
+    import shutil
+
+    shutil.rmtree(folder, ignore_errors=True)
     return out
 
 
@@ -384,12 +542,15 @@ def main() -> None:
     out["targets"] = {"gil_max_block_ms": 100, "idle_renders_per_s": 0, "renders_per_canopy": 1,
                       "event_loop_max_gap_ms_at_36_and_below": 200,
                       "event_loop_max_gap_ms_at_K4": 200, "first_window_s": 3,
+                      "layout_edit_event_loop_max_gap_ms_900_plants": 200,
+                      "pick_ms": 50, "mesh_file_event_loop_max_gap_ms": 200,
                       "stop_event_loop_max_gap_ms": 50, "stop_event_loop_max_gap_ms_demo": 50}
     if args.json:
         print(json.dumps(out, indent=1))
-        return
+        return None
     for k, v in out.items():
         print(f"{k}: {v}")
+    return None
 
 
 if __name__ == "__main__":

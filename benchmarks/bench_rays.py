@@ -138,6 +138,38 @@ def best_reset(fn, reset, repeat: int) -> float:
     return min(out)
 
 
+def _bare_rates(packed, org32, s, dirs, len32, ny: int, repeat: int) -> dict[str, float]:
+    """bare_embree_occluded_1t and _2t, Mrays/s (nothing where no C compiler is found)."""
+    bare = bare_embree(packed, org32, s, len32, ny)
+    if bare is None:
+        return {}
+    n = len(org32)
+    reset, trace, blocked, n_lanes = bare
+    reset()
+    trace(0, n_lanes)
+    assert np.array_equal(blocked(), packed.occluded(org32, dirs[:1], len32, row=ny))
+    rates = {}
+    for threads in (1, 2):
+        secs = best_reset(chunked(trace, n_lanes, threads), reset, repeat)
+        rates[f"bare_embree_occluded_{threads}t"] = round(n / secs / 1e6, 2)
+    return rates
+
+
+def _ratios(out: dict) -> dict[str, float]:
+    """speedup_* (packets over single rays) and of_bare_occluded_* (packets over bare
+    Embree), from the rates in ``out``."""
+    ratios = {}
+    for q in ("occluded", "nearest"):
+        for t in ("1t", "2t"):
+            ratios[f"speedup_{q}_{t}"] = round(out[f"packets_{q}_{t}"]
+                                               / out[f"intersect1_{q}_{t}"], 2)
+    for t in ("1t", "2t"):
+        if f"bare_embree_occluded_{t}" in out:
+            ratios[f"of_bare_occluded_{t}"] = round(out[f"packets_occluded_{t}"]
+                                                    / out[f"bare_embree_occluded_{t}"], 2)
+    return ratios
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--json", action="store_true")
@@ -199,15 +231,7 @@ def main() -> None:
         for threads in (1, 2):
             out[f"{name}_{threads}t"] = round(n / best(chunked(fn, n, threads), args.repeat)
                                               / 1e6, 2)
-    bare = bare_embree(packed, org32, s, len32, ny)
-    if bare is not None:
-        reset, trace, blocked, n_lanes = bare
-        reset()
-        trace(0, n_lanes)
-        assert np.array_equal(blocked(), packed.occluded(org32, dirs[:1], len32, row=ny))
-        for threads in (1, 2):
-            secs = best_reset(chunked(trace, n_lanes, threads), reset, args.repeat)
-            out[f"bare_embree_occluded_{threads}t"] = round(n / secs / 1e6, 2)
+    out.update(_bare_rates(packed, org32, s, dirs, len32, ny, args.repeat))
     heights = (0.0, 50.0, 100.0, 150.0, 200.0, 225.0)
     for name, sc, periodic in (("open_packets", packed, False), ("open_single_rays", single, False),
                                ("periodic_block", block, True)):
@@ -218,14 +242,7 @@ def main() -> None:
                                                                            threads=threads),
                         args.repeat)
             out[f"sensor_answers_{name}_{threads}t"] = round(answers / secs / 1e6, 2)
-    for q in ("occluded", "nearest"):
-        for t in ("1t", "2t"):
-            out[f"speedup_{q}_{t}"] = round(out[f"packets_{q}_{t}"]            # type: ignore
-                                            / out[f"intersect1_{q}_{t}"], 2)   # type: ignore
-    for t in ("1t", "2t"):
-        if f"bare_embree_occluded_{t}" in out:
-            out[f"of_bare_occluded_{t}"] = round(out[f"packets_occluded_{t}"]           # type: ignore
-                                                 / out[f"bare_embree_occluded_{t}"], 2)  # type: ignore
+    out.update(_ratios(out))
     out["targets"] = {"packets_occluded_2t": 20.0, "speedup_occluded_2t": 3.0}
     report(out, args.json)
 

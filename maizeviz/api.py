@@ -66,7 +66,7 @@ def read_points(path: str | Path, strict: bool = False,
     References
     ----------
     Piegl, L. & Tiller, W. (1997). The NURBS Book, 2nd ed., Springer (sections 9.2 and 9.4:
-    global surface interpolation).
+    global surface interpolation). https://doi.org/10.1007/978-3-642-59223-2
     """
     return read_leaves(path, strict=strict, progress=progress)
 
@@ -82,15 +82,17 @@ def lay_out(plants: LeavesFromFile | list, tile: tuple[int, int] = (3, 3),
         From :func:`read_points`.
     tile : (int, int)
         Copies of the digitized block along the rows and across them (the paper's 3 x 3).
-    row_spacing, plant_spacing : float
-        cm, used when the block's own spacing cannot be inferred.
+    row_spacing : float
+        Distance between rows [cm], used when the block's own cannot be inferred.
+    plant_spacing : float
+        Distance between plants along a row [cm], likewise.
     layout_file : str or Path, optional
         A layout CSV placing each plant (overrides ``tile``).
 
     Returns
     -------
     CanopyLayout
-        ``placements`` (plant, x, y in cm, rotation in deg), ``bounds`` (x0, y0, x1, y1) cm,
+        ``placements`` (plant, x, y [cm], rotation [deg]), ``bounds`` (x0, y0, x1, y1) [cm],
         ``centre_bounds`` (the central tile, where light is sampled by default).
     """
     return layout_for(_leaves(plants), tuple(tile), row_spacing, plant_spacing,  # type: ignore[arg-type]
@@ -109,6 +111,8 @@ def build_canopy(plants: LeavesFromFile | list, layout: CanopyLayout | None = No
         From :func:`read_points`.
     layout : CanopyLayout, optional
         From :func:`lay_out`; else the block tiled ``tile`` times.
+    tile : (int, int)
+        Copies of the digitized block along and across the rows, without ``layout``.
     level : str or int
         Mesh level: a triangle budget per leaf ("36", 36), "standard" (72), or an
         interpolated level "K4".
@@ -120,12 +124,14 @@ def build_canopy(plants: LeavesFromFile | list, layout: CanopyLayout | None = No
     Returns
     -------
     Canopy
-        ``vertices`` (V, 3) float64 cm, ``faces`` (F, 3) int64, ``n_triangles``, ``layout``,
+        ``vertices`` (V, 3) float64 [cm], ``faces`` (F, 3) int64, ``n_triangles``, ``layout``,
         ``level`` (its label).
 
     References
     ----------
-    Espana, M. L. et al. (1999), Table 2 (mesh levels of the maize canopy).
+    Espana, M. L., Baret, F., Aries, F., Chelle, M., Andrieu, B. & Prevot, L. (1999).
+    Modeling maize canopy 3D architecture: application to reflectance simulation. Ecological
+    Modelling 122, 25-43 (Table 2: the mesh levels). https://doi.org/10.1016/S0304-3800(99)00070-8
     """
     leaves = _leaves(plants)
     if layout is None:

@@ -18,19 +18,27 @@ from collections import Counter
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from maizeviz.canopy.layout import CanopyLayout
 from maizeviz.canopy.measures import check_cover_resolution
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import Leaf
 from maizeviz.light.scene.rays import Rect, ray_count
-from maizeviz.mesh.levels import Level
+from maizeviz.mesh.levels import DEVIATION_K, Level
 
-#: Peak bytes per canopy triangle: the canopy arrays, its Embree scene, the ground-cover scene
-#: and the transients of building them (measured: 345 B at K = 4 on the bundled example).
-BYTES_PER_TRIANGLE = 400
+#: Peak bytes per canopy triangle: the canopy arrays (28 at K = 4), its Embree scene (a float32
+#: copy of the vertices, the indices, a compact BVH: about 54), per-triangle results and the
+#: transients of building them. Measured (benchmarks/bench_field.py): 128 B at K = 4 on 900
+#: plants (30.5 million triangles, periodic), the process's own 0.3 GB included; 345 B before
+#: issue 30.
+BYTES_PER_TRIANGLE = 160
 #: Peak bytes per leaf triangle meshed and measured by ``maizeviz leaf`` (measured on the
 #: bundled example: 272 B from K = 4 to K = 16, 3.2 million more triangles).
 BYTES_PER_LEAF_TRIANGLE = 300
+#: Peak bytes per surface point of the largest leaf's deviation measure (its sample and the
+#: bounds of each point; measured: 46 B on a leaf of 10,000 x 3 points, 1.7 million of them).
+BYTES_PER_DEVIATION_POINT = 64
 #: Leaf triangles meshed and measured per second (measured there: about 1 million).
 LEAF_TRIANGLES_PER_S = 1_000_000
 #: Bytes per traced ray: origins, hits, heights, ground positions (measured: 48-55 B).
@@ -39,6 +47,10 @@ BYTES_PER_RAY = 64
 BYTES_PER_HEATMAP_CELL = 600
 #: Rough speeds on one core of these machines, for the time estimate.
 TRIANGLES_PER_S = 2_000_000              # meshing, placing and Embree building
+#: Seconds of work per digitized leaf below the standard mesh, besides its triangles: gridding,
+#: fitting, the reference mesh's area the widening aims at, the splitting (measured: 3 s per
+#: 14,400 leaves at 36 triangles; the hectare's 1.1 million leaves, 4 minutes of CPU).
+SECONDS_PER_SIMPLIFIED_LEAF = 2e-4
 RAYS_PER_S = 3_000_000                   # tracing, all heights
 #: Work longer than this (estimated seconds) needs a confirmation.
 SLOW_SECONDS = 900.0
@@ -112,13 +124,15 @@ def memory_available() -> int:
         return 8 * 2**30
 
 
-def leaf_triangles(rows: int, cols: int, tip_collapsed: bool, level: Level) -> int:
+def leaf_triangles(rows, cols, tip_collapsed, level: Level):
     """Triangles of one leaf of an m x n point grid at ``level`` (an upper bound below the
-    standard mesh)."""
+    standard mesh); ints, or arrays of them leaf by leaf."""
     k = level.interp if level.interp is not None else 0
     a, b = (rows - 1) * (k + 1), (cols - 1) * (k + 1)
-    full = 2 * a * b - (b if tip_collapsed else 0)          # the collapsed tip row's slivers
-    return full if level.triangles is None else min(level.triangles, full)
+    full = 2 * a * b - b * np.asarray(tip_collapsed, dtype=np.int64)   # the tip's slivers
+    if level.triangles is None:
+        return full
+    return np.minimum(min(level.triangles, 2**62), full)       # a budget past int64: no limit
 
 
 def canopy_cost(leaves: Iterable[Leaf], placements: Mapping[int, int], level: Level,
@@ -127,14 +141,24 @@ def canopy_cost(leaves: Iterable[Leaf], placements: Mapping[int, int], level: Le
     digitized plant standing in the field (set by the input ``quantity``: a tiling or a
     layout)."""
     per_plant: dict[int, int] = {}
-    for lf in leaves:
+    shapes = getattr(leaves, "shapes", None)          # a field's (FieldLeaves): arrays
+    if shapes is not None:
+        each = leaf_triangles(shapes.rows.astype(np.int64), shapes.cols.astype(np.int64),
+                              shapes.tip, level)
+        ids, at = np.unique(shapes.plant, return_inverse=True)
+        per_plant = dict(zip(ids.tolist(), np.bincount(at, each).astype(np.int64).tolist()))
+    for lf in leaves if shapes is None else ():
         m, n = lf.grid.shape
-        per_plant[lf.plant] = per_plant.get(lf.plant, 0) + leaf_triangles(
-            m, n, lf.grid.tip_collapsed, level)
-    tris = sum(per_plant.get(p, 0) * count for p, count in placements.items())
-    plants = sum(placements.values())
+        per_plant[lf.plant] = per_plant.get(lf.plant, 0) + int(leaf_triangles(
+            m, n, lf.grid.tip_collapsed, level))
+    tris = int(sum(per_plant.get(p, 0) * count for p, count in placements.items()))
+    plants = int(sum(placements.values()))
+    placed = [p for p, count in placements.items() if count]
+    leaves_meshed = int(np.isin(shapes.plant, placed).sum()) if shapes is not None else \
+        sum(1 for lf in leaves if lf.plant in placements and placements[lf.plant])
+    per_leaf = SECONDS_PER_SIMPLIFIED_LEAF if level.triangles is not None else 0.0
     return Cost(f"the canopy of {plants:,} plants at {level}", quantity, tris, "triangles",
-                tris * BYTES_PER_TRIANGLE, tris / TRIANGLES_PER_S)
+                tris * BYTES_PER_TRIANGLE, tris / TRIANGLES_PER_S + leaves_meshed * per_leaf)
 
 
 def leaves_cost(leaves: Sequence[Leaf], level: Level, quantity: str, batch: int,
@@ -142,11 +166,21 @@ def leaves_cost(leaves: Sequence[Leaf], level: Level, quantity: str, batch: int,
     """Meshing and measuring ``leaves`` one at a time at ``level`` (``maizeviz leaf``): the
     meshes of ``batch`` leaves are held at once (of all of them when ``keep``, for an export).
     ``quantity`` is the input that chose the level ("interp", "triangles" or "level")."""
-    tris = [leaf_triangles(*lf.grid.shape, lf.grid.tip_collapsed, level) for lf in leaves]
+    tris = [int(leaf_triangles(*lf.grid.shape, lf.grid.tip_collapsed, level)) for lf in leaves]
     held = sum(tris) if keep else max((sum(tris[s:s + batch])
                                        for s in range(0, len(tris), batch)), default=0)
+    # a leaf is measured whole, however many surface points it has (most leaves, a few
+    # thousand, go MEASURE_POINTS at a time): the largest one's points add to the meshes
+    points = max((deviation_points(*lf.grid.shape) for lf in leaves), default=0)
     return Cost(f"meshing {len(tris):,} leaves at {level}", quantity, sum(tris), "triangles",
-                held * BYTES_PER_LEAF_TRIANGLE, sum(tris) / LEAF_TRIANGLES_PER_S)
+                held * BYTES_PER_LEAF_TRIANGLE + points * BYTES_PER_DEVIATION_POINT,
+                sum(tris) / LEAF_TRIANGLES_PER_S)
+
+
+def deviation_points(rows: int, cols: int) -> int:
+    """Surface points of an m x n leaf grid its deviation is measured at (K = 8, as
+    :func:`maizeviz.mesh.levels.measure_leaves` samples it)."""
+    return ((rows - 1) * (DEVIATION_K + 1) + 1) * ((cols - 1) * (DEVIATION_K + 1) + 1)
 
 
 def layout_cost(leaves: Iterable[Leaf], layout: CanopyLayout, level: Level) -> Cost:

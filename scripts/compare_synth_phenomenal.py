@@ -23,7 +23,8 @@ def main():
     ap.add_argument("--seeds", type=int, default=20)
     args = ap.parse_args()
     real = {t.rank: t for t in leaf_traits(load_phenomenal(args.file))}
-    shapes = [plant_leaf_shapes(PlantShape(), rng=np.random.default_rng(s)) for s in range(args.seeds)]
+    shapes = [plant_leaf_shapes(PlantShape(), rng=np.random.default_rng(s))
+              for s in range(args.seeds)]
     print("rank | length cm synth / real | max width cm synth / real | insertion deg synth / real")
     rows = []
     for r in sorted(real):

@@ -8,7 +8,7 @@ cd "$(dirname "$0")/.."
 apt_pkgs=(python3 python3-venv python3-pip xvfb xauth libgl1 libegl1 libglx-mesa0 libxrender1
           libxkbcommon-x11-0 libxcb-icccm4 libxcb-keysyms1 libxcb-image0 libxcb-render-util0
           libxcb-xinerama0 libxcb-randr0 libxcb-shape0 libxcb-xkb1 libxcb-cursor0 libdbus-1-3
-          libfontconfig1 gcc libc6-dev)
+          libfontconfig1 gcc libc6-dev python3-dev)
 missing=()
 if command -v dpkg >/dev/null 2>&1; then
   for p in "${apt_pkgs[@]}"; do
@@ -32,9 +32,7 @@ if [ ! -x .venv/bin/python ]; then
 fi
 .venv/bin/python -m pip install -q --upgrade pip >/dev/null
 .venv/bin/python -m pip install -q -e ".[gui,sweep,test]"
-# Embree's ray packets: compile maizeviz/mesh/_packets.c into the cache now (else at first use;
-# without a compiler maizeviz traces with embreex's single rays, the same hits, slower)
-.venv/bin/python -c "from maizeviz.mesh.packets import build, compiled_path; import sys; \
-p = build(); print('setup: ray packets ' + (str(p) if p else 'not compiled (no C compiler)'), \
-file=sys.stderr)"
+# the install above built Embree's ray-packet kernel (maizeviz/mesh/_packets.c, setup.py);
+# without a C compiler maizeviz traces with embreex's single rays (the same hits, slower)
+.venv/bin/maizeviz --info | grep "^ray kernel" | sed 's/^/setup: /' >&2
 echo "setup: ready (.venv/bin/maizeviz)" >&2

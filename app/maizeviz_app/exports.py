@@ -15,85 +15,123 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
     in a worker as ``work(job, *args)``: returns ``(work, args)``. ``heatmap``: the light
     whose map is shown, the run shown for each light, the height shown (cm).
 
-    ``what``: canopy (mesh with each triangle's light), table (transmission by height),
+    ``what``: canopy (mesh with each triangle's light: its class and its leaf's sunlit share
+    for a sun, its leaf's light per m2 of leaf for a sky or a day), table (transmission by height),
     measures (Table 2), heatmap, plot; steps, leaves, plants, day (of a sky or a day). Nothing
     to export yet: MaizevizError saying what to do first."""
     if what == "canopy":
-        if model.canopy is None:
-            raise MaizevizError("no canopy to export yet")
-        canopy = model.canopy
-        signature = model.signature(model.built.label)
-        cells = {}
-        run = model.runs.for_signature(signature)
-        if run is not None and run.classes is not None:
-            cells["light"] = run.classes.astype("int32")
-        for kind, name in (("sky", "diffuse_per_m2_leaf"), ("day", "par_mol_per_m2_leaf")):
-            run = model.runs.for_signature(signature, kind)
-            if run is not None and run.extra is not None:
-                cells[name] = run.extra.leaf_value.astype("float32")
-
-        def work(job):
-            from maizeviz.canopy.export import export_canopy
-
-            export_canopy(path, canopy, cell_data=cells)
-            return path
-        return work, ()
+        return _canopy_job(path, model)
     if what == "measures":
-        if not model.measures_rows:
-            raise MaizevizError("no canopy measures to export yet")
-        rows = list(model.measures_rows.values())
-
-        def work(job):
-            from maizeviz.io.atomic import write_rows
-
-            write_rows(path, [{k: v.replace(",", "") for k, v in r.items()} for r in rows])
-            return path
-        return work, ()
+        return _measures_job(path, model)
     if what in ("steps", "leaves", "plants", "day"):
         return _diffuse_job(what, path, model)
     if model.runs.last is None:
         raise MaizevizError("no light result to export yet: compute light first")
     if what == "table":
-        header, table_rows = model.runs.table()
-
-        def work(job):
-            from maizeviz.io.atomic import atomic_open
-
-            with atomic_open(path, "w", newline="") as fh:
-                w = csv.writer(fh)
-                w.writerow(["height_cm"] + [f"transmission {h}" for h in header[1:]])
-                w.writerows(table_rows)
-            return path
-        return work, ()
+        return _table_job(path, model)
     if what == "heatmap":
-        shown_kind, shown_runs, height = heatmap
-        kind = shown_kind or model.runs.last.kind
-        run = shown_runs.get(kind) or model.runs.last
-        kind = run.kind
-        if height is None:
-            height = float(run.result.heights_cm[0])
-        result = run.result
-
-        def work(job):
-            from maizeviz.light.report.heatmap import save_figure
-            from maizeviz_app.plots import heatmap_figure_of
-
-            save_figure(heatmap_figure_of(result, height, kind), path)
-            return path
-        return work, ()
+        return _heatmap_job(path, model, heatmap)
     if what == "plot":
-        from maizeviz_app import plots
-
-        curves = model.runs.curves()
-        title = plot_title(model.runs)
-
-        def work(job):
-            from maizeviz.light.report.heatmap import save_figure
-
-            save_figure(plots.transmission_figure(curves, title, width_in=7, dpi=110), path)
-            return path
-        return work, ()
+        return _plot_job(path, model)
     raise MaizevizError(f"unknown export '{what}'")
+
+
+def _canopy_job(path: str, model: StudyModel):
+    """The canopy's mesh with each triangle's light (the sun's class and sunlit share, the
+    sky's and the day's light per m2 of leaf)."""
+    if model.canopy is None:
+        raise MaizevizError("no canopy to export yet")
+    canopy = model.canopy
+    signature = model.signature(model.built.label)
+    # the names of `maizeviz light --export` (maizeviz.light.report.mesh_export.LIGHT_ARRAYS)
+    cells = {}
+    run = model.runs.for_signature(signature)
+    if run is not None and run.classes is not None:
+        cells["sun_class"] = run.classes.astype("int32")
+    if run is not None and run.painting is not None:   # honest where triangles are small
+        cells["sunlit_share"] = run.painting.share.astype("float32")
+    if run is not None and getattr(run.extra, "leaf_value", None) is not None:
+        cells["absorbed_w_per_m2_leaf"] = run.extra.leaf_value.astype("float64")
+    for kind, name in (("sky", "diffuse_cm2_per_cm2_leaf"), ("day", "par_mol_per_m2_leaf")):
+        run = model.runs.for_signature(signature, kind)
+        if run is not None and run.extra is not None and run.extra.leaf_value is not None:
+            cells[name] = run.extra.leaf_value.astype("float64")
+
+    def work(job):
+        from maizeviz.canopy.export import export_canopy
+
+        export_canopy(path, canopy, cell_data=cells)
+        return path
+    return work, ()
+
+
+def _measures_job(path: str, model: StudyModel):
+    """Table 2's measures of the canopies built."""
+    if not model.measures_rows:
+        raise MaizevizError("no canopy measures to export yet")
+    rows = list(model.measures_rows.values())
+
+    def work(job):
+        from maizeviz.io.atomic import write_rows
+
+        write_rows(path, [{k: v.replace(",", "") for k, v in r.items()} for r in rows])
+        return path
+    return work, ()
+
+
+def _table_job(path: str, model: StudyModel):
+    """Transmission by height of the runs compared."""
+    header, table_rows = model.runs.table()
+
+    def work(job):
+        from maizeviz.io.atomic import atomic_open
+
+        with atomic_open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["height_cm"] + [f"transmission {h}" for h in header[1:]])
+            w.writerows(table_rows)
+        return path
+    return work, ()
+
+
+def _heatmap_job(path: str, model: StudyModel, heatmap: tuple):
+    """The heatmap shown (its light, run and height), as shown."""
+    shown_kind, shown_runs, height = heatmap
+    last = model.runs.last
+    assert last is not None                       # export_job refused it before
+    kind = shown_kind or last.kind
+    run = shown_runs.get(kind) or last
+    kind = run.kind
+    if height is None:
+        height = float(run.result.heights_cm[0])
+    result = run.result
+    from maizeviz_app.plots import Look
+
+    look = Look.of(model.colour, shown_runs or {kind: run})    # as shown
+
+    def work(job):
+        from maizeviz.light.report.heatmap import save_figure
+        from maizeviz_app.plots import heatmap_figure_of
+
+        save_figure(heatmap_figure_of(result, height, kind, look=look), path)
+        return path
+    return work, ()
+
+
+def _plot_job(path: str, model: StudyModel):
+    """The transmission curves of the runs compared."""
+    from maizeviz_app import plots
+
+    curves = model.runs.curves()
+    title = plot_title(model.runs)
+
+    def work(job):
+        from maizeviz.light.report.heatmap import save_figure
+
+        save_figure(plots.transmission_figure(curves, title, width_in=7, dpi=110), path)
+        return path
+    return work, ()
+
 
 def _diffuse_job(what: str, path: str, model: StudyModel):
     """The day's steps CSV and figure, the per-leaf and per-plant CSV of the last sky or

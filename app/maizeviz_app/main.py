@@ -96,15 +96,16 @@ def run(argv: Sequence[str] | None = None) -> int:
     return code["value"]
 
 
-def _screenshot_flow(app, window, path: str, code: dict) -> None:
-    """Canopy -> light -> a frame coloured by light -> grab -> quit."""
+def _ends(app, window, path: str, code: dict, before=None):
+    """A screenshot flow's two ends: ``shoot`` (grab, save, quit; ``before()`` first) and
+    ``fail(message)`` (exit code 1); both close the window. A flow fails after 300 s."""
     from PySide6.QtCore import QTimer
-
-    state = {"lit": False}
 
     def shoot() -> None:
         window.grab().save(path)
         print(f"saved {path}")
+        if before is not None:
+            before()
         window.close()
         app.quit()
 
@@ -114,39 +115,41 @@ def _screenshot_flow(app, window, path: str, code: dict) -> None:
         window.close()
         app.quit()
 
+    QTimer.singleShot(300_000, lambda: fail("timed out"))
+    return shoot, fail
+
+
+def _screenshot_flow(app, window, path: str, code: dict) -> None:
+    """Canopy -> light -> a frame coloured by light -> grab -> quit."""
+    from PySide6.QtCore import QTimer
+
+    state = {"lit": False}
+    shoot, fail = _ends(app, window, path, code)
+
     def on_canopy(_label: str) -> None:
         if not state["lit"]:
             state["lit"] = True
-            window.compute_light()
+            window.model.compute_light()
 
     window.canopy_shown.connect(on_canopy)
     window.light_shown.connect(lambda: QTimer.singleShot(800, shoot))
     window.failed.connect(fail)
-    QTimer.singleShot(300_000, lambda: fail("timed out"))
 
 
 def _digitize_screenshot_flow(app, window, path: str, code: dict, points: int = 26) -> None:
-    """The Demo records ``points`` presses into a temporary file, a press comes while paused,
-    the leaves are meshed -> grab -> quit."""
+    """The Demo records ``points`` presses into a temporary file, then pauses (the presses
+    that follow are refused), the leaves are meshed -> grab -> quit."""
     import tempfile
 
     from PySide6.QtCore import QTimer
 
     folder = tempfile.mkdtemp(prefix="maizeviz-screenshot-")
 
-    def shoot() -> None:
-        window.grab().save(path)
-        print(f"saved {path}")
+    def stop_demo() -> None:
         window.digitizer.stopped.disconnect(stopped)
         window.digitizer.stop("screenshot", wait=True)
-        window.close()
-        app.quit()
 
-    def fail(msg: str) -> None:
-        print(f"error: {msg}", file=sys.stderr)
-        code["value"] = 1
-        window.close()
-        app.quit()
+    shoot, fail = _ends(app, window, path, code, before=stop_demo)
 
     def recorded(n: int) -> None:
         panel = window.digitizer
@@ -168,7 +171,6 @@ def _digitize_screenshot_flow(app, window, path: str, code: dict, points: int = 
         fail(f"the demo stopped ({why})")
 
     window.ready.connect(start)
-    QTimer.singleShot(300_000, lambda: fail("timed out"))
 
 
 if __name__ == "__main__":

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from PySide6.QtCore import Qt
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 
 from maizeviz_app.options import CAMERAS, COLOURINGS
@@ -67,14 +68,33 @@ def build_menus(w) -> dict[str, QAction]:
                                     lambda: w.choose_export("plants"))
     acts["export_day"] = _action(w, results, "Day figure (PNG)…",
                                  lambda: w.choose_export("day"))
+    acts["view_image"] = _action(w, f, "Save view as &image…", w.view_link.choose_image,
+                                 "Ctrl+Alt+S", "the 3D view as a PNG of a chosen width, with "
+                                               "its colour key")
     f.addSeparator()
     acts["quit"] = _action(w, f, "&Quit", w.close, QKeySequence.StandardKey.Quit)
+
+    e = bar.addMenu("&Edit")
+    stack = w.undo.stack
+    acts["undo"] = stack.createUndoAction(w, "&Undo")
+    acts["undo"].setShortcut(QKeySequence.StandardKey.Undo)
+    acts["redo"] = stack.createRedoAction(w, "&Redo")
+    acts["redo"].setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")])
+    for name in ("undo", "redo"):
+        # from anywhere in the window (a text field keeps its own Ctrl+Z while it has focus)
+        acts[name].setShortcutContext(Qt.ShortcutContext.ApplicationShortcut)
+        e.addAction(acts[name])
+    e.addSeparator()
+    acts["history"] = _action(w, e, "Undo &history", w.show_history, "Ctrl+Alt+Z",
+                              "every edit of this study, undone and redone by clicking it")
 
     v = bar.addMenu("&View")
     cam = v.addMenu("&Camera")
     for k, (name, text) in enumerate(CAMERAS.items(), start=1):
+        if name == "reset":
+            cam.addSeparator()
         acts[f"camera_{name}"] = _action(w, cam, text, lambda n=name: w.camera(n),
-                                         f"Ctrl+{k}")
+                                         "Ctrl+0" if name == "reset" else f"Ctrl+{k}")
     colour = v.addMenu("C&olour by")
     group = QActionGroup(w)
     for k, (name, text) in enumerate(COLOURINGS.items(), start=1):
@@ -97,7 +117,7 @@ def build_menus(w) -> dict[str, QAction]:
 
     r = bar.addMenu("&Light")
     acts["compute"] = _action(w, r, "&Compute light (sun, sky or day, as chosen)",
-                              w.compute_light, "Ctrl+L")
+                              w.model.compute_light, "Ctrl+L")
     for k, mode in enumerate(("sun", "sky", "day"), start=1):
         acts[f"light_{mode}"] = _action(
             w, r, {"sun": "Su&n: direct light", "sky": "S&ky: diffuse light",
@@ -105,7 +125,8 @@ def build_menus(w) -> dict[str, QAction]:
             lambda m=mode: w.light_panel.set_mode(m), f"Alt+{k}")
     acts["cancel"] = _action(w, r, "C&ancel", w.cancel_jobs, "Esc",
                              "stop the light computation or rebuild under way")
-    acts["sun_place"] = _action(w, r, "&Sun from place", w.sun_from_place, "Ctrl+Shift+L")
+    acts["sun_place"] = _action(w, r, "&Sun from place", w.model.sun_from_place,
+                                "Ctrl+Shift+L")
 
     h = bar.addMenu("&Help")
     acts["about"] = _action(w, h, "&About maizeviz", w.about, QKeySequence.StandardKey.HelpContents)

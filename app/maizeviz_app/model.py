@@ -1,15 +1,26 @@
-"""The study open in the window, without Qt: points, layout, canopy, light results, project.
+"""The study open in the app, without Qt: its settings, its state, and the actions that change
+it (napari's ``ViewerModel`` pattern).
 
-The window and its panels share one :class:`StudyModel`. The model holds the state and says
-when it changes (psygnal signals, as napari's ``ViewerModel``); panels take the model and
-follow it (as napari's ``QtDims(dims)`` takes ``Dims``); the window only wires the model to
-the panels, the workers and the menus. Everything here runs on the GUI thread, and can be
-driven and checked from a test or a script without a window::
+The model holds the state (points, layout, canopy, light results, project) and the settings
+(:mod:`maizeviz_app.settings`: evented objects the widgets bind to), and it runs the app: its
+actions (open points, a project or a mesh; build; compute light; sun from place; save; export;
+restore a project's results) validate, hand their work to the runner
+(:mod:`maizeviz_app.runner`) and keep the results, saying what changed through psygnal
+signals. The window only wires the model to the panels, the 3D view and the menus. Everything
+here runs on the GUI thread (or a script's thread), and a whole study can be driven and checked
+without a window::
 
-    model = StudyModel()
-    model.modified_changed.connect(print)
-    model.open_points(loaded, data, origin)          # a points file read by the core
-    model.edit_layout(layout)                        # True: the edit dropped light results
+    runner = InlineRunner()                 # each job at once (the window: a thread pool)
+    model = StudyModel(runner=runner)
+    model.open_points("plants.csv")         # read, laid out, built at settings.canopy.level
+    model.settings.canopy.level = "8"       # rebuilt at 8 triangles a leaf
+    model.settings.light.mode = "day"
+    model.compute_light()
+    model.save_project("study.maizeviz")
+
+The actions are written in three modules, one per kind of work, and are the model's methods:
+:mod:`maizeviz_app.building` (points, mesh files, canopies), :mod:`maizeviz_app.lighting`
+(light and what is shown of it) and :mod:`maizeviz_app.studyfiles` (projects and exports).
 
 What counts as unsaved work (:attr:`StudyModel.modified`): an edited layout and light results
 not yet in a project. Opening a points file or a project, and saving, start clean; the
@@ -19,25 +30,40 @@ saving a project.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from psygnal import Signal
 
+from maizeviz.errors import MaizevizError
+from maizeviz_app import building, lighting, studyfiles
+from maizeviz_app.colour import ColourSettings
+from maizeviz_app.figures import Figures
+from maizeviz_app.layout_draft import LayoutDraft
+from maizeviz_app.messages import user_message
+from maizeviz_app.runner import InlineRunner, Runner, describe_internal
 from maizeviz_app.runs import LightRuns, Run
+from maizeviz_app.selection import Selection
+from maizeviz_app.settings import StudySettings
 
 
 class StudyModel:
-    """What the window shows and a project saves.
+    """What the window shows and a project saves, and the actions that change it.
 
     Parameters
     ----------
     tile : int
         Tiles along each side of the canopy until a layout is loaded (the app's ``--tile``).
+    runner : Runner, optional
+        Where jobs run (the window's thread pool); default an :class:`InlineRunner`.
 
     Attributes
     ----------
+    settings : StudySettings
+        Canopy, light and digitizer settings (evented; widgets bind to them).
     loaded : maizeviz_app.jobs.Loaded or None
         The points (fitted leaves, plants) and the layout they are arranged in.
     points_bytes : bytes
@@ -51,15 +77,37 @@ class StudyModel:
         Table 2 rows of every level built on these points and layout, by level label.
     runs : LightRuns
         Light results (sun, sky, day) per level, compared while they share their sampling.
+    figures : Figures
+        The heatmaps and the transmission plot of the results shown.
+    summary : str
+        The day's totals in two lines (empty: no day computed).
+    plants_run : Run or None
+        The result whose light per plant is shown.
     project_path : str or None
         The ``.maizeviz`` file the study was opened from or saved to.
+    draft : LayoutDraft
+        The layout being edited (applied by :meth:`apply_layout`).
     layout_edited : bool
         The layout is not the plain tiling of the settings (saved into the project).
     serial : int
         Changes whenever the points or the layout change: a canopy or light result carries
         the serial it was made for, and one made for an older serial is dropped.
+    canopy_key : int
+        Changes with every canopy shown (the light process keeps the last canopy it was sent
+        and its Embree scene, under this key).
     modified : bool
         There is work a project does not hold yet (see the module docstring).
+    confirm_slow : callable(str) -> bool
+        Asked before starting work estimated at over a quarter of an hour (the window asks
+        the user; with no window: no).
+    mesher : callable or None
+        ``mesher(job, canopy, coarse, from_file)`` makes what the 3D view draws of a canopy,
+        in the worker (``coarse()``: the canopy at the view's display level, or None;
+        ``from_file``: a canopy read from a mesh file); None: nothing is drawn (no window).
+    colour : ColourSettings
+        How the 3D view and the heatmaps colour light (evented; saved in a project).
+    selection : Selection
+        The plant or leaf selected (evented; the 3D view and the plants table follow it).
 
     Signals
     -------
@@ -67,39 +115,114 @@ class StudyModel:
     mesh_opened(path) : a canopy read from a mesh file replaces the points; results cleared.
     layout_changed(layout) : the layout edited; results of the previous layout cleared.
     canopy_changed(built) : a canopy built for the current points and layout.
-    runs_changed(runs, info) : a light result added (``info``: what was traced, for the
-        light panel), or results cleared.
+    built_shown(label) : that canopy is shown with the light results it has (a project's
+        results adopted).
+    build_pending(text) : what is being built ('': nothing, or not built: ``text`` says why).
+    runs_changed(runs, info) : a light result added (``info``: what was traced), or cleared.
+    light_running(text) : a light computation started ('' : none runs any more).
+    light_added(run) : a new light result is in the table and figures (``light_shown``
+        follows once its figures are drawn).
+    light_shown() : the light results shown are complete (table, figures, colours).
+    view_light(colour) : the light to paint on the canopy shown changed (``colour``: switch
+        the view's colouring to light).
+    summary_changed(text), plants_changed(run) : the day's totals, the light per plant.
     project_changed(path) : the study opened from or saved to ``path`` (None: no project).
+    project_saved(path), exported(path) : a file written.
     modified_changed(bool) : unsaved work appeared or was saved.
+    said(text, error, status_only) : a line for the user.
+    failed(text, doing, quantity, mode) : an error the user was told about (``quantity``: the
+        setting it is about, ``mode``: the light it was computed for).
     """
 
     points_changed = Signal(object)
     mesh_opened = Signal(str)
     layout_changed = Signal(object)
     canopy_changed = Signal(object)
+    built_shown = Signal(str)
+    build_pending = Signal(str)
     runs_changed = Signal(object, str)
+    light_running = Signal(str)
+    light_added = Signal(object)
+    light_shown = Signal()
+    view_light = Signal(bool)
+    summary_changed = Signal(str)
+    plants_changed = Signal(object)
     project_changed = Signal(object)
+    project_saved = Signal(str)
+    exported = Signal(str)
     modified_changed = Signal(bool)
+    said = Signal(str, bool, bool)
+    failed = Signal(str, str, object, object)
 
-    def __init__(self, tile: int = 3) -> None:
-        self.tile = tile
+    # ------------------------------------------------------------------ actions
+    open_points = building.open_points
+    points_loaded = building.points_loaded
+    open_mesh = building.open_mesh
+    _mesh_read = building._mesh_read
+    build = building.build
+    _built = building._built
+    affordable = building.affordable
+    cancel = building.cancel
+    light_job = lighting.light_job
+    compute_light = lighting.compute_light
+    _light_costs = lighting._light_costs
+    _light_failed = lighting._light_failed
+    _lit = lighting._lit
+    draw_heatmap = lighting.draw_heatmap
+    sun_from_place = lighting.sun_from_place
+    _sun_found = lighting._sun_found
+    adopt_pending_runs = lighting.adopt_pending_runs
+    light_per_plant_run = lighting.light_per_plant_run
+    complete_runs = lighting.complete_runs
+    open_project = studyfiles.open_project
+    _project_read = studyfiles._project_read
+    save_project = studyfiles.save_project
+    _project_saved = studyfiles._project_saved
+    export = studyfiles.export
+
+    def __init__(self, tile: int = 3, runner: Runner | None = None) -> None:
+        self.settings = StudySettings()
+        self.settings.canopy.tile = tile
+        self.runner: Runner = runner if runner is not None else InlineRunner()
         self.loaded: Any = None
         self.points_bytes = b""
         self.points_origin = ""
         self.built: Any = None
         self.measures_rows: dict[str, dict] = {}
         self.runs = LightRuns()
+        self.figures = Figures()
+        self.draft = LayoutDraft()
+        self.summary = ""
+        self.plants_run: Run | None = None
+        self.pending_runs: list[Any] = []       # a project's results, waiting for a canopy
         self.project_path: str | None = None
         self.mesh_path: str | None = None
         self.layout_edited = False
+        self.project_layout = False             # the opening project stores its layout
         self.serial = 0
+        self.canopy_key = 0
         self.modified = False
+        self.closing = False
+        self.cache_folder = str(Path.home() / ".cache" / "maizeviz" / "projects")
+        self.confirm_slow: Callable[[str], bool] = lambda estimate: False
+        self.mesher: Callable[..., Any] | None = None
+        self.applying = 0                       # settings being set by the model itself
+        events: Any = self.settings.canopy.events       # psygnal's, made by @evented
+        events.level.connect(self._canopy_setting)
+        events.preserve_area.connect(self._canopy_setting)
+        self.colour = ColourSettings()
+        self.selection = Selection()
 
     # ------------------------------------------------------------------ reading
     @property
     def canopy(self) -> Any:
         """The canopy on screen (:class:`maizeviz.canopy.scene.Canopy`) or None."""
         return self.built.canopy if self.built is not None else None
+
+    @property
+    def tile(self) -> int:
+        """The tiling a points file is opened with (``settings.canopy.tile``)."""
+        return self.settings.canopy.tile
 
     @property
     def tile_n(self) -> int:
@@ -116,6 +239,11 @@ class StudyModel:
         return (self.serial, label)
 
     @property
+    def shown_signature(self) -> tuple[int, str] | None:
+        """The signature of the canopy shown (None: none)."""
+        return self.signature(self.built.label) if self.built is not None else None
+
+    @property
     def title(self) -> str:
         """The window title: the project's or points file's name, ``[*]`` where Qt marks
         unsaved work."""
@@ -126,9 +254,28 @@ class StudyModel:
         name = Path(self.project_path or self.loaded.path).name
         return f"maizeviz — {name}[*]"
 
+    # ------------------------------------------------------------------ messages
+    def say(self, text: str, error: bool | None = None, status_only: bool = False) -> None:
+        """A line for the user (``error``: default when the line starts with "error")."""
+        if self.closing:
+            return
+        self.said.emit(text, text.startswith("error") if error is None else error,
+                       status_only)
+
+    def fail(self, exc: BaseException, doing: str, mode: str | None = None) -> None:
+        """An error from an action: one line for people; the traceback on stderr if it is a
+        bug (not a MaizevizError, an OSError or a MemoryError)."""
+        if self.closing:
+            return
+        if not isinstance(exc, (MaizevizError, OSError, MemoryError)):
+            describe_internal(exc)
+        text = user_message(exc, doing)
+        self.say(f"error: {text}", error=True)
+        self.failed.emit(text, doing, getattr(exc, "quantity", None), mode)
+
     # ------------------------------------------------------------------ changing
-    def open_points(self, loaded: Any, points_bytes: bytes, origin: str,
-                    project: str | None = None, layout_edited: bool = False) -> None:
+    def set_points(self, loaded: Any, points_bytes: bytes, origin: str,
+                   project: str | None = None, layout_edited: bool = False) -> None:
         """New points (from a points file, or a project at ``project``): every result of the
         previous points is dropped; the study starts unsaved-clean."""
         self.loaded = loaded
@@ -138,11 +285,12 @@ class StudyModel:
         self.project_path = project
         self.layout_edited = layout_edited
         self._renew()
+        self.draft.start(loaded.layout, loaded.plants)
         self.points_changed.emit(loaded)
         self.project_changed.emit(project)
         self._set_modified(False)
 
-    def open_mesh(self, path: str) -> None:
+    def set_mesh(self, path: str) -> None:
         """A canopy read from a mesh file (OBJ, PLY with plant and leaf ids) is studied instead
         of digitized points: no points, no layout to edit, one mesh level (the file's); its
         canopy arrives by :meth:`show_built`. Nothing of it goes into a project."""
@@ -153,20 +301,35 @@ class StudyModel:
         self.mesh_path = str(path)
         self.layout_edited = False
         self._renew()
+        self.draft.start(None, set())
         self.mesh_opened.emit(self.mesh_path)
         self.project_changed.emit(None)
         self._set_modified(False)
 
+    def apply_layout(self, layout: Any) -> bool:
+        """Build the canopy on an edited layout (:meth:`edit_layout`, then :meth:`build`);
+        True if light results were dropped."""
+        dropped = self.edit_layout(layout)
+        if self.loaded is not None and self.loaded.layout is layout:
+            self.build()
+        return dropped
+
     def edit_layout(self, layout: Any) -> bool:
-        """The layout edited in the layout panel; True if light results were dropped."""
+        """The layout edited; True if light results were dropped."""
         if self.loaded is None:
             return False
         dropped = bool(self.runs.runs)
         self.loaded = replace(self.loaded, layout=layout)
+        if tuple(self.draft.placements) != tuple(layout.placements):
+            self.draft.start(layout, self.loaded.plants)    # laid out by a script
         self.layout_edited = True
         self._renew()
         self.layout_changed.emit(layout)
         self._set_modified(True)
+        if dropped:
+            self.say("note: the layout changed; light results of the previous layout were "
+                     "cleared")
+        self.say(f"layout applied: {len(layout.placements)} plants")
         return dropped
 
     def show_built(self, built: Any) -> bool:
@@ -175,8 +338,10 @@ class StudyModel:
         if built.serial != self.serial:
             return False
         self.built = built
+        self.canopy_key += 1
         self.measures_rows[built.label] = built.row
         self.canopy_changed.emit(built)
+        self.build_pending.emit("")
         return True
 
     def add_run(self, run: Run, settings: Any, sampling: Any, info: str = "", *,
@@ -192,17 +357,49 @@ class StudyModel:
             self._set_modified(True)
         return dropped
 
-    def saved(self, path: str) -> None:
+    def mark_saved(self, path: str) -> None:
         """The study was written to ``path``."""
         self.project_path = path
         self.project_changed.emit(path)
         self._set_modified(False)
 
+    def set_summary(self, text: str) -> None:
+        if text != self.summary:
+            self.summary = text
+            self.summary_changed.emit(text)
+
+    def set_plants_run(self, run: Run | None) -> None:
+        self.plants_run = run
+        self.plants_changed.emit(run)
+
+    @contextmanager
+    def quietly(self) -> Iterator[None]:
+        """Settings set by the model itself (a project read, a level refused): no rebuild,
+        no undo step (:attr:`applying` is not 0 meanwhile)."""
+        self.applying += 1
+        try:
+            yield
+        finally:
+            self.applying -= 1
+
+    def apply_settings(self, name: str, values: dict[str, Any]) -> None:
+        """Set a settings group from the model itself (see :meth:`quietly`)."""
+        with self.quietly():
+            self.settings.set(name, values)
+
     # ------------------------------------------------------------------ inside
+    def _canopy_setting(self, *_values: Any) -> None:
+        """A canopy setting changed (the slider, area preservation, an undo): rebuild."""
+        if not self.applying:
+            self.build()
+
     def _renew(self) -> None:
         self.serial += 1
         self.measures_rows.clear()
         self.runs.clear()
+        self.figures.clear()
+        self.set_summary("")
+        self.set_plants_run(None)
         self.runs_changed.emit(self.runs, "")
 
     def _set_modified(self, value: bool) -> None:

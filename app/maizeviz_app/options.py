@@ -2,9 +2,13 @@
 
 #: Colourings of the canopy: name -> what the View menu says.
 COLOURINGS = {"plant": "plant", "leaf": "leaf rank", "light": "light received"}
-#: Camera presets: name -> what the View menu says.
-CAMERAS = {"top": "Top", "along": "Along the rows", "across": "Across the rows",
-           "perspective": "Perspective"}
+#: Camera presets: name -> what the View menu says. Front looks along the rows (+y), side
+#: across them (+x), iso from the south-west corner at 45 degrees up; reset goes back to the
+#: view the canopy first opened in.
+CAMERAS = {"top": "Top", "front": "Front (along the rows)", "side": "Side (across the rows)",
+           "iso": "Isometric", "reset": "Reset view"}
+#: Earlier names of presets, still understood.
+CAMERA_ALIASES = {"along": "front", "across": "side", "perspective": "reset"}
 #: Light class of a triangle in the view: value -> (label, colour). The leaf classes are the
 #: paper's (maizeviz.light.results.per_leaf.triangle_light): 2 direct, 1 second class, 0 none.
 LIGHT_CLASSES = {-2: ("stalk", "#b0875a"), -1: ("not traced", "#c8c8c8"),

@@ -87,35 +87,143 @@ def rgba(fig) -> np.ndarray:
     return np.asarray(canvas.buffer_rgba()).copy()
 
 
+class Look:
+    """How heatmaps are coloured, handed to the worker that draws them: a snapshot of a
+    :class:`~maizeviz_app.colour.ColourScale` and, when the maps share one scale, the results
+    (light -> result) over whose maps at every height the range is taken (binned once, on
+    first use, in the worker). ``Look()`` is the core's own: 0 to 1, viridis."""
+
+    def __init__(self, scale=None, shared: dict | None = None,
+                 bin_cm: float = HEATMAP_BIN_CM) -> None:
+        from maizeviz_app.colour import ColourScale
+
+        self.scale = ColourScale(**scale.to_doc()) if scale is not None else \
+            ColourScale(range="fixed")
+        self.scale.check()
+        self.shared = dict(shared) if shared is not None else None
+        self.bin_cm = bin_cm
+        self._shared_limits: tuple[float, float] | None = None
+
+    @classmethod
+    def of(cls, settings, shown: dict) -> Look:
+        """The look of the heatmaps of ``settings`` (a ``ColourSettings``) for the results
+        shown (light -> its ``Run``, or its result): every height of each shares the scale
+        when ``settings.shared``. Take it on the GUI thread (a snapshot)."""
+        shared = {kind: getattr(run, "result", run) for kind, run in shown.items()} \
+            if settings.shared else None
+        return cls(settings.heatmap, shared)
+
+    def sharing(self, kind: str, result) -> Look:
+        """This look with ``result`` as the ``kind`` shared (a new run's)."""
+        if self.shared is not None:
+            self.shared[kind] = result
+            self._shared_limits = None
+        return self
+
+    def limits(self, tmap) -> tuple[float, float]:
+        """The range of the map ``tmap`` (a ``TransmissionMap``), or of every shared map."""
+        if self.shared is None:
+            return self.scale.limits(tmap.transmission)
+        if self._shared_limits is None:
+            from maizeviz.light.report.heatmap import result_map
+
+            values = [result_map(r, float(h), kind, self.bin_cm).transmission.ravel()
+                      for kind, r in self.shared.items() for h in r.heights_cm]
+            self._shared_limits = self.scale.limits(np.concatenate(values) if values
+                                                    else tmap.transmission)
+        return self._shared_limits
+
+    def colours(self, tmap) -> dict:
+        """The keywords of :func:`maizeviz.light.report.heatmap.heatmap_figure` for ``tmap``."""
+        from maizeviz_app.colour import CMAPS
+
+        lo, hi = self.limits(tmap)
+        return {"vmin": lo, "vmax": hi, "cmap": CMAPS[self.scale.cmap], "log": self.scale.log}
+
+
+@dataclass(frozen=True)
+class Heatmap:
+    """A heatmap drawn, and what lies under each of its pixels.
+
+    Attributes
+    ----------
+    rgba : (h, w, 4) uint8, the figure
+    box : (left, top, right, bottom), the map's axes in the image's pixels
+    x_edges, y_edges : (nx + 1,), (ny + 1,) bin edges, cm, as the axes read
+    values : (nx, ny) the map's transmission (NaN: no ray); rays : (nx, ny) rays per bin
+    height_cm : the sensor plane's height; limits : (low, high) of the colours; what : what
+        the values are (the figure's title)
+    """
+
+    rgba: np.ndarray
+    box: tuple[float, float, float, float]
+    x_edges: np.ndarray
+    y_edges: np.ndarray
+    values: np.ndarray
+    rays: np.ndarray
+    height_cm: float
+    limits: tuple[float, float]
+    what: str
+
+    def value_at(self, px: float, py: float) -> tuple[float, float, float, int] | None:
+        """(x cm, y cm, value, rays) of the bin under the image pixel (``px``, ``py``; from
+        the top left), None off the map."""
+        left, top, right, bottom = self.box
+        if not (left <= px <= right and top <= py <= bottom) or right <= left or bottom <= top:
+            return None
+        xe, ye = self.x_edges, self.y_edges
+        x = xe[0] + (px - left) / (right - left) * (xe[-1] - xe[0])
+        y = ye[-1] - (py - top) / (bottom - top) * (ye[-1] - ye[0])     # y grows upwards
+        i = int(np.clip(np.searchsorted(xe, x, "right") - 1, 0, len(xe) - 2))
+        j = int(np.clip(np.searchsorted(ye, y, "right") - 1, 0, len(ye) - 2))
+        return float(x), float(y), float(self.values[i, j]), int(self.rays[i, j])
+
+
 def heatmap_figure_of(result, height: float, kind: str = "sun", width_in: float = 8.0,
-                      dpi: int = 110, bin_cm: float = HEATMAP_BIN_CM):
+                      dpi: int = 110, bin_cm: float = HEATMAP_BIN_CM, look: Look | None = None):
     """The core's heatmap figure of one height of a light result (a sun's ``LightResult``, a
     ``SkyLight`` or a ``PeriodLight``; ``kind`` sun, sky or day), a sun's in ``bin_cm`` bins
     (:func:`maizeviz.light.report.heatmap.result_figure`, titled as
-    ``maizeviz light --heatmaps``)."""
-    from maizeviz.light.report.heatmap import result_figure
+    ``maizeviz light --heatmaps``), coloured as ``look`` says (None: the core's 0 to 1)."""
+    from maizeviz.light.report.heatmap import result_figure, result_map
 
-    return result_figure(result, float(height), kind, bin_cm, width_in=width_in, dpi=dpi)
+    tmap = result_map(result, float(height), kind, bin_cm)
+    colours = (look or Look()).colours(tmap)
+    return result_figure(result, float(height), kind, bin_cm, width_in=width_in, dpi=dpi,
+                         tmap=tmap, **colours)
 
 
 def heatmap_image(result, height: float, bin_cm: float = HEATMAP_BIN_CM, width_in: float = 8.0,
-                  dpi: int = 64, kind: str = "sun") -> np.ndarray:
+                  dpi: int = 64, kind: str = "sun", look: Look | None = None) -> Heatmap:
     """The core's heatmap of one height of a light result (:func:`heatmap_figure_of`),
-    drawn (RGBA)."""
-    return rgba(heatmap_figure_of(result, height, kind, width_in, dpi, bin_cm))
+    drawn, with where its bins lie in the picture (for the value under the mouse)."""
+    from maizeviz.light.report.heatmap import map_title, result_figure, result_map
+
+    tmap = result_map(result, float(height), kind, bin_cm)
+    colours = (look or Look()).colours(tmap)
+    fig = result_figure(result, float(height), kind, bin_cm, width_in=width_in, dpi=dpi,
+                        tmap=tmap, **colours)
+    pixels = rgba(fig)
+    h = pixels.shape[0]
+    ext = fig.axes[0].get_window_extent()              # drawn: the box after the aspect
+    return Heatmap(pixels, (float(ext.x0), float(h - ext.y1), float(ext.x1), float(h - ext.y0)),
+                   np.asarray(tmap.x_edges), np.asarray(tmap.y_edges),
+                   np.asarray(tmap.transmission), np.asarray(tmap.rays), tmap.height_cm,
+                   (colours["vmin"], colours["vmax"]), map_title(result, kind)[0])
 
 
 def heatmap_images(result, first: int = 0, all_heights: bool = False, check=None,
-                   kind: str = "sun") -> list[tuple[float, np.ndarray | None]]:
-    """[(height, RGBA or None)] for every height of a light result: the ``first`` one drawn
+                   kind: str = "sun", look: Look | None = None
+                   ) -> list[tuple[float, Heatmap | None]]:
+    """[(height, Heatmap or None)] for every height of a light result: the ``first`` one drawn
     (each figure takes 0.3-1 s), the others too with ``all_heights``, else drawn when asked
     for. ``check()`` is called between figures (it may raise InterruptedError)."""
     heights = [float(h) for h in result.heights_cm]
     first = first if 0 <= first < len(heights) else 0
-    out: list[tuple[float, np.ndarray | None]] = []
+    out: list[tuple[float, Heatmap | None]] = []
     for k, h in enumerate(heights):
         if check is not None:
             check()
         drawn = k == first or all_heights
-        out.append((h, heatmap_image(result, h, kind=kind) if drawn else None))
+        out.append((h, heatmap_image(result, h, kind=kind, look=look) if drawn else None))
     return out

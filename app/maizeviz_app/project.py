@@ -16,7 +16,7 @@ from maizeviz.project.settings import run_settings, settings_doc  # noqa: F401 -
 from maizeviz.project.study import CANOPY, LIGHT, Opened, StoredResult
 
 __all__ = ["CANOPY", "LIGHT", "Opened", "StoredRun", "canopy_settings", "light_settings",
-           "run_settings", "settings_doc", "stored_run"]
+           "run_settings", "settings_doc", "stored_run", "view_settings"]
 
 
 class StoredRun(NamedTuple):
@@ -88,3 +88,15 @@ def light_settings(opened: Opened) -> dict:
                 raise ProjectError(f"{where}: light setting '{key}' is '{out[key]}', not one "
                                    f"of {', '.join(allowed)}")
     return out
+
+
+def view_settings(opened: Opened) -> dict:
+    """How the views colour light, stored in a project (checked; ``{}`` in a project saved
+    before colours were kept: the defaults); a value that cannot be used is a ProjectError."""
+    from maizeviz_app.colour import ColourError, ColourSettings
+
+    try:
+        ColourSettings().update_from_doc(opened.view, opened.path)
+    except ColourError as exc:
+        raise ProjectError(str(exc)) from None
+    return dict(opened.view)

@@ -40,7 +40,9 @@ class Run:
     triangle's light class (F,) int8 (None until computed); for a sky or a day ``extra``
     holds what the light process made of it (per-leaf and per-plant rows, per-triangle
     values: :class:`maizeviz_app.jobs.Diffuse`); for a sun traced with leaf optics, the light
-    absorbed with scattering (:class:`maizeviz_app.jobs.Absorbed`)."""
+    absorbed with scattering (:class:`maizeviz_app.jobs.Absorbed`). A sun's ``painting``
+    (:class:`maizeviz.light.results.painting.SunPainting`, made with its classes) says how its light
+    can be painted honestly: per triangle or per leaf."""
 
     label: str
     signature: tuple
@@ -48,6 +50,7 @@ class Run:
     classes: np.ndarray | None = None
     kind: str = "sun"
     extra: Any = None
+    painting: Any = None
 
     @property
     def name(self) -> str:

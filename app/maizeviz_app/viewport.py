@@ -13,14 +13,21 @@ The canopy is one actor over one merged mesh (leaves and stalks), with per-trian
 ``plant`` (digitized plant id), ``instance`` (placement, from 1), ``leaf`` (rank; 0 for
 stalks) and ``light`` (2 direct, 1 second class, 0 none, -1 not traced; -2 for stalks), and
 ``plant`` and ``leaf`` per vertex too: those colourings use them (cheaper to draw on software
-OpenGL than colours per triangle; see :func:`_point_values`), light uses the cell data.
-Colouring switches the mapper's array and lookup table; nothing is rebuilt. The mesh is made
+OpenGL than colours per triangle; see :func:`_point_values`), light uses the cell data: the
+sun's classes through a lookup table, light values (a sky's, a day's, a leaf's sunlit share)
+as one RGB per triangle (``light_rgb``) computed from the view's colour scale
+(:mod:`maizeviz_app.colour`: range, colour map, log), so that a clipped range clamps leaves to
+the ends of the map and stalks keep their colour. Colouring switches the mapper's array and
+lookup table; nothing is rebuilt. The mesh is made
 by :func:`canopy_polydata`, which worker threads call, so the GUI thread only swaps it in.
 
 Touch the widget from the GUI thread only.
 """
 
 from __future__ import annotations
+
+import threading
+import time
 
 import numpy as np
 import pyvista as pv
@@ -30,7 +37,16 @@ from PySide6.QtWidgets import QWidget
 from pyvistaqt import QtInteractor
 
 from maizeviz.ids import groups
-from maizeviz_app.options import CAMERAS, COLOURINGS, LIGHT_CLASSES, NOT_TRACED, STALK
+from maizeviz_app.colour import tick_text
+from maizeviz_app.options import (
+    CAMERA_ALIASES,
+    CAMERAS,
+    COLOURINGS,
+    LIGHT_CLASSES,
+    NOT_TRACED,
+    STALK,
+)
+from maizeviz_app.picking import Pick, make_pickable, part_bounds, part_mesh, pick
 
 #: Text alignments of the painted axes and legends.
 CENTRE = Qt.AlignmentFlag.AlignCenter
@@ -42,7 +58,9 @@ _PLANT_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564
 
 def canopy_polydata(canopy) -> pv.PolyData:
     """One mesh of a :class:`~maizeviz.canopy.scene.Canopy`'s leaves and stalks (float32
-    vertices, cm) with the cell data listed in the module docstring. Safe off the GUI thread."""
+    vertices, cm) with the cell data listed in the module docstring, its ground made too
+    (:func:`ground_for`). Safe off the GUI thread."""
+    _prepare_ground(canopy.layout)
     return _settle(_polydata(canopy, canopy.vertices, canopy.faces, canopy.face_plant,
                              canopy.face_instance, canopy.face_leaf))
 
@@ -116,7 +134,7 @@ def _settle(poly: pv.PolyData) -> pv.PolyData:
     poly.GetBounds()
     poly.GetCellsBounds([0.0] * 6)
     poly.GetPoints().GetData().GetRange(0)
-    return poly
+    return make_pickable(poly)
 
 
 #: Leaf and stalk triangles the view draws at most at the level asked: a frame of 2.7 M
@@ -126,7 +144,7 @@ def _settle(poly: pv.PolyData) -> pv.PolyData:
 VIEW_BUDGET = 800_000
 
 
-def display_polydata(canopy, coarse) -> pv.PolyData:
+def display_polydata(canopy, coarse, fine: np.ndarray | None = None) -> pv.PolyData:
     """What the view draws of a canopy larger than :data:`VIEW_BUDGET`: the plants standing in
     the sample tile (the central one, whose light is traced and reported) at the canopy's own
     level, the others from ``coarse`` (the same plants and layout at a coarser level). Safe
@@ -137,11 +155,14 @@ def display_polydata(canopy, coarse) -> pv.PolyData:
     ``canopy_triangles``; ``canopy_leaf`` (each canopy triangle's leaf), ``leaf_first`` (a
     triangle of each leaf) and ``drawn_leaf`` (each coarse triangle's leaf), so that light
     given per triangle of ``canopy`` colours the coarse plants per leaf
-    (:meth:`Viewport.set_light`).
+    (:meth:`Viewport.set_light`). ``fine``: (P,) bool, the placements drawn at the canopy's
+    level, if not those of the sample tile.
     """
-    x0, y0, x1, y1 = canopy.layout.centre_bounds
-    sampled = np.array([x0 <= p.x <= x1 and y0 <= p.y <= y1
-                        for p in canopy.layout.placements], bool)
+    if fine is None:
+        x0, y0, x1, y1 = canopy.layout.centre_bounds
+        fine = np.array([x0 <= p.x <= x1 and y0 <= p.y <= y1
+                         for p in canopy.layout.placements], bool)
+    sampled = np.asarray(fine, bool)
     fine = np.flatnonzero(sampled[canopy.face_instance])
     rough = np.flatnonzero(~sampled[coarse.face_instance])
     # only the vertices these triangles use (the canopy's other plants' would be uploaded to
@@ -173,6 +194,7 @@ def display_polydata(canopy, coarse) -> pv.PolyData:
     poly.field_data["canopy_leaf"] = inv.astype(np.int32)
     poly.field_data["leaf_first"] = first
     poly.field_data["drawn_leaf"] = np.where(present[want], rank[want], -1).astype(np.int64)
+    _prepare_ground(canopy.layout)
     return _settle(poly)
 
 
@@ -199,6 +221,12 @@ def _per_drawn(mesh: pv.PolyData, values: np.ndarray, classes: bool) -> np.ndarr
     return out
 
 
+def _rgb(colour: str) -> tuple[int, int, int]:
+    """A colour name or #rrggbb as 0-255 RGB."""
+    r, g, b = pv.Color(colour).int_rgb
+    return int(r), int(g), int(b)
+
+
 def _categorical(values: dict[int, tuple[str, str]]):
     """A lookup table of named categories: value -> (label, colour)."""
     lut = pv.LookupTable()
@@ -216,6 +244,17 @@ class Viewport(QtInteractor):
 
     #: After each frame: the number of frames rendered so far.
     rendered = Signal(int)
+    #: The (low, high) the light values' colours span, each time they are painted.
+    limits_shown = Signal(float, float)
+    #: A click on the canopy (a :class:`~maizeviz_app.picking.Pick`), or beside it (None).
+    picked = Signal(object)
+    #: A canopy's mesh was put on screen (show_canopy).
+    canopy_set = Signal()
+
+    #: A press and release closer than this (pixels) is a click, not a drag of the camera.
+    CLICK_PX = 4
+    #: Colour of the picked leaf or plant.
+    HIGHLIGHT = "#00e5ff"
 
     def __init__(self, parent=None):
         super().__init__(parent, auto_update=False, multi_samples=0, lighting="none")
@@ -244,6 +283,18 @@ class Viewport(QtInteractor):
         self._layout = None
         self._framed = False
         self._digitizing_frame = None
+        self._scale = None                   # the light values' ColourScale (set_colour_scale)
+        #: What a sun's painting shows and why (set_sun).
+        self.painting_note = ""
+        #: Milliseconds the last click took to be answered (the pick and every slot of
+        #: ``picked``: the selection, the info card), from the release event's delivery.
+        self.last_pick_ms: float | None = None
+        self._press: tuple[float, float] | None = None
+        self._held = None                       # a left press not yet handed to VTK
+        self.info = InfoCard(self)
+        self.info.hide()
+        #: The (low, high) the light values' colours span, once painted.
+        self.shown_limits: tuple[float, float] | None = None
 
     # ------------------------------------------------------------------ rendering
     def render(self) -> None:
@@ -274,6 +325,7 @@ class Viewport(QtInteractor):
         else:
             self._canopy_actor.mapper.SetInputData(poly)
         self._canopy_actor.SetVisibility(True)
+        self._highlight_actor()
         self._set_ground(canopy.layout)
         if "light_value" not in poly.cell_data:
             self.light_variant = "classes"
@@ -281,9 +333,10 @@ class Viewport(QtInteractor):
             self.colouring = "leaf"
         self._apply_colouring()
         if not self._framed:
-            self.camera_preset("perspective")
+            self.camera_preset("reset")
             self._framed = True
         self.render()
+        self.canopy_set.emit()
 
     def has_light(self) -> bool:
         if self.canopy_mesh is None:
@@ -312,6 +365,24 @@ class Viewport(QtInteractor):
         if self.colouring == "light":
             self._apply_colouring()
             self.render()
+
+    def set_sun(self, painting, asked: str = "auto", classes: np.ndarray | None = None) -> None:
+        """A sun's light as ``painting`` (a :class:`maizeviz.light.results.painting.SunPainting`)
+        says is honest, or as ``asked`` (``auto``, ``triangles``, ``leaves``): each triangle's
+        class, or each leaf's sunlit share on the colour scale. Without a painting, the
+        triangles' ``classes``. :attr:`painting_note` says which and why."""
+        if painting is None:
+            self.painting_note = ""
+            self.set_light(classes)
+            return
+        per = painting.chosen(asked)
+        self.painting_note = painting.note(per)
+        if per == "leaves":
+            self.set_light_values(painting.share, "sunlit share of each leaf (too few rays "
+                                  "per triangle to class each)" if painting.per == "leaves"
+                                  else "sunlit share of each leaf", "")
+        else:
+            self.set_light(painting.classes)
 
     def set_light_values(self, values: np.ndarray, title: str, unit: str) -> None:
         """A value per leaf triangle (F,) (a sky's or a day's light per m2 of leaf, NaN where
@@ -353,24 +424,13 @@ class Viewport(QtInteractor):
         cells = self.canopy_mesh.cell_data
         array = what
         if what == "light" and self.light_variant == "values":
-            array = "light_value"
-            values = cells["light_value"]
-            leaf = values[np.isfinite(values) & (values >= 0)]
-            lo, hi = 0.0, float(leaf.max()) if len(leaf) and leaf.max() > 0 else 1.0
-            lut = pv.LookupTable(cmap="inferno", n_values=256)
-            lut.SetBelowRangeColor(*pv.Color(LIGHT_CLASSES[STALK][1]).float_rgb, 1.0)
-            lut.UseBelowRangeColorOn()
-            lut.SetNanColor(*pv.Color(LIGHT_CLASSES[NOT_TRACED][1]).float_rgb, 1.0)
-            title, unit = self._light_key
-            items = [LIGHT_CLASSES[STALK]]
-            if np.isnan(values).any():
-                items.append(LIGHT_CLASSES[NOT_TRACED])
-            self.key.set_gradient(title, np.asarray(lut.values), "0", f"{hi:.3g} {unit}",
-                                  items)
-        elif what == "light":
+            self._paint_values(mapper)
+            return
+        mapper.SetColorModeToMapScalars()
+        if what == "light":
             shown = {k: v for k, v in LIGHT_CLASSES.items() if k != NOT_TRACED}
             lut = _categorical(LIGHT_CLASSES)
-            lo, hi = min(LIGHT_CLASSES), max(LIGHT_CLASSES)
+            lo, hi = float(min(LIGHT_CLASSES)), float(max(LIGHT_CLASSES))
             self.key.set_categories("light received (the paper's classes)",
                                        [shown[k] for k in sorted(shown, reverse=True)])
         elif what == "plant":
@@ -401,43 +461,95 @@ class Viewport(QtInteractor):
         mapper.ScalarVisibilityOn()
         self.key.show()
 
+    def set_colour_scale(self, scale) -> None:
+        """Colour light values by ``scale`` (a :class:`~maizeviz_app.colour.ColourScale`,
+        followed: a change repaints the canopy if it shows light values)."""
+        if self._scale is not None:
+            self._scale.events.disconnect(self._on_scale)
+        self._scale = scale
+        scale.events.connect(self._on_scale)
+        self._on_scale()
+
+    def _on_scale(self, *_args) -> None:
+        if self.colouring == "light" and self.light_variant == "values":
+            self._apply_colouring()
+            self.render()
+
+    def _paint_values(self, mapper) -> None:
+        """Light values (cell data ``light_value``: leaves' values, NaN not traced, -1 for
+        stalks) as colours of the view's scale, one RGB per triangle (``light_rgb``): stalks
+        and triangles not traced keep their own colours whatever the range clips."""
+        from maizeviz_app.colour import ColourError, ColourScale, colour_table, colours_of
+
+        mesh = self.canopy_mesh
+        assert mesh is not None
+        nf = int(mesh.field_data["leaf_triangles"][0])
+        values = np.asarray(mesh.cell_data["light_value"])
+        scale = self._scale if self._scale is not None else ColourScale(cmap="inferno")
+        try:
+            lo, hi = scale.limits(values[:nf])
+        except ColourError:                       # a range being typed: the data's for now
+            lo, hi = ColourScale(log=scale.log).limits(values[:nf])
+        table = colour_table(scale.cmap)
+        rgb = np.empty((mesh.n_cells, 3), np.uint8)
+        rgb[:nf] = colours_of(values[:nf], lo, hi, table, scale.log,
+                              nan=_rgb(LIGHT_CLASSES[NOT_TRACED][1]))
+        rgb[nf:] = _rgb(LIGHT_CLASSES[STALK][1])
+        mesh.cell_data["light_rgb"] = rgb
+        self.shown_limits = (lo, hi)
+        self.limits_shown.emit(lo, hi)
+        mapper.SetScalarModeToUseCellFieldData()
+        mapper.SelectColorArray("light_rgb")
+        mapper.SetColorModeToDirectScalars()
+        mapper.ScalarVisibilityOn()
+        title, unit = self._light_key
+        leaf = values[:nf][np.isfinite(values[:nf])]
+        low = ("≤ " if len(leaf) and leaf.min() < lo else "") + tick_text(lo)
+        high = ("≥ " if len(leaf) and leaf.max() > hi else "") + tick_text(hi)
+        items = [LIGHT_CLASSES[STALK]]
+        if np.isnan(values[:nf]).any():
+            items.append(LIGHT_CLASSES[NOT_TRACED])
+        self.key.set_gradient(title + (" (log scale)" if scale.log else ""), table,
+                              low, f"{high} {unit}".rstrip(), items)
+        self.key.show()
+
     # ------------------------------------------------------------------ ground
     def _set_ground(self, layout) -> None:
         """The ground: the field with its plant cells as a grid, and the x and y axes with
-        cm labels in a margin around it, all one textured rectangle (one cheap draw)."""
-        bounds = tuple(round(v, 6) for v in layout.bounds) + (layout.row_spacing,
-                                                              layout.plant_spacing)
-        if bounds == self._ground_bounds:
+        cm labels in a margin around it, all one textured rectangle (one cheap draw); made by
+        the worker that made the canopy's mesh when it could (:func:`ground_for`)."""
+        key = _ground_key(layout)
+        if key == self._ground_bounds:
             return
-        self._ground_bounds = bounds
-        x0, y0, x1, y1, rs, ps = bounds
-        margin = max(25.0, 0.09 * max(x1 - x0, y1 - y0))
-        gx0, gy0, gx1, gy1 = x0 - margin, y0 - margin, x1 + margin, y1 + margin
-        ground = pv.Plane(center=((gx0 + gx1) / 2, (gy0 + gy1) / 2, -0.05),
-                          i_size=gx1 - gx0, j_size=gy1 - gy0)
-        image = ground_image((x0, y0, x1, y1), margin, _ticks(x0, x1, rs), _ticks(y0, y1, ps))
-        self.add_mesh(ground, name="ground", texture=pv.Texture(image), render=False,
+        self._ground_bounds = key
+        ground, texture = ground_for(layout)
+        self.add_mesh(ground, name="ground", texture=texture, render=False,
                       pickable=False, lighting=False)
 
     # ------------------------------------------------------------------ camera
     def camera_preset(self, name: str) -> None:
-        """``top``, ``along`` (looking along the rows, +y), ``across`` (along +x) or
-        ``perspective``; frames the canopy."""
+        """``top``, ``front`` (looking along the rows, +y), ``side`` (across them, +x),
+        ``iso`` (from the south-west corner, 45 degrees up) or ``reset`` (the view a canopy
+        first opens in: from the south-west, above, so that the ground's labels read the right
+        way up); each frames the canopy. The earlier names ``along``, ``across`` and
+        ``perspective`` are understood."""
+        name = CAMERA_ALIASES.get(name, name)
         if name not in CAMERAS:
             raise ValueError(f"unknown camera preset {name}")
         cam = self.camera
         if name == "top":
             self.view_xy(render=False)
-        elif name == "along":
+        elif name == "front":
             self.view_xz(render=False)
-        elif name == "across":
-            self.view_yz(render=False)
+        elif name == "side":
+            self.view_yz(negative=True, render=False)
+        elif name == "iso":
+            self.view_vector((-1.0, -1.0, np.sqrt(2.0)), viewup=(0, 0, 1), render=False)
         else:
-            # from the south-west, above: the ground's labels read the right way up
             self.view_vector((-0.75, -1.3, 0.95), viewup=(0, 0, 1), render=False)
         cam.SetParallelProjection(False)
         self.reset_camera(render=False)
-        if name == "perspective":
+        if name == "reset":
             cam.Zoom(1.25)
         self.render()
 
@@ -445,8 +557,9 @@ class Viewport(QtInteractor):
     def hide_canopy(self) -> None:
         """Make room for a digitizing session: the canopy and the ground go (the canopy comes
         back with :meth:`restore_canopy` or the next :meth:`show_canopy`)."""
-        for name in ("canopy", "ground"):
+        for name in ("canopy", "ground", "selection"):
             self.remove_actor(name, render=False)
+        self.info.set_lines([])
         self._canopy_actor = None
         self._ground_bounds = None
         self.key.hide()
@@ -458,7 +571,7 @@ class Viewport(QtInteractor):
         self._clear_digitizing()
         if self.canopy_mesh is not None and self._layout is not None:
             self.show_canopy(_Shown(self._layout), self.canopy_mesh)
-            self.camera_preset("perspective")
+            self.camera_preset("reset")
         self.render()
 
     def _clear_digitizing(self) -> None:
@@ -536,6 +649,110 @@ class Viewport(QtInteractor):
                 self.frame_bounds(np.column_stack(self._digitizing_frame).ravel(), render=False)
         self.render()
 
+    # ------------------------------------------------------------------ picking
+    def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        super().resizeEvent(event)
+        if self.info.isVisible():
+            self.info.set_lines(self.info.text().splitlines())
+
+    # A left press is held back from VTK until the mouse moves: a click then picks without
+    # VTK's camera interaction starting and stopping, each of which renders a frame at once
+    # (two frames of 150-300 ms per click at K = 4 on software OpenGL); a drag is handed to
+    # VTK from the press's own position, so the camera turns as before.
+    def mousePressEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if event.button() == Qt.MouseButton.LeftButton and event.buttons() == event.button():
+            self._press = (event.position().x(), event.position().y())
+            self._held = event.clone()
+            return
+        self._release_held()
+        super().mousePressEvent(event)
+
+    def mouseMoveEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if self._held is not None and self._press is not None:
+            pos = event.position()
+            if abs(pos.x() - self._press[0]) + abs(pos.y() - self._press[1]) > self.CLICK_PX:
+                self._release_held()
+        super().mouseMoveEvent(event)
+
+    def mouseReleaseEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        t0 = time.perf_counter()
+        if self._held is not None and event.button() == Qt.MouseButton.LeftButton:
+            self._held, self._press = None, None                  # a click: VTK never saw it
+            pos = event.position()
+            self.picked.emit(self.pick_at(pos.x(), pos.y()))
+            self.last_pick_ms = 1000 * (time.perf_counter() - t0)
+            return
+        self._press = None
+        super().mouseReleaseEvent(event)
+
+    def _release_held(self) -> None:
+        """Hand the held press to VTK (a drag begins)."""
+        held, self._held = self._held, None
+        if held is not None:
+            super().mousePressEvent(held)
+
+    def pick_at(self, x: float, y: float) -> Pick | None:
+        """What of the canopy is under the widget point (``x``, ``y``), None if nothing."""
+        if self._canopy_actor is None or not self._canopy_actor.GetVisibility():
+            return None
+        ratio = self.devicePixelRatioF()
+        return pick(self.canopy_mesh, self.renderer, x * ratio, (self.height() - y - 1) * ratio)
+
+    def display_point(self, world) -> tuple[float, float]:
+        """The widget point (x, y) where the world point ``world`` (cm) is drawn."""
+        ren = self.renderer
+        ren.SetWorldPoint(float(world[0]), float(world[1]), float(world[2]), 1.0)
+        ren.WorldToDisplay()
+        dx, dy, _ = ren.GetDisplayPoint()
+        ratio = self.devicePixelRatioF()
+        return dx / ratio, self.height() - 1 - dy / ratio
+
+    def highlight(self, instance: int, leaf: int = -1) -> bool:
+        """Draw placement ``instance``'s leaf ``leaf`` (or the whole plant, -1) highlighted,
+        over the canopy; a negative ``instance`` clears. False if none of it is drawn. One
+        actor, made once, takes each selection's triangles (a new actor per click costs
+        pyvista's set-up, 5-50 ms)."""
+        part = None
+        if instance >= 0 and self.canopy_mesh is not None:
+            part = part_mesh(self.canopy_mesh, instance, leaf)
+        actor = self.actors.get("selection")
+        if part is None:
+            if actor is not None and actor.GetVisibility():
+                actor.SetVisibility(False)
+                self.render()
+            return False
+        actor = self._highlight_actor()
+        actor.mapper.dataset = part
+        actor.SetVisibility(True)
+        self.render()
+        return True
+
+    def _highlight_actor(self):
+        """The actor that draws the selection (made once, hidden; show_canopy makes it, so
+        that the first click does not pay for it)."""
+        actor = self.actors.get("selection")
+        if actor is None:
+            dummy = pv.PolyData.from_regular_faces(np.eye(3, dtype=np.float32),
+                                                   np.array([[0, 1, 2]]))
+            actor = self.add_mesh(dummy, name="selection", color=self.HIGHLIGHT, render=False,
+                                  reset_camera=False, pickable=False, lighting=True)
+            # drawn over the canopy's same triangles, not fighting them for the pixels
+            actor.mapper.SetResolveCoincidentTopologyToPolygonOffset()
+            actor.mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(-2.0, -2.0)
+            actor.SetVisibility(False)
+        return actor
+
+    def frame_part(self, instance: int, leaf: int = -1) -> bool:
+        """Point the camera at placement ``instance`` (its leaf ``leaf``), keeping its
+        direction; False if none of it is drawn."""
+        if self.canopy_mesh is None:
+            return False
+        bounds = part_bounds(self.canopy_mesh, instance, leaf)
+        if bounds is None:
+            return False
+        self.frame_bounds(bounds)
+        return True
+
     def close(self) -> None:
         try:
             self.ren_win.RemoveObservers("EndEvent")
@@ -544,11 +761,107 @@ class Viewport(QtInteractor):
         super().close()
 
 
+def _card(widget: QWidget) -> QPainter:
+    """A painter on ``widget`` after its card: a rounded, nearly opaque white rectangle (the
+    view shows through a little); the pen set for dark text."""
+    p = QPainter(widget)
+    p.setRenderHint(QPainter.RenderHint.Antialiasing)
+    p.setPen(Qt.PenStyle.NoPen)
+    p.setBrush(QColor(255, 255, 255, 220))
+    p.drawRoundedRect(QRectF(widget.rect()), 6, 6)
+    p.setPen(QColor("#222222"))
+    return p
+
+
+class InfoCard(QWidget):
+    """What was picked, over the 3D view's bottom left: a few lines of text on a white card
+    (a Qt widget: nothing is drawn in the 3D scene). Clicks go through it to the view."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents)
+        self._lines: list[str] = []
+
+    def set_lines(self, lines: list[str]) -> None:
+        """Show ``lines`` (none: hide the card)."""
+        self._lines = list(lines)
+        if not self._lines:
+            self.hide()
+            return
+        fm = self.fontMetrics()
+        width = max(fm.horizontalAdvance(t) for t in self._lines) + 20
+        height = (fm.height() + 2) * len(self._lines) + 12
+        self.resize(width, height)
+        parent = self.parentWidget()
+        if parent is not None:
+            self.move(10, max(parent.height() - height - 10, 10))
+        self.show()
+        self.raise_()
+        self.update()
+
+    def text(self) -> str:
+        return "\n".join(self._lines)
+
+    def paintEvent(self, _event) -> None:  # noqa: N802 - Qt's name
+        p = _card(self)
+        fm = self.fontMetrics()
+        y = 6
+        for k, line in enumerate(self._lines):
+            font = p.font()
+            font.setBold(k == 0)
+            p.setFont(font)
+            p.drawText(QRectF(10, y, self.width() - 20, fm.height() + 2), LEFT, line)
+            y += fm.height() + 2
+        p.end()
+
+
 class _Shown:
     """What :meth:`Viewport.show_canopy` needs of a canopy whose mesh it already has."""
 
     def __init__(self, layout):
         self.layout = layout
+
+
+#: Grounds made for the last few layouts (key -> plane, texture), by the workers that make the
+#: canopies' meshes, so that a new field's first frame does not wait for its texture (50-150
+#: ms of painting and copying on the GUI thread).
+_GROUNDS: dict[tuple, tuple[pv.PolyData, pv.Texture]] = {}
+_GROUNDS_LOCK = threading.Lock()
+
+
+def _ground_key(layout) -> tuple:
+    return tuple(round(v, 6) for v in layout.bounds) + (layout.row_spacing,
+                                                        layout.plant_spacing)
+
+
+def ground_for(layout) -> tuple[pv.PolyData, pv.Texture]:
+    """The ground plane and its texture (:func:`ground_image`) of ``layout``'s field, made
+    once per field (any thread: the texture is painted on a QImage)."""
+    key = _ground_key(layout)
+    with _GROUNDS_LOCK:
+        made = _GROUNDS.get(key)
+    if made is not None:
+        return made
+    x0, y0, x1, y1, rs, ps = key
+    margin = max(25.0, 0.09 * max(x1 - x0, y1 - y0))
+    gx0, gy0, gx1, gy1 = x0 - margin, y0 - margin, x1 + margin, y1 + margin
+    ground = pv.Plane(center=((gx0 + gx1) / 2, (gy0 + gy1) / 2, -0.05),
+                      i_size=gx1 - gx0, j_size=gy1 - gy0)
+    image = ground_image((x0, y0, x1, y1), margin, _ticks(x0, x1, rs), _ticks(y0, y1, ps))
+    made = (ground, pv.Texture(image))
+    with _GROUNDS_LOCK:
+        while len(_GROUNDS) >= 4:
+            _GROUNDS.pop(next(iter(_GROUNDS)))
+        _GROUNDS[key] = made
+    return made
+
+
+def _prepare_ground(layout) -> None:
+    """Make ``layout``'s ground ahead (a worker, where an application exists to paint text)."""
+    from PySide6.QtGui import QGuiApplication
+
+    if QGuiApplication.instance() is not None:
+        ground_for(layout)
 
 
 def _ticks(lo: float, hi: float, step: float) -> np.ndarray:
@@ -565,7 +878,7 @@ def ground_image(field: tuple[float, float, float, float], margin: float, xs: np
     """The ground texture (h, w, 4) uint8, row 0 at the largest y (as pyvista maps an image
     on a plane): the field (tan) with grid
     lines at ``xs`` / ``ys`` (cm), and a ``margin`` (cm) carrying the tick labels in cm and
-    the axis names. GUI thread (QPainter)."""
+    the axis names. Any thread (QPainter on a QImage), once an application exists."""
     x0, y0, x1, y1 = field
     width_cm, height_cm = x1 - x0 + 2 * margin, y1 - y0 + 2 * margin
     scale = min(4.0, max_px / max(width_cm, height_cm))
@@ -650,14 +963,9 @@ class Legend(QWidget):
         self.update()
 
     def paintEvent(self, _event) -> None:  # noqa: N802 - Qt's name
-        p = QPainter(self)
-        p.setRenderHint(QPainter.RenderHint.Antialiasing)
-        p.setPen(Qt.PenStyle.NoPen)
-        p.setBrush(QColor(255, 255, 255, 215))
-        p.drawRoundedRect(QRectF(self.rect()), 6, 6)
+        p = _card(self)
         fm = self.fontMetrics()
         line = fm.height() + 4
-        p.setPen(QColor("#222222"))
         y = 6
         p.drawText(QRectF(8, y, self.width() - 16, line), LEFT, self._title)
         y += line

@@ -24,48 +24,16 @@ from __future__ import annotations
 
 import itertools
 import sys
-import threading
-import time
-import traceback
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from typing import Any
 
 from PySide6.QtCore import QObject, QRunnable, QThreadPool, Signal
 
 from maizeviz_app.process import CoreProcess
+from maizeviz_app.runner import Job, JobTable, describe_internal  # noqa: F401 - the app's names
 
 
-@dataclass
-class Job:
-    """A unit of work: id, kind, what it is doing (for the status bar), a cancel flag."""
-
-    id: int
-    kind: str
-    label: str
-    runner: JobRunner
-    cancel: threading.Event = field(default_factory=threading.Event)
-    started: float = field(default_factory=time.perf_counter)
-
-    def report(self, done: int, total: int, text: str = "") -> bool:
-        """Progress from any thread (``text``: what is being done, e.g. "time step 7 of 29";
-        else the job's label); False once the job is cancelled (the work should stop)."""
-        if self.cancel.is_set():
-            return False
-        self.runner._progress_from_thread(self, done, total, text)
-        return not self.cancel.is_set()
-
-    @property
-    def cancelled(self) -> bool:
-        return self.cancel.is_set()
-
-    def check(self) -> None:
-        """Raise InterruptedError if cancelled (between steps of a job)."""
-        if self.cancel.is_set():
-            raise InterruptedError(f"{self.kind} cancelled")
-
-
-class JobRunner(QObject):
+class JobRunner(QObject, JobTable):
     """Runs jobs on the thread pool; see the module docstring.
 
     Signals (GUI thread): ``progressed(job id, kind, text, done, total)`` (text: what the job
@@ -94,17 +62,6 @@ class JobRunner(QObject):
         self.light_process = CoreProcess("light")
 
     # ------------------------------------------------------------------ running
-    @property
-    def closed(self) -> bool:
-        return self._closed
-
-    def running(self) -> list[Job]:
-        """The latest job of each kind that has not finished."""
-        return [j for j in self._current.values() if not j.cancelled]
-
-    def current(self, kind: str) -> Job | None:
-        return self._current.get(kind)
-
     def run(self, kind: str, label: str, func: Callable[..., Any], *args: Any,
             on_done: Callable[[Any], None],
             on_error: Callable[[BaseException], None] | None = None,
@@ -218,10 +175,3 @@ class _Task(QRunnable):
 
     def run(self) -> None:
         self._fn()
-
-
-def describe_internal(exc: BaseException) -> None:
-    """Write an unexpected exception's traceback to stderr (the window shows one line)."""
-    child = getattr(exc, "child_traceback", None)
-    text = child or "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
-    print(f"maizeviz: internal error\n{text}", file=sys.stderr)

@@ -17,11 +17,11 @@ from __future__ import annotations
 from PySide6.QtCore import QObject, QSettings, Qt, Signal
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 
-#: name -> (menu text, shortcut, docks shown, the dock raised in each tab group, what it is for)
+#: name -> (menu text, shortcut, docks shown ("*": all but the digitizer), the dock raised in
+#: each tab group, what it is for)
 WORKSPACES = {
-    "analyse": ("&Analyse", "Ctrl+Alt+1", ("canopy", "light", "layout", "results", "messages"),
-                ("canopy", "results"), "the canopy, light and layout panels with the light "
-                                       "results under the view"),
+    "analyse": ("&Analyse", "Ctrl+Alt+1", "*", ("canopy", "results"),
+                "the canopy, light and layout panels with the light results under the view"),
     "digitize": ("&Digitize", "Ctrl+Alt+2", ("digitizer",), ("digitizer",),
                  "the view large with the digitizer beside it; the light results hidden"),
 }
@@ -115,10 +115,11 @@ class Workspaces(QObject):
         _text, _shortcut, shown, raised, _tip = WORKSPACES[self.current]
         docks = self.window.docks
         for name, dock in docks.items():
+            want = name != "digitizer" if shown == "*" else name in shown
             # by the dock's open state: a tab behind another is not visible, yet open (asking
             # it to show again re-lays its tab bar out)
-            if dock.toggleViewAction().isChecked() != (name in shown):
-                dock.setVisible(name in shown)
+            if dock.toggleViewAction().isChecked() != want:
+                dock.setVisible(want)
         for name in raised:
             if name in docks:
                 docks[name].raise_()

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from maizeviz.canopy.layout import field_period
 from maizeviz.canopy.scene import Canopy
 from maizeviz.io.meshfile import write_mesh
 
@@ -41,5 +42,26 @@ def canopy_cells(canopy: Canopy, cell_data: dict[str, np.ndarray] | None = None,
 
 def export_canopy(path: str | Path, canopy: Canopy,
                   cell_data: dict[str, np.ndarray] | None = None) -> Path:
-    """Write a canopy with its stalks (see :func:`canopy_cells`); format by extension."""
-    return write_mesh(path, *canopy_cells(canopy, cell_data))
+    """Write a canopy with its stalks as a mesh file, the format chosen by the extension.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write (.ply, .obj, .vtp, .vtu, .vtk, .stl...), atomically.
+    canopy : Canopy
+        The canopy (its leaves, then its stalks).
+    cell_data : dict of str to numpy.ndarray, optional
+        Per-triangle values to carry, each (F,) over the canopy's leaf triangles (stalks get 0,
+        or NaN for floats), beside ``plant`` and ``leaf`` (:func:`canopy_cells`).
+
+    The file carries the plot (the layout's bounds) and, for a tiling, the period of its
+    periodic field (:func:`~maizeviz.canopy.layout.field_period`), so that read back without
+    a field it has the same ground, LAI and light (:mod:`maizeviz.canopy.from_mesh`).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
+    """
+    return write_mesh(path, *canopy_cells(canopy, cell_data), field_cm=canopy.layout.bounds,
+                      period_cm=field_period(canopy.layout))

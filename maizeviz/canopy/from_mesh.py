@@ -18,8 +18,15 @@ What is taken from the file, and nothing else changed:
   seen from above (only the tables' ``x_cm, y_cm`` and which plants a sample rectangle holds
   depend on it);
 - **field** (the ground: LAI, ground cover, the periodic field's tile, the default sample
-  rectangle): a rectangle x0, y0, x1, y1 in cm if given, else the mesh's bounding box seen
-  from above.
+  rectangle): a rectangle x0, y0, x1, y1 in cm if given, else the one the file carries (a
+  ``maizeviz field_cm`` comment, as maizeviz's exports write it), else the mesh's bounding
+  box seen from above;
+- **period**: a file that carries its field may also carry the block its periodic field
+  repeats (``maizeviz period_cm``: a tiled canopy's central tile). With the file's field it
+  is the default sample rectangle and, once the light has checked that the triangles do
+  repeat with it, the period the periodic field's sensors are read over, as for the tiled
+  canopy the file came from (:func:`maizeviz.light.scene.tiling.carried_period`). A field given
+  wins over the file's, and then the file's period is not used.
 """
 
 from __future__ import annotations
@@ -34,8 +41,7 @@ from maizeviz.canopy.layout import MAX_COORD_CM, CanopyLayout, Placement
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.ids import groups
-from maizeviz.io.mesh_canopy import MeshData, read_mesh
-from maizeviz.mesh.tessellate import triangle_areas_normals
+from maizeviz.io.mesh_canopy import CARRIED, MeshData, read_mesh
 from maizeviz.numbers import number
 
 #: cm per unit of a mesh file.
@@ -83,6 +89,55 @@ def check_field(field: tuple[float, float, float, float] | list[float] | str
                             f"less than {MIN_FIELD_CM:g} cm across: is it in cm?",
                             quantity="field")
     return vals
+
+
+def _carried(mesh: MeshData, unit: str | None, up: str, source: str, notes: list[str],
+             strict: bool) -> tuple[tuple[float, ...] | None, tuple[float, ...] | None]:
+    """The plot and period the file carries (``field_cm``, ``period_cm`` comments or field
+    data: :data:`maizeviz.io.mesh_data.CARRIED`) in cm, or None; a broken one is refused
+    when ``strict`` (no field given), else said in a note."""
+    if not mesh.carried:
+        return None, None
+    if up != "z":
+        notes.append(f"{source}: the file's field and period are written for z up: not used "
+                     "with the y axis up")
+        return None, None
+    scale = UNITS[unit or "cm"]
+    out: list[tuple[float, ...] | None] = []
+    for key in CARRIED:
+        if key not in mesh.carried:
+            out.append(None)
+            continue
+        where, text = mesh.carried[key]
+        try:
+            rect = check_field(text)
+        except MaizevizError as exc:
+            if not strict:                          # a field given: the file's is not needed
+                notes.append(f"{source}: {where}: the {key} the file carries is not read: "
+                             f"{exc}")
+                return None, None
+            raise MaizevizError(f"{source}: {where}: the {key} the file carries: {exc}",
+                                quantity="field") from None
+        out.append(tuple(v * scale for v in rect))
+    return out[0], out[1]
+
+
+def _period_in(period: tuple[float, ...] | None, field: tuple[float, ...], source: str,
+               notes: list[str]) -> tuple[float, float, float, float] | None:
+    """The carried period if the field holds a whole number of it (more than one), else
+    None with a note."""
+    if period is None:
+        return None
+    x0, y0, x1, y1 = field
+    px0, py0, px1, py1 = period
+    counts = ((x1 - x0) / (px1 - px0), (y1 - y0) / (py1 - py0))
+    whole = all(abs(c - round(c)) <= 1e-9 * c for c in counts)
+    inside = x0 - 1e-6 <= px0 and px1 <= x1 + 1e-6 and y0 - 1e-6 <= py0 and py1 <= y1 + 1e-6
+    if not (whole and inside) or round(counts[0]) * round(counts[1]) < 2:
+        notes.append(f"{source}: the file's period x {px0:g}..{px1:g}, y {py0:g}..{py1:g} cm is "
+                     "not a block the field holds a whole number of times: not used")
+        return None
+    return (float(px0), float(py0), float(px1), float(py1))
 
 
 def _field_coordinates(mesh: MeshData, unit: str | None, up: str, src: str) -> np.ndarray:
@@ -133,18 +188,43 @@ def _distinct(a: np.ndarray) -> np.ndarray:
     return np.unique(a[starts])
 
 
+def _mix(h: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """A 64-bit hash ``h`` (n,) uint64 with the words ``v`` (n,) uint64 folded in."""
+    with np.errstate(over="ignore"):
+        h = (h ^ v) * np.uint64(0x9E3779B97F4A7C15)
+        return h ^ (h >> np.uint64(31))
+
+
 def repeated_triangles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """(T,) bool: the triangles whose three corners (by position, in any order and either
     orientation) are those of an earlier triangle.
 
     vertices : (V, 3) float64; faces : (T, 3) int64. A surface written twice (a file
     concatenated with itself, a double-sided export) would otherwise count its area, and
-    intercept its light, twice.
+    intercept its light, twice. Each triangle is first given a 64-bit hash of its corners'
+    coordinates, in any order: a repeated triangle has the hash of the one it repeats, so a
+    mesh whose hashes all differ (the usual case) has none, found with one sort of the
+    hashes; otherwise the rows are sorted and compared exactly.
     """
     out = np.zeros(len(faces), dtype=bool)
     if len(faces) < 2:
         return out
-    _, same = np.unique(vertices, axis=0, return_inverse=True)
+    bits = np.ascontiguousarray(vertices + 0.0).view(np.uint64)   # + 0.0: -0.0 is 0.0
+    at = np.zeros(len(vertices), np.uint64)
+    for k in range(3):
+        at = _mix(at, bits[:, k])
+    corner = np.sort(at[faces], axis=1)
+    key = np.zeros(len(faces), np.uint64)
+    for k in range(3):
+        key = _mix(key, corner[:, k])
+    key.sort()
+    if not np.any(key[1:] == key[:-1]):
+        return out
+    # vertices by position: their coordinates' bit patterns (-0.0 made 0.0) grouped as int64
+    # columns, whose sort releases the GIL (np.unique(axis=0) sorts rows as one structured
+    # type: 3 s holding it for the K = 4 canopy's 1.4 M vertices, and the app's window with it)
+    bits = np.ascontiguousarray(np.asarray(vertices, dtype=np.float64) + 0.0).view(np.int64)
+    _, same = groups(bits[:, 0], bits[:, 1], bits[:, 2])
     corners = np.sort(same.reshape(-1)[faces], axis=1)
     order = np.lexsort(corners.T[::-1])                # stable: the first of equals first
     ranked = corners[order]
@@ -173,6 +253,8 @@ def _split(vertices: np.ndarray, faces: np.ndarray, is_leaf: np.ndarray
     """Leaf vertices and faces, stalk vertices and faces, each renumbered, vertices in file
     order. The stalk's vertices are those only stalk triangles use; the leaves keep every
     other vertex (also those no face uses: the file's vertices come back as they were)."""
+    if is_leaf.all():
+        return vertices, faces, np.empty((0, 3)), np.empty((0, 3), np.int64)
     stalk_f = faces[~is_leaf]
     leaf_f = faces[is_leaf]
     used_by_leaf = np.zeros(len(vertices), bool)
@@ -181,23 +263,44 @@ def _split(vertices: np.ndarray, faces: np.ndarray, is_leaf: np.ndarray
     in_stalk[stalk_f.ravel()] = True
     stalk_only = in_stalk & ~used_by_leaf
     keep_leaf = ~stalk_only
-    new_leaf = np.cumsum(keep_leaf) - 1
-    if len(stalk_f):
-        # a vertex both organs use is copied into the stalk's vertices
-        new_stalk = np.cumsum(in_stalk) - 1
-        stalk = (vertices[in_stalk], new_stalk[stalk_f].astype(np.int64))
+    first_gone = int(np.argmax(stalk_only)) if stalk_only.any() else len(vertices)
+    if first_gone == len(vertices) or keep_leaf[first_gone:].sum() == 0:
+        # the stalks' own vertices come after every leaf vertex (as maizeviz writes them):
+        # the leaves' numbers stay
+        leaf_faces = leaf_f
     else:
-        stalk = (np.empty((0, 3)), np.empty((0, 3), np.int64))
-    return vertices[keep_leaf], new_leaf[leaf_f].astype(np.int64), *stalk
+        new_leaf = np.cumsum(keep_leaf) - 1
+        leaf_faces = new_leaf[leaf_f]
+    # a vertex both organs use is copied into the stalk's vertices
+    new_stalk = np.cumsum(in_stalk) - 1
+    stalk = (vertices[in_stalk], new_stalk[stalk_f])
+    return vertices[keep_leaf], leaf_faces, *stalk
 
 
-def _positions(plants: np.ndarray, leaf_v: np.ndarray, leaf_f: np.ndarray, area: np.ndarray,
-               leaf_inst: np.ndarray, stalk_v: np.ndarray, stalk_f: np.ndarray,
-               stalk_inst: np.ndarray) -> np.ndarray:
+def _areas_centres(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Areas (F,) cm2 and centroids seen from above (F, 2) cm of triangles ``f`` (F, 3) of
+    vertices ``v`` (V, 3) cm, a coordinate at a time from contiguous columns (at K = 4 a
+    seventh of the time of gathering the triangles whole and crossing their edges)."""
+    vt, ft = np.ascontiguousarray(v.T), np.ascontiguousarray(f.T)
+    e1, e2, centre = [], [], np.empty((len(f), 2))
+    for k in range(3):
+        a, b, d = (vt[k][ft[j]] for j in range(3))
+        if k < 2:
+            centre[:, k] = (a + b + d) / 3.0
+        b -= a
+        d -= a
+        e1.append(b)
+        e2.append(d)
+    cross2 = (e1[1] * e2[2] - e1[2] * e2[1]) ** 2
+    cross2 += (e1[2] * e2[0] - e1[0] * e2[2]) ** 2
+    cross2 += (e1[0] * e2[1] - e1[1] * e2[0]) ** 2
+    return 0.5 * np.sqrt(cross2), centre
+
+
+def _positions(n: int, centre: np.ndarray, area: np.ndarray, leaf_inst: np.ndarray,
+               stalk_v: np.ndarray, stalk_f: np.ndarray, stalk_inst: np.ndarray) -> np.ndarray:
     """(P, 2) cm: the mean of each plant's stalk vertices, or its leaves' area-weighted centre
-    (``area``: of each leaf triangle)."""
-    n = len(plants)
-    centre = leaf_v[leaf_f].mean(axis=1)[:, :2]
+    (``centre``, ``area``: of each leaf triangle)."""
     weight = np.bincount(leaf_inst, area, n)
     count = np.bincount(leaf_inst, minlength=n).astype(np.float64)
     out = np.zeros((n, 2))
@@ -228,7 +331,7 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
     mesh : as :func:`maizeviz.io.mesh_canopy.read_mesh` reads it
     unit : "m", "cm" or "mm"; None: cm, refusing a height that suggests another unit
     up : "z" or "y", the file's up axis
-    field : x0, y0, x1, y1 cm; None: the mesh's bounding box seen from above
+    field : x0, y0, x1, y1 cm; None: the file's, else the mesh's bounding box seen from above
     source : the file, for messages
 
     Raises
@@ -242,6 +345,15 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
         field = check_field(field)                                    # type: ignore[assignment]
     mesh, said = _without_repeats(mesh, source)
     notes += said
+    carried_field, period = _carried(mesh, unit, up, source, notes, strict=field is None)
+    if field is None and carried_field is not None:
+        field, fsrc = carried_field, "the file's"                     # type: ignore[assignment]
+    elif field is not None:
+        fsrc = "given"
+    if period is not None and field != carried_field:
+        notes.append(f"{source}: the file's period is for its own field, not the one given: "
+                     "not used")
+        period = None
     verts = _field_coordinates(mesh, unit, up, source)
     is_leaf = mesh.leaf != 0
     n_leaf = int(is_leaf.sum())
@@ -249,7 +361,7 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
         raise MaizevizError(f"{source}: no leaf triangle: all {mesh.n_triangles:,} have leaf id "
                             "0 (a stalk or another organ that is not a leaf)")
     leaf_v, leaf_f, stalk_v, stalk_f = _split(verts, mesh.faces, is_leaf)
-    area, _ = triangle_areas_normals(leaf_v, leaf_f)
+    area, centre = _areas_centres(leaf_v, leaf_f)
     flat = int((area == 0).sum())
     if flat == n_leaf:
         raise MaizevizError(f"{source}: all {n_leaf:,} leaf triangles are degenerate (no area: "
@@ -264,11 +376,13 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
     leaf_ids = mesh.leaf[is_leaf].astype(np.int32)
     pairs, _ = groups(leaf_inst, leaf_ids)
     leaves_per = np.bincount(pairs[:, 0], minlength=len(plants)).astype(np.int32)
-    xy = _positions(plants, leaf_v, leaf_f, area, leaf_inst, stalk_v, stalk_f, stalk_inst)
+    xy = _positions(len(plants), centre, area, leaf_inst, stalk_v, stalk_f, stalk_inst)
+    del centre
     placements = tuple(Placement(int(p), float(x), float(y)) for p, (x, y) in zip(plants, xy))
     if field is None:
-        every = np.vstack([leaf_v, stalk_v])
-        lo, hi = every[:, :2].min(axis=0), every[:, :2].max(axis=0)
+        parts = [a[:, :2] for a in (leaf_v, stalk_v) if len(a)]
+        lo = np.min([a.min(axis=0) for a in parts], axis=0)
+        hi = np.max([a.max(axis=0) for a in parts], axis=0)
         if not (hi[0] > lo[0] and hi[1] > lo[1]):
             raise MaizevizError(f"{source}: the mesh has no extent in "
                                 f"{'x' if not hi[0] > lo[0] else 'y'} seen from above: give "
@@ -276,7 +390,6 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
         field = (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
         fsrc = "the mesh's bounding box"
     else:
-        fsrc = "given"
         x0, y0, x1, y1 = field
         outside = [p.plant for p in placements if not (x0 <= p.x <= x1 and y0 <= p.y <= y1)]
         if len(outside) == len(placements):
@@ -296,9 +409,15 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
                      "z = 0 (sensor heights count from it)")
     x0, y0, x1, y1 = field
     cells = np.array([field], np.float64)
-    layout = CanopyLayout(placements, cells, x1 - x0, y1 - y0, 0.0, cells.copy(),
-                          (f"the field is {fsrc}: x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f} "
-                           "cm",), (x1 - x0) * (y1 - y0), "mesh")
+    period = _period_in(period, field, source, notes)
+    field_said = f"the field is {fsrc}: x {x0:.1f}..{x1:.1f}, y {y0:.1f}..{y1:.1f} cm"
+    if period is not None:
+        px0, py0, px1, py1 = period
+        field_said += (f", repeating every {px1 - px0:.1f} x {py1 - py0:.1f} cm in a periodic field "
+                 "(the file's period; its block is the default sample rectangle)")
+    layout = CanopyLayout(placements, cells, x1 - x0, y1 - y0, 0.0,
+                          np.array([period], np.float64) if period else cells.copy(),
+                          (field_said,), (x1 - x0) * (y1 - y0), "mesh", period)
     canopy = Canopy(leaf_v, leaf_f, leaf_inst, mesh.plant[is_leaf].astype(np.int32), leaf_ids,
                     layout, MESH_LEVEL, stalk_v, stalk_f, leaves_per,
                     stalk_instance=stalk_inst)
@@ -309,8 +428,33 @@ def read_mesh_canopy(path: str | Path, unit: str | None = None, up: str = "z",
                      field: tuple[float, float, float, float] | None = None,
                      plant_property: str | None = None,
                      leaf_property: str | None = None) -> tuple[Canopy, MeshData, list[str]]:
-    """Read a mesh file (:func:`maizeviz.io.mesh_canopy.read_mesh`) as a canopy
-    (:func:`canopy_from_mesh`): the canopy, the file's mesh, and notes."""
+    """Read a mesh file as a canopy.
+
+    The file's triangles with plant and leaf ids (:func:`maizeviz.io.mesh_canopy.read_mesh`)
+    become a canopy (:func:`canopy_from_mesh`).
+
+    Parameters
+    ----------
+    path : str or Path
+        A PLY or OBJ file with plant and leaf ids.
+    unit : {"m", "cm", "mm"}, optional
+        The file's length unit; None: cm, refusing a height that suggests another unit.
+    up : {"z", "y"}
+        The file's up axis.
+    field : (x0, y0, x1, y1) tuple of float, optional
+        The plot [cm]; None: the mesh's bounding box seen from above.
+    plant_property, leaf_property : str, optional
+        Names of the per-face plant and leaf id properties, where not the usual ones.
+
+    Returns
+    -------
+    canopy : Canopy
+        The canopy of the mesh's triangles.
+    mesh : MeshData
+        The file's mesh as read.
+    notes : list of str
+        What was decided (one line each).
+    """
     mesh = read_mesh(path, plant_property, leaf_property)
     canopy, notes = canopy_from_mesh(mesh, unit, up, field, str(path))
     return canopy, mesh, notes

@@ -92,6 +92,9 @@ class CanopyLayout:
     ground_area : float, cm2, or None: the union of the cells
     quantity : the input that set the plants (see :data:`maizeviz.errors.QUANTITIES`):
         "tile" for a tiling, "layout" for a layout document; costs name it
+    period : (x0, y0, x1, y1) cm or None: the smallest rectangle the plot repeats, as a mesh
+        file says it (:mod:`maizeviz.canopy.from_mesh`); a claim the light verifies before
+        using it. A tiling's is :func:`field_period`.
     """
 
     placements: tuple[Placement, ...]
@@ -103,6 +106,7 @@ class CanopyLayout:
     warnings: tuple[str, ...] = ()
     ground_area: float | None = None
     quantity: str = "tile"
+    period: tuple[float, float, float, float] | None = None
 
     @property
     def ground_area_cm2(self) -> float:
@@ -120,6 +124,17 @@ class CanopyLayout:
     def centre_bounds(self) -> tuple[float, float, float, float]:
         c = self.centre_cells if len(self.centre_cells) else self.cells
         return float(c[:, 0].min()), float(c[:, 1].min()), float(c[:, 2].max()), float(c[:, 3].max())
+
+
+def field_period(layout: CanopyLayout) -> tuple[float, float, float, float] | None:
+    """The rectangle (x0, y0, x1, y1) cm a periodic field of ``layout``'s plot repeats, when
+    smaller than the plot: a tiling's block (its central tile, the default sample rectangle),
+    or the period a mesh file carried; None otherwise (a layout file, one tile)."""
+    if layout.period is not None:
+        return layout.period
+    if layout.quantity == "tile" and len({p.tile for p in layout.placements}) >= 2:
+        return layout.centre_bounds
+    return None
 
 
 #: Columns of :func:`placements_array`.
@@ -334,9 +349,10 @@ def tiled_layout(bases: dict[int, tuple[float, float]], tile: tuple[int, int],
 #: Above this many overlapping pairs of cells, the warning gives their count only (the area
 #: counted twice would need every pair in memory).
 MAX_OVERLAP_PAIRS = 2_000_000
-#: Up to this many cells, overlaps are found among all pairs with numpy (half a million pairs
-#: at most); above, with a k-d tree.
-SMALL_FIELD = 1_000
+#: Up to this many cells, overlaps are found among all pairs with numpy (20,000 pairs at most);
+#: above, with a k-d tree (900 cells: 0.17 s for all pairs, 0.01 s with the tree; the layout
+#: editor checks a layout at every edit).
+SMALL_FIELD = 200
 
 
 def _overlaps(cells: np.ndarray) -> str:
@@ -462,6 +478,45 @@ def load_layout(path: str | Path, plants: set[int] | None = None) -> CanopyLayou
     return layout_from_dict(data, plants, str(path))
 
 
+def _field(data: dict, source: str) -> tuple[float, float, float, float]:
+    """A layout document's ``field`` {x0, y0, x1, y1} [cm], each side at least
+    :data:`MIN_LENGTH_CM`."""
+    coord = {"low": -MAX_COORD_CM, "high": MAX_COORD_CM}
+    fld = data.get("field")
+    if not isinstance(fld, dict):
+        raise LayoutError(f"{source}: 'field' must be an object {{x0, y0, x1, y1}} in cm")
+    x0, y0, x1, y1 = (_number(fld, k, f"{source}: field", **coord) for k in ("x0", "y0", "x1", "y1"))
+    if x1 <= x0 or y1 <= y0:
+        raise LayoutError(f"{source}: field must have x1 > x0 and y1 > y0")
+    if x1 - x0 < MIN_LENGTH_CM or y1 - y0 < MIN_LENGTH_CM:
+        raise LayoutError(f"{source}: field is {x1 - x0:g} x {y1 - y0:g} cm; each side must be "
+                          f"at least {MIN_LENGTH_CM:g} cm")
+    return x0, y0, x1, y1
+
+
+def _stand(pos, x: float, w: str, plants: set[int] | None,
+           rng: np.random.Generator) -> tuple[Placement, float]:
+    """One plant of a row at ``x`` [cm]: its placement (moved by its jitter, drawn from
+    ``rng``) and the y [cm] it was given at."""
+    coord = {"low": -MAX_COORD_CM, "high": MAX_COORD_CM}
+    if not isinstance(pos, dict):
+        raise LayoutError(f"{w} must be an object {{y, plant}}")
+    y = _number(pos, "y", w, **coord)
+    pid = _plant_id(pos, w, plants)
+    az = _number(pos, "azimuth_deg", w, default=0.0, low=-MAX_ANGLE_DEG,
+                 high=MAX_ANGLE_DEG, unit=" degrees")
+    jitter = _number(pos, "jitter_cm", w, default=0.0)
+    if not 0 <= jitter <= MAX_JITTER_CM:
+        raise LayoutError(f"{w}: 'jitter_cm' is {jitter:g} cm; it must be from 0 to "
+                          f"{MAX_JITTER_CM:g} cm (farther, the plant has another place: "
+                          "give that position)")
+    px, py = x, y
+    if jitter > 0:
+        r, t = jitter * np.sqrt(rng.random()), 2 * np.pi * rng.random()
+        px, py = x + r * np.cos(t), y + r * np.sin(t)
+    return Placement(pid, px, py, az, (0, 0)), y
+
+
 def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout") -> CanopyLayout:
     """Validate a layout document (already parsed JSON); see :func:`load_layout`.
 
@@ -483,15 +538,7 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
     ps = _number(data, "plant_spacing", source, positive=True, **length)
     north = _number(data, "north_deg", source, default=0.0, low=-MAX_ANGLE_DEG,
                     high=MAX_ANGLE_DEG, unit=" degrees")
-    fld = data.get("field")
-    if not isinstance(fld, dict):
-        raise LayoutError(f"{source}: 'field' must be an object {{x0, y0, x1, y1}} in cm")
-    x0, y0, x1, y1 = (_number(fld, k, f"{source}: field", **coord) for k in ("x0", "y0", "x1", "y1"))
-    if x1 <= x0 or y1 <= y0:
-        raise LayoutError(f"{source}: field must have x1 > x0 and y1 > y0")
-    if x1 - x0 < MIN_LENGTH_CM or y1 - y0 < MIN_LENGTH_CM:
-        raise LayoutError(f"{source}: field is {x1 - x0:g} x {y1 - y0:g} cm; each side must be "
-                          f"at least {MIN_LENGTH_CM:g} cm")
+    x0, y0, x1, y1 = _field(data, source)
     rows = data.get("rows")
     if not isinstance(rows, list) or not rows:
         raise LayoutError(f"{source}: 'rows' must be a non-empty list")
@@ -512,24 +559,10 @@ def layout_from_dict(data, plants: set[int] | None = None, source: str = "layout
             raise LayoutError(f"{where}: 'plants' must be a list")
         for j, pos in enumerate(plist):
             w = f"{where}.plants[{j}]"
-            if not isinstance(pos, dict):
-                raise LayoutError(f"{w} must be an object {{y, plant}}")
-            y = _number(pos, "y", w, **coord)
-            pid = _plant_id(pos, w, plants)
-            az = _number(pos, "azimuth_deg", w, default=0.0, low=-MAX_ANGLE_DEG,
-                         high=MAX_ANGLE_DEG, unit=" degrees")
-            jitter = _number(pos, "jitter_cm", w, default=0.0)
-            if not 0 <= jitter <= MAX_JITTER_CM:
-                raise LayoutError(f"{w}: 'jitter_cm' is {jitter:g} cm; it must be from 0 to "
-                                  f"{MAX_JITTER_CM:g} cm (farther, the plant has another place: "
-                                  "give that position)")
-            px, py = x, y
-            if jitter > 0:
-                r, t = jitter * np.sqrt(rng.random()), 2 * np.pi * rng.random()
-                px, py = x + r * np.cos(t), y + r * np.sin(t)
-            if not (x0 <= px <= x1 and y0 <= py <= y1):
-                outside.append(f"{w}: plant at ({px:.1f}, {py:.1f}) cm")
-            placements.append(Placement(pid, px, py, az, (0, 0)))
+            place, y = _stand(pos, x, w, plants, rng)
+            if not (x0 <= place.x <= x1 and y0 <= place.y <= y1):
+                outside.append(f"{w}: plant at ({place.x:.1f}, {place.y:.1f}) cm")
+            placements.append(place)
             cells.append(_cell(x, y, rs, ps))
     if not placements:
         raise LayoutError(f"{source}: no plant stands in the layout: every row's 'plants' "
@@ -602,7 +635,15 @@ def layout_for(leaves: list[Leaf], tile: tuple[int, int] = (1, 1), row_spacing: 
                plant_spacing: float = 30.0, block: tuple[int, int] | None = None,
                layout_file: str | Path | None = None) -> CanopyLayout:
     """Where the digitized plants of ``leaves`` stand: a layout file if given, else the
-    digitized block tiled ``tile`` times (the paper's 3 x 3)."""
+    digitized block tiled ``tile`` times (the paper's 3 x 3). ``leaves``: fitted leaves, or a
+    field's (:class:`~maizeviz.canopy.field.FieldLeaves`, which knows its plants' bases)."""
+    field_bases = getattr(leaves, "bases", None)
+    if field_bases is not None:
+        if not field_bases:
+            raise LayoutError("no leaf could be reconstructed; the canopy is empty")
+        if layout_file is not None:
+            return load_layout(layout_file, set(field_bases))
+        return tiled_layout(field_bases, tile, row_spacing, plant_spacing, block)
     plants = {lf.grid.plant for lf in leaves}
     if not plants:
         raise LayoutError("no leaf could be reconstructed; the canopy is empty")

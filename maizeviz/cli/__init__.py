@@ -15,6 +15,7 @@ import importlib
 import os
 import sys
 import traceback
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
@@ -29,7 +30,8 @@ __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_FAIL", "EXIT_USAGE", "EXIT_P
 COMMANDS = {"leaf": "maizeviz.cli.leaf", "canopy": "maizeviz.cli.canopy",
             "light": "maizeviz.cli.light", "sweep": "maizeviz.sweep.command",
             "record": "maizeviz.cli.record", "fastrak-sim": "maizeviz.cli.simulate",
-            "synth": "maizeviz.cli.synth", "import-phenomenal": "maizeviz.cli.phenomenal"}
+            "synth": "maizeviz.cli.synth", "import-phenomenal": "maizeviz.cli.phenomenal",
+            "convert": "maizeviz.cli.convert", "subplots": "maizeviz.cli.subplots"}
 #: Entry-point group under which the desktop app registers its ``run(argv) -> int``.
 GUI_GROUP = "maizeviz.gui"
 GUI_HINT = 'the desktop app is not installed: pip install "maizeviz[gui]"'
@@ -43,6 +45,9 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         description="Digitized maize plants: leaf surfaces, mesh complexity, canopies, light. "
                     "Without a subcommand, opens the desktop app.")
     parser.add_argument("--version", action="version", version=f"maizeviz {__version__}")
+    parser.add_argument("--info", action="store_true",
+                        help="print versions, the Embree library, the ray kernel in use and "
+                             "why, and threads (for bug reports), then exit")
     parser.add_argument("--debug", action="store_true", help="show tracebacks")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name, module in COMMANDS.items():
@@ -102,15 +107,27 @@ def _no_command(argv: list[str]) -> int:
     return main(["canopy", str(example_points()), "--tile", "3x3", "--levels"])
 
 
+def _say_warnings(message, category, filename, lineno, file=None, line=None) -> None:
+    """Python warnings (maizeviz's fallbacks, a library's deprecation) as one line each."""
+    say(f"warning: {message}")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     tokens = list(sys.argv[1:] if argv is None else argv)
     first = next((t for t in tokens if t != "--debug"), None)
+    if first == "--info":
+        from maizeviz.info import report
+
+        print(report())
+        return EXIT_OK
     if first not in COMMANDS and first not in ("-h", "--help", "--version"):
         return _no_command(tokens)                 # the app, with its own options
     args = build_parser(first if first in COMMANDS else None).parse_args(tokens)
     debug = args.debug or bool(os.environ.get("MAIZEVIZ_DEBUG"))
     try:
-        return int(args.run(args))
+        with warnings.catch_warnings():
+            warnings.showwarning = _say_warnings
+            return int(args.run(args))
     except MaizevizError as exc:
         say(error_line(exc))
         return EXIT_FAIL
@@ -119,7 +136,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 130
     except BrokenPipeError:
         return EXIT_OK
-    except Exception as exc:  # a bug: say so in one line unless asked for the traceback
+    except Exception as exc:  # noqa: BLE001 - a bug: one line unless asked for the traceback
         if debug:
             traceback.print_exc()
         else:

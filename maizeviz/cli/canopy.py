@@ -7,6 +7,7 @@ import json
 import time
 
 from maizeviz.canopy.export import export_canopy
+from maizeviz.canopy.field import canopy_of
 from maizeviz.canopy.layout import CanopyLayout, save_layout
 from maizeviz.canopy.measures import (
     TABLE2_COLUMNS,
@@ -15,7 +16,7 @@ from maizeviz.canopy.measures import (
     measure_canopy,
     table2_row,
 )
-from maizeviz.canopy.scene import Canopy, build_canopy
+from maizeviz.canopy.scene import Canopy
 from maizeviz.cli.common import (
     NUMBER_ARG,
     Progress,
@@ -80,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
             variants.append(False)                     # the paper's splitting, widths untouched
         for preserve in variants:
             t0 = time.perf_counter()
-            canopy = build_canopy(leaves, layout, level, preserve, Progress(f"building {level}"))
+            canopy = canopy_of(leaves, layout, level, preserve, Progress(f"building {level}"))
             runs.append(_measured(args, canopy, level.variant_label(preserve), t0, preserve))
     _report(args, runs, layout)
     return leaves_summary(len(leaves), skipped)

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import time
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -74,16 +76,30 @@ def fmt_table(headers: Sequence[str], rows: Sequence[Sequence[object]]) -> str:
     return "\n".join(lines)
 
 
+#: Seconds a piece of work runs before its progress is written to a log (not a terminal).
+QUIET_SECONDS = 5.0
+
+
 class Progress:
-    """A progress callback for the core: a bar on stderr when it is a terminal, else silent."""
+    """A progress callback for the core: a bar on stderr when it is a terminal; otherwise (a
+    log, a batch job) a line each tenth of work that has run for :data:`QUIET_SECONDS`."""
 
     def __init__(self, label: str):
         self.label = label
         self.tty = sys.stderr.isatty()
         self.last = -1
+        self.start = time.monotonic()
 
     def __call__(self, done: int, total: int) -> bool | None:
-        if not self.tty or total <= 0:
+        if total <= 0:
+            return None
+        if not self.tty:
+            tenth = int(10 * done / total)
+            if tenth > self.last and time.monotonic() - self.start >= QUIET_SECONDS:
+                self.last = tenth
+                sys.stderr.write(f"{self.label}: {100 * done / total:.0f}% "
+                                 f"({time.monotonic() - self.start:.0f} s)\n")
+                sys.stderr.flush()
             return None
         pct = int(100 * done / total)
         if pct != self.last:
@@ -130,7 +146,7 @@ def levels_from(args: argparse.Namespace, default_k: int = 4) -> list[Level]:
 
 
 def add_canopy_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("points", help="points CSV of the digitized plants (field coordinates, cm), "
+    p.add_argument("points", help="points file of the digitized plants (CSV or Parquet; field coordinates, cm), "
                                   "a .maizeviz project (its points and its layout), or a mesh "
                                   "file (.ply, .obj) with a plant and leaf id per face")
     p.add_argument("--tile", metavar="AxB",
@@ -177,7 +193,21 @@ def check_canopy_costs(leaves: list[Leaf], layout: CanopyLayout, levels: list[Le
 
 def load_leaves(path: str, strict: bool = False, degree: int = 3, method: str = "chord",
                 progress: ProgressCallback | None = None) -> tuple[list[Leaf], list[LeafError]]:
-    """Read, grid and fit a points file, saying skipped lines and repairs on stderr."""
+    """Read, grid and fit a points file, saying skipped lines and repairs on stderr. A field
+    (:func:`maizeviz.canopy.field.field_input`: a large Parquet file) is surveyed instead,
+    its leaves fitted when a canopy is built (:class:`~maizeviz.canopy.field.FieldLeaves`)."""
+    if degree == 3 and method == "chord":
+        from maizeviz.canopy.field import field_input, read_field
+
+        if field_input(path):
+            field = read_field(path, strict, progress or Progress("reading the field"),
+                               workers=os.cpu_count() or 1)
+            if field is not None:
+                for note in field.notes:
+                    say(f"note: {note}")
+                say(f"note: {path}: a field of {len(field.bases):,} plants and {len(field):,} "
+                    "leaves, read plant by plant")
+                return field, field.skipped  # type: ignore[return-value]
     found = read_leaves(path, strict, degree, method, progress)
     for problem in found.problems:
         say(f"warning: {problem}")

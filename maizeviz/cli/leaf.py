@@ -45,7 +45,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         NAME, help="fit NURBS surfaces through digitized leaves and mesh them",
         description="Fit a NURBS surface through every leaf of a points file and mesh it at "
                     "the chosen complexity. Areas in cm2, lengths in cm.")
-    p.add_argument("points", help="points CSV (plant,leaf,row,col,x,y,z in cm)")
+    p.add_argument("points", help="points file, CSV or Parquet (plant,leaf,row,col,x,y,z in cm)")
     add_level_options(p, DEFAULT_LEVELS)
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.add_argument("--export", metavar="PATH",

@@ -12,13 +12,15 @@ import json
 import math
 import os
 import time
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
+from maizeviz.canopy.export import export_canopy
+from maizeviz.canopy.field import canopy_of
 from maizeviz.canopy.from_mesh import MESH_LEVEL
-from maizeviz.canopy.scene import Canopy, build_canopy
+from maizeviz.canopy.scene import Canopy
 from maizeviz.cli.common import (
     NUMBER_ARG,
     WHOLE_ARG,
@@ -27,6 +29,7 @@ from maizeviz.cli.common import (
     add_level_options,
     canopy_setup,
     check_canopy_costs,
+    check_export,
     check_input_options,
     floats,
     fmt_table,
@@ -46,6 +49,7 @@ from maizeviz.leaf.fit import Leaf
 from maizeviz.light.engine import LightEngine
 from maizeviz.light.report.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping
 from maizeviz.light.report.heatmap import map_stems, save_figure, write_heatmaps
+from maizeviz.light.report.mesh_export import light_cells
 from maizeviz.light.report.tables import write_steps
 from maizeviz.light.results.absorbed import AbsorbedLight
 from maizeviz.light.results.assimilation import assimilate
@@ -114,9 +118,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     per.add_argument("--to", metavar="HH:MM", help="end of the period on --date")
     per.add_argument("--step", type=NUMBER_ARG, default=None, metavar="MIN",
                      help="time step, minutes (default 30)")
-    per.add_argument("--weather", metavar="CSV",
-                     help="irradiance from a weather file (time with zone, ghi W/m2, optional "
-                          "dni, dhi) instead of the clear sky; the file sets the period")
+    per.add_argument("--weather", metavar="FILE",
+                     help="irradiance from a weather file instead of the clear sky: maizeviz's "
+                          "CSV (time with zone, ghi W/m2, optional dni, dhi, par umol/m2/s, "
+                          "temp_air), an EPW, TMY3 or NSRDB PSM3/PSM4 file; the file sets the "
+                          "period (and, EPW/TMY3/PSM, the time zone and the place)")
     per.add_argument("--linke-turbidity", type=NUMBER_ARG, default=None, metavar="T",
                      help=f"Linke turbidity of the clear sky (default {DEFAULT_LINKE_TURBIDITY:g})")
     per.add_argument("--altitude", type=NUMBER_ARG, default=0.0, metavar="M",
@@ -149,6 +155,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--leaf-light", metavar="CSV",
                    help="write the light intercepted by every lit leaf")
     p.add_argument("--plant-light", metavar="CSV", help="the same summed per plant")
+    p.add_argument("--export", metavar="PATH",
+                   help="write the canopy mesh of one level with each triangle's light (its "
+                        "leaf's, as --leaf-light): .vtu .vtp .vtk .ply .obj .stl")
     ab = p.add_argument_group(
         "absorbed light with scattering (any of these turns it on; needs a sun)")
     ab.add_argument("--band", choices=BANDS, default=None,
@@ -260,8 +269,9 @@ def _check_options(args: argparse.Namespace) -> None:
                                     "--day, --from, --to or --step with --weather")
             if args.linke_turbidity is not None:
                 raise MaizevizError("--linke-turbidity is for the clear sky, not for --weather")
-            if args.lat is None or args.lon is None:
-                raise MaizevizError("a weather file needs the place: give --lat and --lon")
+            if (args.lat is None) != (args.lon is None):
+                raise MaizevizError("give both --lat and --lon (or neither, with a weather file "
+                                    "whose header gives the place: EPW, TMY3, PSM)")
         else:
             if args.date is None or args.lat is None or args.lon is None:
                 raise MaizevizError(f"{what} needs --date, --lat and --lon (and --tz)")
@@ -312,7 +322,15 @@ def period_from(args: argparse.Namespace) -> Period | None:
     par = DEFAULT_PAR_UMOL_PER_J if args.par_factor is None else args.par_factor
     if args.weather:
         weather = read_weather(args.weather, tz=args.tz)
-        return weather_period(weather, args.lat, args.lon, args.altitude, par)
+        lat, lon = args.lat, args.lon
+        if lat is None:
+            lat, lon = weather.place.get("latitude"), weather.place.get("longitude")
+            if lat is None or lon is None:
+                raise MaizevizError("a weather CSV file needs the place: give --lat and --lon",
+                                    quantity="weather")
+            say(f"place: latitude {lat:g}, longitude {lon:g} (the header of "
+                f"{os.path.basename(args.weather)})")
+        return weather_period(weather, lat, lon, args.altitude, par)
     linke = DEFAULT_LINKE_TURBIDITY if args.linke_turbidity is None else args.linke_turbidity
     return clear_sky_period(args.date, args.lat, args.lon, args.tz or "UTC",
                             30.0 if args.step is None else args.step, args.from_, args.to,
@@ -328,41 +346,95 @@ def sky_from(args: argparse.Namespace, period: Period | None) -> Sky | None:
 
 
 # ------------------------------------------------------------------------------ run
+@dataclass
+class _Job:
+    """What one ``maizeviz light`` run traces on every level: its options read and checked
+    once, and the warnings already said (each is said once for all levels)."""
+
+    args: argparse.Namespace
+    sun: Sun | None
+    heights: tuple[float, ...]
+    rect: tuple[float, ...] | None
+    period: Period | None
+    sky: Sky | None
+    optics: Any
+    leaf_model: LeafModel | None
+    temp_c: float
+    want_rows: bool
+    n_levels: int
+    said: set[str] = field(default_factory=set)
+
+
+@dataclass
+class _Level:
+    """One level's canopy, engine and outputs as its handlers fill them."""
+
+    canopy: Canopy
+    label: str
+    engine: LightEngine
+    rec: dict[str, Any]
+    warnings: list[str] = field(default_factory=list)
+    tables: list[list[dict]] = field(default_factory=list)
+    plant_extra: dict[int, dict[str, float]] = field(default_factory=dict)
+    res: LightResult | None = None
+    sky_res: SkyLight | None = None
+    per_res: PeriodLight | None = None
+    ab: AbsorbedLight | None = None
+
+
 def run(args: argparse.Namespace) -> int:
+    """``maizeviz light``: the options read once, then each level traced by one handler per
+    light asked for (sun, sky or period, absorbed light over a sun or a period) over the
+    level's :class:`LightEngine`, and the tables or JSON written."""
     _check_options(args)
     check_input_options(args)
     mesh = is_mesh(args.points)
     levels = levels_from(args)
     labels = [MESH_LEVEL] if mesh else [level.label for level in levels]
+    check_export(args.export, [] if mesh else levels)
+    job = _job(args, labels)
+    if mesh:
+        t0 = time.perf_counter()
+        mesh_canopy = mesh_setup(args)
+        read_s = time.perf_counter() - t0
+        leaves: list[Leaf] = []
+        skipped: list[LeafError] = []
+        layout = mesh_canopy.layout
+    else:
+        leaves, skipped, layout = canopy_setup(args)
+    work = _costs(job, layout)
+    if mesh:
+        check([[mesh_cost(mesh_canopy.n_triangles), *work]], args.force)
+    else:
+        check_canopy_costs(leaves, layout, levels, args.force, work)
+    records: list[dict[str, Any]] = []
+    for level in [None] if mesh else levels:
+        t0 = time.perf_counter()
+        if level is None:
+            canopy, canopy_s = mesh_canopy, read_s
+        else:
+            canopy = canopy_of(leaves, layout, level, args.preserve_area,
+                               Progress(f"building {level}"))
+            canopy_s = time.perf_counter() - t0
+        records.append(_trace_level(job, canopy, canopy_s))
+    if args.json:
+        print(json.dumps(_jsonable(records[0] if len(records) == 1 else {"levels": records}),
+                         indent=1))
+    else:
+        _print_tables(records, job.sun, job.heights, args)
+    return leaves_summary(mesh_canopy.n_leaves if mesh else len(leaves), skipped)
+
+
+def _job(args: argparse.Namespace, labels: list[str]) -> _Job:
+    """The run's options read and checked (in the order their errors are said), and what
+    it traces announced."""
     sun = sun_from(args)
     heights = tuple(floats(args.heights, "heights", "heights"))
-    absorbed_optics = None
-    if _absorbed_asked(args):
-        if sun is None and not _period_asked(args):
-            raise MaizevizError("absorbed light with scattering needs a sun or a period: "
-                                "give --sun-zenith/--sun-azimuth, --date, --time, --lat, "
-                                "--lon, or --day", quantity="band")
-        if sun is None and (args.irradiance is not None or args.diffuse):
-            raise MaizevizError("over a period the irradiance is the period's (clear sky or "
-                                "weather file): --irradiance and --diffuse are for one sun",
-                                quantity="irradiance")
-        absorbed_optics = optics_for(args.band or "par", args.reflectance, args.transmittance,
-                                     args.ground_reflectance)
+    optics = _absorbed_optics(args, sun)
     leaf_model_ = _leaf_model_from(args)
     temp_c = 25.0 if args.temperature is None else args.temperature
-    if absorbed_optics is not None:
-        if args.optics_table is not None:
-            absorbed_optics = replace(absorbed_optics, ranks=read_optics_table(
-                args.optics_table, absorbed_optics.band))
-        if args.irradiance is not None:
-            check_range(args.irradiance, "the direct irradiance (W/m2)", 0, 5000, "irradiance")
-        check_range(args.diffuse, "the diffuse irradiance (W/m2)", 0, 5000, "irradiance")
-        args.depth = DEFAULT_DEPTH if args.depth is None else args.depth
-        args.seed = 0 if args.seed is None else args.seed
-        check_range(args.depth, "the scattering depth", 0, 10_000, "depth", whole=True)
-        check_range(args.seed, "the random seed", 0, 2**32 - 1, "seed", whole=True)
-        if args.precision is not None:
-            check_precision(args.precision)
+    if optics is not None:
+        optics = _checked_scattering(args, optics)
     rect = tuple(floats(args.rect, "the sample rectangle", "rect", 4)) if args.rect else None
     if not args.heatmap_bin > 0:
         raise MaizevizError(f"the heatmap bin must be > 0 cm, got {args.heatmap_bin}",
@@ -370,6 +442,48 @@ def run(args: argparse.Namespace) -> int:
     _check_paths(args, labels, sun is not None, heights)
     period = period_from(args)
     sky = sky_from(args, period)
+    _announce(args, sun, sky, period)
+    return _Job(args, sun, heights, rect, period, sky, optics, leaf_model_, temp_c,
+                bool(args.leaf_light or args.plant_light), len(labels))
+
+
+def _absorbed_optics(args: argparse.Namespace, sun: Sun | None):
+    """The band's optics when absorbed light is asked for (else None), refusing it without a
+    sun or a period, or with an irradiance over a period."""
+    if not _absorbed_asked(args):
+        return None
+    if sun is None and not _period_asked(args):
+        raise MaizevizError("absorbed light with scattering needs a sun or a period: "
+                            "give --sun-zenith/--sun-azimuth, --date, --time, --lat, "
+                            "--lon, or --day", quantity="band")
+    if sun is None and (args.irradiance is not None or args.diffuse):
+        raise MaizevizError("over a period the irradiance is the period's (clear sky or "
+                            "weather file): --irradiance and --diffuse are for one sun",
+                            quantity="irradiance")
+    return optics_for(args.band or "par", args.reflectance, args.transmittance,
+                      args.ground_reflectance)
+
+
+def _checked_scattering(args: argparse.Namespace, optics):
+    """The optics with the ranks of ``--optics-table``; the irradiance, depth, seed and
+    precision checked (depth and seed given their defaults in ``args``)."""
+    if args.optics_table is not None:
+        optics = replace(optics, ranks=read_optics_table(args.optics_table, optics.band))
+    if args.irradiance is not None:
+        check_range(args.irradiance, "the direct irradiance (W/m2)", 0, 5000, "irradiance")
+    check_range(args.diffuse, "the diffuse irradiance (W/m2)", 0, 5000, "irradiance")
+    args.depth = DEFAULT_DEPTH if args.depth is None else args.depth
+    args.seed = 0 if args.seed is None else args.seed
+    check_range(args.depth, "the scattering depth", 0, 10_000, "depth", whole=True)
+    check_range(args.seed, "the random seed", 0, 2**32 - 1, "seed", whole=True)
+    if args.precision is not None:
+        check_precision(args.precision)
+    return optics
+
+
+def _announce(args: argparse.Namespace, sun: Sun | None, sky: Sky | None,
+              period: Period | None) -> None:
+    """One line each for the sun, the sky and the period about to be traced."""
     if sun is not None:
         say(f"sun: zenith {sun.zenith_deg:.2f} deg, azimuth {sun.azimuth_deg:.2f} deg"
             + (f" ({sun.when})" if sun.when else ""))
@@ -382,164 +496,180 @@ def run(args: argparse.Namespace) -> int:
     if period is not None:
         say(f"period: {period.start.isoformat()} to {period.end.isoformat()}, "
             f"{period.n_steps} steps with the sun up; {period.source}")
-    if mesh:
-        t0 = time.perf_counter()
-        mesh_canopy = mesh_setup(args)
-        read_s = time.perf_counter() - t0
-        leaves: list[Leaf] = []
-        skipped: list[LeafError] = []
-        layout = mesh_canopy.layout
-    else:
-        leaves, skipped, layout = canopy_setup(args)
-    sampled = rect or layout.centre_bounds
-    directions = (sun is not None) + (sky.n if sky is not None else 0) + \
-        (period.n_steps if period is not None else 0)
-    maps = (sun is not None) + (sky is not None) + (period is not None) if args.heatmaps else 0
-    work = light_costs(sampled, args.density, len(heights), directions, maps,  # type: ignore[arg-type]
-                       args.heatmap_bin)
-    if mesh:
-        check([[mesh_cost(mesh_canopy.n_triangles), *work]], args.force)
-    else:
-        check_canopy_costs(leaves, layout, levels, args.force, work)
-    want_rows = bool(args.leaf_light or args.plant_light)
-    records: list[dict[str, Any]] = []
-    said: set[str] = set()
-    for level in [None] if mesh else levels:
-        t0 = time.perf_counter()
-        if level is None:
-            canopy, canopy_s = mesh_canopy, read_s
-        else:
-            canopy = build_canopy(leaves, layout, level, args.preserve_area,
-                                  Progress(f"building {level}"))
-            canopy_s = time.perf_counter() - t0
-        label = canopy.level
-        sampling = Sampling(heights, args.density, rect, args.periodic, args.threads)  # type: ignore[arg-type]
-        engine = LightEngine(canopy, sampling, with_stalks=args.with_stalks)
-        engine.scene()
-        scene_s = engine.build_seconds[args.periodic]
-        rec: dict[str, Any] = {"level": label, "triangles": canopy.n_triangles,
-                               "heights_cm": [float(h) for h in heights],
-                               "periodic": args.periodic, "threads": args.threads,
-                               "seconds": {"canopy": canopy_s, "scene": scene_s}}
-        warnings: list[str] = []
-        tables: list[list[dict]] = []
-        plant_extra: dict[int, dict[str, float]] = {}
-        res = sky_res = per_res = None
-        if sun is not None:
-            res = engine.sun(sun, classes=want_rows or len(labels) == 1,
-                             progress=Progress(f"tracing {label}"))
-            warnings += res.warnings
-            rec.update(_sun_record(res, sun, canopy, args, heights))
-            rec["seconds"].update(trace=res.seconds["trace"],
-                                  second_hits=res.seconds.get("second", 0.0))
-            if want_rows:
-                tables.append(res.leaf_rows(canopy))
-        if period is not None:
-            per_res = engine.day(period, sky=PEREZ if args.sky == PEREZ else sky,
-                                 directions=sky.n if sky is not None else 46,
-                                 bin_cm=args.heatmap_bin,
-                                 progress=Progress(f"tracing the period, {label}"))
-            sky_res = per_res.sky
-            warnings += per_res.warnings
-            rec["seconds"]["period"] = per_res.seconds["trace"]
-        elif sky is not None:
-            sky_res = engine.sky(sky, progress=Progress(f"tracing the sky, {label}"),
-                                 bin_cm=args.heatmap_bin)
-            warnings += sky_res.warnings
-            rec["seconds"]["sky"] = sky_res.seconds["trace"]
-        if sky_res is not None:
-            rec["diffuse"] = _sky_record(sky_res, canopy, args, heights)
-            if args.sky == PEREZ:
-                rec["diffuse"]["part"] = "isotropic part of the Perez sky"
 
-            if want_rows:
-                tables.append(sky_res.leaf_rows(canopy))
-        elif sky is not None and period is not None:
-            rec["diffuse"] = None                   # the sun never rose: no sky traced
-        if per_res is not None:
-            rec["period"] = _period_record(per_res, args)
-            if want_rows:
-                tables.append(per_res.leaf_rows(canopy))
-        for w in warnings:
-            if w not in said:
-                said.add(w)
-                say(f"{'note' if w in (period.notes if period else ()) else 'warning'}: {w}")
-        rec["warnings"] = list(dict.fromkeys(warnings))
-        if absorbed_optics is not None and sun is None and period is not None:
-            def trace_day(density: float, engine=engine, label=label):
-                d = engine.absorbed_day(period, optics=absorbed_optics,
-                                        sky=args.sky or "soc",
-                                        directions=args.sky_directions or 46,
-                                        depth=args.depth, seed=args.seed,
-                                        photosynthesis=leaf_model_, temperature_c=temp_c,
-                                        density=density,
-                                        progress=Progress(f"absorbed light over the period, "
-                                                          f"{label}"))
-                if d.assimilation is not None:
-                    return (d, d.assimilation.canopy_gross_mol_m2,
-                            d.assimilation.canopy_gross_error_mol_m2 or 0.0)
-                return d, d.balance.absorbed_leaves, d.absorbed_leaves_error or 0.0
 
-            abd = _traced(trace_day, args, rec, said)
-            _warn_unresolved(abd.balance, abd.depth, rec, said)
-            rec["balance"] = dict(abd.balance.as_dict(), units="MJ/m2 of ground")
-            rec["balance_se"] = abd.balance_errors
-            rec["absorbed"] = _absorbed_period_record(abd)
-            if abd.assimilation is not None:
-                rec["photosynthesis"] = abd.assimilation.as_dict()
-                if want_rows:
-                    tables.append(_assimilation_rows(canopy, abd.assimilation))
-                    _merge(plant_extra, _plant_errors(canopy, abd.assimilation))
-            if want_rows:
-                tables.append(_assimilation_rows(canopy, abd))
-                _merge(plant_extra, _plant_errors(canopy, abd))
-            rec["seconds"]["scatter"] = abd.seconds.get("trace", 0.0) + \
-                abd.seconds.get("scatter", 0.0)
-        elif absorbed_optics is not None:
-            def trace_sun(density: float, engine=engine, canopy=canopy):
-                a = engine.absorbed(sun, optics=absorbed_optics, direct_w_m2=args.irradiance,
-                                    diffuse_w_m2=args.diffuse, sky=args.sky or "soc",
-                                    directions=args.sky_directions or 46, depth=args.depth,
-                                    seed=args.seed, density=density)
-                if leaf_model_ is not None:
-                    g = assimilate(canopy, a, leaf_model_, temp_c)
-                    return a, g.canopy_gross_umol_m2_s, g.canopy_gross_error_umol_m2_s or 0.0
-                return a, a.balance.absorbed_leaves, a.absorbed_leaves_error or 0.0
+def _costs(job: _Job, layout) -> list:
+    """What tracing costs per level (the rays and maps of every direction)."""
+    sampled = job.rect or layout.centre_bounds
+    directions = (job.sun is not None) + (job.sky.n if job.sky is not None else 0) + \
+        (job.period.n_steps if job.period is not None else 0)
+    maps = (job.sun is not None) + (job.sky is not None) + (job.period is not None) \
+        if job.args.heatmaps else 0
+    return light_costs(sampled, job.args.density, len(job.heights), directions, maps,  # type: ignore[arg-type]
+                       job.args.heatmap_bin)
 
-            ab = _traced(trace_sun, args, rec, said)
-            _warn_unresolved(ab.balance, ab.depth, rec, said)
-            rec["balance"] = ab.balance.as_dict()
-            rec["balance_se"] = ab.balance_errors
-            rec["absorbed"] = _absorbed_record(ab, canopy)
-            rec["seconds"]["scatter"] = ab.seconds["trace"] + ab.seconds["scatter"]
-            if want_rows:
-                tables.append(ab.leaf_rows(canopy))
-                _merge(plant_extra, _plant_errors(canopy, ab))
-            if leaf_model_ is not None:
-                asm = assimilate(canopy, ab, leaf_model_, temp_c)
-                rec["photosynthesis"] = asm.as_dict()
-                for w in asm.warnings:
-                    if w not in said:
-                        said.add(w)
-                        say(f"warning: {w}")
-                if want_rows:
-                    tables.append(_assimilation_rows(canopy, asm))
-                    _merge(plant_extra, _plant_errors(canopy, asm))
-        if sun is None:
-            rays = per_res.rays if per_res else sky_res.rays if sky_res else 0
-            x0, y0, x1, y1 = per_res.rect if per_res else sky_res.rect if sky_res else (0, 0, 1, 1)
-            rec.update(sun=None, transmission=None, rays=rays, rect_cm=[x0, y0, x1, y1],
-                       density_per_cm2=rays / ((x1 - x0) * (y1 - y0)))
-        _write_outputs(args, canopy, label, len(labels), res, sky_res, per_res, tables,
-                       plant_extra)
-        records.append(rec)
 
-    if args.json:
-        print(json.dumps(_jsonable(records[0] if len(records) == 1 else {"levels": records}),
-                         indent=1))
-    else:
-        _print_tables(records, sun, heights, args)
-    return leaves_summary(mesh_canopy.n_leaves if mesh else len(leaves), skipped)
+def _trace_level(job: _Job, canopy: Canopy, canopy_s: float) -> dict[str, Any]:
+    """One level: its engine, then each light asked for, its outputs written; its record."""
+    args = job.args
+    sampling = Sampling(job.heights, args.density, job.rect, args.periodic, args.threads)  # type: ignore[arg-type]
+    engine = LightEngine(canopy, sampling, with_stalks=args.with_stalks)
+    engine.scene()
+    rec: dict[str, Any] = {"level": canopy.level, "triangles": canopy.n_triangles,
+                           "heights_cm": [float(h) for h in job.heights],
+                           "periodic": args.periodic, "threads": args.threads,
+                           "kernel": "packets" if engine.scene().packets else "embreex",
+                           "seconds": {"canopy": canopy_s,
+                                       "scene": engine.build_seconds[args.periodic]}}
+    lv = _Level(canopy, canopy.level, engine, rec)
+    if job.sun is not None:
+        _trace_sun(job, lv)
+    _trace_diffuse(job, lv)
+    _say_once(job, lv.warnings, job.period.notes if job.period else ())
+    rec["warnings"] = list(dict.fromkeys(lv.warnings))
+    if job.optics is not None and job.sun is None and job.period is not None:
+        _trace_absorbed_period(job, lv)
+    elif job.optics is not None:
+        _trace_absorbed_sun(job, lv)
+    if job.sun is None:
+        _without_sun(lv)
+    _write_outputs(args, canopy, lv.label, job.n_levels, lv.res, lv.sky_res, lv.per_res,
+                   lv.tables, lv.plant_extra)
+    if args.export:
+        path = export_canopy(args.export, canopy,
+                             light_cells(canopy, lv.res, lv.sky_res, lv.per_res, lv.ab))
+        say(f"wrote {canopy.n_triangles:,} leaf triangles of {canopy.n_plants} plants with "
+            f"their light (and their stalks) to {path}")
+    return rec
+
+
+def _trace_sun(job: _Job, lv: _Level) -> None:
+    """The sun: transmission by height and, for the tables, its hit classes."""
+    assert job.sun is not None
+    res = lv.engine.sun(job.sun, classes=job.want_rows or job.n_levels == 1
+                        or bool(job.args.export),
+                        progress=Progress(f"tracing {lv.label}"))
+    lv.res = res
+    lv.warnings += res.warnings
+    lv.rec.update(_sun_record(res, job.sun, lv.canopy, job.args, job.heights))
+    lv.rec["seconds"].update(trace=res.seconds["trace"],
+                             second_hits=res.seconds.get("second", 0.0))
+    if job.want_rows:
+        lv.tables.append(res.leaf_rows(lv.canopy))
+
+
+def _trace_diffuse(job: _Job, lv: _Level) -> None:
+    """The period (its suns and its sky) or the sky alone, and their records."""
+    args, sky, period = job.args, job.sky, job.period
+    if period is not None:
+        lv.per_res = lv.engine.day(period, sky=PEREZ if args.sky == PEREZ else sky,
+                                   directions=sky.n if sky is not None else 46,
+                                   bin_cm=args.heatmap_bin,
+                                   progress=Progress(f"tracing the period, {lv.label}"))
+        lv.sky_res = lv.per_res.sky
+        lv.warnings += lv.per_res.warnings
+        lv.rec["seconds"]["period"] = lv.per_res.seconds["trace"]
+    elif sky is not None:
+        lv.sky_res = lv.engine.sky(sky, progress=Progress(f"tracing the sky, {lv.label}"),
+                                   bin_cm=args.heatmap_bin)
+        lv.warnings += lv.sky_res.warnings
+        lv.rec["seconds"]["sky"] = lv.sky_res.seconds["trace"]
+    if lv.sky_res is not None:
+        lv.rec["diffuse"] = _sky_record(lv.sky_res, lv.canopy, args, job.heights)
+        if args.sky == PEREZ:
+            lv.rec["diffuse"]["part"] = "isotropic part of the Perez sky"
+        if job.want_rows:
+            lv.tables.append(lv.sky_res.leaf_rows(lv.canopy))
+    elif sky is not None and period is not None:
+        lv.rec["diffuse"] = None                   # the sun never rose: no sky traced
+    if lv.per_res is not None:
+        lv.rec["period"] = _period_record(lv.per_res, args)
+        if job.want_rows:
+            lv.tables.append(lv.per_res.leaf_rows(lv.canopy))
+
+
+def _say_once(job: _Job, warnings: list[str], notes=()) -> None:
+    """Each warning (a period's note as a note) said once in the run."""
+    for w in warnings:
+        if w not in job.said:
+            job.said.add(w)
+            say(f"{'note' if w in notes else 'warning'}: {w}")
+
+
+def _trace_absorbed_period(job: _Job, lv: _Level) -> None:
+    """Absorbed light over the period (and the leaves' assimilation), at ``--precision``."""
+    args = job.args
+
+    def trace_day(density: float):
+        d = lv.engine.absorbed_day(job.period, optics=job.optics, sky=args.sky or "soc",
+                                   directions=args.sky_directions or 46, depth=args.depth,
+                                   seed=args.seed, photosynthesis=job.leaf_model,
+                                   temperature_c=job.temp_c, density=density,
+                                   progress=Progress(f"absorbed light over the period, "
+                                                     f"{lv.label}"))
+        if d.assimilation is not None:
+            return (d, d.assimilation.canopy_gross_mol_m2,
+                    d.assimilation.canopy_gross_error_mol_m2 or 0.0)
+        return d, d.balance.absorbed_leaves, d.absorbed_leaves_error or 0.0
+
+    abd = _traced(trace_day, args, lv.rec, job.said)
+    _warn_unresolved(abd.balance, abd.depth, lv.rec, job.said)
+    lv.rec["balance"] = dict(abd.balance.as_dict(), units="MJ/m2 of ground")
+    lv.rec["balance_se"] = abd.balance_errors
+    lv.rec["absorbed"] = _absorbed_period_record(abd)
+    if abd.assimilation is not None:
+        lv.rec["photosynthesis"] = abd.assimilation.as_dict()
+        if job.want_rows:
+            lv.tables.append(_assimilation_rows(lv.canopy, abd.assimilation))
+            _merge(lv.plant_extra, _plant_errors(lv.canopy, abd.assimilation))
+    if job.want_rows:
+        lv.tables.append(_assimilation_rows(lv.canopy, abd))
+        _merge(lv.plant_extra, _plant_errors(lv.canopy, abd))
+    lv.rec["seconds"]["scatter"] = abd.seconds.get("trace", 0.0) + \
+        abd.seconds.get("scatter", 0.0)
+
+
+def _trace_absorbed_sun(job: _Job, lv: _Level) -> None:
+    """Absorbed light under the sun (and a sky), and the leaves' assimilation, at
+    ``--precision``."""
+    args = job.args
+
+    def trace_sun(density: float):
+        a = lv.engine.absorbed(job.sun, optics=job.optics, direct_w_m2=args.irradiance,
+                               diffuse_w_m2=args.diffuse, sky=args.sky or "soc",
+                               directions=args.sky_directions or 46, depth=args.depth,
+                               seed=args.seed, density=density)
+        if job.leaf_model is not None:
+            g = assimilate(lv.canopy, a, job.leaf_model, job.temp_c)
+            return a, g.canopy_gross_umol_m2_s, g.canopy_gross_error_umol_m2_s or 0.0
+        return a, a.balance.absorbed_leaves, a.absorbed_leaves_error or 0.0
+
+    ab = lv.ab = _traced(trace_sun, args, lv.rec, job.said)
+    _warn_unresolved(ab.balance, ab.depth, lv.rec, job.said)
+    lv.rec["balance"] = ab.balance.as_dict()
+    lv.rec["balance_se"] = ab.balance_errors
+    lv.rec["absorbed"] = _absorbed_record(ab, lv.canopy)
+    lv.rec["seconds"]["scatter"] = ab.seconds["trace"] + ab.seconds["scatter"]
+    if job.want_rows:
+        lv.tables.append(ab.leaf_rows(lv.canopy))
+        _merge(lv.plant_extra, _plant_errors(lv.canopy, ab))
+    if job.leaf_model is not None:
+        asm = assimilate(lv.canopy, ab, job.leaf_model, job.temp_c)
+        lv.rec["photosynthesis"] = asm.as_dict()
+        _say_once(job, list(asm.warnings))
+        if job.want_rows:
+            lv.tables.append(_assimilation_rows(lv.canopy, asm))
+            _merge(lv.plant_extra, _plant_errors(lv.canopy, asm))
+
+
+def _without_sun(lv: _Level) -> None:
+    """A record without a sun still says its rays, rectangle and density (the sky's or the
+    period's)."""
+    res = lv.per_res or lv.sky_res
+    rays = res.rays if res else 0
+    x0, y0, x1, y1 = res.rect if res else (0, 0, 1, 1)
+    lv.rec.update(sun=None, transmission=None, rays=rays, rect_cm=[x0, y0, x1, y1],
+                  density_per_cm2=rays / ((x1 - x0) * (y1 - y0)))
 
 
 # ------------------------------------------------------------------------------ records
@@ -734,7 +864,7 @@ def _check_paths(args: argparse.Namespace, labels: list[str], sun: bool,
     """Refuse, before any work, outputs (every per-level file and every file of the heatmap
     and plot folders) that would overwrite an input or each other."""
     period = _period_asked(args)
-    tables = [("the leaf light table", args.leaf_light),
+    tables = [("the mesh export", args.export), ("the leaf light table", args.leaf_light),
               ("the plant light table", args.plant_light),
               ("the time-step table", args.steps if period else None)]
     kinds = [kind for kind, asked in (("sun", sun), ("sky", args.sky is not None or period),

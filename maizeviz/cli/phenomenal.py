@@ -22,7 +22,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                     "gzip-compressed, mm) as a points file (cm): each leaf's midrib and "
                     "surface voxels become cross-sections of 5 points.")
     p.add_argument("file", help="Phenomenal plant, .json or .json.gz")
-    p.add_argument("--out", required=True, help="points CSV to write")
+    p.add_argument("--out", required=True,
+                   help="points file to write: CSV, or Parquet if it ends in .parquet or .pq")
     p.add_argument("--plant", type=WHOLE_ARG, default=1, help="plant id to give it (default 1)")
     p.add_argument("--at", metavar="X,Y", help="move the stalk base to x,y (cm)")
     p.set_defaults(run=run)

@@ -13,6 +13,7 @@ from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import DEFAULT_COLS, Session
 from maizeviz.errors import MaizevizError, check_range
 from maizeviz.io.outputs import check_run_paths
+from maizeviz.io.points import is_parquet_name
 
 #: The subcommand.
 NAME = "record"
@@ -24,7 +25,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description="Record stylus presses from a FASTRAK as points of plants, leaves and "
                     "cross-sections. Every point is on disk (fsync) before it is reported. "
                     "Controls, one per line on standard input: n next leaf, p next plant, "
-                    "r end the row early (tip), u undo the last point, q finish.")
+                    "r end the row early (tip), u undo the last point, s pause or resume "
+                    "(presses while paused are said and not recorded), q finish.")
     p.add_argument("--port", required=True, help="serial port, e.g. /dev/ttyUSB0")
     p.add_argument("--out", required=True, help="points CSV to append to")
     p.add_argument("--cols", type=WHOLE_ARG, default=None,
@@ -42,6 +44,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     check_range(args.answer_timeout, "the answer timeout", 0.01, 600, "answer_timeout", unit="s")
     check_range(args.baud, "the baud rate", 300, 4_000_000, "baud", whole=True)
+    if is_parquet_name(args.out):
+        raise MaizevizError(f"{args.out}: a recording is a CSV journal, written point by point; "
+                            "record to a .csv file (maizeviz convert then writes it as Parquet)")
     check_run_paths([], [("the serial port", args.port)], appended=[("the recording", args.out)])
     session = Session(args.out, args.cols, args.resume, args.reference_station)
     for message in session.messages:
@@ -74,14 +79,15 @@ def run(args: argparse.Namespace) -> int:
     if sys.stdin is not None and not sys.stdin.closed:
         threading.Thread(target=read_stdin, daemon=True, name="controls").start()
     old = signal.signal(signal.SIGTERM, lambda signum, _frame: recorder.signal(signum))
-    print(f"ready on {args.port}: press the stylus; controls n, p, r, u, q + Enter", flush=True)
+    print(f"ready on {args.port}: press the stylus; controls n, p, r, u, s, q + Enter", flush=True)
     code = EXIT_OK
     try:
         while not recorder.finished:
             for update in recorder.poll(timeout=0.5):
                 if update.kind in ("lost", "failed"):
                     say(f"error: {update.message}")
-                elif update.kind in ("recorded", "refused", "control", "said"):
+                elif update.kind in ("recorded", "refused", "control", "said", "paused",
+                                     "resumed", "ignored"):
                     print(update.message, flush=True)
                 code = update.code or code
     except KeyboardInterrupt:

@@ -35,6 +35,9 @@ from maizeviz.errors import MaizevizError
 #: signal (SIGTERM) received.
 UpdateKind = Literal["recorded", "refused", "garbled", "control", "said", "paused", "resumed",
                      "ignored", "finished", "lost", "failed", "signal"]
+#: The control that pauses or resumes recording (the technician's other controls are the
+#: session's: :data:`maizeviz.digitizer.session.CONTROLS`).
+PAUSE_KEY = "s"
 #: Kinds after which the recorder handles nothing more.
 FINAL_KINDS = ("finished", "lost", "failed", "signal")
 
@@ -106,7 +109,8 @@ class Recorder:
 
     # thread-safe producers -------------------------------------------------------------
     def control(self, key: str) -> None:
-        """Queue a technician's control (n, p, r, u, q), from any thread."""
+        """Queue a technician's control (n, p, r, u, q; s pauses or resumes), from any
+        thread."""
         self.events.put(("control", key))
 
     def say(self, message: str) -> None:
@@ -162,6 +166,8 @@ class Recorder:
             key = str(value)
             if not key.strip():
                 return None
+            if key.strip().lower() == PAUSE_KEY:
+                return self._pause(not self.paused)
             msg = self.session.control(key)
             if msg == "quit":
                 return Update("finished", "finished")

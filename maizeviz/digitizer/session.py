@@ -332,7 +332,7 @@ class Session:
                                f"10000, got {cols}", quantity="cols")
         self.path = Path(path)
         # None while resuming: the recording's own, known once it is replayed (_width)
-        self.cols: int = DEFAULT_COLS if cols is None and not resume else cols  # type: ignore
+        self.cols: int = DEFAULT_COLS if cols is None and not resume else cols  # type: ignore[assignment]
         self.reference_station = reference_station
         self.pos = start or Position()
         self.count = Counters()
@@ -678,7 +678,8 @@ class Session:
         """
         key = key.strip().lower()
         if key not in CONTROLS:
-            return f"unknown control '{key[:20]}': n next leaf, p next plant, r end row, u undo, q quit"
+            return (f"unknown control '{key[:20]}': n next leaf, p next plant, r end row, u undo, "
+                    "s pause or resume, q quit")
         action = CONTROLS[key]
         p = self.pos
         if action == "quit":

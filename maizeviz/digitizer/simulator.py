@@ -253,6 +253,35 @@ class FastrakSimulator:
             self._write(bytes(self.rng.integers(0x80, 0x100, 40, dtype=np.uint8)) + b"\r\n")
             return
         c, args = cmd[0], cmd[1:].rstrip("\r")
+        if self._switch(c):
+            return
+        if c == "S":
+            self._write(self._status(min(self.active) if self.active else 1))
+        elif c == "W":
+            self._reset()
+        elif c == "\x19":
+            self._reset()
+            time.sleep(0.05)
+        elif c in "Bb":
+            pass
+        elif c == "O":
+            self._output_list(cmd, args)
+        elif c == "l":
+            self._station(cmd, args)
+        elif c == "e":
+            parts = args.split(",")
+            if len(parts) > 1 and parts[1] in ("0", "1"):
+                self.point_mode = parts[1] == "1"
+            else:
+                self._write(self._error(cmd.strip(), -1))
+        elif c in WITH_PARAMS:
+            pass
+        else:
+            self._write(self._error(repr(cmd), -99))
+
+    def _switch(self, c: str) -> bool:
+        """The one-letter commands that switch a mode (or ask for a point); whether ``c``
+        was one of them (a format or unit command the unit ignores is not)."""
         if c == "P":
             self._emit_all()
         elif c == "C":
@@ -268,48 +297,36 @@ class FastrakSimulator:
             self.centimetres = False
         elif c == "u" and not self.ignore_units:
             self.centimetres = True
-        elif c == "S":
-            self._write(self._status(min(self.active) if self.active else 1))
-        elif c == "W":
-            self._reset()
-        elif c == "\x19":
-            self._reset()
-            time.sleep(0.05)
-        elif c in "Bb":
-            pass
-        elif c == "O":
-            parts = args.split(",")
-            try:
-                st = int(parts[0])
-                items = tuple(int(p) for p in parts[1:] if p != "")
-            except ValueError:
-                self._write(self._error(cmd.strip(), -2))
-                return
-            if not 1 <= st <= 4 or any(i not in ITEMS for i in items):
-                self._write(self._error(cmd.strip(), -3))
-                return
-            self.items[st] = items
-        elif c == "l":
-            parts = args.split(",")
-            try:
-                st = int(parts[0])
-            except ValueError:
-                self._write(self._error(cmd.strip(), -2))
-                return
-            if len(parts) > 1 and parts[1] != "":
-                (self.active.add if parts[1] == "1" else self.active.discard)(st)
-            else:
-                self._write(f"2{st}l{int(st in self.active)}\r\n".encode())
-        elif c == "e":
-            parts = args.split(",")
-            if len(parts) > 1 and parts[1] in ("0", "1"):
-                self.point_mode = parts[1] == "1"
-            else:
-                self._write(self._error(cmd.strip(), -1))
-        elif c in WITH_PARAMS:
-            pass
         else:
-            self._write(self._error(repr(cmd), -99))
+            return False
+        return True
+
+    def _output_list(self, cmd: str, args: str) -> None:
+        """``O station,items``: the items a station reports (errors -2 and -3 as the unit)."""
+        parts = args.split(",")
+        try:
+            st = int(parts[0])
+            items = tuple(int(p) for p in parts[1:] if p != "")
+        except ValueError:
+            self._write(self._error(cmd.strip(), -2))
+            return
+        if not 1 <= st <= 4 or any(i not in ITEMS for i in items):
+            self._write(self._error(cmd.strip(), -3))
+            return
+        self.items[st] = items
+
+    def _station(self, cmd: str, args: str) -> None:
+        """``l station[,state]``: turn a station on or off, or report its state."""
+        parts = args.split(",")
+        try:
+            st = int(parts[0])
+        except ValueError:
+            self._write(self._error(cmd.strip(), -2))
+            return
+        if len(parts) > 1 and parts[1] != "":
+            (self.active.add if parts[1] == "1" else self.active.discard)(st)
+        else:
+            self._write(f"2{st}l{int(st in self.active)}\r\n".encode())
 
     def _reset(self):
         self.binary = False

@@ -24,10 +24,31 @@ from typing import IO, Any
 from maizeviz.errors import MaizevizError
 
 
-def _umask_mode() -> int:
-    mask = os.umask(0)
+def read_umask() -> int:
+    """The process's umask, without a moment where it is 0.
+
+    Linux tells it in /proc/self/status; elsewhere ``os.umask`` can only read it by setting
+    it, so it is set to 0o077 for that instant: a file another thread creates meanwhile is
+    private, never world-writable (setting 0, as before, gave such a file mode 0o666).
+    """
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    mask = os.umask(0o077)
     os.umask(mask)
-    return 0o666 & ~mask
+    return mask
+
+
+#: The umask, read once when maizeviz.io.atomic is imported (before any thread of maizeviz
+#: writes): never set again while files are written.
+UMASK = read_umask()
+#: Mode of the files written here: what ``open`` would give a new file under :data:`UMASK`
+#: (0o644 under the usual 0o022; mkstemp's temporary file is 0o600).
+FILE_MODE = 0o666 & ~UMASK
 
 
 def _fsync_folder(folder: Path) -> None:
@@ -68,11 +89,15 @@ def make_folder(path: str | Path) -> Path:
 def check_output(path: str | Path) -> Path:
     """Refuse, before any work, an output whose folder is missing or that is a folder."""
     path = Path(path)
-    if path.is_dir():
+    try:
+        is_dir, folder_there = path.is_dir(), path.parent.is_dir()
+    except (OSError, ValueError) as exc:       # a name too long, a NUL: not a lookup failure
+        why = getattr(exc, "strerror", None) or str(exc)
+        raise MaizevizError(f"{path}: cannot be looked up ({why})") from None
+    if is_dir:
         raise MaizevizError(f"{path} is a folder; give a file name")
-    folder = path.parent
-    if not folder.is_dir():
-        raise MaizevizError(f"{path}: the folder {folder} does not exist")
+    if not folder_there:
+        raise MaizevizError(f"{path}: the folder {path.parent} does not exist")
     return path
 
 
@@ -146,7 +171,7 @@ def atomic_path(path: str | Path) -> Iterator[Path]:
     os.close(fd)
     tmp = Path(tmp_name)
     try:
-        os.chmod(tmp, _umask_mode())
+        os.chmod(tmp, FILE_MODE)
         yield tmp
         with open(tmp, "rb+") as fh:
             os.fsync(fh.fileno())

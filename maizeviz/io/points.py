@@ -76,6 +76,9 @@ MAX_BAD_LEAVES = 100_000
 _BINARY_SNIFF = 4096
 #: Bytes read at a time; blocks of plain numeric lines are parsed by numpy in one go.
 BLOCK_BYTES = 1 << 20
+#: Files at least this large read their numeric blocks through pyarrow (whose import costs
+#: about what numpy takes to parse 4 MB).
+COLUMNAR_BYTES = 4 << 20
 #: What a block of plain numeric lines may hold, besides its delimiter.
 _NUMERIC = b"0123456789+-.eE \r\n"
 
@@ -299,6 +302,7 @@ class LineParser:
         self.carry_start = 0
         self.torn: tuple[int, str] | None = None  # (line number, text) of a cut-off last line
         self.journal = False
+        self.columnar = False                     # blocks through pyarrow (_numbers)
 
     # ------------------------------------------------------------------ header
     def _set_header(self, lineno: int, text: str) -> None:
@@ -343,16 +347,10 @@ class LineParser:
         # a quoted field may run over line ends, except in a recording: the recorder never
         # writes one, and a torn line's open quote must not swallow the lines after it
         if self.carry or (text.count('"') % 2 and terminated and not self.journal):
-            if not self.carry:
-                self.carry_start = lineno
-            self.carry += text
-            if len(self.carry) > MAX_LINE_BYTES:
-                raise PointsFileError(
-                    f"{self.source}: line {self.carry_start}: a quoted field runs over more "
-                    f"than {MAX_LINE_BYTES:,} bytes; not a readable CSV file of points")
-            if self.carry.count('"') % 2 and terminated:
+            joined = self._carried(lineno, text, terminated)
+            if joined is None:
                 return                              # the quoted field goes on
-            text, lineno, self.carry = self.carry, self.carry_start, ""
+            lineno, text = joined
         if not terminated:
             self.torn = (lineno, text)
         if self.header is None:
@@ -383,6 +381,22 @@ class LineParser:
             self._note(outcome[1])                  # a repair mark cut short: wait for the next
         else:
             self._settle(outcome)
+
+    def _carried(self, lineno: int, text: str, terminated: bool) -> tuple[int, str] | None:
+        """Add a line to a quoted field running over line ends: the whole record (its first
+        line's number and text) once the field closes, else None."""
+        if not self.carry:
+            self.carry_start = lineno
+        self.carry += text
+        if len(self.carry) > MAX_LINE_BYTES:
+            raise PointsFileError(
+                f"{self.source}: line {self.carry_start}: a quoted field runs over more "
+                f"than {MAX_LINE_BYTES:,} bytes; not a readable CSV file of points")
+        if self.carry.count('"') % 2 and terminated:
+            return None
+        joined = (self.carry_start, self.carry)
+        self.carry = ""
+        return joined
 
     def _settle(self, outcome) -> None:
         """Commit the line before, then hold this one until the next line is seen."""
@@ -487,7 +501,7 @@ class LineParser:
         kind = outcome[0]
         if kind == "point":
             plant, leaf, row, col, coords, extras = outcome[1]
-            if len(self.lines) >= self.max_points:
+            if self.points >= self.max_points:
                 raise PointsFileError(
                     f"{self.source}: line {outcome[2]}: more than {self.max_points:,} points; "
                     "that many would take over "
@@ -513,7 +527,7 @@ class LineParser:
             elif len(msgs) == 5:
                 msgs.append("more lines like these")
         elif kind == "undo":
-            self.undone.append((outcome[1], len(self.lines)))
+            self.undone.append((outcome[1], self.points))
 
     # ------------------------------------------------------------------ blocks
     def feed_block(self, block: bytes, lineno: int) -> int:
@@ -546,37 +560,40 @@ class LineParser:
         """Parse a block of plain numeric lines with numpy; returns the lines taken (0: the
         block is not plain, read it line by line)."""
         delim = self.delimiter.encode()
-        if block.translate(None, _NUMERIC + delim) or block.count(b"\r") != block.count(b"\r\n"):
+        if block.translate(None, _NUMERIC + delim) or \
+                (b"\r" in block and block.count(b"\r") != block.count(b"\r\n")):
             return 0                                   # quotes, words, nan, blanks in lines...
         ends = np.flatnonzero(np.frombuffer(block, np.uint8) == 10)
         n = len(ends) + (0 if block.endswith(b"\n") else 1)
         lengths = np.diff(np.concatenate([[-1], ends, [len(block) - 1]]))[:n]
         if not n or lengths.max() > MAX_LINE_BYTES + 1 or lineno + n > self.max_lines:
             return 0                                   # the line-by-line checks say why
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("error")
-                values = np.loadtxt(io.BytesIO(block), delimiter=self.delimiter, comments=None,
-                                    dtype=np.float64, ndmin=2, encoding="latin-1")
-        except (ValueError, Warning):
+        values = _numbers(block, self.delimiter, len(REQUIRED), self.columnar)
+        if values is None or len(values[0]) != n or \
+                not all(np.isfinite(c).all() for c in values):
             return 0
-        if values.shape != (n, len(REQUIRED)) or not np.isfinite(values).all():
+        limits = ((MAX_ID, -MAX_ID), (MAX_ID, -MAX_ID), (MAX_INDEX, 0), (MAX_INDEX, 0))
+        for k, (high, low) in zip(self.index[:4], limits):
+            c = values[k]
+            if not (np.all(c == np.floor(c)) and c.max() <= high and c.min() >= low):
+                return 0
+        ids = np.column_stack([values[k] for k in self.index[:4]]).astype(np.int64)
+        xyz = np.column_stack([values[k] for k in self.index[4:]])
+        if self.points + n > self.max_points:
             return 0
-        ids = values[:, self.index[:4]]
-        xyz = values[:, self.index[4:]]
-        limit = np.array([MAX_ID, MAX_ID, MAX_INDEX, MAX_INDEX], dtype=np.float64)
-        low = np.array([-MAX_ID, -MAX_ID, 0, 0], dtype=np.float64)
-        if not (np.all(ids == np.floor(ids)) and np.all(ids <= limit) and np.all(ids >= low)):
-            return 0
-        if len(self.lines) + n > self.max_points:
-            return 0
-        self.ids.frombytes(ids.astype(np.int64).tobytes())
-        self.xyz.frombytes(np.ascontiguousarray(xyz).tobytes())
-        self.lines.frombytes(np.arange(lineno + 1, lineno + n + 1, dtype=np.int64).tobytes())
+        # appended in place (an array grows by a share of its size: no copy of the whole)
+        self.ids.frombytes(_bytes_of(np.ascontiguousarray(ids, dtype=np.int64)))
+        self.xyz.frombytes(_bytes_of(np.ascontiguousarray(xyz)))
+        self.lines.frombytes(_bytes_of(np.arange(lineno + 1, lineno + n + 1, dtype=np.int64)))
         self.data_lines += n
         if not block.endswith(b"\n"):
             self.torn = (lineno + n, "")
         return n
+
+    @property
+    def points(self) -> int:
+        """Points kept so far."""
+        return len(self.lines)
 
     # ------------------------------------------------------------------ result
     def finish(self) -> PointsTable:
@@ -611,6 +628,53 @@ class LineParser:
             raise PointsFileError(f"{self.source}: header only, no points")
         return PointsTable(ids=ids, xyz=xyz, line=lines, extra=extra, problems=self.problems,
                            bad_leaves=self.bad_leaves, source=self.source)
+
+
+def _bytes_of(a: np.ndarray) -> memoryview:
+    """The bytes of a C-contiguous array, without a copy."""
+    return a.data.cast("B")
+
+
+def _numbers(block: bytes, delimiter: str, columns: int, columnar: bool
+             ) -> list[np.ndarray] | None:
+    """The numbers of a block of plain numeric lines, one (lines,) float64 array per column, or
+    None where the block does not parse as such (a line with another number of fields, a
+    field that is not a number); blank lines are left out (the caller counts lines and finds
+    them missing).
+
+    ``columnar``: through pyarrow's CSV reader (C++, on its own threads), which reads a number
+    as Python's ``float`` does (both round correctly; both refuse ``1e``, ``.``, ``1.2.3``) and
+    an empty field as NaN; otherwise (or without pyarrow) numpy's ``loadtxt``, about 15 times
+    slower but without pyarrow's 0.3 s import.
+    """
+    try:
+        if not columnar:
+            raise ImportError
+        import pyarrow as pa
+        import pyarrow.csv as pacsv
+    except ImportError:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                values = np.loadtxt(io.BytesIO(block), delimiter=delimiter, comments=None,
+                                    dtype=np.float64, ndmin=2, encoding="latin-1")
+        except (ValueError, Warning):
+            return None
+        if values.shape[1] != columns:
+            return None
+        return [values[:, k] for k in range(columns)]
+    names = [str(i) for i in range(columns)]
+    try:
+        table = pacsv.read_csv(
+            pa.py_buffer(block),
+            read_options=pacsv.ReadOptions(column_names=names, block_size=1 << 18),
+            parse_options=pacsv.ParseOptions(delimiter=delimiter, quote_char=False,
+                                             double_quote=False),
+            convert_options=pacsv.ConvertOptions(
+                column_types=dict.fromkeys(names, pa.float64()), quoted_strings_can_be_null=False))
+    except (pa.ArrowInvalid, pa.ArrowTypeError, ValueError):
+        return None
+    return [table.column(k).to_numpy(zero_copy_only=False) for k in range(columns)]
 
 
 def shown(text: str, limit: int = 30) -> str:
@@ -651,7 +715,8 @@ def _parse_stream(lines, source: str, max_points: int, max_lines: int) -> Points
 
 def read_points(path: str | Path, max_points: int = MAX_POINTS,
                 max_lines: int = MAX_LINES) -> PointsTable:
-    """Read a points CSV file, streaming (memory follows the points kept).
+    """Read a points CSV file, streaming (memory follows the points kept), or a Parquet
+    points file (:mod:`maizeviz.io.parquet`: taken by its content, whatever its name).
 
     Blocks of plain numeric lines (no status or extra column, no quote, no blank line, every
     value a number and every id in range) are parsed by numpy in one go; any other block goes
@@ -668,11 +733,16 @@ def read_points(path: str | Path, max_points: int = MAX_POINTS,
     source = str(path)
     fh, size = open_regular(path)
     with fh:
+        if fh.peek(4)[:4] == b"PAR1":
+            from maizeviz.io.parquet import read_points_parquet
+
+            return read_points_parquet(path, max_points, max_lines)
         try:
             zeros = zero_tail(fh, size)
             check_not_only_zeros(source, size, zeros)
             refuse_binary(fh, source, size - zeros)
             parser = LineParser(source, max_points, max_lines)
+            parser.columnar = size >= COLUMNAR_BYTES
             lineno = 0
             for block in file_blocks(fh, limit=size - zeros):
                 lineno = parser.feed_block(block, lineno)
@@ -696,13 +766,19 @@ def parse_points(text: str, source: str = "<memory>", max_points: int = MAX_POIN
 
 def write_points(path: str | Path, grids, decimals: int = 3) -> None:
     """Write point grids in the points format (one line per point, tip rows written once),
-    atomically.
+    atomically: CSV, or Parquet where ``path`` ends in ``.parquet`` or ``.pq``
+    (:func:`maizeviz.io.parquet.write_points_parquet`, the same numbers).
 
     Parameters
     ----------
     grids : iterable of leaf grids (``plant``, ``leaf``, ``points`` (m, n, 3) cm,
         ``tip_collapsed``), e.g. :class:`maizeviz.leaf.grid.LeafGrid`
     """
+    if is_parquet_name(path):
+        from maizeviz.io.parquet import write_points_parquet
+
+        write_points_parquet(path, grids, decimals)
+        return
     with atomic_open(path, "w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(REQUIRED)
@@ -713,3 +789,12 @@ def write_points(path: str | Path, grids, decimals: int = 3) -> None:
                     row = row[:1]
                 for c, p in enumerate(row):
                     writer.writerow([g.plant, g.leaf, r, c, *(f"{v:.{decimals}f}" for v in p)])
+
+
+#: Names of points files written as Parquet.
+PARQUET_SUFFIXES = (".parquet", ".pq")
+
+
+def is_parquet_name(path: str | Path) -> bool:
+    """Whether a points file to write at ``path`` is a Parquet file (by its name)."""
+    return Path(path).suffix.lower() in PARQUET_SUFFIXES

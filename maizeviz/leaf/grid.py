@@ -72,7 +72,11 @@ class LeafGrid:
 def stalk_base(grids) -> tuple[float, float]:
     """(x, y) cm of a plant's stalk base: the median of its leaves' collar points seen from
     above (``grids``: the plant's LeafGrids, at least one)."""
-    collars = np.array([g.collar[:2] for g in grids])
+    return base_of_collars(np.array([g.collar[:2] for g in grids]))
+
+
+def base_of_collars(collars: np.ndarray) -> tuple[float, float]:
+    """(x, y) cm: the median of collar points (k, 2) cm seen from above (:func:`stalk_base`)."""
     return float(np.median(collars[:, 0])), float(np.median(collars[:, 1]))
 
 
@@ -91,6 +95,40 @@ def _merge_duplicates(points: np.ndarray) -> np.ndarray:
     step = np.linalg.norm(np.diff(points, axis=0), axis=1)
     keep = np.concatenate([[True], step > DUPLICATE_TOL_CM])
     return points[keep]
+
+
+def _check_coordinates(pts: np.ndarray, r: int, colids, fail) -> None:
+    """Refuse (through ``fail``) a row's first coordinate that is not a number or lies beyond
+    :data:`MAX_ABS_COORD_CM` [cm], naming its row and col."""
+    bad = ~np.isfinite(pts)
+    if bad.any():
+        k = int(np.argwhere(bad.any(axis=1))[0, 0])
+        fail(f"row {r}, col {colids[k]}: coordinate is {pts[k][bad[k]][0]} (not a number)")
+    huge = np.abs(pts) > MAX_ABS_COORD_CM
+    if huge.any():
+        k = int(np.argwhere(huge.any(axis=1))[0, 0])
+        fail(f"row {r}, col {colids[k]}: coordinate {pts[k][huge[k]][0]:g} cm is beyond "
+             f"{MAX_ABS_COORD_CM:g} cm; not a digitized point")
+
+
+def _columns(kept_rows: list[int], counts: list[int], fail) -> int:
+    """The columns of the leaf's grid: the most common point count of its rows of more than
+    one point (the larger on a tie); refused (through ``fail``) where a row other than the
+    tip is a single point, or there are fewer than 2 rows or 2 columns."""
+    for r, c in zip(kept_rows, counts):
+        if c == 1 and (r != kept_rows[-1] or len(counts) == 1):
+            where = "at the collar" if r == kept_rows[0] else "in the middle of the leaf"
+            fail(f"row {r}: a single point {where}; only the tip row may collapse to one point")
+    regular = [c for c in counts if c > 1]
+    if len(counts) < 2:
+        fail(f"only {len(counts)} row; a leaf needs at least 2 cross-sections")
+    if not regular:
+        fail("every row is a single point; a leaf needs at least 2 points across")
+    tally = Counter(regular)
+    n = max(tally, key=lambda c: (tally[c], c))
+    if n < 2:  # pragma: no cover - regular rows have > 1 point by construction
+        fail("fewer than 2 columns")
+    return n
 
 
 def grid_from_rows(plant: int, leaf: int, rows: dict[int, np.ndarray],
@@ -127,16 +165,7 @@ def grid_from_rows(plant: int, leaf: int, rows: dict[int, np.ndarray],
     cleaned = []
     for r in indices:
         pts = np.asarray(rows[r], dtype=np.float64).reshape(-1, 3)
-        colids = cols[r] if cols is not None else np.arange(len(pts))
-        bad = ~np.isfinite(pts)
-        if bad.any():
-            k = int(np.argwhere(bad.any(axis=1))[0, 0])
-            fail(f"row {r}, col {colids[k]}: coordinate is {pts[k][bad[k]][0]} (not a number)")
-        huge = np.abs(pts) > MAX_ABS_COORD_CM
-        if huge.any():
-            k = int(np.argwhere(huge.any(axis=1))[0, 0])
-            fail(f"row {r}, col {colids[k]}: coordinate {pts[k][huge[k]][0]:g} cm is beyond "
-                 f"{MAX_ABS_COORD_CM:g} cm; not a digitized point")
+        _check_coordinates(pts, r, cols[r] if cols is not None else np.arange(len(pts)), fail)
         merged = _merge_duplicates(pts)
         if len(merged) < len(pts):
             notes.append(f"row {r}: merged {len(pts) - len(merged)} duplicate point(s)")
@@ -153,21 +182,8 @@ def grid_from_rows(plant: int, leaf: int, rows: dict[int, np.ndarray],
         kept.append(pts)
 
     counts = [len(p) for p in kept]
-    single = [r for r, c in zip(kept_rows, counts) if c == 1]
     tip_collapsed = counts[-1] == 1 and len(kept) > 1
-    for r in single:
-        if r != kept_rows[-1] or len(kept) == 1:
-            where = "at the collar" if r == kept_rows[0] else "in the middle of the leaf"
-            fail(f"row {r}: a single point {where}; only the tip row may collapse to one point")
-    regular = [c for c in counts if c > 1]
-    if len(kept) < 2:
-        fail(f"only {len(kept)} row; a leaf needs at least 2 cross-sections")
-    if not regular:
-        fail("every row is a single point; a leaf needs at least 2 points across")
-    tally = Counter(regular)
-    n = max(tally, key=lambda c: (tally[c], c))
-    if n < 2:  # pragma: no cover - regular rows have > 1 point by construction
-        fail("fewer than 2 columns")
+    n = _columns(kept_rows, counts, fail)
 
     # resample ragged rows at the mean arc-length fractions of the regular ones
     reg = [p for p in kept if len(p) == n]

@@ -11,15 +11,37 @@ a canopy's 1,500 leaves are fitted with a few dozen numpy calls, not 1,500 Pytho
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from maizeviz.errors import LeafError
 
+#: Above this many comparisons, :func:`count_at_most` searches leaf by leaf.
+BROADCAST_MOST = 1 << 22
 
-def basis_matrix(x: np.ndarray, knots: np.ndarray, degree: int) -> np.ndarray:
-    """Dense B-spline basis values (The NURBS Book A2.2, vectorised over leaves and points).
+
+def count_at_most(sorted_rows: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """How many values of each row of ``sorted_rows`` (L, K), increasing, are at most each
+    ``x`` (L, A): ``searchsorted(side="right")`` row by row, as (L, A) int64.
+
+    A batch of small rows is compared at once, (L, A, K) booleans; past
+    :data:`BROADCAST_MOST` of them (a leaf of 10,000 cross-sections sampled at K = 8 made 4.5
+    GB of them) each row is searched by itself.
+    """
+    nbatch, na = x.shape
+    if nbatch == 1:
+        return np.searchsorted(sorted_rows[0], x[0], side="right")[None].astype(np.int64)
+    if nbatch * na * sorted_rows.shape[1] <= BROADCAST_MOST:
+        return (x[:, :, None] >= sorted_rows[:, None, :]).sum(axis=2)
+    return np.stack([np.searchsorted(k, xi, side="right")
+                     for k, xi in zip(sorted_rows, x)]).astype(np.int64)
+
+
+def basis_values(x: np.ndarray, knots: np.ndarray, degree: int
+                 ) -> tuple[np.ndarray, np.ndarray, int]:
+    """The non-zero B-spline basis values (The NURBS Book A2.2, vectorised over leaves and
+    points): each point has ``degree + 1`` of them, on consecutive control points.
 
     Parameters
     ----------
@@ -29,15 +51,14 @@ def basis_matrix(x: np.ndarray, knots: np.ndarray, degree: int) -> np.ndarray:
 
     Returns
     -------
-    (L, A, K - degree - 1) float64; rows sum to 1.
+    values : (L, A, degree + 1) float64, summing to 1 over the last axis
+    first : (L, A) int64, the control point of ``values[..., 0]``
+    n_control : K - degree - 1
     """
     x = np.asarray(x, dtype=np.float64)
     nbatch, npts = x.shape
     nctrl = knots.shape[1] - degree - 1
-    if nbatch == 1:
-        span = np.searchsorted(knots[0], x[0], side="right")[None] - 1
-    else:
-        span = (x[:, :, None] >= knots[:, None, :]).sum(axis=2) - 1
+    span = count_at_most(knots, x) - 1
     np.maximum(span, degree, out=span)
     np.minimum(span, nctrl - 1, out=span)                         # (L, A); x = 1 -> last span
     li = np.arange(nbatch)[:, None, None]
@@ -55,11 +76,70 @@ def basis_matrix(x: np.ndarray, knots: np.ndarray, degree: int) -> np.ndarray:
             saved = left[j - r] * temp
         new.append(saved)
         vals = new
+    return np.stack(vals, axis=2), (span - degree).astype(np.int64), nctrl
+
+
+def basis_matrix(x: np.ndarray, knots: np.ndarray, degree: int) -> np.ndarray:
+    """Dense B-spline basis values (:func:`basis_values` spread over every control point).
+
+    Parameters
+    ----------
+    x : (L, A) float64 in [0, 1]
+    knots : (L, K) float64, clamped
+    degree : int
+
+    Returns
+    -------
+    (L, A, K - degree - 1) float64; rows sum to 1.
+    """
+    vals, first, nctrl = basis_values(x, knots, degree)
+    nbatch, npts = first.shape
     out = np.zeros((nbatch, npts, nctrl))
-    first = np.arange(nbatch * npts).reshape(nbatch, npts) * nctrl + span - degree
+    at = np.arange(nbatch * npts).reshape(nbatch, npts) * nctrl + first
     flat = out.reshape(-1)
     for r in range(degree + 1):
-        flat[first + r] = vals[r]
+        flat[at + r] = vals[:, :, r]
+    return out
+
+
+#: From this many control points in a direction, the surface is fitted and evaluated through
+#: its banded basis (``degree + 1`` values a point) rather than dense matrices, whose memory
+#: grows with its square and solve with its cube: a leaf of 10,000 cross-sections took
+#: 45 s and 3.9 GB, then 6.7 GiB more to sample at K = 4. Below it the dense path, one numpy
+#: call for a batch of leaves, is the faster.
+BANDED_FROM = 64
+
+
+def _contract(values: np.ndarray, first: np.ndarray, data: np.ndarray) -> np.ndarray:
+    """Sum over one control-point axis with a banded basis: (L, A, p + 1), (L, A) and data
+    (L, N, ...) -> (L, A, ...), ``out[l, a] = sum_r values[l, a, r] data[l, first[l, a] + r]``."""
+    li = np.arange(len(first))[:, None]
+    shape = values.shape[:2] + (1,) * (data.ndim - 2)
+    out = values[:, :, 0].reshape(shape) * data[li, first]
+    for r in range(1, values.shape[2]):
+        out += values[:, :, r].reshape(shape) * data[li, first + r]
+    return out
+
+
+def _solve_collocation(params: np.ndarray, knots: np.ndarray, degree: int,
+                       rhs: np.ndarray) -> np.ndarray:
+    """Control points through the data: solve N c = rhs for each leaf, N the (n, n)
+    collocation matrix of ``params`` (L, n); rhs (L, n, k). Banded past :data:`BANDED_FROM`
+    (LAPACK's banded LU, O(n) memory), else dense."""
+    n = params.shape[1]
+    if n < BANDED_FROM:
+        return np.linalg.solve(basis_matrix(params, knots, degree), rhs)
+    from scipy.linalg import solve_banded
+
+    vals, first, _ = basis_values(params, knots, degree)
+    out = np.empty_like(rhs)
+    rows = np.arange(n)
+    for k in range(len(params)):
+        band = np.zeros((2 * degree + 1, n))           # upper and lower bandwidth: degree
+        for r in range(degree + 1):
+            col = first[k] + r
+            band[degree + rows - col, col] = vals[k, :, r]
+        out[k] = solve_banded((degree, degree), band, rhs[k])
     return out
 
 
@@ -155,14 +235,50 @@ class NurbsSurfaces:
     weights: np.ndarray
     params_u: np.ndarray
     params_v: np.ndarray
+    #: (batch, index) of a surface taken from a batch by :meth:`__getitem__`, for :meth:`join`
+    _origin: tuple[NurbsSurfaces, int] | None = field(default=None, compare=False, repr=False)
 
     def __len__(self) -> int:
         return len(self.control)
 
     def __getitem__(self, i) -> NurbsSurfaces:
+        """Surface ``i`` (an int: a batch of one whose arrays are views of this batch's, and
+        which :meth:`join` puts back together without a copy), or the surfaces ``i`` picks (a
+        slice, indices, a mask: copies)."""
+        if isinstance(i, (int, np.integer)):
+            k = range(len(self))[i]
+            one = slice(k, k + 1)
+            origin = (self, k) if self._origin is None else (self._origin[0],
+                                                              self._origin[1] + k)
+            return NurbsSurfaces(self.degree_u, self.degree_v, self.knots_u[one],
+                                 self.knots_v[one], self.control[one], self.weights[one],
+                                 self.params_u[one], self.params_v[one], origin)
         i = np.atleast_1d(np.arange(len(self))[i])
         return NurbsSurfaces(self.degree_u, self.degree_v, self.knots_u[i], self.knots_v[i],
                              self.control[i], self.weights[i], self.params_u[i], self.params_v[i])
+
+    @classmethod
+    def join(cls, surfaces: list[NurbsSurfaces]) -> NurbsSurfaces:
+        """One batch of ``surfaces`` (equal degrees and shapes), in order: the batch they were
+        taken from, sliced, where they are consecutive surfaces of one batch (leaves fitted
+        together and meshed together), else their arrays concatenated."""
+        if len(surfaces) == 1:
+            return surfaces[0]
+        first = surfaces[0]._origin
+        if first is not None and all(
+                s._origin is not None and s._origin[0] is first[0]
+                and s._origin[1] == first[1] + k for k, s in enumerate(surfaces)):
+            batch, start = first
+            part = slice(start, start + len(surfaces))
+            return cls(batch.degree_u, batch.degree_v, batch.knots_u[part], batch.knots_v[part],
+                       batch.control[part], batch.weights[part], batch.params_u[part],
+                       batch.params_v[part])
+        s0 = surfaces[0]
+        knots_u, knots_v, control, weights, params_u, params_v = (
+            np.concatenate([getattr(s, f) for s in surfaces])
+            for f in ("knots_u", "knots_v", "control", "weights", "params_u", "params_v"))
+        return cls(s0.degree_u, s0.degree_v, knots_u, knots_v, control, weights, params_u,
+                   params_v)
 
     def _homogeneous(self) -> np.ndarray:
         w = self.weights[..., None]
@@ -182,14 +298,20 @@ class NurbsSurfaces:
         nb = len(self)
         u = np.broadcast_to(np.minimum(np.maximum(u, 0.0), 1.0), (nb, np.shape(u)[-1]))
         v = np.broadcast_to(np.minimum(np.maximum(v, 0.0), 1.0), (nb, np.shape(v)[-1]))
-        bu = basis_matrix(u, self.knots_u, self.degree_u)           # (L, A, nu)
-        bv = basis_matrix(v, self.knots_v, self.degree_v)           # (L, B, nv)
         rational = not np.all(self.weights == 1.0)
         hom = self._homogeneous() if rational else self.control    # (L, nu, nv, c)
-        nu, nc = hom.shape[1], hom.shape[3]
-        na, nbv = bu.shape[1], bv.shape[1]
-        d = bv[:, None] @ hom                                            # (L, nu, B, c)
-        out = (bu @ d.reshape(nb, nu, nbv * nc)).reshape(nb, na, nbv, nc)  # (L, A, B, c)
+        nu, nv, nc = hom.shape[1], hom.shape[2], hom.shape[3]
+        na, nbv = u.shape[1], v.shape[1]
+        if max(nu, nv) < BANDED_FROM:
+            bu = basis_matrix(u, self.knots_u, self.degree_u)           # (L, A, nu)
+            bv = basis_matrix(v, self.knots_v, self.degree_v)           # (L, B, nv)
+            d = bv[:, None] @ hom                                        # (L, nu, B, c)
+            out = (bu @ d.reshape(nb, nu, nbv * nc)).reshape(nb, na, nbv, nc)
+        else:                                    # banded: memory of the points, not A x nu
+            bv, fv, _ = basis_values(v, self.knots_v, self.degree_v)    # (L, B, q + 1)
+            bu, fu, _ = basis_values(u, self.knots_u, self.degree_u)    # (L, A, p + 1)
+            d = _contract(bv, fv, hom.transpose(0, 2, 1, 3))            # (L, B, nu, c)
+            out = _contract(bu, fu, d.transpose(0, 2, 1, 3))            # (L, A, B, c)
         return out[..., :3] / out[..., 3:] if rational else out
 
     def evaluate(self, u, v) -> np.ndarray:
@@ -199,7 +321,26 @@ class NurbsSurfaces:
     def _at(self, u, v, derivative: bool = False):
         u = np.clip(np.asarray(u, dtype=np.float64).ravel(), 0.0, 1.0)
         v = np.clip(np.asarray(v, dtype=np.float64).ravel(), 0.0, 1.0)
-        hom = self._homogeneous()[0]
+        hom = self._homogeneous()[0]                                # (nu, nv, 4)
+        ku, kv, pu, pv = self.knots_u[0], self.knots_v[0], self.degree_u, self.degree_v
+        if max(hom.shape[:2]) < BANDED_FROM:                     # dense: faster when small
+            return self._at_dense(hom, u, v, derivative)
+        a = _at_pairs(hom, u, ku, pu, v, kv, pv)
+        p = a[:, :3] / a[:, 3:]
+        if not derivative:
+            return p, None, None
+        # the derivative is a spline of one degree less on the control points' differences
+        # (The NURBS Book eq. 3.7): banded as the surface itself, whatever its size
+        du_net, ku1 = _derivative_net(hom, ku, pu)
+        dv_net, kv1 = _derivative_net(hom.transpose(1, 0, 2), kv, pv)
+        au = _at_pairs(du_net, u, ku1, pu - 1, v, kv, pv)
+        av = _at_pairs(dv_net.transpose(1, 0, 2), u, ku, pu, v, kv1, pv - 1)
+        w = a[:, 3:]
+        return p, (au[:, :3] - au[:, 3:] * p) / w, (av[:, :3] - av[:, 3:] * p) / w
+
+    def _at_dense(self, hom: np.ndarray, u: np.ndarray, v: np.ndarray, derivative: bool):
+        """:meth:`_at` through dense basis matrices (K, nu) and (K, nv): fewer numpy calls
+        for the nets of ordinary leaves."""
         bu = basis_matrix(u[None], self.knots_u[:1], self.degree_u)[0]
         bv = basis_matrix(v[None], self.knots_v[:1], self.degree_v)[0]
         a = np.einsum("ki,ijc,kj->kc", bu, hom, bv)
@@ -208,7 +349,7 @@ class NurbsSurfaces:
             return p, None, None
         from scipy.interpolate import BSpline  # ~1 s to import: only for normals
 
-        su = BSpline(self.knots_u[0], hom, self.degree_u).derivative()(u)              # (K, nv, 4)
+        su = BSpline(self.knots_u[0], hom, self.degree_u).derivative()(u)      # (K, nv, 4)
         sv = BSpline(self.knots_v[0], hom.transpose(1, 0, 2), self.degree_v).derivative()(v)
         au = np.einsum("kjc,kj->kc", su, bv)
         av = np.einsum("kic,ki->kc", sv, bu)
@@ -240,6 +381,30 @@ class NurbsSurfaces:
             n[bad] = np.cross(du2, dv2)
             length[bad] = np.linalg.norm(n[bad], axis=1)
         return n / np.where(length > 0, length, 1.0)[:, None]
+
+
+def _at_pairs(net: np.ndarray, u: np.ndarray, ku: np.ndarray, pu: int, v: np.ndarray,
+              kv: np.ndarray, pv: int) -> np.ndarray:
+    """The spline of control net (nu, nv, c) at pairs (u[k], v[k]): (K, c), from each pair's
+    (pu + 1) x (pv + 1) control points only."""
+    vu, fu, _ = basis_values(u[None], ku[None], pu)
+    vv, fv, _ = basis_values(v[None], kv[None], pv)
+    out = np.zeros((len(u), net.shape[2]))
+    for r in range(pu + 1):
+        for t in range(pv + 1):
+            out += (vu[0, :, r] * vv[0, :, t])[:, None] * net[fu[0] + r, fv[0] + t]
+    return out
+
+
+def _derivative_net(net: np.ndarray, knots: np.ndarray, degree: int
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """The control net (n - 1, ...) and knots of the derivative along the first axis of a
+    spline of ``degree`` with control net (n, ...) and ``knots``: degree (P_i+1 - P_i) /
+    (t_i+degree+1 - t_i+1), on the knots without their first and last."""
+    n = net.shape[0]
+    span = knots[degree + 1:degree + n] - knots[1:n]
+    scale = np.where(span > 0, degree / np.where(span > 0, span, 1.0), 0.0)
+    return (net[1:] - net[:-1]) * scale.reshape((-1,) + (1,) * (net.ndim - 1)), knots[1:-1]
 
 
 def fit_surfaces(points: np.ndarray, degree_u: int = 3, degree_v: int = 3,
@@ -282,10 +447,9 @@ def fit_surfaces(points: np.ndarray, degree_u: int = 3, degree_v: int = 3,
                             f"(merge or remove the repeated {name})")
     ku = averaged_knots(u, pu)
     kv = averaged_knots(v, pv)
-    nu = basis_matrix(u, ku, pu)                                     # (L, m, m)
-    nv = basis_matrix(v, kv, pv)                                     # (L, n, n)
-    r = np.linalg.solve(nu, points.reshape(nb, m, n * 3)).reshape(nb, m, n, 3)
-    c = np.linalg.solve(nv, r.transpose(0, 2, 1, 3).reshape(nb, n, m * 3)).reshape(nb, n, m, 3)
+    r = _solve_collocation(u, ku, pu, points.reshape(nb, m, n * 3)).reshape(nb, m, n, 3)
+    c = _solve_collocation(v, kv, pv, r.transpose(0, 2, 1, 3).reshape(nb, n, m * 3)
+                           ).reshape(nb, n, m, 3)
     control = np.ascontiguousarray(c.transpose(0, 2, 1, 3))
     return NurbsSurfaces(pu, pv, ku, kv, control, np.ones((nb, m, n)), u, v)
 

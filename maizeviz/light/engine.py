@@ -22,7 +22,8 @@ from __future__ import annotations
 
 import threading
 import time
-from dataclasses import fields, replace
+from dataclasses import fields as dataclass_fields
+from dataclasses import replace
 
 import numpy as np
 
@@ -55,41 +56,49 @@ from maizeviz.progress import ProgressCallback
 
 
 class LightEngine:
-    """Sun, sky and day light through one canopy, on Embree scenes built once.
+    """Sun, sky, day and absorbed light through one canopy, on Embree scenes built once.
+
+    A scene costs about as much as tracing one sun and is the same for every direction: the
+    engine builds it when a request first needs it (one for an open field, one for a
+    periodic field) and keeps it, and keeps the last sky light it traced for the days that
+    follow. It only keeps and dispatches: the tracing is :mod:`maizeviz.light.trace`'s.
 
     Parameters
     ----------
     canopy : Canopy
-        From :func:`maizeviz.canopy.scene.build_canopy` (``maizeviz.build_canopy``).
+        From :func:`maizeviz.build_canopy`.
     sampling : Sampling, optional
-        Sensor heights (cm), ray density (rays per cm2), sample rectangle (cm), periodic field
-        and threads shared by every request; fields given as keywords replace its fields
-        (``LightEngine(canopy, periodic=True, density=2.0)``).
+        Sensor heights [cm], ray density [cm-2], sample rectangle [cm], periodic field and
+        threads shared by every request (default: ``Sampling()``).
     with_stalks : bool
         Stalks intercept light too (their triangles follow the leaves' in per-triangle
         results).
     **fields
-        Any field of :class:`~maizeviz.light.scene.request.Sampling`: ``heights_cm``, ``density``,
-        ``rect``, ``periodic``, ``threads``.
+        Fields of :class:`~maizeviz.light.scene.request.Sampling` replacing the sampling's:
+        ``heights_cm``, ``density``, ``rect``, ``periodic``, ``threads``
+        (``LightEngine(canopy, periodic=True, density=2.0)``).
 
     Attributes
     ----------
-    canopy : Canopy
-    sampling : Sampling
-    with_stalks : bool
-    build_seconds : dict[bool, float]
-        Seconds spent building the scene of an open (False) and a periodic (True) field.
+    build_seconds : dict of bool to float
+        Seconds spent building the scene of an open (False) and a periodic (True) field [s].
 
     Notes
     -----
     Thread-safe: several threads may trace through one engine (a sweep worker's threads); a
     scene is built by the first thread that needs it.
+
+    References
+    ----------
+    Wald, I., Woop, S., Benthin, C., Johnson, G. S. & Ernst, M. (2014). Embree: a kernel
+    framework for efficient CPU ray tracing. ACM Transactions on Graphics 33(4), 143.
+    https://doi.org/10.1145/2601097.2601199
     """
 
     def __init__(self, canopy: Canopy, sampling: Sampling | None = None, *,
-                 with_stalks: bool = False, **fields_):
+                 with_stalks: bool = False, **fields):
         self.canopy = canopy
-        self.sampling = self._sampling(sampling or Sampling(), fields_)
+        self.sampling = self._sampling(sampling or Sampling(), fields)
         self.with_stalks = bool(with_stalks)
         self.build_seconds: dict[bool, float] = {}
         self._scenes: dict[bool, RayScene] = {}
@@ -99,7 +108,7 @@ class LightEngine:
 
     @staticmethod
     def _sampling(base: Sampling, changes: dict) -> Sampling:
-        known = {f.name for f in fields(Sampling)}
+        known = {f.name for f in dataclass_fields(Sampling)}
         unknown = sorted(set(changes) - known)
         if unknown:
             raise TypeError(f"unknown sampling field(s) {', '.join(unknown)} (known: "
@@ -110,8 +119,19 @@ class LightEngine:
 
     # ------------------------------------------------------------------ scenes
     def scene(self, periodic: bool | None = None) -> RayScene:
-        """The Embree scene for an open (``periodic`` False) or periodic field, built on
-        first use and kept (``periodic`` None: the engine's sampling says)."""
+        """The Embree scene of an open or a periodic field, built on first use and kept.
+
+        Parameters
+        ----------
+        periodic : bool, optional
+            A periodic field's scene (its overhanging leaves copied across the plot); None: the
+            engine's sampling says.
+
+        Returns
+        -------
+        RayScene
+            The scene every direction of that field is traced on.
+        """
         key = self.sampling.periodic if periodic is None else bool(periodic)
         return self._scene_and_build(key)[0]
 
@@ -132,37 +152,52 @@ class LightEngine:
             solar_noon: bool = False, altitude: float = 0.0, zenith: float | None = None,
             azimuth: float | None = None, classes: bool = True,
             sampling: Sampling | None = None,
-            progress: ProgressCallback | None = None, **fields_) -> LightResult:
+            progress: ProgressCallback | None = None, **fields) -> LightResult:
         """Direct sunlight: transmission by height and the hit classes of one sun.
 
         Parameters
         ----------
         sun : Sun, optional
-            The sun's angles; else ``zenith`` and ``azimuth`` (deg), or a place and time.
-        date, time : str
-            "YYYY-MM-DD" and local clock time "HH:MM" (:mod:`maizeviz.light.sources.clock`).
-        lat, lon : float
-            deg north and east. ``tz``: IANA time zone. ``solar_noon``: the day's true solar
-            noon instead of ``time``. ``altitude``: m above sea level.
-        zenith, azimuth : float
-            deg, zenith from the vertical, azimuth clockwise from north.
+            The sun's angles; else ``zenith`` and ``azimuth``, or a place and time.
+        date : str, optional
+            The local date, "YYYY-MM-DD".
+        time : str, optional
+            The local clock time "HH:MM[:SS]" (:mod:`maizeviz.light.sources.clock`).
+        lat : float, optional
+            Latitude [deg north].
+        lon : float, optional
+            Longitude [deg east].
+        tz : str, optional
+            IANA time zone of ``time`` ("Asia/Shanghai"); None: UTC or the time's offset.
+        solar_noon : bool
+            The day's true solar noon instead of ``time``.
+        altitude : float
+            Height of the place above sea level [m].
+        zenith : float, optional
+            The sun's angle from the vertical [deg].
+        azimuth : float, optional
+            The sun's azimuth, clockwise from north [deg] (default 180 with ``zenith``).
         classes : bool
             Also trace second hits and per-triangle counts (the hit classes).
         sampling : Sampling, optional
-            Instead of the engine's; keywords (``heights_cm=...``) replace its fields.
+            Instead of the engine's.
         progress : callable, optional
-            ``progress(done, total)`` after each chunk of rays; ``False`` cancels.
+            ``progress(done, total)`` after each chunk of rays; returning ``False`` cancels with
+            InterruptedError.
+        **fields
+            Fields of :class:`~maizeviz.light.scene.request.Sampling` replacing the sampling's
+            (``heights_cm=(0, 100)``).
 
         Returns
         -------
         LightResult
-            ``transmission`` (H,) in [0, 1] at ``heights_cm`` (H,) cm; ``table()`` as a
-            DataFrame. ``seconds["build"]`` is the scene's build time when this call built it.
+            ``transmission`` (H,) in [0, 1] at ``heights_cm`` (H,) [cm]; ``table()`` as a
+            DataFrame; ``seconds["build"]`` is the scene's build time when this call built it [s].
 
         References
         ----------
         Reda, I. & Andreas, A. (2004). Solar position algorithm for solar radiation
-        applications. Solar Energy 76(5), 577-589 (pvlib's ``get_solarposition``).
+        applications. Solar Energy 76(5), 577-589. https://doi.org/10.1016/j.solener.2003.12.003
         """
         if sun is None:
             if zenith is not None:
@@ -172,7 +207,7 @@ class LightEngine:
                     raise TypeError("give a Sun, zenith and azimuth, or date, time, lat and "
                                     "lon")
                 sun = sun_at(date, time, lat, lon, tz, solar_noon, altitude)
-        smp = self._sampling(sampling or self.sampling, fields_)
+        smp = self._sampling(sampling or self.sampling, fields)
         scene, build_s = self._scene_and_build(smp.periodic)
         result = trace_light(self.canopy, LightRequest(sun, smp, classes),
                              progress, self.with_stalks, scene)
@@ -181,32 +216,44 @@ class LightEngine:
 
     def sky(self, sky: Sky | str = "soc", directions: int = 46, split: str = "auto", *,
             sampling: Sampling | None = None, progress: ProgressCallback | None = None,
-            bin_cm: float = 5.0, **fields_) -> SkyLight:
+            bin_cm: float = 5.0, **fields) -> SkyLight:
         """Diffuse light under a sky: every sky direction traced like the sun.
 
         Parameters
         ----------
         sky : Sky or str
-            A :class:`~maizeviz.light.sources.sky.Sky`, or its kind: "soc" (standard overcast) or
-            "uoc" (uniform overcast), split into ``directions`` directions (``split``: "auto",
-            "turtle", "tregenza", "equal").
-        sampling, progress, **fields_ : as :meth:`sun` (``progress`` after each direction).
+            A :class:`~maizeviz.light.sources.sky.Sky`, or its kind: "soc" (standard overcast)
+            or "uoc" (uniform overcast).
+        directions : int
+            Directions of a sky given by its kind (46: den Dulk's turtle).
+        split : {"auto", "turtle", "tregenza", "equal"}
+            How a sky given by its kind is cut into directions.
+        sampling : Sampling, optional
+            Instead of the engine's.
+        progress : callable, optional
+            ``progress(done, total)`` after each direction; returning ``False`` cancels with
+            InterruptedError.
         bin_cm : float
-            Bin edge of the transmission maps, cm.
+            Bin edge of the transmission maps [cm].
+        **fields
+            Fields of :class:`~maizeviz.light.scene.request.Sampling` replacing the sampling's.
 
         Returns
         -------
         SkyLight
-            ``transmission`` (H,): share of the horizontal diffuse irradiance reaching each
+            ``transmission`` (H,): the share of the horizontal diffuse irradiance reaching each
             height; ``table()`` as a DataFrame.
 
         References
         ----------
         Moon, P. & Spencer, D. E. (1942). Illumination from a non-uniform sky. Illuminating
-        Engineering 37, 707-726 (the standard overcast sky).
+        Engineering 37, 707-726 (the standard overcast sky; no DOI).
+        Chelle, M. & Andrieu, B. (1998). The nested radiosity model for the distribution of
+        light within plant canopies. Ecological Modelling 111(1), 75-91 (turtle skies in
+        Caribu). https://doi.org/10.1016/S0304-3800(98)00100-8
         """
         sky_obj = sky if isinstance(sky, Sky) else make_sky(sky, directions, split)
-        smp = self._sampling(sampling or self.sampling, fields_)
+        smp = self._sampling(sampling or self.sampling, fields)
         scene, build_s = self._scene_and_build(smp.periodic)
         light = trace_sky(self.canopy, sky_obj, smp, progress, self.with_stalks, scene, bin_cm)
         light.seconds["build"] = build_s
@@ -219,38 +266,62 @@ class LightEngine:
             altitude: float = 0.0, linke: float = DEFAULT_LINKE_TURBIDITY,
             par_factor: float = DEFAULT_PAR_UMOL_PER_J, sky: Sky | str | None = None,
             sampling: Sampling | None = None, progress: ProgressCallback | None = None,
-            bin_cm: float = 5.0, directions: int = 46, **fields_) -> PeriodLight:
+            bin_cm: float = 5.0, directions: int = 46, **fields) -> PeriodLight:
         """Light over a day (or any period): the sun traced at every time step, the sky once.
 
         Parameters
         ----------
         period : Period, optional
             From :func:`~maizeviz.light.sources.irradiance.clear_sky_period` or
-            :func:`~maizeviz.light.sources.irradiance.weather_period`; else a clear day from ``date``
-            ("YYYY-MM-DD"), ``lat``, ``lon`` (deg), ``tz`` (IANA), ``step_min`` (min),
-            ``start``/``end`` (local "HH:MM"), ``altitude`` (m), ``linke`` (Linke turbidity)
-            and ``par_factor`` (umol of PAR per J of shortwave).
+            :func:`~maizeviz.light.sources.irradiance.weather_period`; else a clear day from
+            ``date``, ``lat``, ``lon`` and the rest.
+        date : str, optional
+            The local date, "YYYY-MM-DD".
+        lat : float, optional
+            Latitude [deg north].
+        lon : float, optional
+            Longitude [deg east].
+        tz : str
+            IANA time zone of the day.
+        step_min : float
+            Time step of a clear day [min].
+        start, end : str, optional
+            Local clock times "HH:MM" bounding the period (None: the whole day).
+        altitude : float
+            Height of the place above sea level [m].
+        linke : float
+            Linke turbidity of the clear sky [-].
+        par_factor : float
+            PAR photons per joule of shortwave [umol J-1].
         sky : Sky or str, optional
-            The sky of the diffuse part (default: standard overcast, 46 directions); the sky
+            The sky of the diffuse part (default: standard overcast of ``directions``); the sky
             light this engine last traced is reused when its sky, sampling and bins match.
-            "perez" (or "perez-driesse") splits each step's diffuse light by Perez's
-            anisotropic model (:mod:`maizeviz.light.sources.perez`): its circumsolar part traced with
-            the sun, its isotropic part over a uniform sky of ``directions`` directions.
+            "perez" (or "perez-driesse") splits each step's diffuse light by Perez's anisotropic
+            model (:mod:`maizeviz.light.sources.perez`): its circumsolar part traced with the
+            sun, its isotropic part over a uniform sky.
+        sampling : Sampling, optional
+            Instead of the engine's.
+        progress : callable, optional
+            ``progress(done, total)`` after each direction (sky directions first, then the time
+            steps); returning ``False`` cancels with InterruptedError.
+        bin_cm : float
+            Bin edge of the maps [cm].
         directions : int
-            Directions of a sky given by its kind (default 46, den Dulk's turtle).
-        sampling, progress, bin_cm, **fields_ : as :meth:`sky` (``progress`` after each
-            direction: sky directions first, then the time steps).
+            Directions of a sky given by its kind (46: den Dulk's turtle).
+        **fields
+            Fields of :class:`~maizeviz.light.scene.request.Sampling` replacing the sampling's.
 
         Returns
         -------
         PeriodLight
-            PAR doses in mol/m2 of ground (``par_incident_mol_m2``,
-            ``par_transmitted_mol_m2`` (H,), ...); ``table()`` as a DataFrame.
+            PAR doses [mol m-2 of ground] (``par_incident_mol_m2``, ``par_transmitted_mol_m2``
+            (H,), ...); ``table()`` as a DataFrame.
 
         References
         ----------
         Ineichen, P. & Perez, R. (2002). A new airmass independent formulation for the Linke
-        turbidity coefficient. Solar Energy 73(3), 151-157 (the clear sky).
+        turbidity coefficient. Solar Energy 73(3), 151-157.
+        https://doi.org/10.1016/S0038-092X(02)00045-2
         """
         from maizeviz.light.sources.irradiance import clear_sky_period
 
@@ -259,7 +330,7 @@ class LightEngine:
                 raise TypeError("give a Period, or date, lat and lon")
             period = clear_sky_period(date, lat, lon, tz, step_min, start, end, altitude,
                                       linke, par_factor)
-        smp = self._sampling(sampling or self.sampling, fields_)
+        smp = self._sampling(sampling or self.sampling, fields)
         model = str(sky).strip().lower() if isinstance(sky, str) else ""
         split = perez_split(period, model) if model in PEREZ_MODELS else None
         sky_obj = sky if isinstance(sky, Sky) else \
@@ -275,8 +346,22 @@ class LightEngine:
 
     def kept_sky(self, sky: Sky, sampling: Sampling | None = None,
                  bin_cm: float = 5.0) -> SkyLight | None:
-        """The sky light this engine last traced, if it was traced with this sky, sampling
-        (threads aside) and bin edge: what :meth:`day` reuses; else None."""
+        """The sky light this engine last traced, if traced with this sky, sampling and bins.
+
+        Parameters
+        ----------
+        sky : Sky
+            The sky asked for.
+        sampling : Sampling, optional
+            The sampling asked for (threads aside); None: the engine's.
+        bin_cm : float
+            Bin edge of the maps [cm].
+
+        Returns
+        -------
+        SkyLight or None
+            What :meth:`day` reuses; None when the last sky light was traced otherwise.
+        """
         smp = sampling or self.sampling
         if self._sky is not None and self._sky[0] == _sky_key(sky, smp, bin_cm):
             return self._sky[1]
@@ -292,38 +377,74 @@ class LightEngine:
                  azimuth: float | None = None, date: str | None = None,
                  time: str | None = None, lat: float | None = None, lon: float | None = None,
                  tz: str | None = None, sky_passes: int = SKY_PASSES,
-                 **fields_) -> AbsorbedLight:
-        """Light absorbed by leaves and ground in one band, with scattering
-        (:func:`maizeviz.light.trace.absorbed.absorbed_light`): the sun's direct beam and,
-        when ``diffuse_w_m2`` > 0, the diffuse light of a sky.
+                 **fields) -> AbsorbedLight:
+        """Light absorbed by leaves and ground in one band, with scattering.
+
+        The sun's direct beam and, when ``diffuse_w_m2`` > 0, the diffuse light of a sky, each
+        followed through the canopy (:func:`maizeviz.light.trace.absorbed.absorbed_light`).
 
         Parameters
         ----------
-        sun, zenith, azimuth, date, time, lat, lon, tz : the sun, as :meth:`sun`
-        band : "par" or "nir"; optics : the band's Optics (default
-            :data:`maizeviz.light.trace.optics.DEFAULT_OPTICS`)
-        direct_w_m2 : the band's direct irradiance on a horizontal plane above the canopy,
-            W/m2 (default: the band's share of 1000 W/m2 of shortwave, 480 in PAR)
-        diffuse_w_m2 : the band's diffuse irradiance on a horizontal plane, W/m2, spread over
-            ``sky`` (kind or Sky) split into ``directions`` directions
-        depth, threshold, seed : scatterings followed, share of the incident power left
-            travelling where tracing stops, random seed
-        sky_passes : with leaves or soil that scatter, in a periodic field, the diffuse light
-            is traced as one beam whose rays each take a sky direction of their own
-            (:func:`~maizeviz.light.trace.scatter.scatter_sky`), this many rays per grid cell
-            (default 4; 0: every sky direction traced over the whole grid, as black leaves
-            are)
-        sampling, progress, **fields_ : as :meth:`sun` (``progress`` after each beam)
+        sun : Sun, optional
+            The sun's angles; else ``zenith`` and ``azimuth``, or a place and time as
+            :meth:`sun`.
+        band : {"par", "nir"}
+            The waveband.
+        optics : Optics, optional
+            The band's leaf and soil optics (default
+            :data:`maizeviz.light.trace.optics.DEFAULT_OPTICS`).
+        direct_w_m2 : float, optional
+            The band's direct irradiance on a horizontal plane above the canopy [W m-2]
+            (default: the band's share of 1000 W m-2 of shortwave, 480 in PAR).
+        diffuse_w_m2 : float
+            The band's diffuse irradiance on a horizontal plane [W m-2], spread over ``sky``.
+        sky : Sky or str
+            The diffuse light's sky, or its kind.
+        directions : int
+            Directions of a sky given by its kind.
+        depth : int
+            Most scatterings followed per ray.
+        threshold : float
+            Share of the incident power still travelling below which tracing stops [-].
+        seed : int
+            Seed of the Monte Carlo scattering (the same seed, the same result).
+        sampling : Sampling, optional
+            Instead of the engine's.
+        progress : callable, optional
+            ``progress(done, total)`` after each beam; returning ``False`` cancels.
+        zenith : float, optional
+            The sun's angle from the vertical [deg].
+        azimuth : float, optional
+            The sun's azimuth, clockwise from north [deg].
+        date : str, optional
+            The local date, "YYYY-MM-DD".
+        time : str, optional
+            The local clock time "HH:MM".
+        lat : float, optional
+            Latitude [deg north].
+        lon : float, optional
+            Longitude [deg east].
+        tz : str, optional
+            IANA time zone of ``time``.
+        sky_passes : int
+            With leaves or soil that scatter, in a periodic field, the diffuse light is traced as
+            one beam whose rays each take a sky direction of their own
+            (:func:`~maizeviz.light.trace.scatter.scatter_sky`), this many rays per grid cell (0:
+            every sky direction traced over the whole grid, as black leaves are).
+        **fields
+            Fields of :class:`~maizeviz.light.scene.request.Sampling` replacing the sampling's.
 
         Returns
         -------
         AbsorbedLight
-            ``balance`` (W/m2 of ground), absorbed W per triangle, ``table("plant", canopy)``,
-            ``absorbed_leaves_error`` (the Monte Carlo standard error).
+            ``balance`` [W m-2 of ground], the W absorbed per triangle, ``table("plant",
+            canopy)``, ``absorbed_leaves_error`` (the Monte Carlo standard error).
 
         References
         ----------
-        Bailey, B. N. (2018). Ecological Modelling 368, 233-245 (Helios' radiation model).
+        Bailey, B. N. (2018). A reverse ray-tracing method for modelling the net radiative flux
+        in leaf-resolving plant canopy simulations. Ecological Modelling 368, 233-245.
+        https://doi.org/10.1016/j.ecolmodel.2017.11.022
         """
         from maizeviz.light.scene.request import check_sampling
         from maizeviz.light.trace.direct import sampler
@@ -339,7 +460,7 @@ class LightEngine:
         if sun is None and (direct > 0 or diffuse_w_m2 == 0):
             raise TypeError("give a Sun, zenith and azimuth, or date, time, lat and lon; or "
                             "direct_w_m2=0 with a diffuse irradiance")
-        smp_req = self._sampling(sampling or self.sampling, fields_)
+        smp_req = self._sampling(sampling or self.sampling, fields)
         rect, _ = check_sampling(self.canopy, smp_req)
         scene, build_s = self._scene_and_build(smp_req.periodic)
         smp = sampler(self.canopy, scene, rect, smp_req.density, smp_req.heights_cm,
@@ -353,16 +474,22 @@ class LightEngine:
 
     def photosynthesis(self, sun: Sun | None = None, *, model="c4",
                        temperature_c: float = 25.0, **absorbed):
-        """Gross CO2 assimilation of the leaves under one sun (and sky): absorbed PAR
-        (:meth:`absorbed`, same keywords) through a leaf model, each triangle's sunlit and
-        shaded parts at their own light (:mod:`maizeviz.light.results.assimilation`).
+        """Gross CO2 assimilation of the leaves under one sun (and sky).
+
+        Absorbed PAR (:meth:`absorbed`, same keywords) through a leaf model, each triangle's
+        sunlit and shaded parts at their own light (:mod:`maizeviz.light.results.assimilation`).
 
         Parameters
         ----------
-        sun, **absorbed : as :meth:`absorbed` (``zenith=``, ``diffuse_w_m2=``, ``optics=``...)
-        model : "c4", "wofost" or a leaf model
-            (:func:`maizeviz.photosynthesis.split.leaf_model` for other parameters)
-        temperature_c : air (leaf) temperature, C
+        sun : Sun, optional
+            The sun, as :meth:`absorbed`.
+        model : {"c4", "wofost"} or LeafModel
+            The leaf model (:func:`maizeviz.photosynthesis.split.leaf_model` for other
+            parameters).
+        temperature_c : float
+            Air (leaf) temperature [degC].
+        **absorbed
+            Keywords of :meth:`absorbed` (``zenith=``, ``diffuse_w_m2=``, ``optics=``...).
 
         Returns
         -------
@@ -372,9 +499,14 @@ class LightEngine:
 
         References
         ----------
-        Collatz, G. J., Ribas-Carbo, M. & Berry, J. A. (1992). Australian Journal of Plant
-        Physiology 19, 519-538. Spitters, C. J. T. (1986). Agricultural and Forest
+        Collatz, G. J., Ribas-Carbo, M. & Berry, J. A. (1992). Coupled photosynthesis-stomatal
+        conductance model for leaves of C4 plants. Australian Journal of Plant Physiology 19,
+        519-538. https://doi.org/10.1071/PP9920519
+        Spitters, C. J. T., Toussaint, H. A. J. M. & Goudriaan, J. (1986). Separating the diffuse
+        and direct component of global radiation and its implications for modeling canopy
+        photosynthesis. Part II. Calculation of canopy photosynthesis. Agricultural and Forest
         Meteorology 38, 231-242.
+        https://doi.org/10.1016/0168-1923(86)90061-4
         """
         from maizeviz.light.results.assimilation import assimilate
         from maizeviz.photosynthesis.split import leaf_model
@@ -394,40 +526,81 @@ class LightEngine:
                      end: str | None = None, altitude: float = 0.0,
                      linke: float = DEFAULT_LINKE_TURBIDITY,
                      par_factor: float = DEFAULT_PAR_UMOL_PER_J, photosynthesis=None,
-                     temperature_c=25.0, **fields_) -> AbsorbedPeriod:
-        """Light absorbed with scattering over a period (a day), in one band: each step's
-        sun with the band's share of its direct irradiance, and the diffuse part spread over
-        ``sky``, traced once per W/m2 and scaled by each step's diffuse irradiance (the
-        transport is linear in the light put in;
+                     temperature_c=25.0, **fields) -> AbsorbedPeriod:
+        """Light absorbed with scattering over a period (a day), in one band.
+
+        Each step's sun with the band's share of its direct irradiance, and the diffuse part
+        spread over ``sky``, traced once per W m-2 and scaled by each step's diffuse irradiance
+        (the transport is linear in the light put in;
         :func:`maizeviz.light.trace.absorbed.absorbed_period`).
 
         Parameters
         ----------
-        period, date, lat, lon, tz, step_min, start, end, altitude, linke, par_factor : the
-            period, as :meth:`day`; the period's PAR factor (umol of PAR per J of shortwave)
-            also sets the band's share of the shortwave
-            (:func:`~maizeviz.light.trace.optics.band_share`: 0.48 for PAR by default), so that
-            black leaves absorb exactly the PAR the same day intercepts
-        band, optics, depth, threshold, seed, sampling, **fields_ : as :meth:`absorbed`
-        sky, directions : the diffuse light's sky (default: standard overcast, 46); "perez"
-            (or "perez-driesse") splits each step's diffuse light by Perez's model
-            (:mod:`maizeviz.light.sources.perez`): its circumsolar part added to that step's direct
-            beam, the rest from a uniform sky
-        progress : after the sky and after each step
+        period : Period, optional
+            The period; else a clear day from ``date``, ``lat``, ``lon`` and the rest, as
+            :meth:`day`. Its PAR factor also sets the band's share of the shortwave
+            (:func:`~maizeviz.light.trace.optics.band_share`: 0.48 for PAR by default), so
+            that black leaves absorb exactly the PAR the same day intercepts.
+        band : {"par", "nir"}
+            The waveband.
+        optics : Optics, optional
+            The band's leaf and soil optics.
+        sky : Sky or str
+            The diffuse light's sky (default: standard overcast); "perez" (or "perez-driesse")
+            splits each step's diffuse light by Perez's model: its circumsolar part added to that
+            step's direct beam, the rest from a uniform sky.
+        directions : int
+            Directions of a sky given by its kind.
+        depth : int
+            Most scatterings followed per ray.
+        threshold : float
+            Share of the incident power still travelling below which tracing stops [-].
+        seed : int
+            Seed of the Monte Carlo scattering.
+        sampling : Sampling, optional
+            Instead of the engine's.
+        progress : callable, optional
+            Called after the sky and after each step; returning ``False`` cancels.
+        date : str, optional
+            The local date, "YYYY-MM-DD".
+        lat : float, optional
+            Latitude [deg north].
+        lon : float, optional
+            Longitude [deg east].
+        tz : str
+            IANA time zone of the day.
+        step_min : float
+            Time step of a clear day [min].
+        start, end : str, optional
+            Local clock times "HH:MM" bounding the period.
+        altitude : float
+            Height of the place above sea level [m].
+        linke : float
+            Linke turbidity of the clear sky [-].
+        par_factor : float
+            PAR photons per joule of shortwave [umol J-1].
         photosynthesis : LeafModel, optional
             Also the leaves' gross CO2 assimilation at every step (PAR only,
             :func:`maizeviz.light.results.assimilation.assimilate`), added up over the period
             (``AbsorbedPeriod.assimilation``).
-        temperature_c : float or (n,) float64
-            Air (leaf) temperature at each step, C (default 25); a period read from a weather
-            file with an air temperature column (``Period.temp_air``) gives its own, these
-            filling the steps it lacks (NaN).
+        temperature_c : float or numpy.ndarray
+            Air (leaf) temperature at each step [degC] (one, or (n,)); a period read from a
+            weather file with an air temperature column gives its own, these filling the steps it
+            lacks (NaN).
+        **fields
+            Fields of :class:`~maizeviz.light.scene.request.Sampling` replacing the sampling's.
 
         Returns
         -------
         AbsorbedPeriod
-            ``balance`` in MJ/m2 of ground, J per triangle, ``absorbed_leaves_mol_m2`` (PAR),
-            ``table("plant", canopy)``.
+            ``balance`` [MJ m-2 of ground], the J absorbed per triangle,
+            ``absorbed_leaves_mol_m2`` (PAR), ``table("plant", canopy)``.
+
+        References
+        ----------
+        Bailey, B. N. (2018). A reverse ray-tracing method for modelling the net radiative flux
+        in leaf-resolving plant canopy simulations. Ecological Modelling 368, 233-245.
+        https://doi.org/10.1016/j.ecolmodel.2017.11.022
         """
         from functools import partial
 
@@ -440,7 +613,7 @@ class LightEngine:
                                       linke, par_factor)
         opt = optics if optics is not None else optics_for(band)
         one = partial(self.absorbed, band=opt.band, optics=opt, directions=directions,
-                      depth=depth, threshold=threshold, seed=seed, sampling=sampling, **fields_)
+                      depth=depth, threshold=threshold, seed=seed, sampling=sampling, **fields)
         return absorbed_period(period, opt, sky, one, progress, self.canopy, photosynthesis,
                                temperature_c)
 

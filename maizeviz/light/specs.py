@@ -20,15 +20,30 @@ from maizeviz.light.trace.scatter import DEFAULT_DEPTH
 
 @dataclass(frozen=True)
 class SkySpec:
-    """A discretised sky: ``kind`` "soc" or "uoc", ``directions`` (16, 46, 145 or any n for
-    an equal-area split), ``split`` "auto" or "equal" (see :func:`maizeviz.light.sources.sky.make_sky`,
-    which :meth:`sky` calls)."""
+    """A discretised sky as a user chooses it (see :func:`maizeviz.light.sources.sky.make_sky`).
+
+    Parameters
+    ----------
+    kind : {"soc", "uoc"}
+        Standard or uniform overcast.
+    directions : int
+        16, 46, 145, or any count for an equal-area split.
+    split : {"auto", "equal"}
+        How the hemisphere is cut.
+    """
 
     kind: str = "soc"
     directions: int = 46
     split: str = "auto"
 
     def sky(self):
+        """The sky the spec describes.
+
+        Returns
+        -------
+        Sky
+            From :func:`maizeviz.light.sources.sky.make_sky`.
+        """
         from maizeviz.light.sources.sky import make_sky
 
         return make_sky(self.kind, self.directions, self.split)
@@ -36,32 +51,41 @@ class SkySpec:
 
 @dataclass(frozen=True)
 class DaySpec:
-    """A day (or part of it) at a place: clear sky (Ineichen-Perez, ``linke`` turbidity) or a
-    weather file (``weather``: its path; it sets the period and its steps).
+    """A day (or part of it) at a place: a clear sky or a weather file.
 
-    Attributes
+    The clear sky is Ineichen and Perez's with ``linke`` turbidity; a weather file (its
+    path) sets the period and its steps instead.
+
+    Parameters
     ----------
     date : str
-        ``YYYY-MM-DD`` (local date at ``tz``).
-    lat, lon : float
-        Degrees north and east.
+        The local date at ``tz``, "YYYY-MM-DD".
+    lat : float
+        Latitude [deg north].
+    lon : float
+        Longitude [deg east].
     tz : str
-        IANA time zone of the clock times (``Asia/Shanghai``, ``UTC``).
+        IANA time zone of the clock times ("Asia/Shanghai", "UTC").
     step_min : float
-        Minutes between time steps of a clear day.
+        Time between the steps of a clear day [min].
     start, end : str or None
-        Clock times ``HH:MM`` bounding the period (None: the whole day).
+        Clock times "HH:MM" bounding the period (None: the whole day).
     linke : float
-        Linke turbidity of the clear sky (dimensionless).
+        Linke turbidity of the clear sky [-].
     par_factor : float
-        µmol of PAR photons per joule of shortwave.
+        PAR photons per joule of shortwave [umol J-1].
     weather : str or None
         A weather file instead of a clear sky.
-    diffuse : str
-        How each step's diffuse light comes from the sky: ``"sky"`` (the sky chosen, one
-        shape all day) or ``"perez"`` (Perez's anisotropic split per step: its circumsolar
-        part with the sun, the rest from a uniform sky of the sky's directions; see
-        :mod:`maizeviz.light.sources.perez`).
+    diffuse : {"sky", "perez"}
+        How each step's diffuse light comes from the sky: the sky chosen, one shape all day,
+        or Perez's anisotropic split per step (its circumsolar part with the sun, the rest
+        from a uniform sky of the sky's directions; :mod:`maizeviz.light.sources.perez`).
+
+    References
+    ----------
+    Ineichen, P. & Perez, R. (2002). A new airmass independent formulation for the Linke
+    turbidity coefficient. Solar Energy 73(3), 151-157.
+    https://doi.org/10.1016/S0038-092X(02)00045-2
     """
 
     date: str = "2005-08-01"
@@ -77,8 +101,19 @@ class DaySpec:
     diffuse: str = "sky"
 
     def period(self):
-        """The Period (maizeviz.light.sources.irradiance) the spec describes; refused with a
-        MaizevizError naming the quantity (date, tz, step, period, weather...)."""
+        """The period the spec describes.
+
+        Returns
+        -------
+        Period
+            Its time steps, sun and irradiance (:mod:`maizeviz.light.sources.irradiance`).
+
+        Raises
+        ------
+        MaizevizError
+            A bad date, zone, step or weather file, or a period without sun (naming the
+            quantity).
+        """
         from maizeviz.errors import MaizevizError
         from maizeviz.light.sources import irradiance as irr
 
@@ -96,9 +131,14 @@ class DaySpec:
         return period
 
     def steps_bound(self) -> int:
-        """At most how many time steps :meth:`period` will have, known without computing it
-        (for the cost estimate): the span over the step for a clear sky, the rows a weather
-        file of its size can hold (24 bytes a row at the least)."""
+        """At most how many time steps :meth:`period` will have, known without computing it.
+
+        Returns
+        -------
+        int
+            The span over the step for a clear sky; the rows a weather file of its size can hold
+            (24 bytes a row at the least); at least 1.
+        """
         import math
         import os
 
@@ -121,38 +161,47 @@ class DaySpec:
 
 @dataclass(frozen=True)
 class OpticsSpec:
-    """Absorbed light with scattering as a user chooses it: the band, the leaf and soil
-    optics, the irradiance and how far scattering is followed (see
-    :meth:`maizeviz.light.engine.LightEngine.absorbed`, which :meth:`absorbed` calls).
+    """Absorbed light with scattering as a user chooses it.
 
-    Attributes
+    The band, the leaf and soil optics, the irradiance and how far scattering is followed
+    (see :meth:`maizeviz.light.engine.LightEngine.absorbed`, which :meth:`absorbed` calls).
+
+    Parameters
     ----------
-    band : str
-        ``"par"`` or ``"nir"``.
-    reflectance, transmittance, ground_reflectance : float or None
-        Leaf and soil fractions in [0, 1] (None: the band's default,
+    band : {"par", "nir"}
+        The waveband.
+    reflectance, transmittance : float or None
+        Leaf fractions in [0, 1] [-] (None: the band's default,
         :data:`maizeviz.light.trace.optics.DEFAULT_OPTICS`).
+    ground_reflectance : float or None
+        Soil fraction in [0, 1] [-] (None: the band's default).
     direct_w_m2 : float or None
-        The band's direct irradiance on a horizontal plane above the canopy, W/m2 (None: the
-        band's share of 1000 W/m2 of shortwave).
+        The band's direct irradiance on a horizontal plane above the canopy [W m-2] (None:
+        the band's share of 1000 W m-2 of shortwave).
     diffuse_w_m2 : float
-        The band's diffuse irradiance on a horizontal plane, W/m2, from a standard overcast
+        The band's diffuse irradiance on a horizontal plane [W m-2], from a standard overcast
         sky of 46 directions (0: the direct beam only).
     depth : int
         Most scatterings followed per ray (0: first hits only; default
-        :data:`maizeviz.light.trace.scatter.DEFAULT_DEPTH`, as the command line; Russian roulette
-        and the energy threshold end most paths long before).
+        :data:`maizeviz.light.trace.scatter.DEFAULT_DEPTH`).
     seed : int
-        Random seed of the Monte Carlo scattering (the same seed gives the same result).
-    ranks : tuple of (rank, reflectance, transmittance)
-        Leaf optics of the ranks that differ (see :class:`maizeviz.light.trace.optics.Optics`).
+        Seed of the Monte Carlo scattering (the same seed gives the same result).
+    ranks : tuple of (int, float, float)
+        ``(rank, reflectance, transmittance)`` of the leaf ranks that differ (see
+        :class:`maizeviz.light.trace.optics.Optics`).
     photosynthesis : str
-        A leaf model turning the absorbed PAR into gross CO2 assimilation: "c4", "wofost",
-        or "" (none; :mod:`maizeviz.photosynthesis`).
+        A leaf model turning the absorbed PAR into gross CO2 assimilation ("c4", "wofost"; ""
+        for none: :func:`maizeviz.photosynthesis.split.leaf_model`).
     temperature_c : float
-        Air (leaf) temperature for the leaf model, C.
-    photosynthesis_params : tuple of (name, value)
-        The leaf model's parameters that differ from its defaults (``vmax``, ``amax``...).
+        Air (leaf) temperature for the leaf model [degC].
+    photosynthesis_params : tuple of (str, float)
+        The leaf model's parameters that differ from its defaults.
+
+    References
+    ----------
+    Bailey, B. N. (2018). A reverse ray-tracing method for modelling the net radiative flux
+    in leaf-resolving plant canopy simulations. Ecological Modelling 368, 233-245.
+    https://doi.org/10.1016/j.ecolmodel.2017.11.022
     """
 
     band: str = "par"
@@ -169,7 +218,18 @@ class OpticsSpec:
     photosynthesis_params: tuple = ()
 
     def leaf_model(self):
-        """The leaf model chosen (checked: MaizevizError naming what is wrong), or None."""
+        """The leaf model chosen, checked.
+
+        Returns
+        -------
+        LeafModel or None
+            None without one.
+
+        Raises
+        ------
+        MaizevizError
+            A band other than PAR, a temperature out of range or a bad model parameter.
+        """
         if not self.photosynthesis:
             return None
         from maizeviz.errors import MaizevizError, check_range
@@ -182,9 +242,20 @@ class OpticsSpec:
         return leaf_model(self.photosynthesis, **dict(self.photosynthesis_params))
 
     def assimilation(self, canopy, light):
-        """Gross CO2 assimilation of ``light`` (this spec's AbsorbedLight, traced on
-        ``canopy``) through the chosen leaf model (an
-        :class:`~maizeviz.light.results.assimilation.Assimilation`), or None without one."""
+        """Gross CO2 assimilation of absorbed light through the chosen leaf model.
+
+        Parameters
+        ----------
+        canopy : Canopy
+            The canopy it was traced on.
+        light : AbsorbedLight
+            This spec's absorbed light.
+
+        Returns
+        -------
+        Assimilation or None
+            None without a leaf model.
+        """
         model = self.leaf_model()
         if model is None:
             return None
@@ -193,8 +264,18 @@ class OpticsSpec:
         return assimilate(canopy, light, model, self.temperature_c)
 
     def optics(self):
-        """The :class:`~maizeviz.light.trace.optics.Optics` of the band (checked: MaizevizError
-        naming the value out of range)."""
+        """The optics of the band.
+
+        Returns
+        -------
+        Optics
+            Checked.
+
+        Raises
+        ------
+        MaizevizError
+            A value out of range (naming it).
+        """
         from dataclasses import replace
 
         from maizeviz.light.trace.optics import optics_for
@@ -204,7 +285,24 @@ class OpticsSpec:
         return replace(base, ranks=tuple(tuple(r) for r in self.ranks)) if self.ranks else base
 
     def absorbed(self, engine, sun, sampling=None, progress=None):
-        """Trace it: ``engine.absorbed`` for ``sun`` (an AbsorbedLight)."""
+        """Trace it: ``engine.absorbed`` for ``sun``.
+
+        Parameters
+        ----------
+        engine : LightEngine
+            The engine of the canopy.
+        sun : Sun
+            The sun.
+        sampling : Sampling, optional
+            Instead of the engine's.
+        progress : callable, optional
+            ``progress(done, total)`` after each beam.
+
+        Returns
+        -------
+        AbsorbedLight
+            As :meth:`maizeviz.light.engine.LightEngine.absorbed` gives it.
+        """
         return engine.absorbed(sun, band=self.band, optics=self.optics(),
                                direct_w_m2=self.direct_w_m2, diffuse_w_m2=self.diffuse_w_m2,
                                depth=self.depth, seed=self.seed, sampling=sampling,

@@ -12,15 +12,34 @@
  * Rays are set up exactly as embreex's EmbreeScene.run sets its single rays (tnear 0, mask
  * all ones, time 0, flags 0, ids invalid), so a packet gives the hits Intersect1 gives.
  *
- * Build: cc -O2 -ffp-contract=off -shared -fPIC _packets.c -o _packets.so (packets.py does
- * it; no fused multiply-add, so float64 steps round as numpy's do).
+ * Built when maizeviz is installed, as the extension module maizeviz.mesh._packets (setup.py:
+ * gcc and clang with -ffp-contract=off, MSVC with /fp:precise, so that float64 steps round
+ * as numpy's do), with Python's stable ABI; packets.py imports it and calls the mz_* functions
+ * below through ctypes (which releases the GIL). The module itself only tells its source's
+ * hash and the packet layout.
  */
+
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
 
 #include <stdint.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <math.h>
+
+#if defined(_MSC_VER)
+#include <malloc.h>
+#define MZ_ALIGNED(x) __declspec(align(x))
+#define MZ_EXPORT __declspec(dllexport)
+#define mz_aligned_alloc(a, size) _aligned_malloc((size), (a))
+#define mz_aligned_free _aligned_free
+#else
+#define MZ_ALIGNED(x) __attribute__((aligned(x)))
+#define MZ_EXPORT __attribute__((visibility("default")))
+#define mz_aligned_alloc(a, size) aligned_alloc((a), (size))
+#define mz_aligned_free free
+#endif
 
 #define INVALID_ID 0xFFFFFFFFu
 #define QUERY_FLAG_COHERENT (1u << 16)     /* RTC_RAY_QUERY_FLAG_COHERENT */
@@ -39,21 +58,21 @@ typedef struct {
 } query_args;
 
 #define DECLARE_PACKET(W)                                                                   \
-    typedef struct {                                                                        \
+    typedef struct MZ_ALIGNED(64) {                                                         \
         float org_x[W], org_y[W], org_z[W], tnear[W];                                       \
         float dir_x[W], dir_y[W], dir_z[W], time[W];                                        \
         float tfar[W];                                                                      \
         uint32_t mask[W], id[W], flags[W];                                                  \
-    } __attribute__((aligned(64))) ray##W;                                                  \
-    typedef struct {                                                                        \
+    } ray##W;                                                                               \
+    typedef struct MZ_ALIGNED(64) {                                                         \
         float ng_x[W], ng_y[W], ng_z[W], u[W], v[W];                                        \
         uint32_t prim_id[W], geom_id[W], inst_id[W];                                        \
         char slack[SLACK];                                                                  \
-    } __attribute__((aligned(64))) hit##W;                                                  \
-    typedef struct {                                                                        \
+    } hit##W;                                                                               \
+    typedef struct MZ_ALIGNED(64) {                                                         \
         ray##W ray;                                                                         \
         hit##W hit;                                                                         \
-    } __attribute__((aligned(64))) rayhit##W;                                               \
+    } rayhit##W;                                                                            \
     typedef void (*intersect##W##_fn)(const int *, void *, rayhit##W *, query_args *);       \
     typedef void (*occluded##W##_fn)(const int *, void *, ray##W *, query_args *);
 
@@ -131,13 +150,13 @@ static int block_next(packet_order *po, int width, int64_t (*idx)[16], int *m) {
 
 #define INTERSECT_BODY(W)                                                                   \
     {                                                                                       \
-        rayhit##W *rh = (rayhit##W *)aligned_alloc(64, BLOCK * sizeof(rayhit##W));          \
-        int (*valid)[W] = (int (*)[W])aligned_alloc(64, BLOCK * W * sizeof(int));           \
+        rayhit##W *rh = (rayhit##W *)mz_aligned_alloc(64, BLOCK * sizeof(rayhit##W));       \
+        int (*valid)[W] = (int (*)[W])mz_aligned_alloc(64, BLOCK * W * sizeof(int));        \
         intersect##W##_fn fn = (intersect##W##_fn)fn_addr;                                  \
         int64_t idx[BLOCK][16];                                                             \
         int m[BLOCK];                                                                       \
         packet_order po;                                                                    \
-        if (!rh || !valid) { free(rh); free(valid); return -3; }                            \
+        if (!rh || !valid) { mz_aligned_free(rh); mz_aligned_free(valid); return -3; }      \
         order_init(&po, n, row, W);                                                         \
         for (int nb; (nb = block_next(&po, W, idx, m)) > 0;) {                              \
             for (int b = 0; b < nb; ++b) {                                                  \
@@ -158,8 +177,8 @@ static int block_next(packet_order *po, int width, int64_t (*idx)[16], int *m) {
                         inst_out[j] = p == INVALID_ID ? -1 : (int32_t)rh[b].hit.inst_id[k]; \
                 }                                                                           \
         }                                                                                   \
-        free(rh);                                                                           \
-        free(valid);                                                                        \
+        mz_aligned_free(rh);                                                                \
+        mz_aligned_free(valid);                                                             \
     }
 
 /* Nearest hits of n rays: origins org (n, 3), directions dir (n, 3) (dir_step 1) or one
@@ -169,9 +188,10 @@ static int block_next(packet_order *po, int width, int64_t (*idx)[16], int *m) {
  * may be NULL. coherent: Embree's coherent-rays flag. row: rays per row when
  * the rays form a grid laid out row by row (packets then take tiles of it), else 0.
  * Returns 0, -1 for an unknown packet width, -3 when memory runs out. */
-int mz_intersect(void *fn_addr, int width, void *scene, int64_t n, const float *org,
-                 const float *dir, int dir_step, const float *tfar, int32_t *prim_out,
-                 float *tfar_out, int32_t *inst_out, int coherent, int64_t row) {
+MZ_EXPORT int mz_intersect(void *fn_addr, int width, void *scene, int64_t n,
+                           const float *org, const float *dir, int dir_step,
+                           const float *tfar, int32_t *prim_out, float *tfar_out,
+                           int32_t *inst_out, int coherent, int64_t row) {
     query_args args;
     init_args(&args, coherent);
     switch (width) {
@@ -185,13 +205,13 @@ int mz_intersect(void *fn_addr, int width, void *scene, int64_t n, const float *
 
 #define OCCLUDED_BODY(W)                                                                    \
     {                                                                                       \
-        ray##W *r = (ray##W *)aligned_alloc(64, BLOCK * sizeof(ray##W));                    \
-        int (*valid)[W] = (int (*)[W])aligned_alloc(64, BLOCK * W * sizeof(int));           \
+        ray##W *r = (ray##W *)mz_aligned_alloc(64, BLOCK * sizeof(ray##W));                 \
+        int (*valid)[W] = (int (*)[W])mz_aligned_alloc(64, BLOCK * W * sizeof(int));        \
         occluded##W##_fn fn = (occluded##W##_fn)fn_addr;                                    \
         int64_t idx[BLOCK][16];                                                             \
         int m[BLOCK];                                                                       \
         packet_order po;                                                                    \
-        if (!r || !valid) { free(r); free(valid); return -3; }                              \
+        if (!r || !valid) { mz_aligned_free(r); mz_aligned_free(valid); return -3; }        \
         order_init(&po, n, row, W);                                                         \
         for (int nb; (nb = block_next(&po, W, idx, m)) > 0;) {                              \
             for (int b = 0; b < nb; ++b) FILL_RAYS(W, &r[b], valid[b], idx[b], m[b])        \
@@ -199,16 +219,16 @@ int mz_intersect(void *fn_addr, int width, void *scene, int64_t n, const float *
             for (int b = 0; b < nb; ++b)          /* Embree sets -inf where blocked */      \
                 for (int k = 0; k < m[b]; ++k) out[idx[b][k]] = r[b].tfar[k] < 0.0f;        \
         }                                                                                   \
-        free(r);                                                                            \
-        free(valid);                                                                        \
+        mz_aligned_free(r);                                                                 \
+        mz_aligned_free(valid);                                                             \
     }
 
 /* Whether anything lies on each of n rays within tfar (as mz_intersect): out (n,) uint8,
  * 1 where blocked; coherent and row as mz_intersect. Returns 0, -1 for an unknown packet
  * width, -3 when memory runs out. */
-int mz_occluded(void *fn_addr, int width, void *scene, int64_t n, const float *org,
-                const float *dir, int dir_step, const float *tfar, uint8_t *out, int coherent,
-                int64_t row) {
+MZ_EXPORT int mz_occluded(void *fn_addr, int width, void *scene, int64_t n,
+                          const float *org, const float *dir, int dir_step, const float *tfar,
+                          uint8_t *out, int coherent, int64_t row) {
     query_args args;
     init_args(&args, coherent);
     switch (width) {
@@ -322,7 +342,7 @@ static void lane_advance(lane *L, const segment *S, int done) {
                                    lane *st, int64_t *act, int64_t n_act,                   \
                                    const double *wrap) {                                    \
         rayhit##W rh;                                                                       \
-        int valid[W] __attribute__((aligned(64)));                                          \
+        MZ_ALIGNED(64) int valid[W];                                                        \
         segment seg[W];                                                                     \
         int64_t kept = 0;                                                                   \
         for (int64_t i = 0; i < n_act; i += W) {                                            \
@@ -385,11 +405,12 @@ WRAPPED_PASS(16)
  * frame_cells (2,) (instances tiling each frame). Rays are traced segment by
  * segment in passes, the rays still travelling packed together. Returns 0; -1 for an unknown
  * packet width, -2 for a ray that never ends, -3 when memory runs out. */
-int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene, int64_t n,
-               const double *org, const double *dir, int dir_step, const double *length,
-               const double *wrap, int any_hit, int32_t *prim_out, int64_t *cell_out,
-               double *dist_out, int32_t *inst_out, uint8_t *blocked_out, int coherent,
-               int64_t row, const int64_t *inst_cells, const int64_t *frame_cells) {
+MZ_EXPORT int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene,
+                         int64_t n, const double *org, const double *dir, int dir_step,
+                         const double *length, const double *wrap, int any_hit,
+                         int32_t *prim_out, int64_t *cell_out, double *dist_out,
+                         int32_t *inst_out, uint8_t *blocked_out, int coherent, int64_t row,
+                         const int64_t *inst_cells, const int64_t *frame_cells) {
     if (width != 4 && width != 8 && width != 16) return -1;
     query_args args;
     init_args(&args, coherent);
@@ -434,6 +455,32 @@ int mz_wrapped(void *fn_intersect, void *fn_occluded, int width, void *scene, in
 
 /* The size in bytes this file gives a packet of width 16 (ray, then hit without slack), for
  * the loader's check against Embree 4's layout: 12 x 64 + 8 x 64. */
-int64_t mz_layout_check(void) {
+MZ_EXPORT int64_t mz_layout_check(void) {
     return (int64_t)sizeof(ray16) * 1000 + (int64_t)offsetof(rayhit16, hit);
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* The Python module: its source's hash (setup.py passes it as MZ_SOURCE_SHA256) and the
+ * packet layout, so that the loader can tell a kernel built from another _packets.c. */
+
+#ifndef MZ_SOURCE_SHA256
+#define MZ_SOURCE_SHA256 unknown
+#endif
+#define MZ_STR2(x) #x
+#define MZ_STR(x) MZ_STR2(x)
+
+static struct PyModuleDef mz_module = {
+    PyModuleDef_HEAD_INIT, "_packets",
+    "Embree ray packets (maizeviz.mesh.packets calls its mz_* functions through ctypes).",
+    -1, NULL, NULL, NULL, NULL, NULL};
+
+PyMODINIT_FUNC PyInit__packets(void) {
+    PyObject *m = PyModule_Create(&mz_module);
+    if (m == NULL) return NULL;
+    if (PyModule_AddStringConstant(m, "source_sha256", MZ_STR(MZ_SOURCE_SHA256)) < 0
+            || PyModule_AddIntConstant(m, "layout", (long)mz_layout_check()) < 0) {
+        Py_DECREF(m);
+        return NULL;
+    }
+    return m;
 }

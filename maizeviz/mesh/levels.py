@@ -7,6 +7,7 @@ paper's standard mesh, K = 4 its reference mesh) or a triangle budget below the 
 
 from __future__ import annotations
 
+import os
 import re
 from collections import defaultdict
 from dataclasses import dataclass
@@ -16,9 +17,9 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.mesh import measures
-from maizeviz.mesh.simplify import simplify
-from maizeviz.mesh.tessellate import LeafMesh, mesh_grid
-from maizeviz.progress import ProgressCallback, report
+from maizeviz.mesh.simplify import count_triangles, simplify_many
+from maizeviz.mesh.tessellate import LeafMesh, mesh_grids
+from maizeviz.progress import ProgressCallback, ordered_map, report
 
 if TYPE_CHECKING:
     # Level and parse_level are light (the app's slider reads them before its window shows);
@@ -40,6 +41,8 @@ COMPLEXITY_STOPS = ("K4", "K2", "K1", "standard", "36", "16", "8", "4")
 MAX_INTERP = 50
 #: Surface points sampled at a time when measuring many leaves (about 50 MB of work arrays).
 MEASURE_POINTS = 1 << 19
+#: Vertices meshed at a time (a chunk per thread): small enough for a few chunks per core.
+MESH_POINTS = 1 << 16
 
 
 @dataclass(frozen=True)
@@ -156,9 +159,9 @@ def reference_areas(leaves: list[Leaf]) -> np.ndarray:
     return out
 
 
-def _chunks(idx: list[int], per_leaf: int) -> list[list[int]]:
-    """``idx`` cut in runs of about :data:`MEASURE_POINTS` // ``per_leaf`` (at least 1)."""
-    step = max(1, MEASURE_POINTS // max(per_leaf, 1))
+def _chunks(idx: list[int], per_leaf: int, points: int = MEASURE_POINTS) -> list[list[int]]:
+    """``idx`` cut in runs of about ``points`` // ``per_leaf`` (at least 1)."""
+    step = max(1, points // max(per_leaf, 1))
     return [idx[k:k + step] for k in range(0, len(idx), step)]
 
 
@@ -171,48 +174,65 @@ def _sample(surfaces: NurbsSurfaces, k: int) -> tuple[np.ndarray, np.ndarray, np
 
 
 def mesh_leaves(leaves: list[Leaf], level: Level, preserve_area: bool = True,
-                progress: ProgressCallback | None = None) -> list[LeafMesh]:
+                progress: ProgressCallback | None = None,
+                threads: int | None = None) -> list[LeafMesh]:
     """Meshes of every leaf at one level, in the order given.
 
-    Leaves of equal grid shape are sampled in one batch. ``progress(done, total)`` is called
-    after each batch or leaf; if it returns ``False`` the work stops with
-    :class:`InterruptedError`.
+    Leaves of equal grid shape are meshed together, :data:`MESH_POINTS` vertices (or
+    standard-grid points, under a triangle budget) at a time, the chunks on ``threads``
+    threads (default: one per core; numpy releases the interpreter's lock in its loops).
+    ``progress(done, total)`` is called after each chunk; if it returns ``False`` the work
+    stops with :class:`InterruptedError`.
     """
     total = len(leaves)
     out: list[LeafMesh | None] = [None] * total
-    done = 0
-
-    def tick(n: int) -> None:
-        nonlocal done
-        done += n
-        report(progress, done, total, "meshing")
-
     groups: dict[tuple[int, int], list[int]] = defaultdict(list)
     for i, leaf in enumerate(leaves):
         groups[leaf.grid.shape].append(i)
-    for idx in groups.values():
-        surf = _stack([leaves[i].surface for i in idx])
-        if level.interp is not None:
-            pts, u, v = _sample(surf, level.interp)
-            for k, i in enumerate(idx):
-                g = leaves[i].grid
-                out[i] = mesh_grid(pts[k], u[k], v[k], level.label, g.plant, g.leaf)
-            tick(len(idx))
-            continue
+    k = level.interp if level.interp is not None else 0
+    chunks = []
+    for (m, n), group in groups.items():
+        per_leaf = ((m - 1) * (k + 1) + 1) * ((n - 1) * (k + 1) + 1)
+        chunks += _chunks(group, per_leaf, MESH_POINTS)
+    done = 0
+
+    def tick(j: int) -> None:
+        nonlocal done
+        done += len(chunks[j - 1])
+        report(progress, done, total, "meshing")
+
+    work = ordered_map(lambda idx: _mesh_chunk(leaves, idx, level, preserve_area), chunks,
+                       threads or os.cpu_count() or 1, tick)
+    for j, meshes in enumerate(work):             # each chunk's tick follows its results
+        for i, mesh in zip(chunks[j], meshes):
+            out[i] = mesh
+    return [m for m in out if m is not None]
+
+
+def _mesh_chunk(leaves: list[Leaf], idx: list[int], level: Level, preserve_area: bool
+                ) -> list[LeafMesh]:
+    """Meshes of ``leaves[i]`` for i in ``idx`` (one grid shape), in that order."""
+    surf = _stack([leaves[i].surface for i in idx])
+    plants = [leaves[i].grid.plant for i in idx]
+    ranks = [leaves[i].grid.leaf for i in idx]
+    if level.interp is not None:
+        pts, u, v = _sample(surf, level.interp)
+        meshes = mesh_grids(pts, u, v, level.label, plants, ranks)
+    else:
         budget = level.triangles
         assert budget is not None                    # a level is K or a budget
         targets = reference_areas([leaves[i] for i in idx]) if preserve_area else None
-        for k, i in enumerate(idx):
-            g = leaves[i].grid
-            target = float(targets[k]) if targets is not None else None
-            try:
-                out[i] = simplify(g.points, surf.params_u[k], surf.params_v[k], budget,
-                                  g.tip_collapsed, target, g.plant, g.leaf)
-            except ValueError as exc:                    # a budget below the coarsest mesh
-                raise MaizevizError(f"{level}: plant {g.plant}, leaf {g.leaf}: {exc}",
-                                    quantity="triangles") from None
-            tick(1)
-    return [m for m in out if m is not None]
+        tips = np.array([leaves[i].grid.tip_collapsed for i in idx])
+        try:
+            meshes = simplify_many(np.stack([leaves[i].grid.points for i in idx]),
+                                   surf.params_u, surf.params_v, budget, tips, targets,
+                                   plants, ranks)
+        except ValueError as exc:                    # a budget below the coarsest mesh
+            first = next(leaves[i].grid for k, i in enumerate(idx)
+                         if budget < count_triangles(2, 2, tips[k]))
+            raise MaizevizError(f"{level}: plant {first.plant}, leaf {first.leaf}: {exc}",
+                                quantity="triangles") from None
+    return meshes
 
 
 def mesh_leaf(leaf: Leaf, level: Level, preserve_area: bool = True) -> LeafMesh:
@@ -223,13 +243,7 @@ def mesh_leaf(leaf: Leaf, level: Level, preserve_area: bool = True) -> LeafMesh:
 def _stack(surfaces: list[NurbsSurfaces]) -> NurbsSurfaces:
     from maizeviz.leaf.nurbs import NurbsSurfaces
 
-    if len(surfaces) == 1:
-        return surfaces[0]
-    s0 = surfaces[0]
-    return NurbsSurfaces(s0.degree_u, s0.degree_v,
-                         *(np.concatenate([getattr(s, f) for s in surfaces])
-                           for f in ("knots_u", "knots_v", "control", "weights",
-                                     "params_u", "params_v")))
+    return NurbsSurfaces.join(surfaces)
 
 
 @dataclass(frozen=True)

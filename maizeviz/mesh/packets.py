@@ -1,24 +1,26 @@
-"""Embree ray packets through a small C kernel (``_packets.c``), loaded with ctypes.
+"""Embree ray packets through a small C kernel (``_packets.c``), called through ctypes.
 
 embreex exposes Embree's single-ray queries only (``rtcIntersect1``/``rtcOccluded1``). Embree
 traces coherent rays faster in packets (``rtcIntersect8``/``16``, ``rtcOccluded8``/``16``, with
 the coherent flag): ``_packets.c`` loops over a batch of rays in packets and writes the hits
 into numpy arrays. It needs no Embree header and no link: the packet functions' addresses are
-taken from the ``libembree4`` embreex loads (:func:`maizeviz.mesh.embree_fill._embree`) and
+taken from the ``libembree4`` embreex loads (:func:`maizeviz.mesh.embree_fill.embree`) and
 passed in as integers, with the scene handle. ctypes releases the GIL during the call, so
 threads trace chunks in parallel.
 
-The kernel is compiled once (``cc -O2 -shared -fPIC``) into a cache folder
-(``$MAIZEVIZ_CACHE``, else ``$XDG_CACHE_HOME/maizeviz``, else ``~/.cache/maizeviz``), named by
-a hash of its source; ``scripts/setup.sh`` compiles it at set-up. Without a C compiler, without
-the library, or with ``MAIZEVIZ_PACKETS=0`` in the environment, :func:`kernel` returns None and
-:class:`~maizeviz.mesh.raytrace.RayScene` uses embreex's single rays: the same hits, ray for
-ray (``tests/core/test_packets.py``).
+The kernel is built when maizeviz is installed, as the extension module
+``maizeviz.mesh._packets`` (``setup.py``; a platform wheel carries it built): nothing is
+compiled or written at run time. Where it cannot be used, :func:`kernel` returns None and
+:class:`~maizeviz.mesh.raytrace.RayScene` traces with embreex's single rays, the same hits ray
+for ray (``tests/core/test_packets.py``), saying once why (:func:`status`: not built at
+install, built from another ``_packets.c``, Embree's library or embreex's scenes not reachable,
+a packet layout other than Embree 4's); ``MAIZEVIZ_PACKETS=0`` in the environment turns it off
+without a word. ``maizeviz --info`` prints what is used and why.
 
 References
 ----------
 Wald, I., Benthin, C., Wagner, M. & Slusallek, P. (2001). Interactive rendering with coherent
-ray tracing. Computer Graphics Forum 20(3), 153-165 (ray packets).
+ray tracing. Computer Graphics Forum 20(3), 153-165. https://doi.org/10.1111/1467-8659.00508
 Embree 4 API: rtcIntersect4/8/16, rtcOccluded4/8/16, RTCIntersectArguments
 (https://github.com/RenderKit/embree/blob/master/doc/src/api.md).
 """
@@ -29,9 +31,8 @@ import ctypes
 import functools
 import hashlib
 import os
-import shutil
-import subprocess
-import tempfile
+import threading
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,44 +45,6 @@ DEFAULT_WIDTH = int(os.environ.get("MAIZEVIZ_PACKET_WIDTH", "8"))
 _LAYOUT = 768 * 1000 + 768
 
 
-def cache_dir() -> Path:
-    """Where the compiled kernel is kept."""
-    if os.environ.get("MAIZEVIZ_CACHE"):
-        return Path(os.environ["MAIZEVIZ_CACHE"])
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "maizeviz"
-
-
-def compiled_path() -> Path:
-    """The kernel's shared library for the current source (it may not exist yet)."""
-    digest = hashlib.sha256(SOURCE.read_bytes()).hexdigest()[:16]
-    return cache_dir() / f"_packets-{digest}.so"
-
-
-def build(force: bool = False) -> Path | None:
-    """Compile ``_packets.c`` into the cache folder (if not there yet); its path, or None
-    where no C compiler is found or compiling fails."""
-    target = compiled_path()
-    if target.exists() and not force:
-        return target
-    cc = os.environ.get("CC") or shutil.which("cc") or shutil.which("gcc")
-    if cc is None:
-        return None
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(suffix=".so", dir=target.parent)
-        os.close(fd)
-        done = subprocess.run([cc, "-O2", "-ffp-contract=off", "-shared", "-fPIC", str(SOURCE),
-                               "-o", tmp, "-lm"], capture_output=True, timeout=120)
-        if done.returncode != 0:
-            os.unlink(tmp)
-            return None
-        os.replace(tmp, target)              # atomic: concurrent builds leave one good file
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return target
-
-
 @dataclass(frozen=True)
 class Kernel:
     """The loaded kernel and the Embree packet functions it calls (addresses)."""
@@ -92,22 +55,52 @@ class Kernel:
     width: int
 
 
-@functools.cache
-def kernel() -> Kernel | None:
-    """The packet kernel, compiled and loaded on first use; None where it cannot be (then
-    embreex's single rays are used)."""
-    if os.environ.get("MAIZEVIZ_PACKETS", "1") == "0":
-        return None
-    from maizeviz.mesh.embree_fill import _embree
+@dataclass(frozen=True)
+class Status:
+    """Which kernel traces rays, and why.
 
-    embree = _embree()
-    path = build() if embree is not None else None
-    if path is None or embree is None:
-        return None
+    Attributes
+    ----------
+    name : {"packets", "embreex"}
+        Embree's ray packets through the built kernel, or embreex's single rays.
+    why : str
+        Why the packets are not used ("" when they are).
+    path : Path or None
+        The kernel's extension module, where it was built.
+    """
+
+    name: str
+    why: str
+    path: Path | None
+
+
+def _load() -> tuple[Kernel | None, Status]:
+    if os.environ.get("MAIZEVIZ_PACKETS", "1") == "0":
+        return None, Status("embreex", "turned off by MAIZEVIZ_PACKETS=0", None)
+    try:
+        from maizeviz.mesh import _packets as ext
+    except ImportError as exc:
+        return None, Status("embreex", "the ray-packet kernel was not built when maizeviz was "
+                            f"installed ({exc}): install a maizeviz wheel for this platform, "
+                            "or reinstall with a C compiler", None)
+    path = Path(ext.__file__)
+    if SOURCE.is_file() and \
+            hashlib.sha256(SOURCE.read_bytes()).hexdigest() != ext.source_sha256:
+        return None, Status("embreex", f"the ray-packet kernel {path.name} was built from "
+                            "another _packets.c: rebuild it (pip install -e . or "
+                            "scripts/setup.sh)", path)
+    if ext.layout != _LAYOUT:
+        return None, Status("embreex", f"the kernel's packets are laid out as {ext.layout}, "
+                            f"not as Embree 4's ({_LAYOUT})", path)
+    from maizeviz.mesh.embree_fill import embree
+
+    e = embree()
+    if e.lib is None or not e.scene_field:
+        return None, Status("embreex", e.why, path)
     try:
         lib = ctypes.CDLL(str(path))
-    except OSError:
-        return None
+    except OSError as exc:  # pragma: no cover - it was imported a moment ago
+        return None, Status("embreex", f"{path} does not load through ctypes ({exc})", path)
     p, i64, i32 = ctypes.c_void_p, ctypes.c_int64, ctypes.c_int
     lib.mz_intersect.restype = i32
     lib.mz_intersect.argtypes = [p, i32, p, i64, p, p, i32, p, p, p, p, i32, i64]
@@ -116,21 +109,52 @@ def kernel() -> Kernel | None:
     lib.mz_wrapped.restype = i32
     lib.mz_wrapped.argtypes = [p, p, i32, p, i64, p, p, i32, p, p, i32, p, p, p, p, p, i32, i64,
                                p, p]
-    lib.mz_layout_check.restype = i64
-    if lib.mz_layout_check() != _LAYOUT:
-        return None
     inter: dict[int, int] = {}
     occl: dict[int, int] = {}
     for w in (4, 8, 16):
-        fi = getattr(embree, f"rtcIntersect{w}", None)
-        fo = getattr(embree, f"rtcOccluded{w}", None)
+        fi = getattr(e.lib, f"rtcIntersect{w}", None)
+        fo = getattr(e.lib, f"rtcOccluded{w}", None)
         ai = ctypes.cast(fi, ctypes.c_void_p).value if fi is not None else None
         ao = ctypes.cast(fo, ctypes.c_void_p).value if fo is not None else None
         if not ai or not ao:
-            return None
+            return None, Status("embreex", f"{e.path} has no rtcIntersect{w}/rtcOccluded{w}",
+                                path)
         inter[w], occl[w] = ai, ao
     width = DEFAULT_WIDTH if DEFAULT_WIDTH in inter else 8
-    return Kernel(lib, inter, occl, width)
+    return Kernel(lib, inter, occl, width), Status("packets", "", path)
+
+
+@functools.cache
+def _loaded() -> tuple[Kernel | None, Status]:
+    return _load()
+
+
+def kernel() -> Kernel | None:
+    """The packet kernel, loaded on first use; None where it cannot be used (then embreex's
+    single rays are used: :func:`status` says why)."""
+    return _loaded()[0]
+
+
+def status() -> Status:
+    """Which kernel traces rays (``"packets"`` or ``"embreex"``) and why."""
+    return _loaded()[1]
+
+
+_warned = threading.Lock()
+_said: set[tuple[str, str]] = set()
+
+
+def warn_once(why: str, what: str = "tracing with embreex's single rays (the same hits, "
+              "about 2x slower)") -> None:
+    """A RuntimeWarning saying ``what`` is done instead of a fast path and ``why``, once per
+    reason in a process (``MAIZEVIZ_PACKETS=0``, a deliberate choice, is not warned about)."""
+    if not why or why.startswith("turned off by MAIZEVIZ_PACKETS"):
+        return
+    with _warned:
+        if (what, why) in _said:
+            return
+        _said.add((what, why))
+    warnings.warn(f"maizeviz: {what}: {why}", RuntimeWarning, stacklevel=3)
 
 
 def _rays(origins: np.ndarray, directions: np.ndarray) -> tuple[np.ndarray, np.ndarray, int]:

@@ -16,13 +16,28 @@ import numpy as np
 try:  # optional native piece: fail only when ray tracing is used
     from embreex.mesh_construction import TriangleMesh
     from embreex.rtcore_scene import EmbreeScene
-except ImportError as _exc:  # pragma: no cover - exercised only without embreex
+except ImportError as _exc:  # exercised by tests/core/test_packets.py in a subprocess
     EmbreeScene = None
     _IMPORT_ERROR = _exc
 
 from maizeviz.errors import MaizevizError
 from maizeviz.mesh import packets as _packets
-from maizeviz.mesh.embree_fill import _handles, fill
+from maizeviz.mesh.embree_fill import _handles, compact, embree, fill
+
+#: Why the fast paths are off when embreex's scene object is not laid out as expected.
+_UNREAD = "embreex's EmbreeScene is not laid out as maizeviz reads it (its scene handle)"
+
+
+def no_embreex(exc: BaseException) -> str:
+    """One line for light asked where embreex does not import: its wheels' platforms, and this
+    one."""
+    import platform
+    import sys
+
+    return (f"light is traced by Embree through embreex, which does not import here ({exc}): "
+            f"embreex has wheels for Linux x86-64, Windows x86-64 and macOS 13 or later, this "
+            f"is {sys.platform} {platform.machine()} (pip install embreex, or build it against "
+            "an Embree 4 of the system)")
 
 
 def _writable(a) -> np.ndarray:
@@ -44,32 +59,54 @@ class RayScene:
     """An Embree scene over triangles (V, 3) cm and faces (F, 3); ray queries by numpy arrays.
 
     Triangle ids returned by queries are indices into ``faces``.
+
+    Memory: Embree's own float32 copy of the vertices (16 bytes each), the index buffer shared
+    with ``faces`` where they are one int32 array (an open field's canopy) and a compact BVH:
+    about 45 bytes a triangle in all at K = 4, where embreex's default (a float32 and an int32
+    copy made first, Embree's copies, its default BVH) held 115 and peaked at 140 while
+    building.
     """
 
-    def __init__(self, vertices: np.ndarray, faces: np.ndarray, robust: bool = False,
-                 by_copy: bool = True, packets: bool = True):
-        """``by_copy``: fill Embree's buffers by memory copy (:mod:`maizeviz.mesh.embree_fill`,
-        about 20x faster); False, or where that cannot be done, embreex's element-by-element
-        ``TriangleMesh`` (the same scene: ``filled_by_copy`` says which was used).
-        ``packets``: trace through Embree's ray packets where the kernel is available
+    def __init__(self, vertices, faces, robust: bool = False, by_copy: bool = True,
+                 packets: bool = True, snap_q: float | None = None):
+        """``vertices`` (V, 3) cm and ``faces`` (F, 3): arrays, or sequences of arrays taken one
+        after the other (the faces numbered over all the vertices). ``snap_q``: x and y rounded
+        to multiples of it (cm) as Embree's copy is made (a periodic field's grid).
+        ``by_copy``: fill Embree's buffers by memory copy (:mod:`maizeviz.mesh.embree_fill`,
+        about 20x faster, no transient copy); False, or where that cannot be done, embreex's
+        element-by-element ``TriangleMesh`` (the same scene: ``filled_by_copy`` says which was
+        used). ``packets``: trace through Embree's ray packets where the kernel is available
         (``self.packets`` says whether it is used), else embreex's single rays."""
-        if EmbreeScene is None:  # pragma: no cover
-            raise MaizevizError(f"ray tracing needs embreex, which failed to import: {_IMPORT_ERROR}")
-        if len(faces) == 0:
+        if EmbreeScene is None:
+            raise MaizevizError(no_embreex(_IMPORT_ERROR), quantity="embreex")
+        n = len(faces) if isinstance(faces, np.ndarray) else sum(len(f) for f in faces)
+        if n == 0:
             raise MaizevizError("the scene is empty: no triangle to trace against")
-        self.n_triangles = len(faces)
+        self.n_triangles = n
         self._scene = EmbreeScene(robust=robust)
-        verts = np.ascontiguousarray(vertices, dtype=np.float32)
-        tris = np.ascontiguousarray(faces, dtype=np.int32)
-        self.filled_by_copy = by_copy and fill(self._scene, verts, tris)
-        if not self.filled_by_copy:
-            self._mesh = TriangleMesh(self._scene, verts, tris)
+        self.compact = by_copy and compact(self._scene)
+        filled = fill(self._scene, vertices, faces, snap_q, share=True) if by_copy else 0
+        self.filled_by_copy = bool(filled)
+        #: the canopy's faces Embree reads in place (kept alive with the scene), or None
+        self._shared = faces if filled == 2 else None
+        if not filled:
+            if by_copy:
+                _packets.warn_once(embree().why or _UNREAD, "filling Embree's scenes through "
+                                   "embreex (the same scene, about 3x slower to build)")
+            verts = np.vstack(vertices) if not isinstance(vertices, np.ndarray) else vertices
+            if snap_q is not None:
+                verts = np.array(verts, dtype=np.float64)
+                verts[:, :2] = np.round(verts[:, :2] / snap_q) * snap_q
+            tris = np.vstack(faces) if not isinstance(faces, np.ndarray) else faces
+            self._mesh = TriangleMesh(self._scene, np.ascontiguousarray(verts, np.float32),
+                                      np.ascontiguousarray(tris, np.int32))
         # commit now: the lazy first build is not thread-safe
         self._scene.run(np.zeros((1, 3), np.float32), np.array([[0, 0, 1]], np.float32))
         self._kernel = _packets.kernel() if packets else None
         handles = _handles(self._scene) if self._kernel is not None else None
         self._handle = handles[0] if handles else 0
-        if not self._handle:
+        if packets and not self._handle:
+            _packets.warn_once(_packets.status().why if self._kernel is None else _UNREAD)
             self._kernel = None
 
     @property

@@ -101,6 +101,46 @@ def mesh_grid(vertices: np.ndarray, u: np.ndarray, v: np.ndarray, level: str = "
     return LeafMesh(vertices, u, v, faces[~bad] if bad.any() else faces, level, plant, leaf)
 
 
+def degenerate_faces_many(vertices: np.ndarray, rel_tol: float = 1e-9) -> np.ndarray:
+    """:func:`degenerate_faces` of many grids (L, a, b, 3) at once: (L, 2 (a-1)(b-1)) bool."""
+    h = np.diff(vertices, axis=2)
+    h = np.einsum("lijk,lijk->lij", h, h)                               # (L, a, b-1) squared
+    w = np.diff(vertices, axis=1)
+    w = np.einsum("lijk,lijk->lij", w, w)                               # (L, a-1, b)
+    nl = len(vertices)
+    longest = np.maximum(h.reshape(nl, -1).max(axis=1, initial=0.0),
+                         w.reshape(nl, -1).max(axis=1, initial=0.0))
+    tol = (rel_tol**2 * np.maximum(longest, 1e-300))[:, None, None]
+    h0, w0 = h <= tol, w <= tol
+    bad = np.empty((nl, vertices.shape[1] - 1, vertices.shape[2] - 1, 2), dtype=bool)
+    bad[..., 0] = h0[:, 1:] | w0[:, :, :-1]
+    bad[..., 1] = h0[:, :-1] | w0[:, :, 1:]
+    return bad.reshape(nl, -1)
+
+
+def mesh_grids(vertices: np.ndarray, u: np.ndarray, v: np.ndarray, level: str = "",
+               plants=None, leaves=None) -> list[LeafMesh]:
+    """:func:`mesh_grid` of many vertex grids of one shape at once.
+
+    Parameters
+    ----------
+    vertices : (L, a, b, 3) float64, cm; u : (L, a), v : (L, b) float64
+    plants, leaves : (L,) ints, the ids of each mesh (default -1)
+
+    Returns
+    -------
+    L meshes, their vertices and parameters views of the arrays given.
+    """
+    nl, a, b = vertices.shape[:3]
+    faces = grid_faces(a, b)
+    bad = degenerate_faces_many(vertices)
+    some = list(np.any(bad, axis=1))
+    plants = [-1] * nl if plants is None else np.asarray(plants).tolist()
+    leaves = [-1] * nl if leaves is None else np.asarray(leaves).tolist()
+    return [LeafMesh(vertices[k], u[k], v[k], faces[~bad[k]] if some[k] else faces, level,
+                     plants[k], leaves[k]) for k in range(nl)]
+
+
 def merge_meshes(meshes: list[LeafMesh]) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
     """Concatenate leaf meshes for export.
 

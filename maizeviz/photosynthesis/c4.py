@@ -65,17 +65,38 @@ def smaller_root(curvature, a, b):
 
 @dataclass(frozen=True)
 class C4Leaf:
-    """Collatz et al. (1992) C4 leaf (see the module docstring), maize parameters by default.
+    """Collatz et al.'s (1992) C4 leaf (see the module docstring), maize parameters by default.
 
-    Attributes
+    Parameters
     ----------
-    vmax : Rubisco capacity at 25 C, umol CO2/m2/s
-    alpha : quantum yield, mol CO2 per mol of absorbed PAR photons
-    k : initial slope of the CO2 response at 25 C, mol/m2/s
-    theta, beta : curvatures of the light-Rubisco and of the CO2 co-limitation
-    rd : leaf (dark) respiration at 25 C, umol CO2/m2/s
-    q10 : of Vmax, k and Rd
-    co2_ppm : ambient CO2, umol/mol; ci_ratio : intercellular / ambient CO2
+    vmax : float
+        Rubisco capacity at 25 C [umol CO2 m-2 s-1].
+    alpha : float
+        Quantum yield [mol CO2 per mol of absorbed PAR photons].
+    k : float
+        Initial slope of the CO2 response at 25 C [mol m-2 s-1].
+    theta, beta : float
+        Curvatures of the light-Rubisco and of the CO2 co-limitation [-].
+    rd : float
+        Leaf (dark) respiration at 25 C [umol CO2 m-2 s-1].
+    q10 : float
+        Q10 of Vmax, k and Rd [-].
+    co2_ppm : float
+        Ambient CO2 [umol mol-1].
+    ci_ratio : float
+        Intercellular over ambient CO2 [-].
+    s1, s2 : float
+        Vmax falls above ``s2`` [degC] with steepness ``s1`` [degC-1].
+    s3, s4 : float
+        Vmax falls below ``s4`` [degC] with steepness ``s3`` [degC-1].
+    s5, s6 : float
+        Rd falls above ``s6`` [degC] with steepness ``s5`` [degC-1].
+
+    References
+    ----------
+    Collatz, G. J., Ribas-Carbo, M. & Berry, J. A. (1992). Coupled photosynthesis-stomatal
+    conductance model for leaves of C4 plants. Australian Journal of Plant Physiology 19,
+    519-538. https://doi.org/10.1071/PP9920519
     """
 
     vmax: float = 39.0
@@ -109,29 +130,70 @@ class C4Leaf:
         return self.q10 ** ((np.asarray(temp_c, dtype=np.float64) - 25.0) / 10.0)
 
     def vmax_at(self, temp_c):
-        """Rubisco capacity Vmax(T), umol/m2/s, at leaf temperature ``temp_c`` (C)."""
+        """Rubisco capacity at a leaf temperature.
+
+        Parameters
+        ----------
+        temp_c : float or numpy.ndarray
+            Leaf temperature [degC].
+
+        Returns
+        -------
+        numpy.ndarray
+            Vmax(T) [umol CO2 m-2 s-1].
+        """
         t = np.asarray(temp_c, dtype=np.float64)
         return self.vmax * self._q10(t) / ((1.0 + np.exp(self.s1 * (t - self.s2)))
                                            * (1.0 + np.exp(self.s3 * (self.s4 - t))))
 
     def k_at(self, temp_c):
-        """Initial slope of the CO2 response k(T), mol/m2/s."""
+        """Initial slope of the CO2 response at a leaf temperature.
+
+        Parameters
+        ----------
+        temp_c : float or numpy.ndarray
+            Leaf temperature [degC].
+
+        Returns
+        -------
+        numpy.ndarray
+            The slope k(T) [mol m-2 s-1].
+        """
         return self.k * self._q10(temp_c)
 
     def respiration(self, temp_c):
-        """Leaf respiration Rd(T), umol CO2/m2/s (per m2 of leaf)."""
+        """Leaf respiration at a leaf temperature.
+
+        Parameters
+        ----------
+        temp_c : float or numpy.ndarray
+            Leaf temperature [degC].
+
+        Returns
+        -------
+        numpy.ndarray
+            Rd(T) [umol CO2 m-2 of leaf s-1].
+        """
         t = np.asarray(temp_c, dtype=np.float64)
         return self.rd * self._q10(t) / (1.0 + np.exp(self.s5 * (t - self.s6)))
 
     # ------------------------------------------------------------------ assimilation
     def gross_umol(self, q_umol, temp_c=25.0, ci_ppm=None):
-        """Gross assimilation, umol CO2/m2 leaf/s.
+        """Gross assimilation of a leaf absorbing a photon flux.
 
         Parameters
         ----------
-        q_umol : (...) float64, PAR photons absorbed, umol/m2 leaf/s
-        temp_c : leaf temperature, C (broadcast against ``q_umol``)
-        ci_ppm : intercellular CO2, umol/mol (default ``ci_ratio * co2_ppm``)
+        q_umol : float or numpy.ndarray
+            PAR photons absorbed [umol m-2 of leaf s-1].
+        temp_c : float or numpy.ndarray
+            Leaf temperature [degC] (broadcast against ``q_umol``).
+        ci_ppm : float, optional
+            Intercellular CO2 [umol mol-1] (default ``ci_ratio * co2_ppm``).
+
+        Returns
+        -------
+        numpy.ndarray
+            Gross assimilation [umol CO2 m-2 of leaf s-1].
         """
         ci = self.ci_ratio * self.co2_ppm if ci_ppm is None else ci_ppm
         light = self.alpha * np.maximum(np.asarray(q_umol, dtype=np.float64), 0.0)
@@ -140,9 +202,28 @@ class C4Leaf:
         return smaller_root(self.beta, m, co2)
 
     def gross(self, par_w_m2, temp_c=25.0):
-        """Gross assimilation, umol CO2/m2 leaf/s, of a leaf absorbing ``par_w_m2`` (W/m2 of
-        leaf, PAR) at ``temp_c`` (C)."""
+        """Gross assimilation of a leaf absorbing PAR.
+
+        Parameters
+        ----------
+        par_w_m2 : float or numpy.ndarray
+            PAR absorbed [W m-2 of leaf].
+        temp_c : float or numpy.ndarray
+            Leaf temperature [degC].
+
+        Returns
+        -------
+        numpy.ndarray
+            Gross assimilation [umol CO2 m-2 of leaf s-1].
+        """
         return self.gross_umol(np.asarray(par_w_m2, dtype=np.float64) * PAR_UMOL_PER_J, temp_c)
 
     def as_dict(self) -> dict[str, float | str]:
+        """The model as a record (its name and parameters).
+
+        Returns
+        -------
+        dict
+            ``{"model": "c4", ...}``.
+        """
         return {"model": self.name, **asdict(self)}

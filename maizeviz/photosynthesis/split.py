@@ -52,10 +52,28 @@ class LeafModel(Protocol):
 
 
 def leaf_model(name: str = "c4", **params) -> LeafModel:
-    """The leaf model ``name`` ("c4" or "wofost") with ``params`` replacing its defaults
-    (None values are left out); MaizevizError naming an unknown model or parameter."""
+    """A leaf photosynthesis model by name, its parameters replacing the defaults.
+
+    Parameters
+    ----------
+    name : {"c4", "wofost"}
+        Collatz et al.'s C4 leaf, or WOFOST's light response.
+    **params
+        Parameters of the model's class (:class:`~maizeviz.photosynthesis.c4.C4Leaf`,
+        :class:`~maizeviz.photosynthesis.wofost.WofostLeaf`); None values are left out.
+
+    Returns
+    -------
+    LeafModel
+        The model.
+
+    Raises
+    ------
+    MaizevizError
+        An unknown model or parameter, or a value out of range.
+    """
     key = str(name).strip().lower()
-    classes: dict[str, type[C4Leaf] | type[WofostLeaf]] = {"c4": C4Leaf, "wofost": WofostLeaf}
+    classes: dict[str, type[C4Leaf | WofostLeaf]] = {"c4": C4Leaf, "wofost": WofostLeaf}
     if key not in classes:
         raise MaizevizError(f"unknown photosynthesis model '{name}' (known: "
                             f"{', '.join(MODELS)})", quantity="photosynthesis")

@@ -35,10 +35,19 @@ from maizeviz.photosynthesis.units import KG_HA_H_PER_UMOL_M2_S
 class WofostLeaf:
     """WOFOST's negative exponential light response (see the module docstring).
 
-    Attributes
+    Parameters
     ----------
-    amax : gross assimilation at light saturation, kg CO2/ha leaf/h
-    eff : initial light use efficiency, kg CO2/ha/h per J/m2/s of absorbed PAR
+    amax : float
+        Gross assimilation at light saturation [kg CO2 ha-1 of leaf h-1].
+    eff : float
+        Initial light use efficiency [kg CO2 ha-1 h-1 per J m-2 s-1 of absorbed PAR].
+
+    References
+    ----------
+    Spitters, C. J. T., Toussaint, H. A. J. M. & Goudriaan, J. (1986). Separating the
+    diffuse and direct component of global radiation and its implications for modeling canopy
+    photosynthesis. Part II. Calculation of canopy photosynthesis. Agricultural and Forest
+    Meteorology 38, 231-242. https://doi.org/10.1016/0168-1923(86)90061-4
     """
 
     amax: float = 70.0
@@ -53,18 +62,59 @@ class WofostLeaf:
         object.__setattr__(self, "eff", float(self.eff))
 
     def gross_kg_ha_h(self, par_w_m2):
-        """Gross assimilation, kg CO2/ha leaf/h, of a leaf absorbing ``par_w_m2`` (W/m2)."""
+        """Gross assimilation of a leaf absorbing PAR, in WOFOST's units.
+
+        Parameters
+        ----------
+        par_w_m2 : float or numpy.ndarray
+            PAR absorbed [W m-2 of leaf].
+
+        Returns
+        -------
+        numpy.ndarray
+            Gross assimilation [kg CO2 ha-1 of leaf h-1].
+        """
         i = np.maximum(np.asarray(par_w_m2, dtype=np.float64), 0.0)
         return self.amax * -np.expm1(-i * self.eff / max(2.0, self.amax))
 
     def gross(self, par_w_m2, temp_c=25.0):
-        """Gross assimilation, umol CO2/m2 leaf/s (``temp_c`` is not used: see the module
-        docstring)."""
+        """Gross assimilation of a leaf absorbing PAR.
+
+        Parameters
+        ----------
+        par_w_m2 : float or numpy.ndarray
+            PAR absorbed [W m-2 of leaf].
+        temp_c : float or numpy.ndarray
+            Leaf temperature [degC] (not used: see the module docstring).
+
+        Returns
+        -------
+        numpy.ndarray
+            Gross assimilation [umol CO2 m-2 of leaf s-1].
+        """
         return self.gross_kg_ha_h(par_w_m2) / KG_HA_H_PER_UMOL_M2_S
 
     def respiration(self, temp_c):
-        """0: WOFOST books respiration at the crop level, not the leaf's."""
+        """Leaf respiration: 0, WOFOST books respiration at the crop level, not the leaf's.
+
+        Parameters
+        ----------
+        temp_c : float or numpy.ndarray
+            Leaf temperature [degC].
+
+        Returns
+        -------
+        numpy.ndarray
+            Zeros [umol CO2 m-2 of leaf s-1].
+        """
         return np.zeros_like(np.asarray(temp_c, dtype=np.float64))
 
     def as_dict(self) -> dict[str, float | str]:
+        """The model as a record (its name and parameters).
+
+        Returns
+        -------
+        dict
+            ``{"model": "wofost", "amax": ..., "eff": ...}``.
+        """
         return {"model": self.name, **asdict(self)}

@@ -48,6 +48,9 @@ _SKY_ARRAYS = ("zenith_deg", "azimuth_deg", "solid_angle_sr", "weights")
 #: Arrays of a Period (each (n,) float64), stored as ``period_<name>``.
 _PERIOD_ARRAYS = ("step_s", "zenith_deg", "azimuth_deg", "ghi", "dni", "dhi",
                   "direct_horizontal")
+#: Arrays a Period may have (a weather file's measured PAR, air temperature; NaN allowed in
+#: the temperature), stored when present.
+_PERIOD_OPTIONAL = {"par_measured": False, "temp_air": True}
 #: Prefix of the arrays of a day's sky light.
 _DIFFUSE = "diffuse_"
 #: Prefix of the arrays of a day's diffuse split by Perez's model.
@@ -144,7 +147,7 @@ def day_record(label: str, light, settings: dict | None = None) -> Record:
                       "par_umol_per_j": float(p.par_umol_per_j),
                       "notes": [str(n) for n in p.notes]}
     arrays = {f"period_{name}": np.asarray(getattr(p, name), np.float64)
-              for name in _PERIOD_ARRAYS}
+              for name in (*_PERIOD_ARRAYS, *_PERIOD_OPTIONAL) if getattr(p, name) is not None}
     arrays.update({"step_transmission": np.asarray(light.step_transmission, np.float64),
                    "step_intercepted_fraction":
                        np.asarray(light.step_intercepted_fraction, np.float64),
@@ -411,6 +414,7 @@ def _time(text: Any, where: str, what: str):
             text is None else "something else"
         raise ProjectError(f"{where}: {what} must be an ISO 8601 time with its UTC offset "
                            f"(2005-08-01T12:00:00+08:00), got {shown}")
+    t: pd.Timestamp | None
     try:
         t = pd.Timestamp(text.strip())
         t = None if t is pd.NaT or t.tz is None else t.as_unit("ns")   # years 1678-2261
@@ -444,6 +448,9 @@ def _period(rec: Record, m: dict, where: str):
     n = len(times)
     arrays = {name: _array(rec, f"period_{name}", where, "a day result's period", (n,))
               for name in _PERIOD_ARRAYS}
+    arrays.update({name: _array(rec, f"period_{name}", where, "a day result's period", (n,),
+                                nan=nan, lo=None if nan else 0.0)
+                   for name, nan in _PERIOD_OPTIONAL.items() if f"period_{name}" in rec.arrays})
     notes = tuple(str(get({"n": v}, "n", str, where=f"{at}: notes"))
                   for v in get(p, "notes", list, [], at))
     try:
@@ -531,6 +538,11 @@ def sun_from_record(rec: Record, where: str) -> tuple[str, Any]:
     for name in ("first_hits", "second_hits"):
         hits[name] = None if name not in rec.arrays else \
             _array(rec, name, where, what, (None,), counts=True, lo=0)
+    if (hits["first_hits"] is None) != (hits["second_hits"] is None) or (
+            hits["first_hits"] is not None
+            and len(hits["first_hits"]) != len(hits["second_hits"])):
+        raise ProjectError(f"{at}: its first and second hits per triangle do not match "
+                           "(one missing, or of other lengths); the project is damaged")
     planes: dict[str, Any] = {}
     if "sensor_lit" in rec.arrays:
         lit = rec.arrays["sensor_lit"]

@@ -32,8 +32,9 @@ from maizeviz.mesh.levels import Level, parse_level
 from maizeviz.project.records import KINDS, per_triangle, run_from_record, run_record
 from maizeviz.project.stands import layout_from_parts, layout_parts, stands_identity
 
-#: Settings groups of a project.
-CANOPY, LIGHT = "canopy", "light"
+#: Settings groups of a project (``view``: how the app colours light, kept for the app; a
+#: project without it opens with the app's defaults).
+CANOPY, LIGHT, VIEW = "canopy", "light", "view"
 
 
 @dataclass(frozen=True)
@@ -81,11 +82,12 @@ class Opened:
     canopy: dict = field(default_factory=dict)
     light: dict = field(default_factory=dict)
     records: list[Record] = field(default_factory=list)
+    view: dict = field(default_factory=dict)
 
 
 def make_project(points_path: str, points_bytes: bytes, layout: CanopyLayout | None,
                  stands: CanopyLayout, canopy: dict, light: dict,
-                 runs: Sequence[tuple]) -> Project:
+                 runs: Sequence[tuple], view: dict | None = None) -> Project:
     """The project of a study.
 
     Parameters
@@ -96,14 +98,15 @@ def make_project(points_path: str, points_bytes: bytes, layout: CanopyLayout | N
         with the identity of the stands it says it was traced on, else with this layout's
     canopy, light : settings (JSON objects)
     runs : (label, result) or (label, result, settings) tuples, results of any light
+    view : how the app colours light (JSON object), or None
     """
     doc, arrays = layout_parts(layout) if layout is not None else (None, {})
     identity = stands_identity(stands)
     records = tuple(run_record(run[0], run[1], run[2] if len(run) > 2 else None,
                                stands=getattr(run[1], "stands", None) or identity)
                     for run in runs)
-    return Project(points_bytes, str(points_path), doc, {CANOPY: canopy, LIGHT: light}, arrays,
-                   records)
+    settings = {CANOPY: canopy, LIGHT: light, **({VIEW: view} if view is not None else {})}
+    return Project(points_bytes, str(points_path), doc, settings, arrays, records)
 
 
 def _points_file(project: Project, cache: str | Path | None, notes: list[str]) -> str:
@@ -137,6 +140,7 @@ def open_project(path: str | Path, cache: str | Path | None = None) -> Opened:
     points_path = _points_file(project, cache, notes)
     canopy = get(project.settings, CANOPY, dict, {}, where)
     light = get(project.settings, LIGHT, dict, {}, where)
+    view = get(project.settings, VIEW, dict, {}, where)
     records = []
     for i, rec in enumerate(project.results):
         if rec.kind not in KINDS:
@@ -149,7 +153,7 @@ def open_project(path: str | Path, cache: str | Path | None = None) -> Opened:
             get(stands, "sha256", str, where=f"{where}: result {i + 1} stands")
         records.append(rec)
     shown = f"{Path(project.points_path).name} (project {Path(path).name})"
-    return Opened(where, project, points_path, shown, notes, canopy, light, records)
+    return Opened(where, project, points_path, shown, notes, canopy, light, records, view)
 
 
 def restore_layout(opened: Opened, plants: set[int]) -> CanopyLayout | None:
@@ -293,19 +297,22 @@ class Study:
 
 def read_study(path: str | Path, cache: str | Path | None = None,
                progress: Any = None) -> Study:
-    """Read a ``.maizeviz`` project: its points fitted, its layout, its canopy settings and
-    the light results that belong to them.
+    """Read a ``.maizeviz`` project: its points fitted, its layout, its settings and results.
 
     Parameters
     ----------
-    path : the project file
-    cache : folder for the project's checked copy of its points when the original file moved
-        or changed (default: the system's temporary folder)
-    progress : ``progress(done, total)`` over the leaves; returning False cancels
+    path : str or Path
+        The project file.
+    cache : str or Path, optional
+        Folder for the project's checked copy of its points when the original file moved or
+        changed (default: the system's temporary folder).
+    progress : callable, optional
+        ``progress(done, total)`` over the leaves; returning False cancels.
 
     Returns
     -------
     Study
+        The leaves, the layout, the canopy's level and the light results that belong to them.
 
     Raises
     ------
@@ -338,16 +345,24 @@ def save_study(path: str | Path, points: str | Path, layout: CanopyLayout,
 
     Parameters
     ----------
-    path : the project file to write (atomically: an existing one stays whole on failure)
-    points : the points file the plants were read from (its bytes go into the project)
-    layout : the stands of the canopy, stored with the project
-    results : light results traced on ``layout`` (``LightResult``, ``SkyLight`` or
-        ``PeriodLight``), each stored under its own mesh level
-    level : mesh level the project opens at; preserve_area : area-preserving triangle budgets
+    path : str or Path
+        The project file to write (atomically: an existing one stays whole on failure).
+    points : str or Path
+        The points file the plants were read from (its bytes go into the project).
+    layout : CanopyLayout
+        The stands of the canopy, stored with the project.
+    results : sequence of light results
+        Results traced on ``layout`` (``LightResult``, ``SkyLight``, ``PeriodLight``...), each
+        stored under its own mesh level.
+    level : str
+        The mesh level the project opens at.
+    preserve_area : bool
+        Area-preserving triangle budgets.
 
     Returns
     -------
     pathlib.Path
+        The project written.
 
     Raises
     ------

@@ -223,7 +223,7 @@ def _group_state(s) -> _GroupState:
 def _charge(state: _GroupState) -> dict:
     """The group's stage seconds for the first row that needed them, zeros afterwards, so
     that seconds summed over rows are the time spent."""
-    spent = {k: 0.0 for k in ("fit", "layout", "build", "scene", "measure")}
+    spent = dict.fromkeys(("fit", "layout", "build", "scene", "measure"), 0.0)
     spent.update(state.seconds)
     state.seconds = {}
     return spent

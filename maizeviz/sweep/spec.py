@@ -52,18 +52,13 @@ import itertools
 import json
 import math
 import os
-import sys
+import tomllib
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from datetime import date, datetime
 from datetime import time as dtime
 from pathlib import Path
 from typing import Any, NoReturn
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - Python 3.10: the tomli backport (the sweep extra installs it)
-    import tomli as tomllib
 
 import maizeviz
 from maizeviz.errors import MaizevizError
@@ -425,21 +420,26 @@ class _Checker:
                     self.fail(f"{where}.{k}", "is missing")
                 t[k] = self.number(t[k], f"{where}.{k}", positive=False)
         else:
-            for k in ("date", "lat", "lon"):
-                if k not in t:
-                    self.fail(f"{where}.{k}", "is missing (a sun from a place needs date, lat, "
-                                              "lon and time or solar_noon)")
-            for k in ("date", "time", "tz"):
-                if k in t:
-                    t[k] = self.text(t[k], f"{where}.{k}")
-            for k in ("lat", "lon", "altitude"):
-                if k in t:
-                    t[k] = self.number(t[k], f"{where}.{k}", positive=False)
-            if "solar_noon" in t:
-                t["solar_noon"] = self.boolean(t["solar_noon"], f"{where}.solar_noon")
-            if "time" not in t and not t.get("solar_noon"):
-                self.fail(f"{where}.time", "is missing (or set solar_noon = true)")
+            self._sun_place(t, where)
         return t
+
+    def _sun_place(self, t: dict, where: str) -> None:
+        """A sun given by a place and time: date, lat and lon, and a time or solar noon,
+        each checked (in place)."""
+        for k in ("date", "lat", "lon"):
+            if k not in t:
+                self.fail(f"{where}.{k}", "is missing (a sun from a place needs date, lat, "
+                                          "lon and time or solar_noon)")
+        for k in ("date", "time", "tz"):
+            if k in t:
+                t[k] = self.text(t[k], f"{where}.{k}")
+        for k in ("lat", "lon", "altitude"):
+            if k in t:
+                t[k] = self.number(t[k], f"{where}.{k}", positive=False)
+        if "solar_noon" in t:
+            t["solar_noon"] = self.boolean(t["solar_noon"], f"{where}.solar_noon")
+        if "time" not in t and not t.get("solar_noon"):
+            self.fail(f"{where}.time", "is missing (or set solar_noon = true)")
 
     def optics(self, v, where) -> OpticsSpec | None:
         """Leaf optics: "black" or false (interception), or a table of OPTICS_KEYS."""
@@ -577,6 +577,50 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
     doc, _ = read_toml(path)
     source = str(path)
     ck = _Checker(source, Path(path).resolve().parent)
+    canopy, light = _sections(ck, doc, source)
+
+    # --- canopy axes
+    points = _points_axis(ck, canopy)
+    arrangements = _arrangements(ck, canopy)
+    levels = ck.axis(canopy, "level", "canopy", ck.level)
+    preserve = ck.axis(canopy, "preserve_area", "canopy", ck.boolean, [True])
+    cover = 0.5
+    if "cover_resolution" in canopy:
+        cover = ck.number(canopy["cover_resolution"], "canopy.cover_resolution")
+
+    # --- light axes
+    suns = ck.axis(light, "sun", "light", ck.sun)
+    densities = ck.axis(light, "density", "light", ck.number, [4.0])
+    periodic = ck.axis(light, "periodic", "light", ck.boolean, [False])
+    optics = ck.axis(light, "optics", "light", ck.optics, [None])
+    photosynthesis = ck.axis(light, "photosynthesis", "light", ck.photosynthesis, [None])
+    heights = _heights(ck, light)
+    rect = _rect(ck, light)
+
+    # --- exclude
+    excludes = doc.get("exclude", [])
+    if not isinstance(excludes, list) or not all(isinstance(e, dict) for e in excludes):
+        ck.fail("exclude", "must be a list of tables such as [{level = \"K4\", density = 16}]")
+    matchers = [_matcher(ck, e, f"exclude[{i}]") for i, e in enumerate(excludes)]
+
+    axes: list[list[Any]] = [points, arrangements, levels, preserve, densities, periodic, suns,
+                             optics, photosynthesis]
+    _check_combinations(source, math.prod(len(a) for a in axes), max_scenarios,
+                        yes or bool(matchers))
+    scenarios, excluded = _scenarios(ck, axes, matchers, heights, rect, cover)
+    if not scenarios:
+        raise SweepSpecError(f"{source}: exclude drops every scenario: nothing to run")
+    if len(scenarios) > max_scenarios and not yes:
+        raise SweepSpecError(f"{source}: {len(scenarios):,} scenarios is more than "
+                             f"{max_scenarios:,}: confirm with --yes, or narrow the axes")
+    document = json.loads(json.dumps(doc, default=str))
+    document["canopy"]["points"] = [{"name": p.name, "sha256": p.sha256} for p in points]
+    fingerprint = _digest(sorted(s.key for s in scenarios))[:24]
+    return SweepSpec(source, document, tuple(scenarios), excluded, fingerprint)
+
+
+def _sections(ck: _Checker, doc: dict, source: str) -> tuple[dict, dict]:
+    """The file's [canopy] and [light] tables, each checked for unknown keys."""
     ck.known(doc, TOP_KEYS, "")
     for sec in ("canopy", "light"):
         if sec not in doc:
@@ -586,12 +630,15 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
     canopy, light = doc["canopy"], doc["light"]
     ck.known(canopy, CANOPY_KEYS, "canopy")
     ck.known(light, LIGHT_KEYS, "light")
+    return canopy, light
 
-    # --- canopy axes
-    paths = ck.axis(canopy, "points", "canopy", ck.files)
+
+def _points_axis(ck: _Checker, canopy: dict) -> list[PointsFile]:
+    """The points files (globs expanded), each once, hashed; two of the same content
+    refused."""
     points: list[PointsFile] = []
     by_sha: dict[str, str] = {}
-    for i, group in enumerate(paths):
+    for i, group in enumerate(ck.axis(canopy, "points", "canopy", ck.files)):
         for p in group:
             if any(q.path == p for q in points):
                 continue                                  # two patterns naming one file
@@ -601,6 +648,11 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
                         f"{by_sha[sha]}: keep one of them")
             by_sha[sha] = ck.shown(p)
             points.append(PointsFile(ck.shown(p), p, sha))
+    return points
+
+
+def _arrangements(ck: _Checker, canopy: dict) -> list[Arrangement]:
+    """The tilings (tile x row spacing x plant spacing, with a block) and layout files."""
     tiling_given = any(k in canopy for k in ("tile", "row_spacing", "plant_spacing", "block"))
     arrangements = []
     if tiling_given or "layout" not in canopy:
@@ -616,56 +668,56 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
             for p in group:
                 arrangements.append(Arrangement(layout=ck.shown(p), layout_path=p,
                                                 layout_sha256=ck.sha(p, f"canopy.layout[{i}]")))
-    levels = ck.axis(canopy, "level", "canopy", ck.level)
-    preserve = ck.axis(canopy, "preserve_area", "canopy", ck.boolean, [True])
-    cover = 0.5
-    if "cover_resolution" in canopy:
-        cover = ck.number(canopy["cover_resolution"], "canopy.cover_resolution")
+    return arrangements
 
-    # --- light axes
-    suns = ck.axis(light, "sun", "light", ck.sun)
-    densities = ck.axis(light, "density", "light", ck.number, [4.0])
-    periodic = ck.axis(light, "periodic", "light", ck.boolean, [False])
-    optics = ck.axis(light, "optics", "light", ck.optics, [None])
-    photosynthesis = ck.axis(light, "photosynthesis", "light", ck.photosynthesis, [None])
-    heights = DEFAULT_HEIGHTS
-    if "heights" in light:
-        raw = light["heights"]
-        if not isinstance(raw, list):
-            ck.fail("light.heights", "must be a list of heights in cm, such as [0, 50, 100]")
-        if not raw:
-            ck.fail("light.heights", "is empty: give at least one height")
-        if len(raw) > MAX_HEIGHTS:
-            ck.fail("light.heights", f"holds {len(raw):,} heights; at most {MAX_HEIGHTS:,}")
-        heights = tuple(ck.number(h, f"light.heights[{i}]", positive=False, minimum=0)
-                        for i, h in enumerate(raw))
-        for i, h in enumerate(heights):
-            if h in heights[:i]:
-                ck.fail(f"light.heights[{i}]", f"height {h + 0.0:g} cm is given twice")
-    rect = None
-    if "rect" in light:
-        raw = light["rect"]
-        if not isinstance(raw, list) or len(raw) != 4:
-            ck.fail("light.rect", "must be [x0, y0, x1, y1] in cm")
-        rect = tuple(ck.number(v, f"light.rect[{i}]", positive=False) for i, v in enumerate(raw))
-        if rect[2] <= rect[0] or rect[3] <= rect[1]:
-            ck.fail("light.rect", f"must have x1 > x0 and y1 > y0, got {list(rect)}")
 
-    # --- exclude
-    excludes = doc.get("exclude", [])
-    if not isinstance(excludes, list) or not all(isinstance(e, dict) for e in excludes):
-        ck.fail("exclude", "must be a list of tables such as [{level = \"K4\", density = 16}]")
-    matchers = [_matcher(ck, e, f"exclude[{i}]") for i, e in enumerate(excludes)]
+def _heights(ck: _Checker, light: dict) -> tuple[float, ...]:
+    """``light.heights``: a list of at most MAX_HEIGHTS heights >= 0 cm, none twice."""
+    if "heights" not in light:
+        return DEFAULT_HEIGHTS
+    raw = light["heights"]
+    if not isinstance(raw, list):
+        ck.fail("light.heights", "must be a list of heights in cm, such as [0, 50, 100]")
+    if not raw:
+        ck.fail("light.heights", "is empty: give at least one height")
+    if len(raw) > MAX_HEIGHTS:
+        ck.fail("light.heights", f"holds {len(raw):,} heights; at most {MAX_HEIGHTS:,}")
+    heights = tuple(ck.number(h, f"light.heights[{i}]", positive=False, minimum=0)
+                    for i, h in enumerate(raw))
+    for i, h in enumerate(heights):
+        if h in heights[:i]:
+            ck.fail(f"light.heights[{i}]", f"height {h + 0.0:g} cm is given twice")
+    return heights
 
-    axes: list[list[Any]] = [points, arrangements, levels, preserve, densities, periodic, suns,
-                             optics, photosynthesis]
-    total = math.prod(len(a) for a in axes)
+
+def _rect(ck: _Checker, light: dict) -> tuple[float, ...] | None:
+    """``light.rect``: [x0, y0, x1, y1] cm with x1 > x0 and y1 > y0, or None."""
+    if "rect" not in light:
+        return None
+    raw = light["rect"]
+    if not isinstance(raw, list) or len(raw) != 4:
+        ck.fail("light.rect", "must be [x0, y0, x1, y1] in cm")
+    rect = tuple(ck.number(v, f"light.rect[{i}]", positive=False) for i, v in enumerate(raw))
+    if rect[2] <= rect[0] or rect[3] <= rect[1]:
+        ck.fail("light.rect", f"must have x1 > x0 and y1 > y0, got {list(rect)}")
+    return rect
+
+
+def _check_combinations(source: str, total: int, max_scenarios: int, allowed: bool) -> None:
+    """Refuse, before listing them, more combinations than a sweep file may hold, and more
+    than ``max_scenarios`` unless ``allowed`` (--yes, or excludes that may drop some)."""
     if total > HARD_MAX_SCENARIOS:
         raise SweepSpecError(f"{source}: the axes make {total:,} combinations, beyond the "
                              f"{HARD_MAX_SCENARIOS:,} one sweep file may hold: split the sweep")
-    if total > max_scenarios and not yes and not matchers:      # refused before listing
+    if total > max_scenarios and not allowed:                  # refused before listing
         raise SweepSpecError(f"{source}: {total:,} scenarios is more than {max_scenarios:,}: "
                              "confirm with --yes, or narrow the axes")
+
+
+def _scenarios(ck: _Checker, axes: list[list[Any]], matchers: list, heights, rect,
+               cover: float) -> tuple[list[Scenario], int]:
+    """Every combination of the axes the excludes keep, as scenarios, and how many were
+    excluded; an exclude that matches nothing is refused."""
     scenarios: list[Scenario] = []
     used, excluded = [False] * len(matchers), 0
     for pf, arr, lv, pa, dens, per, sun, opt, ph in itertools.product(*axes):
@@ -687,15 +739,7 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
     for i, u in enumerate(used):
         if not u:
             ck.fail(f"exclude[{i}]", "matches no scenario (a typo in a value?)")
-    if not scenarios:
-        raise SweepSpecError(f"{source}: exclude drops every scenario: nothing to run")
-    if len(scenarios) > max_scenarios and not yes:
-        raise SweepSpecError(f"{source}: {len(scenarios):,} scenarios is more than "
-                             f"{max_scenarios:,}: confirm with --yes, or narrow the axes")
-    document = json.loads(json.dumps(doc, default=str))
-    document["canopy"]["points"] = [{"name": p.name, "sha256": p.sha256} for p in points]
-    fingerprint = _digest(sorted(s.key for s in scenarios))[:24]
-    return SweepSpec(source, document, tuple(scenarios), excluded, fingerprint)
+    return scenarios, excluded
 
 
 def _matcher(ck: _Checker, entry: dict, where: str) -> Callable[[dict[str, Any]], bool]:

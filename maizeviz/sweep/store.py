@@ -66,13 +66,13 @@ OWN_FILES = {"sweep.json", "parts", "results.parquet", "results.csv", "summary.c
 
 
 def now_iso() -> str:
-    return dt.datetime.now(dt.timezone.utc).astimezone().isoformat(timespec="seconds")
+    return dt.datetime.now(dt.UTC).astimezone().isoformat(timespec="seconds")
 
 
 def scenario_rows(s, result: dict, worker: str | None, finished_at: str) -> list[dict]:
     """Result rows of a scenario, one per height, every column of :data:`COLUMNS`."""
     ok = result.get("status") == "ok"
-    base: dict[str, Any] = {c: None for c in COLUMN_NAMES}
+    base: dict[str, Any] = dict.fromkeys(COLUMN_NAMES)
     base.update(s.axes())
     base.update(scenario=s.key, status=result["status"], error=result.get("error"),
                 worker=worker, maizeviz_version=maizeviz.__version__, finished_at=finished_at)

@@ -127,6 +127,22 @@ def test_lint_is_clean():
     assert proc.returncode == 0, proc.stdout[-5000:] + proc.stderr[-2000:]
 
 
+def test_no_function_is_too_complex():
+    """ruff's C901 (McCabe complexity) is on at 15 over the core, the app, the tests and the
+    benchmarks, and a function of 16 branches is caught (cli/light.py's run was 45)."""
+    import tomllib
+
+    lint = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["ruff"]["lint"]
+    assert "C90" in lint["select"] and lint["mccabe"]["max-complexity"] == 15
+    branches = "".join(f"    if x == {i}:\n        return {i}\n" for i in range(16))
+    ruff = Path(sys.executable).with_name("ruff")
+    proc = subprocess.run([str(ruff), "check", "--no-cache", "--select", "C901", "--config",
+                           "lint.mccabe.max-complexity=15", "--stdin-filename", "x.py", "-"],
+                          input=f"def f(x):\n{branches}    return -1\n", capture_output=True,
+                          text=True, cwd=ROOT, timeout=60)
+    assert proc.returncode == 1 and "`f` is too complex (17 > 15)" in proc.stdout
+
+
 def test_no_reference_to_documents_outside_the_repository():
     outside = re.compile(r"SCIENCE\.md|FASTRAK\.md|PAPER\.md|STYLE\.md|\.\./shared|shared\/data")
     docs = re.compile(r"docs/[A-Za-z0-9_./-]+\.md")
@@ -150,6 +166,7 @@ def test_every_package_folder_is_a_package_of_its_own_name():
     """Each folder with an __init__.py under maizeviz/ and app/maizeviz_app/ installs under its
     own name (packages.find, no package-dir renames), and nothing else does."""
     import tomllib
+
     from setuptools import find_namespace_packages
 
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
@@ -210,6 +227,10 @@ def test_wheel_holds_the_app_and_the_data_under_our_names(wheel_env):
                    "maizeviz/resources/phenotrack3d/1649057232.json.gz",
                    "maizeviz_app/main_window.py"):
         assert needed in names
+    # a platform wheel carrying the built ray-packet kernel (stable ABI) and its source
+    assert "-cp311-abi3-" in wheel.name and not wheel.name.endswith("-any.whl")
+    assert {"maizeviz/mesh/_packets.abi3.so", "maizeviz/mesh/_packets.pyi",
+            "maizeviz/mesh/_packets.c"} <= set(names)
     meta = next(n for n in names if n.endswith("entry_points.txt"))
     text = zipfile.ZipFile(wheel).read(meta).decode()
     assert "maizeviz = maizeviz.cli:main" in text and "maizeviz_app.main:run" in text
@@ -229,6 +250,72 @@ def test_installed_wheel_runs_from_an_empty_folder(wheel_env):
                 "4", "--json")
     assert proc.returncode == 0, proc.stderr
     assert '"plants": 9' in proc.stdout
+    # the wheel's own kernel traces, with no compiler on PATH and nothing written to home
+    home = empty.parent / "home"
+    home.mkdir()
+    info = _run(py, empty, "-m", "maizeviz", "--info",
+                env={"HOME": str(home), "PATH": str(empty), "XDG_CACHE_HOME": str(home)})
+    assert info.returncode == 0, info.stderr
+    kernel = next(line for line in info.stdout.splitlines() if line.startswith("ray kernel"))
+    assert kernel.startswith("ray kernel: packets") and str(ROOT) not in kernel, kernel
+    assert list(home.rglob("*")) == []
+
+
+USER_SCRIPT = """\
+import maizeviz as mv
+
+plants = mv.read_points(mv.example_points())
+canopy = mv.build_canopy(plants, tile=(1, 1), level="8")
+engine = mv.LightEngine(canopy, periodic=True, density=0.3)
+noon = engine.sun(date="2005-08-01", time="12:00", lat=39.9, lon=116.4, tz="Asia/Shanghai")
+day = engine.day(date="2005-08-01", lat=39.9, lon=116.4, tz="Asia/Shanghai")
+absorbed = engine.absorbed(noon.sun, band="par")
+heights = noon.table()
+share: float = day.par_intercepted_mol_m2 / day.par_incident_mol_m2
+reveal_type(mv.read_points)
+reveal_type(canopy)
+reveal_type(noon)
+reveal_type(day)
+reveal_type(absorbed.balance)
+reveal_type(heights)
+reveal_type(mv.DEFAULT_PAR_UMOL_PER_J)
+mv.build_canopy(plants, tile="3x3")
+"""
+
+
+def test_a_users_mypy_sees_the_facades_real_types(wheel_env):
+    """mypy on a user's script against the installed wheel: ``mv.*`` have their real types
+    (not ``object``), and a wrong argument is caught."""
+    _, py, empty = wheel_env
+    (empty / "user.py").write_text(USER_SCRIPT)
+    out = _run(py, empty, "-m", "mypy", "--no-incremental", "--cache-dir", os.devnull,
+               "user.py")
+    revealed = re.findall(r'Revealed type is "([^"]+)"', out.stdout)
+    assert revealed[0].startswith("def (path: str | pathlib.Path") and \
+        revealed[0].endswith("-> maizeviz.leaf.fit.LeavesFromFile"), out.stdout
+    assert revealed[1:] == ["maizeviz.canopy.scene.Canopy",
+                            "maizeviz.light.results.direct.LightResult",
+                            "maizeviz.light.results.diffuse.PeriodLight",
+                            "maizeviz.light.results.absorbed.Balance",
+                            "pandas.core.frame.DataFrame", "float"], out.stdout
+    errors = [line for line in out.stdout.splitlines() if ": error:" in line]
+    assert len(errors) == 1 and "user.py:18: error" in errors[0] and '"tile"' in errors[0], \
+        out.stdout
+
+
+def test_the_facades_type_names_are_its_run_time_names():
+    """The names a type checker sees under TYPE_CHECKING in maizeviz/__init__.py are the
+    names ``maizeviz.__getattr__`` loads, from the same modules."""
+    import ast
+
+    import maizeviz
+
+    tree = ast.parse((ROOT / "maizeviz" / "__init__.py").read_text())
+    block = next(n for n in tree.body if isinstance(n, ast.If)
+                 and getattr(n.test, "id", "") == "TYPE_CHECKING")
+    typed = {a.asname or a.name: imp.module for imp in block.body
+             if isinstance(imp, ast.ImportFrom) for a in imp.names}
+    assert typed == maizeviz._EXPORTS
 
 
 def test_without_the_gui_extra_the_app_is_one_line_away(wheel_env):

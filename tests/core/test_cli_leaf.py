@@ -65,7 +65,7 @@ def test_export_formats(capsys, two_leaves, tmp_path, ext):
         assert set(np.unique(mesh.cell_data["leaf"])) == {1, 2}
     elif ext == ".ply":
         raw = path.read_bytes()
-        assert b"property int32 plant" in raw and b"property int32 leaf" in raw
+        assert b"property int plant" in raw and b"property int leaf" in raw
         import pyvista
         mesh = pyvista.read(path)
         assert 2 <= mesh.n_cells <= 16

@@ -5,7 +5,15 @@ import pytest
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.cli import EXIT_FAIL, main
-from maizeviz.cost import Cost, canopy_cost, check, heatmap_cost, leaf_triangles, light_cost
+from maizeviz.cost import (
+    BYTES_PER_TRIANGLE,
+    Cost,
+    canopy_cost,
+    check,
+    heatmap_cost,
+    leaf_triangles,
+    light_cost,
+)
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.mesh.levels import Level, mesh_leaves
@@ -37,7 +45,7 @@ def test_canopy_cost_counts_every_placed_triangle(block):
     cost = canopy_cost(block, placed, Level(interp=1))
     canopy = build_canopy(block, layout, Level(interp=1))
     assert cost.count == canopy.n_triangles and cost.quantity == "tile"
-    assert cost.bytes == cost.count * 400
+    assert cost.bytes == cost.count * BYTES_PER_TRIANGLE
 
 
 def test_check_refuses_what_does_not_fit_and_what_is_slow():

@@ -66,4 +66,42 @@ def test_a_committed_scene_is_left_to_embreex():
     scene = EmbreeScene(robust=False)
     scene.run(np.zeros((1, 3), np.float32), np.array([[0, 0, 1]], np.float32))
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], np.float32)
-    assert fill(scene, v, np.array([[0, 1, 2]], np.int32)) is False
+    assert not fill(scene, v, np.array([[0, 1, 2]], np.int32))
+
+
+def test_embree_reads_the_canopys_faces_in_place_and_builds_a_compact_bvh(canopy, rays):
+    """The canopy's int32 faces are Embree's index buffer (no copy) and the BVH is compact;
+    the hits are those of a scene with copied buffers and Embree's default BVH."""
+    fast = RayScene(canopy.vertices, canopy.faces)
+    assert fast.compact and fast._shared is canopy.faces
+    copied = RayScene(canopy.vertices, canopy.faces.astype(np.int64))      # not int32: copied
+    assert copied._shared is None
+    default = EmbreeScene(robust=False)
+    assert fill(default, canopy.vertices, canopy.faces.astype(np.int64)) == 1
+    org, d = rays
+    ids, t = fast.first_hit(org, d)
+    for other in (copied,):
+        i2, t2 = other.first_hit(org, d)
+        np.testing.assert_array_equal(ids, i2)
+        np.testing.assert_array_equal(t, t2)
+    out = default.run(org.astype(np.float32), d.astype(np.float32), output=True)
+    np.testing.assert_array_equal(ids, out["primID"])
+    np.testing.assert_array_equal(t, out["tfar"])
+
+
+def test_parts_and_snapping_as_they_are_copied(canopy, rays):
+    """Vertices and faces given in parts, x and y rounded to a grid as Embree's copy is made:
+    the scene of the whole arrays rounded first."""
+    from maizeviz.light.scene.periodic import snap
+
+    q = 2.0 ** -12
+    k = len(canopy.vertices) // 3
+    faces = canopy.faces.astype(np.int64)
+    first = faces[np.all(faces < k, axis=1)]
+    rest = faces[~np.all(faces < k, axis=1)]
+    parts = RayScene([canopy.vertices[:k], canopy.vertices[k:]], [first, rest], snap_q=q)
+    whole = RayScene(snap(canopy.vertices, q), np.vstack([first, rest]))
+    assert parts.n_triangles == len(canopy.faces)
+    org, d = rays
+    for a, b in zip(parts.first_hit(org, d), whole.first_hit(org, d)):
+        np.testing.assert_array_equal(a, b)

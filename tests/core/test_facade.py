@@ -84,3 +84,13 @@ def test_threads_sharing_an_engine_build_its_scene_once(small):
                                 [10.0, 20.0, 30.0, 40.0]))
     builds = [r.seconds["build"] for r in results]
     assert sum(b > 0 for b in builds) == 1 and max(builds) == engine.build_seconds[False]
+
+
+def test_the_package_example_runs_as_a_doctest():
+    """The example of ``maizeviz/__init__.py``'s docstring, run as written."""
+    import doctest
+
+    import maizeviz
+
+    result = doctest.testmod(maizeviz, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert result.attempted >= 7 and result.failed == 0

@@ -43,7 +43,7 @@ def test_extended_precision_items():
 
 
 def test_binary_record_from_the_manual():
-    raw = bytes.fromhex("303120" "0000803f" "00000040" "00004040" "00008040" "0000a040" "0000c040" "0d0a")
+    raw = bytes.fromhex("3031200000803f0000004000004040000080400000a0400000c0400d0a")
     assert len(raw) == 29
     rec = fp.RecordParser(binary=True).feed(raw)[0]
     assert rec.position == (1.0, 2.0, 3.0) and rec.angles == (4.0, 5.0, 6.0)

@@ -137,10 +137,59 @@ NUMERIC = st.one_of(st.integers(-5, 12).map(str), st.sampled_from(["1e3", "2.0",
 
 @FUZZ
 @given(st.lists(st.lists(NUMERIC, min_size=6, max_size=8).map(",".join), max_size=40),
-       st.sampled_from(["\n", "\r\n"]), st.booleans())
-def test_block_and_line_readers_agree(lines, end, last_end):
-    """The numpy block parser gives exactly what reading line by line gives."""
+       st.sampled_from(["\n", "\r\n"]), st.booleans(), st.booleans())
+def test_block_and_line_readers_agree(lines, end, last_end, columnar):
+    """The block parsers (numpy's, and pyarrow's for large files) give exactly what reading
+    line by line gives."""
+    import maizeviz.io.points as points
+
     text = "plant,leaf,row,col,x,y,z" + end + end.join(lines) + (end if last_end else "")
+    old = points.COLUMNAR_BYTES
+    points.COLUMNAR_BYTES = 0 if columnar else old
+    try:
+        _readers_agree(text)
+    finally:
+        points.COLUMNAR_BYTES = old
+
+
+@FUZZ
+@given(st.lists(st.text("0123456789+-.eE ", max_size=12), min_size=1, max_size=30))
+def test_block_numbers_are_pythons_floats(fields):
+    """pyarrow's and numpy's block parsers read a field as Python's float() does, or refuse
+    the block (then read line by line): never another number."""
+    from maizeviz.io.points import _numbers
+
+    block = "".join(f"1,{f}\n" for f in fields).encode()
+    for columnar in (True, False):
+        got = _numbers(block, ",", 2, columnar)
+        if got is None:
+            continue
+        assert len(got) == 2 and len(got[1]) == len(fields)
+        for value, text in zip(got[1], fields):
+            try:
+                expected = float(text)
+            except ValueError:
+                assert np.isnan(value) and not text.strip(), (text, value)   # an empty field
+                continue
+            assert value == expected or (np.isnan(value) and np.isnan(expected)), (text, value)
+            assert np.signbit(value) == np.signbit(expected)
+
+
+@FUZZ
+@given(st.lists(st.floats(allow_nan=False, allow_infinity=False), min_size=1, max_size=30),
+       st.sampled_from(["{!r}", "{:.3f}", "{:.17g}", "{:e}"]))
+def test_block_numbers_round_as_python(values, fmt):
+    from maizeviz.io.points import _numbers
+
+    texts = [fmt.format(v) for v in values]
+    block = "".join(f"1,{t}\n" for t in texts).encode()
+    for columnar in (True, False):
+        got = _numbers(block, ",", 2, columnar)
+        assert got is not None
+        assert [float(t) for t in texts] == got[1].tolist()
+
+
+def _readers_agree(text):
     path = scratch("agree.csv")
     path.write_text(text, newline="")
     try:

@@ -30,8 +30,8 @@ def test_round_trip_rows_in_any_order(tmp_path, leaf_grid):
 
 
 def test_extra_columns_kept_and_case_insensitive_header():
-    text = "Plant,LEAF,row,col,x,y,z,time\n1,2,0,0,0,0,0,t0\n1,2,0,1,1,0,0,t1\n" \
-           "1,2,1,0,0,5,0,t2\n1,2,1,1,1,5,0,t3\n"
+    text = ("Plant,LEAF,row,col,x,y,z,time\n1,2,0,0,0,0,0,t0\n1,2,0,1,1,0,0,t1\n"
+            "1,2,1,0,0,5,0,t2\n1,2,1,1,1,5,0,t3\n")
     table = parse_points(text)
     assert table.extra["time"] == ["t0", "t1", "t2", "t3"]
     grids, errors = build_grids(table)

@@ -185,3 +185,47 @@ def test_live_tip_in_the_plants_frame_and_its_distance_from_the_last_point(tmp_p
     rec.poll()
     assert not rec.live.trustworthy and "motion box" in rec.live.note
     rec.close()
+
+
+def test_pause_in_maizeviz_record(tmp_path):
+    """The command line pauses with 's' too, and says each press it does not record."""
+    import subprocess
+    import sys
+    import threading
+
+    out = tmp_path / "rec.csv"
+    with FastrakSimulator(press_gap_s=0.0, noise_cm=0.0) as sim:
+        proc = subprocess.Popen([sys.executable, "-m", "maizeviz", "record", "--port", sim.path,
+                                 "--out", str(out), "--cols", "3", "--answer-timeout", "0.5"],
+                                stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True, bufsize=1)
+        lines: list[str] = []
+        threading.Thread(target=lambda: lines.extend(proc.stdout), daemon=True).start()
+
+        def expect(prefix):
+            deadline = time.monotonic() + 10
+            while time.monotonic() < deadline:
+                hit = [ln for ln in lines if ln.startswith(prefix)]
+                if hit:
+                    return hit[-1]
+                time.sleep(0.02)
+            raise AssertionError(f"no line starting {prefix!r}: {lines}")
+
+        def type_(text):
+            proc.stdin.write(text + "\n")
+            proc.stdin.flush()
+
+        expect("ready")
+        assert sim.press((1.0, 0.0, 0.0))
+        expect("recorded plant 1 leaf 1 row 0 col 0")
+        type_("s")
+        expect("paused: presses are not recorded")
+        assert sim.press((2.0, 0.0, 0.0))
+        assert "NOT recorded" in expect("paused: the press at 2.0 0.0 0.0 cm")
+        type_("s")
+        expect("resumed: the next press is recorded at plant 1 leaf 1 row 0 col 1")
+        assert sim.press((3.0, 0.0, 0.0))
+        expect("recorded plant 1 leaf 1 row 0 col 1")
+        type_("q")
+        assert proc.wait(timeout=10) == 0
+    assert read_points(out).xyz[:, 0].tolist() == [1.0, 3.0]

@@ -226,8 +226,8 @@ def test_pruning_never_misses_a_nearer_neighbour():
 
 
 def test_flat_leaf_deviation_is_zero_and_k8_mesh_matches_its_samples():
-    leaf = fit_leaves([LeafGrid(1, 1, np.stack(np.meshgrid(
-        np.linspace(0, 50, 5), np.linspace(-4, 4, 4), indexing="ij") + (np.zeros((5, 4)),),
+    leaf = fit_leaves([LeafGrid(1, 1, np.stack([*np.meshgrid(
+        np.linspace(0, 50, 5), np.linspace(-4, 4, 4), indexing="ij"), np.zeros((5, 4))],
         axis=-1), False)])[0][0]
     for level in (Level(interp=0), Level(interp=8), Level(triangles=4)):
         assert measure(leaf, mesh_leaves([leaf], level)[0]).max_deviation_cm < 1e-9

@@ -208,3 +208,162 @@ def test_a_sweep_height_given_twice_is_refused_naming_it(tmp_path):
     path.write_text(text.replace("heights = [0, 50, 100, 150", "heights = [0, 50, 50.0, 100, 150"))
     with pytest.raises(MaizevizError, match=r"light.heights\[2\]: height 50 cm is given twice"):
         load_spec(path, yes=True)
+
+
+# ------------------------------------------------------------------ --json against another way
+
+
+def _json(capsys, argv):
+    capsys.readouterr()
+    code = main(argv)
+    out, err = capsys.readouterr()
+    assert code == 0, err[-600:]
+    return json.loads(out)
+
+
+def _csv(path):
+    import csv
+
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+BASE = ["light", BLOCK, "--tile", "3x3", "--triangles", "36", "--density", "0.5",
+        "--periodic"]
+SUN_30 = ["--sun-zenith", "30", "--sun-azimuth", "150"]
+
+
+def test_periodic_block_equals_its_tiling_traced_whole(capsys):
+    """A periodic field repeats its plot: the bundled block alone, periodic, and the block
+    tiled 3 x 3, periodic, sampled over its whole plot, are the same field on grids that
+    coincide: every --json number of the one equals the other's."""
+    from maizeviz.canopy.layout import layout_for
+    from maizeviz.leaf.fit import read_leaves
+
+    bounds = layout_for(read_leaves(BLOCK).leaves, (3, 3)).bounds
+    common = ["--triangles", "36", *SUN_30, "--density", "1", "--periodic", "--heights",
+              "0,50,100,150,250", "--json"]
+    one = _json(capsys, ["light", BLOCK, "--tile", "1x1", *common])
+    nine = _json(capsys, ["light", BLOCK, "--tile", "3x3", *common,
+                          "--rect=" + ",".join(repr(v) for v in bounds)])
+    assert nine["rays"] == 9 * one["rays"]
+    assert nine["transmission"] == one["transmission"]
+    assert nine["sunlit_intercepted_fraction"] == one["sunlit_intercepted_fraction"]
+    assert 0 < one["transmission"][0] < one["transmission"][-1] <= 1.0
+
+
+@pytest.mark.parametrize("kind", ["sun", "sky", "day", "absorbed"])
+def test_plant_rows_add_up_to_the_canopy_total(capsys, tmp_path, kind):
+    """Per-leaf rows sum to per-plant rows, and those to the canopy total --json gives,
+    computed another way (from the rays, not the triangles)."""
+    leaves, plants = tmp_path / "leaves.csv", tmp_path / "plants.csv"
+    extra = {"sun": SUN_30,
+             "sky": ["--sky", "soc", "--sky-directions", "16"],
+             "day": ["--day", "--date", "2005-08-01", "--lat", "39.9", "--lon", "116.4",
+                     "--tz", "Asia/Shanghai", "--step", "120", "--sky-directions", "16"],
+             "absorbed": [*SUN_30, "--band", "par", "--irradiance", "400"]}[kind]
+    doc = _json(capsys, [*BASE, *extra, "--leaf-light", str(leaves), "--plant-light",
+                         str(plants), "--json"])
+    x0, y0, x1, y1 = doc["rect_cm"] if "rect_cm" in doc else doc["diffuse"]["rect_cm"]
+    area_cm2 = (x1 - x0) * (y1 - y0)
+    column, total = {
+        "sun": ("sunlit_intercepted_cm2", lambda: doc["sunlit_intercepted_fraction"] * area_cm2),
+        "sky": ("diffuse_intercepted_cm2",
+                lambda: doc["diffuse"]["intercepted_fraction"] * area_cm2),
+        "day": ("par_intercepted_mol",
+                lambda: doc["period"]["par_intercepted_mol_m2"] * area_cm2 * 1e-4),
+        "absorbed": ("absorbed_w", lambda: doc["balance"]["absorbed_leaves"] * area_cm2 * 1e-4),
+    }[kind]
+    leaf_rows, plant_rows = _csv(leaves), _csv(plants)
+    assert len(plant_rows) > 1
+    by_plant: dict = {}
+    for r in leaf_rows:
+        by_plant[r["instance"]] = by_plant.get(r["instance"], 0.0) + float(r[column])
+    for p in plant_rows:
+        assert float(p[column]) == pytest.approx(by_plant[p["instance"]], rel=1e-9)
+    assert sum(float(p[column]) for p in plant_rows) == pytest.approx(total(), rel=1e-9)
+
+
+# ------------------------------------------------------------------ order of a file's rows
+
+
+def _shuffled(tmp_path, rename=None, seed=3):
+    """The bundled points file with its lines in another order (header first), plant ids
+    renamed by ``rename`` (a dict) if given."""
+    lines = Path(BLOCK).read_text().splitlines()
+    head, body = lines[0], lines[1:]
+    if rename:
+        body = [",".join([str(rename[int(f[0])]), *f[1:]]) for f in (b.split(",") for b in body)]
+    order = np.random.default_rng(seed).permutation(len(body))
+    path = tmp_path / f"shuffled{seed}.csv"
+    path.write_text("\n".join([head, *(body[i] for i in order)]) + "\n")
+    return path
+
+
+def test_canopy_and_light_are_the_same_whatever_the_order_of_the_file(capsys, tmp_path):
+    """Every line of the points file in another order: plants, leaves and rows read in
+    another order build the same canopy and trace the same light."""
+    argv = ["--tile", "3x3", "--triangles", "36"]
+    for points in (BLOCK, _shuffled(tmp_path, seed=1), _shuffled(tmp_path, seed=2)):
+        canopy = _measures(_json(capsys, ["canopy", str(points), *argv, "--json"]))
+        light = _json(capsys, ["light", str(points), *argv, *SUN_30, "--density", "1",
+                               "--heights", "0,100", "--json"])
+        if points == BLOCK:
+            want_canopy, want_light = canopy, light
+        assert canopy == want_canopy
+        assert light["transmission"] == want_light["transmission"]
+        assert light["sunlit_intercepted_fraction"] == want_light["sunlit_intercepted_fraction"]
+
+
+def test_renamed_plants_trace_the_same_light(capsys, tmp_path):
+    """Plant ids renamed (near 2^31, in another order): the same light, each plant's row
+    under its new name."""
+    ids = sorted({int(line.split(",")[0]) for line in Path(BLOCK).read_text().splitlines()[1:]})
+    rename = {p: 2**31 - 1 - 7 * k for k, p in enumerate(reversed(ids))}
+    argv = ["--tile", "3x3", "--triangles", "36", *SUN_30, "--density", "1", "--heights",
+            "0,100", "--json"]
+    a_rows, b_rows = tmp_path / "a.csv", tmp_path / "b.csv"
+    a = _json(capsys, ["light", BLOCK, *argv, "--plant-light", str(a_rows)])
+    b = _json(capsys, ["light", str(_shuffled(tmp_path, rename)), *argv, "--plant-light",
+                       str(b_rows)])
+    assert b["transmission"] == a["transmission"]
+    got = {(r["x_cm"], r["y_cm"]): (r["plant"], r["sunlit_intercepted_cm2"]) for r in _csv(b_rows)}
+    for r in _csv(a_rows):
+        plant, value = got[(r["x_cm"], r["y_cm"])]
+        assert int(plant) == rename[int(r["plant"])] and value == r["sunlit_intercepted_cm2"]
+
+
+def test_levels_in_any_order_give_the_same_numbers_per_level(capsys):
+    a = _json(capsys, ["canopy", BLOCK, "--tile", "1x1", "--levels", "K1,36,8", "--json"])
+    b = _json(capsys, ["canopy", BLOCK, "--tile", "1x1", "--levels", "8,K1,36", "--json"])
+    per_a = {d["level"]: _measures(d) for d in a["levels"]}
+    per_b = {d["level"]: _measures(d) for d in b["levels"]}
+    assert per_a == per_b and {"K=1", "36 triangles", "8 triangles"} <= set(per_a)
+
+
+def test_a_points_line_written_twice_is_reported_not_counted_twice(capsys, tmp_path):
+    """A repeated line is a point recorded twice: its leaf is refused naming both lines,
+    never counted twice; the other leaves are the same."""
+    lines = Path(BLOCK).read_text().splitlines()
+    path = tmp_path / "twice.csv"
+    path.write_text("\n".join([*lines[:20], lines[10], *lines[20:]]) + "\n")
+    capsys.readouterr()
+    assert main(["leaf", str(path), "--interp", "0"]) == 3
+    err = capsys.readouterr().err
+    plant, leaf = lines[10].split(",")[:2]
+    assert f"plant {plant}, leaf {leaf}: row 1, col 4 appears twice (lines 11 and 21)" in err
+
+
+def test_a_stand_written_twice_in_a_layout_is_reported(capsys, tmp_path):
+    """The same plant at the same place twice is two plants standing in one another: kept
+    (a layout may overlap on purpose) but said, with the area counted twice."""
+    layout = tmp_path / "twice.json"
+    layout.write_text(json.dumps({
+        "maizeviz_layout": 1, "row_spacing": 60, "plant_spacing": 30,
+        "field": {"x0": -30, "y0": -30, "x1": 90, "y1": 30},
+        "rows": [{"x": 0, "plants": [{"y": 0, "plant": 1}, {"y": 0, "plant": 1}]},
+                 {"x": 60, "plants": [{"y": 0, "plant": 2}]}]}))
+    capsys.readouterr()
+    assert main(["canopy", BLOCK, "--layout", str(layout), "--triangles", "8"]) == 0
+    err = capsys.readouterr().err
+    assert "closer than the spacing" in err and "counted twice" in err

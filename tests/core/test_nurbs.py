@@ -124,3 +124,75 @@ def test_parameters_skip_collapsed_tip_row(leaf_grid):
     u, v = data_parameters(leaf_grid)
     assert u[0] == 0 and u[-1] == 1 and np.all(np.diff(u) > 0)
     assert v[0] == 0 and v[-1] == 1 and np.all(np.diff(v) > 0)
+
+
+# ------------------------------------------------------------------ banded, for huge leaves
+def _old_derivatives(s, u, v):
+    """dS/du, dS/dv as maizeviz computed them before the banded basis: scipy's BSpline of
+    the whole control net, contracted with the dense basis (the oracle)."""
+    hom = s._homogeneous()[0]
+    bu = basis_matrix(u[None], s.knots_u[:1], s.degree_u)[0]
+    bv = basis_matrix(v[None], s.knots_v[:1], s.degree_v)[0]
+    a = np.einsum("ki,ijc,kj->kc", bu, hom, bv)
+    p = a[:, :3] / a[:, 3:]
+    su = BSpline(s.knots_u[0], hom, s.degree_u).derivative()(u)
+    sv = BSpline(s.knots_v[0], hom.transpose(1, 0, 2), s.degree_v).derivative()(v)
+    au = np.einsum("kjc,kj->kc", su, bv)
+    av = np.einsum("kic,ki->kc", sv, bu)
+    w = a[:, 3:]
+    return p, (au[:, :3] - au[:, 3:] * p) / w, (av[:, :3] - av[:, 3:] * p) / w
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(2, 90), st.integers(2, 80), st.integers(0, 2**32 - 1))
+def test_banded_fit_and_evaluation_equal_the_dense_ones(m, n, seed):
+    """Past BANDED_FROM control points a direction is solved and evaluated through its
+    banded basis (memory of the points, not their square); the numbers are the dense ones."""
+    import maizeviz.leaf.nurbs as nurbs
+
+    rng = np.random.default_rng(seed)
+    pts = random_grid(rng, m, n)
+    u, v = np.sort(rng.uniform(0, 1, 37)), np.sort(rng.uniform(0, 1, 23))
+    old = nurbs.BANDED_FROM
+    try:
+        nurbs.BANDED_FROM = 10**9                   # dense everywhere
+        dense = fit_surface(pts)
+        dense_grid = dense.evaluate_grid(u, v)
+        nurbs.BANDED_FROM = 2                       # banded everywhere
+        banded = fit_surface(pts)
+        banded_grid = banded.evaluate_grid(u, v)
+        dense_on_banded = fit_surface(pts)
+    finally:
+        nurbs.BANDED_FROM = old
+    scale = np.abs(pts).max()
+    assert np.abs(banded.control - dense.control).max() <= 1e-9 * scale
+    assert np.abs(banded_grid - dense_grid).max() <= 1e-9 * scale
+    assert np.abs(dense_on_banded.evaluate_grid(banded.params_u, banded.params_v)[0]
+                  - pts).max() <= 1e-9 * scale          # still through every point
+    k = rng.uniform(0, 1, (2, 50))
+    want = _old_derivatives(dense, k[0], k[1])
+    try:
+        nurbs.BANDED_FROM = 2                       # points and derivatives, banded
+        got = dense._at(k[0], k[1], derivative=True)
+    finally:
+        nurbs.BANDED_FROM = old
+    for g, w in zip(got, want):
+        assert np.abs(g - w).max() <= 1e-9 * max(1.0, np.abs(w).max())
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(1, 5), st.integers(1, 40), st.integers(1, 30), st.integers(0, 2**32 - 1))
+def test_count_at_most_row_by_row_equals_the_broadcast(nl, na, nk, seed):
+    import maizeviz.leaf.nurbs as nurbs
+
+    rng = np.random.default_rng(seed)
+    rows = np.sort(rng.choice([0.0, 0.25, 0.5, 1.0, *rng.uniform(0, 1, 8)], (nl, nk)), axis=1)
+    x = rng.choice([0.0, 0.25, 0.5, 1.0, *rng.uniform(0, 1, 8)], (nl, na))
+    want = (x[:, :, None] >= rows[:, None, :]).sum(axis=2)
+    old = nurbs.BROADCAST_MOST
+    try:
+        nurbs.BROADCAST_MOST = 0
+        assert np.array_equal(nurbs.count_at_most(rows, x), want)
+    finally:
+        nurbs.BROADCAST_MOST = old
+    assert np.array_equal(nurbs.count_at_most(rows, x), want)

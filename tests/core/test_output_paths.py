@@ -134,7 +134,7 @@ def test_an_output_never_overwrites_an_input_or_another_output(tiny, case, how):
             os.chdir(old)
         after = _snapshot(work)
         lines = [ln for ln in err.getvalue().splitlines() if ln.startswith(("error", "internal"))]
-        assert after == before, f"{argv} {spelled}: files changed or appeared: " \
-            f"{sorted(set(after.items()) ^ set(before.items()))}"
+        assert after == before, (f"{argv} {spelled}: files changed or appeared: "
+                                 f"{sorted(set(after.items()) ^ set(before.items()))}")
         assert code == EXIT_FAIL and len(lines) == 1 and lines[0].startswith("error: "), \
             (argv, spelled, err.getvalue()[-600:])

@@ -1,7 +1,13 @@
 """Embree's ray packets (maizeviz.mesh.packets, the C kernel _packets.c) against embreex's
 single rays, through real Embree: the same triangle and the same float32 distance for every
 ray, coherent or not, in order or in tiles; whole light computations identical either way;
-the kernel compiled into a cache folder, and its absence falls back."""
+the kernel is the extension built at install (nothing compiled or written at run time), the
+Embree library is found in every embreex wheel layout, and every fallback says why, once."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -111,17 +117,145 @@ def test_light_is_the_same_through_packets_or_single_rays(canopy, monkeypatch, p
     np.testing.assert_array_equal(fast[1].maps, slow[1].maps)
 
 
-def test_the_kernel_is_compiled_into_the_cache_and_its_absence_falls_back(tmp_path,
-                                                                          monkeypatch):
-    monkeypatch.setenv("MAIZEVIZ_CACHE", str(tmp_path))
-    if packets.build() is not None:                           # a C compiler is here
-        assert packets.compiled_path().parent == tmp_path
-        assert packets.compiled_path().exists()
-    monkeypatch.setenv("MAIZEVIZ_CACHE", str(tmp_path / "none"))
-    monkeypatch.setenv("CC", "false")                          # a compiler that fails
-    assert packets.build() is None
-    monkeypatch.setattr(raytrace._packets, "kernel", lambda: None)
-    scene = RayScene(np.array([[0, 0, 1.0], [1, 0, 1], [0, 1, 1]]), np.array([[0, 1, 2]]))
-    assert not scene.packets
-    prim, t = scene.first_hit(np.array([[0.2, 0.2, 0.0]]), np.array([[0, 0, 1.0]]))
-    assert prim[0] == 0 and t[0] == pytest.approx(1.0)
+def test_the_kernel_is_the_extension_built_at_install(tmp_path):
+    """The kernel in use is the extension module built from this _packets.c when maizeviz was
+    installed; a light computation with no compiler on PATH and an empty home folder uses it
+    and writes nothing there."""
+    import importlib.machinery
+
+    st = packets.status()
+    assert (st.name, st.why) == ("packets", "")
+    assert st.path is not None and st.path.parent == Path(packets.__file__).parent
+    assert st.path.name.endswith(tuple(importlib.machinery.EXTENSION_SUFFIXES))
+    home = tmp_path / "home"
+    home.mkdir()
+    code = ("import maizeviz as mv, warnings; warnings.simplefilter('error'); "
+            "c = mv.build_canopy(mv.read_points(mv.example_points()), tile=(1, 1), "
+            "level='8'); e = mv.LightEngine(c, density=0.2); r = e.sun(zenith=30, azimuth=0); "
+            "print(e.scene().packets, r.transmission[0])")
+    env = {k: v for k, v in os.environ.items() if k not in ("XDG_CACHE_HOME", "CC")}
+    env.update(HOME=str(home), PATH=str(tmp_path / "no-compiler"), MPLCONFIGDIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         env=env, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split()[0] == "True"
+    assert list(home.rglob("*")) == []
+
+
+def _fallback(code: str, env: dict | None = None) -> subprocess.CompletedProcess:
+    """Run ``code`` after tracing two scenes, warnings recorded: prints the kernel in use and
+    every warning's text, one a line."""
+    prog = ("import warnings, numpy as np\n" + code + "\n"
+            "from maizeviz.mesh.raytrace import RayScene\n"
+            "from maizeviz.mesh import packets\n"
+            "v = np.array([[0, 0, 1.0], [1, 0, 1], [0, 1, 1]]); f = np.array([[0, 1, 2]])\n"
+            "with warnings.catch_warnings(record=True) as said:\n"
+            "    warnings.simplefilter('always')\n"
+            "    scenes = [RayScene(v, f), RayScene(v, f)]\n"
+            "    hit = scenes[1].first_hit(np.array([[0.2, 0.2, 0.0]]), np.array([[0, 0, 1.0]]))\n"
+            "print(packets.status().name, scenes[0].packets, int(hit[0][0]))\n"
+            "for w in said: print(w.category.__name__, w.message)\n")
+    return subprocess.run([sys.executable, "-c", prog], capture_output=True, text=True,
+                          timeout=300, env={**os.environ, **(env or {})})
+
+
+def test_without_the_built_kernel_rays_fall_back_and_say_why_once():
+    out = _fallback("import sys; sys.modules['maizeviz.mesh._packets'] = None")
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert lines[0] == "embreex False 0"                  # the same hit through single rays
+    assert len(lines) == 2 and lines[1].startswith("RuntimeWarning maizeviz: tracing with "
+                                                   "embreex's single rays")
+    assert "was not built when maizeviz was installed" in lines[1]
+
+
+def test_a_kernel_built_from_another_source_is_not_used(tmp_path, monkeypatch):
+    other = tmp_path / "_packets.c"
+    other.write_bytes(packets.SOURCE.read_bytes() + b"\n/* edited */\n")
+    monkeypatch.setattr(packets, "SOURCE", other)
+    k, st = packets._load()
+    assert k is None and st.name == "embreex"
+    assert "was built from another _packets.c" in st.why and "pip install -e ." in st.why
+
+
+def test_turning_the_packets_off_is_not_warned_about():
+    out = _fallback("", {"MAIZEVIZ_PACKETS": "0"})
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.splitlines() == ["embreex False 0"]
+
+
+def test_an_unknown_embreex_keeps_its_scenes_private_and_says_so():
+    """embreex releases whose scene layout maizeviz does not know: neither the copy fill nor
+    the packets read its private scene handle; each fallback is said once."""
+    out = _fallback("import maizeviz.mesh.embree_fill as ef; ef.KNOWN_EMBREEX = ((4, 3),)")
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert lines[0] == "embreex False 0"
+    assert len(lines) == 3
+    assert all("is not a release whose scene layout maizeviz knows (4.3.x)" in w
+               for w in lines[1:])
+    assert "filling Embree's scenes through embreex" in lines[1]
+    assert "tracing with embreex's single rays" in lines[2]
+
+
+#: The Embree library in each embreex 4.4.0.post1 wheel, with the files beside it (from
+#: ``pip download embreex --platform ... --only-binary=:all:``, unpacked).
+WHEEL_FILES = {
+    "manylinux_2_17_x86_64": ("embreex.libs/libembree4-4aef3270.so.4",
+                              ["embreex.libs/libtbb-dcf63f8c.so.12",
+                               "embreex/rtcore.cpython-311-x86_64-linux-gnu.so"]),
+    "macosx_13_0_arm64": ("embreex/.dylibs/libembree4.4.dylib",
+                          ["embreex/.dylibs/libtbb.12.11.dylib",
+                           "embreex/rtcore.cpython-311-darwin.so"]),
+    "macosx_13_0_x86_64": ("embreex/.dylibs/libembree4.4.dylib",
+                           ["embreex/.dylibs/libtbb.12.11.dylib",
+                            "embreex/rtcore_scene.cpython-311-darwin.so"]),
+    "win_amd64": ("embreex.libs/embree4.dll",
+                  ["embreex.libs/tbb12.dll",
+                   "embreex.libs/msvcp140-a4c2229bdc2a2a630acdc095b4d86008.dll",
+                   "embreex/rtcore.cp311-win_amd64.pyd"]),
+}
+
+
+@pytest.mark.parametrize("wheel", sorted(WHEEL_FILES))
+def test_embree_is_found_in_every_wheel_layout(tmp_path, wheel):
+    from maizeviz.mesh.embree_fill import wheel_library
+
+    library, others = WHEEL_FILES[wheel]
+    for name in (library, *others):
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_bytes(b"")
+    assert wheel_library(tmp_path) == tmp_path / library
+    assert wheel_library(tmp_path / "elsewhere") is None
+
+
+def test_the_library_found_is_the_one_embreex_loaded():
+    import embreex
+
+    from maizeviz.mesh.embree_fill import embree, loaded_library, wheel_library
+
+    e = embree()
+    assert e.scene_field and e.why == "" and e.version.startswith("4.")
+    assert e.path == loaded_library()
+    site = Path(embreex.__file__).resolve().parent.parent
+    if (site / "embreex.libs").is_dir() or (site / "embreex" / ".dylibs").is_dir():
+        assert wheel_library(site).resolve() == e.path.resolve()     # embreex's own wheel
+
+
+def test_without_embreex_light_is_refused_in_one_line_naming_the_platform():
+    """Where embreex has no wheel (pyproject's marker leaves it out), maizeviz installs and
+    light is refused in one line naming the platform and where embreex has wheels."""
+    import platform
+
+    code = ("import sys; sys.modules['embreex'] = None\n"
+            "from maizeviz.cli import main\n"
+            "from maizeviz.resources import example_points\n"
+            "sys.exit(main(['light', str(example_points()), '--triangles', '8', '--density', "
+            "'0.2', '--sun-zenith', '30', '--sun-azimuth', '150']))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=300)
+    assert out.returncode == 1
+    errors = [line for line in out.stderr.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1 and "Traceback" not in out.stderr
+    assert "embreex has wheels for Linux x86-64, Windows x86-64 and macOS 13" in errors[0]
+    assert f"this is {sys.platform} {platform.machine()}" in errors[0]

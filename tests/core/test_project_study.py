@@ -225,7 +225,7 @@ leaves = read_leaves(opened.points_path).leaves
 layout = study.project_layout(opened, leaves)
 print(len(layout.placements), layout.warnings[-1])
 try:
-    study.check_canopy_fits(leaves, layout, parse_level("36"), opened.path)
+    study.check_canopy_fits(leaves, layout, parse_level("K1"), opened.path)
 except ProjectError as exc:
     print(exc.quantity, exc)
 """
@@ -458,3 +458,49 @@ def test_a_day_refuses_a_sky_traced_on_other_stands(points, leaves):
     with pytest.raises(MaizevizError, match="traced on other stands"):
         trace_period(build_canopy(leaves, layout_for(leaves, (2, 2)), LEVEL), period, SAMPLING,
                      sky=sky)
+
+
+def test_per_triangle_arrays_of_the_wrong_length_are_one_line(points, leaves, tmp_path):
+    """Issue 25: a project's per-triangle arrays of the wrong length for sun and sky results
+    were accepted and failed later with a broadcast error (a day's were checked). A sun's two
+    hit arrays must match each other when read; any result's light per triangle must match
+    the canopy it is tabled on."""
+    from maizeviz.errors import MaizevizError
+    from maizeviz.light.scene.request import LightRequest
+    from maizeviz.light.sources.sun import Sun
+    from maizeviz.light.trace.direct import trace_light
+
+    layout = layout_for(leaves, (2, 2))
+    canopy = build_canopy(leaves, layout, LEVEL)
+    sun = trace_light(canopy, LightRequest(Sun(30, 180), SAMPLING))
+    sky = trace_sky(canopy, make_sky("soc", 16), SAMPLING)
+    path = tmp_path / "ok.maizeviz"
+    study.save_study(path, points, layout, [sun, sky], level=LEVEL.label)
+    project = load_project(path)
+    short = canopy.n_triangles - 7
+    for name, kind in (("second_hits", 0), ("triangle_share", 1)):
+        rec = project.results[kind]
+        arrays = {**rec.arrays, name: np.asarray(rec.arrays[name])[:short]}
+        results = list(project.results)
+        results[kind] = replace(rec, arrays=arrays)
+        bad = tmp_path / f"short_{name}.maizeviz"
+        save_project(bad, replace(project, results=tuple(results)))
+        if kind == 0:
+            with pytest.raises(ProjectError, match="first and second hits per triangle do not "
+                                                   "match") as exc:
+                study.read_study(bad, tmp_path / "cache")
+            assert "\n" not in str(exc.value)
+        else:
+            back = study.read_study(bad, tmp_path / "cache")
+            stored = [r for r in back.results if r.kind == "sky"][0].result
+            for by in ("leaf", "plant"):
+                with pytest.raises(MaizevizError, match=f"holds light for {short:,} triangles, "
+                                                        "but the canopy has"):
+                    stored.table(by, canopy)
+    # the same tables on the undamaged project add up (leaves = plants)
+    back = study.read_study(path, tmp_path / "cache")
+    for r in back.results:
+        leaf, plant = r.result.table("leaf", canopy), r.result.table("plant", canopy)
+        col = "sunlit_intercepted_cm2" if r.kind == "sun" else "diffuse_intercepted_cm2"
+        assert leaf[col].sum() == pytest.approx(plant[col].sum(), rel=1e-12)
+        assert leaf[col].sum() > 0

@@ -25,7 +25,7 @@ import tempfile
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from hypothesis.stateful import (
     RuleBasedStateMachine,
@@ -417,3 +417,80 @@ def test_an_undo_written_twice_through_maizeviz_record(tmp_path):
         sim.close()
     table = read_points(out)
     assert len(table) == 20 and len({tuple(i) for i in table.ids}) == 20
+
+
+# ------------------------------------------------------------------ any journal the reader reads
+_POS = st.tuples(st.integers(1, 2), st.integers(1, 3), st.integers(0, 3), st.integers(0, 3))
+_LINE = st.one_of(
+    st.tuples(st.just("point"), _POS, st.sampled_from(["recorded", "", "ok"])),
+    st.tuples(st.just("control"), _POS, st.sampled_from(["next_leaf", "next_plant",
+                                                          "end_row"])),
+    st.tuples(st.just("undo"), _POS, st.just("undone")),
+    st.tuples(st.just("junk"), st.sampled_from(sorted(JUNK)), st.just("")),
+)
+
+
+def _journal(lines) -> bytes:
+    out = [",".join(["plant", "leaf", "row", "col", "x", "y", "z", "status", "time",
+                     "station", "error"])]
+    for k, (kind, what, status) in enumerate(lines):
+        if kind == "junk":
+            out.append(JUNK[what].rstrip("\r\n"))
+            continue
+        xyz = ("", "", "") if kind == "control" else (f"{k}.000", "2.500", "100.125")
+        out.append(",".join([*map(str, what), *xyz, status, "1.0",
+                             "1" if kind == "point" else "", ""]))
+    return ("\r\n".join(out) + "\r\n").encode()
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(_LINE, max_size=25), st.integers(1, 4), st.integers(0, 6))
+# the issue's cases, kept whatever the draws: an undo of a point never recorded, the same
+# undo twice, a line the reader skips after a row's last point
+@example([("point", (1, 1, 0, 0), "recorded"), ("undo", (2, 2, 1, 1), "undone")], 2, 2)
+@example([("point", (1, 1, 0, 0), "recorded"), ("point", (1, 1, 0, 1), "recorded"),
+          ("undo", (1, 1, 0, 1), "undone"), ("undo", (1, 1, 0, 1), "undone")], 2, 3)
+@example([("point", (1, 1, 0, 0), "recorded"), ("point", (1, 1, 0, 1), "recorded"),
+          ("point", (1, 1, 1, 0), "recorded"), ("point", (1, 1, 1, 1), "recorded"),
+          ("junk", "unknown status", "")], 2, 3)
+def test_any_journal_the_reader_accepts_resumes_without_losing_a_point(lines, cols, presses):
+    """Whatever a recording holds (points anywhere, controls, undos, lines the reader skips),
+    resuming it keeps the points the reader reads, in their order, and every new press lands
+    where the recorder's rules put it, never on a point already held (which would make the
+    reader refuse its leaf): or the resume is refused in one line with nothing written."""
+    folder = Path(tempfile.mkdtemp(prefix="maizeviz-journal-"))
+    try:
+        path = folder / "rec.csv"
+        path.write_bytes(_journal(lines))
+        try:
+            before = read_points(path)
+            kept = [(tuple(int(v) for v in i), tuple(float(v) for v in x))
+                    for i, x in zip(before.ids, before.xyz)]
+        except PointsFileError:
+            kept = []
+        data = path.read_bytes()
+        try:
+            s = Session(path, cols=cols, resume=True)
+        except SessionError as exc:
+            assert "\n" not in str(exc) and path.read_bytes() == data
+            return
+        with s:
+            assert [((q.plant, q.leaf, q.row, q.col), xyz) for q, xyz in s.history] == kept
+            model = Model(cols)
+            model.pos, model.kept = (s.pos.plant, s.pos.leaf, s.pos.row, s.pos.col), list(kept)
+            assert not any(k == model.pos for k, _ in kept)      # checked when resuming
+            for k in range(presses):
+                xyz = (1000.0 + k, 2.5, 100.125)
+                said = s.on_event(_record(xyz[0]))
+                assert said.startswith("recorded" if model.press(xyz) else "refused"), said
+        try:
+            after = read_points(path)
+            got = [(tuple(int(v) for v in i), tuple(float(v) for v in x))
+                   for i, x in zip(after.ids, after.xyz)]
+        except PointsFileError:                                  # no point at all
+            got = []
+        assert got == model.kept
+        new = [k for k, _ in got[len(kept):]]                   # no new point on a held one:
+        assert len(set(new)) == len(new) and not set(new) & {k for k, _ in kept}  # no leaf lost
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)

@@ -277,8 +277,10 @@ def test_per_plant_tables_add_up_to_the_balance(homogeneous):
     assert (table["sunlit_area_cm2"] <= table["leaf_area_cm2"] + 1e-9).all()
     assert "absorbed_umol_s" not in table                         # NIR: no photon count
     assert list(got.table("balance").columns[:2]) == ["band", "incident"]
-    with pytest.raises(MaizevizError, match="give the canopy"):
+    with pytest.raises(MaizevizError, match="needs the canopy") as info:
         got.table("leaf")
+    assert info.value.quantity == "canopy"
+    assert got.table().equals(got.table("balance"))            # the default: the balance
 
 
 # ----------------------------------------------------------------------------- the sky per ray

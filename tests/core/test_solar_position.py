@@ -24,6 +24,12 @@ CLOCKS = st.tuples(st.integers(0, 23), st.integers(0, 59), st.integers(0, 59),
                    st.sampled_from(["", "+08:00", "-05:00", "+00:00", "+05:45"])).map(
     lambda c: f"{c[0]:02d}:{c[1]:02d}:{c[2]:02d}{c[3]}")
 PLACES = st.tuples(st.floats(-66, 66), st.floats(-180, 180), st.floats(0, 4000))
+#: pandas 3.0 writes a Timestamp with nanoseconds in a zone whose offset has seconds (a
+#: historic local mean time, +08:05:43) with the nanoseconds inside the offset
+#: ("...23.437247+08232:05:43"; right from pandas 3.1): there the oracle writes the text
+#: from the Timestamp's fields
+PANDAS_NS_OFFSET_BUG = pd.Timestamp(1900, 1, 1, 20, 0, 0, 1, nanosecond=232,
+                                    tz="Asia/Shanghai").isoformat().endswith("+08232:05:43")
 
 
 def pvlib_sun(date: str, clock: str | None, lat: float, lon: float, tz: str | None,
@@ -31,14 +37,22 @@ def pvlib_sun(date: str, clock: str | None, lat: float, lon: float, tz: str | No
     """The oracle: pvlib's public wrappers with pandas, as maizeviz called them before."""
     day = dt.date.fromisoformat(date)
     if solar_noon:
-        where = zone(tz) if tz is not None else dt.timezone.utc
+        where = zone(tz) if tz is not None else dt.UTC
         midnight = pd.DatetimeIndex([pd.Timestamp(dt.datetime.combine(day, dt.time(), where))])
         when = pd.Timestamp(pvlib.solarposition.sun_rise_set_transit_spa(
             midnight, lat, lon)["transit"].iloc[0])
     else:
         when = local_time(day, clock, tz)
     pos = pvlib.solarposition.get_solarposition(pd.DatetimeIndex([when]), lat, lon, altitude)
-    return float(pos["apparent_zenith"].iloc[0]), float(pos["azimuth"].iloc[0]), when.isoformat()
+    text = when.isoformat()
+    if PANDAS_NS_OFFSET_BUG and when.nanosecond and when.utcoffset().seconds % 60:
+        # the same text from the Timestamp's fields: date, time, 9 decimals, the offset
+        offset = when.utcoffset()
+        sign, rest = ("-", -offset) if offset.days < 0 else ("+", offset)
+        hh, mm_ss = divmod(rest.seconds, 3600)
+        text = (f"{when:%Y-%m-%dT%H:%M:%S}.{when.microsecond:06d}{when.nanosecond:03d}"
+                f"{sign}{hh:02d}:{mm_ss // 60:02d}:{mm_ss % 60:02d}")
+    return float(pos["apparent_zenith"].iloc[0]), float(pos["azimuth"].iloc[0]), text
 
 
 def outcome(call):

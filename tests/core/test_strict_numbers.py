@@ -195,3 +195,46 @@ def test_weather_and_optics_files_with_underscores(tmp_path):
     optics.write_text("rank,reflectance,transmittance\n1,0.1,0.05\n2,0_1,0.05\n")
     with pytest.raises(MaizevizError, match="line 3: rank, reflectance and transmittance"):
         read_optics_table(optics, "par")
+
+
+# ------------------------------------------------------------------ names too long
+LONG = "a" * 300
+
+
+@pytest.mark.parametrize("argv", [
+    ["leaf", B, "--triangles", "8", "--export", "DIR/LONG.ply"],
+    ["canopy", B, "--tile", "1x1", "--triangles", "8", "--export", "DIR/LONG.obj"],
+    ["canopy", B, "--tile", "1x1", "--triangles", "8", "--save-layout", "DIR/LONG.json"],
+    ["light", B, *SUN, "--tile", "1x1", "--triangles", "8", "--leaf-light", "DIR/LONG.csv"],
+    ["light", B, *SUN, "--tile", "1x1", "--triangles", "8", "--plant-light", "DIR/LONG.csv"],
+    ["light", B, *SUN, "--tile", "1x1", "--triangles", "8", "--heatmaps", "DIR/LONG"],
+    ["synth", "--plants", "1x1", "--out", "DIR/LONG.csv"],
+    ["leaf", "DIR/LONG.csv"],
+    ["canopy", B, "--layout", "DIR/LONG.json"],
+])
+def test_a_name_too_long_is_one_line_for_every_file(capsys, tmp_path, argv):
+    """``--export`` with a 300-character name was an internal error (OSError: File name too
+    long) where every other output refused it in one line."""
+    argv = [a.replace("DIR", str(tmp_path)).replace("LONG", LONG) for a in argv]
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if ln.startswith(("error", "internal"))]
+    assert len(lines) == 1 and lines[0].startswith("error:"), err[-400:]
+    assert "too long" in lines[0].lower()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_weather_rows_with_dhi_above_ghi_are_said(tmp_path):
+    """Doubtful case decided: a row whose dhi exceeds its ghi was cut to no direct light and
+    its dni ignored without a word; the light is the same, now with a note naming it."""
+    from maizeviz.light.sources.irradiance import read_weather, weather_period
+
+    path = tmp_path / "w.csv"
+    path.write_text("time,ghi,dni,dhi\n2005-08-01T11:00+08:00,600,500,200\n"
+                    "2005-08-01T12:00+08:00,300,700,350\n2005-08-01T13:00+08:00,500,400,100\n")
+    period = weather_period(read_weather(path), 39.9, 116.4)
+    said = [n for n in period.notes if "dhi above ghi" in n]
+    assert len(said) == 1 and said[0].startswith("1 row of w.csv with the sun up has dhi above ghi")
+    assert "2005-08-01T12:00:00+08:00" in said[0] and "dni is not used" in said[0]
+    assert period.direct_horizontal[1] == 0 and period.dhi[1] == 300
+    assert period.direct_horizontal[0] == 400 and period.dhi[0] == 200

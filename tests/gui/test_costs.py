@@ -8,7 +8,7 @@ TIMEOUT = 120_000
 
 
 def shown(qtbot, w):
-    if w.canopy is None:
+    if w.model.canopy is None:
         qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait()
     return w
 
@@ -17,13 +17,13 @@ def test_a_canopy_too_big_for_memory_is_refused_and_the_slider_goes_back(window,
                                                                          small_points,
                                                                          monkeypatch):
     w = shown(qtbot, window(small_points, tile=1))
-    level, canopy = w.level, w.canopy
-    monkeypatch.setattr(cost, "memory_available", lambda: 2**20)      # a 1 MiB machine
+    level, canopy = w.model.settings.canopy.level, w.model.canopy
+    monkeypatch.setattr(cost, "memory_available", lambda: 2**18)      # a 256 KiB machine
     w.step_level(-1)                                                   # finer
     qtbot.waitUntil(lambda: "memory" in w.messages.toPlainText(), timeout=5000)
     text = w.messages.toPlainText()
     assert "triangles" in text and "more than the" in text
-    assert w.level == level and w.canopy is canopy                    # nothing changed
+    assert w.model.settings.canopy.level == level and w.model.canopy is canopy                    # nothing changed
     assert w.runner.current("build") is None
     assert w.canopy_panel.asked_label.text() == ""
 
@@ -33,7 +33,7 @@ def test_slow_light_asks_first_and_starts_only_when_confirmed(window, qtbot, sma
     w = shown(qtbot, window(small_points, tile=1))
     monkeypatch.setattr(cost, "SLOW_SECONDS", 1e-9)                   # anything is slow now
     asked = []
-    monkeypatch.setattr(w, "confirm_slow", lambda estimate: asked.append(estimate) or False)
+    monkeypatch.setattr(w.model, "confirm_slow", lambda estimate: asked.append(estimate) or False)
     panel = w.light_panel
     panel.set_mode("sky")
     panel.density.setValue(3.0)
@@ -42,11 +42,11 @@ def test_slow_light_asks_first_and_starts_only_when_confirmed(window, qtbot, sma
     assert "from 46 directions" in asked[0]                            # the sky's directions
     assert w.runner.current("light") is None and panel.compute_button.isEnabled()
     assert "not started" in w.statusBar().currentMessage()
-    monkeypatch.setattr(w, "confirm_slow", lambda estimate: asked.append(estimate) or True)
+    monkeypatch.setattr(w.model, "confirm_slow", lambda estimate: asked.append(estimate) or True)
     panel.density.setValue(0.5)
     with qtbot.waitSignal(w.light_shown, timeout=TIMEOUT):
         panel.compute_button.click()
-    assert len(asked) == 2 and w.runs.of_kind("sky") is not None
+    assert len(asked) == 2 and w.model.runs.of_kind("sky") is not None
 
 
 def test_a_day_is_estimated_from_its_steps(window, qtbot, small_points, monkeypatch):
@@ -59,7 +59,7 @@ def test_a_day_is_estimated_from_its_steps(window, qtbot, small_points, monkeypa
     w = shown(qtbot, window(small_points, tile=1))
     monkeypatch.setattr(cost, "SLOW_SECONDS", 1e-9)
     asked = []
-    monkeypatch.setattr(w, "confirm_slow", lambda estimate: asked.append(estimate) or False)
+    monkeypatch.setattr(w.model, "confirm_slow", lambda estimate: asked.append(estimate) or False)
     panel = w.light_panel
     panel.set_mode("day")
     panel.step.setValue(30.0)

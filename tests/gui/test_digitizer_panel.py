@@ -9,6 +9,7 @@ from PySide6.QtWidgets import QLineEdit
 from maizeviz.digitizer.protocol import Record
 from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import Session
+from maizeviz.digitizer.simulator import FastrakSimulator
 from maizeviz.io.points import read_points
 
 TIMEOUT = 20_000
@@ -172,6 +173,14 @@ def test_lost_port_is_loud_and_every_point_is_on_disk(qtbot, make_panel, sim, tm
     assert any("on disk" in a for a in alerts) and panel.beeps >= 1
     assert len(read_points(out)) == 4
     assert panel.connect_button.isEnabled() and not panel.out_edit.isReadOnly()
+    # plugged back in, Connect continues the same file where it stopped
+    assert panel.resume.isChecked()
+    with FastrakSimulator(press_gap_s=0.0, noise_cm=0.0) as again:
+        _connect(qtbot, panel, again, out)
+        assert panel.session.count.points == 4
+        _press_and_wait(qtbot, panel, again, [(9.0, 0.0, 0.0)])
+        panel.stop(wait=True)
+    assert read_points(out).xyz[:, 0].tolist() == [0, 1, 2, 3, 9]
 
 
 def test_unwritable_output_and_missing_port_are_said(qtbot, make_panel, tmp_path):
@@ -337,8 +346,8 @@ def test_a_canopy_built_while_digitizing_waits_for_the_session(window, two_plant
     w.digitizer._drain()
     qtbot.waitUntil(lambda: "digitized" in w.viewport.actors, timeout=TIMEOUT)
     with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
-        w.slider.setValue(w.slider.value() + 1)             # a rebuild finishes meanwhile
-    assert w.built.label == "16 triangles"
+        w.canopy_panel.slider.setValue(w.canopy_panel.slider.value() + 1)             # a rebuild finishes meanwhile
+    assert w.model.built.label == "16 triangles"
     assert "canopy" not in w.viewport.actors                 # the plant keeps the view
     assert "digitized" in w.viewport.actors
     with qtbot.waitSignal(w.digitizer.stopped, timeout=TIMEOUT):
@@ -346,5 +355,5 @@ def test_a_canopy_built_while_digitizing_waits_for_the_session(window, two_plant
     assert "digitized" in w.viewport.actors                  # still, until Analyse
     w.workspaces.show("analyse")
     assert "canopy" in w.viewport.actors and "digitized" not in w.viewport.actors
-    n_stalk = len(w.canopy.stalk_faces)
-    assert w.viewport.canopy_mesh.n_cells == w.canopy.n_triangles + n_stalk   # the new one
+    n_stalk = len(w.model.canopy.stalk_faces)
+    assert w.viewport.canopy_mesh.n_cells == w.model.canopy.n_triangles + n_stalk   # the new one

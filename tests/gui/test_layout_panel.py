@@ -198,13 +198,13 @@ def test_layout_editor_in_the_window_turns_a_plant(window, two_plants, qtbot):
     panel = w.layout_panel
     assert panel.rows.rowCount() == 2
     first = panel.model.placements[0].plant
-    before = w.canopy.vertices[w.canopy.faces[w.canopy.face_plant == first]].copy()
+    before = w.model.canopy.vertices[w.model.canopy.faces[w.model.canopy.face_plant == first]].copy()
     with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
         panel.rows.setData(panel.rows.index(0, 3), "90")      # the 3D view follows
-    after = w.canopy.vertices[w.canopy.faces[w.canopy.face_plant == first]]
+    after = w.model.canopy.vertices[w.model.canopy.faces[w.model.canopy.face_plant == first]]
     assert not np.allclose(before, after)
-    assert [p.azimuth_deg for p in w.loaded.layout.placements if p.plant == first] == [90]
-    assert w.loaded.layout.ground_area_cm2 == pytest.approx(60 * 60)   # the tiling's ground
+    assert [p.azimuth_deg for p in w.model.loaded.layout.placements if p.plant == first] == [90]
+    assert w.model.loaded.layout.ground_area_cm2 == pytest.approx(60 * 60)   # the tiling's ground
 
 
 def test_the_tiling_has_one_place_and_the_window_follows_it(window, two_plants, qtbot, tmp_path):
@@ -221,13 +221,94 @@ def test_the_tiling_has_one_place_and_the_window_follows_it(window, two_plants, 
     assert tilings == [w.layout_panel.tiling]                # one control, in the layout panel
     with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
         assert w.layout_panel.set_tiling(3)                  # the preset; the view follows
-    assert w.tile_n == 3 and len(w.canopy.layout.placements) == 18
+    assert w.model.tile_n == 3 and len(w.model.canopy.layout.placements) == 18
     path = tmp_path / "tiled.maizeviz"
     with qtbot.waitSignal(w.saved, timeout=120_000):
-        w.save_project(path)
+        w.model.save_project(path)
     with zipfile.ZipFile(path) as zf:
         assert json.loads(zf.read("project.json"))["settings"]["canopy"]["tile"] == 3
     with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
         w.open_points(two_plants)                            # reopened with the tiling shown
-    assert len(w.loaded.layout.placements) == 18
+    assert len(w.model.loaded.layout.placements) == 18
     assert w.layout_panel.tiling.currentData() == 3
+
+
+def test_rows_by_plants_at_spacings_is_one_undoable_edit(panel, qtbot):
+    panel.rows_box.setValue(4)
+    panel.per_row_box.setValue(3)
+    panel.row_spacing_box.setValue(75.0)
+    panel.plant_spacing_box.setValue(25.0)
+    with qtbot.waitSignal(panel.applied) as applied:          # the 3D view follows
+        panel.lay_out_button.click()
+    layout = applied.args[0]
+    assert len(layout.placements) == 12 and len(panel.view.items_) == 12
+    assert panel.rows.rowCount() == 12 and layout.row_spacing == 75.0
+    xs = sorted({p.x for p in layout.placements})
+    assert np.allclose(np.diff(xs), 75.0) and len(xs) == 4
+    assert panel.tiling.currentText() == "4 rows x 3 plants"
+    assert panel.undo_stack.count() == 1
+    panel.undo_action.trigger()
+    assert panel.rows.rowCount() == 2 and panel.rows_box.value() == 1   # the fields follow
+    assert panel.per_row_box.value() == 2 and panel.row_spacing_box.value() == 60.0
+
+
+def test_a_plant_put_onto_another_is_red_and_listed_until_moved(panel, qtbot):
+    from maizeviz_app.panels.field_view import OVERLAPPING, PLANT
+
+    panel.select(0)
+    panel.duplicate_button.click()                            # at the end of its row: ok
+    assert panel.rows.rowCount() == 3 and panel.picked == 2
+    qtbot.wait(100)
+    assert panel.overlaps.isHidden()
+    a = panel.model.placements[0]
+    assert panel.rows.setData(panel.rows.index(2, 0), str(a.x + 2.0))
+    assert panel.rows.setData(panel.rows.index(2, 1), str(a.y + 1.0))   # onto plant 1
+    qtbot.waitUntil(lambda: not panel.overlaps.isHidden(), timeout=2000)
+    assert panel.overlaps.count() == 1
+    assert "rows 1 and 3" in panel.overlaps.item(0).text()
+    assert "2.2 cm apart" in panel.overlaps.item(0).text()
+    assert panel.view.items_[0].brush().color() == OVERLAPPING
+    assert panel.rows.data(panel.rows.index(0, 0), Qt.ForegroundRole) is not None
+    assert panel.view.items_[1].brush().color() == PLANT
+    panel.remove_button.click()                               # the picked one (row 3) goes
+    qtbot.waitUntil(panel.overlaps.isHidden, timeout=2000)
+    assert panel.rows.rowCount() == 2
+    assert panel.view.items_[0].brush().color() == PLANT
+    panel.undo_action.trigger()                               # back: red again
+    qtbot.waitUntil(lambda: not panel.overlaps.isHidden(), timeout=2000)
+    assert panel.rows.rowCount() == 3
+
+
+def test_add_rotate_and_snap(panel, qtbot):
+    panel.select(1)
+    panel.add_button.click()                                  # beyond the end of the row
+    new = panel.model.placements[-1]
+    assert (new.x, new.y) == (BASES[2][0], BASES[2][1] + 30.0) and panel.picked == 2
+    panel.left_button.click()
+    panel.left_button.click()
+    panel.right_button.click()
+    assert panel.model.placements[2].azimuth_deg == 15.0
+    panel.snap.setChecked(True)
+    panel.snap_step.setValue(10.0)
+    view = panel.view
+    item = view.items_[0]
+    start = view.mapFromScene(item.scenePos())
+    qtbot.mousePress(view.viewport(), Qt.LeftButton, pos=start)
+    qtbot.mouseMove(view.viewport(), start + QPoint(37, 0))
+    qtbot.mouseRelease(view.viewport(), Qt.LeftButton, pos=start + QPoint(37, 0))
+    p = panel.model.placements[0]
+    assert p.x % 10.0 == 0 and p.y % 10.0 == 0 and p.x != BASES[1][0]
+    assert view.items_[0].pos() == QPointF(p.x, p.y)          # the disc sits where it snapped
+    assert panel.undo_stack.count() == 5
+
+
+def test_every_layout_control_has_a_name_and_a_tip(panel):
+    from PySide6.QtWidgets import QAbstractButton, QAbstractSpinBox, QComboBox
+
+    controls = [c for c in panel.findChildren(QAbstractButton)
+                + panel.findChildren(QAbstractSpinBox) + panel.findChildren(QComboBox)
+                if not c.objectName().startswith("qt_")]          # Qt's own parts
+    assert len(controls) >= 15
+    for c in controls:
+        assert c.toolTip(), c
+        assert c.accessibleName(), c

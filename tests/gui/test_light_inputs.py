@@ -9,7 +9,7 @@ TIMEOUT = 120_000
 
 
 def shown(qtbot, w):
-    if w.canopy is None:
+    if w.model.canopy is None:
         qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait()
     return w
 

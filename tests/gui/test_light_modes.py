@@ -12,7 +12,7 @@ TIMEOUT = 120_000
 
 
 def shown(qtbot, w):
-    if w.canopy is None:
+    if w.model.canopy is None:
         qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait()
     return w
 
@@ -64,14 +64,14 @@ def test_sky_mode_adds_a_diffuse_curve_maps_and_colours(window, qtbot, small_poi
     assert w.plots.transmission.image() is not None
     # the leaves coloured by the diffuse light they take, with a colour bar
     assert w.viewport.colouring == "light" and w.viewport.light_variant == "values"
-    assert w.viewport.actors["canopy"].mapper.GetArrayName() == "light_value"
+    assert w.viewport.actors["canopy"].mapper.GetArrayName() == "light_rgb"
     assert "diffuse light per leaf" in w.viewport.key.text()
-    values = w.viewport.canopy_mesh.cell_data["light_value"][:w.canopy.n_triangles]
+    values = w.viewport.canopy_mesh.cell_data["light_value"][:w.model.canopy.n_triangles]
     assert np.all(np.isfinite(values)) and values.max() > 0.2
     # what each plant takes: two plants, shares of the sky's light summing to the canopy's
     assert panel.plants.isVisible() and panel.plants.rowCount() == 2
     shares = [float(panel.plants.item(r, 3).text().rstrip("%")) / 100 for r in range(2)]
-    assert sum(shares) == pytest.approx(w.runs.of_kind("sky").result.intercepted_fraction,
+    assert sum(shares) == pytest.approx(w.model.runs.of_kind("sky").result.intercepted_fraction,
                                         abs=0.002)
     # back to the sun's colours and map
     w.plots.source.setCurrentIndex(0)
@@ -106,7 +106,7 @@ def test_day_mode_summary_plants_and_exports(window, qtbot, small_points, tmp_pa
             "table": tmp_path / "table.csv", "canopy": tmp_path / "canopy.vtu"}
     for what, path in outs.items():
         with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
-            w.export(what, path)
+            w.model.export(what, path)
     steps = list(csv.DictReader(outs["steps"].open()))
     assert len(steps) == 14 and {"time", "par_intercepted_mol_m2"} <= set(steps[0])
     assert sum(float(r["par_direct_mol_m2"]) + float(r["par_diffuse_mol_m2"])
@@ -121,7 +121,7 @@ def test_day_mode_summary_plants_and_exports(window, qtbot, small_points, tmp_pa
     import meshio
 
     mesh = meshio.read(outs["canopy"])
-    par = np.concatenate(mesh.cell_data["par_mol_per_m2_leaf"])[:w.canopy.n_triangles]
+    par = np.concatenate(mesh.cell_data["par_mol_per_m2_leaf"])[:w.model.canopy.n_triangles]
     assert np.nanmax(par) > 5
 
 
@@ -226,18 +226,18 @@ def test_project_keeps_the_light_mode_and_its_settings(window, qtbot, small_poin
     panel.par_factor.setValue(2.0)
     panel.source_weather.setChecked(True)
     panel.weather.setText("/data/paris.csv")
-    settings = panel.settings()
+    settings = panel.settings.light_doc()
     path = tmp_path / "day.maizeviz"
     with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
-        w.save_project(path)
+        w.model.save_project(path)
     with zipfile.ZipFile(path) as zf:
         light = json.loads(zf.read("project.json"))["settings"]["light"]
     assert light["mode"] == "day" and light["sky_directions"] == 30
     w2 = shown(qtbot, window(path))
     p2 = w2.light_panel
-    assert p2.mode == "day" and p2.settings() == settings
+    assert p2.mode == "day" and p2.settings.light_doc() == settings
     assert p2.pages.isVisible() and p2.sky_box.isVisible() and not p2.day_date.isEnabled()
-    assert p2.sky_spec().split == "equal" and p2.day_spec().weather == "/data/paris.csv"
+    assert p2.settings.sky_spec().split == "equal" and p2.settings.day_spec().weather == "/data/paris.csv"
 
 
 def test_a_project_without_light_modes_opens_in_sun_mode(window, qtbot, small_points,
@@ -251,4 +251,4 @@ def test_a_project_without_light_modes_opens_in_sun_mode(window, qtbot, small_po
     w = shown(qtbot, window(path))
     panel = w.light_panel
     assert panel.mode == "sun" and panel.heights.text() == "0, 100"
-    assert panel.sky_spec().directions == 46 and panel.day_spec().date == "2005-08-01"
+    assert panel.settings.sky_spec().directions == 46 and panel.settings.day_spec().date == "2005-08-01"

@@ -23,7 +23,7 @@ def test_sun_with_leaf_optics_paints_absorbed_light_and_balances(window, qtbot, 
     assert p.band.currentData() == "par" and p.reflectance.value() == 0.10
     assert p.direct_w.value() == 480.0                      # PAR share of 1000 W/m2
     compute(qtbot, w)
-    run = w.runs.last
+    run = w.model.runs.last
     a = run.extra.light
     b = a.balance
     assert a.band == "par" and b.incident == 480.0
@@ -41,26 +41,26 @@ def test_sun_with_leaf_optics_paints_absorbed_light_and_balances(window, qtbot, 
     area_m2 = (a.rect[2] - a.rect[0]) * (a.rect[3] - a.rect[1]) * 1e-4
     assert abs(total_w - b.absorbed_leaves * area_m2) < 0.01 * len(plants) + 1e-6
     # painted: W per m2 of leaf on each leaf triangle, the colour bar says so
-    values = w.viewport.canopy_mesh.cell_data["light_value"][:w.canopy.n_triangles]
+    values = w.viewport.canopy_mesh.cell_data["light_value"][:w.model.canopy.n_triangles]
     np.testing.assert_allclose(values, run.extra.leaf_value, rtol=1e-6)
     assert w.viewport.colouring == "light" and values.max() > 0
     # the settings and the absorbed light go into the project and come back as computed
     path = tmp_path / "optics.maizeviz"
     table = _rows(p.table)
     with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
-        w.save_project(path)
+        w.model.save_project(path)
     w2 = window(path)
-    qtbot.waitUntil(lambda: w2.runs.last is not None and w2.runs.last.extra is not None
-                    and w2.runs.last.extra.leaf_value is not None, timeout=TIMEOUT)
+    qtbot.waitUntil(lambda: w2.model.runs.last is not None and w2.model.runs.last.extra is not None
+                    and w2.model.runs.last.extra.leaf_value is not None, timeout=TIMEOUT)
     p2 = w2.light_panel
     assert p2.optics_box.isChecked() and p2.reflectance.value() == 0.10
-    run2 = w2.runs.last
+    run2 = w2.model.runs.last
     assert run2.balance == b and _rows(p2.table) == table
     np.testing.assert_array_equal(run2.extra.light.triangle_absorbed_w, a.triangle_absorbed_w)
     np.testing.assert_array_equal(run2.extra.leaf_value, run.extra.leaf_value)
     qtbot.waitUntil(lambda: w2.viewport.colouring == "light", timeout=TIMEOUT)
     np.testing.assert_allclose(
-        w2.viewport.canopy_mesh.cell_data["light_value"][:w2.canopy.n_triangles],
+        w2.viewport.canopy_mesh.cell_data["light_value"][:w2.model.canopy.n_triangles],
         run.extra.leaf_value, rtol=1e-6)
     assert _rows(p2.plants) == plants
     # the same sun and optics again: the comparison goes on (same settings)
@@ -79,7 +79,7 @@ def test_black_leaves_absorb_what_they_intercept(window, qtbot, small_points):
     for box in (p.reflectance, p.transmittance, p.ground_reflectance):
         box.setValue(0.0)
     compute(qtbot, w)
-    run = w.runs.last
+    run = w.model.runs.last
     b = run.extra.light.balance
     assert b.reflected_top == 0 and b.absorbed_ground > 0
     assert abs(b.absorbed_leaves / b.incident - run.result.sunlit_intercepted_fraction) < 1e-9
@@ -107,17 +107,17 @@ def test_a_day_with_perez_diffuse_light(window, qtbot, small_points, tmp_path):
     p.day_diffuse.setCurrentIndex(p.day_diffuse.findData("perez"))
     assert not p.sky_kind.isEnabled() and "uniform sky" in p.sky_kind.toolTip()
     compute(qtbot, w)
-    day = w.runs.last.result
+    day = w.model.runs.last.result
     assert day.diffuse is not None and day.diffuse.model == "perez"
     assert "Perez anisotropic" in p.info.text() and "circumsolar" in p.info.text()
     total = day.par_diffuse_mol_m2
     assert abs(float(day.step_diffuse_mol_m2.sum()) - total) < 1e-9 * max(total, 1)
     path = tmp_path / "perez.maizeviz"
     with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
-        w.save_project(path)
+        w.model.save_project(path)
     w2 = window(path)
-    qtbot.waitUntil(lambda: w2.runs.last is not None, timeout=TIMEOUT)
+    qtbot.waitUntil(lambda: w2.model.runs.last is not None, timeout=TIMEOUT)
     assert w2.light_panel.day_diffuse.currentData() == "perez"
     w2.light_panel.set_mode("sky")
     assert w2.light_panel.sky_kind.isEnabled()          # a sky alone has its own shape
-    assert w2.runs.last.result.diffuse is not None
+    assert w2.model.runs.last.result.diffuse is not None

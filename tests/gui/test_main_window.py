@@ -13,21 +13,21 @@ def test_opens_example_and_slider_rebuilds(window, qtbot):
     assert first.args == ["36 triangles"]
     assert "canopy" in w.viewport.actors
     assert np.any(w.viewport.canopy_mesh.cell_data["light"] == -2)      # stalks, same mesh
-    n36 = w.canopy.n_triangles
-    assert w.table.rowCount() == 1 and w.table.item(0, 0).text() == "36 triangles"
-    lai = float(w.table.item(0, 5).text())
+    n36 = w.model.canopy.n_triangles
+    assert w.canopy_panel.table.rowCount() == 1 and w.canopy_panel.table.item(0, 0).text() == "36 triangles"
+    lai = float(w.canopy_panel.table.item(0, 5).text())
     assert 4.5 < lai < 5.8
-    shown = "at most 36 triangles" in w.level_label.text()
-    w.slider.setValue(LEVELS.index("4"))
+    shown = "at most 36 triangles" in w.canopy_panel.level_label.text()
+    w.canopy_panel.slider.setValue(LEVELS.index("4"))
     qtbot.wait(300)                      # debounced: the build has started, not finished
-    assert shown and "at most 36 triangles" in w.level_label.text()
+    assert shown and "at most 36 triangles" in w.canopy_panel.level_label.text()
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT,
                           check_params_cb=lambda lv: lv == "4 triangles"):
         pass
     # label, table and view changed together
-    assert w.canopy.n_triangles < n36
-    assert w.table.rowCount() == 2
-    assert "at most 4 triangles" in w.level_label.text()
+    assert w.model.canopy.n_triangles < n36
+    assert w.canopy_panel.table.rowCount() == 2
+    assert "at most 4 triangles" in w.canopy_panel.level_label.text()
 
 
 def test_fast_slider_moves_show_only_the_last_level(window, qtbot):
@@ -37,15 +37,13 @@ def test_fast_slider_moves_show_only_the_last_level(window, qtbot):
     w.canopy_shown.connect(shown.append)
     # moves within the debounce interval coalesce into one rebuild
     for stop in ("standard", "16", "8", "K1", "4"):
-        w.slider.setValue(LEVELS.index(stop))
+        w.canopy_panel.slider.setValue(LEVELS.index(stop))
     qtbot.waitUntil(lambda: bool(shown) and shown[-1] == "4 triangles", timeout=TIMEOUT)
-    # rebuilds started back to back: the superseded one's result is dropped
-    w.slider.blockSignals(True)
-    w.slider.setValue(LEVELS.index("K2"))
-    w.rebuild()
-    w.slider.setValue(LEVELS.index("8"))
-    w.rebuild()
-    w.slider.blockSignals(False)
+    # rebuilds started back to back (levels set by a script): the superseded one's result
+    # is dropped, and the slider follows the level set
+    w.model.settings.canopy.level = "K2"
+    w.model.settings.canopy.level = "8"
+    assert w.canopy_panel.level == "8"
     qtbot.waitUntil(lambda: shown[-1] == "8 triangles", timeout=TIMEOUT)
     from PySide6.QtCore import QThreadPool
     QThreadPool.globalInstance().waitForDone(TIMEOUT)
@@ -67,7 +65,7 @@ def test_compute_light_colours_the_leaves(window, qtbot):
     # the leaves are coloured by the light they received, with a legend
     assert w.viewport.colouring == "light"
     assert w.viewport.actors["canopy"].mapper.GetArrayName() == "light"
-    light = w.viewport.canopy_mesh.cell_data["light"][:w.canopy.n_triangles]
+    light = w.viewport.canopy_mesh.cell_data["light"][:w.model.canopy.n_triangles]
     assert set(np.unique(light)) == {0, 1, 2}
     assert w.menu_actions["colour_light"].isChecked()
     # a heatmap per height and the transmission plot
@@ -82,11 +80,11 @@ def test_sun_from_place_and_bad_place(window, qtbot):
     panel = w.light_panel
     panel.place.setText("2005-08-01 12:00 39.9 116.4 Asia/Shanghai")
     panel.zenith.setValue(10)
-    w.sun_from_place()
+    w.model.sun_from_place()
     qtbot.waitUntil(lambda: abs(panel.zenith.value() - 22.34) < 0.02, timeout=TIMEOUT)
     panel.place.setText("yesterday noon somewhere")
     with qtbot.waitSignal(w.failed, timeout=TIMEOUT) as err:
-        w.sun_from_place()
+        w.model.sun_from_place()
     assert "YYYY-MM-DD" in err.args[0]
     assert "error" in w.messages.toPlainText()
     assert "d0342c" in panel.place.styleSheet()            # the field is marked
@@ -101,16 +99,16 @@ def test_bad_points_file_says_so_and_keeps_the_canopy(window, qtbot, tmp_path):
     assert "missing column" in err.args[0] and "Choose a points CSV" in err.args[0]
     assert "Error" not in err.args[0] and "maizeviz.errors" not in err.args[0]
     assert "error" in w.messages.toPlainText()
-    assert w.canopy is None
+    assert w.model.canopy is None
     # a good file, then a bad one: the good one stays, named in the label
     from maizeviz.resources import example_points
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
         w.open_points(example_points())
-    canopy, label = w.canopy, w.canopy_panel.file_label.text()
+    canopy, label = w.model.canopy, w.canopy_panel.file_label.text()
     assert label.endswith("block3x3.csv")
     notnum = tmp_path / "notnum.csv"
     notnum.write_text("plant,leaf,row,col,x,y,z\nA,1,0,0,x,y,z\n")
     with qtbot.waitSignal(w.failed, timeout=TIMEOUT) as err:
         w.open_points(notnum)
     assert "could not convert" not in err.args[0]
-    assert w.canopy is canopy and w.canopy_panel.file_label.text() == label
+    assert w.model.canopy is canopy and w.canopy_panel.file_label.text() == label

@@ -43,7 +43,7 @@ def test_opening_points_starts_a_clean_study(loaded, small_points):
     model = StudyModel(tile=3)
     seen = _record(model)
     assert model.title == "maizeviz" and not model.modified
-    model.open_points(loaded, b"abc", str(small_points))
+    model.set_points(loaded, b"abc", str(small_points))
     assert model.loaded is loaded and model.points_bytes == b"abc" and model.serial == 1
     assert [n for n, _ in seen] == ["runs_changed", "points_changed", "project_changed"]
     assert not model.modified and model.title == f"maizeviz — {small_points.name}[*]"
@@ -52,7 +52,7 @@ def test_opening_points_starts_a_clean_study(loaded, small_points):
 
 def test_light_results_are_unsaved_work_until_saved(loaded, small_points, tmp_path):
     model = StudyModel()
-    model.open_points(loaded, b"", str(small_points))
+    model.set_points(loaded, b"", str(small_points))
     seen = _record(model)
     run = Run("36 triangles", model.signature("36 triangles"), _Result())
     assert not model.add_run(run, ("sun",), ("h",), "traced")
@@ -64,7 +64,7 @@ def test_light_results_are_unsaved_work_until_saved(loaded, small_points, tmp_pa
     assert not model.add_run(stale, ("sun",), ("h",))
     assert list(model.runs.runs) == ["36 triangles"]
     target = str(tmp_path / "s.maizeviz")
-    model.saved(target)
+    model.mark_saved(target)
     assert not model.modified and model.project_path == target
     assert model.title == "maizeviz — s.maizeviz[*]"
     # results read back from a project are not new work
@@ -77,7 +77,7 @@ def test_a_layout_edit_drops_results_and_stales_canopies(loaded, small_points):
     from dataclasses import replace
 
     model = StudyModel()
-    model.open_points(loaded, b"", str(small_points))
+    model.set_points(loaded, b"", str(small_points))
     old_serial = model.serial
     model.add_run(Run("36 triangles", model.signature("36 triangles"), _Result()), (), ())
     seen = _record(model)
@@ -121,7 +121,7 @@ def test_window_marks_unsaved_work_and_asks_before_closing(window, qtbot, small_
 
     answer(QMessageBox.StandardButton.Cancel)
     assert not w.close()                            # Cancel: the window stays, results kept
-    assert w.isVisible() and w.runs.runs and "not in a project" in answers[0]
+    assert w.isVisible() and w.model.runs.runs and "not in a project" in answers[0]
     # Save with a project already named: saved, then closed
     w.model.project_path = str(tmp_path / "kept.maizeviz")
     answer(QMessageBox.StandardButton.Save)
@@ -150,4 +150,16 @@ def test_discarding_lets_another_file_open(window, qtbot, small_points):
     QTimer.singleShot(50, discard)
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
         w.open_points(small_points)
-    assert w.model.serial == serial + 1 and not w.runs.runs and not w.isWindowModified()
+    assert w.model.serial == serial + 1 and not w.model.runs.runs and not w.isWindowModified()
+
+
+def test_the_digitizer_connection_is_a_setting_of_the_study(window, qtbot):
+    w = window(wait_ready=True)
+    d, settings = w.digitizer, w.model.settings.digitizer
+    assert settings.port == d.port and settings.baud == d.baud.value()
+    settings.port, settings.baud = "/dev/ttyS7", 9600          # set by a script: shown
+    assert d.port == "/dev/ttyS7" and d.baud.value() == 9600
+    d.ports.box.setEditText("/dev/ttyUSB3")                     # typed: the study's
+    d.baud.setValue(38400)
+    assert (settings.port, settings.baud) == ("/dev/ttyUSB3", 38400)
+    assert w.undo.stack.count() == 0                            # not an edit of the study

@@ -17,15 +17,20 @@ from maizeviz.errors import LeafError, MaizevizError, PointsFileError
 
 
 def test_slider_asks_once_and_the_label_follows_the_view(qtbot):
-    panel = CanopyPanel(level="36")
+    panel = CanopyPanel()
     qtbot.addWidget(panel)
+    assert panel.level == "36" == panel.settings.canopy.level
     asked = []
-    panel.level_requested.connect(asked.append)
+    panel.settings.canopy.events.level.connect(lambda new, old: asked.append(new))
     for v in (0, 1, 2, 7):                                # moves within the debounce interval
         panel.slider.setValue(v)
     qtbot.waitUntil(lambda: bool(asked), timeout=2000)
     qtbot.wait(400)
-    assert asked == ["4"]
+    assert asked == ["4"] and panel.settings.canopy.level == "4"
+    panel.settings.canopy.level = "K2"                    # set elsewhere: the slider follows
+    assert panel.level == "K2" and asked == ["4", "K2"]
+    qtbot.wait(400)
+    assert asked == ["4", "K2"]                           # and does not ask again
     # the label names the level shown, not the one asked, until the canopy arrives
     assert panel.level_label.text() == "no canopy yet"
     assert "asked" in panel.asked_label.text()
@@ -53,22 +58,32 @@ def test_heights_are_read_or_named():
 def test_light_panel_request_and_problem_marking(qtbot):
     panel = LightPanel()
     qtbot.addWidget(panel)
-    req = panel.request()
+    req = panel.settings.sun_request()
     assert req.classes and req.heights_cm == (0, 50, 100, 150, 200, 225)
+    tip = panel.heights.toolTip()
     panel.heights.setText("0, abc")
+    assert panel.settings.sampling.heights == "0, abc"    # the field is the setting
     with pytest.raises(InputProblem) as err:
-        panel.request()
+        panel.settings.sun_request()
     assert panel.point_at(err.value.quantity, str(err.value))
     assert "d0342c" in panel.heights.styleSheet()
     assert "abc" in panel.heights.toolTip()
     qtbot.keyClicks(panel.heights, "1")                   # editing clears the mark
-    assert panel.heights.styleSheet() == ""
+    assert panel.heights.styleSheet() == "" and panel.heights.toolTip() == tip
     assert not panel.point_at("no such field", "x")
-    settings = panel.settings()
+    # settings read back into other panels' settings show in their fields
+    panel.zenith.setValue(41.5)
+    panel.mode_buttons["day"].click()
+    panel.band.setCurrentIndex(1)                         # NIR: its optics follow
+    assert panel.settings.optics.band == "nir" and panel.reflectance.value() > 0.3
+    doc = panel.settings.light_doc()
     other = LightPanel()
     qtbot.addWidget(other)
-    other.apply_settings(settings)
-    assert other.settings() == settings
+    other.settings.apply_light_doc(doc)
+    assert other.settings.light_doc() == doc
+    assert other.zenith.value() == 41.5 and other.mode == "day"
+    assert other.pages.currentIndex() == 1 and other.reflectance.value() == \
+        panel.reflectance.value()
 
 
 class FakeResult:
@@ -129,7 +144,8 @@ def test_figures_are_the_core_heatmap_and_a_level_comparison(small_canopy):
     maps = heatmap_images(result, all_heights=True)
     assert heatmap_images(result, first=1)[0][1] is None      # drawn when asked for
     assert [h for h, _ in maps] == [0.0, 100.0]
-    assert all(img.ndim == 3 and img.shape[2] == 4 and img.shape[1] > 300 for _, img in maps)
+    assert all(m.rgba.ndim == 3 and m.rgba.shape[2] == 4 and m.rgba.shape[1] > 300
+               for _, m in maps)
     fig = transmission_figure([Curve("K=4", (0.0, 100.0), (0.1, 0.5)),
                                Curve("36 triangles", (0.0, 100.0), (0.11, 0.5))])
     assert [t.get_text() for t in fig.axes[0].get_legend().get_texts()] == \

@@ -7,10 +7,10 @@ TIMEOUT = 120_000
 
 def per_stand(w):
     """Stand (plant, x, y, azimuth) -> the light value shown on its leaves."""
-    values = w.viewport.canopy_mesh.cell_data["light_value"][:w.canopy.n_triangles]
+    values = w.viewport.canopy_mesh.cell_data["light_value"][:w.model.canopy.n_triangles]
     out = {}
-    for i, p in enumerate(w.canopy.layout.placements):
-        mine = values[w.canopy.face_instance == i]
+    for i, p in enumerate(w.model.canopy.layout.placements):
+        mine = values[w.model.canopy.face_instance == i]
         out[(p.plant, round(p.x, 6), round(p.y, 6), round(p.azimuth_deg, 6))] = \
             np.sort(mine)
     return out
@@ -23,10 +23,10 @@ def test_an_edited_layouts_sky_light_stays_on_its_plants(window, qtbot, small_po
     from maizeviz.canopy.layout import layout_for
 
     w = window(small_points, tile=1)
-    if w.canopy is None:
+    if w.model.canopy is None:
         qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait()
     # the layout edited: a 3 x 3 tiling, one plant turned, stands in the tiling's order
-    tiled = layout_for(w.loaded.leaves, (3, 3))
+    tiled = layout_for(w.model.loaded.leaves, (3, 3))
     turned = tuple(replace(p, azimuth_deg=90.0) if i == 4 else p
                    for i, p in enumerate(tiled.placements))
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
@@ -43,12 +43,12 @@ def test_an_edited_layouts_sky_light_stays_on_its_plants(window, qtbot, small_po
     assert len({round(float(v.sum()), 6) for v in before.values()}) > 1
     path = tmp_path / "edited.maizeviz"
     with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
-        w.save_project(path)
+        w.model.save_project(path)
 
     w2 = window(path)
     with qtbot.waitSignal(w2.light_shown, timeout=TIMEOUT):
         pass
-    assert w2.loaded.layout.placements == w.loaded.layout.placements   # order and tiles
+    assert w2.model.loaded.layout.placements == w.model.loaded.layout.placements   # order and tiles
     assert w2.viewport.colouring == "light"
     after = per_stand(w2)
     assert after.keys() == before.keys()
@@ -80,6 +80,6 @@ def test_results_of_other_stands_are_left_out_with_one_line(window, qtbot, small
     w = window(path)
     qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait()
     text = w.messages.toPlainText()
-    assert f"note: the sky result on {level.label} was traced on other stands (18 plants) " \
-           "than the project's layout (2); left out (compute it again)" in text
-    assert not w.runs.runs and w.viewport.colouring != "light"
+    assert (f"note: the sky result on {level.label} was traced on other stands (18 plants) "
+            "than the project's layout (2); left out (compute it again)") in text
+    assert not w.model.runs.runs and w.viewport.colouring != "light"

@@ -16,9 +16,9 @@ def test_a_large_canopy_is_drawn_within_the_budget_and_coloured_by_its_light(
     from maizeviz.mesh.levels import COMPLEXITY_STOPS
 
     with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
-        w.slider.setValue(COMPLEXITY_STOPS.index("standard"))     # finer than 36 a leaf
+        w.canopy_panel.slider.setValue(COMPLEXITY_STOPS.index("standard"))     # finer than 36 a leaf
     mesh = w.viewport.canopy_mesh
-    c = w.canopy
+    c = w.model.canopy
     assert "source" in mesh.field_data and c.n_triangles > 500
     assert "around the sampled tile at 36 triangles a leaf" in w.messages.toPlainText()
     source = np.asarray(mesh.field_data["source"])
@@ -36,8 +36,9 @@ def test_a_large_canopy_is_drawn_within_the_budget_and_coloured_by_its_light(
     np.testing.assert_allclose(np.asarray(mesh.points)[faces[mine]],
                                c.vertices[c.faces[source[mine]]], rtol=1e-6)
     small_light(w.light_panel, "sun")
+    w.model.colour.painting = "triangles"               # each triangle's class, asked for
     compute(qtbot, w)
-    classes = w.runs.last.classes
+    classes = w.model.runs.last.classes
     light = np.asarray(mesh.cell_data["light"])[:n_leaf]
     np.testing.assert_array_equal(light[source >= 0], classes[source[source >= 0]])
     # elsewhere: the most common class of the leaf (instance, rank) among the canopy's
@@ -53,7 +54,7 @@ def test_a_large_canopy_is_drawn_within_the_budget_and_coloured_by_its_light(
     small_light(w.light_panel, "sky")
     compute(qtbot, w)
     values = np.asarray(mesh.cell_data["light_value"])[:n_leaf]
-    leaf_value = w.runs.last.extra.leaf_value
+    leaf_value = w.model.runs.last.extra.leaf_value
     np.testing.assert_array_equal(values[source >= 0], leaf_value[source[source >= 0]])
     k = int(np.flatnonzero(source < 0)[0])
     mine = (c.face_instance == inst[k]) & (c.face_leaf == leaf[k])

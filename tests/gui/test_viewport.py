@@ -46,8 +46,10 @@ def test_canopy_is_one_mesh_with_ids(viewport, small_canopy):
     assert set(np.unique(mesh.cell_data["plant"])) == {p.plant for p in
                                                         small_canopy.layout.placements}
     assert np.all(mesh.cell_data["leaf"][small_canopy.n_triangles:] == 0)      # stalks
-    # one actor for all leaves and stalks: nothing per plant or per leaf
-    assert set(viewport.actors) == {"canopy", "ground"}
+    # one actor for all leaves and stalks: nothing per plant or per leaf (and the selection's,
+    # hidden until a click)
+    assert set(viewport.actors) == {"canopy", "ground", "selection"}
+    assert not viewport.actors["selection"].GetVisibility()
 
 
 def test_light_colouring(qtbot, viewport, small_canopy):

@@ -12,7 +12,7 @@ TIMEOUT = 120_000
 
 
 def shown(qtbot, w):
-    qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait() if w.canopy is None else None
+    qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT).wait() if w.model.canopy is None else None
     return w
 
 
@@ -38,14 +38,14 @@ def test_a_result_queued_at_close_starts_nothing(window, qtbot, small_points):
     from maizeviz.resources import example_points
 
     w = shown(qtbot, window(small_points, tile=1))
-    loaded, label = w.loaded, w.canopy_panel.file_label.text()
+    loaded, label = w.model.loaded, w.canopy_panel.file_label.text()
     w.open_points(example_points())
     QThreadPool.globalInstance().waitForDone(TIMEOUT)     # loaded; result not yet delivered
     builds = []
     w.canopy_shown.connect(builds.append)
     w.close()
     qtbot.wait(1000)
-    assert w.loaded is loaded and w.canopy_panel.file_label.text() == label
+    assert w.model.loaded is loaded and w.canopy_panel.file_label.text() == label
     assert w.runner.current("build") is None and not builds
     assert QThreadPool.globalInstance().waitForDone(10_000)
 
@@ -57,7 +57,7 @@ def test_no_idle_renders_and_one_render_per_canopy(window, qtbot, small_points):
     qtbot.wait(2000)
     assert w.viewport.render_count == before                 # nothing happening: no frame
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
-        w.slider.setValue(w.slider.value() + 1)
+        w.canopy_panel.slider.setValue(w.canopy_panel.slider.value() + 1)
     qtbot.wait(600)
     assert w.viewport.render_count == before + 1             # the new canopy, once
 
@@ -91,23 +91,23 @@ def test_cancel_stops_a_light_run_within_half_a_second(window, qtbot):
 def lit(qtbot, w, density=0.5):
     w.light_panel.density.setValue(density)
     with qtbot.waitSignal(w.light_shown, timeout=TIMEOUT):
-        w.compute_light()
+        w.model.compute_light()
     return w
 
 
 def test_project_round_trip(window, qtbot, small_points, tmp_path):
     w = shown(qtbot, window(small_points, tile=1))
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
-        w.slider.setValue(w.slider.value() + 1)            # 16 triangles
+        w.canopy_panel.slider.setValue(w.canopy_panel.slider.value() + 1)            # 16 triangles
     w.light_panel.heights.setText("0, 100, 200")
     lit(qtbot, w)
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
-        w.slider.setValue(w.slider.value() - 1)            # 36: a second level to compare
+        w.canopy_panel.slider.setValue(w.canopy_panel.slider.value() - 1)            # 36: a second level to compare
     lit(qtbot, w)
     table = [[w.light_panel.table.item(r, c).text() for c in range(3)] for r in range(3)]
     path = tmp_path / "study.maizeviz"
     with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
-        w.save_project(path)
+        w.model.save_project(path)
     with zipfile.ZipFile(path) as zf:
         doc = json.loads(zf.read("project.json"))
     assert doc["settings"]["canopy"]["level"] == "36" and len(doc["results"]) == 2
@@ -115,12 +115,12 @@ def test_project_round_trip(window, qtbot, small_points, tmp_path):
     w2 = window(path)
     with qtbot.waitSignal(w2.light_shown, timeout=TIMEOUT):
         pass
-    assert w2.level == "36" and w2.light_panel.heights.text() == "0, 100, 200"
+    assert w2.model.settings.canopy.level == "36" and w2.light_panel.heights.text() == "0, 100, 200"
     assert "study.maizeviz" in w2.canopy_panel.file_label.text()
     assert [[w2.light_panel.table.item(r, c).text() for c in range(3)] for r in range(3)] == table
     assert w2.viewport.colouring == "light" and w2.plots.height_box.count() == 3
-    np.testing.assert_array_equal(w2.loaded.layout.cells, w.loaded.layout.cells)
-    assert w2.loaded.layout.placements == w.loaded.layout.placements
+    np.testing.assert_array_equal(w2.model.loaded.layout.cells, w.model.loaded.layout.cells)
+    assert w2.model.loaded.layout.placements == w.model.loaded.layout.placements
 
 
 @pytest.mark.parametrize("damage, message", [
@@ -149,12 +149,12 @@ def test_bad_projects_are_refused_and_the_canopy_stays(window, qtbot, small_poin
             for n, b in parts.items():
                 zf.writestr(n, b)
     w = shown(qtbot, window(small_points, tile=1))
-    canopy, label = w.canopy, w.canopy_panel.file_label.text()
+    canopy, label = w.model.canopy, w.canopy_panel.file_label.text()
     with qtbot.waitSignal(w.failed, timeout=TIMEOUT) as err:
         w.open_project(path)
     assert message in err.args[0] and "\n" not in err.args[0]
     assert "ProjectError" not in err.args[0]
-    assert w.canopy is canopy and w.canopy_panel.file_label.text() == label
+    assert w.model.canopy is canopy and w.canopy_panel.file_label.text() == label
 
 
 def test_exports(window, qtbot, small_points, tmp_path):
@@ -166,16 +166,18 @@ def test_exports(window, qtbot, small_points, tmp_path):
             "canopy": tmp_path / "c.vtu"}
     for what, path in outs.items():
         with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
-            w.export(what, path)
+            w.model.export(what, path)
     lines = outs["table"].read_text().splitlines()
     assert lines[0].startswith("height_cm,transmission 36 triangles") and len(lines) == 7
     assert outs["measures"].read_text().startswith("level,triangles,leaf_area_m2")
     for png in ("heatmap", "plot"):
         assert outs[png].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     mesh = meshio.read(outs["canopy"])
-    light = np.concatenate(mesh.cell_data["light"])
-    assert set(np.unique(light[:w.canopy.n_triangles])) <= {0, 1, 2}
+    light = np.concatenate(mesh.cell_data["sun_class"])
+    assert set(np.unique(light[:w.model.canopy.n_triangles])) <= {0, 1, 2}
     assert np.any(light == 2)
+    # the plot travels with the mesh (VTK field data), as the canopy's layout has it
+    assert tuple(mesh.field_data["field_cm"]) == w.model.canopy.layout.bounds
 
 
 def test_menus_show_shortcuts_and_about_names_the_paper(window, qtbot):
@@ -189,7 +191,7 @@ def test_menus_show_shortcuts_and_about_names_the_paper(window, qtbot):
     assert texts["save"] == "Ctrl+S" and texts["quit"] == "Ctrl+Q"
     assert texts["camera_top"] == "Ctrl+1" and texts["colour_light"] == "Ctrl+Shift+3"
     menus = [a.text().replace("&", "") for a in w.menuBar().actions()]
-    assert menus == ["File", "View", "Light", "Help"]
+    assert menus == ["File", "Edit", "View", "Light", "Help"]
     text = about_text()
     assert __version__ in text and "Guo" in text and "Scientia Agricultura Sinica" in text
 
@@ -229,22 +231,22 @@ def test_project_keeps_an_edited_layout(window, qtbot, small_points, tmp_path):
     from dataclasses import replace
 
     w = shown(qtbot, window(small_points, tile=3))
-    layout = w.loaded.layout
+    layout = w.model.loaded.layout
     turned = tuple(replace(p, azimuth_deg=37.5) if i == 4 else p
                    for i, p in enumerate(layout.placements))
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
         w.layout_panel.applied.emit(replace(layout, placements=turned))
     path = tmp_path / "edited.maizeviz"
     with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
-        w.save_project(path)
+        w.model.save_project(path)
     w2 = window(path)
     qtbot.waitSignal(w2.canopy_shown, timeout=TIMEOUT).wait()
     key = lambda p: (p.x, p.y)                                  # noqa: E731
-    back = sorted(w2.loaded.layout.placements, key=key)
+    back = sorted(w2.model.loaded.layout.placements, key=key)
     assert [(p.plant, p.x, p.y, p.azimuth_deg) for p in back] == \
         [(p.plant, p.x, p.y, p.azimuth_deg) for p in sorted(turned, key=key)]
-    assert w2.loaded.layout.ground_area_cm2 == layout.ground_area_cm2
-    np.testing.assert_array_equal(w2.loaded.layout.cells, layout.cells)
+    assert w2.model.loaded.layout.ground_area_cm2 == layout.ground_area_cm2
+    np.testing.assert_array_equal(w2.model.loaded.layout.cells, layout.cells)
 
 
 def test_the_view_is_on_screen_in_a_window_of_its_own(window, qtbot, small_points):

@@ -7,7 +7,7 @@ from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import Session
 
 TIMEOUT = 120_000
-ANALYSE = {"canopy", "light", "layout", "results", "messages"}
+ANALYSE = {"canopy", "light", "layout", "colour", "results", "messages", "history"}
 
 
 def _open(w):
@@ -79,6 +79,6 @@ def test_recording_goes_to_digitize_and_a_light_result_back(qtbot, window, two_p
     assert w.workspaces.current == "digitize"              # stays for the next plant
     assert "digitized" in w.viewport.actors and "canopy" not in w.viewport.actors
     with qtbot.waitSignal(w.light_shown, timeout=TIMEOUT):
-        w.compute_light()
+        w.model.compute_light()
     assert w.workspaces.current == "analyse" and "results" in _open(w)
     assert "canopy" in w.viewport.actors and "digitized" not in w.viewport.actors

@@ -1,9 +1,12 @@
 """The canopy panel: the points file, area preservation, the mesh-complexity slider and Table 2.
 (The tiling is chosen in the layout panel, its one place.)
 
-The slider says what is asked; the level label says what the 3D view shows. Both change
-together with the table when the window hands over a built canopy (:meth:`CanopyPanel.
-show_built`), so the label never names a level the view does not show yet.
+The slider and the area-preservation box are bound to the study's canopy settings
+(:class:`maizeviz_app.settings.CanopySettings`): the slider sets the level once it rests, and
+a level set elsewhere (a project, an undo, a refused build) moves it. The slider says what is
+asked; the level label says what the 3D view shows. Both change together with the table when
+the study shows a built canopy (:meth:`CanopyPanel.show_built`), so the label never names a
+level the view does not show yet.
 """
 
 from __future__ import annotations
@@ -29,12 +32,13 @@ from PySide6.QtWidgets import (
 )
 
 from maizeviz.mesh.levels import COMPLEXITY_STOPS, parse_level
+from maizeviz_app.bind import bind
+from maizeviz_app.building import MESH_LEVEL
+from maizeviz_app.settings import StudySettings
 
 #: What the slider does.
 SLIDER_TIP = ("fine (K=4, the paper's reference mesh) to coarse (4 triangles per leaf); the "
               "canopy is rebuilt when the slider rests")
-#: The level of a canopy read from a mesh file.
-MESH_LEVEL = "mesh"
 
 
 def describe(level: str) -> str:
@@ -47,25 +51,25 @@ def describe(level: str) -> str:
 class CanopyPanel(QWidget):
     """The points file, the slider and Table 2 of the study in ``study`` (a
     :class:`~maizeviz_app.model.StudyModel`, followed: new points clear the table, a built
-    canopy shows its level and row).
+    canopy shows its level and row). Without a study the panel edits ``settings`` (default:
+    settings of its own).
 
-    Signals: ``open_requested()``, ``level_requested(stop)`` (after the slider rests 250 ms),
-    ``preserve_changed(bool)``."""
+    Signals: ``open_requested()``."""
 
     open_requested = Signal()
-    level_requested = Signal(str)
-    preserve_changed = Signal(bool)
 
-    def __init__(self, study=None, level: str = "36", parent=None):
+    def __init__(self, study=None, settings: StudySettings | None = None, parent=None):
         super().__init__(parent)
         self.study = study
+        self.settings = study.settings if study is not None else settings or StudySettings()
+        canopy = self.settings.canopy
         lay = QVBoxLayout(self)
         row = QHBoxLayout()
         self.file_label = QLabel("no file")
         self.file_label.setWordWrap(True)
         self.file_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
         self.open_button = QPushButton("Open points…")
-        self.open_button.setToolTip("Open a digitized points CSV (Ctrl+O)")
+        self.open_button.setToolTip("open a digitized points CSV (Ctrl+O)")
         self.open_button.clicked.connect(self.open_requested)
         row.addWidget(self.file_label, 1)
         row.addWidget(self.open_button)
@@ -74,8 +78,7 @@ class CanopyPanel(QWidget):
         self.preserve = QCheckBox("keep leaf area below the standard mesh")
         self.preserve.setToolTip("widen the kept cross-sections so a coarse leaf keeps the "
                                  "reference mesh's area (off: the paper's plain splitting)")
-        self.preserve.setChecked(True)
-        self.preserve.toggled.connect(self.preserve_changed)
+        bind(self.preserve, canopy, "preserve_area")
         form.addRow(self.preserve)
         lay.addLayout(form)
 
@@ -83,8 +86,8 @@ class CanopyPanel(QWidget):
         g = QVBoxLayout(group)
         self.slider = QSlider(Qt.Orientation.Horizontal)
         self.slider.setRange(0, len(COMPLEXITY_STOPS) - 1)
-        self.slider.setValue(COMPLEXITY_STOPS.index(level) if level in COMPLEXITY_STOPS
-                             else COMPLEXITY_STOPS.index("36"))
+        self.slider.setValue(COMPLEXITY_STOPS.index(canopy.level))
+        self.slider.setAccessibleName("mesh complexity")
         self.slider.setTickPosition(QSlider.TickPosition.TicksBelow)
         self.slider.setPageStep(1)
         self.slider.setToolTip(SLIDER_TIP)
@@ -104,6 +107,9 @@ class CanopyPanel(QWidget):
         lay.addWidget(group)
         lay.addWidget(QLabel("canopy measures per level (the paper's Table 2)"))
         self.table = QTableWidget(0, 0)
+        self.table.setAccessibleName("canopy measures per level")
+        self.table.setToolTip("each level built: its triangles, leaf area, area projected on "
+                              "the ground, ground cover, leaf area index and build time")
         self.table.verticalHeader().setVisible(False)
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
@@ -113,8 +119,10 @@ class CanopyPanel(QWidget):
         self.rows: dict[str, list[str]] = {}
         self.columns: list[str] = []
         self._debounce = QTimer(self, singleShot=True, interval=250)
-        self._debounce.timeout.connect(lambda: self.level_requested.emit(self.level))
+        self._debounce.timeout.connect(self._commit_level)
         self.slider.valueChanged.connect(self._on_slider)
+        canopy.events.level.connect(self.set_level)
+        self.destroyed.connect(lambda *_: canopy.events.level.disconnect(self.set_level))
         if study is not None:
             self._follow(study)
 
@@ -124,18 +132,25 @@ class CanopyPanel(QWidget):
         """The slider's stop (``"K4"`` ... ``"4"``)."""
         return COMPLEXITY_STOPS[self.slider.value()]
 
-    def set_level(self, level: str) -> None:
-        """Move the slider without asking for a rebuild."""
+    def set_level(self, level: str, *_old) -> None:
+        """Move the slider to the level set (a project, an undo, a refused build) without
+        asking for it again."""
         if level in COMPLEXITY_STOPS:
+            self._debounce.stop()
             self.slider.blockSignals(True)
             self.slider.setValue(COMPLEXITY_STOPS.index(level))
             self.slider.blockSignals(False)
+
+    def _commit_level(self) -> None:
+        """The slider rested: its stop becomes the level set (which rebuilds the canopy)."""
+        self.settings.canopy.level = self.level
 
     def _follow(self, study) -> None:
         study.points_changed.connect(self._on_points)
         study.mesh_opened.connect(self._on_mesh)
         study.canopy_changed.connect(
             lambda built: self.show_built(built.level, list(built.columns), built.row))
+        study.build_pending.connect(self.set_pending)
 
     def _on_mesh(self, path: str) -> None:
         self.clear_rows()
@@ -176,12 +191,16 @@ class CanopyPanel(QWidget):
         self.level_label.setText(f"showing: {describe(level)}")
         self.asked_label.setText("")
         # units on a second line: the table fits a 400 px panel without scrolling sideways
-        headers = [h.rsplit(" ", 1)[0] + "\n" + h.rsplit(" ", 1)[1] if " " in h else h
-                   for _, h in columns]
+        # a word a line in the headers, the level wrapped in its cell: the table fits a
+        # 400 px panel (1366 x 768) without scrolling sideways
+        headers = [h.replace(" ", "\n") for _, h in columns]
         if headers != self.columns:
             self.columns = headers
             self.table.setColumnCount(len(headers))
             self.table.setHorizontalHeaderLabels(headers)
+            head = self.table.horizontalHeader()
+            head.setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
+            head.setSectionResizeMode(0, QHeaderView.ResizeMode.Stretch)
         values = [row[k] for k, _ in columns]
         self.rows[values[0]] = values
         self.table.setRowCount(len(self.rows))
@@ -192,5 +211,6 @@ class CanopyPanel(QWidget):
                 item.setTextAlignment((align.AlignLeft if c == 0 else align.AlignRight)
                                       | align.AlignVCenter)
                 self.table.setItem(r, c, item)
+        self.table.resizeRowsToContents()
         shown = list(self.rows).index(values[0])
         self.table.selectRow(shown)

@@ -53,7 +53,7 @@ from PySide6.QtWidgets import (
 )
 
 from maizeviz.digitizer.port import FastrakPort
-from maizeviz.digitizer.recorder import LiveTip, Recorder, Update
+from maizeviz.digitizer.recorder import PAUSE_KEY, LiveTip, Recorder, Update
 from maizeviz.digitizer.session import Session
 from maizeviz.errors import MaizevizError
 from maizeviz.resources import example_points
@@ -63,8 +63,6 @@ from maizeviz_app.workers import JobRunner
 
 #: The technician's controls: key, button text.
 CONTROLS = (("n", "Next leaf"), ("p", "Next plant"), ("r", "End row"), ("u", "Undo"))
-#: The pause key (S: suspend), a toggle.
-PAUSE_KEY = "s"
 #: Seconds between the reader's polls for the stylus's live position.
 LIVE_EVERY_S = 0.1
 #: Band colours (background, text) per state.
@@ -287,6 +285,7 @@ class DigitizerPanel(QWidget):
         lay.addWidget(self.counts)
         self.log = QListWidget()
         self.log.setAccessibleName("digitizer log")
+        self.log.setToolTip("what the session did, newest last: presses, refusals, the port")
         self.log.setUniformItemSizes(True)          # scrolling 400 lines stays instant
         self.log.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
         # the band shows the whole last line
@@ -635,6 +634,8 @@ class DigitizerPanel(QWidget):
         it all happens here and now.
         """
         self.timer.stop()
+        if wait:                                        # an earlier stop's port closed first
+            self._close_pool.waitForDone(10_000)
         connecting, self._connecting = self._connecting, None
         recorder, self.recorder = self.recorder, None
         sim, self.sim = self.sim, None
@@ -690,6 +691,9 @@ class DigitizerPanel(QWidget):
         if self.recording or self._connecting is not None:
             return                                      # a new session began meanwhile
         self._set_paused(False)
+        if recorder is not None and recorder.session.history:
+            # Connect again continues this file where it stopped (the journal replays it)
+            self.resume.setChecked(True)
         where = f"not recording ({why})"
         if self.band.state in ("error", "warn") and why != "finished":
             self.band.set_state(self.band.state, where=where)   # keep the trouble in sight

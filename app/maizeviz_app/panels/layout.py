@@ -1,11 +1,15 @@
 """The canopy-layout editor: where each plant stands, which digitized plant it is, its turn.
 
-A top view of the field (:class:`FieldView`) beside the table of placements. Drag a plant to
-move it, turn it with the wheel or its arrow's knob, or type in the table; every edit is one
-step of an undo stack (Ctrl+Z, Ctrl+Shift+Z). Tiling presets repeat the digitized block (the
-paper's 3 x 3 block tiled 3 x 3 gives its 9 x 9 canopy); a preset that would replace edited
-positions asks first. Positions are kept exactly as they are until edited (the table only
-shows them rounded), so applying an unedited layout changes nothing.
+A top view of the field (:class:`FieldView`) beside the table of placements, over the study's
+layout draft (:class:`maizeviz_app.layout_draft.LayoutDraft`). Edit by hand: drag a plant to
+move it (on a grid when *snap* is on), turn it about its stalk with the wheel, its arrow's knob
+or the rotate buttons, type in the table; add, duplicate or remove a plant. Edit by
+parameters: rows x plants per row at a row and plant spacing, or a tiling of the digitized
+block (the paper's 3 x 3 block tiled 3 x 3 gives its 9 x 9 canopy); replacing edited positions
+asks first. Every edit is one step of the study's undo history (Edit > Undo, Ctrl+Z from
+anywhere). Plants standing on each other's ground are drawn red and listed. Positions are kept
+exactly as they are until edited (the table only shows them rounded), so applying an unedited
+layout changes nothing.
 
 ``applied(layout)`` carries the layout to build: on *Apply*, or after each edit when "3D view
 follows" is on. *Save*/*Load* use the layout file of the README (written atomically).
@@ -13,7 +17,7 @@ follows" is on. *Save*/*Load* use the layout file of the README (written atomica
 
 from __future__ import annotations
 
-from dataclasses import replace
+from typing import TypeVar
 
 from PySide6.QtCore import Qt, QTimer, Signal
 from PySide6.QtGui import QKeySequence, QUndoStack
@@ -21,12 +25,18 @@ from PySide6.QtWidgets import (
     QAbstractItemView,
     QCheckBox,
     QComboBox,
+    QDoubleSpinBox,
     QFileDialog,
+    QGridLayout,
+    QGroupBox,
     QHBoxLayout,
     QHeaderView,
     QLabel,
+    QListWidget,
+    QListWidgetItem,
     QMessageBox,
     QPushButton,
+    QSpinBox,
     QSplitter,
     QStyle,
     QTableView,
@@ -35,45 +45,56 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from maizeviz.canopy.layout import (
-    LayoutError,
-    block_lattice,
-    load_layout,
-    save_layout,
-    tiled_layout,
-)
+from maizeviz.canopy.layout import LayoutError, load_layout, save_layout
 from maizeviz.errors import MaizevizError
-from maizeviz_app.options import TILINGS, tiling_of
+from maizeviz_app.layout_draft import LayoutDraft
+from maizeviz_app.options import TILINGS
 from maizeviz_app.panels.field_view import FieldView
-from maizeviz_app.panels.layout_model import (
-    EditedLayout,
-    EditPlacement,
-    PlacementTable,
-    ReplaceLayout,
-    fmt,
-)
+from maizeviz_app.panels.layout_model import PlacementTable, fmt
 
 FOLLOW_DELAY_MS = 400
+#: The rotate buttons' step, degrees.
+ROTATE_STEP_DEG = 15.0
+#: Overlaps listed at most (the field view draws them all).
+OVERLAPS_LISTED = 50
+
+
+W = TypeVar("W", bound=QWidget)
+
+
+def _named(widget: W, name: str, tip: str) -> W:
+    widget.setAccessibleName(name)
+    widget.setToolTip(tip)
+    return widget
+
+
+def _tool(text: str) -> QToolButton:
+    button = QToolButton()
+    button.setText(text)
+    return button
 
 
 class LayoutPanel(QWidget):
-    """Edit a :class:`~maizeviz.canopy.layout.CanopyLayout`; ``applied`` carries the new one,
-    ``problem`` a line for the technician (a refused edit, a note from the checks). With a
-    ``study`` (:class:`~maizeviz_app.model.StudyModel`) it shows the layout of the points the
-    study opens."""
+    """Edit the layout of ``study`` (a :class:`~maizeviz_app.model.StudyModel`: its draft,
+    shown for the points it opens; what is applied is built); without a study, a draft of
+    its own. ``stack``: the undo history edits go to (the Edit menu's; default: the panel's
+    own). ``applied`` carries the layout applied, ``problem`` a line for the technician (a
+    refused edit, a note from the checks)."""
 
     applied = Signal(object)
     problem = Signal(str)
 
-    def __init__(self, study=None, parent=None):
+    def __init__(self, study=None, stack: QUndoStack | None = None, parent=None):
         super().__init__(parent)
+        from maizeviz_app.undo import UndoRecorder
+
         self.study = study
-        self.model = EditedLayout(self)
-        self.model.changed.connect(self._on_changed)
-        self.bases: dict[int, tuple[float, float]] = {}
-        self.undo_stack = QUndoStack(self)
-        self.undo_stack.indexChanged.connect(self._on_edit)
-        self._quiet = False
+        self.model: LayoutDraft = study.draft if study is not None else LayoutDraft()
+        shared = stack is not None
+        if stack is None:                       # a history of the panel's own
+            self._recorder = UndoRecorder(None, self, draft=self.model)
+            stack = self._recorder.stack
+        self.undo_stack = stack
         self._said: tuple = ()
         self._applied: tuple | None = None
         self._split = False
@@ -82,42 +103,32 @@ class LayoutPanel(QWidget):
         self.info = QLabel("no canopy")
         self.info.setWordWrap(True)
         lay.addWidget(self.info)
+        lay.addLayout(self._history_bar(shared))
+        lay.addWidget(self._parameters())
+        lay.addLayout(self._plant_bar())
 
-        bar = QHBoxLayout()
-        bar.addWidget(QLabel("tiling"))
-        self.tiling = QComboBox()
-        self.tiling.setToolTip("repeat the digitized block; the paper tiles its 3 x 3 block "
-                               "3 x 3 times (9 x 9 plants)")
-        self.tiling.activated.connect(self._on_tiling_chosen)
-        self.tiling.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
-        self.tiling.setMinimumContentsLength(10)
-        bar.addWidget(self.tiling, 1)
-        self.undo_action = self.undo_stack.createUndoAction(self, "Undo")
-        self.undo_action.setShortcut(QKeySequence.StandardKey.Undo)
-        self.redo_action = self.undo_stack.createRedoAction(self, "Redo")
-        self.redo_action.setShortcuts([QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")])
-        for action, icon in ((self.undo_action, QStyle.StandardPixmap.SP_ArrowBack),
-                             (self.redo_action, QStyle.StandardPixmap.SP_ArrowForward)):
-            action.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
-            action.setIcon(self.style().standardIcon(icon))
-            self.addAction(action)
-            button = QToolButton()
-            button.setDefaultAction(action)
-            button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonIconOnly)
-            bar.addWidget(button)
-        self.follow = QCheckBox("3D view follows")
-        self.follow.setToolTip("rebuild the canopy after each edit")
-        self.follow.setChecked(True)
-        bar.addWidget(self.follow)
-        lay.addLayout(bar)
+        self.overlaps = QListWidget()
+        _named(self.overlaps, "overlapping plants", "plants standing on each other's ground "
+               "(closer than 0.9 of a spacing across and along the rows); click one to pick it")
+        self.overlaps.setStyleSheet("color: #b3261e;")
+        self.overlaps.itemClicked.connect(
+            lambda item: self.select(int(item.data(Qt.ItemDataRole.UserRole))))
+        self.overlaps.hide()
+        # above the view: seen without scrolling the panel
+        lay.addWidget(self.overlaps)
 
         self.splitter = QSplitter(Qt.Orientation.Horizontal)
         self.view = FieldView()
-        self.view.moved.connect(self._on_moved)
-        self.view.turned.connect(self._on_turned)
+        self.view.setAccessibleName("field seen from above")
+        self.view.setToolTip("drag a plant to move it; the wheel or the arrow's knob turns it; "
+                             "the wheel elsewhere zooms, a double click fits the field")
+        self.view.moved.connect(lambda i, x, y: self._edit(self.model.move, i, x, y))
+        self.view.turned.connect(lambda i, az, wheel: self._edit(self.model.turn, i, az, wheel))
         self.view.picked.connect(self._on_picked)
         self.table = QTableView()
-        self.rows = PlacementTable(self.model, self._push_edit, self.problem.emit, self)
+        _named(self.table, "plant positions", "each plant's position (cm), digitized plant "
+               "and turn (°); type to edit (exactly: the table shows values rounded)")
+        self.rows = PlacementTable(self.model, self.problem.emit, self)
         self.table.setModel(self.rows)
         self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
         self.table.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
@@ -126,7 +137,7 @@ class LayoutPanel(QWidget):
         # fixed rows: 700 rows stay fast
         self.table.verticalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Fixed)
         self.table.selectionModel().currentRowChanged.connect(
-            lambda cur, _prev: self.view.select(cur.row()))
+            lambda cur, _prev: self._on_selected(cur.row()))
         self.splitter.addWidget(self.view)
         self.splitter.addWidget(self.table)
         self.splitter.setStretchFactor(0, 3)
@@ -138,30 +149,162 @@ class LayoutPanel(QWidget):
         self.state.setWordWrap(True)
         row.addWidget(self.state, 1)
         self.apply_button = QPushButton("Apply")
-        self.apply_button.setToolTip("check the layout and rebuild the canopy with it")
+        _named(self.apply_button, "Apply", "check the layout and rebuild the canopy with it")
         self.apply_button.clicked.connect(self.apply)
-        load = QPushButton("Load…")
-        load.clicked.connect(self._load)
-        save = QPushButton("Save…")
-        save.clicked.connect(self._save)
-        for b in (self.apply_button, load, save):
+        self.load_button = _named(QPushButton("Load…"), "Load…", "replace the layout with a "
+                                  "layout file (JSON, see the README)")
+        self.load_button.clicked.connect(self._load)
+        self.save_button = _named(QPushButton("Save…"), "Save…", "write the edited layout as "
+                                  "a layout file (JSON)")
+        self.save_button.clicked.connect(self._save)
+        for b in (self.apply_button, self.load_button, self.save_button):
             row.addWidget(b)
         lay.addLayout(row)
 
+        self._sync_buttons()
+        self.model.changed.connect(self._on_changed)
+        self.model.edited.connect(self._on_edit)
+        self.model.replayed.connect(self._on_edit)
+        self.destroyed.connect(lambda *_: self._forget(self.model))
         self._follow_timer = QTimer(self, singleShot=True, interval=FOLLOW_DELAY_MS)
         self._follow_timer.timeout.connect(self.apply)
+        self._overlap_timer = QTimer(self, singleShot=True, interval=60)
+        self._overlap_timer.timeout.connect(self._show_overlaps)
         if study is not None:
+            self.applied.connect(study.apply_layout)
+            study.mesh_opened.connect(self._on_mesh)
             study.points_changed.connect(self._on_points)
-            # a mesh file's canopy has no layout to edit
-            study.mesh_opened.connect(lambda _path: self.setEnabled(False))
-            if study.loaded is not None:
-                self.show_layout(study.loaded.layout, study.loaded.plants)
+        if self.model.base is not None:
+            self._on_changed(-1)
 
+    def _forget(self, draft: LayoutDraft) -> None:
+        for signal, slot in ((draft.changed, self._on_changed), (draft.edited, self._on_edit),
+                             (draft.replayed, self._on_edit)):
+            try:
+                signal.disconnect(slot)
+            except (ValueError, RuntimeError):
+                pass
+
+    # ------------------------------------------------------------------ building
+    def _history_bar(self, shared: bool) -> QHBoxLayout:
+        bar = QHBoxLayout()
+        bar.addWidget(QLabel("tiling"))
+        self.tiling = QComboBox()
+        _named(self.tiling, "tiling", "repeat the digitized block; the paper tiles its 3 x 3 "
+               "block 3 x 3 times (9 x 9 plants)")
+        self.tiling.activated.connect(self._on_tiling_chosen)
+        self.tiling.setSizeAdjustPolicy(
+            QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
+        self.tiling.setMinimumContentsLength(10)
+        bar.addWidget(self.tiling, 1)
+        self.undo_action = self.undo_stack.createUndoAction(self, "Undo")
+        self.redo_action = self.undo_stack.createRedoAction(self, "Redo")
+        for action, icon, keys in (
+                (self.undo_action, QStyle.StandardPixmap.SP_ArrowBack,
+                 [QKeySequence(QKeySequence.StandardKey.Undo)]),
+                (self.redo_action, QStyle.StandardPixmap.SP_ArrowForward,
+                 [QKeySequence("Ctrl+Shift+Z"), QKeySequence("Ctrl+Y")])):
+            if not shared:                       # the Edit menu's shortcuts act everywhere
+                action.setShortcuts(keys)
+                action.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+                self.addAction(action)
+            action.setIcon(self.style().standardIcon(icon))
+            button = QToolButton()
+            button.setDefaultAction(action)
+            button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonIconOnly)
+            button.setAccessibleName(action.text().split(" ")[0])
+            bar.addWidget(button)
+        return bar
+
+    def _parameters(self) -> QGroupBox:
+        """Rows x plants per row at a row and a plant spacing: a regular field."""
+        box = QGroupBox("rows x plants")
+        grid = QGridLayout(box)
+        self.rows_box = _named(QSpinBox(minimum=1, maximum=1000, value=3), "rows",
+                               "rows of plants (across x)")
+        self.per_row_box = _named(QSpinBox(minimum=1, maximum=1000, value=3),
+                                  "plants per row", "plants in each row (along y)")
+        self.row_spacing_box = _named(
+            QDoubleSpinBox(decimals=1, minimum=1.0, maximum=1000.0, value=60.0, suffix=" cm"),
+            "row spacing", "distance between rows, cm (the paper: 60)")
+        self.plant_spacing_box = _named(
+            QDoubleSpinBox(decimals=1, minimum=1.0, maximum=1000.0, value=30.0, suffix=" cm"),
+            "plant spacing", "distance between the plants of a row, cm (the paper: 30)")
+        self.lay_out_button = _named(QPushButton("Lay out"), "Lay out",
+                                     "replace the layout with rows x plants at these "
+                                     "spacings, the digitized block repeated")
+        self.lay_out_button.clicked.connect(self.lay_out)
+        grid.addWidget(QLabel("rows"), 0, 0)
+        grid.addWidget(self.rows_box, 0, 1)
+        grid.addWidget(QLabel("× plants"), 0, 2)
+        grid.addWidget(self.per_row_box, 0, 3)
+        grid.addWidget(QLabel("spacing"), 1, 0)
+        grid.addWidget(self.row_spacing_box, 1, 1)
+        grid.addWidget(QLabel("×"), 1, 2, alignment=Qt.AlignmentFlag.AlignCenter)
+        grid.addWidget(self.plant_spacing_box, 1, 3)
+        grid.addWidget(self.lay_out_button, 0, 4, 2, 1)
+        grid.setColumnStretch(1, 1)
+        grid.setColumnStretch(3, 1)
+        return box
+
+    def _plant_bar(self) -> QVBoxLayout:
+        """Add, duplicate, remove, rotate the plant picked; snap; the view following."""
+        rows = QVBoxLayout()
+        bar = QHBoxLayout()
+        self.add_button = _named(QPushButton("Add"), "Add", "a new plant one plant spacing "
+                                 "beyond the end of the picked plant's row (or the last row)")
+        self.add_button.clicked.connect(self.add_plant)
+        self.duplicate_button = _named(QPushButton("Duplicate"), "Duplicate",
+                                       "a copy of the picked plant (the same plant, turned "
+                                       "the same) at the end of its row")
+        self.duplicate_button.clicked.connect(
+            lambda: self._edit(self.model.duplicate, self.picked, select_new=True))
+        self.remove_button = _named(QPushButton("Remove"), "Remove", "take the picked plant "
+                                    "out of the layout (Delete)")
+        self.remove_button.clicked.connect(lambda: self._edit(self.model.remove, self.picked))
+        self.remove_button.setShortcut(QKeySequence(QKeySequence.StandardKey.Delete))
+        self.left_button = _named(_tool("⟲"), "rotate left",
+                                  f"turn the picked plant {ROTATE_STEP_DEG:g}° about its "
+                                  "stalk, counter-clockwise seen from above")
+        self.left_button.clicked.connect(
+            lambda: self._edit(self.model.rotate, self.picked, ROTATE_STEP_DEG))
+        self.right_button = _named(_tool("⟳"), "rotate right",
+                                   f"turn the picked plant {ROTATE_STEP_DEG:g}° about its "
+                                   "stalk, clockwise seen from above")
+        self.right_button.clicked.connect(
+            lambda: self._edit(self.model.rotate, self.picked, -ROTATE_STEP_DEG))
+        for b in (self.add_button, self.duplicate_button, self.remove_button,
+                  self.left_button, self.right_button):
+            bar.addWidget(b)
+        rows.addLayout(bar)
+        bar2 = QHBoxLayout()
+        self.snap = _named(QCheckBox("snap to a grid of"), "snap to a grid of",
+                           "plants dragged, added or duplicated land on a grid")
+        self.snap_step = _named(QDoubleSpinBox(decimals=1, minimum=0.5, maximum=100.0,
+                                               value=5.0, suffix=" cm"),
+                                "grid step", "the snapping grid's step, cm")
+        self.snap.toggled.connect(self._on_snap)
+        self.snap_step.valueChanged.connect(self._on_snap)
+        self.follow = _named(QCheckBox("3D view follows"), "3D view follows",
+                             "rebuild the canopy after each edit")
+        self.follow.setChecked(True)
+        bar2.addWidget(self.snap)
+        bar2.addWidget(self.snap_step)
+        bar2.addStretch(1)
+        bar2.addWidget(self.follow)
+        rows.addLayout(bar2)
+        return rows
+
+    # ------------------------------------------------------------------ the study
     def _on_points(self, loaded) -> None:
         self.setEnabled(True)
-        self.show_layout(loaded.layout, loaded.plants)
+        self._applied = tuple(loaded.layout.placements)
+        self._said = ()
+        self._show_state()
 
-    # ------------------------------------------------------------------------ state
+    def _on_mesh(self, _path: str) -> None:
+        self.setEnabled(False)                  # a mesh file's canopy has no layout to edit
+
     @property
     def layout_(self):
         return self.model.base
@@ -172,26 +315,14 @@ class LayoutPanel(QWidget):
 
     def show_layout(self, layout, plants: set[int],
                     bases: dict[int, tuple[float, float]] | None = None) -> None:
-        """A new canopy (a points file was opened): its layout, the ids of its digitized plants
-        and their stalk bases (cm, for the tiling presets; read from the layout's central tile
-        when it is a tiling and they are not given). Clears the undo history."""
+        """A new canopy: its layout, the ids of its digitized plants and their stalk bases
+        (cm, for the tiling presets; read from the layout's central tile when it is a tiling
+        and they are not given). Clears the undo history."""
         self._follow_timer.stop()
-        tiling = tiling_of(layout)
-        if bases is not None:
-            self.bases = dict(bases)
-        elif tiling is not None:
-            self.bases = {p.plant: (p.x, p.y) for p in layout.placements if p.tile == (0, 0)}
-        self.model.plants = set(plants)
-        self._quiet = True
-        try:
-            self.undo_stack.clear()
-            self.model.base, self.model.tiling = layout, tiling
-            self.model.placements = list(layout.placements)
-            self._applied = tuple(layout.placements)
-            self._said = ()
-            self.model.changed.emit(-1)
-        finally:
-            self._quiet = False
+        self.undo_stack.clear()
+        self._applied = tuple(layout.placements)
+        self._said = ()
+        self.model.start(layout, plants, bases)
 
     def document(self) -> dict:
         """The edited layout as a layout document (schema 1)."""
@@ -199,17 +330,22 @@ class LayoutPanel(QWidget):
 
     def edited_layout(self):
         """The edited layout, checked (raises LayoutError naming the problem)."""
-        if self.model.base is None:
-            raise LayoutError("no layout to edit yet")
         return self.model.layout()
 
+    # ------------------------------------------------------------------ showing
     def _on_changed(self, index: int) -> None:
         base = self.model.base
         if index >= 0:
             self.view.update_plant(index, self.model.placements[index])
         else:
+            picked = self.picked
             self.view.show_layout(base, self.model.placements)
             self._fill_tilings()
+            self._fill_parameters()
+            if 0 <= picked < len(self.model.placements):
+                self.select(picked)
+        self._overlap_timer.start()
+        self._sync_buttons()
         if base is None:
             self.info.setText("no canopy")
             return
@@ -226,10 +362,34 @@ class LayoutPanel(QWidget):
         self.state.setText(f"{edits} plant{'s' if edits != 1 else ''} edited"
                            + ("" if applied else " · not applied yet"))
 
+    def _show_overlaps(self) -> None:
+        """Plants standing on each other's ground: red in the view and the table, listed."""
+        pairs = self.model.overlaps()
+        involved = {i for i, j, _d in pairs} | {j for i, j, _d in pairs}
+        self.view.set_overlapping(involved)
+        self.rows.overlapping = involved
+        if self.rows.rowCount():
+            self.rows.dataChanged.emit(self.rows.index(0, 0),
+                                       self.rows.index(self.rows.rowCount() - 1, 3))
+        self.overlaps.clear()
+        ps = self.model.placements
+        for i, j, d in pairs[:OVERLAPS_LISTED]:
+            item = QListWidgetItem(f"plants {ps[i].plant} and {ps[j].plant} (rows {i + 1} "
+                                   f"and {j + 1}) stand {d:.1f} cm apart")
+            item.setData(Qt.ItemDataRole.UserRole, j)
+            self.overlaps.addItem(item)
+        if len(pairs) > OVERLAPS_LISTED:
+            self.overlaps.addItem(f"… and {len(pairs) - OVERLAPS_LISTED} more pairs")
+        if pairs:                               # as tall as its lines, three at most
+            rows = min(self.overlaps.count(), 3)
+            self.overlaps.setFixedHeight(rows * self.overlaps.sizeHintForRow(0)
+                                         + 2 * self.overlaps.frameWidth() + 2)
+        self.overlaps.setVisible(bool(pairs))
+
     def _fill_tilings(self) -> None:
         self.tiling.blockSignals(True)
         self.tiling.clear()
-        block = self._block()
+        block = self.model.block()
         for n in TILINGS:
             if block is None:
                 break
@@ -244,60 +404,101 @@ class LayoutPanel(QWidget):
                 and block is not None:
             self.tiling.setCurrentIndex(TILINGS.index(current[0]))
         else:
-            self.tiling.addItem("from a layout file" if current is None
-                                else f"{current[0]} x {current[1]} tiles", None)
+            self.tiling.addItem(self.model.source or ("from a layout file" if current is None
+                                                      else f"{current[0]} x {current[1]} "
+                                                      "tiles"), None)
             self.tiling.setCurrentIndex(self.tiling.count() - 1)
         self.tiling.setEnabled(block is not None)
         self.tiling.blockSignals(False)
 
-    def _block(self) -> tuple[int, int] | None:
+    def _fill_parameters(self) -> None:
+        """The parameter fields say the layout shown: its rows x plants and spacings."""
         base = self.model.base
-        if not self.bases or base is None:
-            return None
-        return block_lattice(self.bases, base.row_spacing, base.plant_spacing)[0]
+        if base is None:
+            return
+        rows, per_row = self.model.grid()
+        self.rows_box.setValue(rows)
+        self.per_row_box.setValue(per_row)
+        self.row_spacing_box.setValue(base.row_spacing)
+        self.plant_spacing_box.setValue(base.plant_spacing)
 
-    # ------------------------------------------------------------------------ edits
-    def _push_edit(self, index: int, placement, text: str, merge: bool = False) -> None:
-        self.undo_stack.push(EditPlacement(self.model, index, placement, text, merge))
+    def _sync_buttons(self) -> None:
+        picked = 0 <= self.picked < len(self.model.placements)
+        for b in (self.duplicate_button, self.remove_button, self.left_button,
+                  self.right_button):
+            b.setEnabled(picked)
+        self.add_button.setEnabled(self.model.base is not None)
 
-    def _on_moved(self, index: int, x: float, y: float) -> None:
-        p = self.model.placements[index]
-        self._push_edit(index, replace(p, x=x, y=y), f"move plant {p.plant}")
+    # ------------------------------------------------------------------ picking
+    @property
+    def picked(self) -> int:
+        """The placement picked (the table's current row), -1 when none."""
+        index = self.table.currentIndex()
+        return index.row() if index.isValid() else -1
 
-    def _on_turned(self, index: int, azimuth: float, by_wheel: bool) -> None:
-        p = self.model.placements[index]
-        if azimuth != p.azimuth_deg:
-            self._push_edit(index, replace(p, azimuth_deg=azimuth), f"turn plant {p.plant}",
-                            merge=by_wheel)
+    def select(self, index: int) -> None:
+        """Pick placement ``index`` in the table and the view."""
+        if 0 <= index < self.rows.rowCount():
+            self.table.selectRow(index)
 
     def _on_picked(self, index: int) -> None:
         self.table.selectRow(index)
 
-    def _on_edit(self, _index: int) -> None:
-        if self._quiet:
-            return
+    def _on_selected(self, index: int) -> None:
+        self.view.select(index)
+        self._sync_buttons()
+
+    # ------------------------------------------------------------------ edits
+    def _edit(self, action, *args, select_new: bool = False) -> bool:
+        """An edit of the draft; one refused is said (``problem``) and changes nothing."""
+        try:
+            done = action(*args)
+        except (LayoutError, IndexError) as exc:
+            self.problem.emit(f"layout: {exc}")
+            return False
+        if done and select_new:
+            self.select(len(self.model.placements) - 1)
+        return bool(done)
+
+    def _on_edit(self, *_edit) -> None:
         self._show_state()
         if self.follow.isChecked():
             self._follow_timer.start()
 
+    def _on_snap(self, *_args) -> None:
+        self.model.snap_cm = self.snap_step.value() if self.snap.isChecked() else 0.0
+
+    def add_plant(self) -> bool:
+        """A new plant (the lowest digitized plant id) one plant spacing beyond the end of
+        the picked plant's row (or of the last row); it is picked."""
+        ps = self.model.placements
+        if self.model.base is None or not ps:
+            return False
+        at = self.picked if 0 <= self.picked < len(ps) else \
+            max(range(len(ps)), key=lambda i: ps[i].x)
+        return self._edit(self.model.add, *self.model.row_end(at), select_new=True)
+
+    def lay_out(self) -> bool:
+        """Rows x plants at the spacings typed (asks first over edits)."""
+        if not self._replace_ok("The new rows x plants replace every plant position"):
+            return False
+        return self._edit(self.model.regular, self.rows_box.value(), self.per_row_box.value(),
+                          self.row_spacing_box.value(), self.plant_spacing_box.value())
+
     def set_tiling(self, n: int) -> bool:
         """Tile the digitized block ``n`` x ``n`` times; asks first when it would replace
         edited positions. Returns whether the tiling changed."""
-        base = self.model.base
-        block = self._block()
-        if base is None or block is None or self.model.tiling == (n, n):
+        if self.model.block() is None or self.model.tiling == (n, n) or \
+                not self._replace_ok("The new tiling replaces every plant position"):
             self._fill_tilings()
             return False
+        return self._edit(self.model.tile, n)
+
+    def _replace_ok(self, what: str) -> bool:
         edits = self.model.edits()
-        if edits and not self._confirm(
-                f"The new tiling replaces every plant position: your edits to {edits} "
-                f"plant{'s' if edits != 1 else ''} will be gone (Undo brings them back)."):
-            self._fill_tilings()
-            return False
-        layout = tiled_layout(self.bases, (n, n), base.row_spacing, base.plant_spacing, block,
-                              base.north_deg)
-        self.undo_stack.push(ReplaceLayout(self.model, layout, (n, n), f"tile {n} x {n}"))
-        return True
+        return not edits or self._confirm(
+            f"{what}: your edits to {edits} plant{'s' if edits != 1 else ''} will be gone "
+            "(Undo brings them back).")
 
     def _on_tiling_chosen(self, row: int) -> None:
         n = self.tiling.itemData(row)
@@ -338,13 +539,9 @@ class LayoutPanel(QWidget):
         except LayoutError as exc:
             self.problem.emit(str(exc))
             return False
-        edits = self.model.edits()
-        if edits and not self._confirm(f"The layout file replaces every plant position: your "
-                                       f"edits to {edits} plant(s) will be gone (Undo brings "
-                                       "them back)."):
+        if not self._replace_ok("The layout file replaces every plant position"):
             return False
-        self.undo_stack.push(ReplaceLayout(self.model, new, None, "load layout file"))
-        return True
+        return self._edit(self.model.replace_layout, new, None, "load layout file")
 
     def save(self, path) -> bool:
         """Write the edited layout as a layout file (atomically)."""
@@ -377,4 +574,3 @@ class LayoutPanel(QWidget):
             length = self.width() if wide else self.height()
             self.splitter.setSizes([int(0.6 * length), int(0.4 * length)])
             self._split = True
-

@@ -4,25 +4,26 @@ sky) or a day (direct and diffuse PAR over a day at a place); Compute/Cancel, th
 the light each plant intercepted, and the figures (heatmap per height and light, transmission
 vs height).
 
-:class:`LightRuns` is the model: the last result per mesh level and light (sun, sky, day), all
-sampled the same way (heights, density, periodic field), so switching levels or lights and
-computing again adds a column and a curve to the comparison. Changing the sampling starts a new
-comparison; changing one light's own settings (the sun's angles, the sky, the day) replaces
-that light's results only.
+The panel's fields are bound both ways to the study's light settings
+(:class:`maizeviz_app.settings.StudySettings`: ``light``, ``sun``, ``sampling``, ``sky``,
+``day``, ``optics``): what is typed is the model's, and a project opened or an undo shows in
+the fields. :class:`LightRuns` is the results' model: the last result per mesh level and light
+(sun, sky, day), all sampled the same way (heights, density, periodic field), so switching
+levels or lights and computing again adds a column and a curve to the comparison. Changing the
+sampling starts a new comparison; changing one light's own settings (the sun's angles, the sky,
+the day) replaces that light's results only.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from PySide6.QtCore import QDate, QSize, Qt, Signal
+from PySide6.QtCore import QSize, Qt, Signal
 from PySide6.QtGui import QImage, QPixmap
 from PySide6.QtWidgets import (
     QAbstractItemView,
-    QButtonGroup,
     QCheckBox,
     QComboBox,
     QCompleter,
@@ -46,17 +47,16 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from maizeviz.errors import MaizevizError
-from maizeviz.light.sources.irradiance import (
-    DEFAULT_PAR_UMOL_PER_J,
-    PAR_FRACTION,
-    PAR_UMOL_PER_J_PAR,
-)
-from maizeviz.numbers import number
+from maizeviz_app.bind import bind, bind_choice
 from maizeviz_app.runs import MODES, SKIES, LightRuns, Run, level_order  # noqa: F401 - re-exported
+from maizeviz_app.settings import (  # noqa: F401 - re-exported
+    DEFAULT_HEIGHTS,
+    DEFAULT_PLACE,
+    InputProblem,
+    StudySettings,
+    parse_heights,
+)
 
-DEFAULT_PLACE = "2005-08-01 12:00 39.9 116.4 Asia/Shanghai"
-DEFAULT_HEIGHTS = "0, 50, 100, 150, 200, 225"
 PROBLEM_STYLE = "border: 2px solid #d0342c; border-radius: 3px;"
 MODE_BUTTONS = {"sun": "Sun", "sky": "Sky", "day": "Day"}
 COMPUTE_TEXT = {"sun": "Compute direct light", "sky": "Compute diffuse light",
@@ -64,44 +64,13 @@ COMPUTE_TEXT = {"sun": "Compute direct light", "sky": "Compute diffuse light",
 #: Sky splits offered: directions (None: an equal-area split of n) -> what the combo says.
 SKY_SPLITS = {16: "16 directions (turtle)", 46: "46 directions (turtle, as Caribu)",
               145: "145 directions (Tregenza)", None: "equal-area split of n directions"}
-DEFAULT_DAY: dict[str, Any] = {
-    "date": "2005-08-01", "lat": 39.9, "lon": 116.4, "tz": "Asia/Shanghai", "step_min": 30.0,
-    "from": "", "to": "", "source": "clear", "linke": 3.0, "weather": "",
-    "par_factor": DEFAULT_PAR_UMOL_PER_J}
-
-
-class InputProblem(MaizevizError):
-    """A light setting the user typed that cannot be used; ``quantity`` names the field. A
-    MaizevizError: the user's to correct, told in one line, never an internal error."""
-
-    def __init__(self, message: str, quantity: str):
-        super().__init__(message, quantity=quantity)
-
-
-def parse_heights(text: str) -> tuple[float, ...]:
-    """``"0, 50, 100"`` -> (0.0, 50.0, 100.0); a word that is not a number is named."""
-    out = []
-    for part in text.replace(";", ",").split(","):
-        part = part.strip()
-        if not part:
-            continue
-        try:
-            h = number(part.removesuffix("cm").strip())
-        except ValueError:
-            raise InputProblem(f"heights: '{part}' is not a number of centimetres; write them "
-                               "separated by commas, e.g. 0, 50, 100", "heights") from None
-        if not math.isfinite(h) or h < 0:
-            raise InputProblem(f"heights must be finite numbers of 0 cm or more, got {part}",
-                               "heights")
-        out.append(h)
-    if not out:
-        raise InputProblem("give at least one height in cm, e.g. 0, 50, 100", "heights")
-    return tuple(out)
 
 
 def _form() -> QFormLayout:
     form = QFormLayout()
     form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
+    # a narrow dock (1366 x 768) puts a field under its label rather than cutting either
+    form.setRowWrapPolicy(QFormLayout.RowWrapPolicy.WrapLongRows)
     return form
 
 
@@ -115,41 +84,39 @@ def _time_zones() -> list[str]:
 
 
 class LightPanel(QWidget):
-    """The light settings and the results table of the study in ``study`` (a
-    :class:`~maizeviz_app.model.StudyModel`, followed: its runs fill the table).
+    """The light settings of ``study`` (a :class:`~maizeviz_app.model.StudyModel`; its
+    ``settings``, bound both ways) and its results table (its runs fill it). Without a study
+    the panel edits ``settings`` (default: settings of its own).
 
-    Signals: ``compute_requested()``, ``cancel_requested()``, ``place_requested(text)``,
+    Signals: ``compute_requested()``, ``cancel_requested()``, ``place_requested()``,
     ``export_requested(what)`` with what in ``table``, ``heatmap``, ``plot``, ``canopy``,
-    ``steps``, ``leaves``, ``plants``, ``day``; ``mode_changed(mode)``."""
+    ``steps``, ``leaves``, ``plants``, ``day``."""
 
     compute_requested = Signal()
     cancel_requested = Signal()
-    place_requested = Signal(str)
+    place_requested = Signal()
     export_requested = Signal(str)
-    mode_changed = Signal(str)
 
-    def __init__(self, study=None, parent=None):
+    def __init__(self, study=None, settings: StudySettings | None = None, parent=None):
         super().__init__(parent)
         self.study = study
+        self.settings = study.settings if study is not None else settings or StudySettings()
+        s = self.settings
         lay = QVBoxLayout(self)
         # ---- which light
         modes = QHBoxLayout()
         modes.addWidget(QLabel("light"))
-        self.mode_group = QButtonGroup(self)
         self.mode_buttons: dict[str, QPushButton] = {}
         tips = {"sun": "direct light at one sun position (the paper's Table 3)",
                 "sky": "diffuse light from an overcast sky, traced from many directions",
                 "day": "direct and diffuse PAR over a day at a place: clear sky or a weather "
                        "file"}
-        for k, mode in enumerate(MODES):
+        for mode in MODES:
             b = QPushButton(MODE_BUTTONS[mode])
-            b.setCheckable(True)
             b.setToolTip(tips[mode])
-            self.mode_group.addButton(b, k)
             self.mode_buttons[mode] = b
             modes.addWidget(b, 1)
-        self.mode_buttons["sun"].setChecked(True)
-        self.mode_group.idToggled.connect(self._on_mode_toggled)
+        self.mode_group = bind_choice(self.mode_buttons, s.light, "mode")
         lay.addLayout(modes)
         self.pages = QStackedWidget()
         self.pages.addWidget(self._sun_page())
@@ -160,16 +127,19 @@ class LightPanel(QWidget):
         lay.addWidget(self.sky_box)
         # ---- sampling, shared by every light
         form = _form()
-        self.heights = QLineEdit(DEFAULT_HEIGHTS)
+        self.heights = QLineEdit()
         self.heights.setToolTip("heights of the sensor planes, cm, separated by commas")
+        bind(self.heights, s.sampling, "heights", "heights (cm)")
         form.addRow("heights (cm)", self.heights)
-        self.density = QDoubleSpinBox(decimals=2, minimum=0.01, maximum=100.0, value=2.0,
-                                      suffix=" rays/cm²")
+        self.density = QDoubleSpinBox(decimals=2, suffix=" rays/cm²")
         self.density.setToolTip("rays (and sensors) per cm² of the sample rectangle, for the "
-                                 "sun and for each sky direction and time step")
+                                "sun and for each sky direction and time step")
+        bind(self.density, s.sampling, "density", "ray density")
         form.addRow("ray density", self.density)
         self.periodic = QCheckBox("infinite field (rays wrap at the plot edges)")
-        self.periodic.setChecked(True)
+        self.periodic.setToolTip("rays leaving the plot sideways come back on the other side, "
+                                 "as in a field that goes on (off: an isolated plot)")
+        bind(self.periodic, s.sampling, "periodic")
         form.addRow(self.periodic)
         lay.addLayout(form)
         # ---- compute, cancel, progress, problems
@@ -186,6 +156,7 @@ class LightPanel(QWidget):
         lay.addLayout(buttons)
         self.progress = QLabel("")
         self.progress.setStyleSheet("color: #1f4e79;")
+        self.progress.setWordWrap(True)
         lay.addWidget(self.progress)
         self.problem = QLabel("")
         self.problem.setWordWrap(True)
@@ -198,6 +169,9 @@ class LightPanel(QWidget):
         self.table_title.setWordWrap(True)
         lay.addWidget(self.table_title)
         self.table = QTableWidget(0, 1)
+        self.table.setAccessibleName("transmission table")
+        self.table.setToolTip("the fraction of the light reaching each height, per mesh level "
+                              "and light")
         self.table.setHorizontalHeaderLabels(["height cm"])
         self.table.verticalHeader().setVisible(False)
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
@@ -219,6 +193,8 @@ class LightPanel(QWidget):
         self.plants_title.hide()
         lay.addWidget(self.plants_title)
         self.plants = QTableWidget(0, 0)
+        self.plants.setAccessibleName("light per plant")
+        self.plants.setToolTip("the light each plant intercepted or absorbed")
         self.plants.verticalHeader().setVisible(False)
         self.plants.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.plants.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
@@ -267,56 +243,90 @@ class LightPanel(QWidget):
                     "step": self.step, "period": [self.day_from, self.day_to],
                     "par_factor": self.par_factor, "linke_turbidity": self.linke,
                     "weather": self.weather, "altitude": self.lat, "time": self.day_from}}
-        for edit in (self.heights, self.place, self.tz, self.day_from, self.day_to,
-                     self.weather):
-            edit.textEdited.connect(lambda _t, w=edit: self.clear_problem(w))
-        for box in (self.zenith, self.azimuth, self.density, self.lat, self.lon, self.step,
-                    self.par_factor, self.linke, self.sky_n):
-            box.valueChanged.connect(lambda _v, w=box: self.clear_problem(w))
-        self.sky_kind.currentIndexChanged.connect(lambda _i: self.clear_problem(self.sky_kind))
-        self.day_date.dateChanged.connect(lambda _d: self.clear_problem(self.day_date))
-        self.set_mode("sun")
+        # a field edited loses its problem mark; so does every field when the light changes
+        for name, group in s.groups.items():
+            if name not in ("canopy", "digitizer"):
+                group.events.connect(self._setting_changed)
+        self._show_mode(s.light.mode)
         self._fit_table()
         if study is not None:
             study.runs_changed.connect(self.show_runs)
+            self.destroyed.connect(lambda *_: study.runs_changed.disconnect(self.show_runs))
+
+    def _setting_changed(self, info=None) -> None:
+        """A light setting changed (typed, opened, undone): its field's problem mark goes;
+        the widgets that depend on it follow."""
+        try:
+            name = info.signal.name if info is not None else ""
+        except AttributeError:
+            name = ""
+        if name == "mode":
+            self._show_mode(self.settings.light.mode)
+            self.clear_problem()
+            return
+        if name in ("split", "directions"):
+            self._show_split()
+        if name in ("source",):
+            self._show_source()
+        if name in ("diffuse",):
+            self._sync_sky_kind()
+        widget = self._widget_of(name)
+        if widget is not None:
+            self.clear_problem(widget)
+
+    def _widget_of(self, name: str):
+        return {"heights": self.heights, "density": self.density, "periodic": self.periodic,
+                "zenith_deg": self.zenith, "azimuth_deg": self.azimuth, "place": self.place,
+                "kind": self.sky_kind, "directions": self.sky_n, "date": self.day_date,
+                "latitude": self.lat, "longitude": self.lon, "tz": self.tz,
+                "step_min": self.step, "start": self.day_from, "end": self.day_to,
+                "linke_turbidity": self.linke, "weather": self.weather,
+                "par_factor": self.par_factor, "diffuse": self.day_diffuse,
+                "band": self.band, "reflectance": self.reflectance,
+                "transmittance": self.transmittance,
+                "ground_reflectance": self.ground_reflectance}.get(name)
 
     # ------------------------------------------------------------------ pages
     def _sun_page(self) -> QWidget:
+        s = self.settings.sun
         page = QWidget()
         form = _form()
         form.setContentsMargins(0, 0, 0, 0)
         page.setLayout(form)
-        self.zenith = QDoubleSpinBox(decimals=2, minimum=0.0, maximum=89.9, value=22.34,
-                                     suffix=" °")
+        self.zenith = QDoubleSpinBox(decimals=2, suffix=" °")
         self.zenith.setToolTip("angle of the sun from the vertical")
-        self.azimuth = QDoubleSpinBox(decimals=2, minimum=0.0, maximum=360.0, value=166.95,
-                                      suffix=" ° from N")
+        bind(self.zenith, s, "zenith_deg", "sun zenith")
+        self.azimuth = QDoubleSpinBox(decimals=2, suffix=" ° from N")
         self.azimuth.setToolTip("direction of the sun, clockwise from north")
+        bind(self.azimuth, s, "azimuth_deg", "sun azimuth")
         form.addRow("sun zenith", self.zenith)
         form.addRow("sun azimuth", self.azimuth)
-        self.place = QLineEdit(DEFAULT_PLACE)
-        self.place.setCursorPosition(0)                 # the date shows, not the zone's end
+        self.place = QLineEdit()
         self.place.setToolTip("date, local time, latitude, longitude, time zone: the sun's "
                               "angles are computed with pvlib")
+        bind(self.place, s, "place", "date, time, latitude, longitude, time zone")
         self.place_button = QPushButton("Sun from place")
-        self.place_button.clicked.connect(lambda: self.place_requested.emit(self.place.text()))
+        self.place_button.setToolTip("compute the sun's zenith and azimuth from the date, "
+                                     "time and place typed (Ctrl+Shift+L)")
+        self.place_button.clicked.connect(self.place_requested)
         place_row = QHBoxLayout()
         place_row.addWidget(self.place, 1)
         place_row.addWidget(self.place_button)
-        form.addRow("date time lat lon tz", place_row)
+        # the place on a row of its own: the whole of it shows in a narrow dock
+        form.addRow(QLabel("date, time, latitude, longitude, time zone"))
+        form.addRow(place_row)
         form.addRow(self._optics_group())
         return page
 
     def _optics_group(self) -> QGroupBox:
         """Leaf optics: absorbed light with scattering (off: black leaves, interception)."""
-        from maizeviz.light.trace.optics import DEFAULT_OPTICS, SHORTWAVE_SHARE
-
+        o = self.settings.optics
         box = QGroupBox("leaf optics: absorbed light with scattering")
         box.setCheckable(True)
-        box.setChecked(False)
         box.setToolTip("off: leaves are black (light intercepted at first hits); on: leaves "
                        "reflect and transmit, light is followed through the canopy and each "
                        "leaf's absorbed light painted on the plants, with the energy balance")
+        bind(box, o, "enabled", "leaf optics")
         form = _form()
         box.setLayout(form)
         self.optics_box = box
@@ -325,16 +335,21 @@ class LightPanel(QWidget):
         self.band.addItem("NIR (700-3000 nm)", "nir")
         self.band.setToolTip("the waveband traced; its leaf and soil optics and irradiance "
                              "follow the band's defaults (maize: see docs/method.md)")
+        bind(self.band, o, "band", "band")
         form.addRow("band", self.band)
 
-        def fraction(tip: str) -> QDoubleSpinBox:
-            w = QDoubleSpinBox(decimals=3, minimum=0.0, maximum=1.0, singleStep=0.01)
+        def fraction(name: str, label: str, tip: str) -> QDoubleSpinBox:
+            w = QDoubleSpinBox(decimals=3, singleStep=0.01)
             w.setToolTip(tip)
+            bind(w, o, name, label)
             return w
 
-        self.reflectance = fraction("share of the light a leaf reflects (Lambertian)")
-        self.transmittance = fraction("share of the light a leaf transmits (Lambertian)")
-        self.ground_reflectance = fraction("share of the light the soil reflects")
+        self.reflectance = fraction("reflectance", "leaf ρ",
+                                    "share of the light a leaf reflects (Lambertian)")
+        self.transmittance = fraction("transmittance", "leaf τ",
+                                      "share of the light a leaf transmits (Lambertian)")
+        self.ground_reflectance = fraction("ground_reflectance", "soil ρ",
+                                           "share of the light the soil reflects")
         leaf = QHBoxLayout()
         leaf.addWidget(QLabel("ρ"))
         leaf.addWidget(self.reflectance, 1)
@@ -342,50 +357,26 @@ class LightPanel(QWidget):
         leaf.addWidget(self.transmittance, 1)
         form.addRow("leaf", leaf)
         form.addRow("soil ρ", self.ground_reflectance)
-        self.direct_w = QDoubleSpinBox(decimals=1, minimum=0.0, maximum=2000.0,
-                                       suffix=" W/m²")
+        self.direct_w = QDoubleSpinBox(decimals=1, suffix=" W/m²")
         self.direct_w.setToolTip("the band's direct irradiance on a horizontal plane above the "
                                  "canopy")
-        self.diffuse_w = QDoubleSpinBox(decimals=1, minimum=0.0, maximum=2000.0, value=0.0,
-                                        suffix=" W/m²")
+        bind(self.direct_w, o, "direct_w_m2", "direct")
+        self.diffuse_w = QDoubleSpinBox(decimals=1, suffix=" W/m²")
         self.diffuse_w.setToolTip("the band's diffuse irradiance on a horizontal plane, from a "
                                   "standard overcast sky of 46 directions (0: direct only)")
+        bind(self.diffuse_w, o, "diffuse_w_m2", "diffuse")
         form.addRow("direct", self.direct_w)
         form.addRow("diffuse", self.diffuse_w)
-        from maizeviz.light.trace.scatter import DEFAULT_DEPTH
-
-        self.scatter_depth = QSpinBox(minimum=0, maximum=50, value=DEFAULT_DEPTH)
+        self.scatter_depth = QSpinBox()
         self.scatter_depth.setToolTip("most scatterings followed per ray (0: first hits only; "
                                       "Russian roulette ends most paths long before, as on "
                                       "the command line)")
+        bind(self.scatter_depth, o, "depth", "scattering depth")
         form.addRow("scattering depth", self.scatter_depth)
-
-        def band_defaults(_i: int = 0) -> None:
-            band = str(self.band.currentData())
-            d = DEFAULT_OPTICS[band]
-            self.reflectance.setValue(d.reflectance)
-            self.transmittance.setValue(d.transmittance)
-            self.ground_reflectance.setValue(d.ground_reflectance)
-            self.direct_w.setValue(round(1000.0 * SHORTWAVE_SHARE[band], 1))
-
-        self.band.currentIndexChanged.connect(band_defaults)
-        band_defaults()
         return box
 
-    def optics_spec(self):
-        """Absorbed light as chosen (:class:`maizeviz.light.specs.OpticsSpec`), None when leaf
-        optics are off; leaf scattering above 1 refused naming the field."""
-        from maizeviz.light.specs import OpticsSpec
-
-        if not self.optics_box.isChecked():
-            return None
-        spec = OpticsSpec(str(self.band.currentData()), self.reflectance.value(),
-                          self.transmittance.value(), self.ground_reflectance.value(),
-                          self.direct_w.value(), self.diffuse_w.value(), self.scatter_depth.value())
-        spec.optics()                                   # checked now, named by the core
-        return spec
-
     def _sky_group(self) -> QGroupBox:
+        s = self.settings.sky
         box = QGroupBox("diffuse sky")
         form = _form()
         box.setLayout(form)
@@ -394,47 +385,52 @@ class LightPanel(QWidget):
             self.sky_kind.addItem(text, kind)
         self.sky_kind.setToolTip("how the sky's brightness varies with the zenith angle θ "
                                  "(Moon and Spencer's standard overcast sky, or uniform)")
+        bind(self.sky_kind, s, "kind", "sky")
         form.addRow("sky", self.sky_kind)
         self.sky_split = QComboBox()
         for n, text in SKY_SPLITS.items():
             self.sky_split.addItem(text, n)
-        self.sky_split.setCurrentIndex(list(SKY_SPLITS).index(46))
         self.sky_split.setToolTip("the directions the sky is traced from, each weighted by its "
                                   "share of the horizontal diffuse light (the weights sum to 1)")
-        self.sky_n = QSpinBox(minimum=0, maximum=1000, value=46, suffix=" directions")
+        self.sky_split.setAccessibleName("directions")
+        self.sky_n = QSpinBox(suffix=" directions")
         self.sky_n.setToolTip("directions of an equal-area split of the sky (each cell the "
                               "same solid angle)")
+        bind(self.sky_n, s, "directions", "equal-area directions")
+        self.sky_split.currentIndexChanged.connect(self._on_split)
+        self._show_split()
         split_row = QHBoxLayout()
         split_row.addWidget(self.sky_split, 1)
         split_row.addWidget(self.sky_n)
         form.addRow("directions", split_row)
-        self.sky_split.currentIndexChanged.connect(self._on_split)
-        self._on_split()
         return box
 
     def _day_page(self) -> QWidget:
+        d = self.settings.day
         page = QWidget()
         form = _form()
         form.setContentsMargins(0, 0, 0, 0)
         page.setLayout(form)
-        self.day_date = QDateEdit(QDate(2005, 8, 1))
+        self.day_date = QDateEdit()
         self.day_date.setDisplayFormat("yyyy-MM-dd")
         self.day_date.setCalendarPopup(True)
         self.day_date.setToolTip("the local day traced")
+        bind(self.day_date, d, "date", "date")
         form.addRow("date", self.day_date)
-        self.lat = QDoubleSpinBox(decimals=3, minimum=-90.0, maximum=90.0, value=39.9,
-                                  suffix=" ° N")
+        self.lat = QDoubleSpinBox(decimals=3, suffix=" ° N")
         self.lat.setToolTip("latitude, degrees north (south negative)")
-        self.lon = QDoubleSpinBox(decimals=3, minimum=-180.0, maximum=180.0, value=116.4,
-                                  suffix=" ° E")
+        bind(self.lat, d, "latitude", "latitude")
+        self.lon = QDoubleSpinBox(decimals=3, suffix=" ° E")
         self.lon.setToolTip("longitude, degrees east (west negative)")
+        bind(self.lon, d, "longitude", "longitude")
         where = QHBoxLayout()
         where.addWidget(self.lat, 1)
         where.addWidget(self.lon, 1)
         form.addRow("latitude, longitude", where)
-        self.tz = QLineEdit(str(DEFAULT_DAY["tz"]))
+        self.tz = QLineEdit()
         self.tz.setToolTip("time zone of the clock times (IANA name such as Asia/Shanghai, "
                            "Europe/Paris or UTC)")
+        bind(self.tz, d, "tz", "time zone")
         completer = QCompleter(_time_zones(), self.tz)
         completer.setCaseSensitivity(Qt.CaseSensitivity.CaseInsensitive)
         completer.setFilterMode(Qt.MatchFlag.MatchContains)
@@ -444,33 +440,37 @@ class LightPanel(QWidget):
         self.source_clear.setToolTip("irradiance of a cloudless day, with no downloaded data; "
                                      "the Linke turbidity says how hazy the air is (1 clean, "
                                      "3 average rural, 5 and more hazy)")
-        self.linke = QDoubleSpinBox(decimals=1, minimum=1.0, maximum=10.0, value=3.0,
-                                    singleStep=0.5)
+        self.linke = QDoubleSpinBox(decimals=1, singleStep=0.5)
+        self.linke.setToolTip("Linke turbidity of the clear sky: 1 clean air, 3 average rural, "
+                              "5 and more hazy")
+        bind(self.linke, d, "linke_turbidity", "Linke turbidity")
         clear_row = QHBoxLayout()
         clear_row.addWidget(self.source_clear, 1)
         clear_row.addWidget(self.linke)
         form.addRow(clear_row)
         self.source_weather = QRadioButton("weather file")
         self.source_weather.setToolTip("measured irradiance: a CSV with a time column (with "
-                                       "its time zone) and ghi in W/m², optionally dni and "
-                                       "dhi; it sets the period and its steps")
-        self.weather = QLineEdit("")
-        self.weather.setPlaceholderText("CSV: time, ghi (W/m²) [, dni, dhi]")
+                                       "its time zone) and ghi in W/m², optionally dni, dhi, "
+                                       "par (µmol/m²/s, used as the PAR) and temp_air (°C); "
+                                       "or an EPW, TMY3 or NSRDB PSM3/PSM4 file (its own time "
+                                       "zone); it sets the period and its steps")
+        self.weather = QLineEdit()
+        self.weather.setPlaceholderText("CSV (time, ghi [, dni, dhi, par]), EPW, TMY3, PSM")
         self.weather.setToolTip(self.source_weather.toolTip())
-        self.weather_button = QPushButton("Choose…")
+        bind(self.weather, d, "weather", "weather file path")
+        self.weather_button = QPushButton("Weather file…")
+        self.weather_button.setToolTip("choose the weather file")
         self.weather_button.clicked.connect(self.choose_weather)
         weather_row = QHBoxLayout()
         weather_row.addWidget(self.source_weather)
-        weather_row.addWidget(self.weather, 1)
         weather_row.addWidget(self.weather_button)
         form.addRow(weather_row)
-        self.source_group = QButtonGroup(self)
-        self.source_group.addButton(self.source_clear)
-        self.source_group.addButton(self.source_weather)
-        self.source_clear.setChecked(True)
-        self.step = QDoubleSpinBox(decimals=1, minimum=0.0, maximum=1440.0, value=30.0,
-                                   suffix=" min")
+        form.addRow(self.weather)
+        self.source_group = bind_choice({"clear": self.source_clear,
+                                         "weather": self.source_weather}, d, "source")
+        self.step = QDoubleSpinBox(decimals=1, suffix=" min")
         self.step.setToolTip("time step: the sun is traced once per step (at its middle)")
+        bind(self.step, d, "step_min", "time step")
         form.addRow("time step", self.step)
         self.day_diffuse = QComboBox()
         self.day_diffuse.addItem("the sky chosen below, all day", "sky")
@@ -479,44 +479,51 @@ class LightPanel(QWidget):
             "how each step's diffuse light comes from the sky: one sky shape all day, or "
             "Perez's split of each step (its circumsolar part traced with the sun, the rest "
             "from a uniform sky of the directions chosen below; pvlib)")
+        bind(self.day_diffuse, d, "diffuse", "diffuse light")
         form.addRow("diffuse light", self.day_diffuse)
-        self.day_diffuse.currentIndexChanged.connect(lambda _i: self._sync_sky_kind())
-        self.day_from = QLineEdit("")
+        self.day_from = QLineEdit()
         self.day_from.setPlaceholderText("00:00")
-        self.day_to = QLineEdit("")
+        self.day_to = QLineEdit()
         self.day_to.setPlaceholderText("24:00")
-        for w, what in ((self.day_from, "start"), (self.day_to, "end")):
+        for w, what, name in ((self.day_from, "start", "start"), (self.day_to, "end", "end")):
             w.setToolTip(f"optional {what} of the period, local clock time HH:MM (empty: the "
                          "whole day)")
+            bind(w, d, name, f"hours {'from' if name == 'start' else 'to'}")
         span = QHBoxLayout()
         span.addWidget(QLabel("from"))
         span.addWidget(self.day_from, 1)
         span.addWidget(QLabel("to"))
         span.addWidget(self.day_to, 1)
         form.addRow("hours (optional)", span)
-        self.par_factor = QDoubleSpinBox(decimals=4, minimum=0.0001, maximum=10.0,
-                                         value=float(DEFAULT_DAY["par_factor"]),
-                                         singleStep=0.01,
-                                         suffix=" µmol/J")
+        self.par_factor = QDoubleSpinBox(decimals=4, singleStep=0.01, suffix=" µmol/J")
         self.par_factor.setToolTip("µmol of PAR photons per joule of shortwave (default "
-                                   f"{PAR_FRACTION:g} × {PAR_UMOL_PER_J_PAR:g} = "
-                                   f"{DEFAULT_PAR_UMOL_PER_J:g})")
+                                   f"0.48 × 4.57 = {0.48 * 4.57:g})")
+        bind(self.par_factor, d, "par_factor", "PAR factor")
         form.addRow("PAR factor", self.par_factor)
-        for b in (self.source_clear, self.source_weather):
-            b.toggled.connect(lambda _c: self._on_source())
-        self._on_source()
+        self._show_source()
         return page
 
     def _on_split(self, _index: int = 0) -> None:
         n = self.sky_split.currentData()
-        self.sky_n.setEnabled(n is None)
-        if n is not None:
-            self.sky_n.blockSignals(True)
-            self.sky_n.setValue(int(n))
-            self.sky_n.blockSignals(False)
+        s = self.settings.sky
+        if n is None:
+            s.split = "equal"
+        else:
+            self.settings.set("sky", {"split": "auto", "directions": int(n)})
 
-    def _on_source(self) -> None:
-        weather = self.source_weather.isChecked()
+    def _show_split(self) -> None:
+        """The split combo and the directions box as the sky settings say."""
+        s = self.settings.sky
+        n = None if s.split == "equal" or s.directions not in SKY_SPLITS else s.directions
+        k = list(SKY_SPLITS).index(n)
+        if self.sky_split.currentIndex() != k:
+            self.sky_split.blockSignals(True)
+            self.sky_split.setCurrentIndex(k)
+            self.sky_split.blockSignals(False)
+        self.sky_n.setEnabled(n is None)
+
+    def _show_source(self) -> None:
+        weather = self.settings.day.source == "weather"
         self.linke.setEnabled(not weather)
         self.weather.setEnabled(weather)
         self.weather_button.setEnabled(weather)
@@ -526,27 +533,18 @@ class LightPanel(QWidget):
 
     def choose_weather(self) -> None:
         path, _ = QFileDialog.getOpenFileName(self, "Weather file", self.weather.text(),
-                                              "Weather CSV (*.csv);;All files (*)")
+                                              "Weather files (*.csv *.epw *.CSV *.EPW);;"
+                                              "All files (*)")
         if path:
-            self.weather.setText(path)
-            self.source_weather.setChecked(True)
-            self.clear_problem(self.weather)
+            self.settings.set("day", {"weather": path, "source": "weather"})
 
     # ------------------------------------------------------------------ mode
     @property
     def mode(self) -> str:
-        return MODES[max(self.mode_group.checkedId(), 0)]
+        return self.settings.light.mode
 
     def set_mode(self, mode: str) -> None:
-        if mode not in MODES:
-            mode = "sun"
-        self.mode_buttons[mode].setChecked(True)
-        self._show_mode(mode)
-
-    def _on_mode_toggled(self, index: int, checked: bool) -> None:
-        if checked:
-            self._show_mode(MODES[index])
-            self.mode_changed.emit(MODES[index])
+        self.settings.light.mode = mode if mode in MODES else "sun"
 
     def _show_mode(self, mode: str) -> None:
         page = {"sun": 0, "day": 1, "sky": 2}[mode]
@@ -562,141 +560,19 @@ class LightPanel(QWidget):
         self.sky_box.setTitle("diffuse sky" if mode == "sky" else
                               "diffuse part of the day: the sky it comes from")
         self.compute_button.setText(COMPUTE_TEXT[mode])
+        self.compute_button.setAccessibleName(COMPUTE_TEXT[mode])
         self.pages.adjustSize()
         self._sync_sky_kind()
 
     def _sync_sky_kind(self) -> None:
         """With Perez's diffuse light in a day, the sky's shape is Perez's (a uniform sky for
         its isotropic part, the circumsolar part with the sun): the shape choice is off."""
-        perez = self.mode == "day" and self.day_diffuse.currentData() == "perez"
+        perez = self.mode == "day" and self.settings.day.diffuse == "perez"
         self.sky_kind.setEnabled(not perez)
         self.sky_kind.setToolTip(
             "Perez's diffuse light: its isotropic part comes from a uniform sky of the "
             "directions chosen, its circumsolar part with the sun" if perez else
             "how the sky's brightness varies with the zenith angle θ")
-
-    # ------------------------------------------------------------------ settings
-    def settings(self) -> dict:
-        """The settings as typed (for a project file)."""
-        return {"mode": self.mode,
-                "zenith_deg": self.zenith.value(), "azimuth_deg": self.azimuth.value(),
-                "place": self.place.text(), "heights": self.heights.text(),
-                "density": self.density.value(), "periodic": self.periodic.isChecked(),
-                "sky_kind": self.sky_kind.currentData(),
-                "sky_split": "equal" if self.sky_split.currentData() is None else "auto",
-                "sky_directions": self.sky_n.value(),
-                "day_date": self.day_date.date().toString("yyyy-MM-dd"),
-                "latitude": self.lat.value(), "longitude": self.lon.value(),
-                "tz": self.tz.text(), "step_min": self.step.value(),
-                "from": self.day_from.text(), "to": self.day_to.text(),
-                "source": "weather" if self.source_weather.isChecked() else "clear",
-                "linke_turbidity": self.linke.value(), "weather": self.weather.text(),
-                "par_factor": self.par_factor.value(),
-                "day_diffuse": self.day_diffuse.currentData(),
-                "optics": self.optics_box.isChecked(), "band": self.band.currentData(),
-                "reflectance": self.reflectance.value(),
-                "transmittance": self.transmittance.value(),
-                "ground_reflectance": self.ground_reflectance.value(),
-                "direct_w_m2": self.direct_w.value(), "diffuse_w_m2": self.diffuse_w.value(),
-                "depth": self.scatter_depth.value()}
-
-    def apply_settings(self, s: dict) -> None:
-        if s.get("band") in ("par", "nir"):
-            self.band.setCurrentIndex(self.band.findData(s["band"]))
-        for key, w in (("reflectance", self.reflectance),
-                       ("transmittance", self.transmittance),
-                       ("ground_reflectance", self.ground_reflectance),
-                       ("direct_w_m2", self.direct_w), ("diffuse_w_m2", self.diffuse_w)):
-            if key in s:
-                w.setValue(float(s[key]))
-        if "depth" in s:
-            self.scatter_depth.setValue(int(s["depth"]))
-        self.optics_box.setChecked(bool(s.get("optics", False)))
-        if s.get("day_diffuse") in ("sky", "perez"):
-            self.day_diffuse.setCurrentIndex(self.day_diffuse.findData(s["day_diffuse"]))
-        self.zenith.setValue(float(s.get("zenith_deg", self.zenith.value())))
-        self.azimuth.setValue(float(s.get("azimuth_deg", self.azimuth.value())))
-        self.place.setText(str(s.get("place", self.place.text())))
-        self.place.setCursorPosition(0)
-        self.heights.setText(str(s.get("heights", self.heights.text())))
-        self.density.setValue(float(s.get("density", self.density.value())))
-        self.periodic.setChecked(bool(s.get("periodic", self.periodic.isChecked())))
-        kind = s.get("sky_kind")
-        if kind in SKIES:
-            self.sky_kind.setCurrentIndex(list(SKIES).index(kind))
-        n = int(s.get("sky_directions", self.sky_n.value()))
-        split = None if s.get("sky_split") == "equal" or n not in SKY_SPLITS else n
-        self.sky_split.setCurrentIndex(list(SKY_SPLITS).index(split))
-        self.sky_n.setValue(n)
-        if "day_date" in s:
-            date = QDate.fromString(str(s["day_date"]), "yyyy-MM-dd")
-            if date.isValid():
-                self.day_date.setDate(date)
-        self.lat.setValue(float(s.get("latitude", self.lat.value())))
-        self.lon.setValue(float(s.get("longitude", self.lon.value())))
-        self.tz.setText(str(s.get("tz", self.tz.text())))
-        self.step.setValue(float(s.get("step_min", self.step.value())))
-        self.day_from.setText(str(s.get("from", self.day_from.text())))
-        self.day_to.setText(str(s.get("to", self.day_to.text())))
-        self.linke.setValue(float(s.get("linke_turbidity", self.linke.value())))
-        self.weather.setText(str(s.get("weather", self.weather.text())))
-        self.par_factor.setValue(float(s.get("par_factor", self.par_factor.value())))
-        (self.source_weather if s.get("source") == "weather" else self.source_clear) \
-            .setChecked(True)
-        self.set_mode(str(s.get("mode", "sun")))
-
-    def request(self):
-        """The sun's light request the fields describe (hit classes on: the canopy is
-        coloured).
-
-        Raises
-        ------
-        InputProblem, MaizevizError
-            Naming the field (``quantity``).
-        """
-        from maizeviz.light.scene.request import LightRequest
-        from maizeviz.light.sources.sun import Sun
-
-        sampling = self.sampling()
-        sun = Sun(self.zenith.value(), self.azimuth.value())
-        return LightRequest(sun, sampling, classes=True)
-
-    def sampling(self):
-        """Heights, density and field of a sky or a day (a ``Sampling``; 2 tracing threads)."""
-        from maizeviz.light.scene.request import Sampling
-
-        return Sampling(parse_heights(self.heights.text()), self.density.value(), None,
-                        self.periodic.isChecked(), 2)
-
-    def sky_spec(self):
-        """The sky chosen (:class:`maizeviz_app.jobs.SkySpec`)."""
-        from maizeviz_app.jobs import SkySpec
-
-        equal = self.sky_split.currentData() is None
-        return SkySpec(str(self.sky_kind.currentData()), int(self.sky_n.value()),
-                       "equal" if equal else "auto")
-
-    def day_spec(self):
-        """The day chosen (:class:`maizeviz_app.jobs.DaySpec`); an empty weather file field is
-        refused here, the rest (clock times included) by the core when the period is made."""
-        from maizeviz_app.jobs import DaySpec
-
-        weather = None
-        if self.source_weather.isChecked():
-            weather = self.weather.text().strip()
-            if not weather:
-                raise InputProblem("choose a weather file (CSV with a time column and ghi in "
-                                   "W/m²), or use the clear sky", "weather")
-        return DaySpec(self.day_date.date().toString("yyyy-MM-dd"), self.lat.value(),
-                       self.lon.value(), self.tz.text().strip(), self.step.value(),
-                       self.day_from.text().strip() or None, self.day_to.text().strip() or None,
-                       self.linke.value(), self.par_factor.value(), weather,
-                       str(self.day_diffuse.currentData()))
-
-    def sampling_key(self, heights) -> tuple:
-        """What every result of a comparison shares."""
-        return (tuple(float(h) for h in heights), self.density.value(),
-                self.periodic.isChecked())
 
     # ------------------------------------------------------------------ problems
     def point_at(self, quantity: str | None, message: str, mode: str | None = None) -> bool:
@@ -708,6 +584,8 @@ class LightPanel(QWidget):
             return False
         widgets = found if isinstance(found, list) else [found]
         for w in widgets:
+            if not w.property("tip"):
+                w.setProperty("tip", w.toolTip())
             w.setStyleSheet(PROBLEM_STYLE)
             w.setToolTip(message)
         widgets[0].setFocus()
@@ -731,8 +609,20 @@ class LightPanel(QWidget):
         for f in ([w] if w is not None else self._all_fields()):
             if f.styleSheet():
                 f.setStyleSheet("")
+                if f.property("tip"):                   # its own tooltip back
+                    f.setToolTip(f.property("tip"))
         if w is None or self.problem.isVisible():
             self.show_problem("")
+
+    def show_failure(self, text: str, doing: str, quantity, mode) -> bool:
+        """An error of the study (``doing``: what failed): one about light is said here and
+        its field marked; True when a field was."""
+        if doing not in ("light", "sun"):
+            return False
+        self.show_problem(text)
+        if quantity:
+            return self.point_at(quantity, text, mode or ("sun" if doing == "sun" else None))
+        return False
 
     # ------------------------------------------------------------------ state
     def set_running(self, running: bool) -> None:
@@ -907,18 +797,27 @@ class LightPlots(QWidget):
         self.source.setToolTip("which light's map: the direct sun, the diffuse sky or the "
                                "day's PAR")
         self.source.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToContents)
+        self.source.setAccessibleName("heatmap of")
         top.addWidget(self.source)
         top.addWidget(QLabel("at"))
         self.height_box = QComboBox()
         self.source.currentIndexChanged.connect(lambda _i: self._show_height(
             self.height_box.currentIndex()))
         self.height_box.setToolTip("height of the sample plane shown (PgUp / PgDown)")
+        self.height_box.setAccessibleName("heatmap height")
         self.height_box.currentIndexChanged.connect(self._show_height)
         top.addWidget(self.height_box)
         top.addStretch(1)
         left.addLayout(top)
-        self.heatmap = ImageView("compute light to see where it reaches each height")
+        from maizeviz_app.panels.heatmap_view import HeatmapView
+
+        self.heatmap = HeatmapView("compute light to see where it reaches each height")
         left.addWidget(self.heatmap, 1)
+        # the value under the mouse (always in place: showing a widget relayouts the dock)
+        self.hover = QLabel(" ")
+        self.hover.setToolTip("the value of the heatmap's bin under the mouse")
+        self.heatmap.hovered.connect(lambda text: self.hover.setText(text or " "))
+        left.addWidget(self.hover)
         lay.addLayout(left, 1)
         self.transmission = ImageView("transmission by height appears here")
         lay.addWidget(self.transmission, 1)
@@ -970,6 +869,14 @@ class LightPlots(QWidget):
             del self._maps[k]
         if gone:
             self._fill_sources(None)
+
+    def redraw(self, keep: str | None = None) -> None:
+        """The colours changed: every map (but those of the light ``keep``) is drawn again
+        when shown (the one shown now is asked for at once, by ``heatmap_needed``)."""
+        for kind, maps in self._maps.items():
+            if kind != keep:
+                self._maps[kind] = [(h, None) for h, _ in maps]
+        self._show_height(self.height_box.currentIndex())
 
     def set_heatmap(self, index: int, rgba: np.ndarray, kind: str = "sun") -> None:
         """A height's figure, drawn after it was asked for."""

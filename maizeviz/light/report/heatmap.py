@@ -41,18 +41,29 @@ def transmission_map(result: LightResult, height: float, bin_cm: float = 5.0) ->
 
 def heatmap_figure(tmap: TransmissionMap, result: LightResult | None = None,
                    width_in: float = 8.0, dpi: int = 110, title: str | None = None,
-                   what: str = "direct-light transmission") -> Figure:
+                   what: str = "direct-light transmission", *, vmin: float = 0.0,
+                   vmax: float = 1.0, cmap: str = "viridis", log: bool = False) -> Figure:
     """A figure of one map: colour bar, axes in cm; the title names the sun angles, level and
     rays of ``result``, or is ``title`` (the first line always names ``what``, the height and
-    the plane's total)."""
+    the plane's total). The colours span ``vmin`` to ``vmax`` (values outside take the end
+    colours) on matplotlib's colour map ``cmap``, spaced by the logarithm with ``log``
+    (``vmin`` > 0; values of 0 take the lowest colour); bins no ray reached stay blank."""
+    from matplotlib.colors import LogNorm, Normalize
     from matplotlib.figure import Figure
+
+    if not vmin < vmax or log and vmin <= 0:
+        raise ValueError(f"colour range {vmin:g} to {vmax:g} is not increasing"
+                         + (" and above 0 (log scale)" if log else ""))
 
     xe, ye = tmap.x_edges, tmap.y_edges
     aspect = (ye[-1] - ye[0]) / (xe[-1] - xe[0])
     fig = Figure(figsize=(width_in, width_in * aspect * 0.8 + 0.2 * width_in), dpi=dpi)
     ax = fig.add_subplot()
-    im = ax.pcolormesh(xe, ye, tmap.transmission.T, vmin=0, vmax=1, cmap="viridis",
-                       shading="flat")
+    norm = LogNorm(vmin, vmax, clip=True) if log else Normalize(vmin, vmax)
+    values = tmap.transmission.T
+    if log:                                  # 0 is no light: the lowest colour, not blank
+        values = np.where(values <= 0, vmin, values)
+    im = ax.pcolormesh(xe, ye, values, norm=norm, cmap=cmap, shading="flat")
     ax.set_aspect("equal")
     ax.set_xlabel("x (cm, across rows)")
     ax.set_ylabel("y (cm, along rows)")
@@ -63,9 +74,18 @@ def heatmap_figure(tmap: TransmissionMap, result: LightResult | None = None,
     ax.set_title(f"{what} at {tmap.height_cm:g} cm: {tmap.total:.3f}"
                  + ("\n" + "\n".join(textwrap.wrap(title, 95)) if title else ""), fontsize=9)
     fig.colorbar(im, ax=ax, label="transmission (fraction of the light reaching this height)",
-                 shrink=0.8)
+                 shrink=0.8,
+                 extend=_extend(tmap.transmission, vmin, vmax))
     fig.tight_layout()
     return fig
+
+
+def _extend(values: np.ndarray, vmin: float, vmax: float) -> str:
+    """Which ends of the colour bar get an arrow: values lie beyond them (clipped)."""
+    v = values[np.isfinite(values)]
+    low, high = bool(len(v) and v.min() < vmin), bool(len(v) and v.max() > vmax)
+    return {(False, False): "neither", (True, False): "min", (False, True): "max",
+            (True, True): "both"}[(low, high)]
 
 
 def write_map_csv(path: str | Path, tmap: TransmissionMap) -> None:
@@ -130,14 +150,16 @@ def result_map(result: AnyLight, height: float, kind: str = "sun",
 
 def result_figure(result: AnyLight, height: float, kind: str = "sun", bin_cm: float = 5.0,
                   width_in: float = 8.0, dpi: int = 110,
-                  tmap: TransmissionMap | None = None) -> Figure:
+                  tmap: TransmissionMap | None = None, **colours) -> Figure:
     """The figure of one height of a light result (:func:`result_map`, or ``tmap`` when
-    already made), titled by :func:`map_title`."""
+    already made), titled by :func:`map_title`; ``colours``: :func:`heatmap_figure`'s
+    ``vmin``, ``vmax``, ``cmap``, ``log``."""
     tmap = result_map(result, height, kind, bin_cm) if tmap is None else tmap
     if kind == "sun":
-        return heatmap_figure(tmap, cast(LightResult, result), width_in=width_in, dpi=dpi)
+        return heatmap_figure(tmap, cast(LightResult, result), width_in=width_in, dpi=dpi,
+                              **colours)
     what, title = map_title(result, kind)
-    return heatmap_figure(tmap, width_in=width_in, dpi=dpi, title=title, what=what)
+    return heatmap_figure(tmap, width_in=width_in, dpi=dpi, title=title, what=what, **colours)
 
 
 def heatmap_stems(result: AnyLight, kind: str = "sun") -> list[str]:

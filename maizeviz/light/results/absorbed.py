@@ -16,10 +16,13 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.light.results.per_leaf import LightRow, leaf_sums
+from maizeviz.light.results.traced import TableBy, table_kind
 from maizeviz.light.results.uncertainty import Batches, errors_by
 
-if TYPE_CHECKING:                       # the optics live with the tracing that uses them
-    from maizeviz.light.trace.optics import Optics
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from maizeviz.light.trace.optics import Optics  # with the tracing that uses them
 
 
 #: Share of the incident light left unresolved (still travelling when scattering stopped)
@@ -82,24 +85,59 @@ def _per_plant(frame, sums: tuple[str, ...]):
 class AbsorbedLight:
     """Light absorbed by the leaves (and the ground) in one band, with scattering.
 
-    Attributes
+    From :meth:`maizeviz.light.engine.LightEngine.absorbed`.
+
+    Parameters
     ----------
-    band : "par" or "nir"; optics : Optics
-    irradiance_w_m2 : float, the band's irradiance on a horizontal plane above the canopy
-        (direct plus diffuse as traced), W/m2
-    balance : Balance, W/m2 of sample ground
-    triangle_absorbed_w : (F,) float64 W absorbed by each triangle of the scene (leaves, then
-        stalks), from the light falling on the sample rectangle
-    triangle_sunlit_cm2 : (F,) float64 cm2 of each triangle in the direct beam (0 for a sky)
-    triangle_direct_w : (F,) float64 the part of ``triangle_absorbed_w`` the sun's direct beam
-        deposited (on the sunlit area), or None (a record older than photosynthesis)
-    batches : Batches, the per-batch shares the standard errors come from, or None
-    sun_direction : (3,) unit vector toward the sun, or None (no direct beam)
-    rect : (x0, y0, x1, y1) cm; rays : primary rays per direction; directions : beams traced
-    depth, threshold, seed : as traced; events : scatterings followed; periodic : bool
-    level : the canopy's mesh level; seconds : "trace" (primary beams), "scatter", "build"
-    stands : identity of the stands traced on (:func:`maizeviz.canopy.layout.stands_identity`),
-        None where not known
+    band : {"par", "nir"}
+        The waveband.
+    optics : Optics
+        The leaf and soil optics traced.
+    irradiance_w_m2 : float
+        The band's irradiance on a horizontal plane above the canopy (direct plus diffuse as
+        traced) [W m-2].
+    balance : Balance
+        Where the light went [W m-2 of sample ground].
+    triangle_absorbed_w : numpy.ndarray
+        (F,) float64 power absorbed by each scene triangle (leaves, then stalks) from the
+        light falling on the sample rectangle [W].
+    triangle_sunlit_cm2 : numpy.ndarray
+        (F,) float64 area of each triangle in the direct beam [cm2] (0 for a sky).
+    rect : (x0, y0, x1, y1) tuple of float
+        The sample rectangle [cm].
+    rays : int
+        Primary rays per direction.
+    directions : int
+        Beams traced.
+    depth : int
+        Most scatterings followed per ray.
+    threshold : float
+        Share of the incident power still travelling where tracing stopped [-].
+    seed : int
+        Seed of the Monte Carlo scattering.
+    events : int
+        Scatterings followed.
+    periodic : bool
+        Rays wrapped across the plot.
+    level : str
+        Mesh level label of the canopy.
+    seconds : dict of str to float
+        Time spent [s]: "trace" (primary beams), "scatter", "build".
+    triangle_direct_w : numpy.ndarray or None
+        (F,) float64 the part of ``triangle_absorbed_w`` the sun's direct beam deposited [W]
+        (on the sunlit area; the rest came from the sky and scattered light).
+    batches : Batches or None
+        The per-batch shares of independent batches of rays, the standard errors' source.
+    sun_direction : (3,) tuple of float or None
+        Unit vector toward the sun traced, field coordinates (None without a sun).
+    stands : dict or None
+        ``{"n", "sha256"}``, the identity of the stands of the canopy it was traced on.
+
+    References
+    ----------
+    Bailey, B. N. (2018). A reverse ray-tracing method for modelling the net radiative flux
+    in leaf-resolving plant canopy simulations. Ecological Modelling 368, 233-245.
+    https://doi.org/10.1016/j.ecolmodel.2017.11.022
     """
 
     band: str
@@ -127,8 +165,13 @@ class AbsorbedLight:
 
     @property
     def absorbed_leaves_error(self) -> float | None:
-        """Monte Carlo standard error of ``balance.absorbed_leaves`` (W/m2 of ground), from
-        independent batches of rays; None when the result was not traced in batches."""
+        """Monte Carlo standard error of ``balance.absorbed_leaves``, from batches of rays.
+
+        Returns
+        -------
+        float or None
+            [W m-2 of ground]; None when the result was not traced in batches.
+        """
         total = float(self.triangle_absorbed_w.sum())
         if self.batches is None or total <= 0:
             return None if self.batches is None else 0.0
@@ -136,36 +179,49 @@ class AbsorbedLight:
 
     @property
     def balance_errors(self) -> dict[str, float] | None:
-        """Monte Carlo standard errors of the energy balance's parts, in its units:
-        ``absorbed_leaves`` (:attr:`absorbed_leaves_error`), ``absorbed_ground``,
-        ``reflected_top``, ``escaped_sides``, ``unresolved``; None without batches."""
+        """Monte Carlo standard errors of the energy balance's parts, in its units.
+
+        Returns
+        -------
+        dict of str to float or None
+            ``absorbed_leaves``, ``absorbed_ground``, ``reflected_top``, ``escaped_sides``,
+            ``unresolved``; None without batches.
+        """
         if self.batches is None or self.batches.parts is None:
             return None
         return {"absorbed_leaves": float(self.absorbed_leaves_error or 0.0),
                 **(self.batches.balance_errors(1.0) or {})}
 
-    def table(self, by: str = "plant", canopy=None):
-        """Absorbed light per leaf or per plant as a pandas DataFrame.
+    def table(self, by: TableBy | None = None, canopy: Canopy | None = None) -> pd.DataFrame:
+        """Absorbed light as a table: the energy balance, or per leaf or per plant.
 
-        Columns: ``absorbed_w`` (W), ``absorbed_w_m2_leaf`` (W per m2 of one-sided leaf area),
-        ``sunlit_area_cm2`` and ``shaded_area_cm2`` (leaf area in and out of the direct beam),
-        and for PAR ``absorbed_umol_s`` (umol/s: 4.57 umol per J of PAR). ``by="balance"``:
-        the energy balance (W/m2 of ground) as one row.
+        Parameters
+        ----------
+        by : {None, "balance", "leaf", "plant"}
+            None (the default) or "balance": the energy balance [W m-2 of ground] as one
+            row. "leaf" or "plant": ``absorbed_w`` [W], ``absorbed_w_m2_leaf`` [W m-2 of
+            one-sided leaf area], ``sunlit_area_cm2`` and ``shaded_area_cm2`` [cm2] (leaf area
+            in and out of the direct beam), and for PAR ``absorbed_umol_s`` [umol s-1]
+            (4.57 umol per J of PAR).
+        canopy : Canopy, optional
+            The canopy the light was traced on; needed by leaf and plant.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row, or one per lit leaf or plant.
+
+        Raises
+        ------
+        MaizevizError
+            Another ``by``, or a leaf or plant table without the canopy.
         """
         import pandas as pd
 
-        if by == "balance":
+        kind = table_kind(by, "balance", canopy)
+        if kind == "balance":
             return pd.DataFrame([{"band": self.band, **self.balance.as_dict()}])
-        if by not in ("leaf", "plant"):
-            from maizeviz.errors import MaizevizError
-
-            raise MaizevizError(f"absorbed light is tabled by 'leaf', 'plant' or 'balance', not "
-                                f"'{by}'", quantity="table")
-        if canopy is None:
-            from maizeviz.errors import MaizevizError
-
-            raise MaizevizError("give the canopy the light was traced on to table it by "
-                                f"{by}", quantity="table")
+        assert canopy is not None
         from maizeviz.light.sources.irradiance import PAR_UMOL_PER_J_PAR
 
         rows = leaf_sums(canopy, {"absorbed_w": self.triangle_absorbed_w,
@@ -175,12 +231,12 @@ class AbsorbedLight:
         if frame.empty:
             return frame
         frame["sunlit_area_cm2"] = np.minimum(frame["sunlit_area_cm2"], frame["leaf_area_cm2"])
-        if by == "plant":
+        if kind == "plant":
             frame = _per_plant(frame, ("absorbed_w", "sunlit_area_cm2"))
         if self.batches is not None:
             se = errors_by(canopy, self.batches.absorbed, "absorbed_w", self.rect,
-                           self.periodic, by)
-            keys = frame["instance"] if by == "plant" else zip(frame["instance"], frame["leaf"])
+                           self.periodic, kind)
+            keys = frame["instance"] if kind == "plant" else zip(frame["instance"], frame["leaf"])
             frame["absorbed_w_se"] = [se.get(k, 0.0) for k in keys]
         frame["shaded_area_cm2"] = frame["leaf_area_cm2"] - frame["sunlit_area_cm2"]
         frame["absorbed_w_m2_leaf"] = frame["absorbed_w"] / (frame["leaf_area_cm2"] * 1e-4)
@@ -189,9 +245,23 @@ class AbsorbedLight:
         return frame
 
     def leaf_rows(self, canopy: Canopy) -> list[LightRow]:
-        """Per lit leaf: ``absorbed_w`` (W), ``absorbed_w_m2_leaf`` and
-        ``absorbed_sunlit_area_cm2``, as the light tables of the command line
-        (:func:`maizeviz.light.results.per_leaf.leaf_sums`)."""
+        """Per lit leaf: the power it absorbed.
+
+        ``absorbed_w`` [W], ``absorbed_w_m2_leaf`` [W m-2 of leaf] and
+        ``absorbed_sunlit_area_cm2`` [cm2], as the light tables of the command line.
+
+        Parameters
+        ----------
+        canopy : Canopy
+            The canopy the light was traced on.
+
+        Returns
+        -------
+        list of dict
+            One row per leaf that received light: ``instance``, ``plant``, ``leaf``, ``x_cm``,
+            ``y_cm``, ``leaf_area_cm2`` and the light (copies of a plant in a tile-periodic field
+            reported as one); ``table("leaf", canopy)`` as dicts.
+        """
         rows = leaf_sums(canopy, {"absorbed_w": self.triangle_absorbed_w,
                                   "absorbed_sunlit_area_cm2": self.triangle_sunlit_cm2},
                          self.rect, self.periodic)
@@ -206,25 +276,54 @@ class AbsorbedLight:
 
 @dataclass(frozen=True)
 class AbsorbedPeriod:
-    """Light absorbed by the leaves (and the ground) in one band over a period (a day), with
-    scattering: each time step's sun traced with its direct irradiance, the diffuse part
-    traced once per unit of diffuse irradiance and scaled by each step's (it is linear).
+    """Light absorbed by the leaves (and the ground) in one band over a period, with scattering.
 
-    Attributes
+    From :meth:`maizeviz.light.engine.LightEngine.absorbed_day`: each time step's sun traced
+    with its direct irradiance, the diffuse part traced once per unit of diffuse irradiance
+    and scaled by each step's (it is linear).
+
+    Parameters
     ----------
-    band : "par" or "nir"; optics : Optics
-    period : Period (:mod:`maizeviz.light.sources.irradiance`): its steps, sun and irradiance
-    balance : Balance in MJ/m2 of sample ground over the period
-    triangle_absorbed_j : (F,) float64 J absorbed by each scene triangle over the period
-    step_absorbed_leaves_w_m2 : (n,) float64 W/m2 of ground the leaves absorb at each step
-    step_incident_w_m2 : (n,) float64 the band's irradiance on a horizontal plane at each step
-    rect, rays, depth, seed, periodic, level : as traced; seconds : "trace", "scatter",
-        "build"
-    batches : per-batch shares of ``triangle_absorbed_j`` (``absorbed`` only), for standard
-        errors
-    assimilation : PeriodAssimilation (:mod:`maizeviz.light.results.assimilation`) when a
-        leaf model was given, else None
-    stands : identity of the stands traced on, None where not known
+    band : {"par", "nir"}
+        The waveband.
+    optics : Optics
+        The leaf and soil optics traced.
+    period : Period
+        Its steps, sun and irradiance (:mod:`maizeviz.light.sources.irradiance`).
+    balance : Balance
+        Where the light went over the period [MJ m-2 of sample ground].
+    triangle_absorbed_j : numpy.ndarray
+        (F,) float64 energy absorbed by each scene triangle over the period [J].
+    step_absorbed_leaves_w_m2 : numpy.ndarray
+        (n,) float64 what the leaves absorb at each step [W m-2 of ground].
+    step_incident_w_m2 : numpy.ndarray
+        (n,) float64 the band's irradiance on a horizontal plane at each step [W m-2].
+    rect : (x0, y0, x1, y1) tuple of float
+        The sample rectangle [cm].
+    rays : int
+        Primary rays per direction.
+    depth : int
+        Most scatterings followed per ray.
+    seed : int
+        Seed of the Monte Carlo scattering.
+    periodic : bool
+        Rays wrapped across the plot.
+    level : str
+        Mesh level label of the canopy.
+    seconds : dict of str to float
+        Time spent [s]: "trace", "scatter", "build".
+    batches : Batches or None
+        The per-batch shares of independent batches of rays, the standard errors' source.
+    assimilation : PeriodAssimilation or None
+        The leaves' gross CO2 assimilation over the period, when a leaf model was asked for.
+    stands : dict or None
+        ``{"n", "sha256"}``, the identity of the stands of the canopy it was traced on.
+
+    References
+    ----------
+    Bailey, B. N. (2018). A reverse ray-tracing method for modelling the net radiative flux
+    in leaf-resolving plant canopy simulations. Ecological Modelling 368, 233-245.
+    https://doi.org/10.1016/j.ecolmodel.2017.11.022
     """
 
     band: str
@@ -249,7 +348,13 @@ class AbsorbedPeriod:
 
     @property
     def absorbed_leaves_error(self) -> float | None:
-        """Monte Carlo standard error of ``balance.absorbed_leaves`` (MJ/m2 of ground)."""
+        """Monte Carlo standard error of ``balance.absorbed_leaves``, from batches of rays.
+
+        Returns
+        -------
+        float or None
+            [MJ m-2 of ground]; None when the result was not traced in batches.
+        """
         total = float(self.triangle_absorbed_j.sum())
         if self.batches is None or total <= 0:
             return None if self.batches is None else 0.0
@@ -257,9 +362,14 @@ class AbsorbedPeriod:
 
     @property
     def balance_errors(self) -> dict[str, float] | None:
-        """Monte Carlo standard errors of the energy balance's parts, in its units:
-        ``absorbed_leaves`` (:attr:`absorbed_leaves_error`), ``absorbed_ground``,
-        ``reflected_top``, ``escaped_sides``, ``unresolved``; None without batches."""
+        """Monte Carlo standard errors of the period's energy balance's parts, in its units.
+
+        Returns
+        -------
+        dict of str to float or None
+            ``absorbed_leaves``, ``absorbed_ground``, ``reflected_top``, ``escaped_sides``,
+            ``unresolved`` [MJ m-2 of ground]; None without batches.
+        """
         if self.batches is None or self.batches.parts is None:
             return None
         return {"absorbed_leaves": float(self.absorbed_leaves_error or 0.0),
@@ -267,27 +377,47 @@ class AbsorbedPeriod:
 
     @property
     def absorbed_leaves_mol_m2(self) -> float | None:
-        """PAR the leaves absorbed over the period, mol per m2 of ground (None for NIR)."""
+        """PAR the leaves absorbed over the period.
+
+        Returns
+        -------
+        float or None
+            [mol m-2 of ground] (MJ times 4.57 umol per J of PAR); None for NIR.
+        """
         from maizeviz.light.sources.irradiance import PAR_UMOL_PER_J_PAR
 
         return self.balance.absorbed_leaves * PAR_UMOL_PER_J_PAR if self.band == "par" \
             else None                           # MJ x umol/J = mol
 
-    def table(self, by: str = "plant", canopy=None):
-        """Absorbed light per leaf or per plant over the period as a pandas DataFrame:
-        ``absorbed_mj`` (MJ), ``absorbed_mj_m2_leaf``, and for PAR ``absorbed_mol``;
-        ``by="balance"``: the balance (MJ/m2 of ground) as one row."""
+    def table(self, by: TableBy | None = None, canopy: Canopy | None = None) -> pd.DataFrame:
+        """Absorbed light over the period as a table: the balance, or per leaf or per plant.
+
+        Parameters
+        ----------
+        by : {None, "balance", "leaf", "plant"}
+            None (the default) or "balance": the balance [MJ m-2 of ground] as one row.
+            "leaf" or "plant": ``absorbed_mj`` [MJ], ``absorbed_mj_m2_leaf`` [MJ m-2 of leaf],
+            and for PAR ``absorbed_mol`` [mol].
+        canopy : Canopy, optional
+            The canopy the light was traced on; needed by leaf and plant.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row, or one per lit leaf or plant.
+
+        Raises
+        ------
+        MaizevizError
+            Another ``by``, or a leaf or plant table without the canopy.
+        """
         import pandas as pd
 
-        from maizeviz.errors import MaizevizError
-
-        if by == "balance":
+        kind = table_kind(by, "balance", canopy)
+        if kind == "balance":
             return pd.DataFrame([{"band": self.band, "unit": "MJ/m2",
                                   **self.balance.as_dict()}])
-        if by not in ("leaf", "plant") or canopy is None:
-            raise MaizevizError("absorbed light over a period is tabled by 'leaf' or 'plant' "
-                                "(with the canopy it was traced on) or 'balance'",
-                                quantity="table")
+        assert canopy is not None
         from maizeviz.light.sources.irradiance import PAR_UMOL_PER_J_PAR
 
         rows = leaf_sums(canopy, {"absorbed_mj": self.triangle_absorbed_j * 1e-6}, self.rect,
@@ -295,14 +425,38 @@ class AbsorbedPeriod:
         frame = pd.DataFrame(rows)
         if frame.empty:
             return frame
-        if by == "plant":
+        if kind == "plant":
             frame = _per_plant(frame, ("absorbed_mj",))
         if self.batches is not None:
             se = errors_by(canopy, self.batches.absorbed * 1e-6, "absorbed_mj", self.rect,
-                           self.periodic, by)
-            keys = frame["instance"] if by == "plant" else zip(frame["instance"], frame["leaf"])
+                           self.periodic, kind)
+            keys = frame["instance"] if kind == "plant" else zip(frame["instance"], frame["leaf"])
             frame["absorbed_mj_se"] = [se.get(k, 0.0) for k in keys]
         frame["absorbed_mj_m2_leaf"] = frame["absorbed_mj"] / (frame["leaf_area_cm2"] * 1e-4)
         if self.band == "par":
             frame["absorbed_mol"] = frame["absorbed_mj"] * PAR_UMOL_PER_J_PAR
         return frame
+
+    def leaf_rows(self, canopy: Canopy) -> list[LightRow]:
+        """Per lit leaf: the energy it absorbed over the period.
+
+        ``absorbed_mj`` [MJ] and ``absorbed_mj_m2_leaf`` [MJ m-2 of leaf]
+        (:func:`maizeviz.light.results.per_leaf.leaf_sums`).
+
+        Parameters
+        ----------
+        canopy : Canopy
+            The canopy the light was traced on.
+
+        Returns
+        -------
+        list of dict
+            One row per leaf that received light: ``instance``, ``plant``, ``leaf``, ``x_cm``,
+            ``y_cm``, ``leaf_area_cm2`` and the light (copies of a plant in a tile-periodic field
+            reported as one); ``table("leaf", canopy)`` as dicts.
+        """
+        rows = leaf_sums(canopy, {"absorbed_mj": self.triangle_absorbed_j * 1e-6}, self.rect,
+                         self.periodic)
+        for r in rows:
+            r["absorbed_mj_m2_leaf"] = float(r["absorbed_mj"]) / (float(r["leaf_area_cm2"]) * 1e-4)
+        return rows

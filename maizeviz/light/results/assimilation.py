@@ -41,6 +41,7 @@ if TYPE_CHECKING:
 
     from maizeviz.canopy.scene import Canopy
     from maizeviz.light.results.absorbed import AbsorbedLight
+    from maizeviz.light.results.traced import TableBy
 
 
 #: Height band (cm) over which the background light of a leaf's triangles is pooled.
@@ -73,19 +74,39 @@ def _fold(values: np.ndarray, slot: np.ndarray | None, n_slots: int) -> np.ndarr
 class Assimilation:
     """Gross CO2 assimilation of the leaves under one traced light.
 
-    Attributes
+    Parameters
     ----------
-    model : dict, the leaf model's name and parameters (:meth:`LeafModel.as_dict`)
-    temp_c : leaf (air) temperature, C
-    triangle_gross_umol_s : (F,) float64 umol CO2/s per leaf triangle (in a tile-periodic
-        field, on the copy inside the sample rectangle; its other copies 0)
-    triangle_batches : (BATCHES, F) float64 the same from each batch of rays alone (rows sum
-        to ``triangle_gross_umol_s`` up to the non-linearity), or None
-    ground_m2 : m2 of ground the canopy figure is per (the sample rectangle)
-    respiration_umol_m2_leaf : the model's leaf respiration at ``temp_c``, umol/m2 leaf/s
-    leaf_area_m2 : m2 of leaf the triangles stand for (one copy in a tile-periodic field)
-    rect, periodic : as traced
-    warnings : what the user should know (leaves partly out of the rays' reach)
+    model : dict
+        The leaf model's name and parameters (``LeafModel.as_dict``).
+    temp_c : float
+        Leaf (air) temperature [degC].
+    triangle_gross_umol_s : numpy.ndarray
+        (F,) float64 gross assimilation of each leaf triangle [umol CO2 s-1] (in a
+        tile-periodic field on the copy inside the sample rectangle; its other copies 0).
+    triangle_batches : numpy.ndarray or None
+        (BATCHES, F) float64 the same from each batch of rays alone, or None.
+    ground_m2 : float
+        Ground the canopy figure is per (the sample rectangle) [m2].
+    respiration_umol_m2_leaf : float
+        The model's leaf respiration at ``temp_c`` [umol CO2 m-2 of leaf s-1].
+    leaf_area_m2 : float
+        Leaf the triangles stand for (one copy in a tile-periodic field) [m2].
+    rect : (x0, y0, x1, y1) tuple of float
+        The sample rectangle [cm].
+    periodic : bool
+        Rays wrapped across the plot.
+    warnings : tuple of str
+        What the user should know (leaves partly out of the rays' reach).
+
+    References
+    ----------
+    Collatz, G. J., Ribas-Carbo, M. & Berry, J. A. (1992). Coupled photosynthesis-stomatal
+    conductance model for leaves of C4 plants. Australian Journal of Plant Physiology 19,
+    519-538. https://doi.org/10.1071/PP9920519
+    Spitters, C. J. T., Toussaint, H. A. J. M. & Goudriaan, J. (1986). Separating the
+    diffuse and direct component of global radiation and its implications for modeling canopy
+    photosynthesis. Part II. Calculation of canopy photosynthesis. Agricultural and Forest
+    Meteorology 38, 231-242. https://doi.org/10.1016/0168-1923(86)90061-4
     """
 
     model: dict
@@ -125,12 +146,26 @@ class Assimilation:
             self.respiration_umol_m2_leaf * self.leaf_area_m2 / self.ground_m2
 
     def leaf_model(self) -> LeafModel:
+        """The leaf model it was computed with.
+
+        Returns
+        -------
+        LeafModel
+            Rebuilt from ``model``.
+        """
         return model_from_dict(self.model)
 
     def as_dict(self) -> dict[str, Any]:
-        """The figures the command line's JSON carries (``photosynthesis``)."""
+        """The figures the command line's JSON carries (``photosynthesis``).
+
+        Returns
+        -------
+        dict
+            The model, its parameters, the temperature, the canopy's gross assimilation with its
+            standard error [umol m-2 s-1, kg CO2 ha-1 h-1], net assimilation, LAI and warnings.
+        """
         se = self.canopy_gross_error_umol_m2_s
-        return {**{"model": self.model["model"]},
+        return {"model": self.model["model"],
                 "parameters": {k: v for k, v in self.model.items() if k != "model"},
                 "temperature_c": self.temp_c,
                 "canopy_gross_umol_m2_s": self.canopy_gross_umol_m2_s,
@@ -142,29 +177,58 @@ class Assimilation:
                 "leaf_area_index": self.leaf_area_m2 / self.ground_m2,
                 "warnings": list(self.warnings)}
 
-    def table(self, by: str = "plant", canopy: Canopy | None = None) -> pd.DataFrame:
-        """Gross assimilation per leaf or plant: ``gross_umol_s`` (umol CO2/s), its standard
-        error ``gross_umol_s_se``, ``gross_umol_m2_leaf_s`` (per m2 of leaf)."""
-        return _table(self.triangle_gross_umol_s, self.triangle_batches, "gross_umol_s",
+    def table(self, by: TableBy | None = None, canopy: Canopy | None = None) -> pd.DataFrame:
+        """Gross assimilation as a table: the canopy's, or per leaf or plant.
+
+        Parameters
+        ----------
+        by : {None, "canopy", "leaf", "plant"}
+            None (the default) or "canopy": the canopy's figures as one row (:meth:`as_dict`'s
+            numbers). "leaf" or "plant": ``gross_umol_s`` [umol CO2 s-1], its standard error
+            ``gross_umol_s_se``, ``gross_umol_m2_leaf_s`` [umol CO2 m-2 of leaf s-1].
+        canopy : Canopy, optional
+            The canopy the light was traced on; needed by leaf and plant.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row, or one per leaf or plant.
+        """
+        return _table(self, self.triangle_gross_umol_s, self.triangle_batches, "gross_umol_s",
                       "gross_umol_m2_leaf_s", self.rect, self.periodic, by, canopy)
 
 
 @dataclass(frozen=True)
 class PeriodAssimilation:
-    """Gross CO2 assimilation of the leaves over a period (a day, a weather file): each time
-    step's light through the leaf model at that step's temperature, times the step.
+    """Gross CO2 assimilation of the leaves over a period (a day, a weather file).
 
-    Attributes
+    Each time step's light through the leaf model at that step's temperature, times the step.
+
+    Parameters
     ----------
-    model : dict, the leaf model (:meth:`LeafModel.as_dict`)
-    temperature_c : (n,) float64, air (leaf) temperature of each step, C
-    triangle_gross_mol : (F,) float64 mol CO2 per leaf triangle over the period (tile-periodic
-        fields: on the copy inside the sample rectangle)
-    triangle_batches : (BATCHES, F) float64 the same from each batch of rays alone
-    ground_m2 : m2 of ground (the sample rectangle)
-    step_gross_umol_m2_s : (n,) float64 canopy gross assimilation at each step, umol/m2 of
-        ground/s
-    rect, periodic : as traced
+    model : dict
+        The leaf model (``LeafModel.as_dict``).
+    temperature_c : numpy.ndarray
+        (n,) float64 air (leaf) temperature of each step [degC].
+    triangle_gross_mol : numpy.ndarray
+        (F,) float64 gross assimilation of each leaf triangle over the period [mol CO2]
+        (tile-periodic fields: on the copy inside the sample rectangle).
+    triangle_batches : numpy.ndarray or None
+        (BATCHES, F) float64 the same from each batch of rays alone.
+    ground_m2 : float
+        Ground (the sample rectangle) [m2].
+    step_gross_umol_m2_s : numpy.ndarray
+        (n,) float64 the canopy's gross assimilation at each step [umol m-2 of ground s-1].
+    rect : (x0, y0, x1, y1) tuple of float
+        The sample rectangle [cm].
+    periodic : bool
+        Rays wrapped across the plot.
+
+    References
+    ----------
+    Collatz, G. J., Ribas-Carbo, M. & Berry, J. A. (1992). Coupled photosynthesis-stomatal
+    conductance model for leaves of C4 plants. Australian Journal of Plant Physiology 19,
+    519-538. https://doi.org/10.1071/PP9920519
     """
 
     model: dict
@@ -178,16 +242,35 @@ class PeriodAssimilation:
 
     @property
     def canopy_gross_mol_m2(self) -> float:
-        """mol CO2 per m2 of ground over the period."""
+        """Gross CO2 assimilation over the period per m2 of ground.
+
+        Returns
+        -------
+        float
+            [mol CO2 m-2].
+        """
         return float(self.triangle_gross_mol.sum()) / self.ground_m2
 
     @property
     def canopy_gross_g_m2(self) -> float:
-        """g CO2 per m2 of ground over the period."""
+        """Gross CO2 assimilation over the period per m2 of ground.
+
+        Returns
+        -------
+        float
+            [g CO2 m-2].
+        """
         return self.canopy_gross_mol_m2 * CO2_G_PER_MOL
 
     @property
     def canopy_gross_error_mol_m2(self) -> float | None:
+        """Monte Carlo standard error of :attr:`canopy_gross_mol_m2`.
+
+        Returns
+        -------
+        float or None
+            [mol CO2 m-2]; None without batches.
+        """
         if self.triangle_batches is None:
             return None
         from maizeviz.light.results.uncertainty import batch_error
@@ -195,6 +278,14 @@ class PeriodAssimilation:
         return float(batch_error(self.triangle_batches.sum(axis=1))) / self.ground_m2
 
     def as_dict(self) -> dict[str, Any]:
+        """The figures the command line's JSON carries.
+
+        Returns
+        -------
+        dict
+            The model, its parameters, the temperatures, the canopy's gross assimilation with its
+            standard error [mol m-2, g CO2 m-2] and per step [umol m-2 s-1].
+        """
         se = self.canopy_gross_error_mol_m2
         return {"model": self.model["model"],
                 "parameters": {k: v for k, v in self.model.items() if k != "model"},
@@ -205,28 +296,47 @@ class PeriodAssimilation:
                 "canopy_gross_g_co2_m2_se": None if se is None else se * CO2_G_PER_MOL,
                 "step_gross_umol_m2_s": [float(v) for v in self.step_gross_umol_m2_s]}
 
-    def table(self, by: str = "plant", canopy: Canopy | None = None) -> pd.DataFrame:
-        """Per leaf or plant: ``gross_mol`` (mol CO2 over the period), ``gross_mol_se``,
-        ``gross_g_co2`` (g), ``gross_mol_m2_leaf``."""
-        frame = _table(self.triangle_gross_mol, self.triangle_batches, "gross_mol",
+    def table(self, by: TableBy | None = None, canopy: Canopy | None = None) -> pd.DataFrame:
+        """Gross assimilation over the period as a table: the canopy's, or per leaf or plant.
+
+        Parameters
+        ----------
+        by : {None, "canopy", "leaf", "plant"}
+            None (the default) or "canopy": the canopy's figures as one row (:meth:`as_dict`'s
+            numbers). "leaf" or "plant": ``gross_mol`` [mol CO2] over the period,
+            ``gross_mol_se``, ``gross_g_co2`` [g], ``gross_mol_m2_leaf`` [mol m-2 of leaf].
+        canopy : Canopy, optional
+            The canopy the light was traced on; needed by leaf and plant.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row, or one per leaf or plant.
+        """
+        frame = _table(self, self.triangle_gross_mol, self.triangle_batches, "gross_mol",
                        "gross_mol_m2_leaf", self.rect, self.periodic, by, canopy)
-        if not frame.empty:
+        if by is not None and by != "canopy" and not frame.empty:
             frame["gross_g_co2"] = frame["gross_mol"] * CO2_G_PER_MOL
         return frame
 
 
-def _table(values: np.ndarray, batches: np.ndarray | None, col: str, per_leaf_col: str,
-           rect, periodic: bool, by: str, canopy: Canopy | None) -> pd.DataFrame:
-    """Per-leaf or per-plant sums of per-triangle ``values`` (column ``col``), their standard
-    errors from ``batches`` (column ``col + "_se"``), and ``per_leaf_col``: per m2 of leaf."""
+def _table(result, values: np.ndarray, batches: np.ndarray | None, col: str,
+           per_leaf_col: str, rect, periodic: bool, by: str | None,
+           canopy: Canopy | None) -> pd.DataFrame:
+    """The canopy's figures as one row (``by`` None or "canopy"), or per-leaf or per-plant
+    sums of per-triangle ``values`` (column ``col``), their standard errors from ``batches``
+    (column ``col + "_se"``), and ``per_leaf_col``: per m2 of leaf."""
     import pandas as pd
 
     from maizeviz.light.results.per_leaf import leaf_sums
+    from maizeviz.light.results.traced import table_kind
     from maizeviz.light.results.uncertainty import errors_by
 
-    if by not in ("leaf", "plant") or canopy is None:
-        raise MaizevizError("assimilation is tabled by 'leaf' or 'plant', with the canopy it "
-                            "was computed on", quantity="table")
+    by = table_kind(by, "canopy", canopy)
+    if by == "canopy":
+        return pd.DataFrame([{k: v for k, v in result.as_dict().items()
+                              if isinstance(v, (str, int, float)) or v is None}])
+    assert canopy is not None
     frame = pd.DataFrame(leaf_sums(canopy, {col: values}, rect, periodic))
     if frame.empty:
         return frame

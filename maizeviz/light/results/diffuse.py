@@ -21,25 +21,53 @@ from maizeviz.light.sources.sky import Sky
 
 @dataclass(frozen=True, eq=False, kw_only=True)
 class SkyLight(MappedLight):
-    """Diffuse light under a sky, from :func:`~maizeviz.light.trace.diffuse.trace_sky` (with the shared fields of
-    :class:`~maizeviz.light.results.traced.MappedLight`: heights_cm, rect, rays, maps, map_edges,
-    map_rays, level, warnings, seconds, periodic).
+    """Diffuse light under a sky.
 
-    Attributes
+    From :func:`~maizeviz.light.trace.diffuse.trace_sky` (``LightEngine.sky``): every
+    direction of the sky traced like the sun, weighted by its share of the horizontal
+    diffuse irradiance.
+
+    Parameters
     ----------
+    heights_cm : numpy.ndarray
+        (H,) float64 heights of the sensor planes [cm].
+    rect : (x0, y0, x1, y1) tuple of float
+        The sample rectangle [cm].
+    rays : int
+        Rays per direction (and sensors per plane).
+    level : str
+        Mesh level label of the canopy.
+    warnings : tuple of str
+        What the user should know about this result.
+    seconds : dict of str to float
+        Time spent [s]: "build" (the scene, when this call built it), "trace", ...
+    periodic : bool
+        Rays and sensor paths wrapped across the plot.
+    stands : dict or None
+        ``{"n", "sha256"}``, the identity of the stands of the canopy it was traced on
+        (:func:`maizeviz.canopy.layout.stands_identity`); None where not known.
+    maps : numpy.ndarray
+        (H, a, b) float64, the binned value of each plane (NaN: no sensor in the bin).
+    map_edges : tuple of numpy.ndarray
+        The x (a + 1,) and y (b + 1,) bin edges [cm].
+    map_rays : numpy.ndarray
+        (a, b) int64 sensors per bin (ground grid).
     sky : Sky
-    transmission : (H,) float64 in [0, 1]: sum_i w_i T_i(h), the fraction of the horizontal
-        diffuse irradiance reaching each sensor plane
-    per_direction : (n, H) float64: T_i(h) of each sky direction
-    intercepted_fraction : float: share of the rectangle's diffuse light whose first hit is a
-        leaf
-    per_direction_intercepted : (n,) float64: the same per direction (leaves' share of its beam)
-    triangle_share : (F,) float64: share of the rectangle's diffuse light each scene triangle
-        intercepts (leaf triangles first, then stalks)
-    density : rays per cm2 asked for
-
-    ``maps`` hold the diffuse transmission per bin; ``seconds`` "build", "trace" (wall
-    clock), s.
+        The sky traced.
+    transmission : numpy.ndarray
+        (H,) float64 in [0, 1]: sum_i w_i T_i(h), the share of the horizontal diffuse
+        irradiance reaching each sensor plane.
+    per_direction : numpy.ndarray
+        (n, H) float64: T_i(h) of each sky direction.
+    intercepted_fraction : float
+        Share of the rectangle's diffuse light whose first hit is a leaf [-].
+    per_direction_intercepted : numpy.ndarray
+        (n,) float64: the same per direction (the leaves' share of its beam).
+    triangle_share : numpy.ndarray
+        (F,) float64: share of the rectangle's diffuse light each scene triangle intercepts
+        (leaf triangles first, then stalks).
+    density : float
+        Rays per cm2 asked for [cm-2].
     """
 
     sky: Sky
@@ -52,42 +80,103 @@ class SkyLight(MappedLight):
 
     @property
     def triangle_intercepted_cm2(self) -> np.ndarray:
-        """(F,) float64 cm2: each triangle's share times the rectangle's area (the horizontal
-        area whose diffuse light it takes)."""
+        """Horizontal area whose diffuse light each triangle takes.
+
+        Returns
+        -------
+        numpy.ndarray
+            (F,) float64 [cm2]: each triangle's share times the rectangle's area.
+        """
         return self.triangle_share * self.rect_area_cm2
 
     def transmission_map(self, height: float) -> TransmissionMap:
-        """Diffuse transmission binned over the sensor plane at ``height`` (a traced height)."""
+        """Diffuse transmission binned over one sensor plane.
+
+        Parameters
+        ----------
+        height : float
+            A traced height [cm].
+
+        Returns
+        -------
+        TransmissionMap
+            Its bins, edges [cm] and sensors per bin.
+        """
         return self._map_at(height, self.transmission)
 
     def _height_columns(self) -> dict[str, np.ndarray]:
         return {"diffuse_transmission": self.transmission}
 
     def leaf_rows(self, canopy: Canopy) -> list[LightRow]:
-        """Per leaf: ``diffuse_intercepted_cm2``, the horizontal area whose diffuse light the
-        leaf intercepts (its share of the rectangle's sky light times the rectangle's area)."""
+        """Per leaf: the horizontal area whose diffuse light the leaf intercepts.
+
+        ``diffuse_intercepted_cm2`` [cm2]: its share of the rectangle's sky light times the
+        rectangle's area.
+
+        Parameters
+        ----------
+        canopy : Canopy
+            The canopy the light was traced on.
+
+        Returns
+        -------
+        list of dict
+            One row per leaf that received light: ``instance``, ``plant``, ``leaf``, ``x_cm``,
+            ``y_cm``, ``leaf_area_cm2`` and the light (copies of a plant in a tile-periodic field
+            reported as one); ``table("leaf", canopy)`` as dicts.
+        """
         return leaf_sums(canopy, {"diffuse_intercepted_cm2": self.triangle_intercepted_cm2},
                          self.rect, self.periodic)
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
 class PeriodLight(MappedLight):
-    """Light over a period, from :func:`~maizeviz.light.trace.diffuse.trace_period`. PAR doses are mol/m2 of ground. With the
-    shared fields of :class:`~maizeviz.light.results.traced.MappedLight` (heights_cm, rect, rays, maps:
-    fraction of the period's PAR reaching each bin, map_edges, map_rays, level, warnings,
-    seconds "build" and "trace", periodic).
+    """Light over a period (a day), PAR doses in mol per m2 of ground.
 
-    Attributes
+    From :func:`~maizeviz.light.trace.diffuse.trace_period` (``LightEngine.day``): the sun
+    traced at every time step, the sky once.
+
+    Parameters
     ----------
-    period : Period (times, sun, irradiance, PAR factor)
-    sky : SkyLight used for the diffuse part (None when the sun never rises)
-    step_transmission : (n, H) float64: direct-sun transmission at each step
-    step_intercepted_fraction : (n,) float64: leaves' share of the direct beam at each step
-    triangle_direct_mol, triangle_diffuse_mol : (F,) float64 mol: PAR intercepted by each scene
-        triangle over the period (leaf triangles first, then stalks)
-    diffuse : DiffuseSplit or None: each step's diffuse light split by Perez's model (its
-        circumsolar part traced with the sun, the rest over the uniform ``sky``); None when the
-        whole diffuse part is spread over ``sky``
+    heights_cm : numpy.ndarray
+        (H,) float64 heights of the sensor planes [cm].
+    rect : (x0, y0, x1, y1) tuple of float
+        The sample rectangle [cm].
+    rays : int
+        Rays per direction (and sensors per plane).
+    level : str
+        Mesh level label of the canopy.
+    warnings : tuple of str
+        What the user should know about this result.
+    seconds : dict of str to float
+        Time spent [s]: "build" (the scene, when this call built it), "trace", ...
+    periodic : bool
+        Rays and sensor paths wrapped across the plot.
+    stands : dict or None
+        ``{"n", "sha256"}``, the identity of the stands of the canopy it was traced on
+        (:func:`maizeviz.canopy.layout.stands_identity`); None where not known.
+    maps : numpy.ndarray
+        (H, a, b) float64, the binned value of each plane (NaN: no sensor in the bin).
+    map_edges : tuple of numpy.ndarray
+        The x (a + 1,) and y (b + 1,) bin edges [cm].
+    map_rays : numpy.ndarray
+        (a, b) int64 sensors per bin (ground grid).
+        Here the maps hold the share of the period's PAR reaching each bin.
+    period : Period
+        Its times, sun, irradiance and PAR factor.
+    sky : SkyLight or None
+        The sky light of the diffuse part (None when the sun never rises).
+    step_transmission : numpy.ndarray
+        (n, H) float64: the direct sun's transmission at each step.
+    step_intercepted_fraction : numpy.ndarray
+        (n,) float64: the leaves' share of the direct beam at each step.
+    triangle_direct_mol, triangle_diffuse_mol : numpy.ndarray
+        (F,) float64 PAR intercepted by each scene triangle over the period [mol] (leaf
+        triangles first, then stalks).
+    diffuse : DiffuseSplit or None
+        Each step's diffuse light split by Perez's model (its circumsolar part traced with
+        the sun, the rest over the uniform ``sky``); None when the whole diffuse part is
+        spread over ``sky``.
     """
 
     period: Period
@@ -100,10 +189,24 @@ class PeriodLight(MappedLight):
 
     @property
     def n_steps(self) -> int:
+        """Time steps with the sun up.
+
+        Returns
+        -------
+        int
+            The period's steps.
+        """
         return self.period.n_steps
 
     @property
     def rect_area_m2(self) -> float:
+        """Area of the sample rectangle.
+
+        Returns
+        -------
+        float
+            [m2].
+        """
         return self.rect_area_cm2 * 1e-4
 
     # ---- per step, mol/m2 of ground
@@ -119,8 +222,13 @@ class PeriodLight(MappedLight):
 
     @cached_property
     def step_circumsolar_mol_m2(self) -> np.ndarray:
-        """(n,) the part of each step's diffuse PAR traced with the sun (Perez's circumsolar
-        part; zeros without a diffuse split)."""
+        """The part of each step's diffuse PAR traced with the sun.
+
+        Returns
+        -------
+        numpy.ndarray
+            (n,) float64 [mol m-2]: Perez's circumsolar part; zeros without a diffuse split.
+        """
         if self.diffuse is None:
             return np.zeros(self.n_steps)
         return self.step_diffuse_mol_m2 * self.diffuse.circumsolar_share
@@ -171,29 +279,69 @@ class PeriodLight(MappedLight):
     # ---- the period: sums of the steps
     @property
     def par_incident_mol_m2(self) -> float:
+        """PAR incident over the period.
+
+        Returns
+        -------
+        float
+            [mol m-2 of ground], the exactly rounded sum of the steps.
+        """
         return math.fsum(self.step_incident_mol_m2)
 
     @property
     def par_direct_mol_m2(self) -> float:
+        """Direct PAR incident over the period.
+
+        Returns
+        -------
+        float
+            [mol m-2 of ground].
+        """
         return math.fsum(self.step_direct_mol_m2)
 
     @property
     def par_diffuse_mol_m2(self) -> float:
+        """Diffuse PAR incident over the period.
+
+        Returns
+        -------
+        float
+            [mol m-2 of ground].
+        """
         return math.fsum(self.step_diffuse_mol_m2)
 
     @property
     def par_intercepted_mol_m2(self) -> float:
+        """PAR intercepted by the leaves over the period.
+
+        Returns
+        -------
+        float
+            [mol m-2 of ground].
+        """
         return math.fsum(self.step_intercepted_mol_m2)
 
     @property
     def par_diffuse_intercepted_mol_m2(self) -> float:
-        """Diffuse PAR intercepted by the leaves over the period, mol/m2 of ground."""
+        """Diffuse PAR intercepted by the leaves over the period.
+
+        Returns
+        -------
+        float
+            [mol m-2 of ground].
+        """
         return math.fsum(self.step_diffuse_intercepted_mol_m2)
 
     @property
     def diffuse_transmission_by_height(self) -> np.ndarray:
-        """(H,) transmitted / incident diffuse PAR over the period (the sky's transmission
-        without a diffuse split; NaN when no diffuse light came)."""
+        """Transmitted over incident diffuse PAR over the period, per height.
+
+        Returns
+        -------
+        numpy.ndarray
+            (H,) float64 [-]: the sky's transmission without a diffuse split; NaN when no
+            diffuse light came.
+        """
         inc = self.par_diffuse_mol_m2
         if not inc > 0:
             return np.full(len(self.heights_cm), np.nan)
@@ -201,30 +349,65 @@ class PeriodLight(MappedLight):
 
     @property
     def par_transmitted_mol_m2(self) -> np.ndarray:
-        """(H,) PAR reaching each sensor plane over the period."""
+        """PAR reaching each sensor plane over the period.
+
+        Returns
+        -------
+        numpy.ndarray
+            (H,) float64 [mol m-2].
+        """
         return np.array([math.fsum(c) for c in self.step_transmitted_mol_m2.T]) \
             if self.n_steps else np.zeros(len(self.heights_cm))
 
     @property
     def fraction_intercepted(self) -> float | None:
-        """Intercepted / incident PAR over the period; None when no light came."""
+        """Intercepted over incident PAR over the period.
+
+        Returns
+        -------
+        float or None
+            [-]; None when no light came.
+        """
         inc = self.par_incident_mol_m2
         return self.par_intercepted_mol_m2 / inc if inc > 0 else None
 
     @property
     def transmission_by_height(self) -> np.ndarray:
-        """(H,) transmitted / incident PAR over the period (NaN when no light came)."""
+        """Transmitted over incident PAR over the period, per height.
+
+        Returns
+        -------
+        numpy.ndarray
+            (H,) float64 [-]; NaN when no light came.
+        """
         inc = self.par_incident_mol_m2
         return self.par_transmitted_mol_m2 / inc if inc > 0 else \
             np.full(len(self.heights_cm), np.nan)
 
     @property
     def triangle_mol(self) -> np.ndarray:
-        """(F,) float64 mol: PAR intercepted by each scene triangle over the period."""
+        """PAR intercepted by each scene triangle over the period.
+
+        Returns
+        -------
+        numpy.ndarray
+            (F,) float64 [mol]: direct plus diffuse.
+        """
         return self.triangle_direct_mol + self.triangle_diffuse_mol
 
     def transmission_map(self, height: float) -> TransmissionMap:
-        """Fraction of the period's PAR reaching each bin of the sensor plane at ``height``."""
+        """The share of the period's PAR reaching each bin of one sensor plane.
+
+        Parameters
+        ----------
+        height : float
+            A traced height [cm].
+
+        Returns
+        -------
+        TransmissionMap
+            Its bins, edges [cm] and sensors per bin.
+        """
         return self._map_at(height, self.transmission_by_height)
 
     def _height_columns(self) -> dict[str, np.ndarray]:
@@ -232,8 +415,23 @@ class PeriodLight(MappedLight):
                 "transmission": self.transmission_by_height}
 
     def leaf_rows(self, canopy: Canopy) -> list[LightRow]:
-        """Per leaf: PAR intercepted over the period in mol (``par_intercepted_mol``, its
-        ``direct_`` and ``diffuse_`` parts) and per m2 of leaf (``par_mol_per_m2_leaf``)."""
+        """Per leaf: PAR intercepted over the period.
+
+        ``par_intercepted_mol`` [mol] with its ``direct_`` and ``diffuse_`` parts, and
+        ``par_mol_per_m2_leaf`` [mol m-2 of leaf].
+
+        Parameters
+        ----------
+        canopy : Canopy
+            The canopy the light was traced on.
+
+        Returns
+        -------
+        list of dict
+            One row per leaf that received light: ``instance``, ``plant``, ``leaf``, ``x_cm``,
+            ``y_cm``, ``leaf_area_cm2`` and the light (copies of a plant in a tile-periodic field
+            reported as one); ``table("leaf", canopy)`` as dicts.
+        """
         rows = leaf_sums(canopy, {"par_intercepted_mol": self.triangle_mol,
                                   "direct_par_intercepted_mol": self.triangle_direct_mol,
                                   "diffuse_par_intercepted_mol": self.triangle_diffuse_mol},

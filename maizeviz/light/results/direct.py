@@ -18,26 +18,56 @@ from maizeviz.light.sources.sun import Sun
 
 @dataclass(frozen=True, kw_only=True)
 class LightResult(TracedLight):
-    """Output of :func:`~maizeviz.light.trace.direct.trace_light` (and the shared fields of
-    :class:`~maizeviz.light.results.traced.TracedLight`: heights_cm, rect, rays, level, warnings,
-    seconds, periodic).
+    """A sun's direct light through a canopy.
 
-    Attributes
+    From :func:`~maizeviz.light.trace.direct.trace_light` (``LightEngine.sun``):
+    transmission on the sensor planes, where each ground ray first met a leaf, and the hit
+    classes per triangle.
+
+    Parameters
     ----------
+    heights_cm : numpy.ndarray
+        (H,) float64 heights of the sensor planes [cm].
+    rect : (x0, y0, x1, y1) tuple of float
+        The sample rectangle [cm].
+    rays : int
+        Rays per direction (and sensors per plane).
+    level : str
+        Mesh level label of the canopy.
+    warnings : tuple of str
+        What the user should know about this result.
+    seconds : dict of str to float
+        Time spent [s]: "build" (the scene, when this call built it), "trace", ...
+    periodic : bool
+        Rays and sensor paths wrapped across the plot.
+    stands : dict or None
+        ``{"n", "sha256"}``, the identity of the stands of the canopy it was traced on
+        (:func:`maizeviz.canopy.layout.stands_identity`); None where not known.
     sun : Sun
-    transmission : (H,) float64 in [0, 1], on the sensor planes at ``heights_cm`` (H,) cm
-    ray_area_cm2 : horizontal footprint of a ray (and of a sensor)
-    first_z : (N,) float32, height (cm) of each ground ray's first hit, -inf where none
-    first_hits, second_hits : (F,) int64, rays whose first / second hit is each triangle
-        (None unless the request asked for hit classes)
-    direction : (3,) unit vector toward the sun in field coordinates
-    density : rays per cm2 asked for
-    sensor_lit : (H, ceil(N / 8)) uint8, the sensors of each plane whose path to the sun is
-        clear, bits packed in ray grid order (:meth:`lit`); None for results made elsewhere
-    sensor_offset_cm : (H, 2) float64 cm, where each plane's grid sits relative to the ground
-        grid's cell centres (:meth:`sensor_xy`)
+        The sun traced.
+    transmission : numpy.ndarray
+        (H,) float64 in [0, 1]: the share of each sensor plane's sensors that see the sun.
+    ray_area_cm2 : float
+        Horizontal footprint of a ray (and of a sensor) [cm2].
+    first_z : numpy.ndarray
+        (N,) float32 height of each ground ray's first hit [cm], -inf where none.
+    first_hits, second_hits : numpy.ndarray or None
+        (F,) int64 rays whose first and second hit is each triangle (None unless the request
+        asked for hit classes).
+    direction : numpy.ndarray
+        (3,) unit vector toward the sun in field coordinates.
+    density : float
+        Rays per cm2 asked for [cm-2].
+    sensor_lit : numpy.ndarray or None
+        (H, ceil(N / 8)) uint8: the sensors of each plane whose path to the sun is clear,
+        bits packed in ray grid order (:meth:`lit`); None for results made elsewhere.
+    sensor_offset_cm : numpy.ndarray or None
+        (H, 2) float64, where each plane's grid sits relative to the ground grid's cell
+        centres [cm] (:meth:`sensor_xy`).
 
-    ``seconds`` has "build" and "trace" (and "second" for second hits), s.
+    See Also
+    --------
+    maizeviz.light.engine.LightEngine.sun : What makes it.
     """
 
     sun: Sun
@@ -58,8 +88,13 @@ class LightResult(TracedLight):
 
     @property
     def sunlit_intercepted_fraction(self) -> float | None:
-        """Share of the rectangle's direct sunlight whose first hit is a leaf (None without
-        hit classes)."""
+        """Share of the rectangle's direct sunlight whose first hit is a leaf.
+
+        Returns
+        -------
+        float or None
+            In [0, 1]; None without hit classes.
+        """
         if self.first_hits is None:
             return None
         return float(self.first_hits.sum() * self.ray_area_cm2 / self.rect_area_cm2)
@@ -70,12 +105,39 @@ class LightResult(TracedLight):
         return ray_grid(self.rect, self.density)[0]
 
     def sensor_xy(self, k: int) -> np.ndarray:
-        """Sensor positions (N, 2) cm of the plane of height index ``k``, in ray grid order."""
+        """Sensor positions of one sensor plane.
+
+        Parameters
+        ----------
+        k : int
+            Index of the plane among ``heights_cm``.
+
+        Returns
+        -------
+        numpy.ndarray
+            (N, 2) float64 [cm], in ray grid order.
+        """
         off = np.zeros(2) if self.sensor_offset_cm is None else self.sensor_offset_cm[k]
         return self.ground_xy + off
 
     def lit(self, k: int) -> np.ndarray:
-        """(N,) bool: the sensors of the plane of height index ``k`` that see the sun."""
+        """The sensors of one plane that see the sun.
+
+        Parameters
+        ----------
+        k : int
+            Index of the plane among ``heights_cm``.
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) bool, in ray grid order.
+
+        Raises
+        ------
+        MaizevizError
+            The result carries no sensor planes.
+        """
         if self.sensor_lit is None:
             from maizeviz.errors import MaizevizError
 
@@ -86,14 +148,39 @@ class LightResult(TracedLight):
         return {"transmission": self.transmission}
 
     def leaf_rows(self, canopy: Canopy) -> list[LightRow]:
-        """Per leaf that received rays: sunlit and second-class areas and intercepted light
-        (cm2; :func:`~maizeviz.light.results.per_leaf.leaf_light`)."""
+        """Per leaf that received rays: sunlit and second-class areas and intercepted light.
+
+        Areas [cm2] of leaf lit and intercepted footprints [cm2]
+        (:func:`~maizeviz.light.results.per_leaf.leaf_light`).
+
+        Parameters
+        ----------
+        canopy : Canopy
+            The canopy the light was traced on.
+
+        Returns
+        -------
+        list of dict
+            One row per leaf that received light: ``instance``, ``plant``, ``leaf``, ``x_cm``,
+            ``y_cm``, ``leaf_area_cm2`` and the light (copies of a plant in a tile-periodic field
+            reported as one); ``table("leaf", canopy)`` as dicts.
+        """
         return leaf_light(canopy, self.first_hits, self.second_hits, self.direction,
                           self.ray_area_cm2, self.rect, self.periodic)
 
     def triangle_light(self, canopy: Canopy) -> np.ndarray:
-        """Light class of every leaf triangle (F,) int8: 2 direct, 1 second class only, 0 none,
-        -1 not reached by any traced ray
-        (:func:`~maizeviz.light.results.per_leaf.triangle_light`)."""
+        """Light class of every leaf triangle, for colouring the canopy.
+
+        Parameters
+        ----------
+        canopy : Canopy
+            The canopy the light was traced on.
+
+        Returns
+        -------
+        numpy.ndarray
+            (F,) int8: 2 direct, 1 second class only, 0 none, -1 not reached by any traced ray
+            (:func:`~maizeviz.light.results.per_leaf.triangle_light`).
+        """
         return triangle_light(canopy, self.first_hits, self.second_hits, self.direction,
                               self.rect, self.periodic)

@@ -76,6 +76,25 @@ def tile_representatives(layout: CanopyLayout, rect: Rect | None, periodic: bool
     return rep
 
 
+def leaf_part(canopy: Canopy, values: np.ndarray, what: str) -> np.ndarray:
+    """The leaf triangles' part (F,) of light given per scene triangle (F,) or (F + G,): the
+    canopy's F leaf triangles, then its G stalk triangles when they were traced.
+
+    Raises
+    ------
+    MaizevizError
+        ``values`` has another length: it was traced on another canopy (or read damaged), and
+        its light would be summed on other leaves (or fail to broadcast).
+    """
+    nf, ns = canopy.n_triangles, len(canopy.stalk_faces)
+    values = np.asarray(values)
+    if values.ndim != 1 or len(values) not in (nf, nf + ns):
+        raise MaizevizError(f"{what} holds light for {len(values):,} triangles, but the canopy "
+                            f"has {nf:,} leaf triangles ({nf + ns:,} with its stalks): it was "
+                            "traced on another canopy")
+    return values[:nf]
+
+
 def leaf_light(canopy: Canopy, first_hits: np.ndarray | None, second_hits: np.ndarray | None,
                direction: np.ndarray, ray_area_cm2: float, rect: Rect,
                periodic: bool) -> list[LightRow]:
@@ -111,9 +130,8 @@ def leaf_light(canopy: Canopy, first_hits: np.ndarray | None, second_hits: np.nd
     s = direction
     # a ray on a grazing triangle stands for more than the triangle: capped per leaf below
     lit = ray_area_cm2 * s[2] / np.maximum(np.abs(normals @ s), 1e-6)
-    nf = canopy.n_triangles
-    first = first_hits[:nf].astype(np.float64)
-    second = second_hits[:nf].astype(np.float64)
+    first = leaf_part(canopy, first_hits, "the first hits").astype(np.float64)
+    second = leaf_part(canopy, second_hits, "the second hits").astype(np.float64)
     rows = leaf_sums(canopy, {"sunlit_area_cm2": first * lit,
                               "second_class_area_cm2": second * lit,
                               "sunlit_intercepted_cm2": first * ray_area_cm2,
@@ -143,7 +161,8 @@ def leaf_sums(canopy: Canopy, columns: dict[str, np.ndarray], rect: Rect | None 
     """
     area, _ = triangle_areas_normals(canopy.vertices, canopy.faces)
     nf = canopy.n_triangles
-    cols = {k: np.asarray(v, dtype=np.float64)[:nf] for k, v in columns.items()}
+    cols = {k: leaf_part(canopy, v, f"the column {k}").astype(np.float64)
+            for k, v in columns.items()}
     rep = tile_representatives(canopy.layout, rect, periodic)
     keys, leaf_of = groups(rep[canopy.face_instance], canopy.face_leaf)
     any_light = np.zeros(nf, dtype=bool)
@@ -195,7 +214,7 @@ def plant_light(rows: list[LightRow]) -> list[LightRow]:
         d = per.setdefault(int(r["instance"]), {
             "instance": r["instance"], "plant": r["plant"], "x_cm": r["x_cm"], "y_cm": r["y_cm"],
             **({"level": r["level"]} if "level" in r else {}), "leaves_lit": 0,
-            **{k: 0.0 for k in sums}})
+            **dict.fromkeys(sums, 0.0)})
         d["leaves_lit"] = int(d["leaves_lit"]) + 1
         for k in sums:
             d[k] = float(d[k]) + float(r[k])
@@ -234,7 +253,8 @@ def triangle_light(canopy: Canopy, first_hits: np.ndarray | None,
     if first_hits is None or second_hits is None:
         raise MaizevizError("hit classes were not traced")
     nf = canopy.n_triangles
-    first, second = first_hits[:nf], second_hits[:nf]
+    first = leaf_part(canopy, first_hits, "the first hits")
+    second = leaf_part(canopy, second_hits, "the second hits")
     rep = tile_representatives(canopy.layout, rect, periodic)
     inst = canopy.face_instance.astype(np.int64)
     if nf and (rep != np.arange(len(rep))).any() and np.all(np.diff(inst) >= 0):

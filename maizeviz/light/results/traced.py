@@ -11,7 +11,7 @@ traced on.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
@@ -27,6 +27,44 @@ if TYPE_CHECKING:
 
 #: What :meth:`TracedLight.table` tabulates.
 TABLES = ("height", "leaf", "plant")
+#: What a result's ``table(by=...)`` can be by: its summary (``"height"`` for a sun, a sky
+#: or a period; ``"balance"`` for absorbed light; ``"canopy"`` for assimilation; None is the
+#: summary), or per leaf or plant of the canopy it was traced on.
+TableBy = Literal["height", "balance", "canopy", "leaf", "plant"]
+
+
+def table_kind(by: str | None, summary: str, canopy: Canopy | None) -> str:
+    """The table a result's ``table(by, canopy)`` makes: ``by``, or the result's ``summary``
+    table when None; checked against what the result has and against the canopy.
+
+    Parameters
+    ----------
+    by : str or None
+        Asked for.
+    summary : {"height", "balance", "canopy"}
+        The result's own summary table.
+    canopy : Canopy or None
+        The canopy the light was traced on (per-leaf and per-plant tables need it).
+
+    Returns
+    -------
+    str
+        ``summary``, ``"leaf"`` or ``"plant"``.
+
+    Raises
+    ------
+    MaizevizError
+        Another ``by`` (quantity "by"), or no canopy for a leaf or plant table ("canopy").
+    """
+    kind = summary if by is None else by
+    known = (summary, "leaf", "plant")
+    if kind not in known:
+        raise MaizevizError(f"a light table is by {', '.join(known)}, got '{by}'",
+                            quantity="by")
+    if kind != summary and canopy is None:
+        raise MaizevizError(f"a table by {kind} needs the canopy the light was traced on: "
+                            f"table('{kind}', canopy)", quantity="canopy")
+    return kind
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
@@ -57,12 +95,34 @@ class TracedLight:
 
     @property
     def rect_area_cm2(self) -> float:
-        """Area of the sample rectangle, cm2."""
+        """Area of the sample rectangle.
+
+        Returns
+        -------
+        float
+            [cm2].
+        """
         x0, y0, x1, y1 = self.rect
         return (x1 - x0) * (y1 - y0)
 
     def height_index(self, height: float) -> int:
-        """Index of ``height`` (cm) among the traced heights; MaizevizError if not traced."""
+        """Index of a height among the traced heights.
+
+        Parameters
+        ----------
+        height : float
+            A traced height [cm].
+
+        Returns
+        -------
+        int
+            Its index in ``heights_cm``.
+
+        Raises
+        ------
+        MaizevizError
+            The height was not traced.
+        """
         k = np.flatnonzero(np.isclose(self.heights_cm, height, rtol=0, atol=1e-9))
         if not len(k):
             raise MaizevizError(f"height {height:g} cm was not traced (traced: "
@@ -70,43 +130,60 @@ class TracedLight:
                                 quantity="heights")
         return int(k[0])
 
-    def table(self, by: str = "height", canopy: Canopy | None = None) -> pd.DataFrame:
+    def table(self, by: TableBy | None = None, canopy: Canopy | None = None) -> pd.DataFrame:
         """The result as a table.
 
         Parameters
         ----------
-        by : {"height", "leaf", "plant"}
-            One row per sensor height (column ``height_cm``, cm, then the result's values
-            there), per leaf or per plant (the light each intercepts, areas in cm2, PAR in mol).
-        canopy : Canopy
+        by : {None, "height", "leaf", "plant"}
+            One row per sensor height (None, the default: column ``height_cm`` [cm], then the
+            result's values there), per leaf or per plant (the light each intercepts, areas
+            [cm2], PAR [mol]).
+        canopy : Canopy, optional
             The canopy the light was traced on; needed by leaf and plant.
 
         Returns
         -------
         pandas.DataFrame
+            One row per height, leaf or plant.
+
+        Raises
+        ------
+        MaizevizError
+            Another ``by``, or a leaf or plant table without the canopy.
         """
         import pandas as pd
 
-        if by == "height":
+        kind = table_kind(by, "height", canopy)
+        if kind == "height":
             return pd.DataFrame({"height_cm": np.asarray(self.heights_cm, dtype=np.float64),
                                  **self._height_columns()})
-        if by not in TABLES:
-            raise MaizevizError(f"a light table is by {', '.join(TABLES)}, got '{by}'",
-                                quantity="by")
-        if canopy is None:
-            raise MaizevizError(f"a table by {by} needs the canopy the light was traced on: "
-                                f"table('{by}', canopy)", quantity="canopy")
+        assert canopy is not None
         rows = self.leaf_rows(canopy)
-        return pd.DataFrame(plant_light(rows) if by == "plant" else rows)
+        return pd.DataFrame(plant_light(rows) if kind == "plant" else rows)
 
     def _height_columns(self) -> dict[str, Any]:
         """The per-height columns of :meth:`table`, each (H,)."""
         raise NotImplementedError
 
     def leaf_rows(self, canopy: Canopy) -> list[LightRow]:
-        """One row per leaf that received light: its plant, place, area and the light it
-        received (:mod:`maizeviz.light.results.per_leaf`); ``table("leaf", canopy)`` as
-        dicts."""
+        """One row per leaf that received light.
+
+        Its plant, place, area and the light it received
+        (:mod:`maizeviz.light.results.per_leaf`).
+
+        Parameters
+        ----------
+        canopy : Canopy
+            The canopy the light was traced on.
+
+        Returns
+        -------
+        list of dict
+            One row per leaf that received light: ``instance``, ``plant``, ``leaf``, ``x_cm``,
+            ``y_cm``, ``leaf_area_cm2`` and the light (copies of a plant in a tile-periodic field
+            reported as one); ``table("leaf", canopy)`` as dicts.
+        """
         raise NotImplementedError
 
 

@@ -100,15 +100,32 @@ class Wrap:
         return np.array([self.x0, self.y0])
 
 
-def overhang_copies(verts: np.ndarray, faces: np.ndarray, wrap: Wrap
+def overhang_copies(verts: np.ndarray, faces: np.ndarray, wrap: Wrap, q: float | None = None
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Copies of the triangles of the 8 neighbouring cells that reach into cell (0, 0) (within
     :data:`COPY_MARGIN_CM`): vertices (3k, 3) cm, faces (k, 3) numbered from 0, the triangle
-    each copies (k,) int64 and the cell it comes from (k, 2) int64 (-1, 0 or 1 each)."""
+    each copies (k,) int64 and the cell it comes from (k, 2) int64 (-1, 0 or 1 each).
+
+    ``q``: the vertices' x and y are first rounded to multiples of it (:func:`snap`; the
+    copies are then on the grid too). Only the triangles with a corner near the cell's edges
+    (where rounding may put it) are looked at: a hectare's 40 million triangles are not all
+    gathered as (F, 3, 3) coordinates (72 bytes each) to find the edge's few.
+    """
     x0, y0, w, h = wrap.x0, wrap.y0, wrap.w, wrap.h
     m = COPY_MARGIN_CM
-    tri = verts[faces]
-    lo, hi = tri.min(axis=1), tri.max(axis=1)
+    slack = m + (q or 0.0)                 # rounding moves a coordinate by q / 2 at most
+    near = ((verts[:, 0] < x0 + slack) | (verts[:, 0] > x0 + w - slack) |
+            (verts[:, 1] < y0 + slack) | (verts[:, 1] > y0 + h - slack))
+    cand_parts = []
+    for s in range(0, len(faces), 1 << 20):
+        corner = near.take(faces[s:s + (1 << 20)])          # (k, 3): far faster than
+        cand_parts.append(s + np.flatnonzero(corner[:, 0] | corner[:, 1] | corner[:, 2]))
+    cand = np.concatenate(cand_parts) if cand_parts else np.empty(0, np.int64)
+    tri = verts[faces[cand]]                                # any() over an axis of three
+    if q is not None:
+        tri = snap(tri, q)
+    lo = np.minimum(np.minimum(tri[:, 0], tri[:, 1]), tri[:, 2])   # so are these than
+    hi = np.maximum(np.maximum(tri[:, 0], tri[:, 1]), tri[:, 2])   # min / max over it
     out_v, out_src, out_cell = [], [], []
     for i in (-1, 0, 1):
         for j in (-1, 0, 1):
@@ -120,7 +137,7 @@ def overhang_copies(verts: np.ndarray, faces: np.ndarray, wrap: Wrap
                                   (hi[:, 1] + dy > y0 - m) & (lo[:, 1] + dy < y0 + h + m))
             if len(keep):
                 out_v.append((tri[keep] + np.array([dx, dy, 0.0])).reshape(-1, 3))
-                out_src.append(keep)
+                out_src.append(cand[keep])
                 out_cell.append(np.tile([i, j], (len(keep), 1)))
     if not out_v:
         return (np.empty((0, 3)), np.empty((0, 3), np.int64), np.empty(0, np.int64),

@@ -35,13 +35,18 @@ BYTES_PER_RAY = 16
 class Sampling:
     """Where and how densely light is sampled, for any number of directions.
 
-    Attributes
+    Parameters
     ----------
-    heights_cm : (H,) heights of the sensor planes, cm, >= 0
-    density : rays (and sensors) per cm2 of the sample rectangle
-    rect : (x0, y0, x1, y1) cm, or None for the central tile's footprint
-    periodic : rays leaving the plot sideways re-enter on the opposite side (infinite field)
-    threads : tracing threads
+    heights_cm : tuple of float
+        Heights of the sensor planes [cm], each >= 0.
+    density : float
+        Rays (and sensors) per cm2 of the sample rectangle [cm-2].
+    rect : (x0, y0, x1, y1) tuple of float, optional
+        The sample rectangle [cm]; None: the central tile's footprint.
+    periodic : bool
+        Rays leaving the plot sideways re-enter on the opposite side (an infinite field).
+    threads : int
+        Tracing threads.
     """
 
     heights_cm: tuple[float, ...] = (0.0, 50.0, 100.0, 150.0, 200.0, 225.0)

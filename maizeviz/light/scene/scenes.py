@@ -17,9 +17,14 @@ from maizeviz.light.scene.periodic import (
     Rect,
     Wrap,
     overhang_copies,
-    snap,
 )
-from maizeviz.light.scene.tiling import BlockTiling, block_mesh, block_tiling, tile_triangles
+from maizeviz.light.scene.tiling import (
+    BlockTiling,
+    block_mesh,
+    block_tiling,
+    carried_period,
+    tile_triangles,
+)
 from maizeviz.mesh import packets as _packets
 from maizeviz.mesh.instances import Instances
 from maizeviz.mesh.raytrace import RayScene
@@ -37,18 +42,22 @@ class CanopyScene(RayScene):
     Attributes
     ----------
     n_original : int, leaf + stalk triangles (the ids hits are reported in)
-    source : (F_scene,) int64, the original triangle of each scene triangle (None: identity)
+    source : (C,) int64, the original triangle of each copy, the scene's triangles after the
+        first ``n_original`` (None: no copy)
     wrapped : (x0, y0, x1, y1) cm, the plot whose overhangs were copied, or None
     wrap : Wrap of the periodic field this scene repeats in (the plot), or None
     period : Wrap of the field's smallest known period: the block of a tiled canopy (which
-        the field repeats exactly, :func:`~maizeviz.light.scene.tiling.block_tiling`), else ``wrap``
+        the field repeats exactly, :func:`~maizeviz.light.scene.tiling.block_tiling`), or the one a
+        mesh file carries once checked (:func:`~maizeviz.light.scene.tiling.carried_period`), else
+        ``wrap``
     """
 
-    def __init__(self, vertices: np.ndarray, faces: np.ndarray, n_original: int | None = None,
+    def __init__(self, vertices, faces, n_original: int | None = None,
                  source: np.ndarray | None = None, wrapped: Rect | None = None,
-                 wrap: Wrap | None = None, period: Wrap | None = None):
-        super().__init__(vertices, faces)
-        self.n_original = len(faces) if n_original is None else n_original
+                 wrap: Wrap | None = None, period: Wrap | None = None,
+                 snap_q: float | None = None):
+        super().__init__(vertices, faces, snap_q=snap_q)
+        self.n_original = self.n_triangles if n_original is None else n_original
         self.source = source
         self.wrapped = wrapped
         self.wrap = wrap
@@ -57,7 +66,12 @@ class CanopyScene(RayScene):
     def resolve(self, prim: np.ndarray, cell: np.ndarray | None) -> np.ndarray:
         """Canopy triangle ids (k,) of scene triangles ``prim`` (k,) hit in field cells
         ``cell`` (k, 2) (unused here: every cell holds the same canopy)."""
-        return prim if self.source is None else self.source[prim]
+        if self.source is None:
+            return prim
+        out = np.asarray(prim).copy()
+        copy = out >= self.n_original
+        out[copy] = self.source[out[copy] - self.n_original]
+        return out
 
 
 class BlockScene(CanopyScene):
@@ -167,17 +181,17 @@ def light_scene(canopy: Canopy, with_stalks: bool = False, periodic: bool = Fals
         faces = np.vstack([faces, canopy.stalk_faces + len(canopy.vertices)])
     n = len(faces)
     if not periodic:
-        return CanopyScene(verts, faces)
+        return CanopyScene(verts, faces)            # Embree reads the canopy's faces in place
     tiling = block_tiling(canopy)
     if block and tiling is not None:
         return BlockScene(canopy, tiling, with_stalks)
     bounds = canopy.layout.bounds
     wrap = Wrap.of(bounds)
-    verts = snap(verts, wrap.q)
-    cv, cf, src, _ = overhang_copies(verts, faces, wrap)
-    return CanopyScene(np.vstack([verts, cv]), np.vstack([faces, cf + len(verts)]), n,
-                       np.concatenate([np.arange(n, dtype=np.int64), src]), bounds, wrap,
-                       None if tiling is None else tiling.wrap)
+    # the canopy on the field's grid as Embree's copy is made, with copies of the overhangs
+    period = tiling.wrap if tiling is not None else carried_period(canopy, verts, faces, wrap)
+    cv, cf, src, _ = overhang_copies(verts, faces, wrap, wrap.q)
+    return CanopyScene([verts, cv], [faces, cf + len(verts)], n, src, bounds, wrap, period,
+                       snap_q=wrap.q)
 
 
 def scene_for(canopy: Canopy, periodic: bool, scene: RayScene | None,

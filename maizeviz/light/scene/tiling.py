@@ -174,3 +174,60 @@ def tile_triangles(tiling: BlockTiling, n_leaf: int, local: np.ndarray,
     tile = t.order[i, j]
     return np.where(local < t.faces, tile * t.faces + local,
                     n_leaf + tile * t.stalk_faces + (local - t.faces))
+
+
+def carried_period(canopy: Canopy, verts: np.ndarray, faces: np.ndarray,
+                   plot_wrap: Wrap) -> Wrap | None:
+    """The period a canopy's layout claims (a mesh file's, :attr:`CanopyLayout.period`) as a
+    :class:`Wrap` on the plot's grid, when its triangles do repeat with it; else None.
+
+    The claim is checked on the scene's triangles ``faces`` (F, 3) of ``verts`` (V, 3) cm on
+    the grid of ``plot_wrap`` (:func:`maizeviz.light.scene.periodic.snap`): the plot must be a whole
+    number A x B (> 1) of periods, and each triangle, moved back by whole periods to the cell
+    its first vertex stands in, must be found exactly A x B times, once from every cell of
+    the plot folded modulo A, B. Then the periodic field of the plot is that of the block,
+    and the sensors can be read over the block as for the tiled canopy the file came from
+    (:mod:`maizeviz.light.transmission`). The triangles are compared by a 64-bit hash of
+    their nine grid coordinates (a false match is about 1 in 10^12 at K = 4).
+    """
+    period = canopy.layout.period
+    if period is None or not len(faces):
+        return None
+    verts = snap(verts, plot_wrap.q)
+    wrap = Wrap.of(period, canopy.layout.bounds)
+    if wrap.q != plot_wrap.q:
+        return None
+    a, b = round(plot_wrap.w / wrap.w), round(plot_wrap.h / wrap.h)
+    if a * wrap.w != plot_wrap.w or b * wrap.h != plot_wrap.h or a * b < 2:
+        return None
+    first = verts[faces[:, 0]]
+    i = np.floor((first[:, 0] - wrap.x0) / wrap.w).astype(np.int64)
+    j = np.floor((first[:, 1] - wrap.y0) / wrap.h).astype(np.int64)
+    shift = (np.rint(i * (wrap.w / wrap.q)).astype(np.int64),
+             np.rint(j * (wrap.h / wrap.q)).astype(np.int64))
+    key = _moved_back_keys(verts, faces, shift, wrap.q)
+    # sorted, not np.unique: numpy's hashed unique took 28 s on these 2.68 M keys
+    ordered = np.sort(key)
+    starts = np.flatnonzero(np.concatenate([[True], ordered[1:] != ordered[:-1]]))
+    if not (np.diff(np.append(starts, len(ordered))) == a * b).all():
+        return None
+    cell = (np.mod(i, a) * b + np.mod(j, b)).astype(np.uint64)
+    with np.errstate(over="ignore"):
+        ordered = np.sort(key ^ (cell * np.uint64(0xBF58476D1CE4E5B9)))
+    return wrap if not (ordered[1:] == ordered[:-1]).any() else None
+
+
+def _moved_back_keys(verts: np.ndarray, faces: np.ndarray, shift: tuple[np.ndarray, ...],
+                     q: float) -> np.ndarray:
+    """(F,) uint64 hash of each triangle's nine coordinates, x and y in grid steps ``q``
+    moved back by ``shift`` (F,) steps each, z as its bits."""
+    key = np.zeros(len(faces), np.uint64)
+    with np.errstate(over="ignore"):
+        for k in range(3):
+            corner = verts[faces[:, k]]
+            for c in range(3):
+                v = np.rint(corner[:, c] / q).astype(np.int64) - shift[c] if c < 2 else \
+                    np.ascontiguousarray(corner[:, c]).view(np.int64)
+                key = (key ^ v.view(np.uint64)) * np.uint64(0x9E3779B97F4A7C15)
+                key ^= key >> np.uint64(29)
+    return key

@@ -161,7 +161,7 @@ def local_datetime(day: _dt.date, clock, tz=None, what: str = "clock",
                                 f"or occurs twice in {where} (a daylight-saving change); pick "
                                 "another time", quantity=quantity)
     if offset is None:
-        return zoned if zoned is not None else naive.replace(tzinfo=_dt.timezone.utc)
+        return zoned if zoned is not None else naive.replace(tzinfo=_dt.UTC)
     when = naive.replace(tzinfo=offset)
     if zoned is not None and zoned.utcoffset() != when.utcoffset():
         raise MaizevizError(f"the {what} time {clock} carries UTC offset {when:%z} but the zone "

@@ -9,14 +9,14 @@ whose range (1677-09-21 to 2262-04-11) would silently wrap a year 2300 into 1716
 
 from __future__ import annotations
 
-from typing import Final, Literal
+from typing import Final
 
 from maizeviz.errors import MaizevizError
 
 #: First and last years a date may have (those of :class:`datetime.date`).
 FIRST_YEAR, LAST_YEAR = 1, 9999
 #: The unit of every time array: numpy datetime64 / pandas resolution.
-TIME_UNIT: Final[Literal["us"]] = "us"
+TIME_UNIT: Final = "us"
 
 
 def check_year(year: int, where: str, text: str,

@@ -52,12 +52,19 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from types import MappingProxyType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from maizeviz.errors import MaizevizError
-from maizeviz.io.inputs import read_input
+from maizeviz.io.inputs import open_input, read_input
+from maizeviz.io.weather_files import (
+    PVLIB_FORMATS,
+    WeatherFileError,
+    WeatherTable,
+    detect_format,
+    read_pvlib_file,
+)
 from maizeviz.light.sources.clock import check_altitude as _check_altitude
 from maizeviz.light.sources.clock import check_place as _check_place
 from maizeviz.light.sources.clock import local_time
@@ -86,21 +93,18 @@ MAX_IRRADIANCE_W_M2 = 2000.0
 #: More time steps than this are refused.
 MAX_STEPS = 1_000_000
 
-WEATHER_REQUIRED = ("time", "ghi")
-WEATHER_OPTIONAL = ("dni", "dhi")
+WEATHER_REQUIRED = ("time",)
+WEATHER_OPTIONAL = ("ghi", "dni", "dhi", "par", "temp_air")
+#: Irradiance columns of a weather CSV (W/m2).
+WEATHER_IRRADIANCE = ("ghi", "dni", "dhi")
+#: PAR above this (umol/m2/s) is refused as a unit mistake (full sun gives about 2,200).
+MAX_PAR_UMOL_M2_S = 4000.0
+#: Air temperatures outside this range (deg C) are refused in a weather CSV.
+AIR_TEMPERATURE_C = (-90.0, 70.0)
 WEATHER_LABELS = ("center", "start", "end")
 # a clock time followed by a UTC offset or Z, at the end of the text
 _ZONE_SUFFIX = re.compile(r"\d{2}:\d{2}(?::\d{2}(?:[.,]\d+)?)?\s*(?:Z|[+-]\d{2}(?::?\d{2})?)$",
                           re.IGNORECASE)
-
-
-class WeatherFileError(MaizevizError):
-    """A weather file cannot be used: the message names the file, line, time and column.
-    Its ``quantity`` is ``"weather"`` (the file as an input), so the app can mark the field
-    that names the file and the command line can name ``--weather``."""
-
-    def __init__(self, message: str = "", quantity: str | None = "weather"):
-        super().__init__(message, quantity)
 
 
 # --------------------------------------------------------------------------- small helpers
@@ -299,6 +303,11 @@ class Period:
     parameters : read-only mapping: the same as data (model, linke_turbidity, altitude_m...)
     par_umol_per_j : float, umol of PAR per J of shortwave
     notes : tuple of str: things said once about the period (polar night, dropped rows...)
+    par_measured : (n,) float64 umol/m2/s or None: PAR a quantum sensor measured (a weather
+        file's ``par`` column), used for PAR instead of ghi x ``par_umol_per_j``; its direct
+        and diffuse parts are shared as the shortwave's
+    temp_air : (n,) float64 deg C or None: air temperature at each step (NaN where the file
+        had none), for models of leaf processes; the light does not use it
 
     Integration: step i contributes ``ghi[i] * step_s[i]`` J/m2; every total is the exactly
     rounded sum (math.fsum) of its steps.
@@ -318,6 +327,8 @@ class Period:
     parameters: Mapping[str, object] = field(default_factory=dict)
     par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J
     notes: tuple[str, ...] = ()
+    par_measured: np.ndarray | None = None
+    temp_air: np.ndarray | None = None
 
     def __reduce__(self):
         # the read-only parameters mapping does not pickle; a period crosses process
@@ -337,6 +348,15 @@ class Period:
         object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
         object.__setattr__(self, "par_umol_per_j", _check_par_factor(self.par_umol_per_j))
         object.__setattr__(self, "notes", tuple(self.notes))
+        for name, finite in (("par_measured", True), ("temp_air", False)):
+            if getattr(self, name) is not None:
+                arr = _frozen(getattr(self, name))
+                if arr.shape != (n,) or (finite and not np.all(np.isfinite(arr))) or \
+                        np.any(np.isinf(arr)):
+                    raise MaizevizError(f"period {name} must be {n} finite numbers")
+                object.__setattr__(self, name, arr)
+        if self.par_measured is not None and np.any(self.par_measured < 0):
+            raise MaizevizError("period PAR must be >= 0 umol/m2/s")
         if np.any(self.step_s <= 0) or np.any(self.zenith_deg >= 90):
             raise MaizevizError("period steps must last > 0 s and have the sun above the horizon")
         if np.any(self.dhi < 0) or np.any(self.direct_horizontal < 0):
@@ -362,22 +382,39 @@ class Period:
 
     @property
     def par_umol_m2_s(self) -> np.ndarray:
-        """(n,) float64, umol/m2/s: incident PAR photon flux (PPFD) at each step."""
+        """(n,) float64, umol/m2/s: incident PAR photon flux (PPFD) at each step: measured,
+        else ghi x :attr:`par_umol_per_j`."""
+        if self.par_measured is not None:
+            return self.par_measured
         return self.ghi * self.par_umol_per_j
+
+    @property
+    def _direct_share(self) -> np.ndarray:
+        """(n,) the direct part of each step's shortwave (a measured PAR is shared so; all
+        diffuse where the shortwave is 0)."""
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.ghi > 0, self.direct_horizontal / np.where(
+                self.ghi > 0, self.ghi, 1.0), 0.0)
 
     @property
     def step_par_mol_m2(self) -> np.ndarray:
         """(n,) float64, mol/m2: incident PAR during each step."""
+        if self.par_measured is not None:
+            return self.par_measured * self.step_s * 1e-6
         return self.ghi * self.step_s * self.par_umol_per_j * 1e-6
 
     @property
     def step_direct_par_mol_m2(self) -> np.ndarray:
         """(n,) float64, mol/m2: direct (sun) part of :attr:`step_par_mol_m2`."""
+        if self.par_measured is not None:
+            return self.step_par_mol_m2 * self._direct_share
         return self.direct_horizontal * self.step_s * self.par_umol_per_j * 1e-6
 
     @property
     def step_diffuse_par_mol_m2(self) -> np.ndarray:
         """(n,) float64, mol/m2: diffuse (sky) part of :attr:`step_par_mol_m2`."""
+        if self.par_measured is not None:
+            return self.step_par_mol_m2 - self.step_direct_par_mol_m2
         return self.dhi * self.step_s * self.par_umol_per_j * 1e-6
 
     # ---- period totals: the sums of the steps
@@ -502,7 +539,40 @@ def clear_sky_period(date, lat: float, lon: float, tz: str, step_min: float = 30
                      start: str | None = None, end: str | None = None, altitude: float = 0.0,
                      linke_turbidity: float = DEFAULT_LINKE_TURBIDITY,
                      par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J) -> Period:
-    """``clear_sky(sun_track(...))``: a clear day (or part of it) at a place; see both."""
+    """A clear day (or part of it) at a place: ``clear_sky(sun_track(...))``.
+
+    Parameters
+    ----------
+    date : str
+        The local date, "YYYY-MM-DD".
+    lat : float
+        Latitude [deg north].
+    lon : float
+        Longitude [deg east].
+    tz : str
+        IANA time zone of the day.
+    step_min : float
+        Time between steps [min].
+    start, end : str, optional
+        Local clock times "HH:MM" bounding the period (None: the whole day).
+    altitude : float
+        Height of the place above sea level [m].
+    linke_turbidity : float
+        Linke turbidity of the clear sky [-].
+    par_umol_per_j : float
+        PAR photons per joule of shortwave [umol J-1].
+
+    Returns
+    -------
+    Period
+        The steps with the sun up: their times, sun, irradiance and PAR doses.
+
+    References
+    ----------
+    Ineichen, P. & Perez, R. (2002). A new airmass independent formulation for the Linke
+    turbidity coefficient. Solar Energy 73(3), 151-157.
+    https://doi.org/10.1016/S0038-092X(02)00045-2
+    """
     return clear_sky(sun_track(date, lat, lon, tz, step_min=step_min, start=start, end=end,
                                altitude=altitude),
                      linke_turbidity=linke_turbidity, par_umol_per_j=par_umol_per_j)
@@ -513,18 +583,26 @@ def clear_sky_period(date, lat: float, lon: float, tz: str, step_min: float = 30
 
 @dataclass(frozen=True, eq=False)
 class Weather:
-    """Irradiance read from a weather file, one entry per data row.
+    """A weather file's rows: irradiance, measured PAR and air temperature.
 
     Attributes
     ----------
     path : str
     times : (n,) pandas DatetimeIndex, time-zone aware: middle of the interval of each row
     step_s : (n,) float64, s: length of the interval each row stands for
-    ghi : (n,) float64, W/m2
+    ghi : (n,) float64, W/m2 (a file of PAR alone: estimated from it, see ``estimated``)
     dni, dhi : (n,) float64 W/m2, or None when the file has no such column
     line : (n,) int64: line of each row in the file, for messages
     label : "center", "start" or "end": where the file's times sit in their interval
     start, end : pandas Timestamp: bounds of the period the file covers
+    par : (n,) float64 umol/m2/s, measured PAR (a quantum sensor's PPFD), or None
+    temp_air : (n,) float64 deg C, air temperature (NaN where the file has none), or None;
+        kept for models of leaf processes (photosynthesis), not used by the light
+    kind : "csv", "epw", "tmy3" or "psm": the file's format
+    place : the file's header's latitude, longitude (deg), altitude (m) and name, where the
+        format has them (EPW, TMY3, PSM), else empty
+    notes : what the reader decided, one line each
+    estimated : names of columns estimated rather than read ("ghi" from PAR alone)
     """
 
     path: str
@@ -537,16 +615,23 @@ class Weather:
     label: str
     start: pd.Timestamp
     end: pd.Timestamp
+    par: np.ndarray | None = None
+    temp_air: np.ndarray | None = None
+    kind: str = "csv"
+    place: Mapping[str, object] = field(default_factory=dict)
+    notes: tuple[str, ...] = ()
+    estimated: tuple[str, ...] = ()
 
     def __post_init__(self):
-        for name in ("step_s", "ghi", "dni", "dhi"):
+        for name in ("step_s", "ghi", "dni", "dhi", "par", "temp_air"):
             if getattr(self, name) is not None:
                 object.__setattr__(self, name, _frozen(getattr(self, name)))
 
     @property
     def columns(self) -> tuple[str, ...]:
-        """Irradiance columns the file gave."""
-        return ("ghi", *(c for c in WEATHER_OPTIONAL if getattr(self, c) is not None))
+        """Columns the file gave (irradiance, PAR, air temperature)."""
+        return tuple(c for c in WEATHER_OPTIONAL
+                     if getattr(self, c) is not None and c not in self.estimated)
 
 
 def _read_text(path: Path, max_bytes: int) -> str:
@@ -583,13 +668,15 @@ def _header(line: int, fields: list, path: Path) -> dict:
                                    f"name (known columns: {', '.join(known)})")
         if name not in known:
             raise WeatherFileError(f"{path}, line {line}: unknown column '{fields[k]}' (known "
-                                   f"columns: {', '.join(known)}; irradiance in W/m2)")
+                                   f"columns: {', '.join(known)}; irradiance in W/m2, par in "
+                                   f"umol/m2/s, temp_air in deg C)")
         if names.index(name) != k:
             raise WeatherFileError(f"{path}, line {line}: column '{name}' appears twice")
-    for need in WEATHER_REQUIRED:
-        if need not in names:
-            raise WeatherFileError(f"{path}, line {line}: missing column '{need}' (required: "
-                                   f"time with a time zone, ghi in W/m2; optional: dni, dhi)")
+    if "time" not in names or not ({"ghi", "par"} & set(names)):
+        missing = "time" if "time" not in names else "ghi"
+        raise WeatherFileError(f"{path}, line {line}: missing column '{missing}' (required: "
+                               f"time with a time zone, and ghi in W/m2 or par in umol/m2/s; "
+                               f"optional: dni, dhi, temp_air)")
     return {name: k for k, name in enumerate(names)}
 
 
@@ -655,8 +742,16 @@ def _parse_times(texts: list, lines: list, path: Path, tz):
     return times
 
 
-def _value_problem(text: str) -> str | None:
-    """What is wrong with one irradiance cell, or None."""
+#: Bounds of each CSV column's values, with their unit and what a value beyond them suggests.
+_BOUNDS = {"ghi": (0.0, MAX_IRRADIANCE_W_M2, "W/m2"), "dni": (0.0, MAX_IRRADIANCE_W_M2, "W/m2"),
+           "dhi": (0.0, MAX_IRRADIANCE_W_M2, "W/m2"),
+           "par": (0.0, MAX_PAR_UMOL_M2_S, "umol/m2/s"),
+           "temp_air": (*AIR_TEMPERATURE_C, "deg C")}
+
+
+def _value_problem(text: str, column: str = "ghi") -> str | None:
+    """What is wrong with one cell of ``column``, or None."""
+    lo, hi, unit = _BOUNDS[column]
     if text == "":
         return "missing value"
     try:
@@ -667,25 +762,29 @@ def _value_problem(text: str) -> str | None:
         return f"missing value ('{text}')"
     if not math.isfinite(value):
         return f"'{text}' is not a finite number"
-    if value < 0:
-        return f"negative irradiance {value:g} W/m2"
-    if value > MAX_IRRADIANCE_W_M2:
-        return f"{value:g} W/m2 is more than {MAX_IRRADIANCE_W_M2:g} W/m2; is the unit W/m2?"
+    if value < lo:
+        what = "irradiance" if unit == "W/m2" else column
+        return f"negative {what} {value:g} {unit}" if lo == 0 else \
+            f"{value:g} {unit} is below {lo:g} {unit}; is the unit {unit}?"
+    if value > hi:
+        return f"{value:g} {unit} is more than {hi:g} {unit}; is the unit {unit}?"
     return None
 
 
 def _parse_values(texts: list, lines: list, times: list, column: str, path: Path) -> np.ndarray:
-    """Irradiance cells -> (n,) float64 W/m2; refuses the first bad cell in file order."""
+    """Cells of ``column`` -> (n,) float64 in its unit; refuses the first bad cell in file
+    order."""
+    lo, hi, _ = _BOUNDS[column]
     try:
         values = np.array(texts, dtype=np.float64)
-        ok = np.isfinite(values) & (values >= 0) & (values <= MAX_IRRADIANCE_W_M2)
+        ok = np.isfinite(values) & (values >= lo) & (values <= hi)
         if first_unplain(texts) is not None:          # numpy reads 1_000 as float does
             ok &= np.array([NUMBER.fullmatch(t) is not None for t in texts], bool)
         bad = np.flatnonzero(~ok)
     except ValueError:                              # an empty or non-numeric cell somewhere
         values, bad = None, np.arange(len(texts))
     for k in bad:
-        problem = _value_problem(texts[k])
+        problem = _value_problem(texts[k], column)
         if problem:
             raise WeatherFileError(f"{path}, line {lines[k]} ({times[k]}), column {column}: "
                                    f"{problem}")
@@ -726,43 +825,73 @@ def _intervals(utc_us: np.ndarray, label: str) -> np.ndarray:
     return np.concatenate([[utc_us[0] - steps[0] // 2], mids, [utc_us[-1] + steps[-1] // 2]])
 
 
-def read_weather(path, tz: str | None = None, label: str = "center",
+def read_weather(path, tz: str | None = None, label: str | None = None,
                  max_bytes: int = MAX_WEATHER_BYTES) -> Weather:
-    """Read a weather CSV file of irradiance.
+    """Read a weather file: maizeviz's CSV, or an EnergyPlus EPW, NREL TMY3 or NSRDB
+    PSM3/PSM4 file through pvlib (:mod:`maizeviz.io.weather_files`, recognised by their
+    first lines).
 
-    Format: comma-separated, a header line, blank lines and lines starting with '#' ignored.
-    Columns (any order and case): ``time`` (ISO 8601 with a UTC offset such as
+    maizeviz's CSV: comma-separated, a header line, blank lines and lines starting with '#'
+    ignored. Columns (any order and case): ``time`` (ISO 8601 with a UTC offset such as
     2005-08-01T12:00+08:00 or a trailing Z; without an offset only when ``tz`` is given, the
-    times are then local clock times in ``tz``), ``ghi`` W/m2 (required), ``dni``, ``dhi`` W/m2
-    (optional); no other column.
+    times are then local clock times in ``tz``), ``ghi`` W/m2, ``dni``, ``dhi`` W/m2,
+    ``par`` umol/m2/s (photosynthetic photon flux density measured by a quantum sensor:
+    used for PAR instead of the shortwave times the PAR factor; a file of ``par`` without
+    ``ghi`` has its shortwave estimated from it, for the direct and diffuse split), and
+    ``temp_air`` deg C (kept for leaf process models); ``ghi`` or ``par`` is required, no
+    other column.
 
-    Rules: at least 2 rows; times strictly increasing; a step longer than GAP_FACTOR (1.5) x the
-    median step is a gap and refused; values must be numbers in [0, MAX_IRRADIANCE_W_M2]
-    (no NaN, no empty cell); files over ``max_bytes`` are refused before reading.
+    EPW, TMY3, PSM: the file's time zone comes from its header (a ``tz`` given is not used,
+    said in a note when it differs), its times' place in their interval from the format (see
+    :mod:`maizeviz.io.weather_files`), ghi, dni, dhi and the air temperature from its
+    columns; a typical year is dated in one year.
 
-    Each row stands for an interval (the midpoint rule of this module): with ``label`` "center"
-    (default) the row's time is the middle of an interval reaching halfway to the neighbouring
-    rows; "start" means the interval begins at the row's time and ends at the next row's;
-    "end" means it ends at the row's time (hourly means stamped at the end of the hour).
+    Rules: at least 2 rows; times strictly increasing; a step longer than GAP_FACTOR (1.5) x
+    the median step is a gap and refused; irradiance must be numbers in [0,
+    MAX_IRRADIANCE_W_M2] W/m2, PAR in [0, MAX_PAR_UMOL_M2_S] umol/m2/s, air temperature in
+    AIR_TEMPERATURE_C deg C (no NaN, no empty cell); files over ``max_bytes`` are refused
+    before reading.
+
+    Each row stands for an interval (the midpoint rule of this module): with ``label``
+    "center" (the CSV's default) the row's time is the middle of an interval reaching halfway
+    to the neighbouring rows; "start" means the interval begins at the row's time and ends at
+    the next row's; "end" means it ends at the row's time (hourly means stamped at the end of
+    the hour). None: the format's own (CSV "center").
 
     Parameters
     ----------
     path : str or Path
-    tz : IANA time zone, or None: times must then carry their offset
-    label : "center", "start" or "end"
-    max_bytes : int, largest file accepted
+        The weather file.
+    tz : str, optional
+        IANA time zone of CSV times without an offset; None: CSV times must carry their
+        offset.
+    label : {"center", "start", "end"}, optional
+        Where each row's time sits in its interval; None: the format's own (CSV "center").
+    max_bytes : int
+        Largest file accepted [bytes].
+
+    Returns
+    -------
+    Weather
+        Its times, steps, irradiance columns and, when given, PAR and air temperature.
 
     Raises
     ------
-    WeatherFileError (a MaizevizError)
+    WeatherFileError
         One line naming the file, the line, the time and the column at fault.
     """
     path = Path(path)
-    key = str(label).strip().lower()
-    if key not in WEATHER_LABELS:
+    if label is not None and str(label).strip().lower() not in WEATHER_LABELS:
         raise MaizevizError(f"unknown weather time label '{label}' (known: "
                             f"{', '.join(WEATHER_LABELS)})")
     zone = _time_zone(tz) if tz is not None else None
+    fh, _ = open_input(path, "weather file", WeatherFileError)
+    with fh:
+        head = fh.read(4096)
+    kind = detect_format(path, head)
+    if kind != "csv":
+        return _from_table(path, read_pvlib_file(path, kind, max_bytes), zone, label)
+    key = "center" if label is None else str(label).strip().lower()
     text = _read_text(path, max_bytes)
     rows = _rows(text, path)
     first = next(rows, None)
@@ -784,10 +913,26 @@ def read_weather(path, tz: str | None = None, label: str = "center",
     texts = [row[columns["time"]] for row in data]
     times = _parse_times(texts, lines, path, zone)
     values = {c: _parse_values([row[columns[c]] for row in data], lines, texts, c, path)
-              for c in ("ghi", *WEATHER_OPTIONAL) if c in columns}
+              for c in WEATHER_OPTIONAL if c in columns}
+    notes: list[str] = []
+    estimated: tuple[str, ...] = ()
+    if "ghi" not in values:
+        # PAR alone: its shortwave, for the direct and diffuse split only
+        values["ghi"] = values["par"] / DEFAULT_PAR_UMOL_PER_J
+        estimated = ("ghi",)
+        notes.append(f"{path.name} gives PAR without ghi: the shortwave is taken as PAR / "
+                     f"{DEFAULT_PAR_UMOL_PER_J:.4g} umol/J to split it into direct and "
+                     "diffuse; PAR is the file's")
+    return _assemble(path, times, values, lines, texts, key, "csv", {}, notes, estimated)
+
+
+def _assemble(path: Path, times: Any, values: dict, lines: Any, texts: list, key: str,
+              kind: str, place: dict, notes: list, estimated: tuple) -> Weather:
+    """The Weather of rows read (times, columns, lines): order and gaps checked, each row's
+    interval from ``key``."""
     utc_us = times.tz_convert("UTC").tz_localize(None).to_numpy(
         f"datetime64[{TIME_UNIT}]").astype(np.int64)
-    _check_order(utc_us, lines, texts, path)
+    _check_order(utc_us, list(lines), texts, path)
     edges = _intervals(utc_us, key)
     mids = edges[:-1] + np.diff(edges) // 2
     import pandas as pd
@@ -799,7 +944,37 @@ def read_weather(path, tz: str | None = None, label: str = "center",
     bounds = stamp(edges[[0, -1]])
     return Weather(path=str(path), times=stamp(mids), step_s=_frozen(np.diff(edges) / 1e6),
                    ghi=_frozen(values["ghi"]), dni=values.get("dni"), dhi=values.get("dhi"),
-                   line=_frozen(lines, np.int64), label=key, start=bounds[0], end=bounds[1])
+                   line=_frozen(lines, np.int64), label=key, start=bounds[0], end=bounds[1],
+                   par=values.get("par"), temp_air=values.get("temp_air"), kind=kind,
+                   place=dict(place), notes=tuple(notes), estimated=estimated)
+
+
+def _from_table(path: Path, table: WeatherTable, zone, label: str | None) -> Weather:
+    """A Weather of an EPW, TMY3 or PSM file read by pvlib; the time zone is the file's."""
+    name = PVLIB_FORMATS[table.kind]
+    times = table.times
+    notes = list(table.notes)
+    if zone is not None and times[:1].tz_convert(zone)[0].utcoffset() != times[0].utcoffset():
+        notes.append(f"{path.name}: this {name} file gives its own time zone (UTC"
+                     f"{_offset_text(times[0])}), which its times keep; the zone given "
+                     f"({tz_name(zone)}) is for CSV files without offsets")
+    texts = [t.isoformat() for t in times]
+    values = {c: table.values[c] for c in ("ghi", "dni", "dhi")}
+    if np.isfinite(table.values["temp_air"]).any():
+        values["temp_air"] = table.values["temp_air"]
+    key = table.label if label is None else str(label).strip().lower()
+    return _assemble(path, times, values, table.line, texts, key, table.kind, table.meta,
+                     notes, ())
+
+
+def _offset_text(t) -> str:
+    off = t.utcoffset().total_seconds()
+    return f"{'+' if off >= 0 else '-'}{int(abs(off)) // 3600:02d}:{int(abs(off)) % 3600 // 60:02d}"
+
+
+def tz_name(zone) -> str:
+    """A time zone's name in words (an IANA key, or its UTC offset)."""
+    return str(getattr(zone, "key", None) or zone)
 
 
 def _split_direct_diffuse(weather: Weather, up: np.ndarray, zen: np.ndarray,
@@ -822,10 +997,13 @@ def _split_direct_diffuse(weather: Weather, up: np.ndarray, zen: np.ndarray,
 
 def weather_period(weather: Weather, lat: float, lon: float, altitude: float = 0.0,
                    par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J) -> Period:
-    """Period of a weather file at a place: sun positions, direct and diffuse parts.
+    """The period of a weather file at a place: sun positions, direct and diffuse parts.
 
+    A measured PAR column is the period's PAR (split into direct and diffuse as the
+    shortwave is); the air temperature travels with the steps (:attr:`Period.temp_air`).
     The direct and diffuse parts keep the file's ghi: with ``dhi`` given, direct_horizontal =
-    ghi - dhi (dhi above ghi is cut to ghi); with only ``dni``, direct_horizontal = dni
+    ghi - dhi (dhi above ghi is cut to ghi, said in a note naming the first such row; a
+    ``dni`` column is then not used); with only ``dni``, direct_horizontal = dni
     cos(zenith) (cut to ghi) and dhi the rest; with ghi alone, the Erbs et al. (1982)
     diffuse fraction (pvlib; geometric zenith, day of year) gives dhi. ``dni`` is then
     direct_horizontal / cos(zenith). Rows whose middle has the sun below the horizon are
@@ -833,9 +1011,27 @@ def weather_period(weather: Weather, lat: float, lon: float, altitude: float = 0
 
     Parameters
     ----------
-    weather : Weather from :func:`read_weather`
-    lat, lon : float, deg; altitude : float, m
-    par_umol_per_j : float, umol of PAR per J of shortwave
+    weather : Weather
+        From :func:`read_weather`.
+    lat : float
+        Latitude [deg north].
+    lon : float
+        Longitude [deg east].
+    altitude : float
+        Height of the place above sea level [m].
+    par_umol_per_j : float
+        PAR photons per joule of shortwave [umol J-1].
+
+    Returns
+    -------
+    Period
+        The rows with the sun up: their times, sun, irradiance and PAR doses.
+
+    References
+    ----------
+    Erbs, D. G., Klein, S. A. & Duffie, J. A. (1982). Estimation of the diffuse radiation
+    fraction for hourly, daily and monthly-average global radiation. Solar Energy 28(4),
+    293-302. https://doi.org/10.1016/0038-092X(82)90302-4
     """
     lat, lon = _check_place(lat, lon)
     altitude = _check_altitude(altitude)
@@ -845,7 +1041,17 @@ def weather_period(weather: Weather, lat: float, lon: float, altitude: float = 0
     direct, dhi, decomposition = _split_direct_diffuse(weather, up, zen, true_zen)
     ghi = direct + dhi
     dni = direct / np.cos(np.radians(zen[up]))
-    notes = []
+    notes = list(weather.notes)
+    if weather.dhi is not None:
+        over = np.flatnonzero(weather.dhi[up] > weather.ghi[up])
+        if len(over):                  # a sensor's offset at low sun, or columns swapped
+            first = weather.times[up][int(over[0])]
+            unused = " (its dni is not used: ghi - dhi gives the direct part)" \
+                if weather.dni is not None else ""
+            rows = f"{len(over)} rows" if len(over) > 1 else "1 row"
+            notes.append(f"{rows} of {Path(weather.path).name} with the sun up "
+                         f"{'have' if len(over) > 1 else 'has'} dhi above ghi (first: "
+                         f"{first.isoformat()}): diffuse cut to ghi, no direct light{unused}")
     if not up.any():
         notes.append(_no_sun_note(weather.start, weather.end, lat, lon))
     night = ~up
@@ -856,13 +1062,18 @@ def weather_period(weather: Weather, lat: float, lon: float, altitude: float = 0
                      f"offset) is not traced")
     name = Path(weather.path).name
     given = ", ".join(weather.columns)
-    source = f"weather file {name} ({given} given"
-    source += "; dni and dhi from the Erbs et al. 1982 decomposition in pvlib)" \
-        if decomposition else ")"
+    fmt = "" if weather.kind == "csv" else f"{PVLIB_FORMATS[weather.kind]} "
+    source = f"weather file {fmt}{name} ({given} given"
+    source += "; dni and dhi from the Erbs et al. 1982 decomposition in pvlib" \
+        if decomposition else ""
+    source += "; PAR measured, not from the shortwave)" if weather.par is not None else ")"
     params = {"weather_file": weather.path, "columns": list(weather.columns),
               "decomposition": decomposition, "time_label": weather.label,
-              "altitude_m": altitude}
+              "altitude_m": altitude, "format": weather.kind,
+              "par": "measured" if weather.par is not None else "shortwave x factor"}
     return Period(times=weather.times[up], step_s=weather.step_s[up], zenith_deg=zen[up],
                   azimuth_deg=azi[up], ghi=ghi, dni=dni, dhi=dhi, direct_horizontal=direct,
                   start=weather.start, end=weather.end, source=source, parameters=params,
-                  par_umol_per_j=par, notes=tuple(notes))
+                  par_umol_per_j=par, notes=tuple(notes),
+                  par_measured=None if weather.par is None else weather.par[up],
+                  temp_air=None if weather.temp_air is None else weather.temp_air[up])

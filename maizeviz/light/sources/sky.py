@@ -547,31 +547,38 @@ def _check_count(directions) -> int:
 
 
 def make_sky(kind: str = "soc", directions: int = 46, split: str = "auto") -> Sky:
-    """A sky of the given radiance distribution discretised into ``directions`` directions.
+    """A sky of the given radiance distribution, discretised into ``directions`` directions.
 
     Parameters
     ----------
-    kind : "soc" (standard overcast) or "uoc" (uniform overcast)
-    directions : int >= 1
-    split : "auto" (turtle for 6, 16, 46; Tregenza for 145; equal otherwise), "turtle",
-        "tregenza" or "equal"
+    kind : {"soc", "uoc"}
+        Standard overcast (radiance rising toward the zenith) or uniform overcast.
+    directions : int
+        Directions, at least 1 (6, 16, 46: den Dulk's turtles; 145: Tregenza's patches).
+    split : {"auto", "turtle", "tregenza", "equal"}
+        How the hemisphere is cut: "auto" is the turtle for 6, 16 and 46, Tregenza's for 145,
+        equal solid angles otherwise.
 
     Returns
     -------
     Sky
-        ``zenith_deg``, ``azimuth_deg`` (n,) deg, ``solid_angle_sr`` (n,) sr, ``weights``
-        (n,) summing to 1 (each direction's share of the horizontal diffuse irradiance).
-
-    References
-    ----------
-    Moon, P. & Spencer, D.E. (1942). Illumination from a non-uniform sky. Illuminating
-    Engineering 37, 707-726. den Dulk, J.A. (1989), the turtle; Tregenza, P.R. (1987),
-    Lighting Research and Technology 19, 13-14 (see the module's references).
+        ``zenith_deg``, ``azimuth_deg`` (n,) [deg], ``solid_angle_sr`` (n,) [sr] and
+        ``weights`` (n,) summing to 1 (each direction's share of the horizontal diffuse
+        irradiance).
 
     Raises
     ------
     MaizevizError
         Unknown kind or split, fewer than 1 direction, or a count the split does not offer.
+
+    References
+    ----------
+    Moon, P. & Spencer, D. E. (1942). Illumination from a non-uniform sky. Illuminating
+    Engineering 37, 707-726 (no DOI). den Dulk, J. A. (1989), the turtle; Tregenza, P. R.
+    (1987), Lighting Research and Technology 19, 13-14 (see the module's references).
+    Chelle, M. & Andrieu, B. (1998). The nested radiosity model for the distribution of
+    light within plant canopies. Ecological Modelling 111(1), 75-91.
+    https://doi.org/10.1016/S0304-3800(98)00100-8
     """
     kind = _check_kind(kind)
     n = _check_count(directions)

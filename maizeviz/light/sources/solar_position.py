@@ -30,12 +30,13 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 
-#: What pvlib's wrappers pass to the SPA when not told otherwise (pvlib 0.16):
-#: ``spa_python``'s delta_t (s) and temperature (deg C) and its refraction at the horizon (deg)
+#: What pvlib's wrappers pass to the SPA when not told otherwise (pvlib 0.16, the only minor
+#: release pyproject.toml allows: 0.15 gives other suns): ``spa_python``'s delta_t (s) and
+#: temperature (deg C) and its refraction at the horizon (deg)
 DELTA_T_S = 67.0
 TEMPERATURE_C = 12.0
 ATMOS_REFRACT_DEG = 0.5667
-_EPOCH = _dt.datetime(1970, 1, 1, tzinfo=_dt.timezone.utc)
+_EPOCH = _dt.datetime(1970, 1, 1, tzinfo=_dt.UTC)
 _NS = 10**9
 
 

@@ -18,7 +18,23 @@ from maizeviz.light.sources.clock import check_altitude, check_place, local_date
 
 @dataclass(frozen=True)
 class Sun:
-    """Sun angles (degrees) and, when computed from a place, when and where."""
+    """The sun's angles and, when computed from a place and time, when.
+
+    Parameters
+    ----------
+    zenith_deg : float
+        Angle of the sun from the vertical [deg], in [0, 90).
+    azimuth_deg : float
+        Azimuth, clockwise from north [deg].
+    when : str
+        The local time it was computed for, ISO 8601 with its UTC offset ("" when given as
+        angles).
+
+    Raises
+    ------
+    MaizevizError
+        Angles that are not finite, or a sun at or below the horizon (quantity "sun").
+    """
 
     zenith_deg: float
     azimuth_deg: float
@@ -36,7 +52,18 @@ class Sun:
                                 quantity="sun")
 
     def direction(self, north_deg: float = 0.0) -> np.ndarray:
-        """Unit vector (3,) from the ground toward the sun in field coordinates."""
+        """Unit vector from the ground toward the sun, in field coordinates.
+
+        Parameters
+        ----------
+        north_deg : float
+            Direction of north in the field, clockwise from the field's y axis [deg].
+
+        Returns
+        -------
+        numpy.ndarray
+            (3,) float64 unit vector (x across rows, y along rows, z up).
+        """
         z = np.radians(self.zenith_deg)
         a = np.radians(self.azimuth_deg - north_deg)
         return np.array([np.sin(z) * np.sin(a), np.sin(z) * np.cos(a), np.cos(z)])
@@ -44,16 +71,26 @@ class Sun:
 
 def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None = None,
            solar_noon: bool = False, altitude: float = 0.0) -> Sun:
-    """Sun position at a place and local clock time (or that day's true solar noon).
+    """The sun's position at a place and local clock time (or that day's true solar noon).
 
     Parameters
     ----------
-    date : "YYYY-MM-DD"; time : "HH:MM" or "HH:MM:SS" local clock time in ``tz`` (or with
-        its own offset, "12:00+08:00"), read by :func:`maizeviz.light.sources.clock.local_datetime`
-    lat, lon : degrees (north, east positive); tz : IANA zone such as "Asia/Shanghai" (UTC
-        when neither the time nor ``tz`` says)
-    solar_noon : bool, the day's true solar noon (sun transit) instead of ``time``
-    altitude : float, m above sea level
+    date : str
+        The local date, "YYYY-MM-DD".
+    time : str or None
+        Local clock time "HH:MM" or "HH:MM:SS" in ``tz``, or with its own offset
+        ("12:00+08:00"), read by :func:`maizeviz.light.sources.clock.local_datetime`; None
+        with ``solar_noon``.
+    lat : float
+        Latitude [deg north].
+    lon : float
+        Longitude [deg east].
+    tz : str, optional
+        IANA zone such as "Asia/Shanghai" (UTC when neither the time nor ``tz`` says).
+    solar_noon : bool
+        The day's true solar noon (the sun's transit) instead of ``time``.
+    altitude : float
+        Height of the place above sea level [m].
 
     Returns
     -------
@@ -70,9 +107,12 @@ def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None =
     References
     ----------
     Reda, I. & Andreas, A. (2004). Solar position algorithm for solar radiation
-    applications. Solar Energy 76(5), 577-589: pvlib's implementation, run as its
-    ``get_solarposition`` and ``sun_rise_set_transit_spa`` run it but without importing pandas
-    (:mod:`maizeviz.light.sources.solar_position`).
+    applications. Solar Energy 76(5), 577-589. https://doi.org/10.1016/j.solener.2003.12.003
+    pvlib's implementation, run as its ``get_solarposition`` and ``sun_rise_set_transit_spa``
+    run it but without importing pandas (:mod:`maizeviz.light.sources.solar_position`):
+    Holmgren, W. F., Hansen, C. W. & Mikofski, M. A. (2018). pvlib python: a python package
+    for modeling solar energy systems. Journal of Open Source Software 3(29), 884.
+    https://doi.org/10.21105/joss.00884
     """
     from maizeviz.light.sources import solar_position as spa
 
@@ -83,7 +123,7 @@ def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None =
     except (TypeError, ValueError):
         raise MaizevizError(f"the date must be YYYY-MM-DD, got '{date}'", quantity="date") from None
     if solar_noon:
-        where = zone(tz) if tz is not None else _dt.timezone.utc
+        where = zone(tz) if tz is not None else _dt.UTC
         ns = spa.transit_ns(day, lat, lon)
         unixtime, when = ns / 1e9, spa.iso_ns(ns, where)
     else:

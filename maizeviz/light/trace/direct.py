@@ -272,12 +272,10 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
     rays = SunRays(smp.rect, smp.density, s, smp.top)
     n = rays.n
     heights = smp.heights_cm
-    h32 = heights.astype(np.float32)
     leaf_top = smp.top - 1.0
     planes = [k for k, h in enumerate(heights) if 0.0 < h <= leaf_top]
     fam = None if not planes else (_period_family(smp, s, planes) if _spans_periods(smp)
                                    else _family(smp, s, planes))
-    offsets = sensor_offsets(heights, s, smp.rect, smp.density)
     chunks = _chunks(n if fam is None else len(fam.cells))
     ground_chunks = _chunks(n)
     total = len(chunks) + (len(ground_chunks) if second else 0)
@@ -288,93 +286,136 @@ def trace_direction(smp: Sampler, toward: np.ndarray, ids: bool = False, second:
             report(progress, before + k, total, "light computation")
 
         return list(ordered_map(lambda ab: fn(*ab), parts, threads, done, stop))
-    size = chunks[0][1]
-    down = Tracer(smp.scene, -s, smp.bounds, smp.periodic, max(size, ground_chunks[0][1]))
-    first_z = np.empty(n, dtype=np.float32)
     keep_ids = ids or second
-    first_prim = np.empty(n, dtype=np.int32) if keep_ids else None
-    packed = np.zeros((len(heights), (n + 7) // 8), dtype=np.uint8)
-
-    def check() -> None:
-        if stop is not None and stop.is_set():
-            raise InterruptedError("light computation cancelled")
-
+    p = _Pass(smp, s, rays, planes, sensor_offsets(heights, s, smp.rect, smp.density),
+              Tracer(smp.scene, -s, smp.bounds, smp.periodic,
+                     max(chunks[0][1], ground_chunks[0][1])),
+              np.empty(n, dtype=np.float32),
+              np.empty(n, dtype=np.int32) if keep_ids else None,
+              np.zeros((len(heights), (n + 7) // 8), dtype=np.uint8), stop)
     if fam is None:
-        up = Tracer(smp.scene, s, smp.bounds, smp.periodic, size)
-
-        def chunk(a: int, b: int) -> np.ndarray:
-            check()
-            prim, z = first_hits(down, rays, a, b, ids=keep_ids)
-            first_z[a:b] = z
-            if first_prim is not None and prim is not None:
-                first_prim[a:b] = prim
-            ground = None
-            counts = np.empty(len(heights), dtype=np.int64)
-            for k, h in enumerate(heights):
-                if h > leaf_top:
-                    lit = np.ones(b - a, dtype=bool)
-                elif h == 0.0:
-                    lit = z < h32[k]             # the ground's sensors are the rays' landings
-                else:
-                    if ground is None:
-                        ground = ray_grid(smp.rect, smp.density, a, b)[0]
-                    org = np.empty((b - a, 3))
-                    org[:, :2] = ground + offsets[k]
-                    org[:, 2] = h
-                    lit = ~up.occluded(org, np.full(b - a, (smp.top - h) / s[2]),
-                                       row=rays.shape[1])
-                counts[k] = np.count_nonzero(lit)
-                packed[k, a // 8:(b + 7) // 8] = np.packbits(lit)
-            return counts
-
-        transmission = np.sum(in_chunks(chunk, chunks, 0), axis=0) / n
+        transmission = _sensor_pass(p, chunks, in_chunks)
     else:
-        family = fam
-        fz = np.empty(len(family.cells), dtype=np.float32)
-        fp = np.empty(len(family.cells), dtype=np.int32) if keep_ids else None
-        bh = family.index.shape[1]
-        whole = len(family.cells) == family.index.size     # the box without holes: a grid
-
-        def fchunk(a: int, b: int) -> None:
-            check()
-            i, j = np.divmod(family.cells[a:b], bh)
-            prim, z = lattice_first_hits(down, rays, i + family.lo[0], j + family.lo[1],
-                                         ids=keep_ids, row=bh if whole else 0)
-            fz[a:b] = z
-            if fp is not None and prim is not None:
-                fp[a:b] = prim
-
-        in_chunks(fchunk, chunks, 0)
-        g = family.index[-family.lo[0]:-family.lo[0] + family.size[0],
-                         -family.lo[1]:-family.lo[1] + family.size[1]].ravel()
-        first_z[:] = fz[g]
-        if first_prim is not None and fp is not None:
-            first_prim[:] = fp[g]
-        transmission = np.empty(len(heights))
-        for k, h in enumerate(heights):
-            if h > leaf_top:
-                lit = np.ones(n, dtype=bool)
-            elif k in planes:
-                lit = fz[_plane_rays(family, k)] < h32[k]
-            else:
-                lit = first_z < h32[k]
-            transmission[k] = np.count_nonzero(lit) / n
-            packed[k] = np.packbits(lit)
+        transmission = _family_pass(p, fam, chunks, in_chunks)
     seconds = {"trace": time.perf_counter() - t0}
     seconds_prims = None
-    if second and first_prim is not None:
+    if second and p.first_prim is not None:
         t2 = time.perf_counter()
-        fprim = first_prim
+        fprim = p.first_prim
 
         def chunk2(a: int, b: int) -> np.ndarray:
-            check()
-            return second_hits(down, rays, a, b, fprim[a:b], first_z[a:b])
+            p.check()
+            return second_hits(p.down, rays, a, b, fprim[a:b], p.first_z[a:b])
 
         seconds_prims = in_chunks(chunk2, ground_chunks, len(chunks))
         seconds["second"] = time.perf_counter() - t2
-    return DirectionTrace(s, transmission.astype(np.float64), first_z,
-                          first_prim if keep_ids else None, seconds_prims, packed, offsets,
-                          seconds)
+    return DirectionTrace(s, transmission.astype(np.float64), p.first_z,
+                          p.first_prim if keep_ids else None, seconds_prims, p.packed,
+                          p.offsets, seconds)
+
+
+@dataclass
+class _Pass:
+    """One direction being traced: its rays, the planes a family answers, the downward
+    tracer, and the arrays the chunks fill (first hits, packed sensor bits)."""
+
+    smp: Sampler
+    s: np.ndarray                      # (3,) toward the light
+    rays: SunRays
+    planes: list[int]                  # planes between the ground and the leaves' top
+    offsets: np.ndarray                # (H, 2) cm, each plane's grid offset
+    down: Tracer
+    first_z: np.ndarray                # (N,) float32
+    first_prim: np.ndarray | None      # (N,) int32 with ids
+    packed: np.ndarray                 # (H, ceil(N / 8)) uint8
+    stop: threading.Event | None
+
+    @property
+    def leaf_top(self) -> float:
+        return self.smp.top - 1.0
+
+    def check(self) -> None:
+        if self.stop is not None and self.stop.is_set():
+            raise InterruptedError("light computation cancelled")
+
+
+def _sensor_pass(p: _Pass, chunks: list[tuple[int, int]], in_chunks) -> np.ndarray:
+    """Ground rays chunk by chunk, each plane's sensors asked by an occlusion query (the
+    ground's from the rays' landings); the transmission (H,)."""
+    smp, s, rays = p.smp, p.s, p.rays
+    heights = smp.heights_cm
+    h32 = heights.astype(np.float32)
+    leaf_top = p.leaf_top
+    keep_ids = p.first_prim is not None
+    up = Tracer(smp.scene, s, smp.bounds, smp.periodic, chunks[0][1])
+
+    def chunk(a: int, b: int) -> np.ndarray:
+        p.check()
+        prim, z = first_hits(p.down, rays, a, b, ids=keep_ids)
+        p.first_z[a:b] = z
+        if p.first_prim is not None and prim is not None:
+            p.first_prim[a:b] = prim
+        ground = None
+        counts = np.empty(len(heights), dtype=np.int64)
+        for k, h in enumerate(heights):
+            if h > leaf_top:
+                lit = np.ones(b - a, dtype=bool)
+            elif h == 0.0:
+                lit = z < h32[k]             # the ground's sensors are the rays' landings
+            else:
+                if ground is None:
+                    ground = ray_grid(smp.rect, smp.density, a, b)[0]
+                org = np.empty((b - a, 3))
+                org[:, :2] = ground + p.offsets[k]
+                org[:, 2] = h
+                lit = ~up.occluded(org, np.full(b - a, (smp.top - h) / s[2]),
+                                   row=rays.shape[1])
+            counts[k] = np.count_nonzero(lit)
+            p.packed[k, a // 8:(b + 7) // 8] = np.packbits(lit)
+        return counts
+
+    return np.sum(in_chunks(chunk, chunks, 0), axis=0) / rays.n
+
+
+def _family_pass(p: _Pass, family: _Family, chunks: list[tuple[int, int]],
+                 in_chunks) -> np.ndarray:
+    """The rays of the family through every plane's sensors, chunk by chunk; each sensor lit
+    when its family ray's first hit lies below its plane; the transmission (H,)."""
+    heights = p.smp.heights_cm
+    h32 = heights.astype(np.float32)
+    n = p.rays.n
+    keep_ids = p.first_prim is not None
+    fz = np.empty(len(family.cells), dtype=np.float32)
+    fp = np.empty(len(family.cells), dtype=np.int32) if keep_ids else None
+    bh = family.index.shape[1]
+    whole = len(family.cells) == family.index.size     # the box without holes: a grid
+
+    def fchunk(a: int, b: int) -> None:
+        p.check()
+        i, j = np.divmod(family.cells[a:b], bh)
+        prim, z = lattice_first_hits(p.down, p.rays, i + family.lo[0], j + family.lo[1],
+                                     ids=keep_ids, row=bh if whole else 0)
+        fz[a:b] = z
+        if fp is not None and prim is not None:
+            fp[a:b] = prim
+
+    in_chunks(fchunk, chunks, 0)
+    g = family.index[-family.lo[0]:-family.lo[0] + family.size[0],
+                     -family.lo[1]:-family.lo[1] + family.size[1]].ravel()
+    p.first_z[:] = fz[g]
+    if p.first_prim is not None and fp is not None:
+        p.first_prim[:] = fp[g]
+    transmission = np.empty(len(heights))
+    for k, h in enumerate(heights):
+        if h > p.leaf_top:
+            lit = np.ones(n, dtype=bool)
+        elif k in p.planes:
+            lit = fz[_plane_rays(family, k)] < h32[k]
+        else:
+            lit = p.first_z < h32[k]
+        transmission[k] = np.count_nonzero(lit) / n
+        p.packed[k] = np.packbits(lit)
+    return transmission
 
 
 def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | None = None,

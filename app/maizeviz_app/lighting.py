@@ -1,0 +1,354 @@
+"""The model's light actions: compute the light the settings choose (sun, sky or day) on the
+canopy shown, sun angles from a place and time, the heatmap of another height, and the results
+of a project made whole against their canopy (no Qt: the work goes to the model's runner, the
+Embree work to its light process).
+
+Methods of :class:`maizeviz_app.model.StudyModel` (``study``: the model); see there for the
+state these use.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from maizeviz.errors import MaizevizError
+from maizeviz_app.runs import MODES, Run, day_summary, plot_title, run_info
+from maizeviz_app.settings import InputProblem
+
+if TYPE_CHECKING:
+    from maizeviz_app.model import StudyModel
+
+#: What a light computation is called while it runs, per light.
+RUNNING_TEXT = {"sun": "computing direct light", "sky": "computing diffuse light",
+                "day": "computing the day's light"}
+
+
+def light_job(study: StudyModel) -> tuple[str, str, tuple, Any, Any, Any]:
+    """What a light computation of the settings would trace: (light, core op, its
+    arguments, the settings results are compared by, heights, optics or None).
+
+    Raises
+    ------
+    InputProblem, MaizevizError
+        A setting that cannot be used, naming it (``quantity``).
+    """
+    s = study.settings
+    mode = s.light.mode
+    optics = None
+    if mode == "sun":
+        request = s.sun_request()
+        optics = s.optics_spec()
+        compared = (round(request.sun.zenith_deg, 6), round(request.sun.azimuth_deg, 6),
+                    optics)
+        return mode, "light", (request,), compared, request.heights_cm, optics
+    sampling = s.sampling_spec()
+    sky = s.sky_spec()
+    if mode == "sky":
+        return mode, "sky", (sampling, sky), sky, sampling.heights_cm, None
+    day = s.day_spec()
+    return mode, "period", (sampling, sky, day), (day, sky), sampling.heights_cm, None
+
+def compute_light(study: StudyModel) -> bool:
+    """Compute the light the settings choose (sun, sky or day) on the canopy shown, in the
+    light process (which keeps the canopy's Embree scene); False if it did not start."""
+    if study.closing:
+        return False
+    if study.canopy is None or study.built is None:
+        study.say("error: no canopy yet: open a points file first", error=True)
+        return False
+    mode = study.settings.light.mode
+    try:
+        mode, op, args, compared, heights, optics = study.light_job()
+    except (InputProblem, MaizevizError) as exc:
+        study.fail(exc, "light", mode)
+        return False
+    if not study.affordable([study._light_costs(mode, args, heights, optics)], "light"):
+        return False
+    from maizeviz_app import plots
+
+    canopy, label = study.canopy, study.built.label
+    signature = study.signature(label)
+    sampling_key = study.settings.sampling_key(heights)
+    runs = study.runs.copy()
+    key, runner = study.canopy_key, study.runner
+    first = max(study.figures.shown_index, 0)
+    look = plots.Look.of(study.colour, study.figures.shown_for)
+
+    def work(job):
+        out = runner.light_process.call(op, key, canopy, args, job)
+        job.check()
+        if mode == "sun":
+            from maizeviz.light.results.painting import sun_painting
+
+            absorbed = None
+            if optics is not None:              # leaves with optics: absorbed light too
+                absorbed = runner.light_process.call("absorbed", key, canopy,
+                                                     (args[0], optics), job)
+                job.check()
+            painting = sun_painting(canopy, out)
+            run = Run(label, signature, out, painting.classes, extra=absorbed,
+                      painting=painting)
+        else:
+            run = Run(label, signature, out.light, None, mode, out)
+        maps = plots.heatmap_images(run.result, first=first, check=job.check, kind=mode,
+                                    look=look.sharing(mode, run.result))
+        runs.add(run, compared, sampling_key)
+        plot = plots.rgba(plots.transmission_figure(runs.curves(), plot_title(runs)))
+        return run, compared, sampling_key, maps, plot
+
+    study.light_running.emit(f"{RUNNING_TEXT[mode]} on {label}…")
+    study.runner.run("light", f"{mode} light on {label}", work, on_done=study._lit,
+                    on_error=lambda e: study._light_failed(e, mode))
+    return True
+
+def _light_costs(study: StudyModel, mode: str, args: tuple, heights, optics=None) -> list:
+    """What a light run of ``mode`` on the canopy shown will cost (``maizeviz.cost``): its
+    rays (times the directions: the sun, the sky's, a day's steps; with leaf optics, the
+    absorbed light's beams and their scattering) and its heatmaps."""
+    from maizeviz.cost import light_costs
+    from maizeviz_app.plots import HEATMAP_BIN_CM
+
+    rect = args[0].rect or study.canopy.layout.centre_bounds
+    directions = 1
+    if optics is not None:                          # the beams, each scattered ~3 times
+        directions += 3 * (1 + (46 if optics.diffuse_w_m2 > 0 else 0))
+    if mode != "sun":
+        directions = max(args[1].directions, 1)
+        if mode == "day":
+            directions += args[2].steps_bound()
+    return light_costs(rect, args[0].density, len(heights), directions, 1, HEATMAP_BIN_CM,
+                       study.built.measures.triangles)
+
+def _light_failed(study: StudyModel, exc: BaseException, mode: str = "sun") -> None:
+    study.light_running.emit("")
+    study.fail(exc, "light", mode)
+
+def _lit(study: StudyModel, out) -> None:
+    """A light result: table, summary, plants, figures and colours change together;
+    nothing shown is dropped unless a new comparison starts."""
+    run, compared, sampling_key, maps, plot = out
+    study.light_running.emit("")
+    if run.signature[0] != study.serial:
+        return
+    if study.add_run(run, compared, sampling_key, run_info(run)):
+        study.say("note: the light settings changed; the comparison starts again")
+    r = run.result
+    summary = ""
+    if run.kind == "day":
+        summary = day_summary(r)
+        study.set_summary(summary)
+    elif study.runs.of_kind("day") is None:
+        study.set_summary("")
+    if run.kind != "sun" or run.extra is not None:
+        study.set_plants_run(run)
+    elif study.runs.of_kind("sky") is None and study.runs.of_kind("day") is None:
+        study.set_plants_run(None)
+    f = study.figures
+    f.keep_only({k for k in f.shown_for if study.runs.of_kind(k) is not None} | {run.kind})
+    f.set_maps(run.kind, run, maps)
+    if study.colour.shared:                     # the others' scale includes this run
+        f.restyle(keep=run.kind)
+    f.set_plot(plot)
+    for w in r.warnings:
+        study.say(f"{'note' if 'sun never rises' in w else 'warning'}: {w}")
+    if study.shown_signature == run.signature:
+        study.view_light.emit(True)
+    study.light_added.emit(run)
+    if run.kind == "day":
+        study.say(summary.replace("\n", "; "), status_only=True)
+    else:
+        study.say(f"{run.name}: transmission "
+                 + ", ".join(f"{t:.3f}" for t in run.transmission) + " at "
+                 + ", ".join(f"{h:g}" for h in r.heights_cm) + " cm", status_only=True)
+    study.light_shown.emit()
+
+def draw_heatmap(study: StudyModel, kind: str, index: int) -> None:
+    """The heatmap of another height of a result shown, drawn in a job."""
+    run = study.figures.shown_for.get(kind)
+    if run is None:
+        return
+    from maizeviz_app import plots
+
+    result = run.result
+    height = float(result.heights_cm[index])
+    look = plots.Look.of(study.colour, study.figures.shown_for)
+
+    def done(rgba) -> None:
+        study.figures.set_map(kind, run, index, rgba)
+
+    study.runner.run("heatmap", f"drawing the heatmap at {height:g} cm",
+                     lambda job: plots.heatmap_image(result, height, kind=kind, look=look),
+                     on_done=done, on_error=lambda e: study.fail(e, "light"))
+
+def sun_from_place(study: StudyModel) -> None:
+    """Sun angles from the date, time and place of ``settings.sun.place`` (pvlib, in a
+    job); they become the sun's settings."""
+    text = study.settings.sun.place
+
+    def work(job, t):
+        from maizeviz.light.sources.sun import sun_at
+
+        parts = t.split()
+        if len(parts) != 5:
+            raise MaizevizError("write the place as: YYYY-MM-DD HH:MM latitude longitude "
+                                "time zone", quantity="place")
+        date, clock, lat, lon, tz = parts
+        try:
+            la, lo = float(lat), float(lon)
+        except ValueError:
+            raise MaizevizError(f"latitude and longitude must be numbers, got '{lat}' "
+                                f"'{lon}'", quantity="place") from None
+        return sun_at(date, clock, la, lo, tz)
+
+    study.runner.run("sun", "sun position", work, text, on_done=study._sun_found,
+                    on_error=lambda e: study.fail(e, "sun", "sun"))
+
+def _sun_found(study: StudyModel, sun) -> None:
+    # the sun's range (what its widget offers) holds a risen sun
+    study.settings.set("sun", {"zenith_deg": round(min(sun.zenith_deg, 89.9), 2),
+                              "azimuth_deg": round(sun.azimuth_deg % 360.0, 2)})
+    study.say(f"sun at {sun.when}: zenith {sun.zenith_deg:.2f}°, azimuth "
+             f"{sun.azimuth_deg:.2f}°")
+
+# ------------------------------------------------------------------ a project's results
+def adopt_pending_runs(study: StudyModel) -> None:
+    """Light results of an opened project (sun, sky and day) join the comparison once its
+    canopy is built, shown as after a fresh run: table, plot, heatmaps, the day's summary,
+    the plants' light and the canopy's colours (those of the results traced on the canopy
+    shown are computed against it, the others' when their level is shown)."""
+    if not study.pending_runs or study.built is None:
+        return
+    from maizeviz_app import jobs, plots
+
+    pending, study.pending_runs = study.pending_runs, []
+    absorbed = {s.label: s for s in pending if s.kind == "absorbed"}
+    pending = [s for s in pending if s.kind != "absorbed"]
+    for stored in pending:
+        label, result, kind, compared = stored
+        extra = None
+        if kind == "sun":
+            kept = absorbed.get(label)
+            compared = (round(result.sun.zenith_deg, 6), round(result.sun.azimuth_deg, 6),
+                        kept.settings if kept is not None else None)
+            if kept is not None:                # computed against the canopy later
+                extra = jobs.Absorbed(kept.result, None, None)
+            density = result.density
+        elif kind == "sky":
+            density = result.density
+        else:
+            density = result.sky.density if result.sky is not None else \
+                study.settings.sampling.density
+        sampling = (tuple(float(h) for h in result.heights_cm), density,
+                    bool(getattr(result, "periodic", study.settings.sampling.periodic)))
+        study.add_run(Run(label, study.signature(label), result, None, kind, extra),
+                     compared, sampling, f"{len(pending)} light result(s) from the project",
+                     saved=True)
+    here = study.signature(study.built.label)
+    shown = {}
+    for kind in MODES:
+        run = study.runs.for_signature(here, kind) or study.runs.of_kind(kind)
+        if run is not None:
+            shown[kind] = run
+    if not shown:
+        return
+    day = shown.get("day")
+    study.set_summary(day_summary(day.result) if day is not None else "")
+    study.set_plants_run(study.light_per_plant_run())
+    latest = study.runs.latest(here) or study.runs.last
+    order = sorted(shown, key=lambda k: latest is not None and k == latest.kind)
+    curves = study.runs.curves()
+    title = plot_title(study.runs)
+    study.figures.shown_for = dict(shown)
+    results = [(k, shown[k].result) for k in order]
+    look = plots.Look.of(study.colour, shown)
+
+    def work(job):
+        maps = [(k, plots.heatmap_images(r, check=job.check, kind=k, look=look))
+                for k, r in results]
+        plot = plots.rgba(plots.transmission_figure(curves, title))
+        return maps, plot
+
+    def done(out):
+        for kind, maps in out[0]:
+            if study.figures.shown_for.get(kind) is shown[kind]:
+                study.figures.set_maps(kind, shown[kind], maps)
+        study.figures.set_plot(out[1])
+        if study.runner.current("complete") is None:        # else: once it is done
+            study.light_shown.emit()
+
+    study.runner.run("figures", "drawing the light figures", work, on_done=done,
+                    on_error=lambda e: study.fail(e, "light"))
+    study.view_light.emit(True)
+
+def light_per_plant_run(study: StudyModel) -> Run | None:
+    """The latest result with light per plant to show: a sky's, a day's or a sun's
+    absorbed light (once computed against its canopy)."""
+    runs = [r for r in study.runs.in_order()
+            if r.kind != "sun" or getattr(r.extra, "plant_rows", None) is not None]
+    return runs[-1] if runs else None
+
+def complete_runs(study: StudyModel) -> None:
+    """Results read from a project that were traced on the canopy shown get what the
+    window shows of them, computed against it in a job: a sun's light class per
+    triangle, a sky's or day's light per leaf and plant; then the plants' light and the
+    canopy's colours follow."""
+    if study.built is None or study.canopy is None:
+        return
+    here, canopy = study.shown_signature, study.canopy
+    todo = runs_to_complete(study.runs.runs.values(), here, canopy.n_triangles)
+    if not todo:
+        return
+
+    def work(job):
+        from maizeviz.light.results.painting import sun_painting
+        from maizeviz_app import jobs
+
+        done: list[Any] = []
+        for run in todo:
+            job.check()
+            if run.kind == "sun":
+                absorbed = None if run.extra is None else \
+                    jobs.absorbed_of(canopy, run.extra.light)
+                done.append((sun_painting(canopy, run.result), absorbed))
+            else:
+                done.append(jobs.diffuse_of(canopy, run.result, run.kind))
+        return done
+
+    def adopt(done):
+        for run, value in zip(todo, done):
+            if run.kind == "sun":
+                run.painting, absorbed = value
+                run.classes = run.painting.classes
+                if absorbed is not None:
+                    run.extra = absorbed
+            else:
+                run.extra = value
+        if study.shown_signature == here:
+            study.set_plants_run(study.light_per_plant_run())
+            study.view_light.emit(True)
+            if study.runner.current("figures") is None:     # else: when they are drawn
+                study.light_shown.emit()
+
+    study.runner.run("complete", "light per leaf of the project's results", work,
+                    on_done=adopt, on_error=lambda e: study.fail(e, "light"))
+
+
+def runs_to_complete(runs, here, n: int) -> list:
+    """The runs traced on the canopy of signature ``here`` (of ``n`` leaf triangles) that
+    lack what the window shows of them: a sun's light classes (or its absorbed light's per
+    leaf), a sky's or a day's light per leaf; runs holding light for fewer triangles than
+    the canopy are left alone."""
+    todo = []
+    for run in runs:
+        if run.signature != here:
+            continue
+        r = run.result
+        if run.kind == "sun" and (run.classes is None or run.extra is not None
+                                  and run.extra.leaf_value is None):
+            if r.first_hits is not None and len(r.first_hits) >= n:
+                todo.append(run)
+        elif run.kind != "sun" and run.extra is None:
+            per_triangle = r.triangle_share if run.kind == "sky" else r.triangle_direct_mol
+            if len(per_triangle) >= n:
+                todo.append(run)
+    return todo

@@ -1,0 +1,170 @@
+"""The 3D view kept in step with the study: the canopy built is shown, coloured by the light
+last computed on it; the View menu's colourings and cameras act on it. From the start of a
+digitizing session the view is the digitizer's (the plant being digitized): a canopy built
+meanwhile waits, and comes back in the Analyse workspace once the session has stopped
+(:mod:`maizeviz_app.workspaces`).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from maizeviz_app.runs import value_legend
+
+
+class ViewLink:
+    """Wires ``window.model`` to ``window.viewport`` (made later: nothing happens before)."""
+
+    def __init__(self, window) -> None:
+        self.window = window
+        self.pending: tuple | None = None     # (canopy, mesh) built while digitizing
+        self.away = False                     # the digitizer has the view (until Analyse)
+        m = window.model
+        m.canopy_changed.connect(self.show_built)
+        m.view_light.connect(self.light_to_view)
+        m.light_added.connect(self._painted)
+        m.colour.events.painting.connect(lambda _p: self.light_to_view())
+
+    @property
+    def view(self) -> Any:
+        return self.window.viewport
+
+    @property
+    def digitizing(self) -> bool:
+        """A digitizing session is recording (the view shows the plant being digitized)."""
+        d = self.window.digitizer
+        return d is not None and d.recording
+
+    def show_built(self, built) -> None:
+        """A canopy built: the view changes with the level label and Table 2 (their panel
+        follows the study); while the digitizer records, the canopy waits."""
+        say = self.window.say
+        mesh = built.polydata
+        if self.view is None:
+            return
+        if self.digitizing or self.away:
+            self.pending = (built.canopy, mesh)
+            say(f"{built.label} is ready; it shows in the Analyse workspace once the "
+                "digitizing session stops", status_only=True)
+        else:
+            self.pending = None
+            self.view.show_canopy(built.canopy, mesh)
+        m = built.measures
+        if mesh is not None and "view_note" in mesh.field_data:
+            say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
+                f"responsive {mesh.field_data['view_note'][0]}")
+        elif mesh is not None and "source" in mesh.field_data:
+            say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
+                "responsive the view draws the plants around the sampled tile at 36 "
+                "triangles a leaf (light, tables and exports use every triangle)")
+        if not self.digitizing:
+            say(f"{built.label}: {m.triangles:,} triangles, leaf area {m.leaf_area_m2:.2f} "
+                f"m², LAI {m.lai:.2f}; built in {built.build_s:.2f} s, measured in "
+                f"{built.measure_s:.2f} s", status_only=True)
+
+    def light_to_view(self, colour: bool = False) -> None:
+        """Colour the canopy in view by the light last computed on it (the sun's classes, or a
+        sky's or day's light per leaf), unless the view is busy with the digitizer;
+        ``colour``: switch the colouring to light."""
+        m = self.window.model
+        if self.view is None or m.built is None or self.digitizing or self.away or \
+                self.pending is not None:
+            return
+        run = m.runs.latest(m.shown_signature)
+        if run is not None and run.kind == "sun" and run.classes is not None and \
+                (run.extra is None or run.extra.leaf_value is None):
+            self.view.set_sun(run.painting, m.colour.painting, run.classes)
+            self.window.colour_panel.show_painting(self.view.painting_note)
+        elif run is not None and run.extra is not None and \
+                getattr(run.extra, "leaf_value", None) is not None:
+            title, unit = value_legend(run)
+            self.view.set_light_values(run.extra.leaf_value, title, unit)
+            self.window.colour_panel.show_painting("")      # a sun's painting is not shown
+        if colour and run is not None:
+            self.colour_by("light")
+        self.sync_colour_actions()
+
+    def _painted(self, run) -> None:
+        """A new sun: say how the view paints it (per triangle, or per leaf where triangles
+        are smaller than the ray spacing)."""
+        m = self.window.model
+        if run.painting is not None and self.view is not None and \
+                m.shown_signature == run.signature:
+            self.window.say(f"note: the view shows {self.view.painting_note}")
+
+    def choose_image(self) -> None:
+        """File > Save view as image: ask the width and the file, then save."""
+        if self.view is None:
+            return
+        from maizeviz_app.snapshot import ask_view_image
+
+        chosen = ask_view_image(self.window, self.view, self.window.folder())
+        if chosen is not None:
+            self.save_image(*chosen)
+
+    def save_image(self, path, width: int | None = None) -> None:
+        """The 3D view as a PNG ``width`` pixels wide (None: the view's), with its colour key
+        (:mod:`maizeviz_app.snapshot`)."""
+        if self.view is None:
+            return
+        from maizeviz.errors import MaizevizError
+        from maizeviz_app.snapshot import save_view_image
+
+        try:
+            written = save_view_image(self.view, path, width)
+        except (MaizevizError, OSError, ValueError) as exc:
+            self.window.model.fail(exc, "export")
+            return
+        self.window.say(f"saved the view as {written}")
+        self.window.saved.emit(str(written))
+
+    def camera(self, name: str) -> None:
+        if self.view is not None:
+            self.view.camera_preset(name)
+
+    def colour_by(self, what: str) -> None:
+        if self.view is None:
+            return
+        if not self.view.colour_by(what):
+            self.window.say("no light result for the canopy shown: compute direct light first "
+                            "(Ctrl+L)")
+        self.sync_colour_actions()
+
+    def sync_colour_actions(self) -> None:
+        if self.view is None:
+            return
+        for name in ("plant", "leaf", "light"):
+            act = self.window.menu_actions.get(f"colour_{name}")
+            if act is not None:
+                act.setChecked(self.view.colouring == name)
+
+    def digitizing_started(self) -> None:
+        self.away = True
+        self.window.workspaces.show("digitize")
+
+    def digitizing_stopped(self, _why: str = "") -> None:
+        """In Digitize the plant just digitized stays in the view (no canopy frame on Stop);
+        in Analyse the canopy comes back at once."""
+        if not self.window.model.closing and self.window.workspaces.current == "analyse":
+            self.canopy_back()
+
+    def workspace_changed(self, name: str) -> None:
+        if name == "analyse" and not self.digitizing:
+            self.canopy_back()
+
+    def canopy_back(self) -> None:
+        """The canopy back in the view after a session: the one built meanwhile if any."""
+        if not self.away:
+            return
+        self.away = False
+        if self.window.digitizer is not None:
+            self.window.digitizer.release_view()
+        if self.view is None or self.window.model.canopy is None:
+            return
+        pending, self.pending = self.pending, None
+        if pending is not None:
+            self.view.show_canopy(*pending)
+            self.view.camera_preset("reset")
+        else:
+            self.view.restore_canopy()
+        self.light_to_view()

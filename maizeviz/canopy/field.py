@@ -1,0 +1,249 @@
+"""A field of distinct plants read plant chunk by plant chunk: points too many to hold as
+fitted leaves at once (a hectare: 70,000 plants, 1.1 million leaves, 72 million points, where
+the fitted leaves alone would take about 5 GB).
+
+A Parquet points file with more than :data:`FIELD_POINTS` records whose plants' records lie
+together (as every writer of maizeviz writes them) is read twice, :data:`CHUNK_POINTS` at a
+time, whole plants per chunk (:func:`maizeviz.io.parquet.point_chunks`):
+
+1. the survey (:class:`FieldLeaves`): each chunk's leaf grids are built and only what the
+   commands need before any long work is kept: each leaf's plant and grid shape (the cost
+   estimates), each plant's stalk base (the layout), the leaves refused and the repairs made;
+2. the build (:meth:`FieldLeaves.canopy`): each chunk's grids are built again, fitted and
+   meshed at the level (:func:`~maizeviz.canopy.scene.plant_meshes`), the chunk's leaves let
+   go; the plants' meshes are then placed (:func:`~maizeviz.canopy.scene.place_plants`).
+
+Leaves are gridded, fitted and meshed alone or in batches alike (every stage works leaf by
+leaf, whatever the batch), so the canopy is the one the whole file read at once gives, to the
+bit (``tests/core/test_field.py``); memory follows one chunk plus the meshes.
+"""
+
+from __future__ import annotations
+
+import os
+from collections import defaultdict
+from collections.abc import Iterable
+from pathlib import Path
+
+import numpy as np
+
+from maizeviz.canopy.layout import CanopyLayout
+from maizeviz.canopy.scene import Canopy, PlantMesh, place_plants, plant_meshes
+from maizeviz.errors import LeafError
+from maizeviz.io.parquet import NotStreamable, is_parquet, parquet_rows, point_chunks
+from maizeviz.leaf.fit import fit_leaves
+from maizeviz.leaf.grid import base_of_collars, build_grids
+from maizeviz.mesh.levels import Level
+from maizeviz.progress import ProgressCallback, report
+
+#: Parquet points files with more records than this are read plant chunk by plant chunk.
+FIELD_POINTS = int(os.environ.get("MAIZEVIZ_FIELD_POINTS", 4_000_000))
+#: Points read, gridded, fitted and meshed at a time.
+CHUNK_POINTS = 1 << 20
+#: Processes building a field's chunks side by side, unless a FieldLeaves says (the command
+#: line: one per core; from Python, which starts new processes only from a script guarded by
+#: ``if __name__ == "__main__"``, this process alone).
+WORKERS: int | None = None
+
+
+def field_input(path: str | Path) -> bool:
+    """Whether ``path`` is read as a field (:class:`FieldLeaves`): a Parquet points file of
+    more than :data:`FIELD_POINTS` records."""
+    if not is_parquet(path):
+        return False
+    rows = parquet_rows(path)
+    return rows is not None and rows > FIELD_POINTS
+
+
+class LeafShapes:
+    """Plant and grid shape of every leaf of a field, as arrays (L,): ``plant`` int64,
+    ``rows`` and ``cols`` int32, ``tip`` bool (a collapsed tip row)."""
+
+    def __init__(self, plant: np.ndarray, rows: np.ndarray, cols: np.ndarray, tip: np.ndarray):
+        self.plant, self.rows, self.cols, self.tip = plant, rows, cols, tip
+
+    def __len__(self) -> int:
+        return len(self.plant)
+
+
+class FieldLeaves:
+    """The leaves of a field points file, surveyed chunk by chunk (see the module docstring).
+
+    Stands in for the list of fitted leaves where the commands take one: its length is the
+    number of leaves, :attr:`shapes` gives the cost estimates their grid shapes, :attr:`bases`
+    the layout its plants' stalk bases; :meth:`canopy` builds a canopy at a level.
+
+    Attributes
+    ----------
+    path : the points file
+    shapes : LeafShapes of the leaves kept
+    bases : {plant: (x, y) cm}, stalk bases (median of the leaves' insertions)
+    skipped : LeafError of each leaf refused
+    notes : repairs made, in words ("plant 3, leaf 2: ...")
+    rows : records in the file
+    extents : {plant: (x0, y0, x1, y1) cm}, the bounding box of its points from above
+    highest : cm, the highest point
+    """
+
+    def __init__(self, path: str | Path, strict: bool = False, degree: int = 3,
+                 method: str = "chord", progress: ProgressCallback | None = None,
+                 survey: bool = True, workers: int = 1):
+        self.path = Path(path)
+        #: processes building chunks side by side (:meth:`plant_meshes`)
+        self.workers = workers
+        self.strict, self.degree, self.method = strict, degree, method
+        self.rows = parquet_rows(path) or 0
+        plant: list[int] = []
+        nrows: list[int] = []
+        ncols: list[int] = []
+        tip: list[bool] = []
+        collars: dict[int, list] = defaultdict(list)      # (x, y) of each leaf's collar
+        self.skipped: list[LeafError] = []
+        self.notes: list[str] = []
+        lo: dict[int, np.ndarray] = {}
+        hi: dict[int, np.ndarray] = {}
+        self.highest = -np.inf
+        #: records [start, stop) of each chunk of whole plants, in the file's order
+        self.chunks: list[tuple[int, int]] = []
+        done = 0
+        for table in point_chunks(path, CHUNK_POINTS) if survey else ():
+            self.chunks.append((int(table.line[0]) - 2, int(table.line[-1]) - 1))
+            grids, errors = build_grids(table, strict=strict)
+            self.skipped += errors
+            plant += [g.plant for g in grids]
+            nrows += [g.points.shape[0] for g in grids]
+            ncols += [g.points.shape[1] for g in grids]
+            tip += [g.tip_collapsed for g in grids]
+            for g in grids:
+                collars[g.plant].append(g.collar[:2].copy())
+            self.notes += [f"plant {g.plant}, leaf {g.leaf}: {n}" for g in grids if g.notes
+                           for n in g.notes]
+            # each plant's points seen from above (its records lie together in the chunk)
+            ids, xyz = table.ids[:, 0], table.xyz
+            starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
+            for p, a, b in zip(ids[starts].tolist(), np.minimum.reduceat(xyz, starts),
+                               np.maximum.reduceat(xyz, starts)):
+                lo[p] = np.minimum(lo[p], a) if p in lo else a
+                hi[p] = np.maximum(hi[p], b) if p in hi else b
+            if len(xyz):
+                self.highest = max(self.highest, float(xyz[:, 2].max()))
+            done += len(table)
+            report(progress, done, max(self.rows, done), "reading the field")
+        self.shapes = LeafShapes(np.array(plant, np.int64), np.array(nrows, np.int32),
+                                 np.array(ncols, np.int32), np.array(tip, bool))
+        self.bases = {p: base_of_collars(np.array(c)) for p, c in collars.items()}
+        self.extents = {p: (float(lo[p][0]), float(lo[p][1]), float(hi[p][0]), float(hi[p][1]))
+                        for p in self.bases}
+
+    def spread(self, plant: int) -> float:
+        """How far (cm) the plant's points lie from its stalk base, seen from above (at most)."""
+        x0, y0, x1, y1 = self.extents[plant]
+        bx, by = self.bases[plant]
+        return float(max(np.hypot(x - bx, y - by) for x in (x0, x1) for y in (y0, y1)))
+
+    def __len__(self) -> int:
+        return len(self.shapes)
+
+    @property
+    def plants(self) -> set[int]:
+        return set(self.bases)
+
+    def plant_meshes(self, level: Level, preserve_area: bool = True, only: set[int] | None = None,
+                     progress: ProgressCallback | None = None,
+                     workers: int | None = None) -> dict[int, PlantMesh]:
+        """The meshes of the field's plants (those in ``only``, default all) at ``level``,
+        relative to their stalk bases, chunk by chunk; ``progress`` counts chunks.
+
+        ``workers``: processes building chunks side by side (default: :attr:`workers`, else
+        :data:`WORKERS`); each reads its chunk's records from the file. The meshes are the same
+        either way.
+        """
+        chunks = self.chunks                               # none when not surveyed
+        n = workers or WORKERS or self.workers
+        out: dict[int, PlantMesh] = {}
+        jobs = [(str(self.path), a, b, level, preserve_area, self.strict, self.degree,
+                 self.method, only) for a, b in chunks]
+        if not jobs:                                        # a field known only by its path
+            for table in point_chunks(self.path, CHUNK_POINTS):
+                meshes, errors = _mesh_table(table, level, preserve_area, self.strict,
+                                             self.degree, self.method, only)
+                out.update(meshes)
+                self.skipped += errors
+            return out
+        results: Iterable
+        if n <= 1 or len(jobs) <= 1:
+            results = (_mesh_rows(*job) for job in jobs)
+            pool = None
+        else:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor
+
+            pool = ProcessPoolExecutor(min(n, len(jobs)),
+                                       mp_context=multiprocessing.get_context("forkserver"))
+            results = pool.map(_mesh_rows, *zip(*jobs))
+        try:
+            for k, (meshes, errors) in enumerate(results, start=1):
+                out.update(meshes)
+                self.skipped += [LeafError(*e) for e in errors]
+                report(progress, k, len(jobs), f"building the field at {level}")
+        finally:
+            if pool is not None:
+                pool.shutdown(cancel_futures=True)
+        return out
+
+    def canopy(self, layout: CanopyLayout, level: Level, preserve_area: bool = True,
+               progress: ProgressCallback | None = None) -> Canopy:
+        """The canopy of the plants ``layout`` places, meshed at ``level``: the canopy
+        :func:`~maizeviz.canopy.scene.build_canopy` makes of the same leaves."""
+        placed = {p.plant for p in layout.placements}
+        meshes = self.plant_meshes(level, preserve_area, placed, progress)
+        return place_plants(meshes, layout, level.label)
+
+
+def _mesh_table(table, level: Level, preserve_area: bool, strict: bool, degree: int,
+                method: str, only: set[int] | None):
+    """The plant meshes of a table of whole plants (those in ``only``), and the leaves that
+    could not be fitted (as LeafErrors)."""
+    if only is not None:
+        keep = np.isin(table.ids[:, 0], list(only))
+        if not keep.any():
+            return {}, []
+        table = type(table)(ids=table.ids[keep], xyz=table.xyz[keep], line=table.line[keep],
+                            source=table.source)
+    grids, _ = build_grids(table, strict=strict)                  # said by the survey
+    leaves, errors = fit_leaves(grids, degree, method, strict=strict)
+    return plant_meshes(leaves, level, preserve_area), errors
+
+
+def _mesh_rows(path: str, start: int, stop: int, level: Level, preserve_area: bool,
+               strict: bool, degree: int, method: str, only: set[int] | None):
+    """:func:`_mesh_table` of the records [start, stop) of a Parquet points file (in a worker
+    process: errors as (plant, leaf, detail), which pickle)."""
+    from maizeviz.io.parquet import read_rows
+
+    meshes, errors = _mesh_table(read_rows(path, start, stop), level, preserve_area, strict,
+                                 degree, method, only)
+    return meshes, [(e.plant, e.leaf, e.detail) for e in errors]
+
+
+def canopy_of(leaves, layout: CanopyLayout, level: Level, preserve_area: bool = True,
+              progress: ProgressCallback | None = None) -> Canopy:
+    """:func:`~maizeviz.canopy.scene.build_canopy` of a list of fitted leaves, or
+    :meth:`FieldLeaves.canopy` of a field: what the commands build a canopy with."""
+    if isinstance(leaves, FieldLeaves):
+        return leaves.canopy(layout, level, preserve_area, progress)
+    from maizeviz.canopy.scene import build_canopy
+
+    return build_canopy(leaves, layout, level, preserve_area, progress)
+
+
+def read_field(path: str | Path, strict: bool = False,
+               progress: ProgressCallback | None = None, workers: int = 1) -> FieldLeaves | None:
+    """The survey of a field points file (:func:`field_input`), or None where the file
+    cannot be read chunk by chunk (records the CSV reader must check, a plant's records not
+    together): the caller then reads it whole."""
+    try:
+        return FieldLeaves(path, strict, progress=progress, workers=workers)
+    except NotStreamable:
+        return None
+

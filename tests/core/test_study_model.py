@@ -1,0 +1,182 @@
+"""A whole study driven through the app's model, with no window and no QApplication: open
+points, build at a level, a sun, a day, leaf optics, an edited layout, save, reopen. The oracle
+is the core itself (the same light traced by :class:`maizeviz.light.engine.LightEngine`),
+conservation (the energy balance closes) and round trips (the project reopens to the same
+settings, layout and results)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from maizeviz.io.points import write_points
+from maizeviz.leaf.synth import block_grids
+
+pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
+
+
+@pytest.fixture(scope="module")
+def points(tmp_path_factory):
+    path = tmp_path_factory.mktemp("study") / "two_plants.csv"
+    write_points(path, block_grids(1, 2, seed=3))
+    return path
+
+
+@pytest.fixture
+def study():
+    from maizeviz_app.model import StudyModel
+    from maizeviz_app.runner import InlineRunner
+
+    runner = InlineRunner()
+    model = StudyModel(tile=1, runner=runner)
+    said: list[str] = []
+    model.said.connect(lambda text, error, status_only: said.append(text))
+    model.said_lines = said                               # type: ignore[attr-defined]
+    yield model
+    runner.shutdown()
+
+
+def _errors(model) -> list[str]:
+    return [t for t in model.said_lines if t.startswith("error")]
+
+
+def test_the_model_and_its_actions_run_without_qt():
+    code = ("import sys, maizeviz_app.model, maizeviz_app.runner, maizeviz_app.settings; "
+            "m = maizeviz_app.model.StudyModel(runner=maizeviz_app.runner.InlineRunner()); "
+            "m.settings.light.mode = 'day'; m.compute_light(); "
+            "bad = [n for n in sys.modules if n.split('.')[0] in ('PySide6', 'pyvista', 'vtk')]; "
+            "print(bad); sys.exit(1 if bad else 0)")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+
+
+def test_a_whole_study_through_the_model(study, points, tmp_path):
+    from maizeviz_app.model import StudyModel
+    from maizeviz_app.runner import InlineRunner
+
+    from maizeviz.light.engine import LightEngine
+
+    m = study
+    built = []
+    m.canopy_changed.connect(built.append)
+    # ---- open points: read, laid out, built at the level set
+    m.open_points(points)
+    assert m.loaded is not None and len(m.loaded.plants) == 2
+    assert [b.label for b in built] == ["36 triangles"] and not _errors(m)
+    n36 = m.canopy.n_triangles
+    # ---- another level: setting it rebuilds; Table 2 keeps a row per level
+    m.settings.canopy.level = "8"
+    assert m.built.label == "8 triangles" and m.canopy.n_triangles < n36
+    assert set(m.measures_rows) == {"36 triangles", "8 triangles"}
+    # ---- the sun: what the core traces on the same canopy, to the last bit
+    s = m.settings
+    s.sampling.heights, s.sampling.density = "0, 100, 200", 1.0
+    s.sun.zenith_deg, s.sun.azimuth_deg = 30.0, 120.0
+    assert m.compute_light() and not _errors(m)
+    run = m.runs.of_kind("sun")
+    own = LightEngine(m.canopy).sun(zenith=30.0, azimuth=120.0,
+                                    sampling=s.sampling_spec())
+    np.testing.assert_array_equal(run.transmission, own.transmission)
+    assert run.classes is not None and len(run.classes) == m.canopy.n_triangles
+    assert m.modified and m.figures.plot is not None and len(m.figures.maps["sun"]) == 3
+    # ---- a day: PAR transmitted between 0 and 1, never less light higher up
+    s.light.mode = "day"
+    s.day.step_min, s.day.start, s.day.end = 120.0, "10:00", "14:00"
+    s.sky.split, s.sky.directions = "auto", 16
+    assert m.compute_light() and not _errors(m)
+    day = m.runs.of_kind("day")
+    t = day.transmission
+    assert np.all((0 <= t) & (t <= 1)) and np.all(np.diff(t) >= -1e-12)
+    assert "PAR incident" in m.summary and m.plants_run is day
+    assert m.runs.of_kind("sun") is run                        # both compared
+    # ---- leaf optics: the energy balance closes
+    s.light.mode = "sun"
+    s.optics.enabled = True
+    s.optics.band = "nir"                                      # the band's optics follow
+    assert s.optics.reflectance > 0.3
+    assert m.compute_light() and not _errors(m)
+    balance = m.runs.of_kind("sun").balance
+    assert balance is not None and abs(balance.closure) < 0.02
+    assert m.runs.of_kind("day") is day                        # the sun's settings only
+    # ---- edit the layout: results of the old layout go, the canopy is rebuilt on the new
+    old = m.loaded.layout
+    moved = replace(old.placements[0], x=old.placements[0].x + 7.5, azimuth_deg=90.0)
+    layout = replace(old, placements=(moved,) + old.placements[1:])
+    serial = m.serial
+    assert m.apply_layout(layout) is True
+    assert m.serial == serial + 1 and not m.runs.runs and m.layout_edited
+    assert m.built.serial == m.serial and m.canopy.layout.placements[0] == moved
+    s.optics.enabled = False
+    s.light.mode = "sun"
+    assert m.compute_light()
+    sun_after = m.runs.of_kind("sun").transmission
+    # ---- save, then reopen in a new model: settings, layout and results come back
+    path = tmp_path / "study.maizeviz"
+    assert m.save_project(path) and m.project_path == str(path) and not m.modified
+    runner2 = InlineRunner()
+    try:
+        m2 = StudyModel(tile=3, runner=runner2)
+        m2.open_project(path)
+        assert m2.settings.light_doc() == s.light_doc()
+        assert m2.settings.canopy.level == "8" and m2.loaded.layout.placements[0] == moved
+        assert m2.built.label == "8 triangles" and not m2.modified
+        reread = m2.runs.of_kind("sun")
+        np.testing.assert_array_equal(reread.transmission, sun_after)
+        assert reread.classes is not None                      # completed on its canopy
+    finally:
+        runner2.shutdown()
+
+
+def test_a_setting_out_of_range_is_named(study):
+    from maizeviz_app.settings import InputProblem
+
+    with pytest.raises(InputProblem, match="density.*from 0.01 to 100") as err:
+        study.settings.set("sampling", {"density": 500.0})
+    assert err.value.quantity == "density"
+    with pytest.raises(InputProblem, match="'mode' is 'moon'"):
+        study.settings.set("light", {"mode": "moon"})
+    assert study.settings.sampling.density == 2.0          # nothing set
+
+
+def test_bad_heights_fail_the_light_naming_the_field(study, points):
+    failed = []
+    study.failed.connect(lambda *a: failed.append(a))
+    study.open_points(points)
+    study.settings.sampling.heights = "0, fifty"
+    assert not study.compute_light()
+    text, doing, quantity, mode = failed[-1]
+    assert "fifty" in text and doing == "light" and quantity == "heights" and mode == "sun"
+
+
+def test_the_settings_defaults_are_the_cores():
+    from maizeviz_app.settings import StudySettings, band_defaults
+
+    from maizeviz.light.sources.irradiance import DEFAULT_PAR_UMOL_PER_J
+    from maizeviz.light.trace.scatter import DEFAULT_DEPTH
+
+    s = StudySettings()
+    assert s.day.par_factor == DEFAULT_PAR_UMOL_PER_J and s.optics.depth == DEFAULT_DEPTH
+    o = s.optics
+    assert (o.reflectance, o.transmittance, o.ground_reflectance, o.direct_w_m2) == \
+        band_defaults("par")
+
+
+def test_the_scripting_example_of_docs_app_runs(tmp_path):
+    """docs/app.md's script, run as written in a folder holding a block.csv."""
+    import re
+    from pathlib import Path
+
+    doc = (Path(__file__).parents[2] / "docs" / "app.md").read_text()
+    code = re.search(r"```python\n(.*?)```", doc, re.S).group(1)
+    write_points(tmp_path / "block.csv", block_grids(1, 2, seed=3))
+    (tmp_path / "script.py").write_text(code)
+    proc = subprocess.run([sys.executable, "script.py"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=600)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert "8 triangles: transmission" in proc.stdout and "PAR incident" in proc.stdout
+    assert "saved the project study.maizeviz" in proc.stdout
+    assert (tmp_path / "study.maizeviz").stat().st_size > 0

@@ -1,0 +1,158 @@
+"""A laptop screen (1366 x 768): every panel fits its dock without scrolling sideways and
+without cutting a label, a button or a field's text; every control has a tooltip and an
+accessible name equal to its label, by which a test (and a screen reader) finds it."""
+
+from __future__ import annotations
+
+import pytest
+from maizeviz_app.accessible import controls, label_text
+from PySide6.QtWidgets import (
+    QAbstractButton,
+    QCheckBox,
+    QComboBox,
+    QLabel,
+    QLineEdit,
+    QRadioButton,
+)
+from test_light_modes import TIMEOUT, shown
+
+#: The docks of the panels, raised in turn.
+PANELS = ("canopy", "light", "layout", "digitizer", "colour")
+
+
+def find(root, name: str, kind=None):
+    """The one visible control under ``root`` whose accessible name is ``name``."""
+    found = [c for c in controls(root) if c.accessibleName() == name and c.isVisible()
+             and (kind is None or isinstance(c, kind))]
+    assert len(found) == 1, f"{len(found)} controls named {name!r}"
+    return found[0]
+
+
+def _cut(widget) -> list[str]:
+    """What a panel shows cut: a label, button or check box narrower than its text, a field
+    narrower than its text, a combo narrower than its choice."""
+    cut = []
+    for c in widget.findChildren(QLabel) + widget.findChildren(QAbstractButton):
+        if not c.isVisible() or (isinstance(c, QLabel) and (c.wordWrap() or c.pixmap()
+                                                            and not c.pixmap().isNull())):
+            continue
+        if c.objectName().startswith("qt_") or not c.text():
+            continue
+        if c.sizeHint().width() > c.width() + 1:
+            cut.append(f"{type(c).__name__} {c.text()!r}: {c.width()} < {c.sizeHint().width()}")
+    for e in widget.findChildren(QLineEdit):
+        if e.isVisible() and e.isEnabled() and not e.objectName().startswith("qt_") and \
+                e.fontMetrics().horizontalAdvance(e.text()) + 12 > e.width():
+            cut.append(f"field {e.accessibleName()!r} shows part of {e.text()!r}")
+    for b in widget.findChildren(QComboBox):
+        if b.isVisible() and \
+                b.fontMetrics().horizontalAdvance(b.currentText()) + 30 > b.width():
+            cut.append(f"combo {b.accessibleName()!r} cuts {b.currentText()!r}")
+    return cut
+
+
+def _labelled(control, label: str) -> bool:
+    """The control's name is its label (whatever the case), or, where the same label stands
+    in two groups (the colour panel's two scales), the label after its group's title."""
+    from PySide6.QtWidgets import QGroupBox
+
+    name, label = control.accessibleName().lower(), label_text(label).lower()
+    if name == label:
+        return True
+    parent = control.parent()
+    while parent is not None and not isinstance(parent, QGroupBox):
+        parent = parent.parent()
+    return parent is not None and name == f"{label_text(parent.title())} {label}".lower()
+
+
+def _fits(w, name: str) -> list[str]:
+    area = w.docks[name].widget()
+    problems = [f"{name} scrolls sideways by {area.horizontalScrollBar().maximum()} px"] \
+        if area.horizontalScrollBar().maximum() > 0 else []
+    return problems + [f"{name}: {c}" for c in _cut(area.widget())]
+
+
+@pytest.fixture
+def laptop(window, qtbot, small_points):
+    from PySide6.QtWidgets import QApplication
+
+    w = shown(qtbot, window(small_points, tile=1, size=None))
+    w.resize(1366, 768 - 28)                        # the screen less a panel bar
+    qtbot.wait(300)
+    assert QApplication.primaryScreen() is not None
+    return w
+
+
+def test_every_panel_fits_a_laptop_screen(laptop, qtbot):
+    w = laptop
+    problems = []
+    for name in PANELS:
+        w.docks[name].raise_()
+        qtbot.wait(150)
+        problems += _fits(w, name)
+    light = w.light_panel
+    for mode in ("sky", "day"):                     # the light's other pages
+        w.docks["light"].raise_()
+        light.set_mode(mode)
+        qtbot.wait(150)
+        problems += [f"{mode}: {p}" for p in _fits(w, "light")]
+    light.set_mode("sun")
+    w.model.settings.optics.enabled = True          # the optics open
+    qtbot.wait(150)
+    problems += [f"optics: {p}" for p in _fits(w, "light")]
+    assert not problems, "\n".join(problems)
+
+
+def test_canopy_measures_show_every_column(laptop, qtbot):
+    w = laptop
+    w.docks["canopy"].raise_()
+    with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
+        w.model.settings.canopy.level = "K4"
+    table = w.canopy_panel.table
+    qtbot.wait(100)
+    assert table.rowCount() == 2 and table.horizontalScrollBar().maximum() == 0
+    for c in range(table.columnCount()):
+        assert table.columnWidth(c) >= table.horizontalHeader().sectionSizeHint(c) - 1 or c == 0
+
+
+def test_every_control_has_a_tooltip_and_its_label_as_name(laptop):
+    w = laptop
+    unnamed, no_tip, wrong = [], [], []
+    roots = [w.docks[n].widget() for n in PANELS] + [w.statusBar(), w.plots, w.history,
+                                                     w.messages]
+    seen = 0
+    for root in roots:
+        for c in controls(root):
+            seen += 1
+            if not c.accessibleName():
+                unnamed.append(f"{type(c).__name__} in {type(root).__name__}")
+            if not c.toolTip():
+                no_tip.append(f"{type(c).__name__} {c.accessibleName()!r}")
+            if isinstance(c, (QCheckBox, QRadioButton)) or \
+                    (isinstance(c, QAbstractButton) and c.text() and len(c.text()) > 1):
+                if not _labelled(c, c.text()):
+                    wrong.append(f"{c.text()!r} named {c.accessibleName()!r}")
+        for label in root.findChildren(QLabel):
+            buddy = label.buddy()
+            if buddy is not None and label.text() and not _labelled(buddy, label.text()):
+                wrong.append(f"{label.text()!r} names a field {buddy.accessibleName()!r}")
+    assert seen > 60
+    assert not unnamed and not no_tip and not wrong, (unnamed, no_tip, wrong)
+
+
+def test_a_light_run_by_the_controls_names(laptop, qtbot):
+    """What a screen reader user (or a test) does: find the fields by their names."""
+    w = laptop
+    panel = w.docks["light"].widget()
+    w.docks["light"].raise_()
+    qtbot.wait(50)
+    find(panel, "Sky", QAbstractButton).click()
+    find(panel, "heights (cm)").setText("0, 100")
+    find(panel, "ray density").setValue(0.5)
+    find(panel, "directions").setCurrentIndex(0)             # 16, the turtle
+    assert w.model.settings.sky.directions == 16 and w.model.settings.light.mode == "sky"
+    with qtbot.waitSignal(w.light_shown, timeout=TIMEOUT):
+        find(panel, "Compute diffuse light").click()
+    assert w.model.runs.of_kind("sky") is not None
+    table = find(panel, "transmission table")
+    assert table.rowCount() == 2
