@@ -111,6 +111,15 @@ def test_a_leaf_model_paints_assimilation_and_a_project_keeps_it(window, qtbot, 
     lines = describe(canopy, run.label, [run], inst, leaf)
     said = [line for line in lines if "gross CO₂ assimilation" in line]
     assert said and f"{float(run.extra.gross_value[leaf_tri]):.3g} µmol/m² of leaf/s" in said[0]
+    # the exported canopy carries it per triangle, beside the absorbed light
+    import pyvista as pv
+
+    out = tmp_path / "carbon.vtu"
+    with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
+        w.model.export("canopy", out)
+    mesh = pv.read(out)
+    np.testing.assert_allclose(np.asarray(mesh.cell_data["gross_umol_co2_per_m2_leaf_s"])[:nf],
+                               run.extra.gross_value, rtol=1e-6)
     # a project keeps the model and gives the same assimilation back, painted
     path = tmp_path / "carbon.maizeviz"
     with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
