@@ -758,8 +758,10 @@ class LightPanel(QWidget):
             title = f"{band} each plant absorbs, with scattering"
             assimilation = getattr(run.extra, "assimilation", None)
             if assimilation is not None and "gross_umol_s" in rows[0]:
-                header += ["CO₂ gross µmol/s", "± se"]
-                keys += ("gross_umol_s", "gross_umol_s_se")
+                # beside the light it comes from, before the sunlit area (a narrow dock
+                # shows it without scrolling)
+                header[5:5] = ["CO₂ gross µmol/s", "± se"]
+                keys = keys[:2] + ("gross_umol_s", "gross_umol_s_se") + keys[2:]
                 title += (f", and its gross CO₂ assimilation ({_model_text(assimilation)})")
             self.plants_title.setText(f"{title} ({run.label})")
         elif day:
