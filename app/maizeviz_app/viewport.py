@@ -398,13 +398,7 @@ class Viewport(QtInteractor):
         follows if coloured by light."""
         if self.canopy_mesh is None:
             return
-        nf = int(self.canopy_mesh.field_data["leaf_triangles"][0])
-        given = int(self.canopy_mesh.field_data.get("canopy_triangles", [nf])[0])
-        if len(values) != given:
-            raise ValueError(f"{len(values)} light values for {given} leaf triangles")
-        cells = np.full(self.canopy_mesh.n_cells, -1.0, np.float32)     # stalks below range
-        cells[:nf] = _per_drawn(self.canopy_mesh, np.asarray(values), False)
-        self.canopy_mesh.cell_data["light_value"] = cells
+        self.canopy_mesh.cell_data["light_value"] = self._cells_of(values, "light")
         self.light_variant = "values"
         self._light_key = (title, unit)
         if self.colouring == "light":
@@ -427,17 +421,24 @@ class Viewport(QtInteractor):
                 self._apply_colouring()
                 self.render()
             return
-        nf = int(self.canopy_mesh.field_data["leaf_triangles"][0])
-        given = int(self.canopy_mesh.field_data.get("canopy_triangles", [nf])[0])
-        if len(values) != given:
-            raise ValueError(f"{len(values)} assimilation values for {given} leaf triangles")
-        cells = np.full(self.canopy_mesh.n_cells, -1.0, np.float32)     # stalks below range
-        cells[:nf] = _per_drawn(self.canopy_mesh, np.asarray(values), False)
-        self.canopy_mesh.cell_data["assimilation_value"] = cells
+        self.canopy_mesh.cell_data["assimilation_value"] = self._cells_of(values,
+                                                                         "assimilation")
         self._assimilation_key = (title, unit)
         if self.colouring == "assimilation":
             self._apply_colouring()
             self.render()
+
+    def _cells_of(self, values: np.ndarray, what: str) -> np.ndarray:
+        """(n_cells,) float32 of the drawn mesh from a value per leaf triangle of the canopy
+        (F,): stalks -1 (below any range); ValueError for a wrong length."""
+        assert self.canopy_mesh is not None
+        nf = int(self.canopy_mesh.field_data["leaf_triangles"][0])
+        given = int(self.canopy_mesh.field_data.get("canopy_triangles", [nf])[0])
+        if len(values) != given:
+            raise ValueError(f"{len(values)} {what} values for {given} leaf triangles")
+        cells = np.full(self.canopy_mesh.n_cells, -1.0, np.float32)     # stalks below range
+        cells[:nf] = _per_drawn(self.canopy_mesh, np.asarray(values), False)
+        return cells
 
     def colour_by(self, what: str) -> bool:
         """Colour the canopy by ``plant``, ``leaf``, ``light`` or ``assimilation``; False
