@@ -381,6 +381,7 @@ class _Level:
     sky_res: SkyLight | None = None
     per_res: PeriodLight | None = None
     ab: AbsorbedLight | None = None
+    asm: Any = None                     # the sun's Assimilation, with a leaf model
 
 
 def run(args: argparse.Namespace) -> int:
@@ -538,7 +539,8 @@ def _trace_level(job: _Job, canopy: Canopy, canopy_s: float) -> dict[str, Any]:
                    lv.tables, lv.plant_extra)
     if args.export:
         path = export_canopy(args.export, canopy,
-                             light_cells(canopy, lv.res, lv.sky_res, lv.per_res, lv.ab))
+                             light_cells(canopy, lv.res, lv.sky_res, lv.per_res, lv.ab,
+                                         lv.asm))
         say(f"wrote {canopy.n_triangles:,} leaf triangles of {canopy.n_plants} plants with "
             f"their light (and their stalks) to {path}")
     return rec
@@ -655,7 +657,7 @@ def _trace_absorbed_sun(job: _Job, lv: _Level) -> None:
         lv.tables.append(ab.leaf_rows(lv.canopy))
         _merge(lv.plant_extra, _plant_errors(lv.canopy, ab))
     if job.leaf_model is not None:
-        asm = assimilate(lv.canopy, ab, job.leaf_model, job.temp_c)
+        asm = lv.asm = assimilate(lv.canopy, ab, job.leaf_model, job.temp_c)
         lv.rec["photosynthesis"] = asm.as_dict()
         _say_once(job, list(asm.warnings))
         if job.want_rows:
