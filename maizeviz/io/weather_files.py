@@ -33,6 +33,7 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.io.inputs import read_input
+from maizeviz.numbers import number
 
 #: The formats read here, by name.
 PVLIB_FORMATS = {"epw": "EnergyPlus EPW", "tmy3": "NREL TMY3", "psm": "NSRDB PSM3/PSM4"}
@@ -77,6 +78,29 @@ class WeatherTable:
     label: str
     meta: dict[str, Any] = field(default_factory=dict)
     notes: tuple[str, ...] = ()
+
+
+def weather_text(raw: bytes, path: Path) -> tuple[str, list[str]]:
+    """A weather file's bytes as text (UTF-8, a byte-order mark dropped; else Latin-1) and
+    the notes on it. A file ending in zero bytes (a power cut while it was written leaves its
+    new length without its data) is read up to them, said in a note naming how many bytes
+    are left; a file of nothing but zeros, or with a zero byte before its tail, is refused."""
+    kept = raw.rstrip(b"\x00")
+    notes = []
+    if len(kept) < len(raw):
+        if not kept.strip():
+            raise WeatherFileError(f"{path}: not a text file (only zero bytes)")
+        notes.append(f"{path.name}: the file ends in {len(raw) - len(kept):,} zero bytes (as a "
+                     "power cut leaves a file being written): read up to them, the lines "
+                     "before them are kept")
+    if b"\x00" in kept:
+        line = kept.count(b"\n", 0, kept.index(b"\x00")) + 1
+        raise WeatherFileError(f"{path}, line {line}: a zero byte: not a text file (binary "
+                               "content)")
+    try:
+        return kept.decode("utf-8-sig"), notes
+    except UnicodeDecodeError:
+        return kept.decode("latin-1"), notes          # TMY3 files of SolarAnywhere, old EPW
 
 
 def detect_format(path: Path, head: bytes) -> str:
@@ -138,7 +162,7 @@ def _first_bad_row(text: str, kind: str) -> tuple[int, str] | None:
             if k in texts:
                 continue
             try:
-                float(cells[k])
+                number(cells[k])
             except ValueError:
                 name = f" ({header[k]})" if k < len(header) and header[k] else ""
                 return no, f"column {k + 1}{name} is '{cells[k][:30]}', not a number"
@@ -176,12 +200,8 @@ def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable
     """
     path = Path(path)
     raw = read_input(path, "weather file", max_bytes, WeatherFileError)
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        text = raw.decode("latin-1")                # TMY3 files of SolarAnywhere, old EPW
+    text, notes = weather_text(raw, path)
     name = PVLIB_FORMATS[kind]
-    notes: list[str] = []
     try:
         data, meta = _read(kind, text, None)
         if kind != "psm" and _typical_year(data.index):
@@ -211,9 +231,10 @@ def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable
         missing = np.flatnonzero(np.isin(v, MISSING_CODES[kind]) | ~np.isfinite(v))
         if len(missing):
             k = int(missing[0])
+            what = f"missing value ({v[k]:g}, {name}'s code for one)" \
+                if np.isfinite(v[k]) else f"{v[k]:g} is not a finite number (a missing value?)"
             raise WeatherFileError(f"{path}, line {lines[k]} ({times[k].isoformat()}), column "
-                                   f"{col}: missing value ({v[k]:g}, {name}'s code for one); "
-                                   "fill the gap or cut the file")
+                                   f"{col}: {what}; fill the gap or cut the file")
         values[col] = v
     temp = np.array([_float_or_nan(x) for x in data["temp_air"]]) if "temp_air" in data \
         else np.full(len(data), np.nan)
@@ -234,24 +255,28 @@ def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable
 
 def _floats(column, where: str, lines: np.ndarray, times) -> np.ndarray:
     """A column as (n,) float64; the first cell that is no number is refused, ``where``
-    formatted with its line and time."""
-    try:
-        return np.asarray(column, dtype=np.float64)
-    except (TypeError, ValueError):
-        pass
-    for k, x in enumerate(column):
+    formatted with its line and time. pandas leaves a column of text where a cell is not a
+    number its parser reads; such cells are read by :func:`maizeviz.numbers.number`, which
+    refuses ``8_04`` and full-width digits that ``float`` would take."""
+    values = np.asarray(column)
+    if values.dtype.kind in "fiu":
+        return values.astype(np.float64)
+    out = np.empty(len(values), np.float64)
+    for k, x in enumerate(values):
         try:
-            float(x)
-        except (TypeError, ValueError):
+            out[k] = x if isinstance(x, (int, float)) else number(str(x))
+        except ValueError:
             raise WeatherFileError(where.format(line=lines[k], time=times[k].isoformat())
                                    + f": '{str(x)[:30]}' is not a number") from None
-    return np.array([float(x) for x in column])                     # pragma: no cover
+    return out
 
 
 def _float_or_nan(x) -> float:
-    try:
+    if isinstance(x, (int, float, np.number)):
         return float(x)
-    except (TypeError, ValueError):
+    try:
+        return number(str(x))
+    except ValueError:
         return math.nan
 
 
