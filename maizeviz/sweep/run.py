@@ -187,6 +187,12 @@ def describe_cluster(client, kind: str) -> dict:
             "distributed": distributed.__version__}
 
 
+def max_local_workers() -> int:
+    """Most worker processes of a local cluster: 4 a core (at least 8). The tracing is CPU
+    bound, so more only share the cores; 100,000 asked started processes for minutes."""
+    return max(8, 4 * (os.cpu_count() or 1))
+
+
 @contextmanager
 def dask_client(workers: int | None = None, scheduler: str | None = None,
                 connect_timeout: float = CONNECT_TIMEOUT_S):
@@ -222,8 +228,10 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
         kind = "scheduler"
     else:
         n = workers or os.cpu_count() or 1
-        if n < 1:
-            raise SchedulerError(f"--workers must be >= 1, got {n}")
+        most = max_local_workers()
+        if not 1 <= n <= most:
+            raise SchedulerError(f"--workers must be from 1 to {most} on this machine (4 a "
+                                 f"core of its {os.cpu_count() or 1}; a process each), got {n:,}")
         try:
             with _sigint_ignored(), dask.config.set(LOCAL_CONFIG):
                 cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,

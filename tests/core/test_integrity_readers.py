@@ -87,3 +87,102 @@ def test_a_weather_file_with_a_byte_order_mark_reads_as_without(tmp_path, kind):
     marked.write_bytes(b"\xef\xbb\xbf" + clean.read_bytes())
     a, b = read_weather(clean), read_weather(marked)
     assert np.array_equal(a.ghi, b.ghi) and list(a.times) == list(b.times)
+
+
+# ------------------------------------------------------------------ maizeviz subplots
+
+BLOCK = Path(__file__).resolve().parents[2] / "maizeviz" / "resources" / "block3x3.csv"
+SUN = ["--sun-zenith", "30", "--sun-azimuth", "150"]
+
+
+@pytest.fixture(scope="module")
+def block_parquet(tmp_path_factory):
+    from maizeviz.cli import main
+
+    path = tmp_path_factory.mktemp("pq") / "block.parquet"
+    assert main(["convert", str(BLOCK), "--out", str(path)]) == 0
+    return path
+
+
+def _one_error(capsys, argv) -> str:
+    from maizeviz.cli import main
+
+    capsys.readouterr()
+    code = main(argv)
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if ln.startswith("error")]
+    assert code != 0 and len(lines) == 1 and "Traceback" not in err, err
+    return lines[0]
+
+
+@pytest.mark.parametrize("extra, says", [
+    # took minutes: 8,100 tasks each building the whole block (the windows clamp to the lattice)
+    (["--parts", "100000x100000"], "at most 1,024 are traced (each builds"),
+    (["--parts", "1000x1"], "a sub-plot needs a ray across each way (--parts)"),
+    # started 100,000 worker processes
+    (["--workers", "100000"], "--workers must be from 1 to"),
+    # heights were not checked at all: duplicates, negative and 1e308 gave exit 0
+    (["--heights", "50,0,50"], "height 50 cm is given twice (heights 1 and 3) (--heights)"),
+    (["--heights", "-5"], "heights must be from 0 to 10,000 cm, got -5 (--heights)"),
+    (["--heights", "1e308"], "got 1e+308 (--heights)"),
+    (["--level", "0"], "a triangle budget must be >= 1, got 0 (--level)"),   # said --triangles
+    (["--rect", "0,0,1000,1000"], "is not inside the plot"),
+    (["--density", "1e-308"], "puts no ray across"),
+])
+def test_subplots_refuses_before_any_worker_starts(capsys, block_parquet, extra, says):
+    import time
+
+    start = time.perf_counter()
+    line = _one_error(capsys, ["subplots", str(block_parquet), *SUN, *extra])
+    assert says in line
+    assert "LocalCluster" not in capsys.readouterr().err
+    assert time.perf_counter() - start < 60
+
+
+def test_sweep_refuses_a_hundred_thousand_workers(capsys, tmp_path):
+    from maizeviz.cli import main
+
+    capsys.readouterr()
+    spec = BLOCK.with_name("sweep-example.toml")
+    assert main(["sweep", str(spec), "--workers", "100000", "--out", str(tmp_path / "o")]) == 2
+    assert "--workers must be from 1 to" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
+
+
+def test_subplots_json_equals_the_whole_field_traced_at_once(capsys, tmp_path, block_parquet):
+    """The same quantity computed another way: the sub-plots' transmission (heights given in
+    another order) and each plant's sunlit and second-class light are the numbers `maizeviz
+    light` gives for the whole field traced in one scene; the sunlit leaf area is the
+    intercepted fraction times the rectangle."""
+    import csv
+    import json
+
+    from maizeviz.cli import main
+
+    pytest.importorskip("distributed")
+    heights = [0.0, 50.0, 100.0, 150.0]
+    order = [2, 0, 3, 1]
+    plants_a, plants_b = tmp_path / "a.csv", tmp_path / "b.csv"
+    capsys.readouterr()
+    assert main(["light", str(block_parquet), "--triangles", "36", *SUN, "--density", "1",
+                 "--heights", ",".join(map(str, heights)), "--plant-light", str(plants_a),
+                 "--json"]) == 0
+    whole = json.loads(capsys.readouterr().out)
+    assert main(["subplots", str(block_parquet), *SUN, "--parts", "3x2", "--workers", "2",
+                 "--heights", ",".join(str(heights[k]) for k in order),
+                 "--plant-light", str(plants_b), "--json"]) == 0
+    parts = json.loads(capsys.readouterr().out)
+    assert parts["rays"] == whole["rays"]
+    assert parts["transmission"] == [whole["transmission"][k] for k in order]
+    x0, y0, x1, y1 = whole["rect_cm"]
+    assert parts["sunlit_leaf_area_m2"] == pytest.approx(
+        whole["sunlit_intercepted_fraction"] * (x1 - x0) * (y1 - y0) / 1e4, rel=1e-12)
+    with open(plants_a, newline="") as fa, open(plants_b, newline="") as fb:
+        a = {r["instance"]: r for r in csv.DictReader(fa)}
+        b = {r["instance"]: r for r in csv.DictReader(fb)}
+    assert len(a) == 9 and set(a) <= set(b)
+    for k, row in b.items():
+        lit = a.get(k, {"sunlit_intercepted_cm2": 0, "second_class_intercepted_cm2": 0})
+        assert float(row["sunlit_cm2"]) == pytest.approx(float(lit["sunlit_intercepted_cm2"]))
+        assert float(row["second_cm2"]) == pytest.approx(
+            float(lit["second_class_intercepted_cm2"]))
