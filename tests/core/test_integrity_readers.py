@@ -186,3 +186,58 @@ def test_subplots_json_equals_the_whole_field_traced_at_once(capsys, tmp_path, b
         assert float(row["sunlit_cm2"]) == pytest.approx(float(lit["sunlit_intercepted_cm2"]))
         assert float(row["second_cm2"]) == pytest.approx(
             float(lit["second_class_intercepted_cm2"]))
+
+
+# ------------------------------------------------------------------ mesh files
+
+
+@pytest.fixture(scope="module")
+def small_meshes(tmp_path_factory):
+    """The two-plant test mesh as an ascii PLY, a binary PLY (whose last face, a stalk of
+    leaf 0, ends in zero bytes) and an OBJ."""
+    from tests.core.test_mesh_canopy import F, LEAF, PLANT, V, write_obj, write_ply
+
+    d = tmp_path_factory.mktemp("mesh")
+    props = {"plant": np.array(PLANT), "leaf": np.array(LEAF)}
+    return {"ascii": write_ply(d / "a.ply", V, F, props),
+            "binary": write_ply(d / "b.ply", V, F, props, fmt="binary_little_endian"),
+            "obj": write_obj(d / "c.obj", V, F, [f"plant{p}_leaf{k}" for p, k in
+                                                 zip(PLANT, LEAF)])}
+
+
+def _same_mesh(a, b):
+    for name in ("vertices", "faces", "plant", "leaf", "triangle_face"):
+        assert np.array_equal(getattr(a, name), getattr(b, name)), name
+
+
+@pytest.mark.parametrize("kind", ["ascii", "binary", "obj"])
+def test_a_mesh_ending_in_zeros_reads_up_to_them(tmp_path, small_meshes, kind):
+    """A power cut's zero bytes after a mesh's last line (or a binary PLY's last element) were
+    refused: 'a value of 4,096 characters' (ascii PLY), 'not an OBJ statement' (OBJ), '4,096
+    bytes follow the last element' (binary). Read up to them now, with a note; the binary
+    file's own last bytes (a leaf id of 0) are data, never taken for such zeros."""
+    from maizeviz.io.mesh_canopy import MeshFileError, read_mesh
+
+    clean = small_meshes[kind]
+    assert kind != "binary" or clean.read_bytes().endswith(b"\0\0\0\0")
+    zeros = tmp_path / f"z{clean.suffix}"
+    zeros.write_bytes(clean.read_bytes() + b"\0" * 4096)
+    a, b = read_mesh(clean), read_mesh(zeros)
+    _same_mesh(a, b)
+    assert not any("zero bytes" in n for n in a.notes)
+    assert any("4,096 zero bytes" in n for n in b.notes), b.notes
+    only = tmp_path / f"only{clean.suffix}"
+    only.write_bytes(b"\0" * 64)
+    with pytest.raises(MeshFileError):
+        read_mesh(only)
+
+
+def test_an_ascii_ply_with_a_byte_order_mark_reads_as_without(tmp_path, small_meshes):
+    """Refused before as 'not a PLY file' (an OBJ with the mark was read)."""
+    from maizeviz.io.mesh_canopy import read_mesh
+
+    marked = tmp_path / "bom.ply"
+    marked.write_bytes(b"\xef\xbb\xbf" + small_meshes["ascii"].read_bytes())
+    b = read_mesh(marked)
+    _same_mesh(read_mesh(small_meshes["ascii"]), b)
+    assert any("byte-order mark" in n for n in b.notes)
