@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import Phase, given, settings
 from hypothesis import strategies as st
 
 from maizeviz.canopy.layout import layout_from_dict
@@ -24,6 +24,7 @@ from maizeviz.light.sources.sky import make_sky
 from maizeviz.light.sources.sun import Sun
 from maizeviz.light.trace.diffuse import trace_period, trace_sky
 from maizeviz.light.trace.direct import trace_light
+from tests.core.test_mesh_canopy import write_obj, write_ply
 
 BLOCK = str(Path(__file__).resolve().parents[2] / "maizeviz/resources/block3x3.csv")
 
@@ -162,8 +163,6 @@ def test_a_mesh_written_twice_measures_as_once(tmp_path, capsys, block_mesh, how
     """Issue 25 case 3: every face written twice gave twice the leaf area and LAI, no word.
     A repeated triangle (the same three corners, by position, in any order) counts once, and
     a note says how many were left out."""
-    from tests.core.test_mesh_canopy import write_ply
-
     v, f, plant, leaf = block_mesh
     once = write_ply(tmp_path / "once.ply", v, f, {"plant": plant, "leaf": leaf},
                      fmt="binary_little_endian")
@@ -367,3 +366,145 @@ def test_a_stand_written_twice_in_a_layout_is_reported(capsys, tmp_path):
     assert main(["canopy", BLOCK, "--layout", str(layout), "--triangles", "8"]) == 0
     err = capsys.readouterr().err
     assert "closer than the spacing" in err and "counted twice" in err
+
+
+# ------------------------------------------------------------------ Parquet points files
+
+
+def _parquet_of(tmp_path, csv_path, name):
+    out = tmp_path / f"{name}.parquet"
+    assert main(["convert", str(csv_path), "--out", str(out)]) == 0
+    return out
+
+
+@settings(max_examples=3, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate))
+@given(st.integers(0, 2**31))
+def test_a_parquet_file_in_any_row_order_builds_and_traces_the_same(tmp_path_factory, seed):
+    """The bundled block's records shuffled, then written as Parquet (read column by column,
+    not through the CSV reader): the same canopy and the same light as the CSV in its order."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    tmp = tmp_path_factory.mktemp("pq")
+    table = pq.read_table(_parquet_of(tmp, BLOCK, "block"))
+    order = np.random.default_rng(seed).permutation(table.num_rows)
+    shuffled = tmp / "shuffled.parquet"
+    pq.write_table(table.take(pa.array(order)), shuffled)
+    argv = ["--tile", "3x3", "--triangles", "36"]
+    light = [*argv, *SUN_30, "--density", "1", "--heights", "100,0,50", "--json"]
+    with contextlib.redirect_stderr(io.StringIO()):
+        for points in (BLOCK, shuffled):
+            out = io.StringIO()
+            with contextlib.redirect_stdout(out):
+                assert main(["canopy", str(points), *argv, "--json"]) == 0
+            canopy = _measures(json.loads(out.getvalue()))
+            out = io.StringIO()
+            with contextlib.redirect_stdout(out):
+                assert main(["light", str(points), *light]) == 0
+            doc = json.loads(out.getvalue())
+            got = (canopy, doc["transmission"], doc["sunlit_intercepted_fraction"])
+            if points == BLOCK:
+                want = got
+    assert got == want
+
+
+def test_a_parquet_record_written_twice_is_reported_not_counted_twice(capsys, tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(_parquet_of(tmp_path, BLOCK, "block"))
+    twice = tmp_path / "twice.parquet"
+    pq.write_table(pa.concat_tables([table, table.slice(9, 1)]), twice)
+    plant, leaf, row, col = (table.column(c)[9].as_py() for c in ("plant", "leaf", "row", "col"))
+    capsys.readouterr()
+    assert main(["leaf", str(twice), "--interp", "0"]) == 3
+    err = capsys.readouterr().err
+    assert (f"plant {plant}, leaf {leaf}: row {row}, col {col} appears twice (lines 11 and "
+            f"{table.num_rows + 2})") in err
+
+
+# ------------------------------------------------------------------ mesh files: face order
+
+
+def _mesh_runs(capsys, path):
+    """(canopy measures, light --json, leaf rows by (plant, leaf)) of a mesh file."""
+    import csv
+
+    table = Path(path).with_suffix(".leaves.csv")
+    canopy, _ = _canopy_json(capsys, path)
+    light = _json(capsys, ["light", str(path), "--mesh-unit", "cm", *SUN_30, "--density", "1",
+                           "--heights", "0,50,100", "--leaf-light", str(table), "--json"])
+    with open(table, newline="") as fh:
+        rows = {(r["plant"], r["leaf"]): r for r in csv.DictReader(fh)}
+    return _measures(canopy), light, rows
+
+
+def _number(x):
+    """A JSON value or a CSV cell as a float where it is a number, else as it is."""
+    if isinstance(x, bool) or not isinstance(x, (int, float, str)):
+        return x
+    try:
+        return float(x)
+    except ValueError:
+        return x
+
+
+def _close(a: dict, b: dict, rel: float):
+    assert set(a) == set(b)
+    for k, x in a.items():
+        x, y = _number(x), _number(b[k])
+        if isinstance(x, float):
+            assert y == pytest.approx(x, rel=rel, abs=1e-12), k
+        else:
+            assert y == x, k
+
+
+@settings(max_examples=4, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate))
+@given(st.integers(0, 2**31), st.sampled_from(["ascii", "binary_big_endian", "obj"]),
+       st.integers(0, 2))
+def test_mesh_faces_in_any_order_trace_the_same(tmp_path_factory, block_mesh, seed, fmt, turn):
+    """A mesh file's faces permuted and each face's corners turned (its orientation kept):
+    the same triangles, so the same canopy and light; sums of the same numbers in another
+    order may differ in their last bits (relative 1e-15 seen), nothing more."""
+    capsys = _Capture()
+    v, f, plant, leaf = block_mesh
+    tmp = tmp_path_factory.mktemp("faces")
+    perm = np.random.default_rng(seed).permutation(len(f))
+    g = np.roll(f[perm], turn, axis=1)
+
+    def write(name, faces, p, lf):
+        if fmt == "obj":
+            return write_obj(tmp / f"{name}.obj", v, faces,
+                             [f"plant{a}_leaf{b}" for a, b in zip(p, lf)])
+        return write_ply(tmp / f"{name}.ply", v, faces, {"plant": p, "leaf": lf}, fmt=fmt)
+
+    a = _mesh_runs(capsys, write("file", f, plant, leaf))
+    b = _mesh_runs(capsys, write("permuted", g, plant[perm], leaf[perm]))
+    _close(a[0], b[0], 1e-13)
+    assert b[1]["transmission"] == a[1]["transmission"]
+    assert b[1]["sunlit_intercepted_fraction"] == a[1]["sunlit_intercepted_fraction"]
+    assert set(b[2]) == set(a[2]) and len(a[2]) > 100
+    for key, row in a[2].items():
+        _close(row, b[2][key], 1e-12)
+
+
+class _Capture:
+    """capsys for a hypothesis test (a function-scoped fixture cannot be given): stdout and
+    stderr of one main() call."""
+
+    def readouterr(self):
+        out, err = self._out.getvalue(), self._err.getvalue()
+        self._out, self._err = io.StringIO(), io.StringIO()
+        self._redirect()
+        return out, err
+
+    def __init__(self):
+        self._out, self._err = io.StringIO(), io.StringIO()
+        self._stack = contextlib.ExitStack()
+        self._redirect()
+
+    def _redirect(self):
+        self._stack.close()
+        self._stack = contextlib.ExitStack()
+        self._stack.enter_context(contextlib.redirect_stdout(self._out))
+        self._stack.enter_context(contextlib.redirect_stderr(self._err))
