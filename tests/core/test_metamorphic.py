@@ -508,3 +508,67 @@ class _Capture:
         self._stack = contextlib.ExitStack()
         self._stack.enter_context(contextlib.redirect_stdout(self._out))
         self._stack.enter_context(contextlib.redirect_stderr(self._err))
+
+
+@pytest.fixture(scope="module")
+def exports(tmp_path_factory):
+    """The bundled block's canopy (9 plants, 8 triangles a leaf) exported in every format:
+    {ext: path}, and the plot it carries."""
+    tmp = tmp_path_factory.mktemp("exports")
+    paths = {}
+    with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
+        for ext in (".ply", ".obj", ".vtu", ".vtp", ".vtk", ".stl"):
+            paths[ext] = tmp / f"canopy{ext}"
+            assert main(["canopy", BLOCK, "--triangles", "8", "--export", str(paths[ext])]) == 0
+    import pyvista
+
+    field = tuple(float(v) for v in pyvista.read(paths[".vtu"]).field_data["field_cm"])
+    return paths, field
+
+
+@pytest.mark.parametrize("ext", [".obj", ".vtu", ".vtp", ".vtk", ".stl"])
+def test_each_export_format_carries_the_canopy_the_ply_does(capsys, tmp_path, exports, ext):
+    """A mesh round trip through each export format: its triangles and ids read back (OBJ by
+    maizeviz, the VTK files and the STL by VTK's readers through pyvista), written as a PLY
+    and measured and traced: every --json number is the PLY export's (STL, whose corners are
+    float32 and which carries no ids, takes its ids from the PLY's faces in order, and
+    agrees to float32's precision)."""
+    import pyvista
+
+    from maizeviz.io.mesh_canopy import read_mesh
+
+    paths, field = exports
+    ref = read_mesh(paths[".ply"])
+    if ext == ".obj":
+        got = read_mesh(paths[ext])
+        v, f, plant, leaf = got.vertices, got.faces, got.plant, got.leaf
+    else:
+        mesh = pyvista.read(paths[ext])
+        if not isinstance(mesh, pyvista.UnstructuredGrid):
+            mesh = mesh.cast_to_unstructured_grid()
+        assert set(mesh.celltypes.tolist()) == {5}                  # triangles only
+        v = np.asarray(mesh.points, np.float64)
+        f = mesh.cells.reshape(-1, 4)[:, 1:]
+        if ext == ".stl":
+            assert len(f) == len(ref.faces)
+            plant, leaf = ref.plant, ref.leaf
+        else:
+            plant, leaf = mesh.cell_data["plant"], mesh.cell_data["leaf"]
+    again = write_ply(tmp_path / "again.ply", v, f, {"plant": plant, "leaf": leaf},
+                      fmt="binary_little_endian")
+    common = ["--field=" + ",".join(repr(c) for c in field)]
+    argv = ["--mesh-unit", "cm", *common, *SUN_30, "--density", "1", "--heights", "0,50,100",
+            "--json"]
+    a = _measures(_canopy_json(capsys, paths[".ply"], *common)[0])
+    b = _measures(_canopy_json(capsys, again, *common)[0])
+    la = _json(capsys, ["light", str(paths[".ply"]), *argv])
+    lb = _json(capsys, ["light", str(again), *argv])
+    if ext == ".stl":
+        _close(a, b, 1e-6)
+        for x, y in zip(la["transmission"], lb["transmission"]):
+            assert y == pytest.approx(x, abs=2e-3)              # a ray in 500 on an edge
+    else:
+        assert b == a
+        assert lb["transmission"] == la["transmission"]
+        assert lb["sunlit_intercepted_fraction"] == la["sunlit_intercepted_fraction"]
+    assert a["leaves"] == 140 and 0 < la["transmission"][0] < 1
