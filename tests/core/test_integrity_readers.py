@@ -241,3 +241,28 @@ def test_an_ascii_ply_with_a_byte_order_mark_reads_as_without(tmp_path, small_me
     b = read_mesh(marked)
     _same_mesh(read_mesh(small_meshes["ascii"]), b)
     assert any("byte-order mark" in n for n in b.notes)
+
+
+def test_a_weather_file_day_follows_each_height_whatever_their_order(capsys, tmp_path):
+    """Issue 25 case 1 (T(0) wrong unless 0 came first) re-run through a day read from an
+    EPW file by pvlib: every number by height follows its height."""
+    import json
+
+    from maizeviz.cli import main
+
+    path, skip, _ = WEATHER["epw"]
+    day = tmp_path / "day.epw"
+    lines = path.read_text(encoding="latin-1").split("\n")
+    day.write_text("\n".join(lines[:skip + 24]) + "\n", encoding="latin-1")
+    runs = []
+    for heights in ([150.0, 0.0, 50.0], [0.0, 50.0, 150.0]):
+        capsys.readouterr()
+        assert main(["light", str(BLOCK), "--tile", "3x3", "--triangles", "8", "--weather",
+                     str(day), "--density", "0.5", "--sky-directions", "16", "--periodic",
+                     "--heights", ",".join(map(str, heights)), "--json"]) == 0
+        by = json.loads(capsys.readouterr().out)["period"]["transmission_by_height"]
+        assert by["heights_cm"] == heights
+        runs.append({h: (by["par_mol_m2"][k], by["fraction"][k], by["diffuse_fraction"][k])
+                     for k, h in enumerate(heights)})
+    assert runs[0] == runs[1]
+    assert runs[0][0.0][1] < runs[0][150.0][1]

@@ -251,7 +251,7 @@ def test_periodic_block_equals_its_tiling_traced_whole(capsys):
     assert 0 < one["transmission"][0] < one["transmission"][-1] <= 1.0
 
 
-@pytest.mark.parametrize("kind", ["sun", "sky", "day", "absorbed"])
+@pytest.mark.parametrize("kind", ["sun", "sky", "day", "absorbed", "photosynthesis"])
 def test_plant_rows_add_up_to_the_canopy_total(capsys, tmp_path, kind):
     """Per-leaf rows sum to per-plant rows, and those to the canopy total --json gives,
     computed another way (from the rays, not the triangles)."""
@@ -260,7 +260,8 @@ def test_plant_rows_add_up_to_the_canopy_total(capsys, tmp_path, kind):
              "sky": ["--sky", "soc", "--sky-directions", "16"],
              "day": ["--day", "--date", "2005-08-01", "--lat", "39.9", "--lon", "116.4",
                      "--tz", "Asia/Shanghai", "--step", "120", "--sky-directions", "16"],
-             "absorbed": [*SUN_30, "--band", "par", "--irradiance", "400"]}[kind]
+             "absorbed": [*SUN_30, "--band", "par", "--irradiance", "400"],
+             "photosynthesis": [*SUN_30, "--photosynthesis", "c4"]}[kind]
     doc = _json(capsys, [*BASE, *extra, "--leaf-light", str(leaves), "--plant-light",
                          str(plants), "--json"])
     x0, y0, x1, y1 = doc["rect_cm"] if "rect_cm" in doc else doc["diffuse"]["rect_cm"]
@@ -272,6 +273,8 @@ def test_plant_rows_add_up_to_the_canopy_total(capsys, tmp_path, kind):
         "day": ("par_intercepted_mol",
                 lambda: doc["period"]["par_intercepted_mol_m2"] * area_cm2 * 1e-4),
         "absorbed": ("absorbed_w", lambda: doc["balance"]["absorbed_leaves"] * area_cm2 * 1e-4),
+        "photosynthesis": ("gross_umol_s", lambda: doc["photosynthesis"]["canopy_gross_umol_m2_s"]
+                           * area_cm2 * 1e-4),
     }[kind]
     leaf_rows, plant_rows = _csv(leaves), _csv(plants)
     assert len(plant_rows) > 1
