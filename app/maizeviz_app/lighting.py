@@ -9,6 +9,7 @@ state these use.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from maizeviz.errors import MaizevizError
@@ -209,6 +210,29 @@ def _sun_found(study: StudyModel, sun) -> None:
                               "azimuth_deg": round(sun.azimuth_deg % 360.0, 2)})
     study.say(f"sun at {sun.when}: zenith {sun.zenith_deg:.2f}°, azimuth "
              f"{sun.azimuth_deg:.2f}°")
+
+def choose_weather(study: StudyModel, path: str) -> None:
+    """A weather file chosen: the day's source becomes it and, when its header names a place
+    (EPW, TMY3, PSM), the day's latitude and longitude become that place, in one step of the
+    undo history (read in a job: pvlib's first import takes seconds). A sun traced away from
+    where the file was measured would not match its irradiance."""
+    def work(job, p):
+        from maizeviz.io.weather_files import weather_place
+
+        return weather_place(p)
+
+    def done(place: dict) -> None:
+        values: dict[str, Any] = {"weather": path, "source": "weather"}
+        lat, lon = place.get("latitude"), place.get("longitude")
+        if lat is not None and lon is not None and -90 <= lat <= 90 and -180 <= lon <= 180:
+            values.update(latitude=float(lat), longitude=float(lon))
+            named = f", {place['name']}" if place.get("name") else ""
+            study.say(f"place: latitude {lat:g}, longitude {lon:g}{named} (the header of "
+                      f"{Path(path).name})")
+        study.settings.set("day", values)
+
+    study.runner.run("weather", f"reading the place of {Path(path).name}", work, path,
+                     on_done=done, on_error=lambda e: study.fail(e, "weather", "day"))
 
 # ------------------------------------------------------------------ a project's results
 def adopt_pending_runs(study: StudyModel) -> None:

@@ -171,6 +171,7 @@ class StudyModel:
     draw_heatmap = lighting.draw_heatmap
     sun_from_place = lighting.sun_from_place
     _sun_found = lighting._sun_found
+    choose_weather = lighting.choose_weather
     adopt_pending_runs = lighting.adopt_pending_runs
     light_per_plant_run = lighting.light_per_plant_run
     complete_runs = lighting.complete_runs

@@ -44,6 +44,10 @@ def export_canopy(path: str | Path, canopy: Canopy,
                   cell_data: dict[str, np.ndarray] | None = None) -> Path:
     """Write a canopy with its stalks as a mesh file, the format chosen by the extension.
 
+    The file carries the plot (the layout's bounds) and, for a tiling, the period of its
+    periodic field (:func:`~maizeviz.canopy.layout.field_period`), so that read back without
+    a field it has the same ground, LAI and light (:mod:`maizeviz.canopy.from_mesh`).
+
     Parameters
     ----------
     path : str or Path
@@ -53,10 +57,6 @@ def export_canopy(path: str | Path, canopy: Canopy,
     cell_data : dict of str to numpy.ndarray, optional
         Per-triangle values to carry, each (F,) over the canopy's leaf triangles (stalks get 0,
         or NaN for floats), beside ``plant`` and ``leaf`` (:func:`canopy_cells`).
-
-    The file carries the plot (the layout's bounds) and, for a tiling, the period of its
-    periodic field (:func:`~maizeviz.canopy.layout.field_period`), so that read back without
-    a field it has the same ground, LAI and light (:mod:`maizeviz.canopy.from_mesh`).
 
     Returns
     -------

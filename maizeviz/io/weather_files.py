@@ -247,10 +247,43 @@ def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable
                      f"(first: line {lines[k]}, {temp[k]:g}); kept as missing")
         temp = np.where(absent, np.nan, temp)
     values["temp_air"] = temp
-    place: dict[str, Any] = {"latitude": _number(meta, "latitude"), "longitude": _number(meta, "longitude"),
-             "altitude": _number(meta, "altitude"),
-             "name": str(meta.get("city") or meta.get("Name") or meta.get("City") or "").strip('"')}
-    return WeatherTable(kind, times, values, lines, LABELS[kind], place, tuple(notes))
+    return WeatherTable(kind, times, values, lines, LABELS[kind], _place(meta), tuple(notes))
+
+
+def weather_place(path: str | Path) -> dict[str, Any]:
+    """The place an EPW, TMY3 or PSM file's header names, read from its first lines only
+    (cheap enough for a file chooser); ``{}`` for maizeviz's CSV (no header place) or a
+    file whose header cannot be read (reading the whole file says what is wrong).
+
+    Returns
+    -------
+    dict
+        ``latitude``, ``longitude`` [deg], ``altitude`` [m] (None where absent) and ``name``.
+    """
+    path = Path(path)
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(64 * 1024)
+    except OSError:
+        return {}
+    kind = detect_format(path, head[:4096])
+    if kind == "csv":
+        return {}
+    text = head.decode("latin-1").lstrip("\ufeff\xef\xbb\xbf")
+    lines = text.splitlines()[:_header_lines(kind) + 2]     # the header and two rows
+    try:
+        _data, meta = _read(kind, "\n".join(lines) + "\n", None)
+    except Exception:  # noqa: BLE001 - pvlib and pandas raise many kinds; the read says
+        return {}
+    return _place(meta)
+
+
+def _place(meta: dict) -> dict[str, Any]:
+    """The place of a pvlib reader's metadata."""
+    name = str(meta.get("city") or meta.get("Name") or meta.get("City") or "").strip('" ')
+    return {"latitude": _number(meta, "latitude"), "longitude": _number(meta, "longitude"),
+            "altitude": _number(meta, "altitude"),
+            "name": "" if name.lower() in ("-", "unknown", "none", "nan") else name}
 
 
 def _floats(column, where: str, lines: np.ndarray, times) -> np.ndarray:

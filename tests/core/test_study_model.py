@@ -180,3 +180,31 @@ def test_the_scripting_example_of_docs_app_runs(tmp_path):
     assert "8 triangles: transmission" in proc.stdout and "PAR incident" in proc.stdout
     assert "saved the project study.maizeviz" in proc.stdout
     assert (tmp_path / "study.maizeviz").stat().st_size > 0
+
+
+WEATHER = __import__("pathlib").Path(__file__).parents[1] / "data" / "weather"
+
+
+@pytest.mark.parametrize("name, lat, lon", [("pvgis_tmy_45N_8E_july.epw", 45.0, 8.0),
+                                            ("tmy3_703165_july.csv", 55.317, -160.517),
+                                            ("psm3_401182_july.csv", 40.53, -108.54)])
+def test_a_weather_file_chosen_brings_its_place(study, name, lat, lon):
+    """Choosing an EPW, TMY3 or PSM file sets the day's place to its header's (the app's
+    default place is Beijing: a sun traced there would not match the file's irradiance)."""
+    day = study.settings.day
+    assert (day.latitude, day.longitude) != (lat, lon)
+    study.choose_weather(str(WEATHER / name))
+    assert day.source == "weather" and day.weather.endswith(name)
+    assert (day.latitude, day.longitude) == (lat, lon)
+    assert any(t.startswith(f"place: latitude {lat:g}, longitude {lon:g}")
+               for t in study.said_lines)
+
+
+def test_a_weather_csv_keeps_the_place_set(study, tmp_path):
+    path = tmp_path / "station.csv"
+    path.write_text("time,ghi\n2005-08-01T12:00+08:00,800\n2005-08-01T13:00+08:00,700\n")
+    before = (study.settings.day.latitude, study.settings.day.longitude)
+    study.choose_weather(str(path))
+    assert study.settings.day.weather == str(path)
+    assert (study.settings.day.latitude, study.settings.day.longitude) == before
+    assert not _errors(study)

@@ -267,3 +267,23 @@ def test_damaged_weather_files_give_only_weather_errors(tmp_path, data, path):
     else:
         assert len(w.times) >= 2 and np.all(np.diff(w.times.asi8) > 0)
         assert np.all(np.isfinite(w.ghi)) and np.all(w.ghi >= 0)
+
+
+def test_the_place_of_a_header_is_read_from_its_first_lines():
+    from maizeviz.io.weather_files import weather_place
+
+    for path in (EPW, TMY3, PSM3):
+        assert weather_place(path) == read_weather(path).place
+    assert weather_place(B) == {}
+    assert weather_place(DATA / "no such file.epw") == {}
+
+
+def test_a_sun_placed_away_from_the_files_place_is_said():
+    """The sun positions of a weather period computed far from where the file was measured
+    do not match its irradiance: a note says so; at the file's place, none."""
+    w = read_weather(EPW)
+    assert not any("not where" in n for n in weather_period(w, 45.0, 8.0).notes)
+    assert not any("not where" in n for n in weather_period(w, 45.02, 8.03).notes)
+    away = [n for n in weather_period(w, 39.9, 116.4).notes if "not where" in n]
+    assert len(away) == 1 and "latitude 45, longitude 8" in away[0]
+    assert EPW.name in away[0]

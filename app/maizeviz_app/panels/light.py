@@ -535,7 +535,9 @@ class LightPanel(QWidget):
         path, _ = QFileDialog.getOpenFileName(self, "Weather file", self.weather.text(),
                                               "Weather files (*.csv *.epw *.CSV *.EPW);;"
                                               "All files (*)")
-        if path:
+        if path and self.study is not None:
+            self.study.choose_weather(path)         # its header's place too, one step
+        elif path:
             self.settings.set("day", {"weather": path, "source": "weather"})
 
     # ------------------------------------------------------------------ mode

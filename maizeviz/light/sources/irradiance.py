@@ -824,9 +824,10 @@ def _intervals(utc_us: np.ndarray, label: str) -> np.ndarray:
 
 def read_weather(path, tz: str | None = None, label: str | None = None,
                  max_bytes: int = MAX_WEATHER_BYTES) -> Weather:
-    """Read a weather file: maizeviz's CSV, or an EnergyPlus EPW, NREL TMY3 or NSRDB
-    PSM3/PSM4 file through pvlib (:mod:`maizeviz.io.weather_files`, recognised by their
-    first lines).
+    """Read a weather file: maizeviz's CSV, or an EPW, TMY3 or PSM file through pvlib.
+
+    EnergyPlus EPW, NREL TMY3 and NSRDB PSM3/PSM4 files are read through pvlib
+    (:mod:`maizeviz.io.weather_files`), recognised by their first lines.
 
     maizeviz's CSV: comma-separated, a header line, blank lines and lines starting with '#'
     ignored. Columns (any order and case): ``time`` (ISO 8601 with a UTC offset such as
@@ -998,6 +999,27 @@ def _split_direct_diffuse(weather: Weather, up: np.ndarray, zen: np.ndarray,
     return ghi - dhi, dhi, "erbs"
 
 
+#: How far [deg] the place traced may be from the one a weather file's header names before a
+#: note says so (0.05 deg is about 5 km: the same station, rounded).
+PLACE_TOLERANCE_DEG = 0.05
+
+
+def _place_note(weather: Weather, lat: float, lon: float) -> str:
+    """A note when the sun is placed away from the place of the weather file's header
+    (its times are that place's, its sun positions are computed at ``lat``, ``lon``)."""
+    f_lat, f_lon = weather.place.get("latitude"), weather.place.get("longitude")
+    if not isinstance(f_lat, (int, float)) or not isinstance(f_lon, (int, float)):
+        return ""
+    d_lon = abs((lon - f_lon + 180.0) % 360.0 - 180.0)
+    if abs(lat - f_lat) <= PLACE_TOLERANCE_DEG and d_lon <= PLACE_TOLERANCE_DEG:
+        return ""
+    where = f", {weather.place['name']}" if weather.place.get("name") else ""
+    return (f"the sun is placed at latitude {lat:g}, longitude {lon:g}, not where "
+            f"{Path(weather.path).name} was measured (latitude {f_lat:g}, longitude "
+            f"{f_lon:g}{where}, in its header): its sun positions do not match its "
+            f"irradiance; use the file's place unless that is meant")
+
+
 def weather_period(weather: Weather, lat: float, lon: float, altitude: float = 0.0,
                    par_umol_per_j: float = DEFAULT_PAR_UMOL_PER_J) -> Period:
     """The period of a weather file at a place: sun positions, direct and diffuse parts.
@@ -1057,6 +1079,9 @@ def weather_period(weather: Weather, lat: float, lon: float, altitude: float = 0
                          f"{first.isoformat()}): diffuse cut to ghi, no direct light{unused}")
     if not up.any():
         notes.append(_no_sun_note(weather.start, weather.end, lat, lon))
+    away = _place_note(weather, lat, lon)
+    if away:
+        notes.append(away)
     night = ~up
     night_j = math.fsum(weather.ghi[night] * weather.step_s[night])
     if night_j > 0:
