@@ -129,6 +129,30 @@ def _data_lines(text: str, skip: int) -> np.ndarray:
     return np.asarray(out, np.int64)
 
 
+#: The line of a format's header that holds its place and time zone (counting from 1).
+PLACE_LINE = {"epw": 1, "tmy3": 1, "psm": 2}
+
+
+def _check_header_numbers(text: str, kind: str, path: Path) -> None:
+    """Refuse a header cell (the place, the time zone) that Python's float reads and a data
+    file does not mean as a number: an EPW's time zone of ``1_0`` was read as UTC+10, every
+    time shifted by 9 hours, no word."""
+    lines = text.splitlines()
+    no = PLACE_LINE[kind]
+    if len(lines) < no:
+        return
+    for k, cell in enumerate(next(csv.reader([lines[no - 1]]), [])):
+        try:
+            float(cell)
+        except ValueError:
+            continue                                    # text: a name, a source
+        try:
+            number(cell)
+        except ValueError:
+            raise WeatherFileError(f"{path}, line {no}, field {k + 1} of the header: "
+                                   f"'{cell.strip()[:30]}' is not a number") from None
+
+
 def _text_columns(kind: str, header: list[str]) -> set[int]:
     """Columns of a format that hold text rather than numbers (EPW's data source flags,
     TMY3's date, time and source flags)."""
@@ -202,6 +226,7 @@ def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable
     raw = read_input(path, "weather file", max_bytes, WeatherFileError)
     text, notes = weather_text(raw, path)
     name = PVLIB_FORMATS[kind]
+    _check_header_numbers(text, kind, path)
     try:
         data, meta = _read(kind, text, None)
         if kind != "psm" and _typical_year(data.index):

@@ -266,3 +266,23 @@ def test_a_weather_file_day_follows_each_height_whatever_their_order(capsys, tmp
                      for k, h in enumerate(heights)})
     assert runs[0] == runs[1]
     assert runs[0][0.0][1] < runs[0][150.0][1]
+
+
+@pytest.mark.parametrize("kind, old, new, field", [
+    ("epw", ",1,250", ",1_0,250", 9),              # the time zone: read as UTC+10 before
+    ("epw", "45.000000", "4_5.0", 7),              # the latitude
+    ("tmy3", "-9.0,55.317", "-9_0,55.317", 4),     # the time zone: 'offset must be ...'
+    ("psm", "40.53,-108.54,-7", "4_0.53,-108.54,-7", 6),
+])
+def test_a_weather_header_number_with_an_underscore_is_refused(tmp_path, kind, old, new, field):
+    path, _, _ = WEATHER[kind]
+    text = path.read_text(encoding="latin-1")
+    line = next(k for k, ln in enumerate(text.split("\n"), 1) if old in ln)
+    assert line <= 2
+    bad = tmp_path / f"bad{path.suffix}"
+    bad.write_text(text.replace(old, new, 1), encoding="latin-1")
+    with pytest.raises(WeatherFileError) as err:
+        read_weather(bad)
+    assert str(err.value) == (f"{bad}, line {line}, field {field} of the header: "
+                              f"'{new.split(',')[1 if kind == 'epw' and field == 9 else 0]}' "
+                              "is not a number")
