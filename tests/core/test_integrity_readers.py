@@ -286,3 +286,39 @@ def test_a_weather_header_number_with_an_underscore_is_refused(tmp_path, kind, o
     assert str(err.value) == (f"{bad}, line {line}, field {field} of the header: "
                               f"'{new.split(',')[1 if kind == 'epw' and field == 9 else 0]}' "
                               "is not a number")
+
+
+# ------------------------------------------------------------------ settings files: zeros
+
+
+@pytest.mark.parametrize("kind", ["layout", "sweep", "optics"])
+def test_a_settings_file_ending_in_zeros_is_refused_naming_them(capsys, tmp_path, kind):
+    """Decided (issue 25, doubtful): data files ending in a power cut's zero bytes are read up
+    to them with a note; a settings file is refused naming the zeros, since what followed
+    them (a scenario, a row of plants) is lost and the rest would run something else. They
+    were 'not valid TOML: Invalid statement', 'not valid JSON (Extra data ...)' and
+    '1 values for 3 columns' before."""
+    import json
+
+    from maizeviz.cli import main
+
+    if kind == "layout":
+        text = json.dumps({"maizeviz_layout": 1, "row_spacing": 60, "plant_spacing": 30,
+                           "field": {"x0": -30, "y0": -30, "x1": 90, "y1": 30},
+                           "rows": [{"x": 0, "plants": [{"y": 0, "plant": 1}]}]})
+        argv = ["canopy", str(BLOCK), "--triangles", "8", "--layout"]
+    elif kind == "sweep":
+        text = BLOCK.with_name("sweep-example.toml").read_text().replace(
+            '"block3x3.csv"', json.dumps(str(BLOCK)))
+        argv = ["sweep", "--dry-run"]
+    else:
+        text = "rank,reflectance,transmittance\n1,0.1,0.05\n"
+        argv = ["light", str(BLOCK), "--triangles", "8", *SUN, "--band", "par",
+                "--optics-table"]
+    clean, zeros = tmp_path / f"clean.{kind}", tmp_path / f"zeros.{kind}"
+    clean.write_text(text)
+    zeros.write_bytes(text.encode() + b"\0" * 300)
+    capsys.readouterr()
+    assert main([*argv, str(clean)]) == 0
+    line = _one_error(capsys, [*argv, str(zeros)])
+    assert f"ends in 300 zero bytes after {len(text.encode()):,} bytes of text" in line
