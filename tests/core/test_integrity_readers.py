@@ -322,3 +322,42 @@ def test_a_settings_file_ending_in_zeros_is_refused_naming_them(capsys, tmp_path
     assert main([*argv, str(clean)]) == 0
     line = _one_error(capsys, [*argv, str(zeros)])
     assert f"ends in 300 zero bytes after {len(text.encode()):,} bytes of text" in line
+
+
+# ------------------------------------------------------------------ Parquet points: size
+
+
+def test_a_small_parquet_file_of_huge_repeated_text_is_refused_before_decoding(tmp_path):
+    """A text column beside the points, one 20,000-character value repeated over 14,000
+    records: a file of a few hundred KB that decodes to 280 MB (586 KB holding 100,000 records
+    of 5,000 characters took 1.5 GB to read). Refused from its dictionary, before decoding;
+    the same column of short values is kept as text."""
+    import resource
+
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from maizeviz.errors import PointsFileError
+    from maizeviz.io.points import read_points
+
+    n = 14_000
+    rng = np.random.default_rng(0)
+    columns = {"plant": np.repeat(np.arange(1, n // 100 + 1), 100), "leaf": np.ones(n, int),
+               "row": np.tile(np.repeat(np.arange(10), 10), n // 100),
+               "col": np.tile(np.arange(10), n // 10), "x": rng.uniform(0, 100, n),
+               "y": rng.uniform(0, 100, n), "z": rng.uniform(0, 100, n)}
+
+    def write(name, value):
+        note = pa.DictionaryArray.from_arrays(pa.array(np.zeros(n, np.int32)), pa.array([value]))
+        path = tmp_path / name
+        pq.write_table(pa.table({**columns, "note": note}), path, compression="zstd")
+        return path
+
+    huge = write("huge.parquet", "x" * 20_000)
+    assert huge.stat().st_size < 2**20
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    with pytest.raises(PointsFileError, match=r"'note'...\) hold over 256 MiB once read"):
+        read_points(huge)
+    assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 200 * 1024   # KiB
+    table = read_points(write("short.parquet", "a note"))
+    assert len(table) == n and set(table.extra["note"]) == {"a note"}
