@@ -129,6 +129,8 @@ def _data_lines(text: str, skip: int) -> np.ndarray:
     return np.asarray(out, np.int64)
 
 
+#: Fields of an EPW's first line: LOCATION and nine values.
+EPW_LOCATION_FIELDS = 10
 #: The line of a format's header that holds its place and time zone (counting from 1).
 PLACE_LINE = {"epw": 1, "tmy3": 1, "psm": 2}
 
@@ -226,6 +228,15 @@ def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable
     raw = read_input(path, "weather file", max_bytes, WeatherFileError)
     text, notes = weather_text(raw, path)
     name = PVLIB_FORMATS[kind]
+    if not text.strip():
+        raise WeatherFileError(f"{path}: the weather file is empty")
+    if kind == "epw":
+        place = next(csv.reader([text.lstrip().splitlines()[0]]), [])
+        if len(place) < EPW_LOCATION_FIELDS:
+            raise WeatherFileError(f"{path}, line 1: the LOCATION line has {len(place)} "
+                                   f"fields; an EPW's has {EPW_LOCATION_FIELDS} (city, state, "
+                                   "country, source, WMO, latitude, longitude, time zone, "
+                                   "elevation)")
     _check_header_numbers(text, kind, path)
     try:
         data, meta = _read(kind, text, None)

@@ -361,3 +361,15 @@ def test_a_small_parquet_file_of_huge_repeated_text_is_refused_before_decoding(t
     assert resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - before < 200 * 1024   # KiB
     table = read_points(write("short.parquet", "a note"))
     assert len(table) == n and set(table.extra["note"]) == {"a note"}
+
+
+@pytest.mark.parametrize("content, says", [
+    (b"", "the weather file is empty"),                                   # KeyError: 'altitude'
+    (b"LOCATION,x\n", "line 1: the LOCATION line has 2 fields; an EPW's has 10"),
+])
+def test_an_empty_or_headless_epw_is_one_line_saying_so(tmp_path, content, says):
+    path = tmp_path / "w.epw"
+    path.write_bytes(content)
+    with pytest.raises(WeatherFileError) as err:
+        read_weather(path)
+    assert says in str(err.value) and "KeyError" not in str(err.value)
