@@ -373,3 +373,37 @@ def test_an_empty_or_headless_epw_is_one_line_saying_so(tmp_path, content, says)
     with pytest.raises(WeatherFileError) as err:
         read_weather(path)
     assert says in str(err.value) and "KeyError" not in str(err.value)
+
+
+# ------------------------------------------------------------------ weather files: fuzz
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+TOKENS = st.one_of(
+    st.text("0123456789_.-+eE naif１", max_size=8),
+    st.floats(allow_nan=True, allow_infinity=True).map(repr),
+    st.integers(-10**6, 10**6).map(str),
+    st.sampled_from(["", " ", "9999", "-9900", "-9999", "nan", "inf", "1e400", "0x10", "1,5",
+                     '"', "8_04", "٣"]),
+)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow,
+                                                                 HealthCheck.function_scoped_fixture])
+@given(st.sampled_from(sorted(WEATHER)), st.integers(0, 60), TOKENS)
+def test_any_ghi_cell_is_read_as_its_number_or_refused_in_one_line(tmp_path, kind, row, token):
+    """Any text in a ghi cell of a real EPW, TMY3 or PSM file: either the cell's number (as a
+    data file means it: plain digits, within 0 to 2000 W/m2) is what the reader gives for
+    that row, or one WeatherFileError line names the file; never another exception."""
+    from maizeviz.numbers import number
+
+    path, line = _with_cell(tmp_path, kind, token, row)
+    try:
+        w = read_weather(path)
+    except WeatherFileError as exc:
+        assert "\n" not in str(exc) and str(path) in str(exc)
+        return
+    k = int(np.flatnonzero(w.line == line)[0])
+    assert w.ghi[k] == number(token.strip())
+    assert np.isfinite(w.ghi).all() and (w.ghi >= 0).all() and (w.ghi <= 2000).all()
