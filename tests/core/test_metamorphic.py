@@ -575,3 +575,41 @@ def test_each_export_format_carries_the_canopy_the_ply_does(capsys, tmp_path, ex
         assert lb["transmission"] == la["transmission"]
         assert lb["sunlit_intercepted_fraction"] == la["sunlit_intercepted_fraction"]
     assert a["leaves"] == 140 and 0 < la["transmission"][0] < 1
+
+
+# ------------------------------------------------------------------ order of a layout file
+
+
+@settings(max_examples=3, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate))
+@given(st.integers(0, 2**31))
+def test_a_layout_in_any_order_traces_the_same_field(tmp_path_factory, seed):
+    """The rows of a layout file, and the plants within each row, listed in another order:
+    the same stands, so the same transmission, and each stand (plant id and place) the same
+    light in the plant table."""
+    import csv
+
+    rng = np.random.default_rng(seed)
+    tmp = tmp_path_factory.mktemp("layout")
+    ids = sorted({int(line.split(",")[0]) for line in Path(BLOCK).read_text().splitlines()[1:]})
+    rows = [{"x": 30 + 60 * i, "plants": [{"y": 15 + 30 * j, "plant": ids[(3 * i + j) % 9]}
+                                          for j in range(3)]} for i in range(3)]
+    shuffled = [{"x": r["x"], "plants": [r["plants"][k] for k in rng.permutation(3)]}
+                for r in (rows[k] for k in rng.permutation(3))]
+    runs = []
+    for name, listed in (("a", rows), ("b", shuffled)):
+        path = tmp / f"{name}.json"
+        path.write_text(json.dumps({"maizeviz_layout": 1, "row_spacing": 60, "plant_spacing": 30,
+                                    "field": {"x0": 0, "y0": 0, "x1": 180, "y1": 90},
+                                    "rows": listed}))
+        table = tmp / f"{name}.csv"
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+            assert main(["light", BLOCK, "--layout", str(path), "--triangles", "8", *SUN_30,
+                         "--density", "1", "--periodic", "--heights", "0,100",
+                         "--plant-light", str(table), "--json"]) == 0
+        with open(table, newline="") as fh:
+            plants = {(r["plant"], r["x_cm"], r["y_cm"]): r["sunlit_intercepted_cm2"]
+                      for r in csv.DictReader(fh)}
+        runs.append((json.loads(out.getvalue())["transmission"], plants))
+    assert runs[1][0] == runs[0][0]
+    assert runs[1][1] == runs[0][1] and len(runs[0][1]) == 9
