@@ -613,3 +613,30 @@ def test_a_layout_in_any_order_traces_the_same_field(tmp_path_factory, seed):
         runs.append((json.loads(out.getvalue())["transmission"], plants))
     assert runs[1][0] == runs[0][0]
     assert runs[1][1] == runs[0][1] and len(runs[0][1]) == 9
+
+
+@pytest.mark.parametrize("tile, copies", [("1x1", 1), ("2x3", 6)])
+def test_the_leaf_table_adds_up_to_the_canopy(capsys, tmp_path, tile, copies):
+    """`maizeviz leaf --json` measures each leaf; `maizeviz canopy --json` the field: its leaf
+    area and triangles are the leaves' summed over the copies of the block, its LAI that area
+    over the ground; and the light run's per-leaf table gives each leaf the same area."""
+    import csv
+
+    leaf = _json(capsys, ["leaf", BLOCK, "--triangles", "36", "--json"])
+    canopy = _json(capsys, ["canopy", BLOCK, "--tile", tile, "--triangles", "36", "--json"])
+    area = sum(r["area_cm2"] for r in leaf["leaves"])
+    assert canopy["leaves"] == copies * len(leaf["leaves"]) == copies * 140
+    assert canopy["triangles"] == copies * sum(r["triangles"] for r in leaf["leaves"])
+    assert canopy["leaf_area_m2"] == pytest.approx(copies * area / 1e4, rel=1e-12)
+    assert canopy["lai"] == pytest.approx(canopy["leaf_area_m2"] / canopy["ground_area_m2"],
+                                          rel=1e-12)
+    table = tmp_path / "leaves.csv"
+    _json(capsys, ["light", BLOCK, "--tile", tile, "--triangles", "36", *SUN_30, "--density",
+                   "1", "--periodic", "--leaf-light", str(table), "--json"])
+    by = {(r["plant"], r["leaf"]): r["area_cm2"] for r in leaf["leaves"]}
+    with open(table, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) > 100
+    for r in rows:
+        assert float(r["leaf_area_cm2"]) == pytest.approx(by[(int(r["plant"]), int(r["leaf"]))],
+                                                          rel=1e-12)
