@@ -113,9 +113,9 @@ def detect_format(path: Path, head: bytes) -> str:
         return "epw"
     if second.startswith("Date (MM/DD/YYYY)"):
         return "tmy3"
-    if first.startswith("Source,") and third.replace(" ", "").startswith(
-            "Year,Month,Day,Hour,Minute"):
-        return "psm"
+    if first.startswith("Source,") and (third.replace(" ", "").startswith(
+            "Year,Month,Day,Hour,Minute") or (len(lines) < 3 and "Location ID" in first)):
+        return "psm"                                 # (a PSM file cut after its header too)
     return "csv"
 
 
@@ -230,6 +230,9 @@ def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable
     name = PVLIB_FORMATS[kind]
     if not text.strip():
         raise WeatherFileError(f"{path}: the weather file is empty")
+    if len(text.strip().splitlines()) <= _header_lines(kind):
+        raise WeatherFileError(f"{path}: the file ends within the {_header_lines(kind)}-line "
+                               f"header of an {name} file: no data rows")
     if kind == "epw":
         place = next(csv.reader([text.lstrip().splitlines()[0]]), [])
         if len(place) < EPW_LOCATION_FIELDS:

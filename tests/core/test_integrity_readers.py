@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from maizeviz.light.sources.irradiance import WeatherFileError, read_weather
 
@@ -195,7 +197,7 @@ def test_subplots_json_equals_the_whole_field_traced_at_once(capsys, tmp_path, b
 def small_meshes(tmp_path_factory):
     """The two-plant test mesh as an ascii PLY, a binary PLY (whose last face, a stalk of
     leaf 0, ends in zero bytes) and an OBJ."""
-    from tests.core.test_mesh_canopy import F, LEAF, PLANT, V, write_obj, write_ply
+    from tests.core.test_mesh_canopy import LEAF, PLANT, F, V, write_obj, write_ply
 
     d = tmp_path_factory.mktemp("mesh")
     props = {"plant": np.array(PLANT), "leaf": np.array(LEAF)}
@@ -377,8 +379,6 @@ def test_an_empty_or_headless_epw_is_one_line_saying_so(tmp_path, content, says)
 
 # ------------------------------------------------------------------ weather files: fuzz
 
-from hypothesis import HealthCheck, given, settings  # noqa: E402
-from hypothesis import strategies as st  # noqa: E402
 
 TOKENS = st.one_of(
     st.text("0123456789_.-+eE naif１", max_size=8),
@@ -407,3 +407,22 @@ def test_any_ghi_cell_is_read_as_its_number_or_refused_in_one_line(tmp_path, kin
     k = int(np.flatnonzero(w.line == line)[0])
     assert w.ghi[k] == number(token.strip())
     assert np.isfinite(w.ghi).all() and (w.ghi >= 0).all() and (w.ghi <= 2000).all()
+
+
+@pytest.mark.parametrize("kind", sorted(WEATHER))
+@pytest.mark.parametrize("keep", [1, 2])
+def test_a_weather_file_cut_within_its_header_says_so(tmp_path, kind, keep):
+    """A PSM file cut after 2 lines was taken for maizeviz's CSV ('unknown column Source') or
+    failed in pvlib ('IndexError: list index out of range')."""
+    path, skip, _ = WEATHER[kind]
+    if kind == "tmy3" and keep == 1:
+        pytest.skip("a TMY3 file's first line alone is not told from a CSV's header: refused "
+                    "as one ('unknown column')")
+    cut = tmp_path / f"cut{path.suffix}"
+    cut.write_text("\n".join(path.read_text(encoding="latin-1").split("\n")[:keep]) + "\n",
+                   encoding="latin-1")
+    with pytest.raises(WeatherFileError) as err:
+        read_weather(cut)
+    message = str(err.value)
+    assert "Error" not in message and "unknown column" not in message
+    assert "header of an" in message or "LOCATION line" in message
