@@ -230,9 +230,6 @@ def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable
     name = PVLIB_FORMATS[kind]
     if not text.strip():
         raise WeatherFileError(f"{path}: the weather file is empty")
-    if len(text.strip().splitlines()) <= _header_lines(kind):
-        raise WeatherFileError(f"{path}: the file ends within the {_header_lines(kind)}-line "
-                               f"header of an {name} file: no data rows")
     if kind == "epw":
         place = next(csv.reader([text.lstrip().splitlines()[0]]), [])
         if len(place) < EPW_LOCATION_FIELDS:
@@ -240,6 +237,9 @@ def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable
                                    f"fields; an EPW's has {EPW_LOCATION_FIELDS} (city, state, "
                                    "country, source, WMO, latitude, longitude, time zone, "
                                    "elevation)")
+    if len(text.strip().splitlines()) <= _header_lines(kind):
+        raise WeatherFileError(f"{path}: the file ends within the {_header_lines(kind)}-line "
+                               f"header of an {name} file: no data rows")
     _check_header_numbers(text, kind, path)
     try:
         data, meta = _read(kind, text, None)
