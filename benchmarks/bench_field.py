@@ -8,13 +8,16 @@ file plant chunk by plant chunk, :mod:`maizeviz.canopy.field`), the canopy built
 ``--level``, its scene (``LightEngine.scene``, periodic with ``--periodic``), one sun
 (zenith 30 deg, azimuth 180 deg, ``--density`` rays per cm2, hit classes), as
 ``maizeviz light`` does. Each stage's peak resident memory (``VmHWM`` of /proc, reset between
-stages through ``/proc/self/clear_refs``) is divided by the canopy's triangles.
+stages through ``/proc/self/clear_refs``) is divided by the canopy's triangles; each stage's
+CPU seconds count this process and its finished workers (a field's chunk processes).
 
 The anchor: the same float32 vertices and uint32 triangles (the periodic scene's, copies of
 the overhangs included) given to a bare Embree scene with the same flags, its BVH build timed
 alone (``rtcCommitScene``), just before the scene's own build (on a loaded machine the two
 far apart in time differ by the load); the target is the scene stage within 1.3x of it, and
-the peak of every stage at most 150 bytes a triangle for K = 4 of 900 plants.
+the peak of every stage at most 150 bytes a triangle for K = 4 of 900 plants. A second anchor,
+a fixed numpy pass (sorting 4 million float64) timed before and after, says how fast the
+machine ran numpy at the time (the machine is shared: read seconds over it).
 
     python benchmarks/bench_field.py --points field.parquet [--level K4] [--periodic]
         [--density 4] [--row-spacing 60 --plant-spacing 30] [--json]
@@ -28,8 +31,24 @@ import subprocess
 import sys
 
 CHILD = r"""
-import gc, json, sys, time
+import gc, json, resource, sys, time
 import numpy as np
+
+def cpu():
+    # CPU seconds of this process and of its finished workers (a field's chunk processes)
+    a, b = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return a.ru_utime + a.ru_stime + b.ru_utime + b.ru_stime
+
+def numpy_anchor():
+    # seconds of a fixed numpy pass (sorting 4 million float64, single-threaded): how fast
+    # this machine runs numpy right now; a stage's seconds over it compare across loads
+    x = np.random.default_rng(0).random(1 << 22)
+    best = float("inf")
+    for _ in range(3):
+        t = time.perf_counter()
+        np.sort(x)
+        best = min(best, time.perf_counter() - t)
+    return best
 
 def status():
     d = {}
@@ -56,18 +75,27 @@ out = {"points": args["points"], "level": args["level"], "periodic": args["perio
        "baseline_mb": status()["VmRSS"] / 2**20}
 stages = {}
 
+def workers_cpu():
+    # CPU seconds of a field's worker processes (started by forkserver: not our children)
+    return getattr(leaves, "worker_cpu_s", 0.0) if "leaves" in globals() else 0.0
+
 def stage(name, fn):
     gc.collect()
     reset()
-    t = time.perf_counter()
+    t, c, w = time.perf_counter(), cpu(), workers_cpu()
     got = fn()
     s = status()
-    stages[name] = {"s": time.perf_counter() - t, "peak_bytes": s["VmHWM"], "after_bytes": s["VmRSS"]}
+    w_after = getattr(got[0], "worker_cpu_s", 0.0) if name == "read" else workers_cpu()
+    stages[name] = {"s": time.perf_counter() - t, "cpu_s": cpu() - c + w_after - w,
+                    "peak_bytes": s["VmHWM"], "after_bytes": s["VmRSS"]}
     return got
+
+out["numpy_anchor_s"] = numpy_anchor()
 
 leaves, skipped = stage("read", lambda: load_leaves(args["points"]))
 layout = layout_for(leaves, (1, 1), args["row_spacing"], args["plant_spacing"])
 canopy = stage("canopy", lambda: canopy_of(leaves, layout, parse_level(args["level"])))
+out["worker_cpu_s"] = getattr(leaves, "worker_cpu_s", 0.0)
 del leaves
 F = canopy.n_triangles
 out.update(triangles=F, plants=len(layout.placements), canopy_bytes=canopy.nbytes)
@@ -104,6 +132,10 @@ for k, st in stages.items():
 out["stages"] = stages
 out["peak_bytes_per_triangle"] = max(st["peak_bytes"] for st in stages.values()) / F
 out["scene_over_embree_bvh"] = stages["scene"]["s"] / out["embree_bvh_s"]
+out["numpy_anchor_end_s"] = numpy_anchor()
+out["whole_s"] = sum(st["s"] for st in stages.values())
+out["whole_cpu_s"] = sum(st["cpu_s"] for st in stages.values())
+out["peak_gib"] = max(st["peak_bytes"] for st in stages.values()) / 2**30
 print(json.dumps(out))
 """
 
@@ -138,8 +170,10 @@ def main() -> None:
     print(f"{out['plants']:,} plants, {out['triangles']:,} triangles at {out['level']}"
           f"{' (periodic)' if out['periodic'] else ''}, {out['rays']:,} rays")
     for name, st in out["stages"].items():
-        print(f"{name:>8}: {st['s']:7.2f} s, peak {st['peak_bytes_per_triangle']:6.1f} B a "
-              f"triangle ({st['peak_bytes'] / 2**30:.2f} GiB)")
+        print(f"{name:>8}: {st['s']:7.2f} s ({st['cpu_s']:7.2f} s of CPU), peak "
+              f"{st['peak_bytes_per_triangle']:6.1f} B a triangle ({st['peak_bytes'] / 2**30:.2f} GiB)")
+    print(f"numpy anchor (sorting 4 M float64): {out['numpy_anchor_s'] * 1e3:.0f} ms before, "
+          f"{out['numpy_anchor_end_s'] * 1e3:.0f} ms after")
     print(f"Embree's own BVH build {out['embree_bvh_s']:.2f} s; scene / that "
           f"{out['scene_over_embree_bvh']:.2f} (target 1.3); peak "
           f"{out['peak_bytes_per_triangle']:.0f} B a triangle (target 150 at K = 4, 900 plants)")

@@ -15,8 +15,12 @@ noisy machines); the anchor (a fixed numpy workload) is measured in the same run
 Wall times on a machine other jobs keep busy say little about Dask, so CPU seconds are reported
 too (``cpu``): the 1-worker run's CPU (workers, and this process: client, scheduler, nannies)
 over the loop's is the overhead, and the 1-worker run's worker CPU over the busiest worker's in
-the 2-worker run is the speedup two free cores would give (``speedup_on_free_cores``).
-Targets: speedup >= 1.6 on 2 cores; the 1-worker sweep within 15 % of the serial loop.
+the 2-worker run is the speedup two free cores would give (``speedup_on_free_cores``). Each
+repeat runs the loop and the 1-worker sweep back to back, so the two see about the same load:
+``paired`` gives each repeat's 1-worker / serial ratios (wall and CPU) and their medians, the
+figure to read on a shared machine (the best-of wall times pair a quiet moment of one with a
+busy moment of the other).
+Targets: speedup >= 1.6 on 2 cores; the 1-worker sweep within 5 % of the serial loop.
 
     python benchmarks/bench_sweep.py [--json] [--tile 1x1] [--density 32] [--repeat 1]
 """
@@ -27,6 +31,7 @@ import argparse
 import json
 import logging
 import os
+import statistics
 import tempfile
 import time
 from pathlib import Path
@@ -110,6 +115,7 @@ def main():
     best = {"serial": float("inf"), 1: float("inf"), 2: float("inf")}
     cpu = {"serial": float("inf"), 1: None, 2: None}
     same = True
+    paired: list[tuple[float, float]] = []           # (wall, CPU) 1 worker / serial, per repeat
     load = [os.getloadavg()[0]]
     anchor_s = min(matmul_anchor() for _ in range(3))
     try:
@@ -119,6 +125,8 @@ def main():
             cpu["serial"] = min(cpu["serial"], c)
             for n in (1, 2):
                 t, driver, workers, got = on_cluster(clusters[n][1], spec, tmp / f"out{n}_{i}")
+                if n == 1:
+                    paired.append((t / s, (driver + sum(workers)) / c))
                 if t < best[n]:
                     best[n] = t
                     cpu[n] = {"driver": driver, "workers": workers}
@@ -149,9 +157,13 @@ def main():
                    "two_workers_each_s": cpu[2]["workers"],
                    "two_workers_driver_s": cpu[2]["driver"],
                    "speedup_on_free_cores": sum(cpu[1]["workers"]) / max(cpu[2]["workers"])},
+           "paired": {"one_worker_over_serial_wall": [p[0] for p in paired],
+                      "one_worker_over_serial_cpu": [p[1] for p in paired],
+                      "median_wall": statistics.median(p[0] for p in paired),
+                      "median_cpu": statistics.median(p[1] for p in paired)},
            "load_average": load,
            "scene_reuse": compute.describe_core()["scene_reuse"],
-           "targets": {"speedup": 1.6, "one_worker_over_serial": 1.15}}
+           "targets": {"speedup": 1.6, "one_worker_over_serial": 1.05}}
     if args.json:
         print(json.dumps(out, indent=1))
     else:
@@ -160,7 +172,8 @@ def main():
               f"1 worker {best[1]:.2f} s "
               f"({out['one_worker_over_serial']:.2f}x serial, {out['overhead_per_task_s']:+.3f} s "
               f"per task), 2 workers {best[2]:.2f} s (speedup {out['speedup']:.2f}); "
-              f"results identical: {same}")
+              f"paired 1 worker / serial: median {out['paired']['median_wall']:.3f} wall, "
+              f"{out['paired']['median_cpu']:.3f} CPU; results identical: {same}")
 
 
 if __name__ == "__main__":

@@ -44,10 +44,11 @@ def info() -> dict[str, object]:
         ``maizeviz``, ``python``, ``platform``, ``packages`` and ``optional`` (name ->
         version), ``embreex``, ``embree`` (Embree's version), ``embree_library`` (its file),
         ``kernel`` ("packets" or "embreex"), ``kernel_why``, ``kernel_module`` (the built
-        kernel's file), ``scene_fill`` ("copy" or "embreex"), ``scene_fill_why``, ``cores``,
+        kernel's file), ``scene_fill`` ("copy" or "embreex"), ``scene_fill_why``, ``loops``
+        ("compiled" or "numpy": the loops of :mod:`maizeviz.loops`), ``loops_why``, ``cores``,
         ``usable_cores``, ``threads`` (what light traces on by default).
     """
-    from maizeviz import __version__
+    from maizeviz import __version__, loops
     from maizeviz.mesh.embree_fill import embree
     from maizeviz.mesh.packets import DEFAULT_WIDTH, status
 
@@ -68,6 +69,8 @@ def info() -> dict[str, object]:
         "kernel_module": str(k.path) if k.path else None,
         "scene_fill": "copy" if e.scene_field else "embreex",
         "scene_fill_why": e.why or "Embree's buffers filled by memory copy",
+        "loops": "compiled" if loops.available() else "numpy",
+        "loops_why": loops.why() or "surface bases, reference areas and splitting in C",
         "cores": os.cpu_count() or 1,
         "usable_cores": usable_cores(),
         "threads": os.cpu_count() or 1,
@@ -90,6 +93,7 @@ def report() -> str:
         f"Embree {d['embree']} (embreex {d['embreex']}): {d['embree_library'] or 'not found'}",
         f"ray kernel: {kernel}" + (f": {d['kernel_module']}" if d["kernel_module"] else ""),
         f"scene fill: {d['scene_fill']} ({d['scene_fill_why']})",
+        f"compiled loops: {d['loops']} ({d['loops_why']})",
         f"threads: {d['cores']} cores, {d['usable_cores']} usable; light traces on "
         f"{d['threads']} threads by default (maizeviz light --threads)",
     ])

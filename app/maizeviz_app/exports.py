@@ -52,6 +52,8 @@ def _canopy_job(path: str, model: StudyModel):
         cells["sunlit_share"] = run.painting.share.astype("float32")
     if run is not None and getattr(run.extra, "leaf_value", None) is not None:
         cells["absorbed_w_per_m2_leaf"] = run.extra.leaf_value.astype("float64")
+    if run is not None and getattr(run.extra, "gross_value", None) is not None:
+        cells["gross_umol_co2_per_m2_leaf_s"] = run.extra.gross_value.astype("float64")
     for kind, name in (("sky", "diffuse_cm2_per_cm2_leaf"), ("day", "par_mol_per_m2_leaf")):
         run = model.runs.for_signature(signature, kind)
         if run is not None and run.extra is not None and run.extra.leaf_value is not None:

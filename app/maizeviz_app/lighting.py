@@ -314,14 +314,17 @@ def light_per_plant_run(study: StudyModel) -> Run | None:
 def complete_runs(study: StudyModel) -> None:
     """Results read from a project that were traced on the canopy shown get what the
     window shows of them, computed against it in a job: a sun's light class per
-    triangle, a sky's or day's light per leaf and plant; then the plants' light and the
-    canopy's colours follow."""
+    triangle (and its absorbed light per leaf, with the CO2 assimilation of the leaf model
+    its optics were stored with), a sky's or day's light per leaf and plant; then the
+    plants' light and the canopy's colours follow."""
     if study.built is None or study.canopy is None:
         return
     here, canopy = study.shown_signature, study.canopy
     todo = runs_to_complete(study.runs.runs.values(), here, canopy.n_triangles)
     if not todo:
         return
+    sun = study.runs.settings.get("sun")            # (zenith, azimuth, OpticsSpec or None)
+    spec = sun[2] if isinstance(sun, tuple) and len(sun) == 3 else None
 
     def work(job):
         from maizeviz.light.results.painting import sun_painting
@@ -332,7 +335,7 @@ def complete_runs(study: StudyModel) -> None:
             job.check()
             if run.kind == "sun":
                 absorbed = None if run.extra is None else \
-                    jobs.absorbed_of(canopy, run.extra.light)
+                    jobs.absorbed_of(canopy, run.extra.light, spec)
                 done.append((sun_painting(canopy, run.result), absorbed))
             else:
                 done.append(jobs.diffuse_of(canopy, run.result, run.kind))

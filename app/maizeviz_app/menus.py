@@ -98,7 +98,7 @@ def build_menus(w) -> dict[str, QAction]:
     colour = v.addMenu("C&olour by")
     group = QActionGroup(w)
     for k, (name, text) in enumerate(COLOURINGS.items(), start=1):
-        act = _action(w, colour, text.capitalize(), lambda n=name: w.colour_by(n),
+        act = _action(w, colour, text[0].upper() + text[1:], lambda n=name: w.colour_by(n),
                       f"Ctrl+Shift+{k}")
         act.setCheckable(True)
         act.setChecked(name == "leaf")

@@ -1,7 +1,8 @@
 """Names the menus, the panels and the 3D view share (no Qt, no pyvista: cheap to import)."""
 
 #: Colourings of the canopy: name -> what the View menu says.
-COLOURINGS = {"plant": "plant", "leaf": "leaf rank", "light": "light received"}
+COLOURINGS = {"plant": "plant", "leaf": "leaf rank", "light": "light received",
+              "assimilation": "CO₂ assimilation"}
 #: Camera presets: name -> what the View menu says. Front looks along the rows (+y), side
 #: across them (+x), iso from the south-west corner at 45 degrees up; reset goes back to the
 #: view the canopy first opened in.

@@ -68,11 +68,16 @@ LIGHT_SETTINGS = (("zenith_deg", (int, float)), ("azimuth_deg", (int, float)), (
                   ("par_factor", (int, float)), ("optics", bool), ("band", str),
                   ("reflectance", (int, float)), ("transmittance", (int, float)),
                   ("ground_reflectance", (int, float)), ("direct_w_m2", (int, float)),
-                  ("diffuse_w_m2", (int, float)), ("depth", int), ("day_diffuse", str))
+                  ("diffuse_w_m2", (int, float)), ("depth", int), ("day_diffuse", str),
+                  ("photosynthesis", str), ("leaf_temperature_c", (int, float)),
+                  ("c4_vmax", (int, float)), ("c4_alpha", (int, float)),
+                  ("co2_ppm", (int, float)), ("wofost_amax", (int, float)),
+                  ("wofost_eff", (int, float)))
 #: Allowed values of the light settings that name a choice.
 LIGHT_CHOICES = {"mode": ("sun", "sky", "day"), "sky_kind": ("soc", "uoc"),
                  "sky_split": ("auto", "equal"), "source": ("clear", "weather"),
-                 "band": ("par", "nir"), "day_diffuse": ("sky", "perez")}
+                 "band": ("par", "nir"), "day_diffuse": ("sky", "perez"),
+                 "photosynthesis": ("none", "c4", "wofost")}
 
 
 def light_settings(opened: Opened) -> dict:

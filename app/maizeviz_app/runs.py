@@ -20,6 +20,8 @@ BALANCE_ROWS = (("incident", "{band} incident W/m²"),
                 ("absorbed_ground", "absorbed by the ground W/m²"),
                 ("reflected_top", "reflected out of the top W/m²"),
                 ("escaped_sides", "out of the sides W/m²"))
+#: The results table's row of a sun's canopy gross CO2 assimilation (with a leaf model).
+ASSIMILATION_ROW = "gross CO₂ µmol/m²/s"
 #: Skies: kind -> (what the light panel's combo says, how a result is named in the table).
 SKIES = {"soc": ("standard overcast (SOC): brightness (1 + 2 cos θ)/3", "overcast sky"),
          "uoc": ("uniform overcast (UOC)", "uniform sky")}
@@ -160,7 +162,9 @@ class LightRuns:
 
     def table(self) -> tuple[list[str], list[list[str]]]:
         """Header and rows (one per height) of the results table; then, when a sun was traced
-        with leaf optics, its energy balance (W/m2 of ground) in rows of their own."""
+        with leaf optics, its energy balance (W/m2 of ground) in rows of their own, and with a
+        leaf model the canopy's gross CO2 assimilation (umol per m2 of ground per s, with its
+        Monte Carlo standard error)."""
         names = list(self.runs)
         header = ["height cm"] + names
         rows = []
@@ -180,6 +184,16 @@ class LightRuns:
                     b = balances.get(name)
                     row.append(f"{getattr(b, field):.1f}" if b is not None else "")
                 rows.append(row)
+        gross = {name: r.extra.assimilation for name, r in self.runs.items()
+                 if r.kind == "sun" and getattr(r.extra, "assimilation", None) is not None}
+        if gross:                       # the levels' carbon side by side (the paper's question)
+            row = [ASSIMILATION_ROW]
+            for name in names:
+                g = gross.get(name)
+                se = g.canopy_gross_error_umol_m2_s if g is not None else None
+                row.append("" if g is None else f"{g.canopy_gross_umol_m2_s:.2f}"
+                           + (f" ± {se:.2f}" if se is not None else ""))
+            rows.append(row)
         return header, rows
 
 
@@ -215,6 +229,12 @@ def value_legend(run: Run) -> tuple[str, str]:
     return "diffuse light per leaf area (1: the sky's on open ground)", ""
 
 
+def assimilation_legend(run: Run) -> tuple[str, str]:
+    """Colour-bar title and unit of a sun's gross CO2 assimilation per leaf."""
+    model = run.extra.assimilation.model["model"].upper()
+    return f"gross CO₂ assimilation per leaf area ({model})", "µmol/m² leaf/s"
+
+
 def run_info(run: Run) -> str:
     """What was traced and how long it took, for the light panel."""
     r = run.result
@@ -238,6 +258,15 @@ def run_info(run: Run) -> str:
                      f"{b.reflected_top / b.incident if b.incident else 0:.1%} is reflected "
                      f"(balance closes within {abs(b.closure):.2%}; scattering "
                      f"{a.seconds.get('scatter', 0):.2f} s)")
+            g = getattr(run.extra, "assimilation", None)
+            if g is not None:
+                se = g.canopy_gross_error_umol_m2_s
+                info += (f"; gross CO₂ assimilation ({g.model['model'].upper()} leaf model, "
+                         f"{g.temp_c:g} °C) {g.canopy_gross_umol_m2_s:.2f}"
+                         + (f" ± {se:.2f}" if se is not None else "")
+                         + f" µmol/m² of ground/s = {g.canopy_gross_kg_co2_ha_h:.1f} kg "
+                         f"CO₂/ha/h (net of leaf respiration {g.canopy_net_umol_m2_s:.2f} "
+                         "µmol/m²/s)")
     elif run.kind == "sky":
         info = (f"{r.sky.description}; {r.rays:,} rays per direction; level {run.label}; "
                 f"Embree scene {build}, tracing {secs.get('trace', 0):.2f} s; leaves "

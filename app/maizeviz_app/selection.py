@@ -69,10 +69,26 @@ def describe(canopy: Any, label: str, runs: Sequence[Any], instance: int,
     lines = [f"plant {p.plant}, {what} ({where})",
              f"level {label}; leaf area {area.sum():,.1f} cm² ({len(rows):,} triangles)"]
     for run in runs:
-        line = _light_line(run, rows, area, leaf)
-        if line:
-            lines.append(line)
+        for line in (_light_line(run, rows, area, leaf),
+                     _assimilation_line(run, rows, area, leaf)):
+            if line:
+                lines.append(line)
     return lines
+
+
+def _assimilation_line(run: Any, rows: np.ndarray, area: np.ndarray, leaf: int) -> str:
+    """A sun's gross CO2 assimilation (a leaf model on its absorbed PAR) on the triangles
+    ``rows``: per m2 of leaf (area-weighted) and in all, umol CO2 per s."""
+    gross = getattr(run.extra, "gross_value", None)
+    if run.kind != "sun" or gross is None or len(gross) <= rows.max(initial=-1):
+        return ""
+    v = _mean(np.asarray(gross)[rows], area)
+    if not np.isfinite(v):
+        return ""
+    per = "" if leaf > 0 else " (mean over its leaves)"
+    model = run.extra.assimilation.model["model"].upper()
+    return (f"sun: gross CO₂ assimilation ({model}) {v:.3g} µmol/m² of leaf/s{per}, "
+            f"{v * area.sum() * 1e-4:.3g} µmol/s")
 
 
 def _mean(values: np.ndarray, area: np.ndarray) -> float:

@@ -199,6 +199,34 @@ class OpticsSettings:
     depth: int = field(default=DEFAULT_DEPTH, metadata=_range(0, 50))
 
 
+#: Leaf photosynthesis models the light panel offers ("none": absorbed light only).
+PHOTOSYNTHESIS = ("none", "c4", "wofost")
+#: The main parameters of each leaf model (the fields of :class:`PhotosynthesisSettings` that
+#: are its, by the core's names: maizeviz.photosynthesis.c4.C4Leaf, .wofost.WofostLeaf).
+MODEL_PARAMS = {"c4": ("vmax", "alpha", "co2_ppm"), "wofost": ("amax", "eff")}
+
+
+@evented
+@dataclass
+class PhotosynthesisSettings:
+    """Leaf photosynthesis of a sun's absorbed PAR (leaf optics on, band PAR): ``model``
+    none, c4 (Collatz et al. 1992, maize) or wofost (its negative exponential); the leaves'
+    ``temperature_c``; the C4 model's Rubisco capacity ``vmax`` at 25 C, quantum yield
+    ``alpha`` and ambient ``co2_ppm``; WOFOST's ``amax`` and ``eff``. The defaults are the
+    core's (a test holds them equal)."""
+
+    if TYPE_CHECKING:                           # made by @evented
+        events: ClassVar[SignalGroup]
+
+    model: str = "none"
+    temperature_c: float = field(default=25.0, metadata=_range(-50.0, 70.0, "°C"))
+    vmax: float = field(default=39.0, metadata=_range(0.0, 500.0, "µmol/m²/s"))
+    alpha: float = field(default=0.04, metadata=_range(0.0, 0.125, "mol/mol"))
+    co2_ppm: float = field(default=400.0, metadata=_range(0.0, 5000.0, "ppm"))
+    amax: float = field(default=70.0, metadata=_range(0.0, 500.0, "kg CO₂/ha/h"))
+    eff: float = field(default=0.45, metadata=_range(0.0, 5.0, "kg CO₂/ha/h per W/m²"))
+
+
 @evented
 @dataclass
 class DigitizerSettings:
@@ -231,11 +259,17 @@ LIGHT_DOC = {
     "ground_reflectance": ("optics", "ground_reflectance"),
     "direct_w_m2": ("optics", "direct_w_m2"), "diffuse_w_m2": ("optics", "diffuse_w_m2"),
     "depth": ("optics", "depth"),
+    "photosynthesis": ("photosynthesis", "model"),
+    "leaf_temperature_c": ("photosynthesis", "temperature_c"),
+    "c4_vmax": ("photosynthesis", "vmax"), "c4_alpha": ("photosynthesis", "alpha"),
+    "co2_ppm": ("photosynthesis", "co2_ppm"), "wofost_amax": ("photosynthesis", "amax"),
+    "wofost_eff": ("photosynthesis", "eff"),
 }
 #: Choices a text setting may take: (group, field) -> allowed values.
 CHOICES = {("light", "mode"): MODES, ("sky", "kind"): ("soc", "uoc"),
            ("sky", "split"): ("auto", "equal"), ("day", "source"): ("clear", "weather"),
-           ("day", "diffuse"): ("sky", "perez"), ("optics", "band"): ("par", "nir")}
+           ("day", "diffuse"): ("sky", "perez"), ("optics", "band"): ("par", "nir"),
+           ("photosynthesis", "model"): PHOTOSYNTHESIS}
 
 
 def field_names(group: Any) -> list[str]:
@@ -253,7 +287,7 @@ def field_range(group: Any, name: str) -> tuple[float, float] | None:
 
 class StudySettings:
     """Every settings group of a study, by name (:attr:`groups`): ``canopy``, ``light``,
-    ``sun``, ``sampling``, ``sky``, ``day``, ``optics``, ``digitizer``.
+    ``sun``, ``sampling``, ``sky``, ``day``, ``optics``, ``photosynthesis``, ``digitizer``.
 
     The one rule between fields lives here: choosing a band sets the optics to the band's
     defaults (as the command line's defaults follow ``--band``)."""
@@ -266,6 +300,7 @@ class StudySettings:
         self.sky = SkySettings()
         self.day = DaySettings()
         self.optics = OpticsSettings()
+        self.photosynthesis = PhotosynthesisSettings()
         self.digitizer = DigitizerSettings()
         # the PAR defaults are the dataclass's (a test holds them equal to the core's)
         self.optics.events.band.connect(self._band_defaults)
@@ -274,7 +309,8 @@ class StudySettings:
     def groups(self) -> dict[str, Any]:
         return {"canopy": self.canopy, "light": self.light, "sun": self.sun,
                 "sampling": self.sampling, "sky": self.sky, "day": self.day,
-                "optics": self.optics, "digitizer": self.digitizer}
+                "optics": self.optics, "photosynthesis": self.photosynthesis,
+                "digitizer": self.digitizer}
 
     def _band_defaults(self, band: str, *_old) -> None:
         o = self.optics
@@ -337,7 +373,7 @@ class StudySettings:
         if by_group.get("sky", {}).get("split") == "auto" and \
                 by_group["sky"].get("directions", 46) not in (16, 46, 145):
             by_group["sky"]["split"] = "equal"
-        for g in ("optics", "sun", "sampling", "sky", "day", "light"):
+        for g in ("optics", "photosynthesis", "sun", "sampling", "sky", "day", "light"):
             if g in by_group:
                 self.set(g, by_group[g])
 
@@ -392,14 +428,30 @@ class StudySettings:
                        d.par_factor, weather, d.diffuse)
 
     def optics_spec(self):
-        """Absorbed light as chosen (:class:`maizeviz.light.specs.OpticsSpec`), None when leaf
-        optics are off; leaf scattering above 1 refused naming the field."""
+        """Absorbed light as chosen (:class:`maizeviz.light.specs.OpticsSpec`), with the leaf
+        model when one is chosen; None when leaf optics are off. Leaf scattering above 1, or
+        photosynthesis from NIR, refused naming the field."""
         from maizeviz.light.specs import OpticsSpec
 
         o = self.optics
         if not o.enabled:
             return None
+        model, temperature, params = self.photosynthesis_choice()
         spec = OpticsSpec(o.band, o.reflectance, o.transmittance, o.ground_reflectance,
-                          o.direct_w_m2, o.diffuse_w_m2, o.depth)
+                          o.direct_w_m2, o.diffuse_w_m2, o.depth, photosynthesis=model,
+                          temperature_c=temperature, photosynthesis_params=params)
         spec.optics()                                   # checked now, named by the core
+        spec.leaf_model()
         return spec
+
+    def photosynthesis_choice(self) -> tuple[str, float, tuple]:
+        """The leaf model as :class:`maizeviz.light.specs.OpticsSpec` takes it: its name (""
+        for none), the leaf temperature (C) and the main parameters that differ from the
+        model's defaults, as ``((name, value), ...)`` in :data:`MODEL_PARAMS` order."""
+        p = self.photosynthesis
+        if p.model == "none":
+            return "", 25.0, ()
+        default = PhotosynthesisSettings()
+        params = tuple((k, float(getattr(p, k))) for k in MODEL_PARAMS[p.model]
+                       if getattr(p, k) != getattr(default, k))
+        return p.model, float(p.temperature_c), params

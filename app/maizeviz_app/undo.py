@@ -27,7 +27,7 @@ from maizeviz_app.settings import field_names
 
 #: Settings groups whose edits are undoable (the digitizer's connection is not an edit of the
 #: study).
-UNDOABLE = ("canopy", "light", "sun", "sampling", "sky", "day", "optics")
+UNDOABLE = ("canopy", "light", "sun", "sampling", "sky", "day", "optics", "photosynthesis")
 #: The colour settings' groups (:class:`maizeviz_app.colour.ColourSettings`): the 3D view's
 #: scale, the heatmaps' and the rest; undoable too (as ParaView's colour map edits), though
 #: they change no result.
@@ -52,7 +52,16 @@ NAMES = {"level": "mesh level", "preserve_area": "area preservation", "mode": "l
          "depth": "scattering depth", "tile": "tiling", "range": "colour range",
          "vmin": "colour min", "vmax": "colour max", "clip": "colour clip",
          "cmap": "colour map", "log": "log scale", "shared": "one heatmap scale",
-         "painting": "sun painted"}
+         "painting": "sun painted", "model": "photosynthesis",
+         "temperature_c": "leaf temperature", "alpha": "C4 quantum yield",
+         "co2_ppm": "CO₂", "amax": "WOFOST AMAX", "eff": "WOFOST EFF",
+         # a field whose name another group uses too: by group and field
+         "photosynthesis.vmax": "C4 Vmax"}
+
+
+def _named(group: str, name: str) -> str:
+    """What field ``name`` of settings group ``group`` is called in the Edit menu."""
+    return NAMES.get(f"{group}.{name}", NAMES.get(name, name))
 
 
 def _shown(value: Any) -> str:
@@ -78,12 +87,12 @@ class SettingsEdit(QUndoCommand):
 
     def _name(self) -> None:
         (group, name), (_old, new) = next(reversed(self.changes.items()))
-        names = {NAMES.get(f, f) for _g, f in self.changes}
+        names = {_named(g, f) for g, f in self.changes}
         where = {"view colours": "3D view ", "heatmap colours": "heatmap "}.get(group, "")
         if len(names) == 1:
-            self.setText(f"{where}{NAMES.get(name, name)} {_shown(new)}")
+            self.setText(f"{where}{_named(group, name)} {_shown(new)}")
         else:
-            self.setText(f"{where}{NAMES.get(name, name)} {_shown(new)} and "
+            self.setText(f"{where}{_named(group, name)} {_shown(new)} and "
                          f"{len(names) - 1} more")
 
     def id(self) -> int:  # noqa: A003 - Qt's name

@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from maizeviz_app.runs import value_legend
+from maizeviz_app.options import COLOURINGS
+from maizeviz_app.runs import assimilation_legend, value_legend
 
 
 class ViewLink:
@@ -80,7 +81,12 @@ class ViewLink:
             title, unit = value_legend(run)
             self.view.set_light_values(run.extra.leaf_value, title, unit)
             self.window.colour_panel.show_painting("")      # a sun's painting is not shown
-        if colour and run is not None:
+        gross = getattr(run.extra, "gross_value", None) if run is not None else None
+        if gross is not None:                   # a leaf model too: its CO2 assimilation
+            self.view.set_assimilation_values(gross, *assimilation_legend(run))
+        else:
+            self.view.set_assimilation_values(None)
+        if colour and run is not None and self.view.colouring != "assimilation":
             self.colour_by("light")
         self.sync_colour_actions()
 
@@ -126,14 +132,17 @@ class ViewLink:
         if self.view is None:
             return
         if not self.view.colour_by(what):
-            self.window.say("no light result for the canopy shown: compute direct light first "
+            self.window.say("no CO₂ assimilation for the canopy shown: trace a sun with leaf "
+                            "optics (PAR) and a photosynthesis model in the Light panel"
+                            if what == "assimilation" else
+                            "no light result for the canopy shown: compute direct light first "
                             "(Ctrl+L)")
         self.sync_colour_actions()
 
     def sync_colour_actions(self) -> None:
         if self.view is None:
             return
-        for name in ("plant", "leaf", "light"):
+        for name in COLOURINGS:
             act = self.window.menu_actions.get(f"colour_{name}")
             if act is not None:
                 act.setChecked(self.view.colouring == name)

@@ -278,6 +278,7 @@ class Viewport(QtInteractor):
         #: What the "light" colouring shows: "classes" (a sun) or "values" (a sky, a day).
         self.light_variant = "classes"
         self._light_key: tuple[str, str] = ("", "")        # colour-bar title, unit
+        self._assimilation_key: tuple[str, str] = ("", "")
         self._canopy_actor = None
         self._ground_bounds = None
         self._layout = None
@@ -329,6 +330,8 @@ class Viewport(QtInteractor):
         self._set_ground(canopy.layout)
         if "light_value" not in poly.cell_data:
             self.light_variant = "classes"
+        if self.colouring == "assimilation" and not self.has_assimilation():
+            self.colouring = "light"
         if self.colouring == "light" and not self.has_light():
             self.colouring = "leaf"
         self._apply_colouring()
@@ -337,6 +340,11 @@ class Viewport(QtInteractor):
             self._framed = True
         self.render()
         self.canopy_set.emit()
+
+    def has_assimilation(self) -> bool:
+        """The canopy shown has CO2 assimilation values to colour by."""
+        return self.canopy_mesh is not None and \
+            "assimilation_value" in self.canopy_mesh.cell_data
 
     def has_light(self) -> bool:
         if self.canopy_mesh is None:
@@ -390,25 +398,56 @@ class Viewport(QtInteractor):
         follows if coloured by light."""
         if self.canopy_mesh is None:
             return
-        nf = int(self.canopy_mesh.field_data["leaf_triangles"][0])
-        given = int(self.canopy_mesh.field_data.get("canopy_triangles", [nf])[0])
-        if len(values) != given:
-            raise ValueError(f"{len(values)} light values for {given} leaf triangles")
-        cells = np.full(self.canopy_mesh.n_cells, -1.0, np.float32)     # stalks below range
-        cells[:nf] = _per_drawn(self.canopy_mesh, np.asarray(values), False)
-        self.canopy_mesh.cell_data["light_value"] = cells
+        self.canopy_mesh.cell_data["light_value"] = self._cells_of(values, "light")
         self.light_variant = "values"
         self._light_key = (title, unit)
         if self.colouring == "light":
             self._apply_colouring()
             self.render()
 
+    def set_assimilation_values(self, values: np.ndarray | None, title: str = "",
+                                unit: str = "") -> None:
+        """Gross CO2 assimilation per m2 of leaf on each leaf triangle (F,) float (NaN where
+        not traced) for the ``assimilation`` colouring, with a colour bar titled ``title``;
+        None forgets it (a light without a leaf model), and a view coloured by it goes back
+        to the light."""
+        if self.canopy_mesh is None:
+            return
+        if values is None:
+            if "assimilation_value" in self.canopy_mesh.cell_data:
+                del self.canopy_mesh.cell_data["assimilation_value"]
+            if self.colouring == "assimilation":
+                self.colouring = "light" if self.has_light() else "leaf"
+                self._apply_colouring()
+                self.render()
+            return
+        self.canopy_mesh.cell_data["assimilation_value"] = self._cells_of(values,
+                                                                         "assimilation")
+        self._assimilation_key = (title, unit)
+        if self.colouring == "assimilation":
+            self._apply_colouring()
+            self.render()
+
+    def _cells_of(self, values: np.ndarray, what: str) -> np.ndarray:
+        """(n_cells,) float32 of the drawn mesh from a value per leaf triangle of the canopy
+        (F,): stalks -1 (below any range); ValueError for a wrong length."""
+        assert self.canopy_mesh is not None
+        nf = int(self.canopy_mesh.field_data["leaf_triangles"][0])
+        given = int(self.canopy_mesh.field_data.get("canopy_triangles", [nf])[0])
+        if len(values) != given:
+            raise ValueError(f"{len(values)} {what} values for {given} leaf triangles")
+        cells = np.full(self.canopy_mesh.n_cells, -1.0, np.float32)     # stalks below range
+        cells[:nf] = _per_drawn(self.canopy_mesh, np.asarray(values), False)
+        return cells
+
     def colour_by(self, what: str) -> bool:
-        """Colour the canopy by ``plant``, ``leaf`` or ``light``; False (and nothing changes)
-        for light when no light result belongs to this canopy."""
+        """Colour the canopy by ``plant``, ``leaf``, ``light`` or ``assimilation``; False
+        (and nothing changes) for light or assimilation when no such result belongs to this
+        canopy."""
         if what not in COLOURINGS:
             raise ValueError(f"unknown colouring {what}")
-        if what == "light" and not self.has_light():
+        if what == "light" and not self.has_light() or \
+                what == "assimilation" and not self.has_assimilation():
             return False
         if what != self.colouring:
             self.colouring = what
@@ -424,7 +463,10 @@ class Viewport(QtInteractor):
         cells = self.canopy_mesh.cell_data
         array = what
         if what == "light" and self.light_variant == "values":
-            self._paint_values(mapper)
+            self._paint_values(mapper, "light_value", self._light_key)
+            return
+        if what == "assimilation":
+            self._paint_values(mapper, "assimilation_value", self._assimilation_key)
             return
         mapper.SetColorModeToMapScalars()
         if what == "light":
@@ -471,20 +513,23 @@ class Viewport(QtInteractor):
         self._on_scale()
 
     def _on_scale(self, *_args) -> None:
-        if self.colouring == "light" and self.light_variant == "values":
+        if self.colouring == "light" and self.light_variant == "values" or \
+                self.colouring == "assimilation":
             self._apply_colouring()
             self.render()
 
-    def _paint_values(self, mapper) -> None:
-        """Light values (cell data ``light_value``: leaves' values, NaN not traced, -1 for
-        stalks) as colours of the view's scale, one RGB per triangle (``light_rgb``): stalks
-        and triangles not traced keep their own colours whatever the range clips."""
+    def _paint_values(self, mapper, array: str, key: tuple[str, str]) -> None:
+        """Values per triangle (cell data ``array``: ``light_value`` or
+        ``assimilation_value``; leaves' values, NaN not traced, -1 for stalks) as colours of
+        the view's scale, one RGB per triangle (``light_rgb``), the colour bar titled
+        ``key`` (title, unit): stalks and triangles not traced keep their own colours
+        whatever the range clips."""
         from maizeviz_app.colour import ColourError, ColourScale, colour_table, colours_of
 
         mesh = self.canopy_mesh
         assert mesh is not None
         nf = int(mesh.field_data["leaf_triangles"][0])
-        values = np.asarray(mesh.cell_data["light_value"])
+        values = np.asarray(mesh.cell_data[array])
         scale = self._scale if self._scale is not None else ColourScale(cmap="inferno")
         try:
             lo, hi = scale.limits(values[:nf])
@@ -502,7 +547,7 @@ class Viewport(QtInteractor):
         mapper.SelectColorArray("light_rgb")
         mapper.SetColorModeToDirectScalars()
         mapper.ScalarVisibilityOn()
-        title, unit = self._light_key
+        title, unit = key
         leaf = values[:nf][np.isfinite(values[:nf])]
         low = ("≤ " if len(leaf) and leaf.min() < lo else "") + tick_text(lo)
         high = ("≥ " if len(leaf) and leaf.max() > hi else "") + tick_text(hi)

@@ -9,6 +9,8 @@ time, whole plants per chunk (:func:`maizeviz.io.parquet.point_chunks`):
 1. the survey (:class:`FieldLeaves`): each chunk's leaf grids are built and only what the
    commands need before any long work is kept: each leaf's plant and grid shape (the cost
    estimates), each plant's stalk base (the layout), the leaves refused and the repairs made;
+   with workers, the chunks' bounds are read from the plant column alone
+   (:func:`~maizeviz.io.parquet.plant_chunk_bounds`) and each chunk surveyed on a process;
 2. the build (:meth:`FieldLeaves.canopy`): each chunk's grids are built again, fitted and
    meshed at the level (:func:`~maizeviz.canopy.scene.plant_meshes`), the chunk's leaves let
    go; the plants' meshes are then placed (:func:`~maizeviz.canopy.scene.place_plants`).
@@ -23,6 +25,7 @@ from __future__ import annotations
 import os
 from collections import defaultdict
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -30,7 +33,13 @@ import numpy as np
 from maizeviz.canopy.layout import CanopyLayout
 from maizeviz.canopy.scene import Canopy, PlantMesh, place_plants, plant_meshes
 from maizeviz.errors import LeafError
-from maizeviz.io.parquet import NotStreamable, is_parquet, parquet_rows, point_chunks
+from maizeviz.io.parquet import (
+    NotStreamable,
+    is_parquet,
+    parquet_rows,
+    plant_chunk_bounds,
+    point_chunks,
+)
 from maizeviz.leaf.fit import fit_leaves
 from maizeviz.leaf.grid import base_of_collars, build_grids
 from maizeviz.mesh.levels import Level
@@ -83,6 +92,8 @@ class FieldLeaves:
     rows : records in the file
     extents : {plant: (x0, y0, x1, y1) cm}, the bounding box of its points from above
     highest : cm, the highest point
+    worker_cpu_s : CPU seconds the worker processes spent on its chunks so far (survey and
+        builds; 0 when this process did all the work)
     """
 
     def __init__(self, path: str | Path, strict: bool = False, degree: int = 3,
@@ -93,6 +104,31 @@ class FieldLeaves:
         self.workers = workers
         self.strict, self.degree, self.method = strict, degree, method
         self.rows = parquet_rows(path) or 0
+        self.worker_cpu_s = 0.0
+        #: records [start, stop) of each chunk of whole plants, in the file's order
+        self.chunks: list[tuple[int, int]] = []
+        parts: Iterable[_Survey] = ()
+        pool = None
+        if survey and workers > 1 and not strict:
+            # the chunks' bounds from the plant column alone, then each chunk surveyed in a
+            # worker (the same numbers: each chunk's leaves are gridded alone either way)
+            self.chunks = plant_chunk_bounds(path, CHUNK_POINTS)
+            if len(self.chunks) > 1:
+                pool = _pool(min(workers, len(self.chunks)))
+                parts = pool.map(_survey_rows, [str(path)] * len(self.chunks),
+                                 *zip(*self.chunks))
+            else:
+                parts = (_survey_rows(str(path), a, b) for a, b in self.chunks)
+        elif survey:
+            parts = (_survey_table(t, strict) for t in point_chunks(path, CHUNK_POINTS))
+        try:
+            self._gather(parts, progress)
+        finally:
+            if pool is not None:
+                pool.shutdown(cancel_futures=True)
+
+    def _gather(self, parts: Iterable[_Survey], progress: ProgressCallback | None) -> None:
+        """The survey's attributes from each chunk's, in the file's order."""
         plant: list[int] = []
         nrows: list[int] = []
         ncols: list[int] = []
@@ -103,32 +139,26 @@ class FieldLeaves:
         lo: dict[int, np.ndarray] = {}
         hi: dict[int, np.ndarray] = {}
         self.highest = -np.inf
-        #: records [start, stop) of each chunk of whole plants, in the file's order
-        self.chunks: list[tuple[int, int]] = []
+        bounds = []
         done = 0
-        for table in point_chunks(path, CHUNK_POINTS) if survey else ():
-            self.chunks.append((int(table.line[0]) - 2, int(table.line[-1]) - 1))
-            grids, errors = build_grids(table, strict=strict)
-            self.skipped += errors
-            plant += [g.plant for g in grids]
-            nrows += [g.points.shape[0] for g in grids]
-            ncols += [g.points.shape[1] for g in grids]
-            tip += [g.tip_collapsed for g in grids]
-            for g in grids:
-                collars[g.plant].append(g.collar[:2].copy())
-            self.notes += [f"plant {g.plant}, leaf {g.leaf}: {n}" for g in grids if g.notes
-                           for n in g.notes]
-            # each plant's points seen from above (its records lie together in the chunk)
-            ids, xyz = table.ids[:, 0], table.xyz
-            starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
-            for p, a, b in zip(ids[starts].tolist(), np.minimum.reduceat(xyz, starts),
-                               np.maximum.reduceat(xyz, starts)):
+        for part in parts:
+            self.worker_cpu_s += part.cpu_s
+            bounds.append(part.bounds)
+            self.skipped += [LeafError(*e) for e in part.errors]
+            plant += part.plant
+            nrows += part.rows
+            ncols += part.cols
+            tip += part.tip
+            for p, xy in zip(part.plant, part.collars):
+                collars[p].append(xy)
+            self.notes += part.notes
+            for p, a, b in zip(part.extent_plants, part.lo, part.hi):
                 lo[p] = np.minimum(lo[p], a) if p in lo else a
                 hi[p] = np.maximum(hi[p], b) if p in hi else b
-            if len(xyz):
-                self.highest = max(self.highest, float(xyz[:, 2].max()))
-            done += len(table)
+            self.highest = max(self.highest, part.highest)
+            done += part.records
             report(progress, done, max(self.rows, done), "reading the field")
+        self.chunks = bounds
         self.shapes = LeafShapes(np.array(plant, np.int64), np.array(nrows, np.int32),
                                  np.array(ncols, np.int32), np.array(tip, bool))
         self.bases = {p: base_of_collars(np.array(c)) for p, c in collars.items()}
@@ -175,14 +205,11 @@ class FieldLeaves:
             results = (_mesh_rows(*job) for job in jobs)
             pool = None
         else:
-            import multiprocessing
-            from concurrent.futures import ProcessPoolExecutor
-
-            pool = ProcessPoolExecutor(min(n, len(jobs)),
-                                       mp_context=multiprocessing.get_context("forkserver"))
+            pool = _pool(min(n, len(jobs)))
             results = pool.map(_mesh_rows, *zip(*jobs))
         try:
-            for k, (meshes, errors) in enumerate(results, start=1):
+            for k, (meshes, errors, cpu_s) in enumerate(results, start=1):
+                self.worker_cpu_s += cpu_s
                 out.update(meshes)
                 self.skipped += [LeafError(*e) for e in errors]
                 report(progress, k, len(jobs), f"building the field at {level}")
@@ -198,6 +225,77 @@ class FieldLeaves:
         placed = {p.plant for p in layout.placements}
         meshes = self.plant_meshes(level, preserve_area, placed, progress)
         return place_plants(meshes, layout, level.label)
+
+
+@dataclass
+class _Survey:
+    """What the survey keeps of one chunk of whole plants (pickles: errors as tuples)."""
+
+    bounds: tuple[int, int]
+    records: int
+    errors: list[tuple]
+    plant: list[int]
+    rows: list[int]
+    cols: list[int]
+    tip: list[bool]
+    collars: list[np.ndarray]
+    notes: list[str]
+    extent_plants: list[int]
+    lo: np.ndarray
+    hi: np.ndarray
+    highest: float
+    cpu_s: float = 0.0                  # CPU seconds a worker process spent on it
+
+
+def _survey_table(table, strict: bool = False) -> _Survey:
+    """The survey of one table of whole plants (:class:`FieldLeaves`)."""
+    grids, errors = build_grids(table, strict=strict)
+    # each plant's points seen from above (its records lie together in the chunk)
+    ids, xyz = table.ids[:, 0], table.xyz
+    starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]]) if len(ids) else \
+        np.zeros(0, np.int64)
+    some = len(xyz) > 0
+    return _Survey(
+        bounds=(int(table.line[0]) - 2, int(table.line[-1]) - 1) if some else (0, 0),
+        records=len(table), errors=[(e.plant, e.leaf, e.detail) for e in errors],
+        plant=[g.plant for g in grids], rows=[g.points.shape[0] for g in grids],
+        cols=[g.points.shape[1] for g in grids], tip=[g.tip_collapsed for g in grids],
+        collars=[g.collar[:2].copy() for g in grids],
+        notes=[f"plant {g.plant}, leaf {g.leaf}: {n}" for g in grids if g.notes
+               for n in g.notes],
+        extent_plants=ids[starts].tolist(),
+        lo=np.minimum.reduceat(xyz, starts) if some else np.zeros((0, 3)),
+        hi=np.maximum.reduceat(xyz, starts) if some else np.zeros((0, 3)),
+        highest=float(xyz[:, 2].max()) if some else -np.inf)
+
+
+def _survey_rows(path: str, start: int, stop: int) -> _Survey:
+    """:func:`_survey_table` of the records [start, stop) of a Parquet points file (in a
+    worker process)."""
+    import time
+
+    from maizeviz.io.parquet import read_rows
+
+    t = time.process_time()
+    out = _survey_table(read_rows(path, start, stop))
+    out.cpu_s = time.process_time() - t if _in_worker() else 0.0
+    return out
+
+
+def _in_worker() -> bool:
+    """Whether this process is a worker started by :mod:`multiprocessing`."""
+    import multiprocessing
+
+    return multiprocessing.parent_process() is not None
+
+
+def _pool(n: int):
+    """Processes for a field's chunks (started by forkserver: no copy of this process's
+    memory, nor of its threads' locks)."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("forkserver"))
 
 
 def _mesh_table(table, level: Level, preserve_area: bool, strict: bool, degree: int,
@@ -219,11 +317,15 @@ def _mesh_rows(path: str, start: int, stop: int, level: Level, preserve_area: bo
                strict: bool, degree: int, method: str, only: set[int] | None):
     """:func:`_mesh_table` of the records [start, stop) of a Parquet points file (in a worker
     process: errors as (plant, leaf, detail), which pickle)."""
+    import time
+
     from maizeviz.io.parquet import read_rows
 
+    t = time.process_time()
     meshes, errors = _mesh_table(read_rows(path, start, stop), level, preserve_area, strict,
                                  degree, method, only)
-    return meshes, [(e.plant, e.leaf, e.detail) for e in errors]
+    cpu_s = time.process_time() - t if _in_worker() else 0.0
+    return meshes, [(e.plant, e.leaf, e.detail) for e in errors], cpu_s
 
 
 def canopy_of(leaves, layout: CanopyLayout, level: Level, preserve_area: bool = True,

@@ -188,7 +188,16 @@ def check_canopy_costs(leaves: list[Leaf], layout: CanopyLayout, levels: list[Le
                        force: bool, per_level: Sequence[Cost] = ()) -> None:
     """Refuse, before building anything, canopies (plus ``per_level`` work on each) that would
     not fit in memory, or take too long unless ``force``."""
-    check([[layout_cost(leaves, layout, level), *per_level] for level in levels], force)
+    say_estimate(check([[layout_cost(leaves, layout, level), *per_level] for level in levels],
+                       force))
+
+
+def say_estimate(estimate) -> None:
+    """Tell the estimate (:func:`maizeviz.cost.check`'s) of work long enough to wait for."""
+    from maizeviz.cost import SAY_SECONDS
+
+    if estimate is not None and estimate.seconds >= SAY_SECONDS:
+        say(f"estimate: {estimate.describe()}")
 
 
 def load_leaves(path: str, strict: bool = False, degree: int = 3, method: str = "chord",

@@ -40,6 +40,7 @@ from maizeviz.cli.common import (
     levels_from,
     mesh_setup,
     say,
+    say_estimate,
 )
 from maizeviz.cost import check, light_costs, mesh_cost
 from maizeviz.errors import LeafError, MaizevizError, check_range
@@ -380,6 +381,7 @@ class _Level:
     sky_res: SkyLight | None = None
     per_res: PeriodLight | None = None
     ab: AbsorbedLight | None = None
+    asm: Any = None                     # the sun's Assimilation, with a leaf model
 
 
 def run(args: argparse.Namespace) -> int:
@@ -404,7 +406,7 @@ def run(args: argparse.Namespace) -> int:
         leaves, skipped, layout = canopy_setup(args)
     work = _costs(job, layout)
     if mesh:
-        check([[mesh_cost(mesh_canopy.n_triangles), *work]], args.force)
+        say_estimate(check([[mesh_cost(mesh_canopy.n_triangles), *work]], args.force))
     else:
         check_canopy_costs(leaves, layout, levels, args.force, work)
     records: list[dict[str, Any]] = []
@@ -537,7 +539,8 @@ def _trace_level(job: _Job, canopy: Canopy, canopy_s: float) -> dict[str, Any]:
                    lv.tables, lv.plant_extra)
     if args.export:
         path = export_canopy(args.export, canopy,
-                             light_cells(canopy, lv.res, lv.sky_res, lv.per_res, lv.ab))
+                             light_cells(canopy, lv.res, lv.sky_res, lv.per_res, lv.ab,
+                                         lv.asm))
         say(f"wrote {canopy.n_triangles:,} leaf triangles of {canopy.n_plants} plants with "
             f"their light (and their stalks) to {path}")
     return rec
@@ -654,7 +657,7 @@ def _trace_absorbed_sun(job: _Job, lv: _Level) -> None:
         lv.tables.append(ab.leaf_rows(lv.canopy))
         _merge(lv.plant_extra, _plant_errors(lv.canopy, ab))
     if job.leaf_model is not None:
-        asm = assimilate(lv.canopy, ab, job.leaf_model, job.temp_c)
+        asm = lv.asm = assimilate(lv.canopy, ab, job.leaf_model, job.temp_c)
         lv.rec["photosynthesis"] = asm.as_dict()
         _say_once(job, list(asm.warnings))
         if job.want_rows:

@@ -305,6 +305,8 @@ def _read_ascii(fh: BinaryIO, end: int, size: int, head, header_lines: int, src:
     try:
         with warnings.catch_warnings():        # plyfile's loadtxt on an empty list warns
             warnings.simplefilter("ignore", UserWarning)
+            # numpy 2.0-2.2's loadtxt reads 9.5 as an integer 9 with this warning: refuse it
+            warnings.filterwarnings("error", ".*integer via a float", DeprecationWarning)
             ply = plyfile.PlyData.read(io.BytesIO(text))
     except plyfile.PlyElementParseError as exc:
         el, row = exc.element, int(exc.row or 0)
@@ -318,7 +320,7 @@ def _read_ascii(fh: BinaryIO, end: int, size: int, head, header_lines: int, src:
         problem = _ascii_problem(lines[at].split(), el)
         raise MeshFileError(f"{src}: line {int(line_of[at])}: {el.name} {row} (counting from "
                             f"0): {problem}") from None
-    except (ValueError, OverflowError) as exc:        # a number beyond its type
+    except (ValueError, OverflowError, DeprecationWarning) as exc:  # a number beyond its type
         found = _first_problem(lines, head)
         if found is None:                                             # pragma: no cover
             raise MeshFileError(f"{src}: a value cannot be read ({exc})") from None

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from maizeviz import loops
 from maizeviz.errors import LeafError
 
 #: Above this many comparisons, :func:`count_at_most` searches leaf by leaf.
@@ -92,6 +93,9 @@ def basis_matrix(x: np.ndarray, knots: np.ndarray, degree: int) -> np.ndarray:
     -------
     (L, A, K - degree - 1) float64; rows sum to 1.
     """
+    out = loops.basis_matrix(x, knots, degree)       # the same values in one C pass
+    if out is not None:
+        return out
     vals, first, nctrl = basis_values(x, knots, degree)
     nbatch, npts = first.shape
     out = np.zeros((nbatch, npts, nctrl))

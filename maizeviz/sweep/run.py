@@ -309,12 +309,22 @@ class _CtrlC:
     def __init__(self):
         self.depth = 0
         self.pending = False
+        self.asked = False
         self.old = None
 
     def _handler(self, signum, frame):
+        self.asked = True
         if self.depth:
             self.pending = True
         else:
+            # raised wherever the main thread is; inside a finalizer (distributed's
+            # Future.__del__) Python ignores it, so the driving loop also polls ``asked``
+            raise KeyboardInterrupt
+
+    def check(self) -> None:
+        """Raise KeyboardInterrupt if Ctrl-C was pressed (and not yet raised where it
+        counts)."""
+        if self.asked:
             raise KeyboardInterrupt
 
     def __enter__(self):
@@ -430,6 +440,20 @@ def _given(client):
     yield client, "given client"
 
 
+def _completed(pending, ctrl_c, poll_s: float = 0.05):
+    """The futures of ``pending`` (a distributed ``as_completed``) as they finish, polled so
+    that a Ctrl-C whose KeyboardInterrupt was lost in a finalizer still stops the run."""
+    while not pending.is_empty():
+        ctrl_c.check()
+        ready = pending.next_batch(block=False)
+        if not ready:
+            time.sleep(poll_s)
+            continue
+        for fut in ready:
+            ctrl_c.check()
+            yield fut
+
+
 def _drive(client, chunks, store, outcome, bar, on_result, ctrl_c) -> None:
     """Submit the chunks and record their results as they complete."""
     from distributed import as_completed
@@ -443,7 +467,7 @@ def _drive(client, chunks, store, outcome, bar, on_result, ctrl_c) -> None:
         futures[fut] = chunk
     last_flush = time.monotonic()
     try:
-        for fut in as_completed(list(futures)):
+        for fut in _completed(as_completed(list(futures)), ctrl_c):
             chunk = futures.pop(fut)
             if fut.status == "finished":
                 res = fut.result()

@@ -227,10 +227,11 @@ def test_wheel_holds_the_app_and_the_data_under_our_names(wheel_env):
                    "maizeviz/resources/phenotrack3d/1649057232.json.gz",
                    "maizeviz_app/main_window.py"):
         assert needed in names
-    # a platform wheel carrying the built ray-packet kernel (stable ABI) and its source
+    # a platform wheel carrying the built ray-packet kernel and meshing loops (stable ABI)
+    # and their sources
     assert "-cp311-abi3-" in wheel.name and not wheel.name.endswith("-any.whl")
-    assert {"maizeviz/mesh/_packets.abi3.so", "maizeviz/mesh/_packets.pyi",
-            "maizeviz/mesh/_packets.c"} <= set(names)
+    assert {f"maizeviz/{m}{ext}" for m in ("mesh/_packets", "_loops")
+            for ext in (".abi3.so", ".pyi", ".c")} <= set(names)
     meta = next(n for n in names if n.endswith("entry_points.txt"))
     text = zipfile.ZipFile(wheel).read(meta).decode()
     assert "maizeviz = maizeviz.cli:main" in text and "maizeviz_app.main:run" in text

@@ -36,6 +36,7 @@ def test_info_names_the_versions_the_library_and_the_kernel_in_use(capsys):
     assert kernel.startswith("ray kernel: packets (Embree's ray packets of 8): ")
     assert kernel.endswith(str(packets.status().path))
     assert "scene fill: copy" in text
+    assert "compiled loops: compiled (" in text
     assert f"threads: {os.cpu_count()} cores" in text
 
 
@@ -43,6 +44,8 @@ def test_info_says_why_the_packets_are_off():
     out = run("--info", env={"MAIZEVIZ_PACKETS": "0"})
     assert out.returncode == 0, out.stderr
     assert "ray kernel: embreex's single rays (turned off by MAIZEVIZ_PACKETS=0)" in out.stdout
+    out = run("--info", env={"MAIZEVIZ_LOOPS": "0"})
+    assert "compiled loops: numpy (turned off by MAIZEVIZ_LOOPS=0)" in out.stdout
 
 
 @pytest.fixture(scope="module")

@@ -100,3 +100,52 @@ def test_a_field_whose_plants_are_scattered_is_read_whole(tmp_path, small_chunks
     write_points(path, grids[::2] + grids[1::2])            # plant 1's leaves in two places
     assert field.read_field(path) is None
     assert main(["canopy", str(path), "--json", "--interp", "0"]) == EXIT_OK
+
+
+def test_a_survey_in_workers_is_the_survey_in_one_process(points, small_chunks):
+    """The chunks' bounds read from the plant column alone, each chunk surveyed in a worker
+    process: the same leaves, shapes, bases, extents, notes and refusals as one process
+    reading the chunks in turn, chunks of whole plants covering every record once, and the
+    same canopy built from them."""
+    one = FieldLeaves(points)
+    two = FieldLeaves(points, workers=2)
+    assert len(two.chunks) > 2
+    assert two.chunks[0][0] == 0 and two.chunks[-1][1] == two.rows
+    assert all(a[1] == b[0] for a, b in zip(two.chunks, two.chunks[1:]))
+    for name in ("plant", "rows", "cols", "tip"):
+        assert np.array_equal(getattr(one.shapes, name), getattr(two.shapes, name)), name
+    assert one.bases == two.bases and one.extents == two.extents
+    assert one.notes == two.notes and one.highest == two.highest
+    assert [str(e) for e in one.skipped] == [str(e) for e in two.skipped]
+    layout = layout_for(one, (1, 1))
+    same_canopy(canopy_of(two, layout, parse_level("8")), canopy_of(one, layout,
+                                                                   parse_level("8")))
+
+
+def test_scattered_plants_are_found_from_the_plant_column(tmp_path, small_chunks):
+    from maizeviz.io.parquet import NotStreamable, plant_chunk_bounds
+
+    grids = block_grids(2, 2, seed=2)
+    path = tmp_path / "mixed.parquet"
+    write_points(path, grids[::2] + grids[1::2])
+    with pytest.raises(NotStreamable, match="not together"):
+        plant_chunk_bounds(path, 100)
+    assert field.read_field(path, workers=2) is None
+
+
+def test_long_work_is_estimated_before_it_starts(points, small_chunks, capsys, monkeypatch):
+    """Work estimated past SAY_SECONDS is told on stderr before the canopy is built: its
+    time and memory, and its largest part."""
+    import maizeviz.cost as cost
+
+    argv = ["light", str(points), "--triangles", "36", "--sun-zenith", "35", "--sun-azimuth",
+            "120", "--density", "1"]
+    assert main(argv) == EXIT_PARTIAL                       # the spoiled leaf
+    assert "estimate:" not in capsys.readouterr().err       # seconds of work: not told
+    monkeypatch.setattr(cost, "SAY_SECONDS", 0.0)
+    assert main(argv) == EXIT_PARTIAL                       # the spoiled leaf
+    err = capsys.readouterr().err
+    line = next(x for x in err.splitlines() if x.startswith("estimate:"))
+    assert "of work and" in line and "of memory (the largest part: " in line
+    assert "36 triangles" in line or "rays" in line
+    assert err.index("read plant by plant") < err.index("estimate:")   # after the survey

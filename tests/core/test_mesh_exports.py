@@ -244,3 +244,30 @@ def test_the_carried_period_is_used_only_when_the_triangles_repeat_with_it(tmp_p
     assert bent.layout.period == canopy.layout.period                  # claimed...
     scene = light_scene(bent, periodic=True)
     assert (scene.period.w, scene.period.h) == (540.0, 270.0)          # ...not believed
+
+
+def test_a_leaf_models_assimilation_is_exported_per_triangle(tmp_path):
+    """`--photosynthesis c4 --export`: each leaf triangle carries its leaf's gross umol CO2
+    per m2 of leaf per s, the leaf table's gross_umol_s over its area (copies of a plant in
+    the periodic field take their representative's); stalks none."""
+    path, table = tmp_path / "carbon.vtp", tmp_path / "leaves.csv"
+    assert main(["light", B, "--tile", "3x3", "--triangles", "8", "--periodic", "--density",
+                 "1", "--sun-zenith", "30", "--sun-azimuth", "120", "--photosynthesis", "c4",
+                 "--json", "--export", str(path), "--leaf-light", str(table)]) == EXIT_OK
+    with open(table, newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if r.get("gross_umol_s")]
+    mesh = pyvista.read(path)
+    plant, leaf = np.asarray(mesh.cell_data["plant"]), np.asarray(mesh.cell_data["leaf"])
+    got = np.asarray(mesh.cell_data["gross_umol_co2_per_m2_leaf_s"])
+    layout = layout_for(read_leaves(B).leaves, (3, 3))
+    rep = tile_representatives(layout, layout.centre_bounds, True)
+    by = {(int(r["instance"]), int(r["leaf"])): r for r in rows}
+    want = np.full(len(plant), np.nan)
+    for t, (p, lf) in enumerate(zip(plant, leaf)):
+        if lf > 0:
+            r = by.get((int(rep[p - 1]) + 1, int(lf)))
+            want[t] = float(r["gross_umol_s"]) / (float(r["leaf_area_cm2"]) * 1e-4) \
+                if r else 0.0
+    is_leaf = leaf > 0
+    np.testing.assert_allclose(got[is_leaf], want[is_leaf], rtol=1e-9, atol=1e-12)
+    assert np.nanmax(got) > 1.0 and np.isnan(got[~is_leaf]).all()

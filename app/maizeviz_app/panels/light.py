@@ -6,12 +6,12 @@ vs height).
 
 The panel's fields are bound both ways to the study's light settings
 (:class:`maizeviz_app.settings.StudySettings`: ``light``, ``sun``, ``sampling``, ``sky``,
-``day``, ``optics``): what is typed is the model's, and a project opened or an undo shows in
-the fields. :class:`LightRuns` is the results' model: the last result per mesh level and light
-(sun, sky, day), all sampled the same way (heights, density, periodic field), so switching
-levels or lights and computing again adds a column and a curve to the comparison. Changing the
-sampling starts a new comparison; changing one light's own settings (the sun's angles, the sky,
-the day) replaces that light's results only.
+``day``, ``optics``, ``photosynthesis``): what is typed is the model's, and a project opened or
+an undo shows in the fields. :class:`LightRuns` is the results' model: the last result per mesh
+level and light (sun, sky, day), all sampled the same way (heights, density, periodic field),
+so switching levels or lights and computing again adds a column and a curve to the comparison.
+Changing the sampling starts a new comparison; changing one light's own settings (the sun's
+angles, the sky, the day) replaces that light's results only.
 """
 
 from __future__ import annotations
@@ -234,6 +234,7 @@ class LightPanel(QWidget):
             "sun": {"band": self.band, "reflectance": self.reflectance,
                     "transmittance": self.transmittance,
                     "ground_reflectance": self.ground_reflectance,
+                    "photosynthesis": self.photo_model, "temperature": self.leaf_temp,
                     "sun": self.zenith, "place": self.place, "date": self.place,
                     "time": self.place, "tz": self.place},
             "sky": {"sky": self.sky_kind, "sky_directions": self.sky_n},
@@ -270,6 +271,8 @@ class LightPanel(QWidget):
             self._show_source()
         if name in ("diffuse",):
             self._sync_sky_kind()
+        if name == "model":
+            self._show_photosynthesis()
         widget = self._widget_of(name)
         if widget is not None:
             self.clear_problem(widget)
@@ -284,7 +287,10 @@ class LightPanel(QWidget):
                 "par_factor": self.par_factor, "diffuse": self.day_diffuse,
                 "band": self.band, "reflectance": self.reflectance,
                 "transmittance": self.transmittance,
-                "ground_reflectance": self.ground_reflectance}.get(name)
+                "ground_reflectance": self.ground_reflectance, "model": self.photo_model,
+                "temperature_c": self.leaf_temp, "alpha": self.c4_alpha,
+                "co2_ppm": self.co2, "amax": self.wofost_amax,
+                "eff": self.wofost_eff, "vmax": self.c4_vmax}.get(name)
 
     # ------------------------------------------------------------------ pages
     def _sun_page(self) -> QWidget:
@@ -373,7 +379,71 @@ class LightPanel(QWidget):
                                       "the command line)")
         bind(self.scatter_depth, o, "depth", "scattering depth")
         form.addRow("scattering depth", self.scatter_depth)
+        form.addRow(self._photosynthesis_group())
         return box
+
+    def _photosynthesis_group(self) -> QGroupBox:
+        """Leaf photosynthesis of the absorbed PAR: the model and its main parameters (those
+        of the model chosen show), bound to ``settings.photosynthesis``."""
+        ph = self.settings.photosynthesis
+        box = QGroupBox("photosynthesis (gross CO₂ assimilation)")
+        box.setToolTip("each leaf's absorbed PAR turned into gross CO₂ assimilation, the sunlit "
+                       "and shaded parts of every triangle each at its own light; painted on "
+                       "the plants (View > Colour by > CO₂ assimilation) and added to the "
+                       "plants table. PAR only")
+        form = _form()
+        box.setLayout(form)
+        self.photo_box = box
+        self.photo_model = QComboBox()
+        self.photo_model.addItem("none (absorbed light only)", "none")
+        self.photo_model.addItem("C4 leaf (Collatz et al. 1992, maize)", "c4")
+        self.photo_model.addItem("WOFOST negative exponential", "wofost")
+        self.photo_model.setToolTip("the leaf model: Collatz, Ribas-Carbo & Berry's C4 leaf "
+                                    "with maize parameters, or the crop model WOFOST's light "
+                                    "response (see docs/method.md)")
+        bind(self.photo_model, ph, "model", "leaf model")
+        form.addRow("leaf model", self.photo_model)
+
+        def number(name: str, label: str, decimals: int, suffix: str, tip: str,
+                   step: float = 1.0) -> QDoubleSpinBox:
+            w = QDoubleSpinBox(decimals=decimals, suffix=suffix, singleStep=step)
+            w.setToolTip(tip)
+            bind(w, ph, name, label)
+            return w
+
+        self.leaf_temp = number("temperature_c", "leaf temperature", 1, " °C",
+                                "air (leaf) temperature: the C4 model's Vmax, k and Rd "
+                                "follow it (WOFOST's leaf response does not)")
+        self.c4_vmax = number("vmax", "C4 Vmax at 25 °C", 1, " µmol/m²/s",
+                              "Rubisco capacity at 25 °C (maize: 39, Collatz et al. 1992)")
+        self.c4_alpha = number("alpha", "C4 quantum yield", 3, " mol/mol",
+                               "CO₂ fixed per absorbed PAR photon (maize: 0.04)", 0.005)
+        self.co2 = number("co2_ppm", "CO₂", 0, " ppm", "ambient CO₂ (intercellular: 0.4 of it)",
+                          10.0)
+        self.wofost_amax = number("amax", "WOFOST AMAX", 1, " kg CO₂/ha/h",
+                                  "assimilation at light saturation (maize: 70)")
+        self.wofost_eff = number("eff", "WOFOST EFF", 3, " kg/ha/h per W/m²",
+                                 "initial light use efficiency (0.45)", 0.01)
+        self.photo_rows: dict[str, list[QWidget]] = {"c4": [], "wofost": []}
+        form.addRow("leaf temperature", self.leaf_temp)
+        for model, widget, text in (("c4", self.c4_vmax, "Vmax (25 °C)"),
+                                    ("c4", self.c4_alpha, "quantum yield α"),
+                                    ("c4", self.co2, "CO₂"),
+                                    ("wofost", self.wofost_amax, "AMAX"),
+                                    ("wofost", self.wofost_eff, "EFF")):
+            label = QLabel(text)
+            form.addRow(label, widget)
+            self.photo_rows[model] += [label, widget]
+        self._show_photosynthesis()
+        return box
+
+    def _show_photosynthesis(self) -> None:
+        """Only the chosen model's parameters show (and the temperature with a model)."""
+        model = self.settings.photosynthesis.model
+        for name, widgets in self.photo_rows.items():
+            for w in widgets:
+                w.setVisible(name == model)
+        self.leaf_temp.setEnabled(model != "none")
 
     def _sky_group(self) -> QGroupBox:
         s = self.settings.sky
@@ -685,8 +755,15 @@ class LightPanel(QWidget):
                       "sunlit m² leaf"]
             keys = ("absorbed_w", "absorbed_w_m2_leaf", "sunlit_area_cm2")
             fmt = "{:.2f}"
-            self.plants_title.setText(f"{band} each plant absorbs, with scattering "
-                                      f"({run.label})")
+            title = f"{band} each plant absorbs, with scattering"
+            assimilation = getattr(run.extra, "assimilation", None)
+            if assimilation is not None and "gross_umol_s" in rows[0]:
+                # beside the light it comes from, before the sunlit area (a narrow dock
+                # shows it without scrolling)
+                header[5:5] = ["CO₂ gross µmol/s", "± se"]
+                keys = keys[:2] + ("gross_umol_s", "gross_umol_s_se") + keys[2:]
+                title += (f", and its gross CO₂ assimilation ({_model_text(assimilation)})")
+            self.plants_title.setText(f"{title} ({run.label})")
         elif day:
             header = ["stand", "plant", "x, y cm", "PAR mol", "direct mol", "diffuse mol"]
             keys = ("par_intercepted_mol", "direct_par_intercepted_mol",
@@ -734,6 +811,18 @@ class LightPanel(QWidget):
         if t.horizontalScrollBar().isVisible() or t.columnCount() > 4:
             h += t.horizontalScrollBar().sizeHint().height()
         t.setFixedHeight(max(h, head + 30))
+
+
+def _model_text(assimilation) -> str:
+    """The leaf model of an assimilation result in a few words: its name, main parameters
+    and the leaves' temperature."""
+    d = assimilation.model
+    if d.get("model") == "wofost":
+        what = f"WOFOST, AMAX {d['amax']:g} kg CO₂/ha/h, EFF {d['eff']:g}"
+    else:
+        what = (f"C4 leaf, Vmax {d['vmax']:g} µmol/m²/s, α {d['alpha']:g}, CO₂ "
+                f"{d['co2_ppm']:g} ppm")
+    return f"{what}, leaves at {assimilation.temp_c:g} °C"
 
 
 class ImageView(QLabel):

@@ -23,16 +23,19 @@ LIGHT_ARRAYS = {
                                 "ground receives)",
     "par_mol_per_m2_leaf": "PAR its leaf intercepted over the period, mol per m2 of leaf",
     "absorbed_w_per_m2_leaf": "light its leaf absorbed with scattering, W per m2 of leaf",
+    "gross_umol_co2_per_m2_leaf_s": "its leaf's gross CO2 assimilation (a leaf model on the "
+                                    "absorbed PAR), umol CO2 per m2 of leaf per s",
 }
 
 
-def light_cells(canopy: Canopy, sun=None, sky=None, period=None, absorbed=None
-                ) -> dict[str, np.ndarray]:
+def light_cells(canopy: Canopy, sun=None, sky=None, period=None, absorbed=None,
+                assimilation=None) -> dict[str, np.ndarray]:
     """Per leaf triangle (F,) arrays of the light computed on ``canopy``: ``sun`` a
     :class:`~maizeviz.light.results.direct.LightResult` traced with its hit classes, ``sky``
     a :class:`~maizeviz.light.results.diffuse.SkyLight`, ``period`` a
     :class:`~maizeviz.light.results.diffuse.PeriodLight`, ``absorbed`` an
-    :class:`~maizeviz.light.results.absorbed.AbsorbedLight` (see :data:`LIGHT_ARRAYS`)."""
+    :class:`~maizeviz.light.results.absorbed.AbsorbedLight`, ``assimilation`` its
+    :class:`~maizeviz.light.results.assimilation.Assimilation` (see :data:`LIGHT_ARRAYS`)."""
     out: dict[str, np.ndarray] = {}
     if sun is not None and sun.first_hits is not None:
         out["sun_class"] = sun.triangle_light(canopy).astype(np.int32)
@@ -43,4 +46,8 @@ def light_cells(canopy: Canopy, sun=None, sky=None, period=None, absorbed=None
         if light is not None:
             out[name] = scale * leaf_values(canopy, light.leaf_rows(canopy), column, light.rect,
                                             light.periodic)
+    if assimilation is not None:
+        out["gross_umol_co2_per_m2_leaf_s"] = leaf_values(
+            canopy, assimilation.table("leaf", canopy).to_dict("records"), "gross_umol_s",
+            assimilation.rect, assimilation.periodic)
     return out

@@ -62,7 +62,7 @@ def copy_slots(canopy: Canopy, rect, periodic: bool) -> np.ndarray | None:
         return None
     starts = np.searchsorted(inst, np.arange(len(rep)))
     local = np.arange(nf) - starts[inst]
-    _, slot = np.unique(rep[inst] * (int(local.max()) + 1) + local, return_inverse=True)
+    _, slot = groups(rep[inst], local)
     return slot.astype(np.int64)
 
 
@@ -403,9 +403,8 @@ def assimilate(canopy: Canopy, light: AbsorbedLight, model: LeafModel,
     # the triangles of its leaf in the same height band, where it hardly varies, so that the
     # concave response does not turn the rays' noise into a bias (see the module docstring)
     zc = canopy.vertices[canopy.faces[first]][:, :, 2].mean(axis=1)
-    _, pool = groups(canopy.face_instance[first], canopy.face_leaf[first],
-                     np.floor(zc / pool_cm).astype(np.int64) if pool_cm > 0
-                     else np.zeros(len(zc), np.int64))
+    band = np.floor(zc / pool_cm).astype(np.int64) if pool_cm > 0 else np.arange(len(zc))
+    _, pool = groups(canopy.face_instance[first], canopy.face_leaf[first], band)
     pool_area = np.bincount(pool, weights=area_s)
 
     def gross_of(absorbed, direct, sunlit_cm2):
