@@ -21,7 +21,7 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.io.atomic import write_text
-from maizeviz.io.inputs import read_input
+from maizeviz.io.inputs import read_input, refuse_zero_tail
 from maizeviz.io.points import MAX_ID as MAX_PLANT_ID  # plant ids as in points files
 from maizeviz.leaf.fit import Leaf
 from maizeviz.leaf.grid import stalk_base
@@ -468,7 +468,8 @@ def load_layout(path: str | Path, plants: set[int] | None = None) -> CanopyLayou
         Naming the field that is wrong.
     """
     path = Path(path)
-    raw = read_input(path, "layout file", MAX_LAYOUT_BYTES, LayoutError)
+    raw = refuse_zero_tail(read_input(path, "layout file", MAX_LAYOUT_BYTES, LayoutError), path,
+                           "layout file", LayoutError)
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

@@ -14,6 +14,9 @@ from maizeviz.errors import MaizevizError
 
 #: The subcommand (``maizeviz.cli`` lists this module among its commands).
 NAME = "subplots"
+#: Most sub-plots one run cuts a field into (``--parts``): each is a task building every
+#: plant within a shadow's reach of it, so more parts than this build the field many times.
+MAX_SUBPLOTS = 1024
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -56,16 +59,31 @@ def run(args: argparse.Namespace) -> int:
     from maizeviz.cli.common import Progress, floats, fmt_table, leaves_summary, say
     from maizeviz.io.outputs import check_run_paths
     from maizeviz.io.parquet import is_parquet
-    from maizeviz.light.scene.rays import check_rect, ray_count
+    from maizeviz.light.scene.rays import grid_shape, ray_count
+    from maizeviz.light.scene.request import check_heights, check_rect_in_plot
     from maizeviz.light.sources.sun import Sun
     from maizeviz.mesh.levels import parse_level
-    from maizeviz.sweep.run import dask_client
+    from maizeviz.sweep.run import dask_client, max_local_workers
     from maizeviz.sweep.subplots import trace_field
 
     parts = parse_shape(args.parts, "parts")
-    level = parse_level(args.level)
+    if parts[0] * parts[1] > MAX_SUBPLOTS:
+        raise MaizevizError(f"{parts[0]:,} x {parts[1]:,} sub-plots; at most {MAX_SUBPLOTS:,} "
+                            "are traced (each builds every plant within a shadow's reach of "
+                            "it) (--parts)")
+    try:
+        level = parse_level(args.level)
+    except MaizevizError as exc:                 # the level's own flag here, not --triangles
+        raise MaizevizError(f"{exc} (--level)") from None
     heights = tuple(floats(args.heights, "the sensor heights", "heights"))
+    check_heights(heights)
     check_run_paths([("the plant table", args.plant_light)], [("the points file", args.points)])
+    if args.workers is not None and args.scheduler:
+        raise MaizevizError("--workers sizes the local cluster; with --scheduler the cluster "
+                            "has its own")
+    if args.workers is not None and not 1 <= args.workers <= max_local_workers():
+        raise MaizevizError(f"--workers must be from 1 to {max_local_workers()} on this machine "
+                            f"(4 a core), got {args.workers:,}")
     if not is_parquet(args.points):
         raise MaizevizError(f"{args.points}: sub-plots read a Parquet points file, plant by "
                             "plant, on every worker (maizeviz convert writes one)")
@@ -80,7 +98,12 @@ def run(args: argparse.Namespace) -> int:
     rect = layout.centre_bounds
     if args.rect:
         x0, y0, x1, y1 = floats(args.rect, "the sample rectangle", "rect", 4)
-        rect = check_rect((x0, y0, x1, y1))
+        rect = check_rect_in_plot((x0, y0, x1, y1), layout.bounds)
+    lattice = grid_shape(rect, args.density)          # the density checked before the cluster
+    if parts[0] > lattice[0] or parts[1] > lattice[1]:
+        raise MaizevizError(f"{parts[0]:,} x {parts[1]:,} sub-plots of a lattice of "
+                            f"{lattice[0]:,} x {lattice[1]:,} rays: a sub-plot needs a ray "
+                            "across each way (--parts)")
     toward = sun.direction(layout.north_deg)
     with dask_client(args.workers, args.scheduler, args.connect_timeout) as (client, kind):
         say(f"{kind}: {len(client.scheduler_info().get('workers', {}))} workers, "

@@ -87,3 +87,20 @@ def read_input(path: str | Path, what: str, max_bytes: int,
     if len(data) > max_bytes:
         raise error(f"{path}: more than the {_size(max_bytes)} limit for {_a(what)}")
     return data
+
+
+def refuse_zero_tail(raw: bytes, path: str | Path, what: str,
+                     error: type[MaizevizError] = MaizevizError) -> bytes:
+    """``raw`` unless it ends in zero bytes, as a power cut leaves a file being written (its
+    new length on disk, not its data). Settings files (a layout, a sweep, an optics table) are
+    refused then, naming the zeros: what followed them was lost, and a run of the part before
+    them would run something else than was written. Data files are read up to the zeros with
+    a note instead (points, journals, weather, meshes)."""
+    kept = raw.rstrip(b"\x00")
+    if len(kept) < len(raw):
+        raise error(f"{path}: ends in {len(raw) - len(kept):,} zero bytes after "
+                    f"{len(kept):,} bytes of text, as a power cut leaves a file being "
+                    f"written: part of {_a(what)} may be lost; cut the zeros (or restore the "
+                    "file) and check it")
+    return raw
+

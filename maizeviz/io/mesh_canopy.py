@@ -47,6 +47,9 @@ or :data:`MAX_BINARY_BYTES` (binary PLY).
 
 from __future__ import annotations
 
+import io
+import re
+from dataclasses import replace
 from pathlib import Path
 
 from maizeviz.io.inputs import open_input
@@ -67,6 +70,7 @@ from maizeviz.io.mesh_data import (
 )
 from maizeviz.io.mesh_obj import parse_group_name, read_obj
 from maizeviz.io.mesh_ply import read_ply
+from maizeviz.io.points import zero_tail
 
 __all__ = ["CARRIED", "LEAF_PROPERTIES", "MAX_BINARY_BYTES", "MAX_HEADER_BYTES", "MAX_LEAF_ID",
            "MAX_PLANT_ID", "MAX_POLYGON", "MAX_TEXT_BYTES", "MAX_VALUE_CHARS", "MESH_SUFFIXES",
@@ -105,16 +109,57 @@ def read_mesh(path: str | Path, plant_property: str | None = None,
         if size == 0:
             raise MeshFileError(f"{path}: the file is empty; no mesh in it")
         try:
+            head = fh.read(MAX_HEADER_LINE_BYTES)
+            fh.seek(0)
+            # zeros end a text file's lines; a binary PLY's last value may end in zero bytes
+            text = ext == ".obj" or re.search(rb"[\r\n]format[ \t]+ascii", head) is not None
+            size, notes = _zero_tail(fh, size, path) if text else (size, [])
             if ext == ".ply":
-                return read_ply(fh, size, str(path), plant_property, leaf_property)
-            if plant_property or leaf_property:
-                raise MeshFileError(f"{path}: an OBJ file takes its ids from its o/g names; "
-                                    "face properties are for PLY files", quantity="mesh_ids")
-            if size > MAX_TEXT_BYTES:
-                raise MeshFileError(f"{path}: {size:,} bytes, more than the "
-                                    f"{MAX_TEXT_BYTES // 2**20} MiB limit for a text mesh")
-            return read_obj(fh.read(), str(path))
+                if head.startswith(_BOM):
+                    fh, size = _past_bom(fh, size, path)
+                    notes.append(f"{path}: the file starts with a byte-order mark (as a text "
+                                 "editor saves one): read past it")
+                fh.seek(0)
+                mesh = read_ply(fh, size, str(path), plant_property, leaf_property)
+            else:
+                if plant_property or leaf_property:
+                    raise MeshFileError(f"{path}: an OBJ file takes its ids from its o/g names; "
+                                        "face properties are for PLY files", quantity="mesh_ids")
+                if size > MAX_TEXT_BYTES:
+                    raise MeshFileError(f"{path}: {size:,} bytes, more than the "
+                                        f"{MAX_TEXT_BYTES // 2**20} MiB limit for a text mesh")
+                mesh = read_obj(fh.read(size), str(path))
         except OSError as exc:
             raise MeshFileError(f"{path}: cannot be read ({exc.strerror or exc})") from None
         except MemoryError:
             raise MeshFileError(f"{path}: not enough memory to read this mesh") from None
+    return replace(mesh, notes=(*notes, *mesh.notes)) if notes else mesh
+
+
+_BOM = b"\xef\xbb\xbf"
+#: Bytes read to find a PLY's format line (the second line of its header).
+MAX_HEADER_LINE_BYTES = 4096
+
+
+def _zero_tail(fh, size: int, path: Path) -> tuple[int, list[str]]:
+    """(bytes before the zero bytes ending the file, notes). A power cut while a file grows can
+    leave its new length without its data: zeros after intact lines (or, in a binary PLY,
+    after its last element). The mesh is read up to them, said in a note; a file of nothing
+    but zeros is refused."""
+    zeros = zero_tail(fh, size)
+    if not zeros:
+        return size, []
+    if zeros == size:
+        raise MeshFileError(f"{path}: only zero bytes; no mesh in it")
+    return size - zeros, [f"{path}: the file ends in {zeros:,} zero bytes (as a power cut "
+                          "leaves a file being written): read up to them"]
+
+
+def _past_bom(fh, size: int, path: Path):
+    """A PLY file that starts with a UTF-8 byte-order mark (an ascii PLY saved by a Windows
+    editor), as a file of the bytes after it: (file, size)."""
+    if size > MAX_TEXT_BYTES:
+        raise MeshFileError(f"{path}: starts with a byte-order mark, as a text editor saves "
+                            "one, and is too large for an ascii PLY; save it without the mark")
+    fh.seek(len(_BOM))
+    return io.BytesIO(fh.read(size - len(_BOM))), size - len(_BOM)

@@ -204,12 +204,15 @@ def _read_binary(fh: BinaryIO, end: int, size: int, head, src: str):
                 raise _cut(src, exc.element, int(exc.row or 0)) from None
             raise MeshFileError(f"{src}: {exc}") from None
     rest = size - fh.tell()
+    zeros = 0
     if rest > 0:
-        fh.seek(-min(rest, 4096), io.SEEK_END)
-        if rest > 4096 or fh.read().strip(b" \t\r\n"):
+        tail = fh.read(min(rest, 1 << 20))
+        if len(tail) == rest and not tail.strip(b"\x00"):
+            zeros = rest                    # a power cut's zeros after the last element
+        elif rest > 4096 or tail.strip(b" \t\r\n"):
             raise MeshFileError(f"{src}: {rest:,} bytes follow the last element the header "
                                 "declares: the counts in the header do not match the data")
-    return ply
+    return ply, zeros
 
 
 # ------------------------------------------------------------------------------ ascii
@@ -352,14 +355,19 @@ def read_ply(fh: BinaryIO, size: int, src: str, plant_property: str | None,
         raise MeshFileError(f"{src}: {size:,} bytes, more than the {limit // 2**20} MiB limit "
                             f"for {'an ascii' if head.text else 'a binary'} PLY")
     _check_counts(head, size - end, src)
+    carried_notes: list[str] = []
     fmt = "ascii" if head.text else \
         "binary_little_endian" if head.byte_order == "<" else "binary_big_endian"
     if head.text:
         ply, lines_by = _read_ascii(fh, end, size, head, header_lines, src)
         vlines, flines = lines_by["vertex"], lines_by["face"]
     else:
-        ply = _read_binary(fh, end, size, head, src)
+        ply, zeros = _read_binary(fh, end, size, head, src)
         vlines = flines = None
+        if zeros:
+            carried_notes.append(f"{src}: {zeros:,} zero bytes follow the last element the "
+                                 "header declares (as a power cut leaves a file being "
+                                 "written): read up to them")
     vdata = np.asarray(ply["vertex"].data)            # a plain array, not plyfile's memmap
     vertices = np.empty((len(vdata), 3), np.float64)
     for k, axis in enumerate("xyz"):
@@ -387,4 +395,4 @@ def read_ply(fh: BinaryIO, size: int, src: str, plant_property: str | None,
     if polygons:
         plant, leaf = plant[tri_face], leaf[tri_face]
     return MeshData(vertices, faces, tri_face, plant, leaf, _FORMATS[fmt], ids, n, polygons,
-                    tuple(notes), vlines, flines, carried)
+                    (*carried_notes, *notes), vlines, flines, carried)

@@ -48,6 +48,10 @@ from maizeviz.io.points import (
 MAGIC = b"PAR1"
 #: Points per row group written, rounded to whole plants.
 ROW_GROUP_POINTS = 1 << 20
+#: Most text, once decoded, the columns beside the points may hold (bytes): a CSV line holds
+#: at most 10,000 bytes, but a compressed Parquet column of one value repeated decodes to any
+#: size from a small file.
+MAX_EXTRA_TEXT_BYTES = 256 * 2**20
 
 
 def is_parquet(path: str | Path) -> bool:
@@ -108,10 +112,15 @@ def read_points_parquet(path: str | Path, max_points: int = MAX_POINTS,
                               "GB of memory (split the file by plant)")
     if len(set(names)) != len(names):
         raise PointsFileError(f"{source}: columns named alike ('{shown(','.join(names), 80)}')")
+    texts = [f.name for f in pf.schema_arrow if f.name.strip().lower() not in REQUIRED
+             and _is_text(f.type, pa)]
     try:
+        if texts:          # read as dictionaries: a repeated value is held once until checked
+            pf = pq.ParquetFile(path, read_dictionary=texts)
         table = pf.read()
     except (pa.ArrowException, OSError) as exc:
         raise PointsFileError(f"{source}: not a readable Parquet file ({exc})") from None
+    _check_text_size(table, texts, source)
     table = table.rename_columns(names)
     got = _plain(table, pa)
     if got is not None:
@@ -123,6 +132,38 @@ def read_points_parquet(path: str | Path, max_points: int = MAX_POINTS,
         return PointsTable(ids=ids, xyz=xyz, line=np.arange(2, len(ids) + 2, dtype=np.int64),
                            extra=extra, source=source)
     return _as_csv(table, source, pa, max_points, max_lines)
+
+
+def _is_text(t, pa) -> bool:
+    """Whether an arrow type holds text or bytes (plain or dictionary-encoded)."""
+    if pa.types.is_dictionary(t):
+        t = t.value_type
+    return bool(pa.types.is_string(t) or pa.types.is_large_string(t) or pa.types.is_binary(t)
+                or pa.types.is_large_binary(t))
+
+
+def _check_text_size(table, texts: list[str], source: str) -> None:
+    """Refuse extra text columns holding more than :data:`MAX_EXTRA_TEXT_BYTES` once decoded
+    (counted on their dictionaries, before any is decoded). A compressed column of one long
+    value repeated is a small file that decodes to any size: 586 KB holding 100,000 records
+    of a 5,000-character note took 1.5 GB to read, a million would take 15."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    total = 0
+    for name in texts:
+        for chunk in table.column(name).chunks:
+            if not pa.types.is_dictionary(chunk.type):
+                total += int(pc.sum(pc.binary_length(chunk)).as_py() or 0)
+                continue
+            lengths = pc.binary_length(chunk.dictionary).to_numpy(zero_copy_only=False)
+            index = chunk.indices.fill_null(0).to_numpy(zero_copy_only=False)
+            total += int(np.nan_to_num(lengths)[index].sum()) if len(lengths) else 0
+        if total > MAX_EXTRA_TEXT_BYTES:
+            raise PointsFileError(
+                f"{source}: the text columns beside the points ('{shown(name, 40)}'...) hold "
+                f"over {MAX_EXTRA_TEXT_BYTES // 2**20} MiB once read (they are kept as text, "
+                "as a CSV's are): drop them, or split the file by plant")
 
 
 def _plain(table, pa) -> tuple[np.ndarray, np.ndarray] | None:

@@ -33,6 +33,7 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.io.inputs import read_input
+from maizeviz.numbers import number
 
 #: The formats read here, by name.
 PVLIB_FORMATS = {"epw": "EnergyPlus EPW", "tmy3": "NREL TMY3", "psm": "NSRDB PSM3/PSM4"}
@@ -79,6 +80,29 @@ class WeatherTable:
     notes: tuple[str, ...] = ()
 
 
+def weather_text(raw: bytes, path: Path) -> tuple[str, list[str]]:
+    """A weather file's bytes as text (UTF-8, a byte-order mark dropped; else Latin-1) and
+    the notes on it. A file ending in zero bytes (a power cut while it was written leaves its
+    new length without its data) is read up to them, said in a note naming how many bytes
+    are left; a file of nothing but zeros, or with a zero byte before its tail, is refused."""
+    kept = raw.rstrip(b"\x00")
+    notes = []
+    if len(kept) < len(raw):
+        if not kept.strip():
+            raise WeatherFileError(f"{path}: not a text file (only zero bytes)")
+        notes.append(f"{path.name}: the file ends in {len(raw) - len(kept):,} zero bytes (as a "
+                     "power cut leaves a file being written): read up to them, the lines "
+                     "before them are kept")
+    if b"\x00" in kept:
+        line = kept.count(b"\n", 0, kept.index(b"\x00")) + 1
+        raise WeatherFileError(f"{path}, line {line}: a zero byte: not a text file (binary "
+                               "content)")
+    try:
+        return kept.decode("utf-8-sig"), notes
+    except UnicodeDecodeError:
+        return kept.decode("latin-1"), notes          # TMY3 files of SolarAnywhere, old EPW
+
+
 def detect_format(path: Path, head: bytes) -> str:
     """"epw", "tmy3", "psm" or "csv" (maizeviz's own) from a file's name and first bytes."""
     lines = head.decode("latin-1").lstrip("\ufeff\xef\xbb\xbf").splitlines()[:3]
@@ -89,9 +113,9 @@ def detect_format(path: Path, head: bytes) -> str:
         return "epw"
     if second.startswith("Date (MM/DD/YYYY)"):
         return "tmy3"
-    if first.startswith("Source,") and third.replace(" ", "").startswith(
-            "Year,Month,Day,Hour,Minute"):
-        return "psm"
+    if first.startswith("Source,") and (third.replace(" ", "").startswith(
+            "Year,Month,Day,Hour,Minute") or (len(lines) < 3 and "Location ID" in first)):
+        return "psm"                                 # (a PSM file cut after its header too)
     return "csv"
 
 
@@ -103,6 +127,32 @@ def _data_lines(text: str, skip: int) -> np.ndarray:
     """The line number of each data row: the non-blank lines after the header."""
     out = [no for no, ln in enumerate(text.splitlines(), 1) if no > skip and ln.strip(" ,\t")]
     return np.asarray(out, np.int64)
+
+
+#: Fields of an EPW's first line: LOCATION and nine values.
+EPW_LOCATION_FIELDS = 10
+#: The line of a format's header that holds its place and time zone (counting from 1).
+PLACE_LINE = {"epw": 1, "tmy3": 1, "psm": 2}
+
+
+def _check_header_numbers(text: str, kind: str, path: Path) -> None:
+    """Refuse a header cell (the place, the time zone) that Python's float reads and a data
+    file does not mean as a number: an EPW's time zone of ``1_0`` was read as UTC+10, every
+    time shifted by 9 hours, no word."""
+    lines = text.splitlines()
+    no = PLACE_LINE[kind]
+    if len(lines) < no:
+        return
+    for k, cell in enumerate(next(csv.reader([lines[no - 1]]), [])):
+        try:
+            float(cell)
+        except ValueError:
+            continue                                    # text: a name, a source
+        try:
+            number(cell)
+        except ValueError:
+            raise WeatherFileError(f"{path}, line {no}, field {k + 1} of the header: "
+                                   f"'{cell.strip()[:30]}' is not a number") from None
 
 
 def _text_columns(kind: str, header: list[str]) -> set[int]:
@@ -138,7 +188,7 @@ def _first_bad_row(text: str, kind: str) -> tuple[int, str] | None:
             if k in texts:
                 continue
             try:
-                float(cells[k])
+                number(cells[k])
             except ValueError:
                 name = f" ({header[k]})" if k < len(header) and header[k] else ""
                 return no, f"column {k + 1}{name} is '{cells[k][:30]}', not a number"
@@ -176,12 +226,21 @@ def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable
     """
     path = Path(path)
     raw = read_input(path, "weather file", max_bytes, WeatherFileError)
-    try:
-        text = raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        text = raw.decode("latin-1")                # TMY3 files of SolarAnywhere, old EPW
+    text, notes = weather_text(raw, path)
     name = PVLIB_FORMATS[kind]
-    notes: list[str] = []
+    if not text.strip():
+        raise WeatherFileError(f"{path}: the weather file is empty")
+    if kind == "epw":
+        place = next(csv.reader([text.lstrip().splitlines()[0]]), [])
+        if len(place) < EPW_LOCATION_FIELDS:
+            raise WeatherFileError(f"{path}, line 1: the LOCATION line has {len(place)} "
+                                   f"fields; an EPW's has {EPW_LOCATION_FIELDS} (city, state, "
+                                   "country, source, WMO, latitude, longitude, time zone, "
+                                   "elevation)")
+    if len(text.strip().splitlines()) <= _header_lines(kind):
+        raise WeatherFileError(f"{path}: the file ends within the {_header_lines(kind)}-line "
+                               f"header of an {name} file: no data rows")
+    _check_header_numbers(text, kind, path)
     try:
         data, meta = _read(kind, text, None)
         if kind != "psm" and _typical_year(data.index):
@@ -211,9 +270,10 @@ def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable
         missing = np.flatnonzero(np.isin(v, MISSING_CODES[kind]) | ~np.isfinite(v))
         if len(missing):
             k = int(missing[0])
+            what = f"missing value ({v[k]:g}, {name}'s code for one)" \
+                if np.isfinite(v[k]) else f"{v[k]:g} is not a finite number (a missing value?)"
             raise WeatherFileError(f"{path}, line {lines[k]} ({times[k].isoformat()}), column "
-                                   f"{col}: missing value ({v[k]:g}, {name}'s code for one); "
-                                   "fill the gap or cut the file")
+                                   f"{col}: {what}; fill the gap or cut the file")
         values[col] = v
     temp = np.array([_float_or_nan(x) for x in data["temp_air"]]) if "temp_air" in data \
         else np.full(len(data), np.nan)
@@ -267,24 +327,28 @@ def _place(meta: dict) -> dict[str, Any]:
 
 def _floats(column, where: str, lines: np.ndarray, times) -> np.ndarray:
     """A column as (n,) float64; the first cell that is no number is refused, ``where``
-    formatted with its line and time."""
-    try:
-        return np.asarray(column, dtype=np.float64)
-    except (TypeError, ValueError):
-        pass
-    for k, x in enumerate(column):
+    formatted with its line and time. pandas leaves a column of text where a cell is not a
+    number its parser reads; such cells are read by :func:`maizeviz.numbers.number`, which
+    refuses ``8_04`` and full-width digits that ``float`` would take."""
+    values = np.asarray(column)
+    if values.dtype.kind in "fiu":
+        return values.astype(np.float64)
+    out = np.empty(len(values), np.float64)
+    for k, x in enumerate(values):
         try:
-            float(x)
-        except (TypeError, ValueError):
+            out[k] = x if isinstance(x, (int, float)) else number(str(x))
+        except ValueError:
             raise WeatherFileError(where.format(line=lines[k], time=times[k].isoformat())
                                    + f": '{str(x)[:30]}' is not a number") from None
-    return np.array([float(x) for x in column])                     # pragma: no cover
+    return out
 
 
 def _float_or_nan(x) -> float:
-    try:
+    if isinstance(x, (int, float, np.number)):
         return float(x)
-    except (TypeError, ValueError):
+    try:
+        return number(str(x))
+    except ValueError:
         return math.nan
 
 

@@ -79,8 +79,11 @@ def run_sweep(args) -> int:
     if not args.dry_run and not args.out:
         _say("error: give --out DIR for the results (or --dry-run)")
         return EXIT_USAGE
-    if args.workers is not None and args.workers < 1:
-        _say(f"error: --workers must be >= 1, got {args.workers}")
+    from maizeviz.sweep.run import max_local_workers
+
+    if args.workers is not None and not 1 <= args.workers <= max_local_workers():
+        _say(f"error: --workers must be from 1 to {max_local_workers()} on this machine (4 a "
+             f"core), got {args.workers:,}")
         return EXIT_USAGE
     if not (args.tolerance >= 0):
         _say(f"error: --tolerance must be >= 0, got {args.tolerance}")

@@ -187,6 +187,12 @@ def describe_cluster(client, kind: str) -> dict:
             "distributed": distributed.__version__}
 
 
+def max_local_workers() -> int:
+    """Most worker processes of a local cluster: 4 a core (at least 8). The tracing is CPU
+    bound, so more only share the cores; 100,000 asked started processes for minutes."""
+    return max(8, 4 * (os.cpu_count() or 1))
+
+
 @contextmanager
 def dask_client(workers: int | None = None, scheduler: str | None = None,
                 connect_timeout: float = CONNECT_TIMEOUT_S):
@@ -222,8 +228,10 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
         kind = "scheduler"
     else:
         n = workers or os.cpu_count() or 1
-        if n < 1:
-            raise SchedulerError(f"--workers must be >= 1, got {n}")
+        most = max_local_workers()
+        if not 1 <= n <= most:
+            raise SchedulerError(f"--workers must be from 1 to {most} on this machine (4 a "
+                                 f"core of its {os.cpu_count() or 1}; a process each), got {n:,}")
         try:
             with _sigint_ignored(), dask.config.set(LOCAL_CONFIG):
                 cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
@@ -301,12 +309,22 @@ class _CtrlC:
     def __init__(self):
         self.depth = 0
         self.pending = False
+        self.asked = False
         self.old = None
 
     def _handler(self, signum, frame):
+        self.asked = True
         if self.depth:
             self.pending = True
         else:
+            # raised wherever the main thread is; inside a finalizer (distributed's
+            # Future.__del__) Python ignores it, so the driving loop also polls ``asked``
+            raise KeyboardInterrupt
+
+    def check(self) -> None:
+        """Raise KeyboardInterrupt if Ctrl-C was pressed (and not yet raised where it
+        counts)."""
+        if self.asked:
             raise KeyboardInterrupt
 
     def __enter__(self):
@@ -422,6 +440,20 @@ def _given(client):
     yield client, "given client"
 
 
+def _completed(pending, ctrl_c, poll_s: float = 0.05):
+    """The futures of ``pending`` (a distributed ``as_completed``) as they finish, polled so
+    that a Ctrl-C whose KeyboardInterrupt was lost in a finalizer still stops the run."""
+    while not pending.is_empty():
+        ctrl_c.check()
+        ready = pending.next_batch(block=False)
+        if not ready:
+            time.sleep(poll_s)
+            continue
+        for fut in ready:
+            ctrl_c.check()
+            yield fut
+
+
 def _drive(client, chunks, store, outcome, bar, on_result, ctrl_c) -> None:
     """Submit the chunks and record their results as they complete."""
     from distributed import as_completed
@@ -435,7 +467,7 @@ def _drive(client, chunks, store, outcome, bar, on_result, ctrl_c) -> None:
         futures[fut] = chunk
     last_flush = time.monotonic()
     try:
-        for fut in as_completed(list(futures)):
+        for fut in _completed(as_completed(list(futures)), ctrl_c):
             chunk = futures.pop(fut)
             if fut.status == "finished":
                 res = fut.result()

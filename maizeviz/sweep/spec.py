@@ -62,7 +62,7 @@ from typing import Any, NoReturn
 
 import maizeviz
 from maizeviz.errors import MaizevizError
-from maizeviz.io.inputs import read_input
+from maizeviz.io.inputs import read_input, refuse_zero_tail
 from maizeviz.light.scene.request import MAX_HEIGHTS
 from maizeviz.light.specs import OpticsSpec
 from maizeviz.sweep import compute
@@ -547,7 +547,8 @@ def read_toml(path) -> tuple[dict, str]:
     """The parsed sweep file and its text; SweepSpecError for a file that is missing, not a
     regular file (a FIFO is refused at once, not waited on), over :data:`MAX_SPEC_BYTES`, or
     not TOML."""
-    raw = read_input(path, "sweep file", MAX_SPEC_BYTES, SweepSpecError)
+    raw = refuse_zero_tail(read_input(path, "sweep file", MAX_SPEC_BYTES, SweepSpecError), path,
+                           "sweep file", SweepSpecError)
     try:
         # a byte order mark (Windows editors write one) is read past, as in points files
         text = raw.decode("utf-8").removeprefix("\ufeff")

@@ -84,9 +84,14 @@ def _light_tables(tmp_path, capsys, points, layout):
     ((1, 2), range(1, 10_004), 1),                         # 10,003 leaves on plant 1
     ((BIG, -BIG), [BIG, BIG - 1, 1, 10_000, 20_001], BIG),  # ids next to 2^31
 ])
+@pytest.mark.parametrize("fmt", ["csv", "parquet"])
 def test_leaves_keep_their_plant_whatever_their_ids(tmp_path, capsys, plant_ids, leaf_ids_1,
-                                                    leaf_id_2):
+                                                    leaf_id_2, fmt):
+    """The same in a Parquet points file (ids stored as int32, read column by column)."""
     points, layout = _two_plants(tmp_path, plant_ids, leaf_ids_1, leaf_id_2)
+    if fmt == "parquet":
+        assert main(["convert", str(points), "--out", str(points.with_suffix(".parquet"))]) == 0
+        points = points.with_suffix(".parquet")
     doc, leaf_rows, plant_rows = _light_tables(tmp_path, capsys, points, layout)
     # each leaf row names its own plant and leaf
     by_instance = {int(r["instance"]): int(r["plant"]) for r in plant_rows}

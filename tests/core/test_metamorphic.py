@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import Phase, given, settings
 from hypothesis import strategies as st
 
 from maizeviz.canopy.layout import layout_from_dict
@@ -24,6 +24,7 @@ from maizeviz.light.sources.sky import make_sky
 from maizeviz.light.sources.sun import Sun
 from maizeviz.light.trace.diffuse import trace_period, trace_sky
 from maizeviz.light.trace.direct import trace_light
+from tests.core.test_mesh_canopy import write_obj, write_ply
 
 BLOCK = str(Path(__file__).resolve().parents[2] / "maizeviz/resources/block3x3.csv")
 
@@ -162,8 +163,6 @@ def test_a_mesh_written_twice_measures_as_once(tmp_path, capsys, block_mesh, how
     """Issue 25 case 3: every face written twice gave twice the leaf area and LAI, no word.
     A repeated triangle (the same three corners, by position, in any order) counts once, and
     a note says how many were left out."""
-    from tests.core.test_mesh_canopy import write_ply
-
     v, f, plant, leaf = block_mesh
     once = write_ply(tmp_path / "once.ply", v, f, {"plant": plant, "leaf": leaf},
                      fmt="binary_little_endian")
@@ -252,7 +251,7 @@ def test_periodic_block_equals_its_tiling_traced_whole(capsys):
     assert 0 < one["transmission"][0] < one["transmission"][-1] <= 1.0
 
 
-@pytest.mark.parametrize("kind", ["sun", "sky", "day", "absorbed"])
+@pytest.mark.parametrize("kind", ["sun", "sky", "day", "absorbed", "photosynthesis"])
 def test_plant_rows_add_up_to_the_canopy_total(capsys, tmp_path, kind):
     """Per-leaf rows sum to per-plant rows, and those to the canopy total --json gives,
     computed another way (from the rays, not the triangles)."""
@@ -261,7 +260,8 @@ def test_plant_rows_add_up_to_the_canopy_total(capsys, tmp_path, kind):
              "sky": ["--sky", "soc", "--sky-directions", "16"],
              "day": ["--day", "--date", "2005-08-01", "--lat", "39.9", "--lon", "116.4",
                      "--tz", "Asia/Shanghai", "--step", "120", "--sky-directions", "16"],
-             "absorbed": [*SUN_30, "--band", "par", "--irradiance", "400"]}[kind]
+             "absorbed": [*SUN_30, "--band", "par", "--irradiance", "400"],
+             "photosynthesis": [*SUN_30, "--photosynthesis", "c4"]}[kind]
     doc = _json(capsys, [*BASE, *extra, "--leaf-light", str(leaves), "--plant-light",
                          str(plants), "--json"])
     x0, y0, x1, y1 = doc["rect_cm"] if "rect_cm" in doc else doc["diffuse"]["rect_cm"]
@@ -273,6 +273,8 @@ def test_plant_rows_add_up_to_the_canopy_total(capsys, tmp_path, kind):
         "day": ("par_intercepted_mol",
                 lambda: doc["period"]["par_intercepted_mol_m2"] * area_cm2 * 1e-4),
         "absorbed": ("absorbed_w", lambda: doc["balance"]["absorbed_leaves"] * area_cm2 * 1e-4),
+        "photosynthesis": ("gross_umol_s", lambda: doc["photosynthesis"]["canopy_gross_umol_m2_s"]
+                           * area_cm2 * 1e-4),
     }[kind]
     leaf_rows, plant_rows = _csv(leaves), _csv(plants)
     assert len(plant_rows) > 1
@@ -367,3 +369,274 @@ def test_a_stand_written_twice_in_a_layout_is_reported(capsys, tmp_path):
     assert main(["canopy", BLOCK, "--layout", str(layout), "--triangles", "8"]) == 0
     err = capsys.readouterr().err
     assert "closer than the spacing" in err and "counted twice" in err
+
+
+# ------------------------------------------------------------------ Parquet points files
+
+
+def _parquet_of(tmp_path, csv_path, name):
+    out = tmp_path / f"{name}.parquet"
+    assert main(["convert", str(csv_path), "--out", str(out)]) == 0
+    return out
+
+
+@settings(max_examples=3, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate))
+@given(st.integers(0, 2**31))
+def test_a_parquet_file_in_any_row_order_builds_and_traces_the_same(tmp_path_factory, seed):
+    """The bundled block's records shuffled, then written as Parquet (read column by column,
+    not through the CSV reader): the same canopy and the same light as the CSV in its order."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    tmp = tmp_path_factory.mktemp("pq")
+    table = pq.read_table(_parquet_of(tmp, BLOCK, "block"))
+    order = np.random.default_rng(seed).permutation(table.num_rows)
+    shuffled = tmp / "shuffled.parquet"
+    pq.write_table(table.take(pa.array(order)), shuffled)
+    argv = ["--tile", "3x3", "--triangles", "36"]
+    light = [*argv, *SUN_30, "--density", "1", "--heights", "100,0,50", "--json"]
+    with contextlib.redirect_stderr(io.StringIO()):
+        for points in (BLOCK, shuffled):
+            out = io.StringIO()
+            with contextlib.redirect_stdout(out):
+                assert main(["canopy", str(points), *argv, "--json"]) == 0
+            canopy = _measures(json.loads(out.getvalue()))
+            out = io.StringIO()
+            with contextlib.redirect_stdout(out):
+                assert main(["light", str(points), *light]) == 0
+            doc = json.loads(out.getvalue())
+            got = (canopy, doc["transmission"], doc["sunlit_intercepted_fraction"])
+            if points == BLOCK:
+                want = got
+    assert got == want
+
+
+def test_a_parquet_record_written_twice_is_reported_not_counted_twice(capsys, tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(_parquet_of(tmp_path, BLOCK, "block"))
+    twice = tmp_path / "twice.parquet"
+    pq.write_table(pa.concat_tables([table, table.slice(9, 1)]), twice)
+    plant, leaf, row, col = (table.column(c)[9].as_py() for c in ("plant", "leaf", "row", "col"))
+    capsys.readouterr()
+    assert main(["leaf", str(twice), "--interp", "0"]) == 3
+    err = capsys.readouterr().err
+    assert (f"plant {plant}, leaf {leaf}: row {row}, col {col} appears twice (lines 11 and "
+            f"{table.num_rows + 2})") in err
+
+
+# ------------------------------------------------------------------ mesh files: face order
+
+
+def _mesh_runs(capsys, path):
+    """(canopy measures, light --json, leaf rows by (plant, leaf)) of a mesh file."""
+    import csv
+
+    table = Path(path).with_suffix(".leaves.csv")
+    canopy, _ = _canopy_json(capsys, path)
+    light = _json(capsys, ["light", str(path), "--mesh-unit", "cm", *SUN_30, "--density", "1",
+                           "--heights", "0,50,100", "--leaf-light", str(table), "--json"])
+    with open(table, newline="") as fh:
+        rows = {(r["plant"], r["leaf"]): r for r in csv.DictReader(fh)}
+    return _measures(canopy), light, rows
+
+
+def _number(x):
+    """A JSON value or a CSV cell as a float where it is a number, else as it is."""
+    if isinstance(x, bool) or not isinstance(x, (int, float, str)):
+        return x
+    try:
+        return float(x)
+    except ValueError:
+        return x
+
+
+def _close(a: dict, b: dict, rel: float):
+    assert set(a) == set(b)
+    for k, x in a.items():
+        x, y = _number(x), _number(b[k])
+        if isinstance(x, float):
+            assert y == pytest.approx(x, rel=rel, abs=1e-12), k
+        else:
+            assert y == x, k
+
+
+@settings(max_examples=4, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate))
+@given(st.integers(0, 2**31), st.sampled_from(["ascii", "binary_big_endian", "obj"]),
+       st.integers(0, 2))
+def test_mesh_faces_in_any_order_trace_the_same(tmp_path_factory, block_mesh, seed, fmt, turn):
+    """A mesh file's faces permuted and each face's corners turned (its orientation kept):
+    the same triangles, so the same canopy and light; sums of the same numbers in another
+    order may differ in their last bits (relative 1e-15 seen), nothing more."""
+    capsys = _Capture()
+    v, f, plant, leaf = block_mesh
+    tmp = tmp_path_factory.mktemp("faces")
+    perm = np.random.default_rng(seed).permutation(len(f))
+    g = np.roll(f[perm], turn, axis=1)
+
+    def write(name, faces, p, lf):
+        if fmt == "obj":
+            return write_obj(tmp / f"{name}.obj", v, faces,
+                             [f"plant{a}_leaf{b}" for a, b in zip(p, lf)])
+        return write_ply(tmp / f"{name}.ply", v, faces, {"plant": p, "leaf": lf}, fmt=fmt)
+
+    a = _mesh_runs(capsys, write("file", f, plant, leaf))
+    b = _mesh_runs(capsys, write("permuted", g, plant[perm], leaf[perm]))
+    _close(a[0], b[0], 1e-13)
+    assert b[1]["transmission"] == a[1]["transmission"]
+    assert b[1]["sunlit_intercepted_fraction"] == a[1]["sunlit_intercepted_fraction"]
+    assert set(b[2]) == set(a[2]) and len(a[2]) > 100
+    for key, row in a[2].items():
+        _close(row, b[2][key], 1e-12)
+
+
+class _Capture:
+    """capsys for a hypothesis test (a function-scoped fixture cannot be given): stdout and
+    stderr of one main() call."""
+
+    def readouterr(self):
+        out, err = self._out.getvalue(), self._err.getvalue()
+        self._out, self._err = io.StringIO(), io.StringIO()
+        self._redirect()
+        return out, err
+
+    def __init__(self):
+        self._out, self._err = io.StringIO(), io.StringIO()
+        self._stack = contextlib.ExitStack()
+        self._redirect()
+
+    def _redirect(self):
+        self._stack.close()
+        self._stack = contextlib.ExitStack()
+        self._stack.enter_context(contextlib.redirect_stdout(self._out))
+        self._stack.enter_context(contextlib.redirect_stderr(self._err))
+
+
+@pytest.fixture(scope="module")
+def exports(tmp_path_factory):
+    """The bundled block's canopy (9 plants, 8 triangles a leaf) exported in every format:
+    {ext: path}, and the plot it carries."""
+    tmp = tmp_path_factory.mktemp("exports")
+    paths = {}
+    with contextlib.redirect_stderr(io.StringIO()), contextlib.redirect_stdout(io.StringIO()):
+        for ext in (".ply", ".obj", ".vtu", ".vtp", ".vtk", ".stl"):
+            paths[ext] = tmp / f"canopy{ext}"
+            assert main(["canopy", BLOCK, "--triangles", "8", "--export", str(paths[ext])]) == 0
+    import pyvista
+
+    field = tuple(float(v) for v in pyvista.read(paths[".vtu"]).field_data["field_cm"])
+    return paths, field
+
+
+@pytest.mark.parametrize("ext", [".obj", ".vtu", ".vtp", ".vtk", ".stl"])
+def test_each_export_format_carries_the_canopy_the_ply_does(capsys, tmp_path, exports, ext):
+    """A mesh round trip through each export format: its triangles and ids read back (OBJ by
+    maizeviz, the VTK files and the STL by VTK's readers through pyvista), written as a PLY
+    and measured and traced: every --json number is the PLY export's (STL, whose corners are
+    float32 and which carries no ids, takes its ids from the PLY's faces in order, and
+    agrees to float32's precision)."""
+    import pyvista
+
+    from maizeviz.io.mesh_canopy import read_mesh
+
+    paths, field = exports
+    ref = read_mesh(paths[".ply"])
+    if ext == ".obj":
+        got = read_mesh(paths[ext])
+        v, f, plant, leaf = got.vertices, got.faces, got.plant, got.leaf
+    else:
+        mesh = pyvista.read(paths[ext])
+        if not isinstance(mesh, pyvista.UnstructuredGrid):
+            mesh = mesh.cast_to_unstructured_grid()
+        assert set(mesh.celltypes.tolist()) == {5}                  # triangles only
+        v = np.asarray(mesh.points, np.float64)
+        f = mesh.cells.reshape(-1, 4)[:, 1:]
+        if ext == ".stl":
+            assert len(f) == len(ref.faces)
+            plant, leaf = ref.plant, ref.leaf
+        else:
+            plant, leaf = mesh.cell_data["plant"], mesh.cell_data["leaf"]
+    again = write_ply(tmp_path / "again.ply", v, f, {"plant": plant, "leaf": leaf},
+                      fmt="binary_little_endian")
+    common = ["--field=" + ",".join(repr(c) for c in field)]
+    argv = ["--mesh-unit", "cm", *common, *SUN_30, "--density", "1", "--heights", "0,50,100",
+            "--json"]
+    a = _measures(_canopy_json(capsys, paths[".ply"], *common)[0])
+    b = _measures(_canopy_json(capsys, again, *common)[0])
+    la = _json(capsys, ["light", str(paths[".ply"]), *argv])
+    lb = _json(capsys, ["light", str(again), *argv])
+    if ext == ".stl":
+        _close(a, b, 1e-6)
+        for x, y in zip(la["transmission"], lb["transmission"]):
+            assert y == pytest.approx(x, abs=2e-3)              # a ray in 500 on an edge
+    else:
+        assert b == a
+        assert lb["transmission"] == la["transmission"]
+        assert lb["sunlit_intercepted_fraction"] == la["sunlit_intercepted_fraction"]
+    assert a["leaves"] == 140 and 0 < la["transmission"][0] < 1
+
+
+# ------------------------------------------------------------------ order of a layout file
+
+
+@settings(max_examples=3, deadline=None, phases=(Phase.explicit, Phase.reuse, Phase.generate))
+@given(st.integers(0, 2**31))
+def test_a_layout_in_any_order_traces_the_same_field(tmp_path_factory, seed):
+    """The rows of a layout file, and the plants within each row, listed in another order:
+    the same stands, so the same transmission, and each stand (plant id and place) the same
+    light in the plant table."""
+    import csv
+
+    rng = np.random.default_rng(seed)
+    tmp = tmp_path_factory.mktemp("layout")
+    ids = sorted({int(line.split(",")[0]) for line in Path(BLOCK).read_text().splitlines()[1:]})
+    rows = [{"x": 30 + 60 * i, "plants": [{"y": 15 + 30 * j, "plant": ids[(3 * i + j) % 9]}
+                                          for j in range(3)]} for i in range(3)]
+    shuffled = [{"x": r["x"], "plants": [r["plants"][k] for k in rng.permutation(3)]}
+                for r in (rows[k] for k in rng.permutation(3))]
+    runs = []
+    for name, listed in (("a", rows), ("b", shuffled)):
+        path = tmp / f"{name}.json"
+        path.write_text(json.dumps({"maizeviz_layout": 1, "row_spacing": 60, "plant_spacing": 30,
+                                    "field": {"x0": 0, "y0": 0, "x1": 180, "y1": 90},
+                                    "rows": listed}))
+        table = tmp / f"{name}.csv"
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+            assert main(["light", BLOCK, "--layout", str(path), "--triangles", "8", *SUN_30,
+                         "--density", "1", "--periodic", "--heights", "0,100",
+                         "--plant-light", str(table), "--json"]) == 0
+        with open(table, newline="") as fh:
+            plants = {(r["plant"], r["x_cm"], r["y_cm"]): r["sunlit_intercepted_cm2"]
+                      for r in csv.DictReader(fh)}
+        runs.append((json.loads(out.getvalue())["transmission"], plants))
+    assert runs[1][0] == runs[0][0]
+    assert runs[1][1] == runs[0][1] and len(runs[0][1]) == 9
+
+
+@pytest.mark.parametrize("tile, copies", [("1x1", 1), ("2x3", 6)])
+def test_the_leaf_table_adds_up_to_the_canopy(capsys, tmp_path, tile, copies):
+    """`maizeviz leaf --json` measures each leaf; `maizeviz canopy --json` the field: its leaf
+    area and triangles are the leaves' summed over the copies of the block, its LAI that area
+    over the ground; and the light run's per-leaf table gives each leaf the same area."""
+    import csv
+
+    leaf = _json(capsys, ["leaf", BLOCK, "--triangles", "36", "--json"])
+    canopy = _json(capsys, ["canopy", BLOCK, "--tile", tile, "--triangles", "36", "--json"])
+    area = sum(r["area_cm2"] for r in leaf["leaves"])
+    assert canopy["leaves"] == copies * len(leaf["leaves"]) == copies * 140
+    assert canopy["triangles"] == copies * sum(r["triangles"] for r in leaf["leaves"])
+    assert canopy["leaf_area_m2"] == pytest.approx(copies * area / 1e4, rel=1e-12)
+    assert canopy["lai"] == pytest.approx(canopy["leaf_area_m2"] / canopy["ground_area_m2"],
+                                          rel=1e-12)
+    table = tmp_path / "leaves.csv"
+    _json(capsys, ["light", BLOCK, "--tile", tile, "--triangles", "36", *SUN_30, "--density",
+                   "1", "--periodic", "--leaf-light", str(table), "--json"])
+    by = {(r["plant"], r["leaf"]): r["area_cm2"] for r in leaf["leaves"]}
+    with open(table, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) > 100
+    for r in rows:
+        assert float(r["leaf_area_cm2"]) == pytest.approx(by[(int(r["plant"]), int(r["leaf"]))],
+                                                          rel=1e-12)

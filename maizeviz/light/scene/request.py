@@ -145,6 +145,37 @@ def check_request(canopy: Canopy, req: LightRequest) -> tuple[Rect, list[str]]:
     return rect, warnings
 
 
+def check_heights(heights_cm) -> None:
+    """Refuse sensor heights (cm) that are none, more than :data:`MAX_HEIGHTS`, outside 0 to
+    :data:`MAX_HEIGHT_CM` or given twice, naming the first such."""
+    if not heights_cm:
+        raise MaizevizError("give at least one height", quantity="heights")
+    if len(heights_cm) > MAX_HEIGHTS:
+        raise MaizevizError(f"{len(heights_cm):,} heights; at most {MAX_HEIGHTS:,} sensor "
+                            "planes are traced (one every cm over 10 m)", quantity="heights")
+    seen: dict[float, int] = {}
+    for k, h in enumerate(heights_cm):
+        if not math.isfinite(h) or not 0 <= h <= MAX_HEIGHT_CM:
+            raise MaizevizError(f"heights must be from 0 to {MAX_HEIGHT_CM:,.0f} cm, got {h:g}",
+                                quantity="heights")
+        if h in seen:
+            raise MaizevizError(f"height {h + 0.0:g} cm is given twice (heights {seen[h] + 1} and "
+                                f"{k + 1})", quantity="heights")
+        seen[h] = k
+
+
+def check_rect_in_plot(rect: Rect, plot: Rect) -> Rect:
+    """The sample rectangle (x0, y0, x1, y1) cm checked (:func:`check_rect`) and refused when
+    it reaches beyond the ``plot``."""
+    px0, py0, px1, py1 = plot
+    rect = check_rect(rect)
+    x0, y0, x1, y1 = rect
+    if x0 < px0 - 1e-6 or y0 < py0 - 1e-6 or x1 > px1 + 1e-6 or y1 > py1 + 1e-6:
+        raise MaizevizError(f"the sample rectangle {rect} cm is not inside the plot "
+                            f"({px0:.0f}, {py0:.0f}, {px1:.0f}, {py1:.0f}) cm", quantity="rect")
+    return rect
+
+
 def check_sampling(canopy: Canopy, req: Sampling) -> tuple[Rect, list[str]]:
     """Validate the sun-independent part of a request; returns the sample rectangle (cm) and
     warnings (heights above the canopy).
@@ -157,28 +188,11 @@ def check_sampling(canopy: Canopy, req: Sampling) -> tuple[Rect, list[str]]:
     warnings = []
     if canopy.n_triangles == 0:
         raise MaizevizError("the canopy is empty: no leaf triangle to intercept light")
-    if not req.heights_cm:
-        raise MaizevizError("give at least one height", quantity="heights")
-    if len(req.heights_cm) > MAX_HEIGHTS:
-        raise MaizevizError(f"{len(req.heights_cm):,} heights; at most {MAX_HEIGHTS:,} sensor "
-                            "planes are traced (one every cm over 10 m)", quantity="heights")
-    seen: dict[float, int] = {}
-    for k, h in enumerate(req.heights_cm):
-        if not math.isfinite(h) or not 0 <= h <= MAX_HEIGHT_CM:
-            raise MaizevizError(f"heights must be from 0 to {MAX_HEIGHT_CM:,.0f} cm, got {h:g}",
-                                quantity="heights")
-        if h in seen:
-            raise MaizevizError(f"height {h + 0.0:g} cm is given twice (heights {seen[h] + 1} and "
-                                f"{k + 1})", quantity="heights")
-        seen[h] = k
+    check_heights(req.heights_cm)
     check_density(req.density)
     check_range(req.threads, "tracing threads", 1, MAX_THREADS, "threads", whole=True)
-    px0, py0, px1, py1 = canopy.layout.bounds
-    rect = check_rect(req.rect or canopy.layout.centre_bounds)
+    rect = check_rect_in_plot(req.rect or canopy.layout.centre_bounds, canopy.layout.bounds)
     x0, y0, x1, y1 = rect
-    if x0 < px0 - 1e-6 or y0 < py0 - 1e-6 or x1 > px1 + 1e-6 or y1 > py1 + 1e-6:
-        raise MaizevizError(f"the sample rectangle {rect} cm is not inside the plot "
-                            f"({px0:.0f}, {py0:.0f}, {px1:.0f}, {py1:.0f}) cm", quantity="rect")
     n = ray_count(rect, req.density)
     if n > MAX_RAYS:
         raise MaizevizError(

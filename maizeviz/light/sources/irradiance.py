@@ -64,6 +64,7 @@ from maizeviz.io.weather_files import (
     WeatherTable,
     detect_format,
     read_pvlib_file,
+    weather_text,
 )
 from maizeviz.light.sources.clock import check_altitude as _check_altitude
 from maizeviz.light.sources.clock import check_place as _check_place
@@ -634,16 +635,12 @@ class Weather:
                      if getattr(self, c) is not None and c not in self.estimated)
 
 
-def _read_text(path: Path, max_bytes: int) -> str:
+def _read_text(path: Path, max_bytes: int) -> tuple[str, list[str]]:
+    """The text of a weather CSV and the notes on it (a zero-filled tail read up to)."""
     raw = read_input(path, "weather file", max_bytes, WeatherFileError)
     if not raw:
         raise WeatherFileError(f"{path}: the weather file is empty")
-    if b"\x00" in raw[:4096]:
-        raise WeatherFileError(f"{path}: not a CSV text file (binary content)")
-    try:
-        return raw.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        return raw.decode("latin-1")
+    return weather_text(raw, path)
 
 
 def _rows(text: str, path: Path):
@@ -893,7 +890,7 @@ def read_weather(path, tz: str | None = None, label: str | None = None,
     if kind != "csv":
         return _from_table(path, read_pvlib_file(path, kind, max_bytes), zone, label)
     key = "center" if label is None else str(label).strip().lower()
-    text = _read_text(path, max_bytes)
+    text, notes = _read_text(path, max_bytes)
     rows = _rows(text, path)
     first = next(rows, None)
     if first is None:
@@ -915,7 +912,6 @@ def read_weather(path, tz: str | None = None, label: str | None = None,
     times = _parse_times(texts, lines, path, zone)
     values = {c: _parse_values([row[columns[c]] for row in data], lines, texts, c, path)
               for c in WEATHER_OPTIONAL if c in columns}
-    notes: list[str] = []
     estimated: tuple[str, ...] = ()
     if "ghi" not in values:
         # PAR alone: its shortwave, for the direct and diffuse split only
@@ -961,6 +957,13 @@ def _from_table(path: Path, table: WeatherTable, zone, label: str | None) -> Wea
                      f"({tz_name(zone)}) is for CSV files without offsets")
     texts = [t.isoformat() for t in times]
     values = {c: table.values[c] for c in ("ghi", "dni", "dhi")}
+    for c, v in values.items():                       # the bounds a CSV's cells are held to
+        lo, hi, _ = _BOUNDS[c]
+        bad = np.flatnonzero(~((v >= lo) & (v <= hi)))
+        if len(bad):
+            k = int(bad[0])
+            raise WeatherFileError(f"{path}, line {table.line[k]} ({texts[k]}), column {c}: "
+                                   f"{_value_problem(repr(float(v[k])), c)}")
     if np.isfinite(table.values["temp_air"]).any():
         values["temp_air"] = table.values["temp_air"]
     key = table.label if label is None else str(label).strip().lower()

@@ -194,10 +194,11 @@ def read_optics_table(path, band: str) -> tuple[tuple[int, float, float], ...]:
     """
     import csv
 
-    from maizeviz.io.inputs import read_input
+    from maizeviz.io.inputs import read_input, refuse_zero_tail
 
     # utf-8-sig: a spreadsheet's "CSV UTF-8" starts with a byte-order mark
-    text = read_input(path, "optics table", max_bytes=4 * 2**20).decode("utf-8-sig", "replace")
+    raw = read_input(path, "optics table", max_bytes=4 * 2**20)
+    text = refuse_zero_tail(raw, path, "optics table").decode("utf-8-sig", "replace")
     rows = list(csv.reader(text.splitlines()))
     if not rows:
         raise MaizevizError(f"{path}: the optics table is empty", quantity="optics_table")
