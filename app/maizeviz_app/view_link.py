@@ -91,7 +91,7 @@ class ViewLink:
         are smaller than the ray spacing)."""
         m = self.window.model
         if run.painting is not None and self.view is not None and \
-                m.shown_signature == run.signature:
+                m.shown_signature == run.signature and self.view.painting_note:
             self.window.say(f"note: the view shows {self.view.painting_note}")
 
     def choose_image(self) -> None:

@@ -102,9 +102,22 @@ def _no_command(argv: list[str]) -> int:
             "follows; for the window run 'xvfb-run -a maizeviz --screenshot app.png' or use a "
             "desktop")
     if rest and not rest[0].startswith("-"):
-        say(f"note: opening {rest[0]} needs the desktop app; the report below is on the bundled "
-            "example")
+        return _report_on(rest[0])
     return main(["canopy", str(example_points()), "--tile", "3x3", "--levels"])
+
+
+def _report_on(path: str) -> int:
+    """The headless report on the file the app was asked to open: its canopy at every level
+    for points or a mesh; a missing file or a project (the window's) refused in one line."""
+    if not os.path.isfile(path):
+        say(f"error: {path}: no such file (the app opens points, a canopy mesh or a project)")
+        return EXIT_FAIL
+    if Path(path).suffix.lower() == ".maizeviz":
+        say(f"error: {path} is a project: it opens in the desktop app (without a screen: "
+            f"xvfb-run -a maizeviz {path} --screenshot view.png)")
+        return EXIT_FAIL
+    say(f"note: the headless report on {path} (maizeviz canopy {path} --levels)")
+    return main(["canopy", path, "--levels"])
 
 
 def _say_warnings(message, category, filename, lineno, file=None, line=None) -> None:

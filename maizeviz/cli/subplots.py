@@ -117,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
            "heights_cm": list(heights), "transmission": counts.transmission.tolist(),
            "plants_per_part": [int(len(p.placements)) for p in plan],
            "plants": len(layout.placements),
-           "sunlit_leaf_area_m2": float(counts.first.sum() * ray_area / 1e4)}
+           "sunlit_intercepted_m2": float(counts.first.sum() * ray_area / 1e4)}
     if args.plant_light:
         from maizeviz.io.atomic import atomic_open
 
@@ -135,5 +135,6 @@ def run(args: argparse.Namespace) -> int:
                         [[f"{h:g}", f"{t:.4f}"] for h, t in zip(heights, counts.transmission)]))
         print(f"\n{out['plants']:,} plants in {len(plan)} sub-plots "
               f"({', '.join(map(str, out['plants_per_part']))} plants each), {rays:,} rays; "
-              f"sunlit leaf area {out['sunlit_leaf_area_m2']:.2f} m2")
+              f"intercepted by sunlit leaves: the beam of {out['sunlit_intercepted_m2']:.2f} m2 "
+              "of the sample rectangle")
     return leaves_summary(len(field), field.skipped)

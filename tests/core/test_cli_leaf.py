@@ -143,3 +143,31 @@ def test_no_command_without_screen_runs_the_headless_report():
     helped = subprocess.run([sys.executable, "-m", "maizeviz", "--help"], capture_output=True,
                             text=True, env=env)
     assert helped.returncode == 0 and "canopy" in helped.stdout
+
+
+def test_a_file_given_without_screen_is_the_one_reported(tmp_path):
+    """`maizeviz FILE` with no screen reports on FILE (not on the bundled example); a missing
+    file or a project is one line and exit 1, never a report on other plants with exit 0."""
+    import os
+    import shutil
+
+    from maizeviz.resources import example_points
+
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    mine = tmp_path / "mine.csv"
+    shutil.copy(example_points(), mine)
+
+    def run(*args):
+        return subprocess.run([sys.executable, "-m", "maizeviz", *args], capture_output=True,
+                              text=True, env=env, timeout=300)
+
+    proc = run(str(mine))
+    assert proc.returncode == 0, proc.stderr
+    assert f"the headless report on {mine}" in proc.stderr and "LAI" in proc.stdout
+    missing = run(str(tmp_path / "nosuch.csv"))
+    assert missing.returncode == 1 and "nosuch.csv: no such file" in missing.stderr
+    assert "LAI" not in missing.stdout
+    project = tmp_path / "study.maizeviz"
+    project.write_bytes(b"PK")
+    proc = run(str(project))
+    assert proc.returncode == 1 and "is a project" in proc.stderr and "LAI" not in proc.stdout

@@ -154,8 +154,8 @@ def test_sweep_refuses_a_hundred_thousand_workers(capsys, tmp_path):
 def test_subplots_json_equals_the_whole_field_traced_at_once(capsys, tmp_path, block_parquet):
     """The same quantity computed another way: the sub-plots' transmission (heights given in
     another order) and each plant's sunlit and second-class light are the numbers `maizeviz
-    light` gives for the whole field traced in one scene; the sunlit leaf area is the
-    intercepted fraction times the rectangle."""
+    light` gives for the whole field traced in one scene; the beam the sunlit leaves
+    intercept is the intercepted fraction times the rectangle."""
     import csv
     import json
 
@@ -177,7 +177,7 @@ def test_subplots_json_equals_the_whole_field_traced_at_once(capsys, tmp_path, b
     assert parts["rays"] == whole["rays"]
     assert parts["transmission"] == [whole["transmission"][k] for k in order]
     x0, y0, x1, y1 = whole["rect_cm"]
-    assert parts["sunlit_leaf_area_m2"] == pytest.approx(
+    assert parts["sunlit_intercepted_m2"] == pytest.approx(
         whole["sunlit_intercepted_fraction"] * (x1 - x0) * (y1 - y0) / 1e4, rel=1e-12)
     with open(plants_a, newline="") as fa, open(plants_b, newline="") as fb:
         a = {r["instance"]: r for r in csv.DictReader(fa)}

@@ -242,6 +242,8 @@ def test_sun_from_pvlib_beijing():
 @pytest.mark.parametrize("make, match", [
     (lambda: Sun(95, 0), "below the horizon"),
     (lambda: sun_at("2005-08-01", "23:00", 39.9, 116.4, "Asia/Shanghai"), "below the horizon"),
+    # no zone: the clock is UTC, Beijing's noon is its night; the error names the zone
+    (lambda: sun_at("2005-08-01", "12:00", 39.9, 116.4), "read as UTC, as no time zone"),
     (lambda: sun_at("2005-13-01", "12:00", 39.9, 116.4, "UTC"), "YYYY-MM-DD"),
     (lambda: sun_at("2005-08-01", "12:00", 39.9, 116.4, "Mars/Olympus"), "time zone"),
     (lambda: sun_at("2005-08-01", "12:00", 99, 116.4, "UTC"), "latitude"),
