@@ -244,6 +244,8 @@ def test_sun_from_pvlib_beijing():
     (lambda: sun_at("2005-08-01", "23:00", 39.9, 116.4, "Asia/Shanghai"), "below the horizon"),
     # no zone: the clock is UTC, Beijing's noon is its night; the error names the zone
     (lambda: sun_at("2005-08-01", "12:00", 39.9, 116.4), "read as UTC, as no time zone"),
+    # an offset written after the time is a zone: no UTC hint then
+    (lambda: sun_at("2005-08-01", "12:00-05:00", 39.9, 116.4), "at 2005-08-01T12:00:00-05:00: no direct light"),
     (lambda: sun_at("2005-13-01", "12:00", 39.9, 116.4, "UTC"), "YYYY-MM-DD"),
     (lambda: sun_at("2005-08-01", "12:00", 39.9, 116.4, "Mars/Olympus"), "time zone"),
     (lambda: sun_at("2005-08-01", "12:00", 99, 116.4, "UTC"), "latitude"),

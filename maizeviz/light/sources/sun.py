@@ -13,7 +13,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.sources.clock import check_altitude, check_place, local_datetime, zone
+from maizeviz.light.sources.clock import (
+    check_altitude,
+    check_place,
+    local_datetime,
+    parse_clock,
+    zone,
+)
 
 
 @dataclass(frozen=True)
@@ -137,9 +143,8 @@ def sun_at(date: str, time: str | None, lat: float, lon: float, tz: str | None =
                                 "(9999-12-31)", quantity="date") from None
         unixtime, when = spa.unix_seconds(clock), clock.isoformat()
     zenith, azimuth = spa.position(unixtime, lat, lon, altitude)
-    if zenith >= 90.0 and tz is None and not solar_noon and "+" not in str(time) and \
-            not str(time).upper().endswith("Z"):
-        # a clock time without a zone is UTC: a local noon read so is often night
+    if zenith >= 90.0 and tz is None and not solar_noon and parse_clock(time)[1] is None:
+        # a clock time without a zone nor an offset is UTC: a local noon read so is often night
         raise MaizevizError(f"the sun is below the horizon (zenith {zenith:.2f} deg) at {when}: "
                             "the time was read as UTC, as no time zone was given: give the "
                             "place's zone (--tz Asia/Shanghai, say)", quantity="tz")
