@@ -98,9 +98,9 @@ def _no_command(argv: list[str]) -> int:
         except ImportError as exc:              # Qt present but unusable (a missing libxcb...)
             say(f"note: the desktop app cannot start ({exc}); the headless report follows")
     else:
-        say("no screen (DISPLAY is not set): the headless report on the bundled example "
-            "follows; for the window run 'xvfb-run -a maizeviz --screenshot app.png' or use a "
-            "desktop")
+        on = rest[0] if rest and not rest[0].startswith("-") else "the bundled example"
+        say(f"no screen (DISPLAY is not set): the headless report on {on} follows; for the "
+            "window run 'xvfb-run -a maizeviz --screenshot app.png' or use a desktop")
     if rest and not rest[0].startswith("-"):
         return _report_on(rest[0])
     return main(["canopy", str(example_points()), "--tile", "3x3", "--levels"])
@@ -116,7 +116,7 @@ def _report_on(path: str) -> int:
         say(f"error: {path} is a project: it opens in the desktop app (without a screen: "
             f"xvfb-run -a maizeviz {path} --screenshot view.png)")
         return EXIT_FAIL
-    say(f"note: the headless report on {path} (maizeviz canopy {path} --levels)")
+    say(f"note: the same as: maizeviz canopy {path} --levels")
     return main(["canopy", path, "--levels"])
 
 
