@@ -38,8 +38,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from anchors import report  # noqa: E402
 
 from maizeviz.fspm.caribu import CaribuScene  # noqa: E402
-from maizeviz.io.canestra import (encode_label, write_can, write_light, write_opt,  # noqa: E402
-                                  write_pattern)
+from maizeviz.io.canestra import encode_label, write_can, write_light, write_opt, write_pattern  # noqa: E402
 
 
 def homogeneous(lai: float, leaf_cm: float, seed: int = 1) -> dict[str, np.ndarray]:

@@ -107,6 +107,37 @@ def _material(band: str, label, po) -> tuple[float, float, bool]:
     return rho, tau, differ
 
 
+def _opt_files(paths, labels) -> tuple[dict, dict]:
+    """Materials of each label and soil reflectance of each band from Caribu's ``.opt`` files
+    (one a band, named by the file), species by the labels' optical ids."""
+    from maizeviz.io.canestra import decode_label, read_opt
+
+    material: dict[str, dict[Any, Material]] = {}
+    soil: dict[str, float] = {}
+    for path in paths:
+        band = Path(path).name.split(".")[0]
+        ro_soil, species = read_opt(path)
+        soil[band] = ro_soil
+        mats: dict[Any, Material] = {}
+        for lab in labels:
+            oid, transparent, _, _ = decode_label(lab)
+            if oid == 0 and not transparent:
+                mats[lab] = (ro_soil,)
+                continue
+            if oid not in species:
+                raise CaribuSceneError(f"{path}: label {lab} has optical id {oid}, the file "
+                                       f"defines species 1..{len(species)}")
+            stem, r_inf, t_inf, r_sup, t_sup = species[oid]
+            if not transparent:
+                mats[lab] = (stem,)
+            elif (r_inf, t_inf) == (r_sup, t_sup):
+                mats[lab] = (r_inf, t_inf)
+            else:
+                mats[lab] = (r_inf, t_inf, r_sup, t_sup)
+        material[band] = mats
+    return material, soil
+
+
 def _aggregate(values, indices, fun):
     out = {}
     for key, group in groupby(sorted(zip(indices, values), key=lambda x: x[0]),
@@ -271,52 +302,24 @@ class CaribuScene:
 
     def _optics(self, opt, soil_reflectance, scene_arg):
         labels = list(self.scene) if self.scene is not None else []
+        material: dict[Any, dict[Any, Material]]
         if opt is None:
             bands = list(soil_reflectance) if soil_reflectance else [self.default_band]
             soil = dict(soil_reflectance) if soil_reflectance else \
                 {self.default_band: self.default_soil_reflectance}
-            material = {b: {lab: self.default_material for lab in labels} for b in bands}
+            material = {b: dict.fromkeys(labels, self.default_material) for b in bands}
         elif isinstance(opt, list):
             if not isinstance(scene_arg, (str, Path)):
                 raise CaribuSceneError(".opt files go with a .can scene (their species are "
                                        "the labels' optical ids)")
-            from maizeviz.io.canestra import decode_label, read_opt
-
-            material, soil = {}, {}
-            for path in opt:
-                band = Path(path).name.split(".")[0]
-                ro_soil, species = read_opt(path)
-                soil[band] = ro_soil
-                mats = {}
-                for lab in labels:
-                    oid, transparent, _, _ = decode_label(lab)
-                    if oid == 0 and not transparent:
-                        mats[lab] = (ro_soil,)
-                        continue
-                    if oid not in species:
-                        raise CaribuSceneError(f"{path}: label {lab} has optical id {oid}, the "
-                                               f"file defines species 1..{len(species)}")
-                    stem, r_inf, t_inf, r_sup, t_sup = species[oid]
-                    if not transparent:
-                        mats[lab] = (stem,)
-                    elif (r_inf, t_inf) == (r_sup, t_sup):
-                        mats[lab] = (r_inf, t_inf)
-                    else:
-                        mats[lab] = (r_inf, t_inf, r_sup, t_sup)
-                material[band] = mats
+            material, soil = _opt_files(opt, labels)
         elif isinstance(opt, Mapping) and opt:
             first = next(iter(opt.values()))
             if isinstance(first, Mapping):
                 material = {b: dict(m) for b, m in opt.items()}
             else:
-                material = {b: {lab: tuple(m) for lab in labels} for b, m in opt.items()}
-            if soil_reflectance is None:
-                soil = {b: self.default_soil_reflectance for b in material}
-            elif isinstance(soil_reflectance, Mapping) and set(soil_reflectance) == set(material):
-                soil = dict(soil_reflectance)
-            else:
-                raise CaribuSceneError("soil_reflectance is a {band: reflectance} dict with the "
-                                       f"bands of opt ({', '.join(map(str, material))})")
+                material = {b: dict.fromkeys(labels, tuple(m)) for b, m in opt.items()}
+            soil = self._soil(soil_reflectance, material)
         else:
             raise CaribuSceneError("opt is {band: {label: material}}, {band: material} or a "
                                    "list of .opt files")
@@ -332,6 +335,14 @@ class CaribuScene:
                 raise CaribuSceneError(f"band {band}: the soil reflectance must be in [0, 1], "
                                        f"got {r!r}")
         return material, soil
+
+    def _soil(self, soil_reflectance, material) -> dict:
+        if soil_reflectance is None:
+            return dict.fromkeys(material, self.default_soil_reflectance)
+        if isinstance(soil_reflectance, Mapping) and set(soil_reflectance) == set(material):
+            return dict(soil_reflectance)
+        raise CaribuSceneError("soil_reflectance is a {band: reflectance} dict with the bands "
+                               f"of opt ({', '.join(map(str, material))})")
 
     # ------------------------------------------------------------------ Caribu's helpers
     def triangle_areas(self, convert: bool = True) -> np.ndarray:

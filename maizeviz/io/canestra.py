@@ -225,7 +225,9 @@ def read_opt(path: str | Path) -> tuple[float, dict[int, tuple[float, ...]]]:
     species : dict of int to (stem_reflectance, rho_lower, tau_lower, rho_upper, tau_upper)
         Species numbered from 1 in file order (the optical id of a Canestra label).
     """
-    soil, species, declared = None, {}, None
+    soil: float | None = None
+    species: dict[int, tuple[float, ...]] = {}
+    declared: int | None = None
     for no, line in _lines(path, "Canestra optics file (.opt)", MAX_SMALL_BYTES):
         fields = line.split()
         kind = fields[0]

@@ -9,9 +9,19 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from maizeviz.errors import MaizevizError
-from maizeviz.io.canestra import (CanestraFileError, decode_label, encode_label, read_can,
-                                  read_light, read_opt, read_pattern, write_can, write_light,
-                                  write_opt, write_pattern)
+from maizeviz.io.canestra import (
+    CanestraFileError,
+    decode_label,
+    encode_label,
+    read_can,
+    read_light,
+    read_opt,
+    read_pattern,
+    write_can,
+    write_light,
+    write_opt,
+    write_pattern,
+)
 
 coords = st.floats(-1e4, 1e4, allow_nan=False).map(lambda v: round(v, 6))
 

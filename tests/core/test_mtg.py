@@ -1,4 +1,4 @@
-"""maizeviz.io.mtg: digitized plants out to OpenAlea's MTG (FORM-A) and back.
+"""maizeviz.fspm.mtg: digitized plants out to OpenAlea's MTG (FORM-A) and back.
 
 OpenAlea's own reader (``openalea.mtg.io.read_mtg_file``) is not on PyPI; it was run on these
 files while this module was written (docs/fspm.md). Here the files are held to the format's
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import maizeviz as mv
-from maizeviz.io.mtg import MTGFileError, mtg_text, parse_mtg, read_mtg, write_mtg
+from maizeviz.fspm.mtg import MTGFileError, mtg_text, parse_mtg, read_mtg, write_mtg
 
 
 @pytest.fixture(scope="module")
@@ -35,7 +35,7 @@ def test_the_topology_is_plant_then_stalk_bearing_its_leaves(tmp_path, leaves):
     verts = parse_mtg(write_mtg(tmp_path / "plants.mtg", leaves))
     plants = [v for v in verts if v.symbol == "P"]
     assert sorted(v.index for v in plants) == sorted({lf.plant for lf in leaves})
-    for k, v in enumerate(verts):
+    for v in verts:
         if v.symbol == "S":
             assert verts[v.complex].symbol == "P" and v.edge == "/"
         if v.symbol == "L":

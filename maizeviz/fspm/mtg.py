@@ -187,6 +187,98 @@ def _sections(lines: list[tuple[int, str]], path) -> dict[str, int]:
     return found
 
 
+def _classes(lines, sec, path) -> dict[str, int]:
+    scales: dict[str, int] = {}
+    end = sec.get("DESCRIPTION:", sec["FEATURES:"])
+    for no, t in lines[sec["CLASSES:"] + 2:end]:
+        parts = t.split("#")[0].split()
+        if len(parts) != 5:
+            raise MTGFileError(f"{path}: line {no}: a class is SYMBOL SCALE DECOMPOSITION "
+                               "INDEXATION DEFINITION")
+        try:
+            scales[parts[0]] = whole(parts[1])
+        except ValueError:
+            raise MTGFileError(f"{path}: line {no}: the scale {parts[1]!r} is not a whole "
+                               "number") from None
+    return scales
+
+
+def _features(lines, sec, path) -> dict[str, str]:
+    types: dict[str, str] = {}
+    for no, t in lines[sec["FEATURES:"] + 2:sec["MTG:"]]:
+        parts = t.split("#")[0].split()
+        if len(parts) != 2 or parts[1] not in _TYPES:
+            raise MTGFileError(f"{path}: line {no}: a feature is NAME TYPE (TYPE one of "
+                               f"{', '.join(sorted(_TYPES))})")
+        types[parts[0]] = parts[1]
+    return types
+
+
+def _columns(head_no: int, head: str, types: dict[str, str], path) -> dict[int, str]:
+    """Feature of each tab column of the code (the ``ENTITY-CODE`` line sets them)."""
+    if not head.startswith(("ENTITY-CODE", "TOPO")):
+        raise MTGFileError(f"{path}: line {head_no}: the MTG section starts with ENTITY-CODE")
+    cols = head.split("\t")
+    names = [c.strip() for c in cols[1:] if c.strip()]
+    unknown = [n for n in names if n not in types]
+    if unknown:
+        raise MTGFileError(f"{path}: line {head_no}: feature {unknown[0]} is not declared in "
+                           "FEATURES")
+    first = next((k for k, c in enumerate(cols) if k > 0 and c.strip()), len(cols))
+    return {k: c.strip() for k, c in enumerate(cols) if k >= first and c.strip()}
+
+
+def _start(t: str, no: int, last_at: dict[int, int], path) -> tuple[int, str, int]:
+    """(indentation, entity code without ``^``, vertex it starts from) of a code line."""
+    indent = len(t) - len(t.lstrip("\t"))
+    entity = t.strip().split("\t")[0].split()[0]
+    if entity.startswith("^"):
+        if indent not in last_at:
+            raise MTGFileError(f"{path}: line {no}: '^' with no entity before it at this "
+                               "indentation")
+        return indent, entity[1:], last_at[indent]
+    if indent == 0:
+        return indent, entity, 0
+    if indent - 1 in last_at:
+        return indent, entity, last_at[indent - 1]
+    raise MTGFileError(f"{path}: line {no}: indented under no entity")
+
+
+def _add(verts: list[Vertex], current: int, edge: str, symbol: str, index: str,
+         scales: dict[str, int], no: int, path) -> int:
+    """Add one element of an entity code after ``current``; its vertex."""
+    if symbol not in scales:
+        raise MTGFileError(f"{path}: line {no}: symbol {symbol} is not in CLASSES")
+    scale = scales[symbol]
+    cur = verts[current]
+    parent: int | None = None
+    if edge == "/":
+        complex_: int | None = current
+        if scale <= cur.scale:
+            # /P2 after a plant's organs: a new component of the complex at that scale
+            up: int | None = current
+            while up is not None and verts[up].scale >= scale:
+                up = verts[up].complex
+            complex_ = 0 if up is None else up
+    else:
+        if scale != cur.scale:
+            raise MTGFileError(f"{path}: line {no}: {edge}{symbol}{index} joins scale "
+                               f"{cur.scale} to scale {scale}: edges between scales are not "
+                               "read here")
+        complex_, parent = cur.complex, current
+    verts.append(Vertex(f"{symbol}{index}", symbol, int(index) if index else None, scale,
+                        complex_, parent, edge, no))
+    return len(verts) - 1
+
+
+def _value(kind: str, name: str, value: str, no: int, path):
+    try:
+        return whole(value) if kind == "INT" else number(value) if kind == "REAL" else value
+    except ValueError:
+        raise MTGFileError(f"{path}: line {no}: feature {name} {value[:30]!r} is not "
+                           f"{'a whole number' if kind == 'INT' else 'a number'}") from None
+
+
 def parse_mtg(path: str | Path) -> list[Vertex]:
     """The entities of an MTG file (FORM-A), in file order (index 0 is the scene, ``$``).
 
@@ -204,102 +296,34 @@ def parse_mtg(path: str | Path) -> list[Vertex]:
     lines = [(no, t) for no, t in enumerate(text.splitlines(), start=1)
              if t.strip() and not t.strip().startswith("#")]
     sec = _sections(lines, path)
-    code = lines[sec["CODE:"]][1]
+    code_no, code = lines[sec["CODE:"]]
     if "FORM-A" not in code and "FORM-B" not in code:
-        raise MTGFileError(f"{path}: line {lines[sec['CODE:']][0]}: the CODE is not FORM-A or "
-                           "FORM-B")
-    scales: dict[str, int] = {}
-    end = sec.get("DESCRIPTION:", sec["FEATURES:"])
-    for no, t in lines[sec["CLASSES:"] + 2:end]:
-        parts = t.split("#")[0].split()
-        if len(parts) != 5:
-            raise MTGFileError(f"{path}: line {no}: a class is SYMBOL SCALE DECOMPOSITION "
-                               "INDEXATION DEFINITION")
-        try:
-            scales[parts[0]] = whole(parts[1])
-        except ValueError:
-            raise MTGFileError(f"{path}: line {no}: the scale {parts[1]!r} is not a whole "
-                               "number") from None
-    types: dict[str, str] = {}
-    for no, t in lines[sec["FEATURES:"] + 2:sec["MTG:"]]:
-        parts = t.split("#")[0].split()
-        if len(parts) != 2 or parts[1] not in _TYPES:
-            raise MTGFileError(f"{path}: line {no}: a feature is NAME TYPE (TYPE one of "
-                               f"{', '.join(sorted(_TYPES))})")
-        types[parts[0]] = parts[1]
+        raise MTGFileError(f"{path}: line {code_no}: the CODE is not FORM-A or FORM-B")
+    scales = _classes(lines, sec, path)
+    types = _features(lines, sec, path)
+    if sec["MTG:"] + 1 >= len(lines):
+        raise MTGFileError(f"{path}: the MTG section is empty")
     head_no, head = lines[sec["MTG:"] + 1]
-    if not head.startswith(("ENTITY-CODE", "TOPO")):
-        raise MTGFileError(f"{path}: line {head_no}: the MTG section starts with ENTITY-CODE")
-    cols = head.split("\t")
-    names = [c.strip() for c in cols[1:] if c.strip()]
-    unknown = [n for n in names if n not in types]
-    if unknown:
-        raise MTGFileError(f"{path}: line {head_no}: feature {unknown[0]} is not declared in "
-                           "FEATURES")
-    first = next((k for k, c in enumerate(cols) if k > 0 and c.strip()), len(cols))
-    columns = {k: c.strip() for k, c in enumerate(cols) if k >= first and c.strip()}
+    columns = _columns(head_no, head, types, path)
     verts = [Vertex("", "$", None, 0, None, None, "/", head_no)]
     last_at: dict[int, int] = {}                      # indentation -> last vertex of that line
     for no, t in lines[sec["MTG:"] + 2:]:
-        indent = len(t) - len(t.lstrip("\t"))
-        cells = t.split("\t")
-        entity = t.strip().split("\t")[0].split()[0] if t.strip() else ""
-        if entity.startswith("^"):
-            if indent not in last_at:
-                raise MTGFileError(f"{path}: line {no}: '^' with no entity before it at this "
-                                   "indentation")
-            current, entity = last_at[indent], entity[1:]
-        elif indent == 0:
-            current = 0
-        elif indent - 1 in last_at:
-            current = last_at[indent - 1]
-        else:
-            raise MTGFileError(f"{path}: line {no}: indented under no entity")
+        indent, entity, current = _start(t, no, last_at, path)
         elements = _ELEMENT.findall(entity)
         if not elements or "".join("".join(e) for e in elements) != entity:
             raise MTGFileError(f"{path}: line {no}: {entity[:40]!r} is not an entity code "
                                "(/X1, +X1, <X1 ...)")
         for edge, symbol, index in elements:
-            if symbol not in scales:
-                raise MTGFileError(f"{path}: line {no}: symbol {symbol} is not in CLASSES")
-            scale = scales[symbol]
-            cur = verts[current]
-            if edge == "/":
-                if scale <= cur.scale:
-                    # /P2 after a plant's organs: a new component of the complex at that scale
-                    up = current
-                    while up is not None and verts[up].scale >= scale:
-                        up = verts[up].complex
-                    complex_, parent = (0 if up is None else up), None
-                else:
-                    complex_, parent = current, None
-            else:
-                if scale != cur.scale:
-                    raise MTGFileError(f"{path}: line {no}: {edge}{symbol}{index} joins scale "
-                                       f"{cur.scale} to scale {scale}: edges between scales "
-                                       "are not read here")
-                complex_, parent = cur.complex, current
-            verts.append(Vertex(f"{symbol}{index}", symbol, int(index) if index else None,
-                                scale, complex_, parent, edge, no))
-            current = len(verts) - 1
+            current = _add(verts, current, edge, symbol, index, scales, no, path)
         last_at[indent] = current
         for deeper in [k for k in last_at if k > indent]:
             del last_at[deeper]
+        cells = t.split("\t")
         feats = verts[current].features
         for k, name in columns.items():
-            if k - 0 >= len(cells):
-                continue
-            value = cells[k].strip()
-            if not value:
-                continue
-            kind = types[name]
-            try:
-                feats[name] = (whole(value) if kind == "INT" else
-                               number(value) if kind == "REAL" else value)
-            except ValueError:
-                raise MTGFileError(f"{path}: line {no}: feature {name} {value[:30]!r} is not "
-                                   f"{'a whole number' if kind == 'INT' else 'a number'}") \
-                    from None
+            value = cells[k].strip() if k < len(cells) else ""
+            if value:
+                feats[name] = _value(types[name], name, value, no, path)
     return verts
 
 
@@ -352,7 +376,7 @@ def read_mtg(path: str | Path, leaf_symbol: str = "L", plant_symbol: str = "P") 
             up = verts[up].complex
         if up is None or verts[up].index is None:
             raise MTGFileError(f"{where}: leaf {v.label} belongs to no plant {plant_symbol}<n>")
-        plant = int(verts[up].index)                       # type: ignore[arg-type]
+        plant = int(verts[up].index or 0)
         leaf = int(v.features.get("rank", v.index if v.index is not None else 0))
         if (plant, leaf) in seen:
             raise MTGFileError(f"{where}: plant {plant} has two leaves of rank {leaf}")
