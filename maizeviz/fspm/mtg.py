@@ -389,7 +389,8 @@ def read_mtg(path: str | Path, leaf_symbol: str = "L", plant_symbol: str = "P") 
         if rows * cols != len(pts) or rows < 2 or cols < 2:
             raise MTGFileError(f"{where}: leaf {v.label}: {len(pts)} points for a grid of "
                                f"{rows} x {cols}")
-        grids.append(LeafGrid(plant, leaf, pts.reshape(rows, cols, 3),
+        grid = pts.reshape(rows, cols, 3)
+        grids.append(LeafGrid(plant, leaf, grid, bool(np.all(grid[-1] == grid[-1, :1])),
                               rows=tuple(range(rows))))
     if not grids:
         raise MTGFileError(f"{path}: no {leaf_symbol} entity carries points")
