@@ -55,7 +55,7 @@ def _mtg(args: argparse.Namespace) -> int:
         n = sum(g.shape[0] * g.shape[1] for g in grids)
         say(f"wrote {n:,} points of {len(grids):,} leaves to {args.out}")
         return EXIT_OK
-    from maizeviz.api import read_points as read_leaves
+    from maizeviz.leaf.fit import read_leaves
     from maizeviz.fspm.mtg import write_mtg
 
     got = read_leaves(args.points)
