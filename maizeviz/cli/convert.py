@@ -55,8 +55,8 @@ def _mtg(args: argparse.Namespace) -> int:
         n = sum(g.shape[0] * g.shape[1] for g in grids)
         say(f"wrote {n:,} points of {len(grids):,} leaves to {args.out}")
         return EXIT_OK
-    from maizeviz.leaf.fit import read_leaves
     from maizeviz.fspm.mtg import write_mtg
+    from maizeviz.leaf.fit import read_leaves
 
     got = read_leaves(args.points)
     for line in [*got.problems, *(str(e) for e in got.skipped)]:
