@@ -1,0 +1,136 @@
+"""Hostile inputs on the newest surfaces (issue 35, item 7): each case found by the red team
+held by a test that failed before its fix. The oracle is the input itself: a file's own
+header, line and cells, the options as typed."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
+from maizeviz.errors import MaizevizError
+from maizeviz.light.sources.irradiance import WeatherFileError, read_weather, weather_period
+from maizeviz.resources import example_points
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "weather"
+EPW = DATA / "pvgis_tmy_45N_8E_july.epw"
+TMY3 = DATA / "tmy3_703165_july.csv"
+B = str(example_points())
+
+
+def _lines(path: Path) -> list[str]:
+    return path.read_text(encoding="latin-1").splitlines()
+
+
+def _write(tmp_path: Path, name: str, lines: list[str], end: str = "\n") -> Path:
+    out = tmp_path / name
+    out.write_text("\n".join(lines) + end, encoding="latin-1")
+    return out
+
+
+# ------------------------------------------------------------------------------ weather
+TURIN = "LOCATION,{city},-,ITA,IWEC,160590,45.000000,8.000000,1,250"
+
+
+def test_an_epw_city_with_a_quoted_comma_is_read_at_its_own_place(tmp_path):
+    """csv reads a quoted city as one field; pvlib split every comma and traced the day at
+    52.5 N, 45 E, +08:00 for a file at 45 N, 8 E, +01:00."""
+    lines = _lines(EPW)
+    lines[0] = TURIN.format(city='"Turin, IT"')
+    w = read_weather(_write(tmp_path, "turin.epw", lines))
+    assert (w.place["latitude"], w.place["longitude"]) == (45.0, 8.0)
+    assert w.place["name"] == "Turin, IT"
+    assert w.times[0].isoformat().endswith("+01:00")
+    assert np.array_equal(w.ghi, read_weather(EPW).ghi)
+
+
+def test_an_epw_city_with_a_bare_comma_is_refused_naming_the_field(tmp_path):
+    lines = _lines(EPW)
+    lines[0] = TURIN.format(city="Turin, IT")
+    with pytest.raises(WeatherFileError) as exc:
+        read_weather(_write(tmp_path, "turin.epw", lines))
+    msg = str(exc.value)
+    assert "line 1" in msg and "11 fields" in msg and "city" in msg and "\n" not in msg, msg
+
+
+@pytest.mark.parametrize("keep", [3, 40, 150])
+def test_a_tmy3_cut_inside_its_last_row_is_refused(tmp_path, keep):
+    """The cut cell was read as its remaining digits (99 W/m2 direct instead of 41)."""
+    lines = _lines(TMY3)
+    lines[-1] = lines[-1][:keep]
+    bad = _write(tmp_path, "cut.csv", lines, end="")
+    with pytest.raises(WeatherFileError) as exc:
+        read_weather(bad)
+    msg = str(exc.value)
+    assert f"line {len(lines)}" in msg and "cut" in msg and "\n" not in msg, msg
+
+
+def test_an_epw_cut_inside_its_last_row_is_refused(tmp_path):
+    lines = _lines(EPW)
+    lines[-1] = lines[-1][:30]
+    with pytest.raises(WeatherFileError) as exc:
+        read_weather(_write(tmp_path, "cut.epw", lines, end=""))
+    assert f"line {len(lines)}" in str(exc.value)
+
+
+def test_a_typical_year_cut_across_a_month_boundary_is_read(tmp_path):
+    """Months of a typical year come from different years, forward as well as back: 3 July
+    of 1991 followed by 4 July of 2003 was 'a gap of 35065 h'."""
+    lines = _lines(TMY3)
+    rows = lines[2:]
+    first_day = [r for r in rows if r.startswith("07/01/1991")]
+    moved = [r.replace("07/01/1991", "06/30/1991") for r in first_day]
+    later = [r.replace("07/0", "07/0").replace("/1991,", "/2003,") for r in rows]
+    w = read_weather(_write(tmp_path, "typical.csv", lines[:2] + moved + later))
+    assert len(w.times) == len(moved) + len(later)
+    assert np.all(np.diff(w.times.asi8) > 0) and set(np.unique(w.step_s)) == {3600.0}
+    assert any("typical year" in n for n in w.notes)
+
+
+@pytest.mark.parametrize("field, value", [(4, "nan"), (5, "nan")])
+def test_a_nan_header_place_is_named(tmp_path, capsys, field, value):
+    lines = _lines(TMY3)
+    cells = lines[0].split(",")
+    cells[field] = value
+    lines[0] = ",".join(cells)
+    path = _write(tmp_path, "nan.csv", lines)
+    code = main(["light", B, "--triangles", "4", "--density", "0.25", "--weather", str(path)])
+    err = capsys.readouterr().err
+    name = "latitude" if field == 4 else "longitude"
+    assert code == EXIT_FAIL and f"{name} is 'nan'" in err and "needs the place" not in err, err
+    # with the place given, the file is used
+    code = main(["light", B, "--triangles", "4", "--density", "0.25", "--heights", "0",
+                 "--sky-directions", "6", "--weather", str(path), "--lat", "55.3", "--lon",
+                 "-160.5", "--json"])
+    assert code == EXIT_OK, capsys.readouterr().err
+
+
+def _cold(tmp_path, line_no: int, value: str) -> Path:
+    lines = _lines(EPW)
+    cells = lines[line_no - 1].split(",")
+    cells[6] = value                                  # EPW field 7: dry bulb, C
+    lines[line_no - 1] = ",".join(cells)
+    return _write(tmp_path, "cold.epw", lines)
+
+
+def test_a_files_cold_air_is_blamed_on_the_file_and_its_line(tmp_path, capsys):
+    path = _cold(tmp_path, 20, "-80")
+    code = main(["light", B, "--triangles", "4", "--density", "0.25", "--heights", "0",
+                 "--sky-directions", "6", "--weather", str(path), "--photosynthesis", "c4"])
+    err = capsys.readouterr().err
+    assert code == EXIT_FAIL, err
+    last = [ln for ln in err.splitlines() if ln.startswith("error")][-1]
+    assert "line 20" in last and "cold.epw" in last and "--temperature" not in last, last
+
+
+def test_temperature_given_with_a_files_own_says_which_wins(tmp_path, capsys):
+    code = main(["light", B, "--triangles", "4", "--density", "0.25", "--heights", "0",
+                 "--sky-directions", "6", "--weather", str(EPW), "--photosynthesis", "c4",
+                 "--temperature", "10", "--json"])
+    out, err = capsys.readouterr()
+    assert code == EXIT_OK, err
+    assert "--temperature 10" in err and "air temperature" in err, err
