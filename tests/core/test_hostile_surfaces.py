@@ -4,16 +4,13 @@ header, line and cells, the options as typed."""
 
 from __future__ import annotations
 
-import json
-import math
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
-from maizeviz.errors import MaizevizError
-from maizeviz.light.sources.irradiance import WeatherFileError, read_weather, weather_period
+from maizeviz.light.sources.irradiance import WeatherFileError, read_weather
 from maizeviz.resources import example_points
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "weather"
@@ -134,3 +131,99 @@ def test_temperature_given_with_a_files_own_says_which_wins(tmp_path, capsys):
     out, err = capsys.readouterr()
     assert code == EXIT_OK, err
     assert "--temperature 10" in err and "air temperature" in err, err
+
+
+# ------------------------------------------------------------------------------ main job
+def _headless(*args, env_extra=None, timeout=300):
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    env.update(env_extra or {})
+    return subprocess.run([sys.executable, "-m", "maizeviz", *map(str, args)],
+                          capture_output=True, text=True, env=env, timeout=timeout)
+
+
+@pytest.fixture(scope="module")
+def small_points(tmp_path_factory):
+    """Two plants of the bundled example: a file that is not the example."""
+    lines = Path(B).read_text().splitlines()
+    head = [ln for ln in lines if not ln[:1].isdigit()]
+    rows = [ln for ln in lines if ln[:1].isdigit()]
+    plant = [ln for ln in rows if ln.split(",")[0] in ("1", "2")]
+    out = tmp_path_factory.mktemp("pts") / "mine.csv"
+    out.write_text("\n".join(head + plant) + "\n")
+    return out
+
+
+@pytest.mark.parametrize("form", [("--tile", "1", "{p}"), ("--", "{p}"),
+                                  ("{p}", "--tile", "1")])
+def test_the_main_job_reports_on_the_file_wherever_it_stands(small_points, form):
+    """`maizeviz --tile 1 p.csv` and `maizeviz -- p.csv` reported on the bundled example."""
+    args = [a.format(p=small_points) for a in form]
+    proc = _headless(*args)
+    assert proc.returncode == EXIT_OK, proc.stderr
+    assert f"the headless report on {small_points}" in proc.stderr
+    tile = "1x1" if "1" in form else "3x3"
+    assert f"maizeviz canopy {small_points} --tile {tile} --levels" in proc.stderr
+    plants = 2 if tile == "1x1" else 18
+    assert f"canopy: {plants} plants" in proc.stdout, proc.stdout
+
+
+@pytest.mark.parametrize("bad, says", [(("--tile", "4"), "--tile"),
+                                       (("--bogus-option",), "--bogus-option"),
+                                       (("--size", "big"), "--size")])
+def test_the_main_jobs_options_after_the_file_are_checked(small_points, bad, says):
+    proc = _headless(small_points, *bad)
+    assert proc.returncode == 2 and says in proc.stderr and "LAI" not in proc.stdout
+    assert "Traceback" not in proc.stderr
+
+
+def test_the_main_job_on_a_mesh_reports_it_as_it_is(tmp_path, small_points):
+    mesh = tmp_path / "c.ply"
+    assert main(["canopy", str(small_points), "--triangles", "4", "--export",
+                 str(mesh)]) == EXIT_OK
+    proc = _headless(mesh)
+    assert proc.returncode == EXIT_OK, proc.stderr
+    assert "--levels" not in proc.stderr and "mesh" in proc.stdout
+    proc = _headless(mesh, "--tile", "3")
+    assert proc.returncode == 2 and "--tile 3: a mesh file" in proc.stderr
+
+
+def test_a_folder_or_fifo_given_to_the_main_job_is_named_as_such(tmp_path):
+    import os
+
+    proc = _headless(tmp_path)
+    assert proc.returncode == EXIT_FAIL and "is a folder, not a file" in proc.stderr
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    proc = _headless(fifo)
+    assert proc.returncode == EXIT_FAIL and "is a FIFO" in proc.stderr
+    assert "no such file" not in proc.stderr
+
+
+# ------------------------------------------------------------------------------ environment
+@pytest.mark.parametrize("name, value", [("MAIZEVIZ_FIELD_POINTS", "abc"),
+                                         ("MAIZEVIZ_FIELD_POINTS", "1e3"),
+                                         ("MAIZEVIZ_FIELD_POINTS", ""),
+                                         ("MAIZEVIZ_FIELD_POINTS", "-5"),
+                                         ("MAIZEVIZ_PACKET_WIDTH", "abc"),
+                                         ("MAIZEVIZ_PACKET_WIDTH", "7"),
+                                         ("MAIZEVIZ_PACKETS", "maybe"),
+                                         ("MAIZEVIZ_LOOPS", "2"),
+                                         ("MAIZEVIZ_DEBUG", "please")])
+def test_a_bad_environment_variable_is_one_line_when_used(tmp_path, name, value):
+    """They were int() at import: a traceback."""
+    pts = tmp_path / "p.parquet"
+    assert main(["convert", B, "--out", str(pts)]) == EXIT_OK
+    proc = _headless("light", pts, "--tile", "1x1", "--triangles", "4", "--density", "0.25",
+                     "--heights", "0", "--sun-zenith", "30", "--sun-azimuth", "180",
+                     env_extra={name: value})
+    err = proc.stderr.strip()
+    assert proc.returncode == EXIT_FAIL, err
+    assert "Traceback" not in err and f"{name}='{value}'" in err, err
+    assert err.splitlines()[-1].startswith("error:"), err
+    info = _headless("--info", env_extra={name: value})
+    assert info.returncode == EXIT_FAIL and name in info.stderr and "Traceback" not in \
+        info.stderr
