@@ -227,3 +227,66 @@ def test_a_bad_environment_variable_is_one_line_when_used(tmp_path, name, value)
     info = _headless("--info", env_extra={name: value})
     assert info.returncode == EXIT_FAIL and name in info.stderr and "Traceback" not in \
         info.stderr
+
+
+# ------------------------------------------------------------------------------ projects
+@pytest.fixture(scope="module")
+def traced_project(tmp_path_factory):
+    """The bundled block's 2 x 2 tiling at 16 triangles with a sun, a sky and a day."""
+    from maizeviz.canopy.layout import layout_for
+    from maizeviz.canopy.scene import build_canopy
+    from maizeviz.leaf.fit import read_leaves
+    from maizeviz.light.scene.request import LightRequest, Sampling
+    from maizeviz.light.sources.sky import make_sky
+    from maizeviz.light.sources.sun import Sun
+    from maizeviz.light.trace.diffuse import trace_sky
+    from maizeviz.light.trace.direct import trace_light
+    from maizeviz.mesh.levels import parse_level
+    from maizeviz.project.study import save_study
+
+    folder = tmp_path_factory.mktemp("project")
+    leaves = read_leaves(B).leaves
+    layout = layout_for(leaves, (2, 2))
+    level = parse_level("16")
+    canopy = build_canopy(leaves, layout, level)
+    sampling = Sampling((0.0, 100.0), 0.2, None, True, 1)
+    sun = trace_light(canopy, LightRequest(Sun(30, 180), sampling))
+    sky = trace_sky(canopy, make_sky("soc", 16), sampling)
+    path = folder / "ok.maizeviz"
+    save_study(path, B, layout, [sun, sky], level=level.label)
+    return path, canopy.n_triangles, len(canopy.stalk_faces)
+
+
+@pytest.mark.parametrize("name, kind", [("triangle_share", 1), ("first_hits", 0)])
+@pytest.mark.parametrize("cut", ["one short", "half", "one long"])
+def test_a_projects_per_triangle_array_of_another_length_is_refused_at_read(
+        tmp_path, traced_project, name, kind, cut):
+    """read_study accepted a triangle_share one short, half or one long; table() then said
+    the result was 'traced on another canopy'."""
+    from dataclasses import replace
+
+    from maizeviz.io.project import ProjectError, load_project, save_project
+    from maizeviz.project.study import read_study
+
+    path, n, stalks = traced_project
+    assert len(read_study(path, tmp_path).results) == 2          # the undamaged one reads
+    project = load_project(path)
+    rec = project.results[kind]
+    a = np.asarray(rec.arrays[name])
+    changed = {"one short": a[:-1], "half": a[:len(a) // 2],
+               "one long": np.append(a, a[-1:])}[cut]
+    arrays = {**rec.arrays, name: changed}
+    if name == "first_hits":                                    # both hit arrays alike
+        arrays["second_hits"] = np.resize(np.asarray(rec.arrays["second_hits"]),
+                                          len(changed))
+    results = list(project.results)
+    results[kind] = replace(rec, arrays=arrays)
+    bad = tmp_path / "bad.maizeviz"
+    save_project(bad, replace(project, results=tuple(results)))
+    with pytest.raises(ProjectError) as exc:
+        read_study(bad, tmp_path)
+    msg = str(exc.value)
+    said = (f"holds {len(changed):,} values, expected {n:,} (one per leaf triangle of its "
+            f"canopy) or {n + stalks:,}")
+    assert said in msg and "\n" not in msg, msg
+    assert "first_hits" in msg if name == "first_hits" else name in msg
