@@ -42,13 +42,21 @@ from maizeviz.errors import MaizevizError
 from maizeviz_app import building, lighting, studyfiles
 from maizeviz_app.colour import ColourSettings
 from maizeviz_app.figures import Figures
+from maizeviz_app.history import DraftEdit, History, watch
 from maizeviz_app.layout_draft import LayoutDraft
 from maizeviz_app.messages import user_message
 from maizeviz_app.runner import InlineRunner, Runner, describe_internal
 from maizeviz_app.runs import LightRuns, Run
 from maizeviz_app.selection import Selection
-from maizeviz_app.settings import StudySettings
+from maizeviz_app.settings import StudySettings, field_names
 
+#: Settings groups whose edits are undoable (the digitizer's connection is not an edit of the
+#: study; the tiling is set by opening, not edited).
+UNDOABLE = ("canopy", "light", "sun", "sampling", "sky", "day", "optics", "photosynthesis")
+#: The colour settings' groups, by the name the history gives them: the 3D view's scale, the
+#: heatmaps' and the rest; undoable too (as ParaView's colour map edits), though they change
+#: no result.
+COLOUR_GROUPS = ("view colours", "heatmap colours", "colours")
 
 class StudyModel:
     """What the window shows and a project saves, and the actions that change it.
@@ -213,6 +221,8 @@ class StudyModel:
         events.preserve_area.connect(self._canopy_setting)
         self.colour = ColourSettings()
         self.selection = Selection()
+        self.history = History()
+        self._watch_history()
 
     # ------------------------------------------------------------------ reading
     @property
@@ -287,6 +297,7 @@ class StudyModel:
         self.layout_edited = layout_edited
         self._renew()
         self.draft.start(loaded.layout, loaded.plants)
+        self.history.clear()
         self.points_changed.emit(loaded)
         self.project_changed.emit(project)
         self._set_modified(False)
@@ -303,6 +314,7 @@ class StudyModel:
         self.layout_edited = False
         self._renew()
         self.draft.start(None, set())
+        self.history.clear()
         self.mesh_opened.emit(self.mesh_path)
         self.project_changed.emit(None)
         self._set_modified(False)
@@ -387,6 +399,35 @@ class StudyModel:
         """Set a settings group from the model itself (see :meth:`quietly`)."""
         with self.quietly():
             self.settings.set(name, values)
+
+    # ------------------------------------------------------------------ history
+    def edit_groups(self) -> dict[str, Any]:
+        """The groups whose edits the history records, by the name it gives them."""
+        c = self.colour
+        groups = {name: self.settings.groups[name] for name in UNDOABLE}
+        groups.update(zip(COLOUR_GROUPS, (c.view, c.heatmap, c)))
+        return groups
+
+    def _watch_history(self) -> None:
+        groups = self.edit_groups()
+
+        def apply(group: str, name: str, value: Any) -> None:
+            target = groups[group]
+            if group in UNDOABLE:
+                value = self.settings.check(group, name, value)
+            setattr(target, name, value)
+
+        def skip() -> bool:
+            return bool(self.applying or self.closing)
+
+        for name, group in groups.items():
+            fields = [f for f in field_names(group) if (name, f) != ("canopy", "tile")]
+            watch(self.history, name, group, fields, apply, skip)
+        self.draft.edited.connect(self._draft_edited)
+
+    def _draft_edited(self, change: Any, text: str, merge: Any) -> None:
+        if not self.closing:
+            self.history.record(DraftEdit(change, text, merge, self.draft.replay))
 
     # ------------------------------------------------------------------ inside
     def _canopy_setting(self, *_values: Any) -> None:

@@ -100,6 +100,7 @@ class LayoutPanel(QWidget):
             self._recorder = UndoRecorder(None, self, draft=self.model)
             stack = self._recorder.stack
         self.undo_stack = stack
+        self.history = study.history if study is not None else self._recorder.history
         self._said: tuple = ()
         self._applied: tuple | None = None
         self._split = False
@@ -324,7 +325,7 @@ class LayoutPanel(QWidget):
         (cm, for the tiling presets; read from the layout's central tile when it is a tiling
         and they are not given). Clears the undo history."""
         self._follow_timer.stop()
-        self.undo_stack.clear()
+        self.history.clear()
         self._applied = tuple(layout.placements)
         self._said = ()
         self.model.start(layout, plants, bases)
