@@ -28,6 +28,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from maizeviz.canopy.layout import LayoutError
 from maizeviz_app import building, lighting, studyfiles
 from maizeviz_app.runner import Runner
 from maizeviz_app.state import COLOUR_GROUPS, UNDOABLE, StudyState  # noqa: F401 - the app's names
@@ -38,7 +39,8 @@ if TYPE_CHECKING:
 
 class StudyModel(StudyState):
     """The study (:class:`~maizeviz_app.state.StudyState`) and its actions; a canopy setting
-    changed (the slider, area preservation, an undo) rebuilds the canopy.
+    changed (the slider, area preservation, an undo) rebuilds the canopy, and so does an edit
+    of the layout while ``layout_options.follow`` (:meth:`apply_draft`).
 
     Parameters
     ----------
@@ -54,10 +56,17 @@ class StudyModel(StudyState):
         events: Any = self.settings.canopy.events       # psygnal's, made by @evented
         events.level.connect(self._canopy_setting)
         events.preserve_area.connect(self._canopy_setting)
+        self.draft.edited.connect(self._draft_moved)
+        self.draft.replayed.connect(self._draft_moved)
 
     def _canopy_setting(self, *_values: Any) -> None:
         if not self.applying:
             self.build()
+
+    def _draft_moved(self, *_edit: Any) -> None:
+        """The layout edited, or an edit undone or redone: applied when it follows."""
+        if self.layout_options.follow and not self.closing:
+            self.apply_draft()
 
     # ------------------------------------------------------------------ canopy
     def open_points(self, path: str | Path, layout: CanopyLayout | None = None) -> None:
@@ -80,6 +89,28 @@ class StudyModel(StudyState):
         if self.loaded is not None and self.loaded.layout is layout:
             self.build()
         return dropped
+
+    def apply_draft(self) -> bool:
+        """The layout being edited (:attr:`draft`), checked and built: at every edit while
+        ``layout_options.follow``, else when asked (the layout editor's *Apply*). A layout the
+        core refuses is said (one line naming the problem), its notes once; False when it
+        cannot be used or is the layout already built."""
+        if self.loaded is None or self.draft.base is None:
+            return False
+        try:
+            new = self.draft.layout()
+        except LayoutError as exc:
+            self.say(f"error: {exc}", error=True)
+            return False
+        if new.warnings != self.layout_notes:
+            for w in new.warnings:
+                self.say(f"note: {w}")
+            self.layout_notes = new.warnings
+        current = self.loaded.layout
+        if new.placements == current.placements and new.cells is current.cells:
+            return False
+        self.apply_layout(new)
+        return True
 
     def cancel(self, kind: str | None = None) -> list[str]:
         """Stop the jobs of ``kind`` (:func:`maizeviz_app.building.cancel`)."""

@@ -20,11 +20,11 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
-from psygnal import Signal
+from psygnal import Signal, SignalGroup, evented
 
 from maizeviz.errors import MaizevizError
 from maizeviz_app.colour import ColourSettings
@@ -50,6 +50,23 @@ UNDOABLE = ("canopy", "light", "sun", "sampling", "sky", "day", "optics", "photo
 #: heatmaps' and the rest; undoable too (as ParaView's colour map edits), though they change
 #: no result.
 COLOUR_GROUPS = ("view colours", "heatmap colours", "colours")
+
+@evented
+@dataclass
+class LayoutOptions:
+    """How the layout being edited reaches the study (evented: the layout editor binds to it).
+
+    Attributes
+    ----------
+    follow : every edit of the layout (and its undo) is applied at once, the canopy rebuilt
+        on it; off: only when asked (:meth:`maizeviz_app.model.StudyModel.apply_draft`)
+    """
+
+    if TYPE_CHECKING:                           # made by @evented
+        events: ClassVar[SignalGroup]
+
+    follow: bool = True
+
 
 class StudyState:
     """What the window shows and a project saves, and the changes of it.
@@ -167,6 +184,8 @@ class StudyState:
         self.runs = LightRuns()
         self.figures = Figures()
         self.draft = LayoutDraft()
+        self.layout_options = LayoutOptions()
+        self.layout_notes: tuple[str, ...] = ()     # the layout's notes already said
         self.summary = ""
         self.plants_run: Run | None = None
         self.pending_runs: list[StoredRun] = []     # a project's results, waiting for a canopy
