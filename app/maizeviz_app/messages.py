@@ -38,8 +38,8 @@ def user_message(exc: BaseException, doing: str = "") -> str:
         if isinstance(exc, PointsFileError) or doing in ("open points", "open project"):
             if doing == "open points" and _AT_LINE.search(text):
                 # the file has the columns: a value on a line is wrong, not the layout
-                advice = "correct that line and open the file again; the previous canopy " \
-                         "stays open"
+                advice = ("correct that line and open the file again; the previous canopy "
+                          "stays open")
             return _join(text, advice)
         return _join(text, advice if doing in ("save project", "export") else "")
     if isinstance(exc, MemoryError):
