@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from maizeviz.errors import MaizevizError
-from maizeviz_app.runs import MODES, Run, day_summary, plot_title, run_info
+from maizeviz_app.runs import MODES, Run, day_summary, plot_title, run_info, run_warnings
 from maizeviz_app.settings import InputProblem
 
 if TYPE_CHECKING:
@@ -152,7 +152,7 @@ def _lit(study: StudyState, out) -> None:
     if study.colour.shared:                     # the others' scale includes this run
         f.restyle(keep=run.kind)
     f.set_plot(plot)
-    for w in r.warnings:
+    for w in run_warnings(run):
         study.say(f"{'note' if 'sun never rises' in w else 'warning'}: {w}")
     if study.shown_signature == run.signature:
         study.view_light.emit(True)
@@ -213,11 +213,23 @@ def _sun_found(study: StudyState, sun) -> None:
     study.say(f"sun at {sun.when}: zenith {sun.zenith_deg:.2f}°, azimuth "
              f"{sun.azimuth_deg:.2f}°")
 
+def offset_zone(hours: float | None) -> str | None:
+    """The IANA zone of a fixed UTC offset of whole hours ("Etc/GMT-1" is UTC+01:00: the
+    Etc names count west), "UTC" for 0; None for no offset or one of part hours (no IANA
+    name holds it)."""
+    if hours is None or hours != int(hours) or not -14 <= hours <= 12:
+        return None
+    h = int(hours)
+    return "UTC" if h == 0 else f"Etc/GMT{-h:+d}"
+
+
 def choose_weather(study: StudyState, path: str) -> None:
     """A weather file chosen: the day's source becomes it and, when its header names a place
-    (EPW, TMY3, PSM), the day's latitude and longitude become that place, in one step of the
-    undo history (read in a job: pvlib's first import takes seconds). A sun traced away from
-    where the file was measured would not match its irradiance."""
+    (EPW, TMY3, PSM), the day's latitude and longitude become that place, and its time zone
+    the file's own (the fixed offset its times are written in), in one step of the undo
+    history (read in a job: pvlib's first import takes seconds). A sun traced away from
+    where the file was measured would not match its irradiance, and dates and clock times
+    are read in the file's zone."""
     def work(job, p):
         from maizeviz.io.weather_files import weather_place
 
@@ -229,9 +241,14 @@ def choose_weather(study: StudyState, path: str) -> None:
         if lat is not None and lon is not None and -90 <= lat <= 90 and -180 <= lon <= 180:
             values.update(latitude=float(lat), longitude=float(lon))
             named = f", {place['name']}" if place.get("name") else ""
-            study.say(f"place: latitude {lat:g}, longitude {lon:g}{named} (the header of "
-                      f"{Path(path).name})")
-        study.settings.set("day", values)
+            zone = offset_zone(place.get("utc_offset_h"))
+            if zone is not None:
+                values["tz"] = zone
+            clock = f", time zone {zone}" if zone is not None else ""
+            study.say(f"place: latitude {lat:g}, longitude {lon:g}{named}{clock} (the header "
+                      f"of {Path(path).name})")
+        with study.history.step(f"weather file {Path(path).name}"):
+            study.settings.set("day", values)
 
     study.runner.run("weather", f"reading the place of {Path(path).name}", work, path,
                      on_done=done, on_error=lambda e: study.fail(e, "weather", "day"))
@@ -307,11 +324,8 @@ def adopt_pending_runs(study: StudyState) -> None:
     study.view_light.emit(True)
 
 def light_per_plant_run(study: StudyState) -> Run | None:
-    """The latest result with light per plant to show: a sky's, a day's or a sun's
-    absorbed light (once computed against its canopy)."""
-    runs = [r for r in study.runs.in_order()
-            if r.kind != "sun" or getattr(r.extra, "plant_rows", None) is not None]
-    return runs[-1] if runs else None
+    """The latest result with light per plant to show (:meth:`LightRuns.with_plants`)."""
+    return study.runs.with_plants()
 
 def complete_runs(study: StudyState) -> None:
     """Results read from a project that were traced on the canopy shown get what the

@@ -185,19 +185,25 @@ def test_the_scripting_example_of_docs_app_runs(tmp_path):
 WEATHER = __import__("pathlib").Path(__file__).parents[1] / "data" / "weather"
 
 
-@pytest.mark.parametrize("name, lat, lon", [("pvgis_tmy_45N_8E_july.epw", 45.0, 8.0),
-                                            ("tmy3_703165_july.csv", 55.317, -160.517),
-                                            ("psm3_401182_july.csv", 40.53, -108.54)])
-def test_a_weather_file_chosen_brings_its_place(study, name, lat, lon):
+@pytest.mark.parametrize("name, lat, lon, tz", [
+    ("pvgis_tmy_45N_8E_july.epw", 45.0, 8.0, "Etc/GMT-1"),
+    ("tmy3_703165_july.csv", 55.317, -160.517, "Etc/GMT+9"),
+    ("psm3_401182_july.csv", 40.53, -108.54, "Etc/GMT+7")])
+def test_a_weather_file_chosen_brings_its_place_and_zone(study, name, lat, lon, tz):
     """Choosing an EPW, TMY3 or PSM file sets the day's place to its header's (the app's
-    default place is Beijing: a sun traced there would not match the file's irradiance)."""
+    default place is Beijing: a sun traced there would not match the file's irradiance), and
+    its time zone to the header's (issue 37 item 2: it kept Beijing's, and the day then warned
+    about a zone the user never typed); one undo step puts all back."""
     day = study.settings.day
+    before = (day.latitude, day.longitude, day.tz)
     assert (day.latitude, day.longitude) != (lat, lon)
     study.choose_weather(str(WEATHER / name))
     assert day.source == "weather" and day.weather.endswith(name)
-    assert (day.latitude, day.longitude) == (lat, lon)
+    assert (day.latitude, day.longitude, day.tz) == (lat, lon, tz)
     assert any(t.startswith(f"place: latitude {lat:g}, longitude {lon:g}")
-               for t in study.said_lines)
+               and f"time zone {tz}" in t for t in study.said_lines)
+    study.history.undo()
+    assert (day.latitude, day.longitude, day.tz) == before
 
 
 def test_a_weather_csv_keeps_the_place_set(study, tmp_path):
@@ -294,3 +300,50 @@ def test_a_whole_study_with_c4_edits_and_named_undo_steps(study, points, tmp_pat
         assert back["canopy"] == pytest.approx(edited["canopy"], rel=1e-12)
     finally:
         runner2.shutdown()
+
+
+def test_a_removed_plant_then_sun_and_c4_warns_as_the_command_line_does(points):
+    """Issue 37, item 3: on a tiled field edited so that its sample rectangle (the central
+    tile) is no longer a tile of a periodic field, the command line warns that the
+    assimilation of leaves outside the rays' reach is understated; the study says it too,
+    and the light panel's text carries it."""
+    from maizeviz_app.model import StudyModel
+    from maizeviz_app.runner import InlineRunner
+    from maizeviz_app.runs import run_info
+
+    runner = InlineRunner()
+    m = StudyModel(tile=3, runner=runner)
+    said: list[str] = []
+    m.said.connect(lambda text, error, status_only: said.append(text))
+    m.said_lines = said                                   # type: ignore[attr-defined]
+    s = m.settings
+    s.canopy.level = "8"
+    m.open_points(points)
+    s.sampling.heights, s.sampling.density, s.sampling.periodic = "0, 100", 1.0, True
+    s.optics.enabled = True
+    s.photosynthesis.model = "c4"
+    assert m.compute_light() and not _errors(m)
+    run = m.runs.of_kind("sun")
+    assert not run.extra.assimilation.warnings
+    with m.history.step("remove a plant"):
+        assert m.draft.remove(0)
+    assert m.compute_light()
+    run = m.runs.of_kind("sun")
+    expected = run.extra.assimilation.warnings
+    assert expected and "understated" in expected[0]       # the core's own warning
+    said_now = [t for t in said if t.startswith("warning: CO₂ assimilation:")]
+    assert said_now and expected[0] in said_now[-1]
+    assert expected[0] in run_info(run)
+    runner.shutdown()
+
+
+def test_a_points_file_with_a_bad_value_is_named_by_its_line(study, tmp_path):
+    """Issue 37, item 4: a points CSV whose x is 'abc' was refused by asking for the columns
+    the file has; the study names line 2 and the value, as the command line does, and asks
+    for that line to be corrected."""
+    path = tmp_path / "abc.csv"
+    path.write_text("plant,leaf,row,col,x,y,z\n1,1,0,0,abc,2,3\n1,1,0,1,1,2,3\n")
+    study.open_points(path)
+    errors = _errors(study)
+    assert errors and "line 2" in errors[-1] and "x is not a number ('abc')" in errors[-1]
+    assert "columns" not in errors[-1] and "correct that line" in errors[-1].lower()
