@@ -94,6 +94,7 @@ class MainWindow(QMainWindow):
         self._settings = QSettings("maizeviz", "maizeviz")
         self.runner = JobRunner(self)
         self.model = StudyModel(tile, self.runner)
+        self.model.draw_figures = True    # the window shows them (a script draws none)
         self.undo = UndoRecorder(self.model, self)
         self.viewport: Viewport | None = None
         self.view_link = ViewLink(self)

@@ -97,6 +97,10 @@ class StudyState:
         Light results (sun, sky, day) per level, compared while they share their sampling.
     figures : Figures
         The heatmaps and the transmission plot of the results shown.
+    draw_figures : bool
+        Draw the figures of each light result (in a job of their own, after it): the window
+        sets it, since it shows them; a script leaves it off and pays nothing for them
+        (an export draws the figure it writes).
     summary : str
         The day's totals in two lines (empty: no day computed).
     plants_run : Run or None
@@ -138,8 +142,8 @@ class StudyState:
     build_pending(text) : what is being built ('': nothing, or not built: ``text`` says why).
     runs_changed(runs, info) : a light result added (``info``: what was traced), or cleared.
     light_running(text) : a light computation started ('' : none runs any more).
-    light_added(run) : a new light result is in the table and figures (``light_shown``
-        follows once its figures are drawn).
+    light_added(run) : a new light result is in the table (``light_shown`` follows once
+        its figures are drawn, when they are).
     light_shown() : the light results shown are complete (table, figures, colours).
     view_light(colour) : the light to paint on the canopy shown changed (``colour``: switch
         the view's colouring to light).
@@ -183,6 +187,7 @@ class StudyState:
         self.measures_rows: dict[str, dict] = {}
         self.runs = LightRuns()
         self.figures = Figures()
+        self.draw_figures = False               # the window sets it: it shows them
         self.draft = LayoutDraft()
         self.layout_options = LayoutOptions()
         self.layout_notes: tuple[str, ...] = ()     # the layout's notes already said
