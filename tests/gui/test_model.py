@@ -159,6 +159,7 @@ def test_the_digitizer_connection_is_a_setting_of_the_study(window, qtbot):
     assert settings.port == d.port and settings.baud == d.baud.value()
     settings.port, settings.baud = "/dev/ttyS7", 9600          # set by a script: shown
     assert d.port == "/dev/ttyS7" and d.baud.value() == 9600
+    assert d.ports.baud == 9600                                 # Find FASTRAK probes at it
     d.ports.box.setEditText("/dev/ttyUSB3")                     # typed: the study's
     d.baud.setValue(38400)
     assert (settings.port, settings.baud) == ("/dev/ttyUSB3", 38400)
