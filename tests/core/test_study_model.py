@@ -269,12 +269,22 @@ def test_a_whole_study_with_c4_edits_and_named_undo_steps(study, points, tmp_pat
     assert m.compute_light() and not _errors(m)
     first = _numbers(m.runs.of_kind("sun"))
     assert first["canopy"] > 0 and len(first["plants"]) == len(m.loaded.layout.placements)
+    # ---- the view's state: coloured by the new light, then by its CO2 when asked
+    assert m.view.colouring == "light"
+    assert m.colour_view_by("assimilation") and m.view.colouring == "assimilation"
+    cameras = []
+    m.view.events.camera.connect(lambda name, *_: cameras.append(name))
+    m.view.ask_camera("top")
+    m.view.ask_camera("top")                                  # asked again: framed again
+    assert cameras == ["top", "top"] and m.view.camera == "top"
     assert sum(p[2] for p in first["plants"]) > 0
     # ---- the layout edited as the panel edits it: the model applies it and rebuilds
     placements = m.loaded.layout.placements
     with m.history.step("turn the first plant"):
         assert m.draft.turn(0, 90.0)
     assert m.loaded.layout.placements[0].azimuth_deg == 90.0 and not m.runs.runs
+    assert m.view.colouring == "leaf"                         # no light on this canopy
+    assert not m.colour_view_by("light") and "no light result" in m.said_lines[-1]
     assert m.built.serial == m.serial and m.canopy.layout.placements[0].azimuth_deg == 90.0
     # ---- undo the edit and the level, by their names; redo them
     assert m.history.undo_text == "turn the first plant"
