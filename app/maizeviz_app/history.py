@@ -52,6 +52,7 @@ NAMES = {"level": "mesh level", "preserve_area": "area preservation", "mode": "l
          "painting": "sun painted", "model": "photosynthesis",
          "temperature_c": "leaf temperature", "alpha": "C4 quantum yield",
          "co2_ppm": "CO₂", "amax": "WOFOST AMAX", "eff": "WOFOST EFF",
+         "c4_temperature": "C4 temperature response",
          # a field whose name another group uses too: by group and field
          "photosynthesis.vmax": "C4 Vmax"}
 #: Where a colour group's edits are said to be made ("3D view colour map greys").

@@ -421,6 +421,14 @@ class LightPanel(QWidget):
                                "CO₂ fixed per absorbed PAR photon (maize: 0.04)", 0.005)
         self.co2 = number("co2_ppm", "CO₂", 0, " ppm", "ambient CO₂ (intercellular: 0.4 of it)",
                           10.0)
+        self.c4_temperature = QComboBox()
+        self.c4_temperature.addItem("Collatz et al. 1992 (the paper's)", "collatz")
+        self.c4_temperature.addItem("CLM 4.5 (maizeviz 0.2)", "clm45")
+        self.c4_temperature.setToolTip(
+            "how the C4 leaf's Rubisco capacity falls in heat and cold: the paper's own "
+            "response (Vmax 44.7 µmol/m²/s at 35 °C, 25.5 at 40 °C) or the Community Land "
+            "Model 4.5's (62.6 and 54.8), which maizeviz 0.2 used (see docs/method.md)")
+        bind(self.c4_temperature, ph, "c4_temperature", "C4 temperature response")
         self.wofost_amax = number("amax", "WOFOST AMAX", 1, " kg CO₂/ha/h",
                                   "assimilation at light saturation (maize: 70)")
         self.wofost_eff = number("eff", "WOFOST EFF", 3, " kg/ha/h per W/m²",
@@ -430,6 +438,7 @@ class LightPanel(QWidget):
         for model, widget, text in (("c4", self.c4_vmax, "Vmax (25 °C)"),
                                     ("c4", self.c4_alpha, "quantum yield α"),
                                     ("c4", self.co2, "CO₂"),
+                                    ("c4", self.c4_temperature, "temperature response"),
                                     ("wofost", self.wofost_amax, "AMAX"),
                                     ("wofost", self.wofost_eff, "EFF")):
             label = QLabel(text)
@@ -821,8 +830,10 @@ def _model_text(assimilation) -> str:
     if d.get("model") == "wofost":
         what = f"WOFOST, AMAX {d['amax']:g} kg CO₂/ha/h, EFF {d['eff']:g}"
     else:
+        form = {"collatz": "Collatz et al. 1992", "clm45": "CLM 4.5"}.get(
+            str(d.get("temperature_response", "clm45")), "CLM 4.5")
         what = (f"C4 leaf, Vmax {d['vmax']:g} µmol/m²/s, α {d['alpha']:g}, CO₂ "
-                f"{d['co2_ppm']:g} ppm")
+                f"{d['co2_ppm']:g} ppm, temperature response {form}")
     return f"{what}, leaves at {assimilation.temp_c:g} °C"
 
 
