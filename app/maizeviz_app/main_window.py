@@ -308,6 +308,7 @@ class MainWindow(QMainWindow):
             self.viewport = Viewport(self._centre)
             self.viewport.set_colour_scale(self.model.colour.view)
             self.viewport.limits_shown.connect(self.colour_panel.view_editor.show_limits)
+            self.view_link.attach(self.viewport)
             from maizeviz_app.linked import LinkedSelection
 
             self.linked = LinkedSelection(self.model, self.viewport, self.light_panel.plants,

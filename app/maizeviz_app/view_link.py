@@ -30,6 +30,13 @@ class ViewLink:
         m.view.events.colouring.connect(lambda *_: self.render_colouring())
         m.view.events.camera.connect(lambda name, *_: self._point(name))
 
+    def attach(self, viewport) -> None:
+        """The viewport made: the camera's pose goes both ways between it and the study's
+        view state."""
+        state = self.window.model.view
+        viewport.camera_moved.connect(lambda pose: setattr(state, "pose", pose))
+        state.events.pose.connect(lambda pose, *_: viewport.set_camera_pose(pose))
+
     @property
     def view(self) -> Any:
         return self.window.viewport

@@ -13,6 +13,9 @@ from psygnal import SignalGroup, evented
 
 from maizeviz_app.options import CAMERA_ALIASES, CAMERAS, COLOURINGS
 
+#: A camera's position, focal point and view up (cm).
+Pose = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
+
 
 @evented
 @dataclass
@@ -26,6 +29,10 @@ class ViewState:
         assimilation, with a leaf model)
     camera : the camera preset last asked for, a key of :data:`maizeviz_app.options.CAMERAS`
         (asking for it again frames the canopy again: :meth:`ask_camera`)
+    pose : ((3,), (3,), (3,)) float, cm, or None
+        Where the camera is: its position, the point it looks at and its up direction, as
+        the view last reported it (after a preset, a drag or a wheel turn); set by a script,
+        the view goes there. None until a view has shown a canopy.
     """
 
     if TYPE_CHECKING:                           # made by @evented
@@ -33,6 +40,7 @@ class ViewState:
 
     colouring: str = "leaf"
     camera: str = "reset"
+    pose: Pose | None = None
 
     def ask_camera(self, name: str) -> None:
         """Point the camera by preset ``name`` (earlier names understood), even when it is
