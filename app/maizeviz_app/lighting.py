@@ -66,15 +66,10 @@ def compute_light(study: StudyState) -> bool:
         return False
     if not study.affordable([_light_costs(study.built, mode, args, heights, optics)], "light"):
         return False
-    from maizeviz_app import plots
-
     canopy, label = study.canopy, study.built.label
     signature = study.signature(label)
     sampling_key = study.settings.sampling_key(heights)
-    runs = study.runs.copy()
     key, runner = study.canopy_key, study.runner
-    first = max(study.figures.shown_index, 0)
-    look = plots.Look.of(study.colour, study.figures.shown_for)
 
     def work(job):
         out = runner.light_process.call(op, key, canopy, args, job)
@@ -92,11 +87,7 @@ def compute_light(study: StudyState) -> bool:
                       painting=painting)
         else:
             run = Run(label, signature, out.light, None, mode, out)
-        maps = plots.heatmap_images(run.result, first=first, check=job.check, kind=mode,
-                                    look=look.sharing(mode, run.result))
-        runs.add(run, compared, sampling_key)
-        plot = plots.rgba(plots.transmission_figure(runs.curves(), plot_title(runs)))
-        return run, compared, sampling_key, maps, plot
+        return run, compared, sampling_key
 
     study.light_running.emit(f"{RUNNING_TEXT[mode]} on {label}…")
     study.runner.run("light", f"{mode} light on {label}", work,
@@ -127,9 +118,10 @@ def _light_failed(study: StudyState, exc: BaseException, mode: str = "sun") -> N
     study.fail(exc, "light", mode)
 
 def _lit(study: StudyState, out) -> None:
-    """A light result: table, summary, plants, figures and colours change together;
-    nothing shown is dropped unless a new comparison starts."""
-    run, compared, sampling_key, maps, plot = out
+    """A light result: table, summary, plants and colours change together, then its figures
+    (when drawn, :attr:`StudyState.draw_figures`); nothing shown is dropped unless a new
+    comparison starts."""
+    run, compared, sampling_key = out
     study.light_running.emit("")
     if run.signature[0] != study.serial:
         return
@@ -148,10 +140,6 @@ def _lit(study: StudyState, out) -> None:
         study.set_plants_run(None)
     f = study.figures
     f.keep_only({k for k in f.shown_for if study.runs.of_kind(k) is not None} | {run.kind})
-    f.set_maps(run.kind, run, maps)
-    if study.colour.shared:                     # the others' scale includes this run
-        f.restyle(keep=run.kind)
-    f.set_plot(plot)
     for w in run_warnings(run):
         study.say(f"{'note' if 'sun never rises' in w else 'warning'}: {w}")
     if study.shown_signature == run.signature:
@@ -163,7 +151,41 @@ def _lit(study: StudyState, out) -> None:
         study.say(f"{run.name}: transmission "
                  + ", ".join(f"{t:.3f}" for t in run.transmission) + " at "
                  + ", ".join(f"{h:g}" for h in r.heights_cm) + " cm", status_only=True)
-    study.light_shown.emit()
+    if study.draw_figures:
+        draw_figures(study, run)                # light_shown once they are drawn
+    else:
+        study.light_shown.emit()
+
+
+def draw_figures(study: StudyState, run: Run) -> None:
+    """The figures of a new light result, drawn in a job of their own (matplotlib, 0.3-1 s a
+    figure): its heatmap at the height shown (the others when asked for,
+    :func:`draw_heatmap`) and the transmission plot of every result compared; then
+    ``light_shown``. Only where they are shown (:attr:`StudyState.draw_figures`)."""
+    from maizeviz_app import plots
+
+    f = study.figures
+    first = max(f.shown_index, 0)
+    look = plots.Look.of(study.colour, f.shown_for).sharing(run.kind, run.result)
+    curves, title = study.runs.curves(), plot_title(study.runs)
+
+    def work(job):
+        maps = plots.heatmap_images(run.result, first=first, check=job.check, kind=run.kind,
+                                    look=look)
+        return maps, plots.rgba(plots.transmission_figure(curves, title))
+
+    def done(out) -> None:
+        maps, plot = out
+        if study.runs.of_kind(run.kind) is run:         # else: a newer result has its own
+            f.set_maps(run.kind, run, maps)
+            if study.colour.shared:             # the others' scale includes this run
+                f.restyle(keep=run.kind)
+            f.set_plot(plot)
+        study.light_shown.emit()
+
+    study.runner.run("figures", "drawing the light figures", work, on_done=done,
+                     on_error=lambda e: study.fail(e, "light"))
+
 
 def draw_heatmap(study: StudyState, kind: str, index: int) -> None:
     """The heatmap of another height of a result shown, drawn in a job."""
@@ -261,7 +283,7 @@ def adopt_pending_runs(study: StudyState) -> None:
     shown are computed against it, the others' when their level is shown)."""
     if not study.pending_runs or study.built is None:
         return
-    from maizeviz_app import jobs, plots
+    from maizeviz_app import jobs
 
     pending, study.pending_runs = study.pending_runs, []
     absorbed = {s.label: s for s in pending if s.kind == "absorbed"}
@@ -302,6 +324,19 @@ def adopt_pending_runs(study: StudyState) -> None:
     curves = study.runs.curves()
     title = plot_title(study.runs)
     study.figures.shown_for = dict(shown)
+    study.view_light.emit(True)
+    if study.draw_figures:
+        _draw_project_figures(study, shown, order, curves, title)
+    elif study.runner.current("complete") is None:
+        study.light_shown.emit()
+
+
+def _draw_project_figures(study: StudyState, shown: dict, order: list, curves, title: str
+                          ) -> None:
+    """The heatmaps of a project's results shown (``shown``: light -> run, drawn in
+    ``order``) and the transmission plot, in a job; then ``light_shown``."""
+    from maizeviz_app import plots
+
     results = [(k, shown[k].result) for k in order]
     look = plots.Look.of(study.colour, shown)
 
@@ -320,8 +355,8 @@ def adopt_pending_runs(study: StudyState) -> None:
             study.light_shown.emit()
 
     study.runner.run("figures", "drawing the light figures", work, on_done=done,
-                    on_error=lambda e: study.fail(e, "light"))
-    study.view_light.emit(True)
+                     on_error=lambda e: study.fail(e, "light"))
+
 
 def light_per_plant_run(study: StudyState) -> Run | None:
     """The latest result with light per plant to show (:meth:`LightRuns.with_plants`)."""

@@ -94,6 +94,7 @@ class MainWindow(QMainWindow):
         self._settings = QSettings("maizeviz", "maizeviz")
         self.runner = JobRunner(self)
         self.model = StudyModel(tile, self.runner)
+        self.model.draw_figures = True    # the window shows them (a script draws none)
         self.undo = UndoRecorder(self.model, self)
         self.viewport: Viewport | None = None
         self.view_link = ViewLink(self)
@@ -307,6 +308,7 @@ class MainWindow(QMainWindow):
             self.viewport = Viewport(self._centre)
             self.viewport.set_colour_scale(self.model.colour.view)
             self.viewport.limits_shown.connect(self.colour_panel.view_editor.show_limits)
+            self.view_link.attach(self.viewport)
             from maizeviz_app.linked import LinkedSelection
 
             self.linked = LinkedSelection(self.model, self.viewport, self.light_panel.plants,
@@ -321,6 +323,21 @@ class MainWindow(QMainWindow):
 
             gc.freeze()       # start-up objects out of the collector's way: shorter pauses
 
+    def _restore_connection(self) -> None:
+        """The digitizer's port and baud of the last connection (QSettings) into the study's
+        settings; a stored value the settings refuse leaves the default."""
+        from maizeviz_app.settings import InputProblem
+
+        for name in ("port", "baud"):
+            stored = self._settings.value(name)
+            if stored is None:
+                continue
+            try:
+                value = int(str(stored)) if name == "baud" else str(stored)
+                self.model.apply_settings("digitizer", {name: value})
+            except (InputProblem, ValueError):
+                pass                             # the default stays
+
     def _make_late_panels(self) -> None:
         from maizeviz_app.panels.digitizer import DigitizerPanel
         from maizeviz_app.panels.layout import LayoutPanel
@@ -331,12 +348,14 @@ class MainWindow(QMainWindow):
         self.digitizer.alert.connect(lambda text: self.say(text, error=True, status_only=True))
         self.digitizer.stopped.connect(self.view_link.digitizing_stopped)
         self.digitizer.started.connect(self.view_link.digitizing_started)
-        # the study's digitizer settings start as the panel remembered them, then follow it
+        # the study's digitizer settings are the connection last used (the window keeps it);
+        # the panel's port and baud show them and set them
         d, settings = self.digitizer, self.model.settings.digitizer
-        with self.model.quietly():
-            self.model.settings.set("digitizer", {"port": d.port, "baud": d.baud.value()})
+        self._restore_connection()
         bind(d.baud, settings, "baud")
         bind_text(d.ports.box, settings, "port")
+        d.ports.baud = settings.baud            # what Find FASTRAK probes at, as the box
+        settings.events.baud.connect(lambda baud, *_: setattr(d.ports, "baud", baud))
         self.docks["layout"].setWidget(docks.scrolled(self.layout_panel))
         self.docks["digitizer"].setWidget(docks.scrolled(self.digitizer))
         name_controls(self)

@@ -44,6 +44,25 @@ def _errors(model) -> list[str]:
     return [t for t in model.said_lines if t.startswith("error")]
 
 
+def test_a_script_draws_no_figure(points):
+    """compute_light in a script draws no heatmap or plot: matplotlib is not even imported
+    (the window sets draw_figures, since it shows them)."""
+    code = ("import sys\n"
+            "from maizeviz_app.model import StudyModel\n"
+            "from maizeviz_app.runner import InlineRunner\n"
+            "if __name__ == '__main__':\n"
+            "    r = InlineRunner(); m = StudyModel(tile=1, runner=r)\n"
+            f"    m.open_points({str(points)!r})\n"
+            "    m.settings.sampling.heights = '0, 100'\n"
+            "    ok = m.compute_light() and m.runs.of_kind('sun') is not None\n"
+            "    r.shutdown()\n"
+            "    bad = sorted(n for n in sys.modules if n.split('.')[0] == 'matplotlib')\n"
+            "    print(ok, bad[:3]); sys.exit(0 if ok and not bad else 1)\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr[-3000:]
+
+
 def test_the_model_and_its_actions_run_without_qt():
     code = ("import sys, maizeviz_app.model, maizeviz_app.runner, maizeviz_app.settings; "
             "m = maizeviz_app.model.StudyModel(runner=maizeviz_app.runner.InlineRunner()); "
@@ -82,7 +101,15 @@ def test_a_whole_study_through_the_model(study, points, tmp_path):
                                     sampling=s.sampling_spec())
     np.testing.assert_array_equal(run.transmission, own.transmission)
     assert run.classes is not None and len(run.classes) == m.canopy.n_triangles
-    assert m.modified and m.figures.plot is not None and len(m.figures.maps["sun"]) == 3
+    assert m.modified and m.figures.plot is None and not m.figures.maps   # none drawn
+    m.draw_figures = True                                      # as the window draws them
+    shown = []
+    m.light_shown.connect(lambda: shown.append(m.figures.plot))
+    assert m.compute_light() and not _errors(m)
+    assert shown and shown[-1] is not None and len(m.figures.maps["sun"]) == 3
+    assert m.figures.maps["sun"][0][1] is not None             # the height shown drawn
+    np.testing.assert_array_equal(m.runs.of_kind("sun").transmission, run.transmission)
+    run = m.runs.of_kind("sun")
     # ---- a day: PAR transmitted between 0 and 1, never less light higher up
     s.light.mode = "day"
     s.day.step_min, s.day.start, s.day.end = 120.0, "10:00", "14:00"
@@ -248,12 +275,22 @@ def test_a_whole_study_with_c4_edits_and_named_undo_steps(study, points, tmp_pat
     assert m.compute_light() and not _errors(m)
     first = _numbers(m.runs.of_kind("sun"))
     assert first["canopy"] > 0 and len(first["plants"]) == len(m.loaded.layout.placements)
+    # ---- the view's state: coloured by the new light, then by its CO2 when asked
+    assert m.view.colouring == "light"
+    assert m.colour_view_by("assimilation") and m.view.colouring == "assimilation"
+    cameras = []
+    m.view.events.camera.connect(lambda name, *_: cameras.append(name))
+    m.view.ask_camera("top")
+    m.view.ask_camera("top")                                  # asked again: framed again
+    assert cameras == ["top", "top"] and m.view.camera == "top"
     assert sum(p[2] for p in first["plants"]) > 0
     # ---- the layout edited as the panel edits it: the model applies it and rebuilds
     placements = m.loaded.layout.placements
     with m.history.step("turn the first plant"):
         assert m.draft.turn(0, 90.0)
     assert m.loaded.layout.placements[0].azimuth_deg == 90.0 and not m.runs.runs
+    assert m.view.colouring == "leaf"                         # no light on this canopy
+    assert not m.colour_view_by("light") and "no light result" in m.said_lines[-1]
     assert m.built.serial == m.serial and m.canopy.layout.placements[0].azimuth_deg == 90.0
     # ---- undo the edit and the level, by their names; redo them
     assert m.history.undo_text == "turn the first plant"
