@@ -178,7 +178,7 @@ class MainWindow(QMainWindow):
         self._wire_figures()
         from maizeviz_app.panels.colour import ColourPanel
 
-        self.colour_panel = ColourPanel(m.colour)
+        self.colour_panel = ColourPanel(m.colour, step=m.history.step)
         self.plots.heatmap.limits_shown.connect(self.colour_panel.heatmap_editor.show_limits)
         self.messages = docks.messages_widget()
         self.history = QUndoView(self.undo.stack)
