@@ -16,7 +16,7 @@ import sys
 import numpy as np
 import pytest
 
-from maizeviz.digitizer.technician import Technician
+from maizeviz.digitizer.technician import Technician, plan
 from maizeviz.io.points import read_points
 
 TIMEOUT = 120_000
@@ -66,3 +66,32 @@ def test_every_press_is_on_disk_in_order_under_cpu_load(window, two_plants, qtbo
     assert panel.press_beeps == PRESSES and panel.press_count.text() == f"{PRESSES} points"
     assert panel.digitizing.count.refused == 0 and panel.digitizing.warnings == []
     assert panel.beeps == 0
+
+
+def test_the_demo_loses_no_press_under_cpu_load(window, two_plants, qtbot, tmp_path, burners):
+    """The Demo's simulated FASTRAK lives in the window's process (its replay presses from a
+    thread there): 75 presses over 3 leaves, all on disk at their place."""
+    from maizeviz.io.points import write_points
+    from maizeviz.leaf.grid import LeafGrid
+
+    ids, xyz = plan(75)
+    src = tmp_path / "demo_plan.csv"           # (ids, xyz: the technician's plan)
+    write_points(src, [LeafGrid(int(ids[k, 0]), int(ids[k, 1]), xyz[k:k + 25].reshape(5, 5, 3)) for k in range(0, 75, 25)])
+    assert len(read_points(src)) == 75
+    w = window(two_plants, tile=1)
+    panel = w.digitizer
+    panel.confirm_close = False
+    panel.demo_file, panel.demo_pace = src, 0.35
+    panel.cols.setValue(5)
+    out = tmp_path / "demo.csv"
+    panel.out_edit.setText(str(out))
+    with qtbot.waitSignal(panel.stopped, timeout=TIMEOUT + 75 * 2_000) as stopped:
+        panel.demo_button.click()
+    assert stopped.args == ["finished"]
+    pts = read_points(out)
+    assert len(pts) == 75, f"{75 - len(pts)} presses lost"
+    np.testing.assert_array_equal(pts.ids, ids)
+    # the Demo's unit adds its 0.08 cm RMS noise per axis: 6 sigma, which 225 draws exceed
+    # with a probability of 4e-7
+    np.testing.assert_allclose(pts.xyz, xyz, atol=6 * 0.08)
+    assert panel.press_beeps == 75
