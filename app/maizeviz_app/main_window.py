@@ -344,7 +344,7 @@ class MainWindow(QMainWindow):
 
         self.layout_panel = LayoutPanel(self.model, self.undo.stack)
         self.layout_panel.problem.connect(self.say)
-        self.digitizer = DigitizerPanel(self.viewport)
+        self.digitizer = DigitizerPanel(self.viewport, session=self.model.digitizing)
         self.digitizer.alert.connect(lambda text: self.say(text, error=True, status_only=True))
         self.digitizer.stopped.connect(self.view_link.digitizing_stopped)
         self.digitizer.started.connect(self.view_link.digitizing_started)
