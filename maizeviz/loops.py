@@ -32,7 +32,6 @@ from __future__ import annotations
 import ctypes
 import functools
 import hashlib
-import os
 import threading
 import warnings
 from pathlib import Path
@@ -53,7 +52,9 @@ def why() -> str:
 
 @functools.cache
 def _loaded() -> tuple[ctypes.CDLL | None, str]:
-    if os.environ.get("MAIZEVIZ_LOOPS", "1") == "0":
+    from maizeviz.environment import switch
+
+    if not switch("MAIZEVIZ_LOOPS"):
         return None, "turned off by MAIZEVIZ_LOOPS=0"
     try:
         from maizeviz import _loops as ext
