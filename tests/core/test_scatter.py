@@ -8,11 +8,13 @@ import math
 
 import numpy as np
 import pytest
+from scipy import stats
 
 from maizeviz.canopy.layout import layout_from_dict
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.light.engine import LightEngine
+from maizeviz.light.results.uncertainty import BATCHES
 from maizeviz.light.trace.optics import DEFAULT_OPTICS, Optics, optics_for
 
 
@@ -284,6 +286,13 @@ def test_per_plant_tables_add_up_to_the_balance(homogeneous):
 
 
 # ----------------------------------------------------------------------------- the sky per ray
+#: Standard error (W/m2) of the leaves' absorbed light, the sky drawn per ray against every
+#: direction traced (hypot of the two), 100 W/m2 of uniform-overcast diffuse, 46 directions,
+#: 2 rays/cm2 on :func:`homogeneous`: the root mean square of the batches' errors over seeds
+#: 101-120 (per ray 0.168 and 0.098, every direction 0.060 and 0.029).
+SKY_PER_RAY_SIGMA = {"par": 0.178, "nir": 0.103}
+
+
 @pytest.mark.parametrize("band", ["par", "nir"])
 def test_a_sky_drawn_per_ray_gives_the_directions_answers_within_their_errors(homogeneous,
                                                                                band):
@@ -296,9 +305,18 @@ def test_a_sky_drawn_per_ray_gives_the_directions_answers_within_their_errors(ho
     per_ray = eng.absorbed(**kw, seed=1)
     every = eng.absorbed(**kw, seed=2, sky_passes=0)
     assert per_ray.directions == every.directions == 46
+    # Thresholds from the estimators' own errors, not from one CPU's draws (the CPU changes
+    # which draws are made: Embree's kernels round a hit's distance differently): sigma, the
+    # true standard error of the difference, measured as the root mean square of the batches'
+    # standard errors over seeds 101-120 (each 7 degrees of freedom: 280 in all, sigma within
+    # 6 % at one standard deviation; taken 18 % up, three of them). The difference is normal:
+    # within z(1e-6) sigma. The reported error (8 batches each) is sigma sqrt(chi2_7 / 7) at
+    # worst: within sqrt(chi2_7(1e-6) / 7) = 2.41 sigma.
+    sigma = 1.18 * SKY_PER_RAY_SIGMA[band]
     se = math.hypot(per_ray.absorbed_leaves_error, every.absorbed_leaves_error)
-    assert abs(per_ray.balance.absorbed_leaves - every.balance.absorbed_leaves) < 4 * se
-    assert se < 0.005 * every.balance.absorbed_leaves
+    gap = abs(per_ray.balance.absorbed_leaves - every.balance.absorbed_leaves)
+    assert gap < stats.norm.isf(0.5e-6) * sigma
+    assert se < math.sqrt(stats.chi2.isf(1e-6, BATCHES - 1) / (BATCHES - 1)) * sigma
     assert abs(per_ray.balance.closure) < 5 / math.sqrt(4 * per_ray.rays)
     # per plant too (one plant here), and the events are a fraction of the directions'
     assert per_ray.events < every.events / 4
