@@ -4,6 +4,7 @@ header, line and cells, the options as typed."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -290,3 +291,108 @@ def test_a_projects_per_triangle_array_of_another_length_is_refused_at_read(
             f"canopy) or {n + stalks:,}")
     assert said in msg and "\n" not in msg, msg
     assert "first_hits" in msg if name == "first_hits" else name in msg
+
+
+# ------------------------------------------------------------------------------ extra columns
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+#: Text a cell may hold: any character but NUL (a zero byte marks a binary file) and the
+#: surrogates (no UTF-8 for them).
+CELL = st.text(st.characters(exclude_categories=("Cs",), exclude_characters="\x00"),
+               max_size=12)
+
+
+def _points_rows(n: int):
+    """n points of one 2 x ceil(n/2) leaf grid: (plant, leaf, row, col, x, y, z)."""
+    return [(1, 1, k % 2, k // 2, 0.5 * k, 1.0 + k, 10.0 + k) for k in range(n)]
+
+
+@settings(max_examples=60, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture,
+                                 HealthCheck.too_slow])
+@given(texts=st.lists(st.tuples(CELL, CELL), min_size=4, max_size=8))
+def test_extra_columns_survive_convert_both_ways_exactly(tmp_path, texts):
+    """Blanks, tabs, newlines, quotes, commas: the CSV reader stripped blanks and tabs, the
+    Parquet path wrote a newline as the two characters \\n (convert and back: 384 records
+    of 7,650 changed)."""
+    import csv
+
+    from maizeviz.io.points import read_points
+
+    src = tmp_path / "p.csv"
+    with open(src, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(["plant", "leaf", "row", "col", "x", "y", "z", "Note", "operator"])
+        for row, (a, b) in zip(_points_rows(len(texts)), texts):
+            w.writerow([*row, a, b])
+    want = {"Note": [a for a, _ in texts], "operator": [b for _, b in texts]}
+    assert read_points(src).extra == want
+    pq_path, back = tmp_path / "o.parquet", tmp_path / "back.csv"
+    for out, source in ((pq_path, src), (back, pq_path)):
+        if out.exists():
+            out.unlink()
+        assert main(["convert", str(source), "--out", str(out)]) == EXIT_OK
+        assert read_points(out).extra == want, out.name
+
+
+def _parquet(tmp_path, name: str, columns: dict) -> Path:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    out = tmp_path / name
+    pq.write_table(pa.table(columns), out)
+    return out
+
+
+def _plain_columns(n: int = 8) -> dict:
+    rows = _points_rows(n)
+    return {name: [r[k] for r in rows] for k, name in
+            enumerate(("plant", "leaf", "row", "col", "x", "y", "z"))}
+
+
+@pytest.mark.parametrize("how", ["x as list", "nested extra with a NaN x", "struct extra"])
+def test_a_parquet_column_of_lists_or_structs_is_one_line(tmp_path, capsys, how):
+    """It ended in ArrowNotImplementedError (the table cast to text)."""
+    cols = _plain_columns()
+    if how == "x as list":
+        cols["x"] = [[v] for v in cols["x"]]
+    elif how == "nested extra with a NaN x":
+        cols["x"][3] = math.nan
+        cols["tags"] = [[1.0, 2.0]] * len(cols["x"])
+    else:
+        cols["who"] = [{"name": "a", "n": k} for k in range(len(cols["x"]))]
+    path = _parquet(tmp_path, "nested.parquet", cols)
+    code = main(["leaf", str(path)])
+    err = capsys.readouterr().err
+    assert code == EXIT_FAIL and "Traceback" not in err and "internal error" not in err, err
+    last = err.strip().splitlines()[-1]
+    assert last.startswith("error:") and "not numbers or text" in last, err
+
+
+@pytest.mark.parametrize("how", ["nan x", "null plant", "text cell", "status column",
+                                 "interleaved plants"])
+def test_subplots_on_a_parquet_file_needing_the_csv_checks_is_one_line(tmp_path, capsys, how):
+    """It ended in NotStreamable (an internal error) where light reads the file."""
+    lines = Path(B).read_text().splitlines()
+    rows = [ln.split(",") for ln in lines[1:] if ln[:1].isdigit()]
+    cols = {name: [float(r[k]) if k >= 4 else int(r[k]) for r in rows] for k, name in
+            enumerate(("plant", "leaf", "row", "col", "x", "y", "z"))}
+    if how == "nan x":
+        cols["x"][5] = math.nan
+    elif how == "null plant":
+        cols["plant"] = [None if k == 5 else v for k, v in enumerate(cols["plant"])]
+    elif how == "text cell":
+        cols["y"] = [str(v) for v in cols["y"]]
+    elif how == "status column":
+        cols["status"] = ["ok"] * len(cols["x"])
+    else:
+        order = sorted(range(len(cols["x"])), key=lambda k: (k % 2, k))
+        cols = {n: [v[k] for k in order] for n, v in cols.items()}
+    path = _parquet(tmp_path, "f.parquet", cols)
+    code = main(["subplots", str(path), "--parts", "1x1", "--level", "16", "--sun-zenith",
+                 "30", "--sun-azimuth", "180", "--workers", "1"])
+    err = capsys.readouterr().err
+    assert code == EXIT_FAIL and "internal error" not in err, err
+    last = err.strip().splitlines()[-1]
+    assert last.startswith("error:") and str(path) in last and "'maizeviz light'" in last, err
