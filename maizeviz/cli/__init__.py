@@ -32,7 +32,8 @@ COMMANDS = {"leaf": "maizeviz.cli.leaf", "canopy": "maizeviz.cli.canopy",
             "light": "maizeviz.cli.light", "sweep": "maizeviz.sweep.command",
             "record": "maizeviz.cli.record", "fastrak-sim": "maizeviz.cli.simulate",
             "synth": "maizeviz.cli.synth", "import-phenomenal": "maizeviz.cli.phenomenal",
-            "convert": "maizeviz.cli.convert", "subplots": "maizeviz.cli.subplots"}
+            "convert": "maizeviz.cli.convert", "subplots": "maizeviz.cli.subplots",
+            "instrument": "maizeviz.cli.instrument"}
 #: Entry-point group under which the desktop app registers its ``run(argv) -> int``.
 GUI_GROUP = "maizeviz.gui"
 GUI_HINT = 'the desktop app is not installed: pip install "maizeviz[gui]"'

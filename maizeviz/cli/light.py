@@ -75,6 +75,7 @@ from maizeviz.light.trace.optics import BANDS, optics_for, read_optics_table
 from maizeviz.light.trace.precision import check_precision, trace_until
 from maizeviz.light.trace.scatter import DEFAULT_DEPTH
 from maizeviz.mesh.levels import CANOPY_LEVELS
+from maizeviz.photosynthesis.c4 import TEMPERATURE_RESPONSES
 from maizeviz.photosynthesis.split import MODELS, LeafModel, leaf_model
 
 #: The subcommand.
@@ -192,6 +193,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ph.add_argument("--photosynthesis", choices=MODELS, default=None,
                     help="leaf model: c4 (Collatz et al. 1992, maize) or wofost (negative "
                          "exponential)")
+    ph.add_argument("--c4-temperature", choices=tuple(TEMPERATURE_RESPONSES), default=None,
+                    help="c4: how Vmax falls in heat and cold: collatz (the paper's own, "
+                         "Vmax 44.7 at 35 C; default) or clm45 (CLM 4.5's, 62.6 at 35 C; "
+                         "what maizeviz 0.2 computed)")
     ph.add_argument("--amax", type=NUMBER_ARG, default=None, metavar="KG_HA_H",
                     help="wofost: gross assimilation at light saturation, kg CO2/ha leaf/h "
                          "(default 70)")
@@ -201,8 +206,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ph.add_argument("--vmax", type=NUMBER_ARG, default=None, metavar="UMOL_M2_S",
                     help="c4: Rubisco capacity at 25 C, umol/m2/s (default 39)")
     ph.add_argument("--alpha", type=NUMBER_ARG, default=None, metavar="MOL_MOL",
-                    help="c4: quantum yield, mol CO2 per mol of absorbed photons "
-                         "(default 0.04)")
+                    help="c4: quantum yield, mol CO2 per mol of PAR photons the leaf "
+                         "absorbs (default 0.04; a model that applies it to incident "
+                         "photons, as BioCro does, is alpha / absorptance here)")
     ph.add_argument("--co2", type=NUMBER_ARG, default=None, metavar="PPM",
                     help="c4: ambient CO2, umol/mol (default 400; intercellular 0.4 of it)")
     ph.add_argument("--temperature", type=NUMBER_ARG, default=None, metavar="C",
@@ -222,17 +228,20 @@ def _absorbed_asked(args: argparse.Namespace) -> bool:
 def _leaf_model_from(args: argparse.Namespace) -> LeafModel | None:
     """The leaf model ``--photosynthesis`` names, with its flags; refuses another model's
     flags and photosynthesis from NIR."""
-    own = {"c4": ("vmax", "alpha", "co2"), "wofost": ("amax", "eff")}
-    given = [k for k in ("vmax", "alpha", "co2", "amax", "eff", "temperature")
+    own = {"c4": ("vmax", "alpha", "co2", "c4_temperature"), "wofost": ("amax", "eff")}
+    given = [k for k in ("vmax", "alpha", "co2", "c4_temperature", "amax", "eff",
+                         "temperature")
              if getattr(args, k) is not None]
     if args.photosynthesis is None:
         if given:
-            raise MaizevizError(f"--{given[0]} is a parameter of leaf photosynthesis: add "
+            raise MaizevizError(f"--{given[0].replace('_', '-')} is a parameter of leaf "
+                                "photosynthesis: add "
                                 "--photosynthesis c4 or wofost", quantity="photosynthesis")
         return None
     other = [k for k in given if k != "temperature" and k not in own[args.photosynthesis]]
     if other:
-        raise MaizevizError(f"--{other[0]} is not a parameter of the {args.photosynthesis} "
+        raise MaizevizError(f"--{other[0].replace('_', '-')} is not a parameter of the "
+                            f"{args.photosynthesis} "
                             "model", quantity="photosynthesis")
     if args.band == "nir":
         raise MaizevizError("photosynthesis works from absorbed PAR: give no --band nir",
@@ -240,7 +249,8 @@ def _leaf_model_from(args: argparse.Namespace) -> LeafModel | None:
     if args.temperature is not None:
         check_range(args.temperature, "the air temperature (C)", -50, 70, "temperature")
     return leaf_model(args.photosynthesis, vmax=args.vmax, alpha=args.alpha,
-                      co2_ppm=args.co2, amax=args.amax, eff=args.eff)
+                      co2_ppm=args.co2, temperature_response=args.c4_temperature,
+                      amax=args.amax, eff=args.eff)
 
 
 # ------------------------------------------------------------------------------ what is asked
@@ -1114,7 +1124,7 @@ def _print_photosynthesis(records: list[dict]) -> None:
     period = "canopy_gross_mol_m2" in ph
     params = ", ".join(f"{k} {v:g}" for k, v in ph["parameters"].items()
                        if k in ("vmax", "alpha", "co2_ppm", "amax", "eff"))
-    print(f"\ngross CO2 assimilation, {ph['model']} leaf model ({params}), per m2 of ground"
+    print(f"\ngross CO2 assimilation, {ph['label']} ({params}), per m2 of ground"
           + ("" if period else f", leaves at {ph['temperature_c']:g} C") + ":")
     rows = []
     for r in records:

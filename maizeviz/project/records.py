@@ -50,7 +50,7 @@ _PERIOD_ARRAYS = ("step_s", "zenith_deg", "azimuth_deg", "ghi", "dni", "dhi",
                   "direct_horizontal")
 #: Arrays a Period may have (a weather file's measured PAR, air temperature; NaN allowed in
 #: the temperature), stored when present.
-_PERIOD_OPTIONAL = {"par_measured": False, "temp_air": True}
+_PERIOD_OPTIONAL = {"par_measured": False, "temp_air": True, "par_diffuse_share": False}
 #: Prefix of the arrays of a day's sky light.
 _DIFFUSE = "diffuse_"
 #: Prefix of the arrays of a day's diffuse split by Perez's model.
