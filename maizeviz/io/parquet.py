@@ -136,7 +136,7 @@ def read_parquet_table(path: str | Path, max_points: int = MAX_POINTS,
             raise PointsFileError(f"{source}: header only, no points")
         return PointsTable(ids=ids, xyz=xyz, line=np.arange(2, len(ids) + 2, dtype=np.int64),
                            extra=extra, source=source)
-    return _as_csv(table, pa)
+    return _as_csv(table, pa, source)
 
 
 def _cell(v) -> str:
@@ -224,7 +224,7 @@ def _plain(table, pa) -> tuple[np.ndarray, np.ndarray] | None:
     return ids, xyz
 
 
-def _as_csv(table, pa) -> str:
+def _as_csv(table, pa, source: str) -> str:
     """The table as CSV text, every column as text."""
     import pyarrow.csv as pacsv
 

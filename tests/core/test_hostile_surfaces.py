@@ -396,3 +396,79 @@ def test_subplots_on_a_parquet_file_needing_the_csv_checks_is_one_line(tmp_path,
     assert code == EXIT_FAIL and "internal error" not in err, err
     last = err.strip().splitlines()[-1]
     assert last.startswith("error:") and str(path) in last and "'maizeviz light'" in last, err
+
+
+# ------------------------------------------------------------------------------ the class
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _variables_read() -> dict[str, list[str]]:
+    """Every MAIZEVIZ_* name in the package's and the app's code (comments and docstrings
+    too: a name documented is a name someone sets), with the files naming it."""
+    import re
+
+    found: dict[str, list[str]] = {}
+    for folder in ("maizeviz", "app", "scripts"):
+        for path in sorted((ROOT / folder).rglob("*")):
+            if path.suffix not in (".py", ".sh", ".c") or ".venv" in path.parts:
+                continue
+            for name in set(re.findall(r"\bMAIZEVIZ_[A-Z][A-Z0-9_]*", path.read_text(
+                    encoding="utf-8", errors="replace"))):
+                found.setdefault(name, []).append(str(path.relative_to(ROOT)))
+    return found
+
+
+def test_every_environment_variable_read_has_a_checked_parser():
+    """The class behind MAIZEVIZ_FIELD_POINTS=abc's traceback: every variable is in
+    maizeviz.environment, read through its readers, and nothing else reads one."""
+    import re
+
+    from maizeviz import environment
+    from maizeviz.mesh.embree_isa import ISAS
+
+    found = _variables_read()
+    assert set(found) <= set(environment.VARIABLES), \
+        f"read without a parser in maizeviz/environment.py: {set(found) - set(environment.VARIABLES)}"
+    assert set(environment.VARIABLES) <= set(found) - {"MAIZEVIZ_"}
+    # nothing reads one around the module: no os.environ / getenv of a MAIZEVIZ_ name
+    direct = re.compile(r"(environ\.get|environ\[|getenv)\(?\s*[\"']MAIZEVIZ_")
+    for folder in ("maizeviz", "app"):
+        for path in (ROOT / folder).rglob("*.py"):
+            if path.name == "environment.py":
+                continue
+            text = path.read_text(encoding="utf-8")
+            assert not direct.search(text), f"{path} reads a MAIZEVIZ_ variable itself"
+    assert set(environment.VARIABLES["MAIZEVIZ_EMBREE_ISA"].words.values()) == set(ISAS)
+    assert set(environment.READERS) == {v.kind for v in environment.VARIABLES.values()}
+
+
+@settings(max_examples=80, deadline=None)
+@given(name=st.sampled_from(sorted(__import__("maizeviz.environment").environment.VARIABLES)),
+       value=st.text(st.characters(exclude_categories=("Cs",), exclude_characters="\x00"),
+                     max_size=10))
+def test_any_value_of_any_variable_is_its_value_or_one_line(name, value):
+    import os
+
+    from maizeviz import environment
+
+    var = environment.VARIABLES[name]
+    old = os.environ.get(name)
+    os.environ[name] = value
+    try:
+        got = environment.READERS[var.kind](name)
+    except environment.EnvironmentVariableError as exc:
+        msg = str(exc)
+        assert msg.startswith(f"{name}=") and "\n" not in msg and exc.quantity == name
+    else:
+        if var.kind == "whole":
+            assert isinstance(got, int) and got >= var.low
+            assert not var.choices or got in var.choices
+        elif var.kind == "switch":
+            assert isinstance(got, bool)
+        else:
+            assert got is None or got in var.words.values()
+    finally:
+        if old is None:
+            os.environ.pop(name, None)
+        else:
+            os.environ[name] = old
