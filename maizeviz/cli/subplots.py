@@ -41,7 +41,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--density", type=NUMBER_ARG, default=1.0,
                    help="rays per cm2 of the sample rectangle (default 1)")
     p.add_argument("--rect", metavar="X0,Y0,X1,Y1", help="sample rectangle, cm (default: the "
-                                                           "field)")
+                                                           "central tile, as light's)")
     p.add_argument("--plant-light", metavar="CSV", help="write the light of every plant")
     p.add_argument("--workers", type=WHOLE_ARG, metavar="N",
                    help="worker processes of a local Dask cluster (default: one per core)")

@@ -472,3 +472,67 @@ def test_any_value_of_any_variable_is_its_value_or_one_line(name, value):
             os.environ.pop(name, None)
         else:
             os.environ[name] = old
+
+
+# ------------------------------------------------------------------------------ smaller
+def test_info_lists_the_declared_dependencies_as_declared():
+    """--info omitted plyfile and listed pyarrow (required) as optional."""
+    import re
+    import tomllib
+
+    from maizeviz.info import OPTIONAL, REQUIRED
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+
+    def names(reqs):
+        out = []
+        for r in reqs:
+            name, extras = re.match(r"\s*([A-Za-z0-9._-]+)(\[[^\]]*\])?", r).groups()
+            out.append(name)
+            if extras:                                  # dask[distributed]: distributed too
+                out += [e.strip() for e in extras[1:-1].split(",")]
+        return out
+
+    required = names(project["dependencies"])
+    extras = project["optional-dependencies"]
+    optional = [n for n in names(extras["gui"] + extras["sweep"]) if n not in required]
+    assert len(set(REQUIRED)) == len(REQUIRED) and set(REQUIRED) == set(required)
+    assert len(set(OPTIONAL)) == len(OPTIONAL) and set(OPTIONAL) == set(optional)
+    info = _headless("--info")
+    assert "plyfile" in info.stdout, info.stdout
+
+
+def test_subplots_help_says_rect_defaults_to_the_central_tile():
+    """It said 'the field'; the code and docs/cli.md take the central tile."""
+    import contextlib
+    import io
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), pytest.raises(SystemExit):
+        main(["subplots", "--help"])
+    text = " ".join(out.getvalue().split())
+    assert "(default: the central tile" in text and "(default: the field)" not in text
+
+
+def test_a_precision_beyond_reach_says_the_target_in_enough_digits(capsys):
+    """--precision 1e-6 stopped at 1,024 rays/cm2 with '0.00% asked for'."""
+    code = main(["light", B, "--triangles", "4", "--heights", "0", "--sun-zenith", "30",
+                 "--sun-azimuth", "180", "--precision", "1e-6", "--rect", "60,30,70,40"])
+    err = capsys.readouterr().err
+    assert code == EXIT_OK, err
+    assert "above the 0.0001% asked for" in err and "0.00%" not in err, err
+
+
+def test_the_docs_say_what_meshio_reads_of_a_legacy_vtk(tmp_path):
+    """docs/cli.md said meshio reads the plot and period from a legacy .vtk; meshio 5.3.5
+    drops its FIELD data (VTK and pyvista read it)."""
+    import meshio
+    import pyvista
+
+    path = tmp_path / "c.vtk"
+    assert main(["canopy", B, "--triangles", "4", "--export", str(path)]) == EXIT_OK
+    assert "field_cm" in pyvista.read(path).field_data
+    dropped = "field_cm" not in meshio.read(path).field_data
+    row = next(ln for ln in (ROOT / "docs" / "cli.md").read_text().splitlines()
+               if ln.startswith("| `.vtk` (legacy VTK"))
+    assert ("meshio's legacy reader drops FIELD data" in row) == dropped, row
