@@ -786,6 +786,12 @@ def _warn_unresolved(balance, depth: int, rec: dict[str, Any], said: set[str]) -
             say(f"warning: {w}")
 
 
+def _percent(fraction: float) -> str:
+    """A fraction as a percentage with three significant digits, however small (``:.2%``
+    wrote a target of 1e-6 as "0.00%")."""
+    return f"{100 * fraction:.3g}%"
+
+
 def _traced(trace, args: argparse.Namespace, rec: dict[str, Any], said: set[str]) -> Any:
     """``trace(density)``'s result at ``--density``, or with ``--precision`` at the density
     that meets it (recorded in ``rec["precision"]``, a warning when it cannot be)."""
@@ -793,11 +799,12 @@ def _traced(trace, args: argparse.Namespace, rec: dict[str, Any], said: set[str]
         return trace(args.density)[0]
     result, prec = trace_until(trace, args.density, args.precision)
     rec["precision"] = prec.as_dict()
-    say(f"precision: relative standard error {prec.achieved:.2%} at {prec.density:g} rays "
-        f"per cm2 after {prec.passes} trace{'s' if prec.passes > 1 else ''}")
+    say(f"precision: relative standard error {_percent(prec.achieved)} at {prec.density:g} "
+        f"rays per cm2 after {prec.passes} trace{'s' if prec.passes > 1 else ''}")
     if not prec.met:
-        w = (f"the relative standard error {prec.achieved:.2%} is above the {prec.target:.2%} "
-             f"asked for at the densest tracing allowed ({prec.density:g} rays per cm2)")
+        w = (f"the relative standard error {_percent(prec.achieved)} is above the "
+             f"{_percent(prec.target)} asked for at the densest tracing allowed "
+             f"({prec.density:g} rays per cm2)")
         said.add(w)
         say(f"warning: {w}")
         rec["warnings"].append(w)
