@@ -17,8 +17,12 @@ The background light (diffuse sky, scattered light) reaches a triangle as a hand
 fed to a concave response one triangle at a time, that noise alone lowers the answer (by 4 %
 on a spherical canopy of 1 cm2 triangles at 1 ray per cm2, by 0.3 % at 8). It varies little
 within a leaf at one height, so it is pooled over each leaf's triangles in 5 cm height bands
-(``pool_cm``) before the model sees it; the direct beam, which does vary from triangle to
-triangle (sunflecks, orientation), is kept per triangle, its ray count entering linearly.
+(``pool_cm``) before the model sees it. A pool must stand for enough rays
+(:data:`POOL_RAYS`, its leaf area times the density): the bands of leaves too small for that
+are pooled with the small ones of their plant at that height, then of the canopy
+(:func:`background_pools`); pooling a leaf on its own, a canopy of 2 cm leaves at 1 ray per
+cm2 came out 3 % low, 11 standard errors. The direct beam, which does vary from triangle to
+triangle (sunflecks, orientation), is kept per triangle, its sunlit area entering linearly.
 
 Standard errors come from the independent batches of rays the absorbed light was traced in
 (:class:`~maizeviz.light.results.uncertainty.Batches`): the model is run on each batch's light alone.
@@ -46,6 +50,55 @@ if TYPE_CHECKING:
 
 #: Height band (cm) over which the background light of a leaf's triangles is pooled.
 POOL_CM = 5.0
+#: Rays (leaf area in cm2 times rays per cm2) a pool of background light stands for at least.
+POOL_RAYS = 64.0
+
+
+def background_pools(instance: np.ndarray, leaf: np.ndarray, z_cm: np.ndarray,
+                     area_cm2: np.ndarray, density: float, pool_cm: float = POOL_CM,
+                     min_rays: float = POOL_RAYS) -> np.ndarray:
+    """(F,) intp: the pool each triangle's background light is averaged over.
+
+    A leaf's triangles in one ``pool_cm`` height band make a pool when the rays of that
+    band of the leaf are enough (area x density >= ``min_rays``); the triangles of smaller
+    ones are pooled with the other small ones of the same plant in that band, and, when those
+    are still too few, with all the small ones of the canopy in that band. The choice depends
+    on the geometry and the density only (never on the rays traced), and as the density grows
+    every leaf becomes its own pool.
+
+    Parameters
+    ----------
+    instance, leaf : (F,) int
+        Plant standing (instance) and leaf of each triangle.
+    z_cm : (F,) float64
+        Height of each triangle's centre [cm].
+    area_cm2 : (F,) float64
+        One-sided area of each triangle [cm2].
+    density : float
+        Primary rays per cm2 of ground.
+    pool_cm : float
+        Height band [cm]; 0: each triangle its own pool.
+    min_rays : float
+        Rays a pool's leaf area must stand for (its area in cm2 times ``density``).
+
+    Returns
+    -------
+    numpy.ndarray
+        (F,) intp pool of each triangle, numbered from 0.
+    """
+    n = len(z_cm)
+    if pool_cm <= 0:
+        return np.arange(n)
+    band = np.floor(np.asarray(z_cm, np.float64) / pool_cm).astype(np.int64)
+    inst = np.asarray(instance, np.int64)
+    # -1 marks the leaves too small to stand alone at this density, then the plants
+    _, own = groups(inst, leaf, band)
+    small = (np.bincount(own, weights=area_cm2) * density < min_rays)[own]
+    leaf_key = np.where(small, -1, np.asarray(leaf, np.int64))
+    _, plant = groups(inst, leaf_key, band)
+    thin = small & (np.bincount(plant, weights=area_cm2) * density < min_rays)[plant]
+    _, pool = groups(np.where(thin, -1, inst), leaf_key, band)
+    return pool
 
 
 def copy_slots(canopy: Canopy, rect, periodic: bool) -> np.ndarray | None:
@@ -403,8 +456,10 @@ def assimilate(canopy: Canopy, light: AbsorbedLight, model: LeafModel,
     # the triangles of its leaf in the same height band, where it hardly varies, so that the
     # concave response does not turn the rays' noise into a bias (see the module docstring)
     zc = canopy.vertices[canopy.faces[first]][:, :, 2].mean(axis=1)
-    band = np.floor(zc / pool_cm).astype(np.int64) if pool_cm > 0 else np.arange(len(zc))
-    _, pool = groups(canopy.face_instance[first], canopy.face_leaf[first], band)
+    x0, y0, x1, y1 = light.rect
+    density = light.rays / max((x1 - x0) * (y1 - y0), 1e-300)          # rays per cm2
+    pool = background_pools(canopy.face_instance[first], canopy.face_leaf[first], zc,
+                            area_s * 1e4, density, pool_cm)
     pool_area = np.bincount(pool, weights=area_s)
 
     def gross_of(absorbed, direct, sunlit_cm2):
