@@ -345,6 +345,7 @@ class _Carbon:
                 raise TypeError("photosynthesis over a period needs the canopy")
             n = canopy.n_triangles
             self.mol, self.mol_b = np.zeros(n), np.zeros((BATCHES, n))
+            self.bias, self.bias_se = 0.0, 0.0
 
     def add(self, k: int, light: AbsorbedLight | None) -> None:
         if self.model is None:
@@ -368,6 +369,10 @@ class _Carbon:
         self.mol += a.triangle_gross_umol_s * self.step_s[k] * 1e-6
         if a.triangle_batches is not None:
             self.mol_b += a.triangle_batches * self.step_s[k] * 1e-6
+        if a.bias_umol_s is not None:
+            # the steps share the sky's rays: their biases' spreads add up, not in quadrature
+            self.bias += a.bias_umol_s * self.step_s[k] * 1e-6
+            self.bias_se += (a.bias_se_umol_s or 0.0) * self.step_s[k] * 1e-6
         self.step_gross[k] = a.canopy_gross_umol_m2_s
 
     def result(self):
@@ -378,4 +383,4 @@ class _Carbon:
         x0, y0, x1, y1 = self.unit.rect
         return PeriodAssimilation(self.model.as_dict(), self.temps.copy(), self.mol,
                                   self.mol_b, (x1 - x0) * (y1 - y0) * 1e-4, self.step_gross,
-                                  self.unit.rect, self.unit.periodic)
+                                  self.unit.rect, self.unit.periodic, self.bias, self.bias_se)
