@@ -238,7 +238,7 @@ class Assimilation:
         se = self.canopy_gross_error_umol_m2_s
         bias = self.canopy_gross_bias_umol_m2_s
         bias_se = None if self.bias_se_umol_s is None else self.bias_se_umol_s / self.ground_m2
-        return {"model": self.model["model"],
+        return {"model": self.model["model"], "label": self.leaf_model().label,
                 "parameters": {k: v for k, v in self.model.items() if k != "model"},
                 "temperature_c": self.temp_c,
                 "canopy_gross_umol_m2_s": self.canopy_gross_umol_m2_s,
@@ -372,7 +372,7 @@ class PeriodAssimilation:
         """
         se = self.canopy_gross_error_mol_m2
         g = self.ground_m2
-        return {"model": self.model["model"],
+        return {"model": self.model["model"], "label": model_from_dict(self.model).label,
                 "parameters": {k: v for k, v in self.model.items() if k != "model"},
                 "temperature_c": [float(t) for t in self.temperature_c],
                 "canopy_gross_mol_m2": self.canopy_gross_mol_m2,
