@@ -102,7 +102,8 @@ class AbsorbedLight:
         (F,) float64 power absorbed by each scene triangle (leaves, then stalks) from the
         light falling on the sample rectangle [W].
     triangle_sunlit_cm2 : numpy.ndarray
-        (F,) float64 area of each triangle in the direct beam [cm2] (0 for a sky).
+        (F,) float64 area of each triangle in the direct beam [cm2] (0 for a sky), sampled
+        from the triangle (:mod:`maizeviz.light.trace.sunlit`): at most its area.
     rect : (x0, y0, x1, y1) tuple of float
         The sample rectangle [cm].
     rays : int
@@ -125,7 +126,8 @@ class AbsorbedLight:
         Time spent [s]: "trace" (primary beams), "scatter", "build".
     triangle_direct_w : numpy.ndarray or None
         (F,) float64 the part of ``triangle_absorbed_w`` the sun's direct beam deposited [W]
-        (on the sunlit area; the rest came from the sky and scattered light).
+        (its sunlit area at the beam's absorbed flux on its orientation: at most what its
+        whole area would absorb; the rest came from the sky and scattered light).
     batches : Batches or None
         The per-batch shares of independent batches of rays, the standard errors' source.
     sun_direction : (3,) tuple of float or None
@@ -230,7 +232,6 @@ class AbsorbedLight:
         frame = pd.DataFrame(rows)
         if frame.empty:
             return frame
-        frame["sunlit_area_cm2"] = np.minimum(frame["sunlit_area_cm2"], frame["leaf_area_cm2"])
         if kind == "plant":
             frame = _per_plant(frame, ("absorbed_w", "sunlit_area_cm2"))
         if self.batches is not None:
