@@ -63,6 +63,7 @@ from maizeviz.light.sources.irradiance import (
     DEFAULT_PAR_UMOL_PER_J,
     PAR_UMOL_PER_J_PAR,
     Period,
+    WeatherFileError,
     clear_sky_period,
     read_weather,
     weather_period,
@@ -337,15 +338,62 @@ def period_from(args: argparse.Namespace) -> Period | None:
         if lat is None:
             lat, lon = weather.place.get("latitude"), weather.place.get("longitude")
             if lat is None or lon is None:
-                raise MaizevizError("a weather CSV file needs the place: give --lat and --lon",
+                problem = weather.place.get("problem")
+                raise MaizevizError(f"{os.path.basename(args.weather)}: {problem}, not a "
+                                    "place: give --lat and --lon" if problem else
+                                    "a weather CSV file needs the place: give --lat and --lon",
                                     quantity="weather")
             say(f"place: latitude {lat:g}, longitude {lon:g} (the header of "
                 f"{os.path.basename(args.weather)})")
-        return weather_period(weather, lat, lon, args.altitude, par)
+        period = weather_period(weather, lat, lon, args.altitude, par)
+        if args.photosynthesis:
+            check_air_temperature(weather, period)
+        return period
     linke = DEFAULT_LINKE_TURBIDITY if args.linke_turbidity is None else args.linke_turbidity
     return clear_sky_period(args.date, args.lat, args.lon, args.tz or "UTC",
                             30.0 if args.step is None else args.step, args.from_, args.to,
                             args.altitude, linke, par)
+
+
+#: Air temperatures the leaf models take [deg C] (those of ``assimilate``).
+LEAF_TEMPERATURE_C = (-50.0, 70.0)
+
+
+def check_air_temperature(weather, period: Period) -> None:
+    """Refuse a weather file's air temperature outside the leaf models' range on a step
+    the photosynthesis uses, naming the file and its line (it was blamed on
+    ``--temperature``)."""
+    temp = weather.temp_air
+    if temp is None or period.temp_air is None:
+        return
+    lo, hi = LEAF_TEMPERATURE_C
+    used = np.isin(weather.times.asi8, period.times.asi8)
+    with np.errstate(invalid="ignore"):
+        bad = np.flatnonzero(used & np.isfinite(temp) & ((temp < lo) | (temp > hi)))
+    if len(bad):
+        k = int(bad[0])
+        raise WeatherFileError(f"{weather.path}, line {int(weather.line[k])} "
+                               f"({weather.times[k].isoformat()}), column temp_air: "
+                               f"{temp[k]:g} C, outside the {lo:g}..{hi:g} C a leaf model "
+                               "takes; correct the cell or trace the light without "
+                               "--photosynthesis")
+
+
+def temperature_note(args: argparse.Namespace, period: Period | None) -> str:
+    """Which air temperature is used when ``--temperature`` is given with a weather file
+    that has its own: the file's, a measurement of the period traced, and ``--temperature``
+    where the file has none (a note, so that a modeller is not surprised)."""
+    if args.temperature is None or period is None or period.temp_air is None:
+        return ""
+    own = np.isfinite(period.temp_air)
+    if not own.any():
+        return ""
+    name = os.path.basename(str(period.parameters.get("weather_file", "the weather file")))
+    rest = int((~own).sum())
+    fill = f"; --temperature {args.temperature:g} C for the {rest} without one" if rest \
+        else f": --temperature {args.temperature:g} C is not used"
+    return (f"air temperature: {name}'s own on {int(own.sum())} of {len(own)} steps "
+            f"({np.nanmin(period.temp_air):.1f} to {np.nanmax(period.temp_air):.1f} C){fill}")
 
 
 def sky_from(args: argparse.Namespace, period: Period | None) -> Sky | None:
@@ -455,6 +503,8 @@ def _job(args: argparse.Namespace, labels: list[str]) -> _Job:
     period = period_from(args)
     sky = sky_from(args, period)
     _announce(args, sun, sky, period)
+    if temperature_note(args, period):
+        say("note: " + temperature_note(args, period))
     return _Job(args, sun, heights, rect, period, sky, optics, leaf_model_, temp_c,
                 bool(args.leaf_light or args.plant_light), len(labels))
 

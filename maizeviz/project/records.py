@@ -658,7 +658,8 @@ def run_from_record(rec: Record, where: str) -> tuple[str, Any, str, dict | None
 
 #: Arrays of a record that hold one value per canopy triangle (stalks included).
 PER_TRIANGLE = ("first_hits", "second_hits", "triangle_share", "triangle_direct_mol",
-                "triangle_diffuse_mol", "triangle_absorbed_w", "triangle_sunlit_cm2")
+                "triangle_diffuse_mol", "triangle_absorbed_w", "triangle_sunlit_cm2",
+                "triangle_direct_w")
 
 
 def per_triangle(rec: Record) -> int:

@@ -30,9 +30,7 @@ def _with_c4(qtbot, window, small_points, vmax=45.0):
     small_light(p, "sun")
     p.periodic.setChecked(True)
     p.optics_box.setChecked(True)
-    w.undo._next_turn()                         # each edit its own turn of the event loop
     p.photo_model.setCurrentIndex(p.photo_model.findData("c4"))
-    w.undo._next_turn()
     p.c4_vmax.setValue(vmax)
     return w, p
 
@@ -163,9 +161,7 @@ def test_the_model_choice_is_undoable_and_wofost_shows_its_parameters(window, qt
                                                                       small_points):
     w, p = _with_c4(qtbot, window, small_points)
     stack = w.undo.stack
-    w.undo._next_turn()
     p.photo_model.setCurrentIndex(p.photo_model.findData("wofost"))
-    w.undo._next_turn()
     assert w.model.settings.photosynthesis.model == "wofost"
     assert stack.undoText() == "photosynthesis wofost"
     assert p.wofost_amax.isVisibleTo(p) and p.wofost_eff.isVisibleTo(p)

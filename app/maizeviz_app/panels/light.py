@@ -20,8 +20,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from PySide6.QtCore import QSize, Qt, Signal
-from PySide6.QtGui import QImage, QPixmap
+from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QCheckBox,
@@ -48,6 +47,8 @@ from PySide6.QtWidgets import (
 )
 
 from maizeviz_app.bind import bind, bind_choice
+from maizeviz_app.panels.heatmap_view import HeatmapView
+from maizeviz_app.panels.image_view import ImageView
 from maizeviz_app.runs import MODES, SKIES, LightRuns, Run, level_order  # noqa: F401 - re-exported
 from maizeviz_app.settings import (  # noqa: F401 - re-exported
     DEFAULT_HEIGHTS,
@@ -836,47 +837,6 @@ def _model_text(assimilation) -> str:
     return f"{what}, leaves at {assimilation.temp_c:g} °C"
 
 
-class ImageView(QLabel):
-    """A picture scaled to fit the widget, keeping its aspect (figures drawn elsewhere)."""
-
-    def __init__(self, placeholder: str = "", parent=None):
-        super().__init__(placeholder, parent)
-        self._placeholder = placeholder
-        self._image: QImage | None = None
-        self.setAlignment(Qt.AlignmentFlag.AlignCenter)
-        self.setMinimumSize(160, 120)
-        self.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Ignored)
-        self.setStyleSheet("background: white; color: #666;")
-
-    def set_rgba(self, rgba: np.ndarray | None) -> None:
-        if rgba is None:
-            self._image = None
-            self.clear()
-            self.setText(self._placeholder)         # what will appear here
-            return
-        h, w = rgba.shape[:2]
-        self._image = QImage(np.ascontiguousarray(rgba).data, w, h, 4 * w,
-                             QImage.Format.Format_RGBA8888).copy()
-        self._rescale()
-
-    def image(self) -> QImage | None:
-        return self._image
-
-    def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
-        super().resizeEvent(event)
-        self._rescale()
-
-    def _rescale(self) -> None:
-        if self._image is None:
-            return
-        self.setPixmap(QPixmap.fromImage(self._image).scaled(
-            self.size(), Qt.AspectRatioMode.KeepAspectRatio,
-            Qt.TransformationMode.SmoothTransformation))
-
-    def sizeHint(self) -> QSize:  # noqa: N802
-        return QSize(360, 200)
-
-
 #: What the heatmap selector offers, per light.
 MAP_NAMES = {"sun": "direct sun", "sky": "diffuse sky", "day": "the day's PAR"}
 
@@ -911,8 +871,6 @@ class LightPlots(QWidget):
         top.addWidget(self.height_box)
         top.addStretch(1)
         left.addLayout(top)
-        from maizeviz_app.panels.heatmap_view import HeatmapView
-
         self.heatmap = HeatmapView("compute light to see where it reaches each height")
         left.addWidget(self.heatmap, 1)
         # the value under the mouse (always in place: showing a widget relayouts the dock)
