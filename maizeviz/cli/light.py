@@ -1177,7 +1177,8 @@ def _print_balance(records: list[dict]) -> None:
             f"{r['absorbed']['sunlit_lai']:.2f}"
         rows.append([r["level"], f"{b['incident']:.2f}", f"{b['absorbed_leaves']:.2f}",
                      f"{b['absorbed_ground']:.2f}", f"{b['reflected_top']:.2f}",
-                     f"{b['escaped_sides'] + b['unresolved']:.2f}", f"{b['closure']:+.4f}",
-                     last])
+                     f"{b['escaped_sides'] + b['unresolved']:.2f}",
+                     f"{b['closure_fraction']:+.2%}", last])
     print(fmt_table(["level", "incident", "leaves", "ground", "reflected", "other",
-                     "closure", "PAR mol/m2" if period else "sunlit LAI"], rows))
+                     "closure (of incident)", "PAR mol/m2" if period else "sunlit LAI"],
+                    rows))

@@ -263,7 +263,8 @@ def test_the_cli_nir_balance_closes_and_leaf_rows_carry_absorbed_light(capsys, t
     assert code == 0, err
     b = json.loads(out)["balance"]
     assert b["incident"] == pytest.approx(520.0)
-    assert abs(b["closure"]) < 0.02 and b["reflected_top"] > 0.2 * b["incident"]
+    assert abs(b["closure_fraction"]) < 0.02 and b["reflected_top"] > 0.2 * b["incident"]
+    assert "closure" not in b                      # named by what it is: a fraction
     rows = list(csv.DictReader(leaves.open()))
     assert rows and all(float(r["absorbed_w"]) >= 0 for r in rows)
     per_leaf = [float(r["absorbed_w_m2_leaf"]) for r in rows]

@@ -42,7 +42,7 @@ class Balance:
     as the result says).
 
     incident = absorbed_leaves + absorbed_ground + reflected_top + escaped_sides + unresolved,
-    within Monte Carlo noise (``closure``).
+    within Monte Carlo noise (``closure_fraction``, a fraction of the incident light).
     """
 
     incident: float
@@ -53,17 +53,38 @@ class Balance:
     unresolved: float = 0.0
 
     @property
-    def closure(self) -> float:
-        """(sum of the parts) / incident - 1: 0 up to Monte Carlo noise."""
+    def closure_fraction(self) -> float:
+        """How far the parts miss the incident light, as a fraction of it.
+
+        Returns
+        -------
+        float
+            (sum of the parts) / incident - 1 [-]: 0 up to Monte Carlo noise (0 without
+            incident light). Not in the balance's units: a fraction of the incident.
+        """
         parts = (self.absorbed_leaves + self.absorbed_ground + self.reflected_top
                  + self.escaped_sides + self.unresolved)
         return parts / self.incident - 1.0 if self.incident else 0.0
 
+    @property
+    def closure(self) -> float:
+        """The same as :attr:`closure_fraction` (its name in maizeviz 0.2), a fraction of the
+        incident light [-]."""
+        return self.closure_fraction
+
     def as_dict(self) -> dict[str, float]:
+        """The balance as the command line's JSON carries it.
+
+        Returns
+        -------
+        dict
+            The parts in the balance's units, and ``closure_fraction``, a fraction of the
+            incident light [-].
+        """
         return {"incident": self.incident, "absorbed_leaves": self.absorbed_leaves,
                 "absorbed_ground": self.absorbed_ground, "reflected_top": self.reflected_top,
                 "escaped_sides": self.escaped_sides, "unresolved": self.unresolved,
-                "closure": self.closure}
+                "closure_fraction": self.closure_fraction}
 
 
 def _fraction_absorbed(self) -> float:
