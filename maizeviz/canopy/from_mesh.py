@@ -41,7 +41,7 @@ from maizeviz.canopy.layout import MAX_COORD_CM, CanopyLayout, Placement
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.ids import groups
-from maizeviz.io.mesh_canopy import CARRIED, MeshData, read_mesh
+from maizeviz.io.mesh_data import CARRIED, MeshData
 from maizeviz.numbers import number
 
 #: cm per unit of a mesh file.
@@ -513,6 +513,8 @@ def read_mesh_canopy(path: str | Path, unit: str | None = None, up: str = "z",
     notes : list of str
         What was decided (one line each).
     """
+    from maizeviz.io.mesh_canopy import read_mesh  # the parsers (plyfile): when a mesh is read
+
     mesh = read_mesh(path, plant_property, leaf_property)
     canopy, notes = canopy_from_mesh(mesh, unit, up, field, str(path))
     return canopy, mesh, notes
