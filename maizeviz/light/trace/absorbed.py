@@ -23,7 +23,6 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.sparse import csr_array
 
 from maizeviz.canopy.layout import stands_identity
 from maizeviz.canopy.scene import Canopy
@@ -127,6 +126,8 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
         leaf_optics = opt.per_triangle(rank)
         kept = 1.0 - (leaf_optics[0] + leaf_optics[1])
     absorbed, sunlit, direct_t = np.zeros(nf), np.zeros(nf), np.zeros(nf)
+    from scipy.sparse import csr_array  # 0.3 s to import, pulls numpy.f2py: when used
+
     empty = csr_array((BATCHES, nf))
     absorbed_b, direct_b, sunlit_b = empty, empty, empty
     sun_dir = None
