@@ -6,11 +6,11 @@ from __future__ import annotations
 import csv
 
 from maizeviz.errors import MaizevizError
-from maizeviz_app.model import StudyModel
 from maizeviz_app.runs import day_title, plot_title
+from maizeviz_app.state import StudyState
 
 
-def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, {}, None)):
+def export_job(what: str, path: str, model: StudyState, heatmap: tuple = (None, {}, None)):
     """The work writing ``what`` of the study in ``model`` to ``path`` (atomically), to run
     in a worker as ``work(job, *args)``: returns ``(work, args)``. ``heatmap``: the light
     whose map is shown, the run shown for each light, the height shown (cm).
@@ -36,13 +36,14 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
     raise MaizevizError(f"unknown export '{what}'")
 
 
-def _canopy_job(path: str, model: StudyModel):
+def _canopy_job(path: str, model: StudyState):
     """The canopy's mesh with each triangle's light (the sun's class and sunlit share, the
     sky's and the day's light per m2 of leaf)."""
-    if model.canopy is None:
+    built = model.built
+    if built is None:
         raise MaizevizError("no canopy to export yet")
-    canopy = model.canopy
-    signature = model.signature(model.built.label)
+    canopy = built.canopy
+    signature = model.signature(built.label)
     # the names of `maizeviz light --export` (maizeviz.light.report.mesh_export.LIGHT_ARRAYS)
     cells = {}
     run = model.runs.for_signature(signature)
@@ -67,7 +68,7 @@ def _canopy_job(path: str, model: StudyModel):
     return work, ()
 
 
-def _measures_job(path: str, model: StudyModel):
+def _measures_job(path: str, model: StudyState):
     """Table 2's measures of the canopies built."""
     if not model.measures_rows:
         raise MaizevizError("no canopy measures to export yet")
@@ -81,7 +82,7 @@ def _measures_job(path: str, model: StudyModel):
     return work, ()
 
 
-def _table_job(path: str, model: StudyModel):
+def _table_job(path: str, model: StudyState):
     """Transmission by height of the runs compared."""
     header, table_rows = model.runs.table()
 
@@ -96,7 +97,7 @@ def _table_job(path: str, model: StudyModel):
     return work, ()
 
 
-def _heatmap_job(path: str, model: StudyModel, heatmap: tuple):
+def _heatmap_job(path: str, model: StudyState, heatmap: tuple):
     """The heatmap shown (its light, run and height), as shown."""
     shown_kind, shown_runs, height = heatmap
     last = model.runs.last
@@ -120,7 +121,7 @@ def _heatmap_job(path: str, model: StudyModel, heatmap: tuple):
     return work, ()
 
 
-def _plot_job(path: str, model: StudyModel):
+def _plot_job(path: str, model: StudyState):
     """The transmission curves of the runs compared."""
     from maizeviz_app import plots
 
@@ -135,7 +136,7 @@ def _plot_job(path: str, model: StudyModel):
     return work, ()
 
 
-def _diffuse_job(what: str, path: str, model: StudyModel):
+def _diffuse_job(what: str, path: str, model: StudyState):
     """The day's steps CSV and figure, the per-leaf and per-plant CSV of the last sky or
     day (the day when both)."""
     day = model.runs.of_kind("day")

@@ -3,8 +3,8 @@ canopy shown, sun angles from a place and time, the heatmap of another height, a
 of a project made whole against their canopy (no Qt: the work goes to the model's runner, the
 Embree work to its light process).
 
-Methods of :class:`maizeviz_app.model.StudyModel` (``study``: the model); see there for the
-state these use.
+Functions over the study's state (``study``: a :class:`maizeviz_app.state.StudyState`, whose
+public changes they call); :class:`maizeviz_app.model.StudyModel` offers them as methods.
 """
 
 from __future__ import annotations
@@ -17,14 +17,15 @@ from maizeviz_app.runs import MODES, Run, day_summary, plot_title, run_info
 from maizeviz_app.settings import InputProblem
 
 if TYPE_CHECKING:
-    from maizeviz_app.model import StudyModel
+    from maizeviz_app.jobs import Built
+    from maizeviz_app.state import StudyState
 
 #: What a light computation is called while it runs, per light.
 RUNNING_TEXT = {"sun": "computing direct light", "sky": "computing diffuse light",
                 "day": "computing the day's light"}
 
 
-def light_job(study: StudyModel) -> tuple[str, str, tuple, Any, Any, Any]:
+def light_job(study: StudyState) -> tuple[str, str, tuple, Any, Any, Any]:
     """What a light computation of the settings would trace: (light, core op, its
     arguments, the settings results are compared by, heights, optics or None).
 
@@ -49,7 +50,7 @@ def light_job(study: StudyModel) -> tuple[str, str, tuple, Any, Any, Any]:
     day = s.day_spec()
     return mode, "period", (sampling, sky, day), (day, sky), sampling.heights_cm, None
 
-def compute_light(study: StudyModel) -> bool:
+def compute_light(study: StudyState) -> bool:
     """Compute the light the settings choose (sun, sky or day) on the canopy shown, in the
     light process (which keeps the canopy's Embree scene); False if it did not start."""
     if study.closing:
@@ -59,11 +60,11 @@ def compute_light(study: StudyModel) -> bool:
         return False
     mode = study.settings.light.mode
     try:
-        mode, op, args, compared, heights, optics = study.light_job()
+        mode, op, args, compared, heights, optics = light_job(study)
     except (InputProblem, MaizevizError) as exc:
         study.fail(exc, "light", mode)
         return False
-    if not study.affordable([study._light_costs(mode, args, heights, optics)], "light"):
+    if not study.affordable([_light_costs(study.built, mode, args, heights, optics)], "light"):
         return False
     from maizeviz_app import plots
 
@@ -98,18 +99,19 @@ def compute_light(study: StudyModel) -> bool:
         return run, compared, sampling_key, maps, plot
 
     study.light_running.emit(f"{RUNNING_TEXT[mode]} on {label}…")
-    study.runner.run("light", f"{mode} light on {label}", work, on_done=study._lit,
-                    on_error=lambda e: study._light_failed(e, mode))
+    study.runner.run("light", f"{mode} light on {label}", work,
+                     on_done=lambda out: _lit(study, out),
+                     on_error=lambda e: _light_failed(study, e, mode))
     return True
 
-def _light_costs(study: StudyModel, mode: str, args: tuple, heights, optics=None) -> list:
-    """What a light run of ``mode`` on the canopy shown will cost (``maizeviz.cost``): its
+def _light_costs(built: Built, mode: str, args: tuple, heights, optics=None) -> list:
+    """What a light run of ``mode`` on the canopy ``built`` will cost (``maizeviz.cost``): its
     rays (times the directions: the sun, the sky's, a day's steps; with leaf optics, the
     absorbed light's beams and their scattering) and its heatmaps."""
     from maizeviz.cost import light_costs
     from maizeviz_app.plots import HEATMAP_BIN_CM
 
-    rect = args[0].rect or study.canopy.layout.centre_bounds
+    rect = args[0].rect or built.canopy.layout.centre_bounds
     directions = 1
     if optics is not None:                          # the beams, each scattered ~3 times
         directions += 3 * (1 + (46 if optics.diffuse_w_m2 > 0 else 0))
@@ -118,13 +120,13 @@ def _light_costs(study: StudyModel, mode: str, args: tuple, heights, optics=None
         if mode == "day":
             directions += args[2].steps_bound()
     return light_costs(rect, args[0].density, len(heights), directions, 1, HEATMAP_BIN_CM,
-                       study.built.measures.triangles)
+                       built.measures.triangles)
 
-def _light_failed(study: StudyModel, exc: BaseException, mode: str = "sun") -> None:
+def _light_failed(study: StudyState, exc: BaseException, mode: str = "sun") -> None:
     study.light_running.emit("")
     study.fail(exc, "light", mode)
 
-def _lit(study: StudyModel, out) -> None:
+def _lit(study: StudyState, out) -> None:
     """A light result: table, summary, plants, figures and colours change together;
     nothing shown is dropped unless a new comparison starts."""
     run, compared, sampling_key, maps, plot = out
@@ -163,7 +165,7 @@ def _lit(study: StudyModel, out) -> None:
                  + ", ".join(f"{h:g}" for h in r.heights_cm) + " cm", status_only=True)
     study.light_shown.emit()
 
-def draw_heatmap(study: StudyModel, kind: str, index: int) -> None:
+def draw_heatmap(study: StudyState, kind: str, index: int) -> None:
     """The heatmap of another height of a result shown, drawn in a job."""
     run = study.figures.shown_for.get(kind)
     if run is None:
@@ -181,7 +183,7 @@ def draw_heatmap(study: StudyModel, kind: str, index: int) -> None:
                      lambda job: plots.heatmap_image(result, height, kind=kind, look=look),
                      on_done=done, on_error=lambda e: study.fail(e, "light"))
 
-def sun_from_place(study: StudyModel) -> None:
+def sun_from_place(study: StudyState) -> None:
     """Sun angles from the date, time and place of ``settings.sun.place`` (pvlib, in a
     job); they become the sun's settings."""
     text = study.settings.sun.place
@@ -201,17 +203,17 @@ def sun_from_place(study: StudyModel) -> None:
                                 f"'{lon}'", quantity="place") from None
         return sun_at(date, clock, la, lo, tz)
 
-    study.runner.run("sun", "sun position", work, text, on_done=study._sun_found,
+    study.runner.run("sun", "sun position", work, text, on_done=lambda sun: _sun_found(study, sun),
                     on_error=lambda e: study.fail(e, "sun", "sun"))
 
-def _sun_found(study: StudyModel, sun) -> None:
+def _sun_found(study: StudyState, sun) -> None:
     # the sun's range (what its widget offers) holds a risen sun
     study.settings.set("sun", {"zenith_deg": round(min(sun.zenith_deg, 89.9), 2),
                               "azimuth_deg": round(sun.azimuth_deg % 360.0, 2)})
     study.say(f"sun at {sun.when}: zenith {sun.zenith_deg:.2f}°, azimuth "
              f"{sun.azimuth_deg:.2f}°")
 
-def choose_weather(study: StudyModel, path: str) -> None:
+def choose_weather(study: StudyState, path: str) -> None:
     """A weather file chosen: the day's source becomes it and, when its header names a place
     (EPW, TMY3, PSM), the day's latitude and longitude become that place, in one step of the
     undo history (read in a job: pvlib's first import takes seconds). A sun traced away from
@@ -235,7 +237,7 @@ def choose_weather(study: StudyModel, path: str) -> None:
                      on_done=done, on_error=lambda e: study.fail(e, "weather", "day"))
 
 # ------------------------------------------------------------------ a project's results
-def adopt_pending_runs(study: StudyModel) -> None:
+def adopt_pending_runs(study: StudyState) -> None:
     """Light results of an opened project (sun, sky and day) join the comparison once its
     canopy is built, shown as after a fresh run: table, plot, heatmaps, the day's summary,
     the plants' light and the canopy's colours (those of the results traced on the canopy
@@ -277,7 +279,7 @@ def adopt_pending_runs(study: StudyModel) -> None:
         return
     day = shown.get("day")
     study.set_summary(day_summary(day.result) if day is not None else "")
-    study.set_plants_run(study.light_per_plant_run())
+    study.set_plants_run(light_per_plant_run(study))
     latest = study.runs.latest(here) or study.runs.last
     order = sorted(shown, key=lambda k: latest is not None and k == latest.kind)
     curves = study.runs.curves()
@@ -304,14 +306,14 @@ def adopt_pending_runs(study: StudyModel) -> None:
                     on_error=lambda e: study.fail(e, "light"))
     study.view_light.emit(True)
 
-def light_per_plant_run(study: StudyModel) -> Run | None:
+def light_per_plant_run(study: StudyState) -> Run | None:
     """The latest result with light per plant to show: a sky's, a day's or a sun's
     absorbed light (once computed against its canopy)."""
     runs = [r for r in study.runs.in_order()
             if r.kind != "sun" or getattr(r.extra, "plant_rows", None) is not None]
     return runs[-1] if runs else None
 
-def complete_runs(study: StudyModel) -> None:
+def complete_runs(study: StudyState) -> None:
     """Results read from a project that were traced on the canopy shown get what the
     window shows of them, computed against it in a job: a sun's light class per
     triangle (and its absorbed light per leaf, with the CO2 assimilation of the leaf model
@@ -351,7 +353,7 @@ def complete_runs(study: StudyModel) -> None:
             else:
                 run.extra = value
         if study.shown_signature == here:
-            study.set_plants_run(study.light_per_plant_run())
+            study.set_plants_run(light_per_plant_run(study))
             study.view_light.emit(True)
             if study.runner.current("figures") is None:     # else: when they are drawn
                 study.light_shown.emit()

@@ -100,6 +100,9 @@ class MainWindow(QMainWindow):
         self._after_save = None           # what to do once the project is saved (close, open)
         self._progress_shown = 0.0
         self._view_ready = threading.Event()  # the build job waits for it before meshing
+        # the threads this window starts (warm-up, core processes): they end with it
+        self._threads: list[threading.Thread] = []
+        self._threads_stop = threading.Event()
         self._wire_model()
 
         self._centre = QStackedWidget()
@@ -175,7 +178,7 @@ class MainWindow(QMainWindow):
         self._wire_figures()
         from maizeviz_app.panels.colour import ColourPanel
 
-        self.colour_panel = ColourPanel(m.colour)
+        self.colour_panel = ColourPanel(m.colour, step=m.history.step)
         self.plots.heatmap.limits_shown.connect(self.colour_panel.heatmap_editor.show_limits)
         self.messages = docks.messages_widget()
         self.history = QUndoView(self.undo.stack)
@@ -238,7 +241,7 @@ class MainWindow(QMainWindow):
         if self._closing:
             return
         self.say("starting: loading the core and the 3D view…", status_only=True)
-        warmed, view_ready = self._warmed, self._view_ready
+        warmed, view_ready, stop = self._warmed, self._view_ready, self._threads_stop
 
         def work():
             import importlib
@@ -247,9 +250,13 @@ class MainWindow(QMainWindow):
                 error = None
                 try:
                     for name in names:
+                        if stop.is_set():       # the window is closing: import no more
+                            return
                         importlib.import_module(name)
                 except Exception as exc:  # noqa: BLE001 - reported in the window
                     error = exc
+                if stop.is_set():               # closeEvent waits for this thread: the
+                    return                      # window still exists, but says nothing more
                 try:
                     warmed.emit(stage, error)
                 except RuntimeError:            # the window is gone
@@ -259,7 +266,25 @@ class MainWindow(QMainWindow):
                 if error is not None:
                     return
 
-        threading.Thread(target=work, name="maizeviz-warm-up", daemon=True).start()
+        self._start_thread(work, "maizeviz-warm-up")
+
+    def _start_thread(self, target, name: str) -> None:
+        """Start a thread that :meth:`closeEvent` waits for."""
+        if self._closing:
+            return
+        t = threading.Thread(target=target, name=name, daemon=True)
+        self._threads.append(t)
+        t.start()
+
+    def _end_threads(self, timeout: float = 60.0) -> None:
+        """Tell this window's threads to stop and wait for them (an import under way
+        finishes first: one left running at exit can touch Qt, or import, while the
+        interpreter shuts down)."""
+        self._threads_stop.set()
+        deadline = time.monotonic() + timeout
+        for t in self._threads:
+            t.join(max(0.0, deadline - time.monotonic()))
+        self._threads = [t for t in self._threads if t.is_alive()]
 
     def _on_warmed(self, stage: str, error) -> None:
         if self._closing:
@@ -270,8 +295,7 @@ class MainWindow(QMainWindow):
                      "extra: pip install \"maizeviz[gui]\"", error=True)
             return
         if stage == "core":
-            threading.Thread(target=self._start_processes, name="maizeviz-processes",
-                             daemon=True).start()
+            self._start_thread(self._start_processes, "maizeviz-processes")
             if self._to_open:
                 self.open_any(self._to_open)
         elif stage == "view":
@@ -544,6 +568,7 @@ class MainWindow(QMainWindow):
 
             print(f"maizeviz: the digitizer did not stop cleanly: {exc}", file=sys.stderr)
         self.runner.shutdown(10.0)
+        self._end_threads()
         self.workspaces.save()
         docks.save_window(self, self._settings)
         if self.viewport is not None:

@@ -64,6 +64,7 @@ from maizeviz.light.sources.irradiance import (
     DEFAULT_PAR_UMOL_PER_J,
     PAR_UMOL_PER_J_PAR,
     Period,
+    WeatherFileError,
     clear_sky_period,
     read_weather,
     weather_period,
@@ -75,6 +76,7 @@ from maizeviz.light.trace.optics import BANDS, optics_for, read_optics_table
 from maizeviz.light.trace.precision import check_precision, trace_until
 from maizeviz.light.trace.scatter import DEFAULT_DEPTH
 from maizeviz.mesh.levels import CANOPY_LEVELS
+from maizeviz.photosynthesis.c4 import TEMPERATURE_RESPONSES
 from maizeviz.photosynthesis.split import MODELS, LeafModel, leaf_model
 
 #: The subcommand.
@@ -196,6 +198,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ph.add_argument("--photosynthesis", choices=MODELS, default=None,
                     help="leaf model: c4 (Collatz et al. 1992, maize) or wofost (negative "
                          "exponential)")
+    ph.add_argument("--c4-temperature", choices=tuple(TEMPERATURE_RESPONSES), default=None,
+                    help="c4: how Vmax falls in heat and cold: collatz (the paper's own, "
+                         "Vmax 44.7 at 35 C; default) or clm45 (CLM 4.5's, 62.6 at 35 C; "
+                         "what maizeviz 0.2 computed)")
     ph.add_argument("--amax", type=NUMBER_ARG, default=None, metavar="KG_HA_H",
                     help="wofost: gross assimilation at light saturation, kg CO2/ha leaf/h "
                          "(default 70)")
@@ -205,8 +211,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ph.add_argument("--vmax", type=NUMBER_ARG, default=None, metavar="UMOL_M2_S",
                     help="c4: Rubisco capacity at 25 C, umol/m2/s (default 39)")
     ph.add_argument("--alpha", type=NUMBER_ARG, default=None, metavar="MOL_MOL",
-                    help="c4: quantum yield, mol CO2 per mol of absorbed photons "
-                         "(default 0.04)")
+                    help="c4: quantum yield, mol CO2 per mol of PAR photons the leaf "
+                         "absorbs (default 0.04; a model that applies it to incident "
+                         "photons, as BioCro does, is alpha / absorptance here)")
     ph.add_argument("--co2", type=NUMBER_ARG, default=None, metavar="PPM",
                     help="c4: ambient CO2, umol/mol (default 400; intercellular 0.4 of it)")
     ph.add_argument("--temperature", type=NUMBER_ARG, default=None, metavar="C",
@@ -226,17 +233,20 @@ def _absorbed_asked(args: argparse.Namespace) -> bool:
 def _leaf_model_from(args: argparse.Namespace) -> LeafModel | None:
     """The leaf model ``--photosynthesis`` names, with its flags; refuses another model's
     flags and photosynthesis from NIR."""
-    own = {"c4": ("vmax", "alpha", "co2"), "wofost": ("amax", "eff")}
-    given = [k for k in ("vmax", "alpha", "co2", "amax", "eff", "temperature")
+    own = {"c4": ("vmax", "alpha", "co2", "c4_temperature"), "wofost": ("amax", "eff")}
+    given = [k for k in ("vmax", "alpha", "co2", "c4_temperature", "amax", "eff",
+                         "temperature")
              if getattr(args, k) is not None]
     if args.photosynthesis is None:
         if given:
-            raise MaizevizError(f"--{given[0]} is a parameter of leaf photosynthesis: add "
+            raise MaizevizError(f"--{given[0].replace('_', '-')} is a parameter of leaf "
+                                "photosynthesis: add "
                                 "--photosynthesis c4 or wofost", quantity="photosynthesis")
         return None
     other = [k for k in given if k != "temperature" and k not in own[args.photosynthesis]]
     if other:
-        raise MaizevizError(f"--{other[0]} is not a parameter of the {args.photosynthesis} "
+        raise MaizevizError(f"--{other[0].replace('_', '-')} is not a parameter of the "
+                            f"{args.photosynthesis} "
                             "model", quantity="photosynthesis")
     if args.band == "nir":
         raise MaizevizError("photosynthesis works from absorbed PAR: give no --band nir",
@@ -244,7 +254,8 @@ def _leaf_model_from(args: argparse.Namespace) -> LeafModel | None:
     if args.temperature is not None:
         check_range(args.temperature, "the air temperature (C)", -50, 70, "temperature")
     return leaf_model(args.photosynthesis, vmax=args.vmax, alpha=args.alpha,
-                      co2_ppm=args.co2, amax=args.amax, eff=args.eff)
+                      co2_ppm=args.co2, temperature_response=args.c4_temperature,
+                      amax=args.amax, eff=args.eff)
 
 
 # ------------------------------------------------------------------------------ what is asked
@@ -332,15 +343,62 @@ def period_from(args: argparse.Namespace) -> Period | None:
         if lat is None:
             lat, lon = weather.place.get("latitude"), weather.place.get("longitude")
             if lat is None or lon is None:
-                raise MaizevizError("a weather CSV file needs the place: give --lat and --lon",
+                problem = weather.place.get("problem")
+                raise MaizevizError(f"{os.path.basename(args.weather)}: {problem}, not a "
+                                    "place: give --lat and --lon" if problem else
+                                    "a weather CSV file needs the place: give --lat and --lon",
                                     quantity="weather")
             say(f"place: latitude {lat:g}, longitude {lon:g} (the header of "
                 f"{os.path.basename(args.weather)})")
-        return weather_period(weather, lat, lon, args.altitude, par)
+        period = weather_period(weather, lat, lon, args.altitude, par)
+        if args.photosynthesis:
+            check_air_temperature(weather, period)
+        return period
     linke = DEFAULT_LINKE_TURBIDITY if args.linke_turbidity is None else args.linke_turbidity
     return clear_sky_period(args.date, args.lat, args.lon, args.tz or "UTC",
                             30.0 if args.step is None else args.step, args.from_, args.to,
                             args.altitude, linke, par)
+
+
+#: Air temperatures the leaf models take [deg C] (those of ``assimilate``).
+LEAF_TEMPERATURE_C = (-50.0, 70.0)
+
+
+def check_air_temperature(weather, period: Period) -> None:
+    """Refuse a weather file's air temperature outside the leaf models' range on a step
+    the photosynthesis uses, naming the file and its line (it was blamed on
+    ``--temperature``)."""
+    temp = weather.temp_air
+    if temp is None or period.temp_air is None:
+        return
+    lo, hi = LEAF_TEMPERATURE_C
+    used = np.isin(weather.times.asi8, period.times.asi8)
+    with np.errstate(invalid="ignore"):
+        bad = np.flatnonzero(used & np.isfinite(temp) & ((temp < lo) | (temp > hi)))
+    if len(bad):
+        k = int(bad[0])
+        raise WeatherFileError(f"{weather.path}, line {int(weather.line[k])} "
+                               f"({weather.times[k].isoformat()}), column temp_air: "
+                               f"{temp[k]:g} C, outside the {lo:g}..{hi:g} C a leaf model "
+                               "takes; correct the cell or trace the light without "
+                               "--photosynthesis")
+
+
+def temperature_note(args: argparse.Namespace, period: Period | None) -> str:
+    """Which air temperature is used when ``--temperature`` is given with a weather file
+    that has its own: the file's, a measurement of the period traced, and ``--temperature``
+    where the file has none (a note, so that a modeller is not surprised)."""
+    if args.temperature is None or period is None or period.temp_air is None:
+        return ""
+    own = np.isfinite(period.temp_air)
+    if not own.any():
+        return ""
+    name = os.path.basename(str(period.parameters.get("weather_file", "the weather file")))
+    rest = int((~own).sum())
+    fill = f"; --temperature {args.temperature:g} C for the {rest} without one" if rest \
+        else f": --temperature {args.temperature:g} C is not used"
+    return (f"air temperature: {name}'s own on {int(own.sum())} of {len(own)} steps "
+            f"({np.nanmin(period.temp_air):.1f} to {np.nanmax(period.temp_air):.1f} C){fill}")
 
 
 def sky_from(args: argparse.Namespace, period: Period | None) -> Sky | None:
@@ -451,6 +509,8 @@ def _job(args: argparse.Namespace, labels: list[str]) -> _Job:
     period = period_from(args)
     sky = sky_from(args, period)
     _announce(args, sun, sky, period)
+    if temperature_note(args, period):
+        say("note: " + temperature_note(args, period))
     return _Job(args, sun, heights, rect, period, sky, optics, leaf_model_, temp_c,
                 bool(args.leaf_light or args.plant_light), len(labels))
 
@@ -1080,7 +1140,7 @@ def _print_photosynthesis(records: list[dict]) -> None:
     period = "canopy_gross_mol_m2" in ph
     params = ", ".join(f"{k} {v:g}" for k, v in ph["parameters"].items()
                        if k in ("vmax", "alpha", "co2_ppm", "amax", "eff"))
-    print(f"\ngross CO2 assimilation, {ph['model']} leaf model ({params}), per m2 of ground"
+    print(f"\ngross CO2 assimilation, {ph['label']} ({params}), per m2 of ground"
           + ("" if period else f", leaves at {ph['temperature_c']:g} C") + ":")
     rows = []
     for r in records:

@@ -33,14 +33,14 @@ from pathlib import Path
 import numpy as np
 
 from maizeviz.errors import PointsFileError
-from maizeviz.io.points import (
+from maizeviz.io.points_table import (
     MAX_ID,
     MAX_INDEX,
     MAX_LINES,
     MAX_POINTS,
     REQUIRED,
     PointsTable,
-    parse_points,
+    is_parquet_name,
     shown,
 )
 
@@ -83,9 +83,11 @@ def _pyarrow(source: str):
     return pa, pq
 
 
-def read_points_parquet(path: str | Path, max_points: int = MAX_POINTS,
-                        max_lines: int = MAX_LINES) -> PointsTable:
-    """Read a Parquet points file (see the module docstring).
+def read_parquet_table(path: str | Path, max_points: int = MAX_POINTS,
+                       max_lines: int = MAX_LINES) -> PointsTable | str:
+    """Read a Parquet points file (see the module docstring): its records when they are
+    plain (numbers in range, no status column), else the table as CSV text for the CSV reader
+    (:func:`maizeviz.io.points.read_points_parquet` reads it, so its messages are the CSV's).
 
     Raises
     ------
@@ -131,7 +133,7 @@ def read_points_parquet(path: str | Path, max_points: int = MAX_POINTS,
             raise PointsFileError(f"{source}: header only, no points")
         return PointsTable(ids=ids, xyz=xyz, line=np.arange(2, len(ids) + 2, dtype=np.int64),
                            extra=extra, source=source)
-    return _as_csv(table, source, pa, max_points, max_lines)
+    return _as_csv(table, pa)
 
 
 def _is_text(t, pa) -> bool:
@@ -197,15 +199,14 @@ def _plain(table, pa) -> tuple[np.ndarray, np.ndarray] | None:
     return ids, xyz
 
 
-def _as_csv(table, source: str, pa, max_points: int, max_lines: int) -> PointsTable:
-    """The table read through the CSV reader, so that its messages are the CSV's."""
+def _as_csv(table, pa) -> str:
+    """The table as CSV text, every column as text."""
     import pyarrow.csv as pacsv
 
     out = io.BytesIO()
     strings = table.cast(pa.schema([(n, pa.string()) for n in table.column_names]))
     pacsv.write_csv(strings, out, pacsv.WriteOptions(quoting_style="needed"))
-    return parse_points(out.getvalue().decode("utf-8", errors="replace"), source, max_points,
-                        max_lines)
+    return out.getvalue().decode("utf-8", errors="replace")
 
 
 def exact_rounding(values: np.ndarray, decimals: int) -> np.ndarray:
@@ -301,7 +302,6 @@ def write_table(path: str | Path, table: PointsTable, decimals: int | None = Non
     (a CSV then holds each number's shortest text that reads back to it).
     """
     from maizeviz.io.atomic import atomic_open
-    from maizeviz.io.points import is_parquet_name
 
     xyz = table.xyz if decimals is None else exact_rounding(table.xyz, decimals)
     if is_parquet_name(path):
@@ -342,7 +342,8 @@ def parquet_rows(path: str | Path) -> int | None:
 
 def read_rows(path: str | Path, start: int, stop: int) -> PointsTable:
     """The records [start, stop) of a Parquet points file whose records are plain (as
-    :func:`point_chunks` found them), line numbers as :func:`read_points_parquet` gives them.
+    :func:`point_chunks` found them), line numbers as
+    :func:`maizeviz.io.points.read_points_parquet` gives them.
 
     Raises
     ------
@@ -452,8 +453,8 @@ def plant_chunk_bounds(path: str | Path, chunk_points: int = ROW_GROUP_POINTS
 
 def point_chunks(path: str | Path, chunk_points: int = ROW_GROUP_POINTS):
     """The points of a Parquet file in tables of whole plants, about ``chunk_points`` points
-    each, in the file's order (line numbers as :func:`read_points_parquet` gives them; extra
-    columns left out).
+    each, in the file's order (line numbers as
+    :func:`maizeviz.io.points.read_points_parquet` gives them; extra columns left out).
 
     Yields
     ------
@@ -462,7 +463,7 @@ def point_chunks(path: str | Path, chunk_points: int = ROW_GROUP_POINTS):
     Raises
     ------
     PointsFileError
-        As :func:`read_points_parquet`, for the file as a whole.
+        As :func:`read_parquet_table`, for the file as a whole.
     NotStreamable
         A chunk holds records the CSV reader must check, or a plant's records are not
         together in the file.

@@ -41,6 +41,10 @@ class LeafModel(Protocol):
 
     name: str
 
+    @property
+    def label(self) -> str:
+        """The model in words, with its temperature response where it has a choice."""
+
     def gross(self, par_w_m2, temp_c=25.0):
         """Gross assimilation, umol CO2/m2 leaf/s, at absorbed PAR ``par_w_m2`` (W/m2)."""
 
@@ -88,12 +92,27 @@ def leaf_model(name: str = "c4", **params) -> LeafModel:
     return cls(**given)
 
 
+#: Parameters of maizeviz 0.2's C4 records that now come with the temperature response.
+_LEGACY_C4_KEYS = ("s1", "s2", "s3", "s4", "s5", "s6")
+
+
 def model_from_dict(record: dict) -> LeafModel:
-    """The leaf model an :meth:`as_dict` record describes."""
+    """The leaf model an :meth:`as_dict` record describes.
+
+    A C4 record without ``temperature_response`` was written by maizeviz 0.2, which computed
+    with CLM 4.5's response and recorded its constants (``s1``-``s6``): it is read as that
+    (:data:`~maizeviz.photosynthesis.c4.LEGACY_TEMPERATURE_RESPONSE`).
+    """
+    from maizeviz.photosynthesis.c4 import LEGACY_TEMPERATURE_RESPONSE
+
     if not isinstance(record, dict) or not isinstance(record.get("model"), str):
         raise MaizevizError("a photosynthesis record needs its model's name",
                             quantity="photosynthesis")
-    return leaf_model(record["model"], **{k: v for k, v in record.items() if k != "model"})
+    params = {k: v for k, v in record.items() if k != "model"}
+    if str(record["model"]).strip().lower() == "c4":
+        params = {k: v for k, v in params.items() if k not in _LEGACY_C4_KEYS}
+        params.setdefault("temperature_response", LEGACY_TEMPERATURE_RESPONSE)
+    return leaf_model(record["model"], **params)
 
 
 def split_assimilation(model: LeafModel, area_m2, sunlit_m2, direct_w, background_w,

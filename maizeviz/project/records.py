@@ -50,7 +50,7 @@ _PERIOD_ARRAYS = ("step_s", "zenith_deg", "azimuth_deg", "ghi", "dni", "dhi",
                   "direct_horizontal")
 #: Arrays a Period may have (a weather file's measured PAR, air temperature; NaN allowed in
 #: the temperature), stored when present.
-_PERIOD_OPTIONAL = {"par_measured": False, "temp_air": True}
+_PERIOD_OPTIONAL = {"par_measured": False, "temp_air": True, "par_diffuse_share": False}
 #: Prefix of the arrays of a day's sky light.
 _DIFFUSE = "diffuse_"
 #: Prefix of the arrays of a day's diffuse split by Perez's model.
@@ -664,7 +664,8 @@ def run_from_record(rec: Record, where: str) -> tuple[str, Any, str, dict | None
 
 #: Arrays of a record that hold one value per canopy triangle (stalks included).
 PER_TRIANGLE = ("first_hits", "second_hits", "triangle_share", "triangle_direct_mol",
-                "triangle_diffuse_mol", "triangle_absorbed_w", "triangle_sunlit_cm2")
+                "triangle_diffuse_mol", "triangle_absorbed_w", "triangle_sunlit_cm2",
+                "triangle_direct_w")
 
 
 def per_triangle(rec: Record) -> int:

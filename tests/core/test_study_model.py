@@ -208,3 +208,89 @@ def test_a_weather_csv_keeps_the_place_set(study, tmp_path):
     assert study.settings.day.weather == str(path)
     assert (study.settings.day.latitude, study.settings.day.longitude) == before
     assert not _errors(study)
+
+
+def _numbers(run) -> dict:
+    """What a sun run with absorbed light and C4 shows, as numbers: transmission by height,
+    each plant's absorbed light and gross assimilation, the canopy's."""
+    a = run.extra
+    return {"transmission": np.asarray(run.transmission),
+            "heights": np.asarray(run.result.heights_cm),
+            "plants": [(r["plant"], r["absorbed_w"], r["gross_umol_s"]) for r in a.plant_rows],
+            "canopy": a.assimilation.canopy_gross_umol_m2_s}
+
+
+def test_a_whole_study_with_c4_edits_and_named_undo_steps(study, points, tmp_path):
+    """Open, build, a sun with C4 photosynthesis, a layout edit, undo and redo by named
+    steps, save, reopen: every setting, the layout and every number come back."""
+    from maizeviz_app.model import UNDOABLE, StudyModel
+    from maizeviz_app.runner import InlineRunner
+
+    m, s = study, study.settings
+    m.open_points(points)
+    assert m.history.steps == [] and not _errors(m)
+    with m.history.step("sampling"):
+        s.sampling.heights, s.sampling.density, s.sampling.periodic = "0, 100, 200", 1.0, True
+    with m.history.step("noon sun, C4 at 30 °C"):
+        s.sun.zenith_deg, s.sun.azimuth_deg = 30.0, 120.0
+        s.optics.enabled = True
+        s.photosynthesis.model = "c4"
+        s.photosynthesis.temperature_c = 30.0
+    s.canopy.level = "16"                                    # no block: a step of its own
+    assert m.history.texts == ["sampling", "noon sun, C4 at 30 °C", "mesh level 16"]
+    assert m.built.label == "16 triangles"
+    assert m.compute_light() and not _errors(m)
+    first = _numbers(m.runs.of_kind("sun"))
+    assert first["canopy"] > 0 and len(first["plants"]) == len(m.loaded.layout.placements)
+    assert sum(p[2] for p in first["plants"]) > 0
+    # ---- the layout edited as the panel edits it: the model applies it and rebuilds
+    placements = m.loaded.layout.placements
+    with m.history.step("turn the first plant"):
+        assert m.draft.turn(0, 90.0)
+    assert m.loaded.layout.placements[0].azimuth_deg == 90.0 and not m.runs.runs
+    assert m.built.serial == m.serial and m.canopy.layout.placements[0].azimuth_deg == 90.0
+    # ---- undo the edit and the level, by their names; redo them
+    assert m.history.undo_text == "turn the first plant"
+    m.history.undo()
+    assert m.loaded.layout.placements == placements and m.built.serial == m.serial
+    assert m.history.undo_text == "mesh level 16"
+    m.history.undo()
+    assert s.canopy.level == "36" and m.built.label == "36 triangles"
+    assert m.history.redo_text == "mesh level 16"
+    m.history.redo()
+    m.history.redo()
+    assert s.canopy.level == "16" and m.built.label == "16 triangles"
+    assert m.loaded.layout.placements[0].azimuth_deg == 90.0
+    assert m.history.index == len(m.history.steps) == 4
+    # ---- the layout no longer follows: an edit waits for apply_draft
+    m.layout_options.follow = False
+    serial = m.serial
+    assert m.draft.turn(1, 45.0) and m.serial == serial
+    assert m.apply_draft() and m.loaded.layout.placements[1].azimuth_deg == 45.0
+    assert m.compute_light() and not _errors(m)
+    edited = _numbers(m.runs.of_kind("sun"))
+    # ---- save, reopen in a new model: every setting, the layout and every number
+    path = tmp_path / "c4.maizeviz"
+    assert m.save_project(path) and not m.modified
+    runner2 = InlineRunner()
+    try:
+        m2 = StudyModel(tile=3, runner=runner2)
+        said: list[str] = []
+        m2.said.connect(lambda text, error, status_only: said.append(text))
+        m2.open_project(path)
+        assert not [t for t in said if t.startswith(("error", "warning"))], said
+        for group in UNDOABLE:
+            assert m2.settings.snapshot(group) == s.snapshot(group), group
+        assert m2.colour.to_doc() == m.colour.to_doc()
+        assert m2.loaded.layout.placements == m.loaded.layout.placements
+        assert m2.built.label == "16 triangles" and not m2.modified
+        assert m2.history.steps == []                          # a new study, a new history
+        back = _numbers(m2.runs.of_kind("sun"))
+        for key in ("transmission", "heights"):
+            np.testing.assert_array_equal(back[key], edited[key])
+        assert [p[0] for p in back["plants"]] == [p[0] for p in edited["plants"]]
+        np.testing.assert_allclose([p[1:] for p in back["plants"]],
+                                   [p[1:] for p in edited["plants"]], rtol=1e-12)
+        assert back["canopy"] == pytest.approx(edited["canopy"], rel=1e-12)
+    finally:
+        runner2.shutdown()

@@ -283,6 +283,7 @@ def test_the_overlap_note_counts_its_pairs_in_words(panel, qtbot):
     """One pair is "1 overlapping pair", two are "2 overlapping pairs" (issue 25)."""
     said: list[str] = []
     panel.problem.connect(said.append)
+    panel.follow.setChecked(False)                    # applied on Apply only
     a = panel.model.placements[0]
     for k in (1, 2):                                  # a copy of plant 1 beside it, twice
         panel.select(0)

@@ -165,7 +165,7 @@ class Assimilation:
             standard error [umol m-2 s-1, kg CO2 ha-1 h-1], net assimilation, LAI and warnings.
         """
         se = self.canopy_gross_error_umol_m2_s
-        return {"model": self.model["model"],
+        return {"model": self.model["model"], "label": self.leaf_model().label,
                 "parameters": {k: v for k, v in self.model.items() if k != "model"},
                 "temperature_c": self.temp_c,
                 "canopy_gross_umol_m2_s": self.canopy_gross_umol_m2_s,
@@ -287,7 +287,7 @@ class PeriodAssimilation:
             standard error [mol m-2, g CO2 m-2] and per step [umol m-2 s-1].
         """
         se = self.canopy_gross_error_mol_m2
-        return {"model": self.model["model"],
+        return {"model": self.model["model"], "label": model_from_dict(self.model).label,
                 "parameters": {k: v for k, v in self.model.items() if k != "model"},
                 "temperature_c": [float(t) for t in self.temperature_c],
                 "canopy_gross_mol_m2": self.canopy_gross_mol_m2,

@@ -258,11 +258,13 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
     unit = absorbed(None, direct_w_m2=0.0, diffuse_w_m2=1.0,
                     sky="uoc" if split is not None else sky)
     report(progress, 1, steps + 1, "absorbed light: the sky")
-    diffuse_w = np.asarray(period.dhi, np.float64) * share
+    # the band's diffuse part: PAR's own split on a clear-sky period, else the shortwave's
+    ratio = period.diffuse_ratio(optics.band)
+    diffuse_w = np.asarray(period.dhi, np.float64) * share * ratio
     circumsolar_w = np.zeros(steps)
     if split is not None:                   # the circumsolar part comes with the sun
-        circumsolar_w = np.asarray(split.circumsolar_w_m2, np.float64) * share
-        diffuse_w = np.asarray(split.isotropic_w_m2, np.float64) * share
+        circumsolar_w = np.asarray(split.circumsolar_w_m2, np.float64) * share * ratio
+        diffuse_w = np.asarray(split.isotropic_w_m2, np.float64) * share * ratio
     step_s = np.asarray(period.step_s, np.float64)
     joules = unit.triangle_absorbed_w * float(np.sum(diffuse_w * step_s))
     ub_ = unit.batches
@@ -277,7 +279,8 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
                        "escaped_sides", "unresolved", "absorbed_stalks")}
     leaves_w = ub.absorbed_leaves * diffuse_w
     seconds = dict(unit.seconds)
-    direct_w = np.asarray(period.direct_horizontal, np.float64) * share + circumsolar_w
+    direct_w = (np.asarray(period.ghi, np.float64) - np.asarray(period.dhi, np.float64)
+                * ratio) * share + circumsolar_w
     for k in range(steps):
         z = float(period.zenith_deg[k])
         if direct_w[k] > 0 and z < 90.0:

@@ -1,0 +1,292 @@
+"""Hostile inputs on the newest surfaces (issue 35, item 7): each case found by the red team
+held by a test that failed before its fix. The oracle is the input itself: a file's own
+header, line and cells, the options as typed."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
+from maizeviz.light.sources.irradiance import WeatherFileError, read_weather
+from maizeviz.resources import example_points
+
+DATA = Path(__file__).resolve().parents[1] / "data" / "weather"
+EPW = DATA / "pvgis_tmy_45N_8E_july.epw"
+TMY3 = DATA / "tmy3_703165_july.csv"
+B = str(example_points())
+
+
+def _lines(path: Path) -> list[str]:
+    return path.read_text(encoding="latin-1").splitlines()
+
+
+def _write(tmp_path: Path, name: str, lines: list[str], end: str = "\n") -> Path:
+    out = tmp_path / name
+    out.write_text("\n".join(lines) + end, encoding="latin-1")
+    return out
+
+
+# ------------------------------------------------------------------------------ weather
+TURIN = "LOCATION,{city},-,ITA,IWEC,160590,45.000000,8.000000,1,250"
+
+
+def test_an_epw_city_with_a_quoted_comma_is_read_at_its_own_place(tmp_path):
+    """csv reads a quoted city as one field; pvlib split every comma and traced the day at
+    52.5 N, 45 E, +08:00 for a file at 45 N, 8 E, +01:00."""
+    lines = _lines(EPW)
+    lines[0] = TURIN.format(city='"Turin, IT"')
+    w = read_weather(_write(tmp_path, "turin.epw", lines))
+    assert (w.place["latitude"], w.place["longitude"]) == (45.0, 8.0)
+    assert w.place["name"] == "Turin, IT"
+    assert w.times[0].isoformat().endswith("+01:00")
+    assert np.array_equal(w.ghi, read_weather(EPW).ghi)
+
+
+def test_an_epw_city_with_a_bare_comma_is_refused_naming_the_field(tmp_path):
+    lines = _lines(EPW)
+    lines[0] = TURIN.format(city="Turin, IT")
+    with pytest.raises(WeatherFileError) as exc:
+        read_weather(_write(tmp_path, "turin.epw", lines))
+    msg = str(exc.value)
+    assert "line 1" in msg and "11 fields" in msg and "city" in msg and "\n" not in msg, msg
+
+
+@pytest.mark.parametrize("keep", [3, 40, 150])
+def test_a_tmy3_cut_inside_its_last_row_is_refused(tmp_path, keep):
+    """The cut cell was read as its remaining digits (99 W/m2 direct instead of 41)."""
+    lines = _lines(TMY3)
+    lines[-1] = lines[-1][:keep]
+    bad = _write(tmp_path, "cut.csv", lines, end="")
+    with pytest.raises(WeatherFileError) as exc:
+        read_weather(bad)
+    msg = str(exc.value)
+    assert f"line {len(lines)}" in msg and "cut" in msg and "\n" not in msg, msg
+
+
+def test_an_epw_cut_inside_its_last_row_is_refused(tmp_path):
+    lines = _lines(EPW)
+    lines[-1] = lines[-1][:30]
+    with pytest.raises(WeatherFileError) as exc:
+        read_weather(_write(tmp_path, "cut.epw", lines, end=""))
+    assert f"line {len(lines)}" in str(exc.value)
+
+
+def test_a_typical_year_cut_across_a_month_boundary_is_read(tmp_path):
+    """Months of a typical year come from different years, forward as well as back: 3 July
+    of 1991 followed by 4 July of 2003 was 'a gap of 35065 h'."""
+    lines = _lines(TMY3)
+    rows = lines[2:]
+    first_day = [r for r in rows if r.startswith("07/01/1991")]
+    moved = [r.replace("07/01/1991", "06/30/1991") for r in first_day]
+    later = [r.replace("07/0", "07/0").replace("/1991,", "/2003,") for r in rows]
+    w = read_weather(_write(tmp_path, "typical.csv", lines[:2] + moved + later))
+    assert len(w.times) == len(moved) + len(later)
+    assert np.all(np.diff(w.times.asi8) > 0) and set(np.unique(w.step_s)) == {3600.0}
+    assert any("typical year" in n for n in w.notes)
+
+
+@pytest.mark.parametrize("field, value", [(4, "nan"), (5, "nan")])
+def test_a_nan_header_place_is_named(tmp_path, capsys, field, value):
+    lines = _lines(TMY3)
+    cells = lines[0].split(",")
+    cells[field] = value
+    lines[0] = ",".join(cells)
+    path = _write(tmp_path, "nan.csv", lines)
+    code = main(["light", B, "--triangles", "4", "--density", "0.25", "--weather", str(path)])
+    err = capsys.readouterr().err
+    name = "latitude" if field == 4 else "longitude"
+    assert code == EXIT_FAIL and f"{name} is 'nan'" in err and "needs the place" not in err, err
+    # with the place given, the file is used
+    code = main(["light", B, "--triangles", "4", "--density", "0.25", "--heights", "0",
+                 "--sky-directions", "6", "--weather", str(path), "--lat", "55.3", "--lon",
+                 "-160.5", "--json"])
+    assert code == EXIT_OK, capsys.readouterr().err
+
+
+def _cold(tmp_path, line_no: int, value: str) -> Path:
+    lines = _lines(EPW)
+    cells = lines[line_no - 1].split(",")
+    cells[6] = value                                  # EPW field 7: dry bulb, C
+    lines[line_no - 1] = ",".join(cells)
+    return _write(tmp_path, "cold.epw", lines)
+
+
+def test_a_files_cold_air_is_blamed_on_the_file_and_its_line(tmp_path, capsys):
+    path = _cold(tmp_path, 20, "-80")
+    code = main(["light", B, "--triangles", "4", "--density", "0.25", "--heights", "0",
+                 "--sky-directions", "6", "--weather", str(path), "--photosynthesis", "c4"])
+    err = capsys.readouterr().err
+    assert code == EXIT_FAIL, err
+    last = [ln for ln in err.splitlines() if ln.startswith("error")][-1]
+    assert "line 20" in last and "cold.epw" in last and "--temperature" not in last, last
+
+
+def test_temperature_given_with_a_files_own_says_which_wins(tmp_path, capsys):
+    code = main(["light", B, "--triangles", "4", "--density", "0.25", "--heights", "0",
+                 "--sky-directions", "6", "--weather", str(EPW), "--photosynthesis", "c4",
+                 "--temperature", "10", "--json"])
+    out, err = capsys.readouterr()
+    assert code == EXIT_OK, err
+    assert "--temperature 10" in err and "air temperature" in err, err
+
+
+# ------------------------------------------------------------------------------ main job
+def _headless(*args, env_extra=None, timeout=300):
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    env.update(env_extra or {})
+    return subprocess.run([sys.executable, "-m", "maizeviz", *map(str, args)],
+                          capture_output=True, text=True, env=env, timeout=timeout)
+
+
+@pytest.fixture(scope="module")
+def small_points(tmp_path_factory):
+    """Two plants of the bundled example: a file that is not the example."""
+    lines = Path(B).read_text().splitlines()
+    head = [ln for ln in lines if not ln[:1].isdigit()]
+    rows = [ln for ln in lines if ln[:1].isdigit()]
+    plant = [ln for ln in rows if ln.split(",")[0] in ("1", "2")]
+    out = tmp_path_factory.mktemp("pts") / "mine.csv"
+    out.write_text("\n".join(head + plant) + "\n")
+    return out
+
+
+@pytest.mark.parametrize("form", [("--tile", "1", "{p}"), ("--", "{p}"),
+                                  ("{p}", "--tile", "1")])
+def test_the_main_job_reports_on_the_file_wherever_it_stands(small_points, form):
+    """`maizeviz --tile 1 p.csv` and `maizeviz -- p.csv` reported on the bundled example."""
+    args = [a.format(p=small_points) for a in form]
+    proc = _headless(*args)
+    assert proc.returncode == EXIT_OK, proc.stderr
+    assert f"the headless report on {small_points}" in proc.stderr
+    tile = "1x1" if "1" in form else "3x3"
+    assert f"maizeviz canopy {small_points} --tile {tile} --levels" in proc.stderr
+    plants = 2 if tile == "1x1" else 18
+    assert f"canopy: {plants} plants" in proc.stdout, proc.stdout
+
+
+@pytest.mark.parametrize("bad, says", [(("--tile", "4"), "--tile"),
+                                       (("--bogus-option",), "--bogus-option"),
+                                       (("--size", "big"), "--size")])
+def test_the_main_jobs_options_after_the_file_are_checked(small_points, bad, says):
+    proc = _headless(small_points, *bad)
+    assert proc.returncode == 2 and says in proc.stderr and "LAI" not in proc.stdout
+    assert "Traceback" not in proc.stderr
+
+
+def test_the_main_job_on_a_mesh_reports_it_as_it_is(tmp_path, small_points):
+    mesh = tmp_path / "c.ply"
+    assert main(["canopy", str(small_points), "--triangles", "4", "--export",
+                 str(mesh)]) == EXIT_OK
+    proc = _headless(mesh)
+    assert proc.returncode == EXIT_OK, proc.stderr
+    assert "--levels" not in proc.stderr and "mesh" in proc.stdout
+    proc = _headless(mesh, "--tile", "3")
+    assert proc.returncode == 2 and "--tile 3: a mesh file" in proc.stderr
+
+
+def test_a_folder_or_fifo_given_to_the_main_job_is_named_as_such(tmp_path):
+    import os
+
+    proc = _headless(tmp_path)
+    assert proc.returncode == EXIT_FAIL and "is a folder, not a file" in proc.stderr
+    fifo = tmp_path / "pipe.csv"
+    os.mkfifo(fifo)
+    proc = _headless(fifo)
+    assert proc.returncode == EXIT_FAIL and "is a FIFO" in proc.stderr
+    assert "no such file" not in proc.stderr
+
+
+# ------------------------------------------------------------------------------ environment
+@pytest.mark.parametrize("name, value", [("MAIZEVIZ_FIELD_POINTS", "abc"),
+                                         ("MAIZEVIZ_FIELD_POINTS", "1e3"),
+                                         ("MAIZEVIZ_FIELD_POINTS", ""),
+                                         ("MAIZEVIZ_FIELD_POINTS", "-5"),
+                                         ("MAIZEVIZ_PACKET_WIDTH", "abc"),
+                                         ("MAIZEVIZ_PACKET_WIDTH", "7"),
+                                         ("MAIZEVIZ_PACKETS", "maybe"),
+                                         ("MAIZEVIZ_LOOPS", "2"),
+                                         ("MAIZEVIZ_DEBUG", "please")])
+def test_a_bad_environment_variable_is_one_line_when_used(tmp_path, name, value):
+    """They were int() at import: a traceback."""
+    pts = tmp_path / "p.parquet"
+    assert main(["convert", B, "--out", str(pts)]) == EXIT_OK
+    proc = _headless("light", pts, "--tile", "1x1", "--triangles", "4", "--density", "0.25",
+                     "--heights", "0", "--sun-zenith", "30", "--sun-azimuth", "180",
+                     env_extra={name: value})
+    err = proc.stderr.strip()
+    assert proc.returncode == EXIT_FAIL, err
+    assert "Traceback" not in err and f"{name}='{value}'" in err, err
+    assert err.splitlines()[-1].startswith("error:"), err
+    info = _headless("--info", env_extra={name: value})
+    assert info.returncode == EXIT_FAIL and name in info.stderr and "Traceback" not in \
+        info.stderr
+
+
+# ------------------------------------------------------------------------------ projects
+@pytest.fixture(scope="module")
+def traced_project(tmp_path_factory):
+    """The bundled block's 2 x 2 tiling at 16 triangles with a sun, a sky and a day."""
+    from maizeviz.canopy.layout import layout_for
+    from maizeviz.canopy.scene import build_canopy
+    from maizeviz.leaf.fit import read_leaves
+    from maizeviz.light.scene.request import LightRequest, Sampling
+    from maizeviz.light.sources.sky import make_sky
+    from maizeviz.light.sources.sun import Sun
+    from maizeviz.light.trace.diffuse import trace_sky
+    from maizeviz.light.trace.direct import trace_light
+    from maizeviz.mesh.levels import parse_level
+    from maizeviz.project.study import save_study
+
+    folder = tmp_path_factory.mktemp("project")
+    leaves = read_leaves(B).leaves
+    layout = layout_for(leaves, (2, 2))
+    level = parse_level("16")
+    canopy = build_canopy(leaves, layout, level)
+    sampling = Sampling((0.0, 100.0), 0.2, None, True, 1)
+    sun = trace_light(canopy, LightRequest(Sun(30, 180), sampling))
+    sky = trace_sky(canopy, make_sky("soc", 16), sampling)
+    path = folder / "ok.maizeviz"
+    save_study(path, B, layout, [sun, sky], level=level.label)
+    return path, canopy.n_triangles, len(canopy.stalk_faces)
+
+
+@pytest.mark.parametrize("name, kind", [("triangle_share", 1), ("first_hits", 0)])
+@pytest.mark.parametrize("cut", ["one short", "half", "one long"])
+def test_a_projects_per_triangle_array_of_another_length_is_refused_at_read(
+        tmp_path, traced_project, name, kind, cut):
+    """read_study accepted a triangle_share one short, half or one long; table() then said
+    the result was 'traced on another canopy'."""
+    from dataclasses import replace
+
+    from maizeviz.io.project import ProjectError, load_project, save_project
+    from maizeviz.project.study import read_study
+
+    path, n, stalks = traced_project
+    assert len(read_study(path, tmp_path).results) == 2          # the undamaged one reads
+    project = load_project(path)
+    rec = project.results[kind]
+    a = np.asarray(rec.arrays[name])
+    changed = {"one short": a[:-1], "half": a[:len(a) // 2],
+               "one long": np.append(a, a[-1:])}[cut]
+    arrays = {**rec.arrays, name: changed}
+    if name == "first_hits":                                    # both hit arrays alike
+        arrays["second_hits"] = np.resize(np.asarray(rec.arrays["second_hits"]),
+                                          len(changed))
+    results = list(project.results)
+    results[kind] = replace(rec, arrays=arrays)
+    bad = tmp_path / "bad.maizeviz"
+    save_project(bad, replace(project, results=tuple(results)))
+    with pytest.raises(ProjectError) as exc:
+        read_study(bad, tmp_path)
+    msg = str(exc.value)
+    said = (f"holds {len(changed):,} values, expected {n:,} (one per leaf triangle of its "
+            f"canopy) or {n + stalks:,}")
+    assert said in msg and "\n" not in msg, msg
+    assert "first_hits" in msg if name == "first_hits" else name in msg
