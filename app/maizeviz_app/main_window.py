@@ -181,6 +181,11 @@ class MainWindow(QMainWindow):
 
         self.colour_panel = ColourPanel(m.colour, step=m.history.step)
         self.plots.heatmap.limits_shown.connect(self.colour_panel.heatmap_editor.show_limits)
+        from maizeviz_app.panels.instruments import InstrumentsPanel
+
+        self.instruments_panel = InstrumentsPanel(canopy=lambda: m.canopy)
+        self.instruments_panel.failed.connect(lambda text: self.say(f"error: {text}"))
+        m.built_shown.connect(lambda _label: self.instruments_panel.refresh())
         self.messages = docks.messages_widget()
         self.history = QUndoView(self.undo.stack)
         self.history.setEmptyLabel("the study as opened")
@@ -190,7 +195,9 @@ class MainWindow(QMainWindow):
                                              "light": ("Light", self.light_panel),
                                              "layout": ("Layout", None),
                                              "digitizer": ("Digitizer", None),
-                                             "colour": ("Colour", self.colour_panel)},
+                                             "colour": ("Colour", self.colour_panel),
+                                             "instruments": ("Instruments",
+                                                             self.instruments_panel)},
                                       self.plots, self.messages, self.history)
 
     def _wire_figures(self) -> None:
@@ -586,6 +593,7 @@ class MainWindow(QMainWindow):
             import sys
 
             print(f"maizeviz: the digitizer did not stop cleanly: {exc}", file=sys.stderr)
+        self.instruments_panel.shutdown()
         self.runner.shutdown(10.0)
         self._end_threads()
         self.workspaces.save()

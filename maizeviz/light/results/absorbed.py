@@ -41,8 +41,10 @@ class Balance:
     """Where the incident light went, W/m2 of sample ground (or, for a period, MJ/m2 or mol/m2
     as the result says).
 
-    incident = absorbed_leaves + absorbed_ground + reflected_top + escaped_sides + unresolved,
-    within Monte Carlo noise (``closure_fraction``, a fraction of the incident light).
+    incident = absorbed_leaves + absorbed_stalks + absorbed_ground + reflected_top
+    + escaped_sides + unresolved, within Monte Carlo noise (``closure_fraction``, a fraction
+    of the incident light). The stalks absorb where they were traced
+    (``LightEngine(..., with_stalks=True)``, the default), else 0.
     """
 
     incident: float
@@ -51,6 +53,7 @@ class Balance:
     reflected_top: float
     escaped_sides: float = 0.0
     unresolved: float = 0.0
+    absorbed_stalks: float = 0.0
 
     @property
     def closure_fraction(self) -> float:
@@ -62,8 +65,8 @@ class Balance:
             (sum of the parts) / incident - 1 [-]: 0 up to Monte Carlo noise (0 without
             incident light). Not in the balance's units: a fraction of the incident.
         """
-        parts = (self.absorbed_leaves + self.absorbed_ground + self.reflected_top
-                 + self.escaped_sides + self.unresolved)
+        parts = (self.absorbed_leaves + self.absorbed_stalks + self.absorbed_ground
+                 + self.reflected_top + self.escaped_sides + self.unresolved)
         return parts / self.incident - 1.0 if self.incident else 0.0
 
     @property
@@ -82,6 +85,7 @@ class Balance:
             incident light [-].
         """
         return {"incident": self.incident, "absorbed_leaves": self.absorbed_leaves,
+                "absorbed_stalks": self.absorbed_stalks,
                 "absorbed_ground": self.absorbed_ground, "reflected_top": self.reflected_top,
                 "escaped_sides": self.escaped_sides, "unresolved": self.unresolved,
                 "closure_fraction": self.closure_fraction}
