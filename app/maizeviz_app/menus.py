@@ -163,7 +163,17 @@ def build_menus(w) -> dict[str, QAction]:
                                                 "place typed in the Light panel")
 
     h = bar.addMenu("&Help")
-    acts["about"] = _action(w, h, "&About maizeviz", w.about, QKeySequence.StandardKey.HelpContents,
+    acts["docs"] = _action(w, h, "&Documentation", w.open_docs,
+                           QKeySequence.StandardKey.HelpContents,
+                           "the documentation's index: method, commands, this window, "
+                           "validation")
+    acts["shortcuts"] = _action(w, h, "&Keyboard shortcuts", w.show_shortcuts, None,
+                                "every menu command's keys")
+    acts["system_info"] = _action(w, h, "&System information", w.show_system_info, None,
+                                  "what maizeviz --info prints: versions, Embree, the ray "
+                                  "kernel; for a bug report")
+    h.addSeparator()
+    acts["about"] = _action(w, h, "&About maizeviz", w.about, None,
                             "the version, the libraries and where the documentation is")
     return acts
 

@@ -213,6 +213,8 @@ class StudyState:
         self.applying = 0                       # settings being set by the model itself
         self.colour = ColourSettings()
         self.view = ViewState()
+        #: the colouring a project was saved with, restored once its results are complete
+        self.colouring_to_restore: str | None = None
         self.selection = Selection()
         self.history = History()
         self._watch_history()
