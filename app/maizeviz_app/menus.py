@@ -87,6 +87,9 @@ def build_menus(w) -> dict[str, QAction]:
     acts["export_day"] = _action(w, results, "Day figure (PNG)…",
                                  lambda: w.choose_export("day"), None,
                                  "the day's light and transmission over the hours")
+    acts["window_image"] = _action(w, f, "Save &window as image…", w.choose_window_image,
+                                   None, "the whole window, panels and figures as they are "
+                                         "on screen, as a PNG")
     acts["view_image"] = _action(w, f, "Save view as &image…", w.view_link.choose_image,
                                  "Ctrl+Alt+S", "the 3D view as a PNG of a chosen width, with "
                                                "its colour key")

@@ -308,6 +308,10 @@ class Viewport(QtInteractor):
         self.key = Legend(self)
         self.key.move(10, 10)
         self.key.hide()
+        # the field's axes and a scale bar, painted by Qt from the camera after each frame
+        from maizeviz_app.view_overlay import ViewOverlay
+
+        self.overlay = ViewOverlay(self)
         self.canopy_mesh: pv.PolyData | None = None
         self.colouring = "leaf"
         #: What the "light" colouring shows: "classes" (a sun) or "values" (a sky, a day).
@@ -344,6 +348,11 @@ class Viewport(QtInteractor):
 
     def _on_frame(self, *_args) -> None:
         self.render_count += 1
+        cam = self.renderer.GetActiveCamera()
+        if hasattr(self, "overlay"):
+                self.overlay.update_from(
+                cam.GetPosition(), cam.GetFocalPoint(), cam.GetViewUp(), cam.GetViewAngle(),
+                cam.GetParallelScale() if cam.GetParallelProjection() else None)
         self.rendered.emit(self.render_count)
 
     # ------------------------------------------------------------------ canopy
@@ -752,6 +761,7 @@ class Viewport(QtInteractor):
     # ------------------------------------------------------------------ picking
     def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().resizeEvent(event)
+        self.overlay.place()
         if self.info.isVisible():
             self.info.set_lines(self.info.text().splitlines())
 
