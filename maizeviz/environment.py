@@ -14,6 +14,8 @@ import).
 ``MAIZEVIZ_PACKETS``       0 turns the ray-packet kernel off (embreex's single rays)
 ``MAIZEVIZ_LOOPS``         0 turns the compiled loops off (numpy does their work)
 ``MAIZEVIZ_DEBUG``         1 shows the traceback of an internal error on the command line
+``MAIZEVIZ_EMBREE_ISA``    the instruction set Embree traces with (sse2, sse4.2, avx, avx2
+                           or avx512; the CPU's best)
 =========================  ===========================================================
 
 A switch takes 0 or 1 (and no, off, false, yes, on, true, any case); unset or empty is its
@@ -40,7 +42,7 @@ class Variable:
 
     Attributes
     ----------
-    kind : {"switch", "whole"}
+    kind : {"switch", "whole", "word"}
     default : bool or int
     meaning : str
         What it sets, in words.
@@ -48,13 +50,16 @@ class Variable:
         Smallest whole number taken.
     choices : tuple of int
         The only whole numbers taken (empty: any from ``low`` on).
+    words : tuple of str
+        The words a "word" variable takes (lower case).
     """
 
     kind: str
-    default: bool | int
+    default: bool | int | str
     meaning: str
     low: int = 0
     choices: tuple[int, ...] = ()
+    words: tuple[str, ...] = ()
 
 
 #: Every environment variable maizeviz reads.
@@ -67,6 +72,8 @@ VARIABLES: dict[str, Variable] = {
     "MAIZEVIZ_PACKETS": Variable("switch", True, "the ray-packet kernel"),
     "MAIZEVIZ_LOOPS": Variable("switch", True, "the compiled loops"),
     "MAIZEVIZ_DEBUG": Variable("switch", False, "tracebacks of internal errors"),
+    "MAIZEVIZ_EMBREE_ISA": Variable("word", "", "the instruction set Embree traces with",
+                                    words=("sse2", "sse4.2", "avx", "avx2", "avx512")),
 }
 
 _ON = ("1", "yes", "on", "true")
@@ -130,13 +137,31 @@ def whole_number(name: str) -> int:
     return value
 
 
+def word(name: str) -> str:
+    """The value of a word variable, in lower case: its default when unset or empty.
+
+    Raises
+    ------
+    EnvironmentVariableError
+        A word it does not take.
+    """
+    var = _variable(name, "word")
+    raw = os.environ.get(name, "")
+    text = raw.strip().lower()
+    if not text:
+        return str(var.default)
+    if text not in var.words:
+        raise _refuse(name, raw, f"takes one of {', '.join(var.words)}")
+    return text
+
+
 def problems() -> list[str]:
     """One line for each ``MAIZEVIZ_*`` variable set to a value it does not take (for
     ``--info``)."""
     out = []
     for name, var in VARIABLES.items():
         try:
-            (switch if var.kind == "switch" else whole_number)(name)
+            {"switch": switch, "whole": whole_number, "word": word}[var.kind](name)
         except EnvironmentVariableError as exc:
             out.append(str(exc))
     return out

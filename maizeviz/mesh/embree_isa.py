@@ -23,19 +23,20 @@ from __future__ import annotations
 
 import ctypes
 import functools
-import os
 
+from maizeviz.environment import VARIABLES, word
 from maizeviz.errors import MaizevizError
 
+#: The environment variable naming one of :data:`ISAS` (unset or empty: the CPU's best),
+#: read by :func:`maizeviz.environment.word`.
+ENV = "MAIZEVIZ_EMBREE_ISA"
 #: The instruction sets an Embree 4 release build (as embreex's wheels vendor it) carries
 #: kernels for, lowest first, as its configuration string spells them.
-ISAS = ("sse2", "sse4.2", "avx", "avx2", "avx512")
-#: The environment variable naming one of :data:`ISAS` (unset or empty: the CPU's best).
-ENV = "MAIZEVIZ_EMBREE_ISA"
+ISAS = VARIABLES[ENV].words
 _PTR = ctypes.sizeof(ctypes.c_void_p)
 
 
-def check_isa(value: str | None, where: str = ENV) -> str | None:
+def check_isa(value: str | None, where: str = "the Embree instruction set") -> str | None:
     """``value`` as one of :data:`ISAS` (lower case; ``sse42`` read as ``sse4.2``), None for
     None or an empty text; else a MaizevizError naming ``where``."""
     if value is None or not value.strip():
@@ -49,8 +50,10 @@ def check_isa(value: str | None, where: str = ENV) -> str | None:
 
 
 def requested() -> str | None:
-    """The instruction set ``MAIZEVIZ_EMBREE_ISA`` names (checked), or None."""
-    return check_isa(os.environ.get(ENV))
+    """The instruction set ``MAIZEVIZ_EMBREE_ISA`` names, or None (unset or empty); a word it
+    does not take is refused in one line as every variable is
+    (:class:`maizeviz.environment.EnvironmentVariableError`)."""
+    return word(ENV) or None
 
 
 def _new(lib, isa: str) -> int:
