@@ -618,3 +618,15 @@ def test_a_weather_time_run_into_the_next_is_refused_not_guessed(tmp_path):
                     "2005-08-01T032005-08-01T04:00+08:00,10\n2005-08-01T05:00+08:00,20\n")
     with pytest.raises(WeatherFileError, match="line 3, column time: cannot read"):
         read_weather(path)
+
+
+def test_converting_to_an_mtg_names_the_columns_it_cannot_hold(tmp_path, capsys):
+    """An MTG holds fitted leaves: the records' extra columns cannot go in; said, not lost
+    without a word."""
+    lines = Path(B).read_text().splitlines()
+    src = tmp_path / "noted.csv"
+    src.write_text("\n".join([lines[0] + ",Note"] + [ln + ",x" for ln in lines[1:] if ln]) + "\n")
+    code = main(["convert", str(src), "--out", str(tmp_path / "p.mtg")])
+    err = capsys.readouterr().err
+    assert code == EXIT_OK, err
+    assert "the column(s) Note of" in err and "not in it" in err, err
