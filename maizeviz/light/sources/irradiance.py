@@ -828,8 +828,8 @@ def _parse_times(texts: list, lines: list, path: Path, tz):
                                f"or give the zone")
 
     def parse_one(k):
-        try:
-            stamp = pd.Timestamp(texts[k])
+        try:              # ISO 8601 only: pd.Timestamp read '...T032005-08-01T04:00+08:00'
+            stamp = pd.to_datetime([texts[k]], format="ISO8601")[0]
         except (ValueError, TypeError, OverflowError):
             raise WeatherFileError(f"{path}, line {lines[k]}, column time: cannot read "
                                    f"'{texts[k]}' as an ISO 8601 time") from None
@@ -844,8 +844,10 @@ def _parse_times(texts: list, lines: list, path: Path, tz):
         except (ValueError, TypeError, OverflowError):
             # pandas refuses a mix it cannot hold in one resolution (nanosecond digits and a
             # year out of the nanosecond range): row by row, naming the first bad one
-            found = pd.DatetimeIndex([parse_one(k) for k in idx])
-            found = found.tz_convert("UTC") if kw.get("utc") else found
+            stamps = [parse_one(k) for k in idx]
+            if kw.get("utc"):                   # offsets of every kind, as one zone
+                stamps = [t.tz_convert("UTC") for t in stamps]
+            found = pd.DatetimeIndex(stamps)
         return found.as_unit(TIME_UNIT)
 
     utc = np.empty(len(texts), dtype=f"datetime64[{TIME_UNIT}]")
