@@ -60,14 +60,14 @@ def test_absorbed_and_assimilation_results_share_one_base(engine):
                                                        rel=1e-12)
     assert carbon.canopy_gross_error_mol_m2 == pytest.approx(
         carbon.triangle_total_error / carbon.ground_m2, rel=1e-12)
-    area = (light.rect[2] - light.rect[0]) * (light.rect[3] - light.rect[1]) * 1e-4
-    assert light.triangle_total == pytest.approx(light.balance.absorbed_leaves * area,
-                                                 rel=1e-9)
+    # the leaves' absorbed light's error is the triangles' total's, in the balance's units
     assert light.absorbed_leaves_error == pytest.approx(
-        light.triangle_total_error / area, rel=1e-6)
+        light.triangle_total_error * light.balance.absorbed_leaves / light.triangle_total,
+        rel=1e-12)
     # tables per leaf without the canopy passed back, their sums the totals
-    assert day.table("leaf")["absorbed_mj"].sum() == pytest.approx(
-        day.triangle_total * 1e-6, rel=1e-9)
+    leaves = day.triangle_absorbed_j[:engine.canopy.n_triangles]        # then the stalks'
+    assert day.table("leaf")["absorbed_mj"].sum() == pytest.approx(leaves.sum() * 1e-6,
+                                                                   rel=1e-9)
     assert np.isclose(carbon.table("plant")["gross_mol"].sum(), carbon.triangle_total)
 
 

@@ -88,7 +88,8 @@ class TriangleResult(OnCanopy):
         Returns
         -------
         float
-            The total over the canopy's triangles.
+            The total over the result's triangles (absorbed light: the scene's, leaves then
+            stalks where they were traced; assimilation: the leaves').
         """
         return float(np.sum(self._triangle_values()))
 
