@@ -308,6 +308,10 @@ class Viewport(QtInteractor):
         self.key = Legend(self)
         self.key.move(10, 10)
         self.key.hide()
+        # the field's axes and a scale bar, painted by Qt from the camera after each frame
+        from maizeviz_app.view_overlay import ViewOverlay
+
+        self.overlay = ViewOverlay(self)
         self.canopy_mesh: pv.PolyData | None = None
         self.colouring = "leaf"
         #: What the "light" colouring shows: "classes" (a sun) or "values" (a sky, a day).
@@ -344,6 +348,11 @@ class Viewport(QtInteractor):
 
     def _on_frame(self, *_args) -> None:
         self.render_count += 1
+        cam = self.renderer.GetActiveCamera()
+        if hasattr(self, "overlay"):
+                self.overlay.update_from(
+                cam.GetPosition(), cam.GetFocalPoint(), cam.GetViewUp(), cam.GetViewAngle(),
+                cam.GetParallelScale() if cam.GetParallelProjection() else None)
         self.rendered.emit(self.render_count)
 
     # ------------------------------------------------------------------ canopy
@@ -752,6 +761,7 @@ class Viewport(QtInteractor):
     # ------------------------------------------------------------------ picking
     def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().resizeEvent(event)
+        self.overlay.place()
         if self.info.isVisible():
             self.info.set_lines(self.info.text().splitlines())
 
@@ -822,14 +832,68 @@ class Viewport(QtInteractor):
             part = part_mesh(self.canopy_mesh, instance, leaf)
         actor = self.actors.get("selection")
         if part is None:
+            changed = self._draw_others(False)
             if actor is not None and actor.GetVisibility():
                 actor.SetVisibility(False)
+                changed = True
+            if changed:
                 self.render()
             return False
         actor = self._highlight_actor()
         actor.mapper.dataset = part
         actor.SetVisibility(True)
+        self._draw_others(True)
         self.render()
+        return True
+
+    PROBE = "#ff6f00"
+
+    def show_probe(self, points, closed: bool = False) -> None:
+        """The probe's points (k, 3) cm and the line through them (closed: a polygon); none:
+        nothing drawn."""
+        for name in ("probe_points", "probe_line"):
+            if name in self.actors:
+                self.remove_actor(name, render=False)
+        pts = np.asarray(points, np.float64).reshape(-1, 3)
+        if len(pts):
+            self.add_mesh(pv.PolyData(pts), name="probe_points", color=self.PROBE,
+                          point_size=9, style="points", pickable=False, reset_camera=False,
+                          render=False, lighting=False)
+        if len(pts) >= 2:
+            order = list(range(len(pts))) + ([0] if closed and len(pts) >= 3 else [])
+            line = pv.PolyData(pts, lines=np.array([len(order), *order]))
+            self.add_mesh(line, name="probe_line", color=self.PROBE, line_width=3,
+                          pickable=False, reset_camera=False, render=False, lighting=False)
+        self.render()
+
+    def set_others(self, mode: str) -> None:
+        """How the plants other than the selection are drawn while there is one: "shown",
+        "faded" (the selection seen through them) or "hidden" (the selection alone)."""
+        from maizeviz_app.view_state import OTHERS
+
+        if mode not in OTHERS:
+            raise ValueError(f"unknown mode {mode}; one of {', '.join(OTHERS)}")
+        self.others = mode
+        actor = self.actors.get("selection")
+        if self._draw_others(actor is not None and bool(actor.GetVisibility())):
+            self.render()
+
+    def _draw_others(self, selected: bool) -> bool:
+        """The canopy drawn as :attr:`others` says (as it is without a selection); whether
+        anything changed."""
+        from maizeviz_app.view_state import FADED_OPACITY
+
+        actor = self._canopy_actor
+        if actor is None:
+            return False
+        mode = getattr(self, "others", "shown") if selected else "shown"
+        visible = mode != "hidden"
+        opacity = FADED_OPACITY if mode == "faded" else 1.0
+        prop = actor.GetProperty()
+        if bool(actor.GetVisibility()) == visible and prop.GetOpacity() == opacity:
+            return False
+        actor.SetVisibility(visible)
+        prop.SetOpacity(opacity)
         return True
 
     def _highlight_actor(self):
