@@ -304,8 +304,10 @@ def test_per_plant_tables_add_up_to_the_balance(homogeneous):
     assert (table["sunlit_area_cm2"] <= table["leaf_area_cm2"] + 1e-9).all()
     assert "absorbed_umol_s" not in table                         # NIR: no photon count
     assert list(got.table("balance").columns[:2]) == ["band", "incident"]
+    # the result knows its canopy: a leaf table without passing it back is the same table
+    assert got.table("leaf").equals(got.table("leaf", homogeneous))
     with pytest.raises(MaizevizError, match="needs the canopy") as info:
-        got.table("leaf")
+        got.with_canopy(None).table("leaf")                   # one read back, say
     assert info.value.quantity == "canopy"
     assert got.table().equals(got.table("balance"))            # the default: the balance
 
