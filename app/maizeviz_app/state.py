@@ -216,6 +216,7 @@ class StudyState:
         self.selection = Selection()
         self.history = History()
         self._watch_history()
+        self.settings.together = self.history.step      # settings.set: one step
         self.view_light.connect(self._light_colouring)
         self.canopy_changed.connect(lambda _built: self._check_colouring())
 
