@@ -722,12 +722,6 @@ class DigitizerPanel(QWidget):
         if not self.recording:
             self.plant.clear()
 
-    def wait_closed(self, msecs: int = 10_000) -> bool:
-        """Wait for the port to be closed after :meth:`stop` (tests, the window closing)."""
-        ok = self._close_pool.waitForDone(msecs)
-        QApplication.processEvents()
-        return ok
-
     def may_close(self, parent: QWidget | None = None) -> bool:
         """Ask before the window closes while recording; True when it may close."""
         if not self.confirm_close or (not self.recording and self._connecting is None):
