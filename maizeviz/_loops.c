@@ -71,9 +71,11 @@ static void quad_row(int64_t n, double tol, const double *restrict h0x,
  * grid edge of the triangle is no longer than rel_tol2 x the grid's longest squared edge
  * (what _grid_areas leaves out). Each grid's edges and diagonals are computed once, into
  * scratch arrays one coordinate apart, so that the triangles' loop runs in SIMD lanes.
- * Returns 0, or -3 out of memory. */
+ * Returns 0, -2 for a grid under 2 x 2 or a negative count (nothing written), or -3 out of
+ * memory. */
 MZ_EXPORT int mz_grid_twice_areas(const double *vertices, int64_t nl, int64_t a, int64_t b,
                                   double rel_tol2, double *first, double *second) {
+    if (nl < 0 || a < 2 || b < 2) return -2;
     const int64_t row = 3 * b, grid = a * row, q = (a - 1) * (b - 1), c = b - 1;
     const int64_t nh = a * c, nw = (a - 1) * b;
     double *buf = malloc(sizeof(double) * (size_t)(4 * nh + 4 * nw + 3 * q));
@@ -174,11 +176,17 @@ static void chord_distances(int64_t n, const double *restrict x, const double *r
 /* For R lines of nl grids whose x, y, z are three (nl, m, n) float64 arrays (C order): the
  * largest distance of line[r]'s n points of grid leaf[r] from the chords joining, point by
  * point, lines lo[r] and hi[r] of that grid, as simplify.py's _segment_distance(...).max()
- * computes it (a NaN if any distance is). Returns 0, or -3 out of memory. */
-MZ_EXPORT int mz_chord_errors(const double *x, const double *y, const double *z, int64_t m,
-                              int64_t n, int64_t r_count, const int64_t *leaf,
+ * computes it (a NaN if any distance is). Returns 0, -2 for an index outside the grids or
+ * n < 1 (nothing written), or -3 out of memory. */
+MZ_EXPORT int mz_chord_errors(const double *x, const double *y, const double *z, int64_t nl,
+                              int64_t m, int64_t n, int64_t r_count, const int64_t *leaf,
                               const int64_t *line, const int64_t *lo, const int64_t *hi,
                               double *out) {
+    if (n < 1 || m < 0 || nl < 0 || r_count < 0) return -2;
+    for (int64_t r = 0; r < r_count; ++r)     /* every index first: all or nothing written */
+        if (leaf[r] < 0 || leaf[r] >= nl || line[r] < 0 || line[r] >= m || lo[r] < 0
+                || lo[r] >= m || hi[r] < 0 || hi[r] >= m)
+            return -2;
     double *d = malloc(sizeof(double) * (size_t)(n > 0 ? n : 1));
     if (d == NULL) return -3;
     for (int64_t r = 0; r < r_count; ++r) {
@@ -205,11 +213,14 @@ MZ_EXPORT int mz_chord_errors(const double *x, const double *y, const double *z,
  * (nl, nk), out (nl, na, nk - degree - 1) zero but for each point's degree + 1 values. The
  * span is the count of knots at most x, less one, kept within degree .. n_control - 1; the
  * values come from the same divisions, products and sums in the same order (a first sum
- * 0.0 + y included, which turns -0.0 into 0.0 as numpy's does). degree <= 15. Returns 0, or
- * -1 for a degree past 15. */
+ * 0.0 + y included, which turns -0.0 into 0.0 as numpy's does). degree <= 15. Returns 0, -1
+ * for a degree past 15, or -2 for fewer than 2 (degree + 1) knots a row (a clamped vector
+ * needs degree + 1 at each end: with fewer, the span's knots k[span - degree + 1 ..
+ * span + degree] reach outside the row), nothing written. */
 MZ_EXPORT int mz_basis_matrix(const double *x, const double *knots, int64_t nl, int64_t na,
                               int64_t nk, int64_t degree, double *out) {
     if (degree > 15 || degree < 0) return -1;
+    if (nk < 2 * (degree + 1) || nl < 0 || na < 0) return -2;
     const int64_t nctrl = nk - degree - 1;
     for (int64_t l = 0; l < nl; ++l) {
         const double *k = knots + l * nk;

@@ -14,10 +14,11 @@ import sys
 from importlib.metadata import PackageNotFoundError, version
 
 #: The packages maizeviz needs, then those of its extras (gui, sweep), as their
-#: distributions are named.
-REQUIRED = ("numpy", "scipy", "pandas", "pvlib", "embreex", "meshio", "matplotlib", "pyserial")
-OPTIONAL = ("PySide6", "pyvista", "pyvistaqt", "psygnal", "dask", "distributed", "pyarrow",
-            "tqdm")
+#: distributions are named (pyproject.toml's; tests/core/test_hostile_surfaces.py holds
+#: them to it: plyfile was missing and pyarrow, required, was listed as optional).
+REQUIRED = ("numpy", "scipy", "pandas", "pvlib", "embreex", "meshio", "plyfile", "matplotlib",
+            "pyserial", "pyarrow")
+OPTIONAL = ("PySide6", "pyvista", "pyvistaqt", "psygnal", "dask", "distributed", "tqdm")
 
 
 def _version(name: str) -> str:
@@ -46,7 +47,9 @@ def info() -> dict[str, object]:
         ``kernel`` ("packets" or "embreex"), ``kernel_why``, ``kernel_module`` (the built
         kernel's file), ``scene_fill`` ("copy" or "embreex"), ``scene_fill_why``, ``loops``
         ("compiled" or "numpy": the loops of :mod:`maizeviz.loops`), ``loops_why``, ``cores``,
-        ``usable_cores``, ``threads`` (what light traces on by default).
+        ``usable_cores``, ``threads`` (what light traces on by default), ``embree_isa`` (the
+        instruction set Embree traces with: ``MAIZEVIZ_EMBREE_ISA``'s, or the CPU's best, or
+        why the variable is refused), ``embree_isas`` (those Embree accepts on this CPU).
     """
     from maizeviz import __version__, loops
     from maizeviz.mesh.embree_fill import embree
@@ -54,6 +57,13 @@ def info() -> dict[str, object]:
 
     e = embree()
     k = status()
+    from maizeviz.errors import MaizevizError
+    from maizeviz.mesh.embree_isa import requested, supported
+
+    try:
+        isa = requested() or "the CPU's best"
+    except MaizevizError as exc:
+        isa = f"refused: {exc}"
     return {
         "maizeviz": __version__,
         "python": f"{platform.python_version()} ({platform.python_implementation()}, "
@@ -64,6 +74,8 @@ def info() -> dict[str, object]:
         "embreex": e.embreex or "not importable",
         "embree": e.version or "not found",
         "embree_library": str(e.path) if e.path else None,
+        "embree_isa": isa,
+        "embree_isas": list(supported()),
         "kernel": k.name,
         "kernel_why": k.why or f"Embree's ray packets of {DEFAULT_WIDTH}",
         "kernel_module": str(k.path) if k.path else None,
@@ -91,6 +103,8 @@ def report() -> str:
         f"packages: {packages}",
         f"optional: {optional}",
         f"Embree {d['embree']} (embreex {d['embreex']}): {d['embree_library'] or 'not found'}",
+        f"Embree instruction set: {d['embree_isa']} (this CPU: "
+        f"{', '.join(d['embree_isas']) or 'none'}; MAIZEVIZ_EMBREE_ISA chooses)",  # type: ignore[arg-type]
         f"ray kernel: {kernel}" + (f": {d['kernel_module']}" if d["kernel_module"] else ""),
         f"scene fill: {d['scene_fill']} ({d['scene_fill_why']})",
         f"compiled loops: {d['loops']} ({d['loops_why']})",

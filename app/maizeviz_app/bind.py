@@ -5,6 +5,11 @@
 project opened, an undo, a script) sets the widget, without the widget echoing it back. The
 widget gets the field's range where it has one, and an accessible name (its label, what screen
 readers say and tests find it by) when it has none yet.
+
+Ctrl+Z and Ctrl+Shift+Z in a bound spin box or line edit are the study's Undo and Redo (the
+Edit menu's), not the box's own undo of its text: what was typed is already a step of the
+study's history (:mod:`maizeviz_app.history`), and the box's undo would change the text
+without the history knowing.
 """
 
 from __future__ import annotations
@@ -12,7 +17,8 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any
 
-from PySide6.QtCore import QDate, QSignalBlocker
+from PySide6.QtCore import QDate, QEvent, QObject, QSignalBlocker
+from PySide6.QtGui import QKeyEvent, QKeySequence
 from PySide6.QtWidgets import (
     QAbstractButton,
     QAbstractSpinBox,
@@ -49,6 +55,32 @@ def bind(widget: QWidget, group: Any, name: str, label: str = "") -> None:
         widget.setAccessibleName(label)
     if isinstance(widget, QAbstractSpinBox):
         widget.setKeyboardTracking(True)
+    if isinstance(widget, (QAbstractSpinBox, QLineEdit)):
+        widget.installEventFilter(_study_undo_keys(widget))
+
+
+class _StudyUndoKeys(QObject):
+    """Lets Undo and Redo keys pass a text box to the window's shortcuts."""
+
+    KEYS = (QKeySequence.StandardKey.Undo, QKeySequence.StandardKey.Redo)
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:  # noqa: N802 - Qt's name
+        if event.type() == QEvent.Type.ShortcutOverride and isinstance(event, QKeyEvent) \
+                and any(event.matches(k) for k in self.KEYS):
+            event.ignore()                      # not overridden: the shortcut runs
+            return True
+        return False
+
+
+def _study_undo_keys(widget: QWidget) -> _StudyUndoKeys:
+    """The filter, one per application (parented to it, so it lives as long)."""
+    from PySide6.QtWidgets import QApplication
+
+    app = QApplication.instance()
+    found = app.findChild(_StudyUndoKeys) if app is not None else None
+    if found is None:
+        found = _StudyUndoKeys(app if app is not None else widget)
+    return found
 
 
 def _attach(widget: QWidget, group: Any, name: str) -> Callable[[Any], None]:
@@ -108,8 +140,8 @@ def _set_range(widget: QDoubleSpinBox | QSpinBox, group: Any, name: str) -> None
 
 def bind_text(box: QComboBox, group: Any, name: str) -> None:
     """An editable combo box's text (a choice or what is typed) bound to ``group.<name>``,
-    both ways (the digitizer's serial port: listed ports, or one typed)."""
-    box.currentTextChanged.connect(lambda v: _set(group, name, v.strip()))
+    both ways (the digitizer's serial port: listed ports, or one typed); the box starts with
+    the field's value."""
 
     def follow(value: Any, *_old: Any) -> None:
         if box.currentText().strip() != value:
@@ -119,6 +151,8 @@ def bind_text(box: QComboBox, group: Any, name: str) -> None:
                     box.setCurrentIndex(k)
                 box.setEditText(value)
 
+    follow(getattr(group, name))
+    box.currentTextChanged.connect(lambda v: _set(group, name, v.strip()))
     getattr(group.events, name).connect(follow)
     box.destroyed.connect(lambda *_: _disconnect(group, name, follow))
 

@@ -1,8 +1,8 @@
 """The model's actions that make a canopy: open a points file, read a canopy mesh, build at
 the level the settings say (no Qt: the work goes to the model's runner).
 
-Methods of :class:`maizeviz_app.model.StudyModel` (``study``: the model); see there for the
-state these use.
+Functions over the study's state (``study``: a :class:`maizeviz_app.state.StudyState`, whose
+public changes they call); :class:`maizeviz_app.model.StudyModel` offers them as methods.
 """
 
 from __future__ import annotations
@@ -12,9 +12,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from maizeviz.errors import MaizevizError
+from maizeviz_app import lighting
 
 if TYPE_CHECKING:
-    from maizeviz_app.model import StudyModel
+    from maizeviz_app.state import StudyState
 
 #: The level the view draws the plants around the sampled tile at, when the canopy has more
 #: triangles than the view's budget (maizeviz_app.viewport.VIEW_BUDGET).
@@ -28,7 +29,7 @@ def count(n: int, one: str, many: str | None = None) -> str:
     return f"{n} {one if n == 1 else many or one + 's'}"
 
 
-def open_points(study: StudyModel, path: str | Path, layout: Any = None) -> None:
+def open_points(study: StudyState, path: str | Path, layout: Any = None) -> None:
     """Read a points file (laid out as ``layout``, else tiled as the layout shown) in a
     job; then build it. The current canopy stays until it has loaded."""
     from maizeviz_app import jobs
@@ -42,10 +43,10 @@ def open_points(study: StudyModel, path: str | Path, layout: Any = None) -> None
         return loaded, Path(p).read_bytes()
 
     study.runner.run("load", f"reading {Path(path).name}", load, path,
-                    on_done=lambda r: study.points_loaded(r[0], r[1], None, r[0].path),
+                    on_done=lambda r: points_loaded(study, r[0], r[1], None, r[0].path),
                     on_error=lambda e: study.fail(e, "open points"))
 
-def points_loaded(study: StudyModel, loaded, points_bytes: bytes, project: str | None,
+def points_loaded(study: StudyState, loaded, points_bytes: bytes, project: str | None,
                   origin: str) -> None:
     """Points read (from a file or a project): they replace the study, then are built."""
     study.set_points(loaded, points_bytes, origin, project,
@@ -57,9 +58,9 @@ def points_loaded(study: StudyModel, loaded, points_bytes: bytes, project: str |
     study.say(f"{count(len(loaded.leaves), 'leaf', 'leaves')} of "
              f"{count(len(loaded.plants), 'plant')}; "
              f"{len(loaded.layout.placements)} plants in the canopy")
-    study.build()
+    build(study)
 
-def open_mesh(study: StudyModel, path: str | Path, unit: str | None = None, up: str = "z",
+def open_mesh(study: StudyState, path: str | Path, unit: str | None = None, up: str = "z",
               field: str | tuple[float, float, float, float] | None = None) -> None:
     """Read a canopy mesh in a job (:func:`maizeviz.canopy.from_mesh.read_mesh_canopy`:
     ``unit`` cm, m or mm, None: cm, refused when the size says otherwise; ``field`` x0,
@@ -96,20 +97,20 @@ def open_mesh(study: StudyModel, path: str | Path, unit: str | None = None, up: 
         return notes, (canopy, m, read_s, measure_s, mesh, tuple(TABLE2_COLUMNS), row)
 
     study.runner.run("load", f"reading {Path(path).name}", work,
-                    on_done=lambda out: study._mesh_read(path, *out),
+                    on_done=lambda out: _mesh_read(study, path, *out),
                     on_error=lambda e: study.fail(e, "open mesh"))
 
-def _mesh_read(study: StudyModel, path: str, notes: list, parts: tuple) -> None:
+def _mesh_read(study: StudyState, path: str, notes: list, parts: tuple) -> None:
     from maizeviz_app import jobs
 
     study.set_mesh(path)
     canopy, m, read_s, measure_s, mesh, columns, row = parts
     for note in [*notes, *canopy.layout.warnings]:         # the latter say the field
         study.say(f"note: {note}")
-    study._built(jobs.Built(MESH_LEVEL, MESH_LEVEL, canopy, m, read_s, measure_s, mesh,
+    _built(study, jobs.Built(MESH_LEVEL, MESH_LEVEL, canopy, m, read_s, measure_s, mesh,
                            columns, row, study.serial))
 
-def build(study: StudyModel) -> None:
+def build(study: StudyState) -> None:
     """Build the canopy at ``settings.canopy`` (level, area preservation) in a job; a
     running build is superseded. Work too large for this machine is refused; work over a
     quarter of an hour is asked about (:attr:`confirm_slow`)."""
@@ -146,43 +147,26 @@ def build(study: StudyModel) -> None:
     stage = [layout_cost(loaded.leaves, loaded.layout, parse_level(level)),
              cover_cost(loaded.layout, jobs.APP_COVER_RESOLUTION_CM)]
     if not study.affordable([stage], "build"):
-        shown = study.built is not None and study.built.serial == serial
-        if shown:                           # the level shown stays the level set
-            study.apply_settings("canopy", {"level": study.built.level})
+        built = study.built
+        shown = built is not None and built.serial == serial
+        if built is not None and shown:     # the level shown stays the level set
+            study.apply_settings("canopy", {"level": built.level})
         study.build_pending.emit("" if shown else
                                 "not built: choose a coarser level or fewer plants")
         return
     study.build_pending.emit(f"building: {parse_level(level).description}…")
     study.runner.run("build", f"building {parse_level(level).label}", work,
-                    on_done=study._built, on_error=lambda e: study.fail(e, "build"))
+                    on_done=lambda b: _built(study, b), on_error=lambda e: study.fail(e, "build"))
 
-def _built(study: StudyModel, built) -> None:
+def _built(study: StudyState, built) -> None:
     if not study.show_built(built):
         return
-    study.adopt_pending_runs()
-    study.complete_runs()
+    lighting.adopt_pending_runs(study)
+    lighting.complete_runs(study)
     study.view_light.emit(False)
     study.built_shown.emit(built.label)
 
-def affordable(study: StudyModel, stages, doing: str) -> bool:
-    """Whether to start work estimated as ``stages`` (lists of ``maizeviz.cost.Cost``): no,
-    with a message, when it would not fit in this machine's memory; when merely slow, as
-    :attr:`confirm_slow` answers."""
-    from maizeviz.cost import TooSlow, check
-
-    try:
-        check(stages)
-    except TooSlow as exc:
-        if study.confirm_slow(exc.estimate):
-            return True
-        study.say(f"not started: {exc.estimate}", status_only=True)
-        return False
-    except MaizevizError as exc:
-        study.fail(exc, doing)
-        return False
-    return True
-
-def cancel(study: StudyModel, kind: str | None = None) -> list[str]:
+def cancel(study: StudyState, kind: str | None = None) -> list[str]:
     """Stop the jobs of ``kind`` under way (every kind: None); what was stopped."""
     running = [j for j in study.runner.running() if kind is None or j.kind == kind]
     if not running:

@@ -6,11 +6,11 @@ from __future__ import annotations
 import csv
 
 from maizeviz.errors import MaizevizError
-from maizeviz_app.model import StudyModel
 from maizeviz_app.runs import day_title, plot_title
+from maizeviz_app.state import StudyState
 
 
-def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, {}, None)):
+def export_job(what: str, path: str, model: StudyState, heatmap: tuple = (None, {}, None)):
     """The work writing ``what`` of the study in ``model`` to ``path`` (atomically), to run
     in a worker as ``work(job, *args)``: returns ``(work, args)``. ``heatmap``: the light
     whose map is shown, the run shown for each light, the height shown (cm).
@@ -36,13 +36,14 @@ def export_job(what: str, path: str, model: StudyModel, heatmap: tuple = (None, 
     raise MaizevizError(f"unknown export '{what}'")
 
 
-def _canopy_job(path: str, model: StudyModel):
+def _canopy_job(path: str, model: StudyState):
     """The canopy's mesh with each triangle's light (the sun's class and sunlit share, the
     sky's and the day's light per m2 of leaf)."""
-    if model.canopy is None:
+    built = model.built
+    if built is None:
         raise MaizevizError("no canopy to export yet")
-    canopy = model.canopy
-    signature = model.signature(model.built.label)
+    canopy = built.canopy
+    signature = model.signature(built.label)
     # the names of `maizeviz light --export` (maizeviz.light.report.mesh_export.LIGHT_ARRAYS)
     cells = {}
     run = model.runs.for_signature(signature)
@@ -67,7 +68,7 @@ def _canopy_job(path: str, model: StudyModel):
     return work, ()
 
 
-def _measures_job(path: str, model: StudyModel):
+def _measures_job(path: str, model: StudyState):
     """Table 2's measures of the canopies built."""
     if not model.measures_rows:
         raise MaizevizError("no canopy measures to export yet")
@@ -81,7 +82,7 @@ def _measures_job(path: str, model: StudyModel):
     return work, ()
 
 
-def _table_job(path: str, model: StudyModel):
+def _table_job(path: str, model: StudyState):
     """Transmission by height of the runs compared."""
     header, table_rows = model.runs.table()
 
@@ -96,7 +97,7 @@ def _table_job(path: str, model: StudyModel):
     return work, ()
 
 
-def _heatmap_job(path: str, model: StudyModel, heatmap: tuple):
+def _heatmap_job(path: str, model: StudyState, heatmap: tuple):
     """The heatmap shown (its light, run and height), as shown."""
     shown_kind, shown_runs, height = heatmap
     last = model.runs.last
@@ -120,7 +121,7 @@ def _heatmap_job(path: str, model: StudyModel, heatmap: tuple):
     return work, ()
 
 
-def _plot_job(path: str, model: StudyModel):
+def _plot_job(path: str, model: StudyState):
     """The transmission curves of the runs compared."""
     from maizeviz_app import plots
 
@@ -135,17 +136,20 @@ def _plot_job(path: str, model: StudyModel):
     return work, ()
 
 
-def _diffuse_job(what: str, path: str, model: StudyModel):
-    """The day's steps CSV and figure, the per-leaf and per-plant CSV of the last sky or
-    day (the day when both)."""
+def _diffuse_job(what: str, path: str, model: StudyState):
+    """The day's steps CSV and figure (the last day's); the per-leaf and per-plant CSV of the
+    latest result with light per leaf: a sky, a day, or a sun traced with leaf optics (its
+    absorbed light, and its CO2 assimilation with a leaf model)."""
     day = model.runs.of_kind("day")
-    run = day if day is not None else model.runs.of_kind("sky")
     if what in ("steps", "day") and day is None:
         raise MaizevizError("no day computed yet: choose Day in the light panel and "
                             "compute the day's light first")
+    run = day if what in ("steps", "day") else model.runs.with_plants()
     if run is None:
-        raise MaizevizError("no sky or day computed yet: choose Sky or Day in the light "
-                            "panel and compute first")
+        raise MaizevizError("no light per leaf computed yet: compute a sky, a day, or a sun "
+                            "with leaf optics first")
+    if run.kind == "sun":
+        return _absorbed_table_job(what, path, run, model)
     light, extra, label = run.result, run.extra, run.label
     if what == "steps":
         def work(job):
@@ -176,3 +180,29 @@ def _diffuse_job(what: str, path: str, model: StudyModel):
         write_rows(path, rows if what == "leaves" else plant_light(rows))
         return path
     return write_table, ()
+
+
+def _absorbed_table_job(what: str, path: str, run, model: StudyState):
+    """The light each leaf or plant absorbed in a sun traced with leaf optics, with its
+    gross CO2 assimilation when a leaf model was chosen (the tables of ``maizeviz light
+    --leaf-light / --plant-light``)."""
+    canopy, label = model.canopy, run.label
+    if canopy is None or run.signature != model.shown_signature:
+        raise MaizevizError(f"the light per leaf of the sun on {label} is computed against "
+                            f"its canopy: show level {label} first")
+    light, assimilation = run.extra.light, run.extra.assimilation
+
+    def work(job):
+        from maizeviz.io.atomic import write_rows
+
+        kind = "leaf" if what == "leaves" else "plant"
+        frame = light.table(kind, canopy)
+        if assimilation is not None:
+            keys = ["instance", "plant", "leaf"] if kind == "leaf" else ["instance"]
+            carbon = assimilation.table(kind, canopy)
+            new = [c for c in carbon.columns if c not in frame.columns or c in keys]
+            frame = frame.merge(carbon[new], on=keys, how="left")
+        frame.insert(0, "level", label)
+        write_rows(path, frame.to_dict("records"))
+        return path
+    return work, ()

@@ -3,8 +3,8 @@ canopy shown, sun angles from a place and time, the heatmap of another height, a
 of a project made whole against their canopy (no Qt: the work goes to the model's runner, the
 Embree work to its light process).
 
-Methods of :class:`maizeviz_app.model.StudyModel` (``study``: the model); see there for the
-state these use.
+Functions over the study's state (``study``: a :class:`maizeviz_app.state.StudyState`, whose
+public changes they call); :class:`maizeviz_app.model.StudyModel` offers them as methods.
 """
 
 from __future__ import annotations
@@ -13,18 +13,19 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from maizeviz.errors import MaizevizError
-from maizeviz_app.runs import MODES, Run, day_summary, plot_title, run_info
+from maizeviz_app.runs import MODES, Run, day_summary, plot_title, run_info, run_warnings
 from maizeviz_app.settings import InputProblem
 
 if TYPE_CHECKING:
-    from maizeviz_app.model import StudyModel
+    from maizeviz_app.jobs import Built
+    from maizeviz_app.state import StudyState
 
 #: What a light computation is called while it runs, per light.
 RUNNING_TEXT = {"sun": "computing direct light", "sky": "computing diffuse light",
                 "day": "computing the day's light"}
 
 
-def light_job(study: StudyModel) -> tuple[str, str, tuple, Any, Any, Any]:
+def light_job(study: StudyState) -> tuple[str, str, tuple, Any, Any, Any]:
     """What a light computation of the settings would trace: (light, core op, its
     arguments, the settings results are compared by, heights, optics or None).
 
@@ -49,7 +50,7 @@ def light_job(study: StudyModel) -> tuple[str, str, tuple, Any, Any, Any]:
     day = s.day_spec()
     return mode, "period", (sampling, sky, day), (day, sky), sampling.heights_cm, None
 
-def compute_light(study: StudyModel) -> bool:
+def compute_light(study: StudyState) -> bool:
     """Compute the light the settings choose (sun, sky or day) on the canopy shown, in the
     light process (which keeps the canopy's Embree scene); False if it did not start."""
     if study.closing:
@@ -59,21 +60,16 @@ def compute_light(study: StudyModel) -> bool:
         return False
     mode = study.settings.light.mode
     try:
-        mode, op, args, compared, heights, optics = study.light_job()
+        mode, op, args, compared, heights, optics = light_job(study)
     except (InputProblem, MaizevizError) as exc:
         study.fail(exc, "light", mode)
         return False
-    if not study.affordable([study._light_costs(mode, args, heights, optics)], "light"):
+    if not study.affordable([_light_costs(study.built, mode, args, heights, optics)], "light"):
         return False
-    from maizeviz_app import plots
-
     canopy, label = study.canopy, study.built.label
     signature = study.signature(label)
     sampling_key = study.settings.sampling_key(heights)
-    runs = study.runs.copy()
     key, runner = study.canopy_key, study.runner
-    first = max(study.figures.shown_index, 0)
-    look = plots.Look.of(study.colour, study.figures.shown_for)
 
     def work(job):
         out = runner.light_process.call(op, key, canopy, args, job)
@@ -91,25 +87,22 @@ def compute_light(study: StudyModel) -> bool:
                       painting=painting)
         else:
             run = Run(label, signature, out.light, None, mode, out)
-        maps = plots.heatmap_images(run.result, first=first, check=job.check, kind=mode,
-                                    look=look.sharing(mode, run.result))
-        runs.add(run, compared, sampling_key)
-        plot = plots.rgba(plots.transmission_figure(runs.curves(), plot_title(runs)))
-        return run, compared, sampling_key, maps, plot
+        return run, compared, sampling_key
 
     study.light_running.emit(f"{RUNNING_TEXT[mode]} on {label}…")
-    study.runner.run("light", f"{mode} light on {label}", work, on_done=study._lit,
-                    on_error=lambda e: study._light_failed(e, mode))
+    study.runner.run("light", f"{mode} light on {label}", work,
+                     on_done=lambda out: _lit(study, out),
+                     on_error=lambda e: _light_failed(study, e, mode))
     return True
 
-def _light_costs(study: StudyModel, mode: str, args: tuple, heights, optics=None) -> list:
-    """What a light run of ``mode`` on the canopy shown will cost (``maizeviz.cost``): its
+def _light_costs(built: Built, mode: str, args: tuple, heights, optics=None) -> list:
+    """What a light run of ``mode`` on the canopy ``built`` will cost (``maizeviz.cost``): its
     rays (times the directions: the sun, the sky's, a day's steps; with leaf optics, the
     absorbed light's beams and their scattering) and its heatmaps."""
     from maizeviz.cost import light_costs
     from maizeviz_app.plots import HEATMAP_BIN_CM
 
-    rect = args[0].rect or study.canopy.layout.centre_bounds
+    rect = args[0].rect or built.canopy.layout.centre_bounds
     directions = 1
     if optics is not None:                          # the beams, each scattered ~3 times
         directions += 3 * (1 + (46 if optics.diffuse_w_m2 > 0 else 0))
@@ -118,16 +111,17 @@ def _light_costs(study: StudyModel, mode: str, args: tuple, heights, optics=None
         if mode == "day":
             directions += args[2].steps_bound()
     return light_costs(rect, args[0].density, len(heights), directions, 1, HEATMAP_BIN_CM,
-                       study.built.measures.triangles)
+                       built.measures.triangles)
 
-def _light_failed(study: StudyModel, exc: BaseException, mode: str = "sun") -> None:
+def _light_failed(study: StudyState, exc: BaseException, mode: str = "sun") -> None:
     study.light_running.emit("")
     study.fail(exc, "light", mode)
 
-def _lit(study: StudyModel, out) -> None:
-    """A light result: table, summary, plants, figures and colours change together;
-    nothing shown is dropped unless a new comparison starts."""
-    run, compared, sampling_key, maps, plot = out
+def _lit(study: StudyState, out) -> None:
+    """A light result: table, summary, plants and colours change together, then its figures
+    (when drawn, :attr:`StudyState.draw_figures`); nothing shown is dropped unless a new
+    comparison starts."""
+    run, compared, sampling_key = out
     study.light_running.emit("")
     if run.signature[0] != study.serial:
         return
@@ -146,11 +140,7 @@ def _lit(study: StudyModel, out) -> None:
         study.set_plants_run(None)
     f = study.figures
     f.keep_only({k for k in f.shown_for if study.runs.of_kind(k) is not None} | {run.kind})
-    f.set_maps(run.kind, run, maps)
-    if study.colour.shared:                     # the others' scale includes this run
-        f.restyle(keep=run.kind)
-    f.set_plot(plot)
-    for w in r.warnings:
+    for w in run_warnings(run):
         study.say(f"{'note' if 'sun never rises' in w else 'warning'}: {w}")
     if study.shown_signature == run.signature:
         study.view_light.emit(True)
@@ -161,9 +151,43 @@ def _lit(study: StudyModel, out) -> None:
         study.say(f"{run.name}: transmission "
                  + ", ".join(f"{t:.3f}" for t in run.transmission) + " at "
                  + ", ".join(f"{h:g}" for h in r.heights_cm) + " cm", status_only=True)
-    study.light_shown.emit()
+    if study.draw_figures:
+        draw_figures(study, run)                # light_shown once they are drawn
+    else:
+        study.light_shown.emit()
 
-def draw_heatmap(study: StudyModel, kind: str, index: int) -> None:
+
+def draw_figures(study: StudyState, run: Run) -> None:
+    """The figures of a new light result, drawn in a job of their own (matplotlib, 0.3-1 s a
+    figure): its heatmap at the height shown (the others when asked for,
+    :func:`draw_heatmap`) and the transmission plot of every result compared; then
+    ``light_shown``. Only where they are shown (:attr:`StudyState.draw_figures`)."""
+    from maizeviz_app import plots
+
+    f = study.figures
+    first = max(f.shown_index, 0)
+    look = plots.Look.of(study.colour, f.shown_for).sharing(run.kind, run.result)
+    curves, title = study.runs.curves(), plot_title(study.runs)
+
+    def work(job):
+        maps = plots.heatmap_images(run.result, first=first, check=job.check, kind=run.kind,
+                                    look=look)
+        return maps, plots.rgba(plots.transmission_figure(curves, title))
+
+    def done(out) -> None:
+        maps, plot = out
+        if study.runs.of_kind(run.kind) is run:         # else: a newer result has its own
+            f.set_maps(run.kind, run, maps)
+            if study.colour.shared:             # the others' scale includes this run
+                f.restyle(keep=run.kind)
+            f.set_plot(plot)
+        study.light_shown.emit()
+
+    study.runner.run("figures", "drawing the light figures", work, on_done=done,
+                     on_error=lambda e: study.fail(e, "light"))
+
+
+def draw_heatmap(study: StudyState, kind: str, index: int) -> None:
     """The heatmap of another height of a result shown, drawn in a job."""
     run = study.figures.shown_for.get(kind)
     if run is None:
@@ -181,7 +205,7 @@ def draw_heatmap(study: StudyModel, kind: str, index: int) -> None:
                      lambda job: plots.heatmap_image(result, height, kind=kind, look=look),
                      on_done=done, on_error=lambda e: study.fail(e, "light"))
 
-def sun_from_place(study: StudyModel) -> None:
+def sun_from_place(study: StudyState) -> None:
     """Sun angles from the date, time and place of ``settings.sun.place`` (pvlib, in a
     job); they become the sun's settings."""
     text = study.settings.sun.place
@@ -201,21 +225,33 @@ def sun_from_place(study: StudyModel) -> None:
                                 f"'{lon}'", quantity="place") from None
         return sun_at(date, clock, la, lo, tz)
 
-    study.runner.run("sun", "sun position", work, text, on_done=study._sun_found,
+    study.runner.run("sun", "sun position", work, text, on_done=lambda sun: _sun_found(study, sun),
                     on_error=lambda e: study.fail(e, "sun", "sun"))
 
-def _sun_found(study: StudyModel, sun) -> None:
+def _sun_found(study: StudyState, sun) -> None:
     # the sun's range (what its widget offers) holds a risen sun
     study.settings.set("sun", {"zenith_deg": round(min(sun.zenith_deg, 89.9), 2),
                               "azimuth_deg": round(sun.azimuth_deg % 360.0, 2)})
     study.say(f"sun at {sun.when}: zenith {sun.zenith_deg:.2f}°, azimuth "
              f"{sun.azimuth_deg:.2f}°")
 
-def choose_weather(study: StudyModel, path: str) -> None:
+def offset_zone(hours: float | None) -> str | None:
+    """The IANA zone of a fixed UTC offset of whole hours ("Etc/GMT-1" is UTC+01:00: the
+    Etc names count west), "UTC" for 0; None for no offset or one of part hours (no IANA
+    name holds it)."""
+    if hours is None or hours != int(hours) or not -14 <= hours <= 12:
+        return None
+    h = int(hours)
+    return "UTC" if h == 0 else f"Etc/GMT{-h:+d}"
+
+
+def choose_weather(study: StudyState, path: str) -> None:
     """A weather file chosen: the day's source becomes it and, when its header names a place
-    (EPW, TMY3, PSM), the day's latitude and longitude become that place, in one step of the
-    undo history (read in a job: pvlib's first import takes seconds). A sun traced away from
-    where the file was measured would not match its irradiance."""
+    (EPW, TMY3, PSM), the day's latitude and longitude become that place, and its time zone
+    the file's own (the fixed offset its times are written in), in one step of the undo
+    history (read in a job: pvlib's first import takes seconds). A sun traced away from
+    where the file was measured would not match its irradiance, and dates and clock times
+    are read in the file's zone."""
     def work(job, p):
         from maizeviz.io.weather_files import weather_place
 
@@ -227,22 +263,27 @@ def choose_weather(study: StudyModel, path: str) -> None:
         if lat is not None and lon is not None and -90 <= lat <= 90 and -180 <= lon <= 180:
             values.update(latitude=float(lat), longitude=float(lon))
             named = f", {place['name']}" if place.get("name") else ""
-            study.say(f"place: latitude {lat:g}, longitude {lon:g}{named} (the header of "
-                      f"{Path(path).name})")
-        study.settings.set("day", values)
+            zone = offset_zone(place.get("utc_offset_h"))
+            if zone is not None:
+                values["tz"] = zone
+            clock = f", time zone {zone}" if zone is not None else ""
+            study.say(f"place: latitude {lat:g}, longitude {lon:g}{named}{clock} (the header "
+                      f"of {Path(path).name})")
+        with study.history.step(f"weather file {Path(path).name}"):
+            study.settings.set("day", values)
 
     study.runner.run("weather", f"reading the place of {Path(path).name}", work, path,
                      on_done=done, on_error=lambda e: study.fail(e, "weather", "day"))
 
 # ------------------------------------------------------------------ a project's results
-def adopt_pending_runs(study: StudyModel) -> None:
+def adopt_pending_runs(study: StudyState) -> None:
     """Light results of an opened project (sun, sky and day) join the comparison once its
     canopy is built, shown as after a fresh run: table, plot, heatmaps, the day's summary,
     the plants' light and the canopy's colours (those of the results traced on the canopy
     shown are computed against it, the others' when their level is shown)."""
     if not study.pending_runs or study.built is None:
         return
-    from maizeviz_app import jobs, plots
+    from maizeviz_app import jobs
 
     pending, study.pending_runs = study.pending_runs, []
     absorbed = {s.label: s for s in pending if s.kind == "absorbed"}
@@ -277,12 +318,25 @@ def adopt_pending_runs(study: StudyModel) -> None:
         return
     day = shown.get("day")
     study.set_summary(day_summary(day.result) if day is not None else "")
-    study.set_plants_run(study.light_per_plant_run())
+    study.set_plants_run(light_per_plant_run(study))
     latest = study.runs.latest(here) or study.runs.last
     order = sorted(shown, key=lambda k: latest is not None and k == latest.kind)
     curves = study.runs.curves()
     title = plot_title(study.runs)
     study.figures.shown_for = dict(shown)
+    study.view_light.emit(True)
+    if study.draw_figures:
+        _draw_project_figures(study, shown, order, curves, title)
+    elif study.runner.current("complete") is None:
+        study.light_shown.emit()
+
+
+def _draw_project_figures(study: StudyState, shown: dict, order: list, curves, title: str
+                          ) -> None:
+    """The heatmaps of a project's results shown (``shown``: light -> run, drawn in
+    ``order``) and the transmission plot, in a job; then ``light_shown``."""
+    from maizeviz_app import plots
+
     results = [(k, shown[k].result) for k in order]
     look = plots.Look.of(study.colour, shown)
 
@@ -301,17 +355,14 @@ def adopt_pending_runs(study: StudyModel) -> None:
             study.light_shown.emit()
 
     study.runner.run("figures", "drawing the light figures", work, on_done=done,
-                    on_error=lambda e: study.fail(e, "light"))
-    study.view_light.emit(True)
+                     on_error=lambda e: study.fail(e, "light"))
 
-def light_per_plant_run(study: StudyModel) -> Run | None:
-    """The latest result with light per plant to show: a sky's, a day's or a sun's
-    absorbed light (once computed against its canopy)."""
-    runs = [r for r in study.runs.in_order()
-            if r.kind != "sun" or getattr(r.extra, "plant_rows", None) is not None]
-    return runs[-1] if runs else None
 
-def complete_runs(study: StudyModel) -> None:
+def light_per_plant_run(study: StudyState) -> Run | None:
+    """The latest result with light per plant to show (:meth:`LightRuns.with_plants`)."""
+    return study.runs.with_plants()
+
+def complete_runs(study: StudyState) -> None:
     """Results read from a project that were traced on the canopy shown get what the
     window shows of them, computed against it in a job: a sun's light class per
     triangle (and its absorbed light per leaf, with the CO2 assimilation of the leaf model
@@ -351,7 +402,7 @@ def complete_runs(study: StudyModel) -> None:
             else:
                 run.extra = value
         if study.shown_signature == here:
-            study.set_plants_run(study.light_per_plant_run())
+            study.set_plants_run(light_per_plant_run(study))
             study.view_light.emit(True)
             if study.runner.current("figures") is None:     # else: when they are drawn
                 study.light_shown.emit()

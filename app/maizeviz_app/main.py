@@ -12,7 +12,6 @@ pictures the Digitize workspace instead, during a Demo session (a simulated FAST
 
 from __future__ import annotations
 
-import argparse
 import importlib.util
 import os
 import sys
@@ -46,20 +45,10 @@ def gl_format() -> None:
 
 
 def run(argv: Sequence[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(prog="maizeviz", description="The maizeviz desktop app.")
-    ap.add_argument("points", nargs="?",
-                    help="points CSV, .maizeviz project or canopy mesh (.ply, .obj with plant "
-                         "and leaf ids, cm, z up) (default: the last one opened, or the "
-                         "bundled 3x3 block)")
-    ap.add_argument("--tile", type=int, default=3, choices=(1, 3, 5, 7, 9),
-                    help="tiling of the digitized block, N x N (default 3: the paper's 81 "
-                         "plants)")
-    ap.add_argument("--screenshot", metavar="PNG", help="save the window and quit")
-    ap.add_argument("--size", default="1366x768", metavar="WxH",
-                    help="window size for --screenshot (default 1366x768, a laptop screen)")
-    ap.add_argument("--workspace", choices=("analyse", "digitize"),
-                    help="start in this workspace (default: the one the app was closed in)")
-    args = ap.parse_args(argv)
+    from maizeviz.main_command import DEFAULT_TILE, main_parser
+
+    # the same command line as the headless report's (maizeviz.cli.main_job)
+    args = main_parser().parse_args(argv)
     os.environ.setdefault("QT_API", "pyside6")
     from PySide6.QtWidgets import QApplication
 
@@ -74,16 +63,12 @@ def run(argv: Sequence[str] | None = None) -> int:
         from maizeviz.resources import example_points
 
         points = str(example_points())
-    window = MainWindow(points, args.tile)
+    window = MainWindow(points, DEFAULT_TILE if args.tile is None else args.tile)
     if args.workspace:
         window.workspaces.show(args.workspace)
     code = {"value": 0}
     if args.screenshot:
-        try:
-            w, h = (int(v) for v in args.size.lower().split("x"))
-        except ValueError:
-            ap.error(f"--size must look like 1366x768, got {args.size}")
-        window.resize(w, h)
+        window.resize(*args.size)
         # nothing to save: without this the unsaved-results question waited, unanswered,
         # until the flow's 300 s timeout (and the exit code was 1)
         window.confirm_unsaved = False
@@ -153,7 +138,7 @@ def _digitize_screenshot_flow(app, window, path: str, code: dict, points: int = 
 
     def recorded(n: int) -> None:
         panel = window.digitizer
-        if n == points:
+        if n >= points and not panel.paused:    # (two points can show in one tick)
             panel.toggle_pause()
             panel.plant.wait()
             QTimer.singleShot(1500, shoot)

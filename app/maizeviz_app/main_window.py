@@ -94,12 +94,16 @@ class MainWindow(QMainWindow):
         self._settings = QSettings("maizeviz", "maizeviz")
         self.runner = JobRunner(self)
         self.model = StudyModel(tile, self.runner)
+        self.model.draw_figures = True    # the window shows them (a script draws none)
         self.undo = UndoRecorder(self.model, self)
         self.viewport: Viewport | None = None
         self.view_link = ViewLink(self)
         self._after_save = None           # what to do once the project is saved (close, open)
         self._progress_shown = 0.0
         self._view_ready = threading.Event()  # the build job waits for it before meshing
+        # the threads this window starts (warm-up, core processes): they end with it
+        self._threads: list[threading.Thread] = []
+        self._threads_stop = threading.Event()
         self._wire_model()
 
         self._centre = QStackedWidget()
@@ -175,8 +179,13 @@ class MainWindow(QMainWindow):
         self._wire_figures()
         from maizeviz_app.panels.colour import ColourPanel
 
-        self.colour_panel = ColourPanel(m.colour)
+        self.colour_panel = ColourPanel(m.colour, step=m.history.step)
         self.plots.heatmap.limits_shown.connect(self.colour_panel.heatmap_editor.show_limits)
+        from maizeviz_app.panels.instruments import InstrumentsPanel
+
+        self.instruments_panel = InstrumentsPanel(canopy=lambda: m.canopy)
+        self.instruments_panel.failed.connect(lambda text: self.say(f"error: {text}"))
+        m.built_shown.connect(lambda _label: self.instruments_panel.refresh())
         self.messages = docks.messages_widget()
         self.history = QUndoView(self.undo.stack)
         self.history.setEmptyLabel("the study as opened")
@@ -186,7 +195,9 @@ class MainWindow(QMainWindow):
                                              "light": ("Light", self.light_panel),
                                              "layout": ("Layout", None),
                                              "digitizer": ("Digitizer", None),
-                                             "colour": ("Colour", self.colour_panel)},
+                                             "colour": ("Colour", self.colour_panel),
+                                             "instruments": ("Instruments",
+                                                             self.instruments_panel)},
                                       self.plots, self.messages, self.history)
 
     def _wire_figures(self) -> None:
@@ -238,7 +249,7 @@ class MainWindow(QMainWindow):
         if self._closing:
             return
         self.say("starting: loading the core and the 3D view…", status_only=True)
-        warmed, view_ready = self._warmed, self._view_ready
+        warmed, view_ready, stop = self._warmed, self._view_ready, self._threads_stop
 
         def work():
             import importlib
@@ -247,9 +258,13 @@ class MainWindow(QMainWindow):
                 error = None
                 try:
                     for name in names:
+                        if stop.is_set():       # the window is closing: import no more
+                            return
                         importlib.import_module(name)
                 except Exception as exc:  # noqa: BLE001 - reported in the window
                     error = exc
+                if stop.is_set():               # closeEvent waits for this thread: the
+                    return                      # window still exists, but says nothing more
                 try:
                     warmed.emit(stage, error)
                 except RuntimeError:            # the window is gone
@@ -259,7 +274,25 @@ class MainWindow(QMainWindow):
                 if error is not None:
                     return
 
-        threading.Thread(target=work, name="maizeviz-warm-up", daemon=True).start()
+        self._start_thread(work, "maizeviz-warm-up")
+
+    def _start_thread(self, target, name: str) -> None:
+        """Start a thread that :meth:`closeEvent` waits for."""
+        if self._closing:
+            return
+        t = threading.Thread(target=target, name=name, daemon=True)
+        self._threads.append(t)
+        t.start()
+
+    def _end_threads(self, timeout: float = 60.0) -> None:
+        """Tell this window's threads to stop and wait for them (an import under way
+        finishes first: one left running at exit can touch Qt, or import, while the
+        interpreter shuts down)."""
+        self._threads_stop.set()
+        deadline = time.monotonic() + timeout
+        for t in self._threads:
+            t.join(max(0.0, deadline - time.monotonic()))
+        self._threads = [t for t in self._threads if t.is_alive()]
 
     def _on_warmed(self, stage: str, error) -> None:
         if self._closing:
@@ -270,8 +303,7 @@ class MainWindow(QMainWindow):
                      "extra: pip install \"maizeviz[gui]\"", error=True)
             return
         if stage == "core":
-            threading.Thread(target=self._start_processes, name="maizeviz-processes",
-                             daemon=True).start()
+            self._start_thread(self._start_processes, "maizeviz-processes")
             if self._to_open:
                 self.open_any(self._to_open)
         elif stage == "view":
@@ -283,6 +315,7 @@ class MainWindow(QMainWindow):
             self.viewport = Viewport(self._centre)
             self.viewport.set_colour_scale(self.model.colour.view)
             self.viewport.limits_shown.connect(self.colour_panel.view_editor.show_limits)
+            self.view_link.attach(self.viewport)
             from maizeviz_app.linked import LinkedSelection
 
             self.linked = LinkedSelection(self.model, self.viewport, self.light_panel.plants,
@@ -297,22 +330,39 @@ class MainWindow(QMainWindow):
 
             gc.freeze()       # start-up objects out of the collector's way: shorter pauses
 
+    def _restore_connection(self) -> None:
+        """The digitizer's port and baud of the last connection (QSettings) into the study's
+        settings; a stored value the settings refuse leaves the default."""
+        from maizeviz_app.settings import InputProblem
+
+        for name in ("port", "baud"):
+            stored = self._settings.value(name)
+            if stored is None:
+                continue
+            try:
+                value = int(str(stored)) if name == "baud" else str(stored)
+                self.model.apply_settings("digitizer", {name: value})
+            except (InputProblem, ValueError):
+                pass                             # the default stays
+
     def _make_late_panels(self) -> None:
         from maizeviz_app.panels.digitizer import DigitizerPanel
         from maizeviz_app.panels.layout import LayoutPanel
 
         self.layout_panel = LayoutPanel(self.model, self.undo.stack)
         self.layout_panel.problem.connect(self.say)
-        self.digitizer = DigitizerPanel(self.viewport)
+        self.digitizer = DigitizerPanel(self.viewport, session=self.model.digitizing)
         self.digitizer.alert.connect(lambda text: self.say(text, error=True, status_only=True))
         self.digitizer.stopped.connect(self.view_link.digitizing_stopped)
         self.digitizer.started.connect(self.view_link.digitizing_started)
-        # the study's digitizer settings start as the panel remembered them, then follow it
+        # the study's digitizer settings are the connection last used (the window keeps it);
+        # the panel's port and baud show them and set them
         d, settings = self.digitizer, self.model.settings.digitizer
-        with self.model.quietly():
-            self.model.settings.set("digitizer", {"port": d.port, "baud": d.baud.value()})
+        self._restore_connection()
         bind(d.baud, settings, "baud")
         bind_text(d.ports.box, settings, "port")
+        d.ports.baud = settings.baud            # what Find FASTRAK probes at, as the box
+        settings.events.baud.connect(lambda baud, *_: setattr(d.ports, "baud", baud))
         self.docks["layout"].setWidget(docks.scrolled(self.layout_panel))
         self.docks["digitizer"].setWidget(docks.scrolled(self.digitizer))
         name_controls(self)
@@ -543,7 +593,9 @@ class MainWindow(QMainWindow):
             import sys
 
             print(f"maizeviz: the digitizer did not stop cleanly: {exc}", file=sys.stderr)
+        self.instruments_panel.shutdown()
         self.runner.shutdown(10.0)
+        self._end_threads()
         self.workspaces.save()
         docks.save_window(self, self._settings)
         if self.viewport is not None:

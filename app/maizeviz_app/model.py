@@ -1,14 +1,14 @@
-"""The study open in the app, without Qt: its settings, its state, and the actions that change
-it (napari's ``ViewerModel`` pattern).
+"""The study open in the app as one object, without Qt: its state (:mod:`maizeviz_app.state`)
+and the actions over it, for the window and for scripts (napari's ``ViewerModel`` pattern).
 
-The model holds the state (points, layout, canopy, light results, project) and the settings
-(:mod:`maizeviz_app.settings`: evented objects the widgets bind to), and it runs the app: its
-actions (open points, a project or a mesh; build; compute light; sun from place; save; export;
-restore a project's results) validate, hand their work to the runner
-(:mod:`maizeviz_app.runner`) and keep the results, saying what changed through psygnal
-signals. The window only wires the model to the panels, the 3D view and the menus. Everything
-here runs on the GUI thread (or a script's thread), and a whole study can be driven and checked
-without a window::
+The actions are functions in three modules, one per kind of work, that import the state and
+not this module: :mod:`maizeviz_app.building` (points, mesh files, canopies),
+:mod:`maizeviz_app.lighting` (light and what is shown of it) and
+:mod:`maizeviz_app.studyfiles` (projects and exports). Each validates, hands its work to the
+runner (:mod:`maizeviz_app.runner`) and keeps the results in the state, which says what
+changed through psygnal signals. The window only wires the model to the panels, the 3D view
+and the menus. Everything here runs on the GUI thread (or a script's thread), and a whole study
+can be driven and checked without a window::
 
     runner = InlineRunner()                 # each job at once (the window: a thread pool)
     model = StudyModel(runner=runner)
@@ -16,298 +16,83 @@ without a window::
     model.settings.canopy.level = "8"       # rebuilt at 8 triangles a leaf
     model.settings.light.mode = "day"
     model.compute_light()
+    with model.history.step("C4 at 30 °C"): # one named step of the undo history
+        model.settings.photosynthesis.model = "c4"
+        model.settings.photosynthesis.temperature_c = 30.0
+    model.history.undo()
     model.save_project("study.maizeviz")
-
-The actions are written in three modules, one per kind of work, and are the model's methods:
-:mod:`maizeviz_app.building` (points, mesh files, canopies), :mod:`maizeviz_app.lighting`
-(light and what is shown of it) and :mod:`maizeviz_app.studyfiles` (projects and exports).
-
-What counts as unsaved work (:attr:`StudyModel.modified`): an edited layout and light results
-not yet in a project. Opening a points file or a project, and saving, start clean; the
-digitized points themselves are journalled by the recorder as they arrive and never depend on
-saving a project.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
-from dataclasses import replace
+from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from psygnal import Signal
-
-from maizeviz.errors import MaizevizError
+from maizeviz.canopy.layout import LayoutError
 from maizeviz_app import building, lighting, studyfiles
-from maizeviz_app.colour import ColourSettings
-from maizeviz_app.figures import Figures
-from maizeviz_app.layout_draft import LayoutDraft
-from maizeviz_app.messages import user_message
-from maizeviz_app.runner import InlineRunner, Runner, describe_internal
-from maizeviz_app.runs import LightRuns, Run
-from maizeviz_app.selection import Selection
-from maizeviz_app.settings import StudySettings
+from maizeviz_app.runner import Runner
+from maizeviz_app.state import COLOUR_GROUPS, UNDOABLE, StudyState  # noqa: F401 - the app's names
+
+if TYPE_CHECKING:
+    from maizeviz.canopy.layout import CanopyLayout
+    from maizeviz_app.digitizing import DigitizingSession
 
 
-class StudyModel:
-    """What the window shows and a project saves, and the actions that change it.
+class StudyModel(StudyState):
+    """The study (:class:`~maizeviz_app.state.StudyState`) and its actions; a canopy setting
+    changed (the slider, area preservation, an undo) rebuilds the canopy, and so does an edit
+    of the layout while ``layout_options.follow`` (:meth:`apply_draft`).
 
     Parameters
     ----------
     tile : int
         Tiles along each side of the canopy until a layout is loaded (the app's ``--tile``).
     runner : Runner, optional
-        Where jobs run (the window's thread pool); default an :class:`InlineRunner`.
-
-    Attributes
-    ----------
-    settings : StudySettings
-        Canopy, light and digitizer settings (evented; widgets bind to them).
-    loaded : maizeviz_app.jobs.Loaded or None
-        The points (fitted leaves, plants) and the layout they are arranged in.
-    points_bytes : bytes
-        The points file as read, saved into a project byte for byte.
-    points_origin : str
-        Where the points came from (a project's original file), resolved.
-    built : maizeviz_app.jobs.Built or None
-        The canopy on screen: its level, Embree-ready meshes, Table 2 measures (the last one
-        built stays until the canopy of new points or a new layout replaces it).
-    measures_rows : dict[str, dict]
-        Table 2 rows of every level built on these points and layout, by level label.
-    runs : LightRuns
-        Light results (sun, sky, day) per level, compared while they share their sampling.
-    figures : Figures
-        The heatmaps and the transmission plot of the results shown.
-    summary : str
-        The day's totals in two lines (empty: no day computed).
-    plants_run : Run or None
-        The result whose light per plant is shown.
-    project_path : str or None
-        The ``.maizeviz`` file the study was opened from or saved to.
-    draft : LayoutDraft
-        The layout being edited (applied by :meth:`apply_layout`).
-    layout_edited : bool
-        The layout is not the plain tiling of the settings (saved into the project).
-    serial : int
-        Changes whenever the points or the layout change: a canopy or light result carries
-        the serial it was made for, and one made for an older serial is dropped.
-    canopy_key : int
-        Changes with every canopy shown (the light process keeps the last canopy it was sent
-        and its Embree scene, under this key).
-    modified : bool
-        There is work a project does not hold yet (see the module docstring).
-    confirm_slow : callable(str) -> bool
-        Asked before starting work estimated at over a quarter of an hour (the window asks
-        the user; with no window: no).
-    mesher : callable or None
-        ``mesher(job, canopy, coarse, from_file)`` makes what the 3D view draws of a canopy,
-        in the worker (``coarse()``: the canopy at the view's display level, or None;
-        ``from_file``: a canopy read from a mesh file); None: nothing is drawn (no window).
-    colour : ColourSettings
-        How the 3D view and the heatmaps colour light (evented; saved in a project).
-    selection : Selection
-        The plant or leaf selected (evented; the 3D view and the plants table follow it).
-
-    Signals
-    -------
-    points_changed(loaded) : new points (and layout) opened; results cleared.
-    mesh_opened(path) : a canopy read from a mesh file replaces the points; results cleared.
-    layout_changed(layout) : the layout edited; results of the previous layout cleared.
-    canopy_changed(built) : a canopy built for the current points and layout.
-    built_shown(label) : that canopy is shown with the light results it has (a project's
-        results adopted).
-    build_pending(text) : what is being built ('': nothing, or not built: ``text`` says why).
-    runs_changed(runs, info) : a light result added (``info``: what was traced), or cleared.
-    light_running(text) : a light computation started ('' : none runs any more).
-    light_added(run) : a new light result is in the table and figures (``light_shown``
-        follows once its figures are drawn).
-    light_shown() : the light results shown are complete (table, figures, colours).
-    view_light(colour) : the light to paint on the canopy shown changed (``colour``: switch
-        the view's colouring to light).
-    summary_changed(text), plants_changed(run) : the day's totals, the light per plant.
-    project_changed(path) : the study opened from or saved to ``path`` (None: no project).
-    project_saved(path), exported(path) : a file written.
-    modified_changed(bool) : unsaved work appeared or was saved.
-    said(text, error, status_only) : a line for the user.
-    failed(text, doing, quantity, mode) : an error the user was told about (``quantity``: the
-        setting it is about, ``mode``: the light it was computed for).
+        Where jobs run (the window's thread pool); default an
+        :class:`~maizeviz_app.runner.InlineRunner`.
     """
 
-    points_changed = Signal(object)
-    mesh_opened = Signal(str)
-    layout_changed = Signal(object)
-    canopy_changed = Signal(object)
-    built_shown = Signal(str)
-    build_pending = Signal(str)
-    runs_changed = Signal(object, str)
-    light_running = Signal(str)
-    light_added = Signal(object)
-    light_shown = Signal()
-    view_light = Signal(bool)
-    summary_changed = Signal(str)
-    plants_changed = Signal(object)
-    project_changed = Signal(object)
-    project_saved = Signal(str)
-    exported = Signal(str)
-    modified_changed = Signal(bool)
-    said = Signal(str, bool, bool)
-    failed = Signal(str, str, object, object)
-
-    # ------------------------------------------------------------------ actions
-    open_points = building.open_points
-    points_loaded = building.points_loaded
-    open_mesh = building.open_mesh
-    _mesh_read = building._mesh_read
-    build = building.build
-    _built = building._built
-    affordable = building.affordable
-    cancel = building.cancel
-    light_job = lighting.light_job
-    compute_light = lighting.compute_light
-    _light_costs = lighting._light_costs
-    _light_failed = lighting._light_failed
-    _lit = lighting._lit
-    draw_heatmap = lighting.draw_heatmap
-    sun_from_place = lighting.sun_from_place
-    _sun_found = lighting._sun_found
-    choose_weather = lighting.choose_weather
-    adopt_pending_runs = lighting.adopt_pending_runs
-    light_per_plant_run = lighting.light_per_plant_run
-    complete_runs = lighting.complete_runs
-    open_project = studyfiles.open_project
-    _project_read = studyfiles._project_read
-    save_project = studyfiles.save_project
-    _project_saved = studyfiles._project_saved
-    export = studyfiles.export
-
     def __init__(self, tile: int = 3, runner: Runner | None = None) -> None:
-        self.settings = StudySettings()
-        self.settings.canopy.tile = tile
-        self.runner: Runner = runner if runner is not None else InlineRunner()
-        self.loaded: Any = None
-        self.points_bytes = b""
-        self.points_origin = ""
-        self.built: Any = None
-        self.measures_rows: dict[str, dict] = {}
-        self.runs = LightRuns()
-        self.figures = Figures()
-        self.draft = LayoutDraft()
-        self.summary = ""
-        self.plants_run: Run | None = None
-        self.pending_runs: list[Any] = []       # a project's results, waiting for a canopy
-        self.project_path: str | None = None
-        self.mesh_path: str | None = None
-        self.layout_edited = False
-        self.project_layout = False             # the opening project stores its layout
-        self.serial = 0
-        self.canopy_key = 0
-        self.modified = False
-        self.closing = False
-        self.cache_folder = str(Path.home() / ".cache" / "maizeviz" / "projects")
-        self.confirm_slow: Callable[[str], bool] = lambda estimate: False
-        self.mesher: Callable[..., Any] | None = None
-        self.applying = 0                       # settings being set by the model itself
+        super().__init__(tile, runner)
         events: Any = self.settings.canopy.events       # psygnal's, made by @evented
         events.level.connect(self._canopy_setting)
         events.preserve_area.connect(self._canopy_setting)
-        self.colour = ColourSettings()
-        self.selection = Selection()
+        self.draft.edited.connect(self._draft_moved)
+        self.draft.replayed.connect(self._draft_moved)
 
-    # ------------------------------------------------------------------ reading
-    @property
-    def canopy(self) -> Any:
-        """The canopy on screen (:class:`maizeviz.canopy.scene.Canopy`) or None."""
-        return self.built.canopy if self.built is not None else None
+    @cached_property
+    def digitizing(self) -> DigitizingSession:
+        """The digitizing session (the recorder's process, what is on disk, the counts and
+        warnings); the digitizer panel shows it (:mod:`maizeviz_app.digitizing`)."""
+        from maizeviz_app.digitizing import DigitizingSession
 
-    @property
-    def tile(self) -> int:
-        """The tiling a points file is opened with (``settings.canopy.tile``)."""
-        return self.settings.canopy.tile
+        return DigitizingSession()
 
-    @property
-    def tile_n(self) -> int:
-        """Tiles along each side of the layout (a square tiling), else the starting tiling."""
-        from maizeviz_app.options import tiling_of
+    def _canopy_setting(self, *_values: Any) -> None:
+        if not self.applying:
+            self.build()
 
-        tiles = tiling_of(self.loaded.layout) if self.loaded is not None else None
-        if tiles is not None and tiles[0] == tiles[1]:
-            return tiles[0]
-        return self.tile
+    def _draft_moved(self, *_edit: Any) -> None:
+        """The layout edited, or an edit undone or redone: applied when it follows."""
+        if self.layout_options.follow and not self.closing:
+            self.apply_draft()
 
-    def signature(self, label: str) -> tuple[int, str]:
-        """What identifies a canopy: the points and layout (serial) and the level label."""
-        return (self.serial, label)
+    # ------------------------------------------------------------------ canopy
+    def open_points(self, path: str | Path, layout: CanopyLayout | None = None) -> None:
+        """Read a points file and build it (:func:`maizeviz_app.building.open_points`)."""
+        building.open_points(self, path, layout)
 
-    @property
-    def shown_signature(self) -> tuple[int, str] | None:
-        """The signature of the canopy shown (None: none)."""
-        return self.signature(self.built.label) if self.built is not None else None
+    def open_mesh(self, path: str | Path, unit: str | None = None, up: str = "z",
+                  field: str | tuple[float, float, float, float] | None = None) -> None:
+        """Read a canopy mesh instead of points (:func:`maizeviz_app.building.open_mesh`)."""
+        building.open_mesh(self, path, unit, up, field)
 
-    @property
-    def title(self) -> str:
-        """The window title: the project's or points file's name, ``[*]`` where Qt marks
-        unsaved work."""
-        if self.mesh_path is not None:
-            return f"maizeviz — {Path(self.mesh_path).name}[*]"
-        if self.loaded is None:
-            return "maizeviz"
-        name = Path(self.project_path or self.loaded.path).name
-        return f"maizeviz — {name}[*]"
+    def build(self) -> None:
+        """Build the canopy at the settings (:func:`maizeviz_app.building.build`)."""
+        building.build(self)
 
-    # ------------------------------------------------------------------ messages
-    def say(self, text: str, error: bool | None = None, status_only: bool = False) -> None:
-        """A line for the user (``error``: default when the line starts with "error")."""
-        if self.closing:
-            return
-        self.said.emit(text, text.startswith("error") if error is None else error,
-                       status_only)
-
-    def fail(self, exc: BaseException, doing: str, mode: str | None = None) -> None:
-        """An error from an action: one line for people; the traceback on stderr if it is a
-        bug (not a MaizevizError, an OSError or a MemoryError)."""
-        if self.closing:
-            return
-        if not isinstance(exc, (MaizevizError, OSError, MemoryError)):
-            describe_internal(exc)
-        text = user_message(exc, doing)
-        self.say(f"error: {text}", error=True)
-        self.failed.emit(text, doing, getattr(exc, "quantity", None), mode)
-
-    # ------------------------------------------------------------------ changing
-    def set_points(self, loaded: Any, points_bytes: bytes, origin: str,
-                   project: str | None = None, layout_edited: bool = False) -> None:
-        """New points (from a points file, or a project at ``project``): every result of the
-        previous points is dropped; the study starts unsaved-clean."""
-        self.loaded = loaded
-        self.mesh_path = None
-        self.points_bytes = points_bytes
-        self.points_origin = str(Path(origin).resolve())
-        self.project_path = project
-        self.layout_edited = layout_edited
-        self._renew()
-        self.draft.start(loaded.layout, loaded.plants)
-        self.points_changed.emit(loaded)
-        self.project_changed.emit(project)
-        self._set_modified(False)
-
-    def set_mesh(self, path: str) -> None:
-        """A canopy read from a mesh file (OBJ, PLY with plant and leaf ids) is studied instead
-        of digitized points: no points, no layout to edit, one mesh level (the file's); its
-        canopy arrives by :meth:`show_built`. Nothing of it goes into a project."""
-        self.loaded = None
-        self.points_bytes = b""
-        self.points_origin = ""
-        self.project_path = None
-        self.mesh_path = str(path)
-        self.layout_edited = False
-        self._renew()
-        self.draft.start(None, set())
-        self.mesh_opened.emit(self.mesh_path)
-        self.project_changed.emit(None)
-        self._set_modified(False)
-
-    def apply_layout(self, layout: Any) -> bool:
+    def apply_layout(self, layout: CanopyLayout) -> bool:
         """Build the canopy on an edited layout (:meth:`edit_layout`, then :meth:`build`);
         True if light results were dropped."""
         dropped = self.edit_layout(layout)
@@ -315,95 +100,59 @@ class StudyModel:
             self.build()
         return dropped
 
-    def edit_layout(self, layout: Any) -> bool:
-        """The layout edited; True if light results were dropped."""
-        if self.loaded is None:
+    def apply_draft(self) -> bool:
+        """The layout being edited (:attr:`draft`), checked and built: at every edit while
+        ``layout_options.follow``, else when asked (the layout editor's *Apply*). A layout the
+        core refuses is said (one line naming the problem), its notes once; False when it
+        cannot be used or is the layout already built."""
+        if self.loaded is None or self.draft.base is None:
             return False
-        dropped = bool(self.runs.runs)
-        self.loaded = replace(self.loaded, layout=layout)
-        if tuple(self.draft.placements) != tuple(layout.placements):
-            self.draft.start(layout, self.loaded.plants)    # laid out by a script
-        self.layout_edited = True
-        self._renew()
-        self.layout_changed.emit(layout)
-        self._set_modified(True)
-        if dropped:
-            self.say("note: the layout changed; light results of the previous layout were "
-                     "cleared")
-        self.say(f"layout applied: {len(layout.placements)} plants")
-        return dropped
-
-    def show_built(self, built: Any) -> bool:
-        """A canopy built; False (and nothing changes) if it was built for older points or
-        an older layout."""
-        if built.serial != self.serial:
+        try:
+            new = self.draft.layout()
+        except LayoutError as exc:
+            self.say(f"error: {exc}", error=True)
             return False
-        self.built = built
-        self.canopy_key += 1
-        self.measures_rows[built.label] = built.row
-        self.canopy_changed.emit(built)
-        self.build_pending.emit("")
+        if new.warnings != self.layout_notes:
+            for w in new.warnings:
+                self.say(f"note: {w}")
+            self.layout_notes = new.warnings
+        current = self.loaded.layout
+        if new.placements == current.placements and new.cells is current.cells:
+            return False
+        self.apply_layout(new)
         return True
 
-    def add_run(self, run: Run, settings: Any, sampling: Any, info: str = "", *,
-                saved: bool = False) -> bool:
-        """Keep a light result (``info``: what was traced; ``saved``: read from the project,
-        not new work); True if it replaced results traced with other settings. A result for
-        older points or layout is ignored (False)."""
-        if run.signature[0] != self.serial:
-            return False
-        dropped = self.runs.add(run, settings, sampling)
-        self.runs_changed.emit(self.runs, info)
-        if not saved:
-            self._set_modified(True)
-        return dropped
+    def cancel(self, kind: str | None = None) -> list[str]:
+        """Stop the jobs of ``kind`` (:func:`maizeviz_app.building.cancel`)."""
+        return building.cancel(self, kind)
 
-    def mark_saved(self, path: str) -> None:
-        """The study was written to ``path``."""
-        self.project_path = path
-        self.project_changed.emit(path)
-        self._set_modified(False)
+    # ------------------------------------------------------------------ light
+    def compute_light(self) -> bool:
+        """Compute the light the settings choose (:func:`maizeviz_app.lighting.compute_light`);
+        False if it did not start."""
+        return lighting.compute_light(self)
 
-    def set_summary(self, text: str) -> None:
-        if text != self.summary:
-            self.summary = text
-            self.summary_changed.emit(text)
+    def draw_heatmap(self, kind: str, index: int) -> None:
+        """The heatmap of another height (:func:`maizeviz_app.lighting.draw_heatmap`)."""
+        lighting.draw_heatmap(self, kind, index)
 
-    def set_plants_run(self, run: Run | None) -> None:
-        self.plants_run = run
-        self.plants_changed.emit(run)
+    def sun_from_place(self) -> None:
+        """Sun angles from the place and time (:func:`maizeviz_app.lighting.sun_from_place`)."""
+        lighting.sun_from_place(self)
 
-    @contextmanager
-    def quietly(self) -> Iterator[None]:
-        """Settings set by the model itself (a project read, a level refused): no rebuild,
-        no undo step (:attr:`applying` is not 0 meanwhile)."""
-        self.applying += 1
-        try:
-            yield
-        finally:
-            self.applying -= 1
+    def choose_weather(self, path: str) -> None:
+        """A weather file and its place (:func:`maizeviz_app.lighting.choose_weather`)."""
+        lighting.choose_weather(self, path)
 
-    def apply_settings(self, name: str, values: dict[str, Any]) -> None:
-        """Set a settings group from the model itself (see :meth:`quietly`)."""
-        with self.quietly():
-            self.settings.set(name, values)
+    # ------------------------------------------------------------------ files
+    def open_project(self, path: str | Path) -> None:
+        """Read a project (:func:`maizeviz_app.studyfiles.open_project`)."""
+        studyfiles.open_project(self, path)
 
-    # ------------------------------------------------------------------ inside
-    def _canopy_setting(self, *_values: Any) -> None:
-        """A canopy setting changed (the slider, area preservation, an undo): rebuild."""
-        if not self.applying:
-            self.build()
+    def save_project(self, path: str | Path) -> bool:
+        """Write the project (:func:`maizeviz_app.studyfiles.save_project`)."""
+        return studyfiles.save_project(self, path)
 
-    def _renew(self) -> None:
-        self.serial += 1
-        self.measures_rows.clear()
-        self.runs.clear()
-        self.figures.clear()
-        self.set_summary("")
-        self.set_plants_run(None)
-        self.runs_changed.emit(self.runs, "")
-
-    def _set_modified(self, value: bool) -> None:
-        if value != self.modified:
-            self.modified = value
-            self.modified_changed.emit(value)
+    def export(self, what: str, path: str | Path) -> bool:
+        """Write ``what`` to ``path`` (:func:`maizeviz_app.studyfiles.export`)."""
+        return studyfiles.export(self, what, path)

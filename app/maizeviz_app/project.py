@@ -72,12 +72,13 @@ LIGHT_SETTINGS = (("zenith_deg", (int, float)), ("azimuth_deg", (int, float)), (
                   ("photosynthesis", str), ("leaf_temperature_c", (int, float)),
                   ("c4_vmax", (int, float)), ("c4_alpha", (int, float)),
                   ("co2_ppm", (int, float)), ("wofost_amax", (int, float)),
-                  ("wofost_eff", (int, float)))
+                  ("wofost_eff", (int, float)), ("c4_temperature", str))
 #: Allowed values of the light settings that name a choice.
 LIGHT_CHOICES = {"mode": ("sun", "sky", "day"), "sky_kind": ("soc", "uoc"),
                  "sky_split": ("auto", "equal"), "source": ("clear", "weather"),
                  "band": ("par", "nir"), "day_diffuse": ("sky", "perez"),
-                 "photosynthesis": ("none", "c4", "wofost")}
+                 "photosynthesis": ("none", "c4", "wofost"),
+                 "c4_temperature": ("collatz", "clm45")}
 
 
 def light_settings(opened: Opened) -> dict:

@@ -220,8 +220,9 @@ class PhotosynthesisSettings:
     """Leaf photosynthesis of a sun's absorbed PAR (leaf optics on, band PAR): ``model``
     none, c4 (Collatz et al. 1992, maize) or wofost (its negative exponential); the leaves'
     ``temperature_c``; the C4 model's Rubisco capacity ``vmax`` at 25 C, quantum yield
-    ``alpha`` and ambient ``co2_ppm``; WOFOST's ``amax`` and ``eff``. The defaults are the
-    core's (a test holds them equal)."""
+    ``alpha``, ambient ``co2_ppm`` and temperature response ``c4_temperature`` (collatz, the
+    paper's; clm45, CLM 4.5's); WOFOST's ``amax`` and ``eff``. The defaults are the core's (a
+    test holds them equal)."""
 
     if TYPE_CHECKING:                           # made by @evented
         events: ClassVar[SignalGroup]
@@ -233,6 +234,7 @@ class PhotosynthesisSettings:
     co2_ppm: float = field(default=400.0, metadata=_range(0.0, 5000.0, "ppm"))
     amax: float = field(default=70.0, metadata=_range(0.0, 500.0, "kg CO₂/ha/h"))
     eff: float = field(default=0.45, metadata=_range(0.0, 5.0, "kg CO₂/ha/h per W/m²"))
+    c4_temperature: str = "collatz"
 
 
 @evented
@@ -272,12 +274,14 @@ LIGHT_DOC = {
     "c4_vmax": ("photosynthesis", "vmax"), "c4_alpha": ("photosynthesis", "alpha"),
     "co2_ppm": ("photosynthesis", "co2_ppm"), "wofost_amax": ("photosynthesis", "amax"),
     "wofost_eff": ("photosynthesis", "eff"),
+    "c4_temperature": ("photosynthesis", "c4_temperature"),
 }
 #: Choices a text setting may take: (group, field) -> allowed values.
 CHOICES = {("light", "mode"): MODES, ("sky", "kind"): ("soc", "uoc"),
            ("sky", "split"): ("auto", "equal"), ("day", "source"): ("clear", "weather"),
            ("day", "diffuse"): ("sky", "perez"), ("optics", "band"): ("par", "nir"),
-           ("photosynthesis", "model"): PHOTOSYNTHESIS}
+           ("photosynthesis", "model"): PHOTOSYNTHESIS,
+           ("photosynthesis", "c4_temperature"): ("collatz", "clm45")}
 
 
 def field_names(group: Any) -> list[str]:
@@ -378,6 +382,9 @@ class StudySettings:
         for key, (g, f) in LIGHT_DOC.items():
             if key in doc:
                 by_group.setdefault(g, {})[f] = doc[key]
+        if doc.get("photosynthesis") == "c4" and "c4_temperature" not in doc:
+            # saved before the C4 temperature response was a choice: CLM 4.5's, what it computed
+            by_group["photosynthesis"]["c4_temperature"] = "clm45"
         if by_group.get("sky", {}).get("split") == "auto" and \
                 by_group["sky"].get("directions", 46) not in (16, 46, 145):
             by_group["sky"]["split"] = "equal"
@@ -447,7 +454,8 @@ class StudySettings:
         model, temperature, params = self.photosynthesis_choice()
         spec = OpticsSpec(o.band, o.reflectance, o.transmittance, o.ground_reflectance,
                           o.direct_w_m2, o.diffuse_w_m2, o.depth, photosynthesis=model,
-                          temperature_c=temperature, photosynthesis_params=params)
+                          temperature_c=temperature, photosynthesis_params=params,
+                          c4_temperature=self.photosynthesis.c4_temperature)
         spec.optics()                                   # checked now, named by the core
         spec.leaf_model()
         return spec

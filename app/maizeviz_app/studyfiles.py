@@ -1,8 +1,8 @@
 """The model's file actions: open and save a project, export what the study holds (no Qt: the
 work goes to the model's runner, files are written atomically).
 
-Methods of :class:`maizeviz_app.model.StudyModel` (``study``: the model); see there for the
-state these use.
+Functions over the study's state (``study``: a :class:`maizeviz_app.state.StudyState`, whose
+public changes they call); :class:`maizeviz_app.model.StudyModel` offers them as methods.
 """
 
 from __future__ import annotations
@@ -12,12 +12,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from maizeviz.errors import MaizevizError
+from maizeviz_app import building
 
 if TYPE_CHECKING:
-    from maizeviz_app.model import StudyModel
+    from maizeviz_app.state import StudyState
 
 
-def open_project(study: StudyModel, path: str | Path) -> None:
+def open_project(study: StudyState, path: str | Path) -> None:
     """Read a project in a job: its points, layout, settings and light results (which
     join the comparison once the canopy is built). The current canopy stays if the
     project cannot be used."""
@@ -48,10 +49,10 @@ def open_project(study: StudyModel, path: str | Path) -> None:
         return opened, loaded, (tile, level, preserve), light, runs
 
     study.runner.run("load", f"opening {Path(path).name}", work,
-                    on_done=study._project_read,
+                    on_done=lambda out: _project_read(study, out),
                     on_error=lambda e: study.fail(e, "open project"))
 
-def _project_read(study: StudyModel, out) -> None:
+def _project_read(study: StudyState, out) -> None:
     opened, loaded, (tile, level, preserve), light, runs = out
     for note in opened.notes:
         study.say(f"note: {note}")
@@ -62,10 +63,10 @@ def _project_read(study: StudyModel, out) -> None:
         study.colour.update_from_doc(opened.view, opened.path)
     study.project_layout = opened.project.layout is not None
     study.pending_runs = list(runs)
-    study.points_loaded(loaded, opened.project.points_csv, opened.path,
+    building.points_loaded(study, loaded, opened.project.points_csv, opened.path,
                        opened.project.points_path)
 
-def save_project(study: StudyModel, path: str | Path) -> bool:
+def save_project(study: StudyState, path: str | Path) -> bool:
     """Write the project (points, layout, settings, light results) in a job; False (and
     said why) when there is nothing a project can hold."""
     if study.mesh_path is not None:
@@ -103,16 +104,17 @@ def save_project(study: StudyModel, path: str | Path) -> bool:
         save_project(path, proj)
         return path
 
-    study.runner.run("save", f"saving {Path(path).name}", work, on_done=study._project_saved,
-                    on_error=lambda e: study.fail(e, "save project"), supersede=False)
+    study.runner.run("save", f"saving {Path(path).name}", work,
+                     on_done=lambda p: _project_saved(study, p),
+                     on_error=lambda e: study.fail(e, "save project"), supersede=False)
     return True
 
-def _project_saved(study: StudyModel, path: str) -> None:
+def _project_saved(study: StudyState, path: str) -> None:
     study.mark_saved(path)
     study.say(f"saved the project {path}")
     study.project_saved.emit(path)
 
-def export(study: StudyModel, what: str, path: str | Path) -> bool:
+def export(study: StudyState, what: str, path: str | Path) -> bool:
     """Write ``what`` (canopy, table, measures, heatmap, plot; steps, leaves, plants, day
     for a sky or a day) to ``path`` in a job, atomically; False (and said why) when there
     is nothing of it yet."""

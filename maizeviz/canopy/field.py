@@ -22,7 +22,6 @@ bit (``tests/core/test_field.py``); memory follows one chunk plus the meshes.
 
 from __future__ import annotations
 
-import os
 from collections import defaultdict
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -45,8 +44,9 @@ from maizeviz.leaf.grid import base_of_collars, build_grids
 from maizeviz.mesh.levels import Level
 from maizeviz.progress import ProgressCallback, report
 
-#: Parquet points files with more records than this are read plant chunk by plant chunk.
-FIELD_POINTS = int(os.environ.get("MAIZEVIZ_FIELD_POINTS", 4_000_000))
+#: Parquet points files with more records than this are read plant chunk by plant chunk;
+#: None: ``MAIZEVIZ_FIELD_POINTS`` or 4,000,000 (:mod:`maizeviz.environment`).
+FIELD_POINTS: int | None = None
 #: Points read, gridded, fitted and meshed at a time.
 CHUNK_POINTS = 1 << 20
 #: Processes building a field's chunks side by side, unless a FieldLeaves says (the command
@@ -60,8 +60,11 @@ def field_input(path: str | Path) -> bool:
     more than :data:`FIELD_POINTS` records."""
     if not is_parquet(path):
         return False
+    from maizeviz.environment import whole_number
+
+    limit = whole_number("MAIZEVIZ_FIELD_POINTS") if FIELD_POINTS is None else FIELD_POINTS
     rows = parquet_rows(path)
-    return rows is not None and rows > FIELD_POINTS
+    return rows is not None and rows > limit
 
 
 class LeafShapes:

@@ -21,6 +21,7 @@ from pathlib import Path
 
 from maizeviz import __version__
 from maizeviz.cli.common import EXIT_FAIL, EXIT_OK, EXIT_PARTIAL, EXIT_USAGE, error_line, say
+from maizeviz.environment import switch
 from maizeviz.errors import MaizevizError
 
 __all__ = ["main", "build_parser", "EXIT_OK", "EXIT_FAIL", "EXIT_USAGE", "EXIT_PARTIAL"]
@@ -31,7 +32,8 @@ COMMANDS = {"leaf": "maizeviz.cli.leaf", "canopy": "maizeviz.cli.canopy",
             "light": "maizeviz.cli.light", "sweep": "maizeviz.sweep.command",
             "record": "maizeviz.cli.record", "fastrak-sim": "maizeviz.cli.simulate",
             "synth": "maizeviz.cli.synth", "import-phenomenal": "maizeviz.cli.phenomenal",
-            "convert": "maizeviz.cli.convert", "subplots": "maizeviz.cli.subplots"}
+            "convert": "maizeviz.cli.convert", "subplots": "maizeviz.cli.subplots",
+            "instrument": "maizeviz.cli.instrument"}
 #: Entry-point group under which the desktop app registers its ``run(argv) -> int``.
 GUI_GROUP = "maizeviz.gui"
 GUI_HINT = 'the desktop app is not installed: pip install "maizeviz[gui]"'
@@ -77,47 +79,33 @@ def find_gui() -> tuple[Callable[[Sequence[str]], int] | None, str]:
 
 
 def _no_command(argv: list[str]) -> int:
-    """No subcommand: the desktop app where there is a screen, else the headless report."""
-    from maizeviz.resources import example_points
+    """No subcommand: the desktop app where there is a screen, else the headless report;
+    the command line parsed first, as the app and the report both read it
+    (:mod:`maizeviz.cli.main_job`)."""
+    from maizeviz.cli.main_job import headless_report
+    from maizeviz.main_command import main_parser
 
     rest = [a for a in argv if a != "--debug"]
-    if rest and not rest[0].startswith("-") and not Path(rest[0]).exists():
+    named = main_parser().parse_args(rest).points     # a bad option: usage, exit 2
+    if named and not named.startswith("-") and not Path(named).exists():
         import difflib
 
-        close = difflib.get_close_matches(rest[0].lower(), list(COMMANDS), n=1, cutoff=0.6)
+        close = difflib.get_close_matches(named.lower(), list(COMMANDS), n=1, cutoff=0.6)
         if close:                               # a mistyped command, not a file to open
-            say(f"error: unknown command '{rest[0]}' (did you mean '{close[0]}'? "
+            say(f"error: unknown command '{named}' (did you mean '{close[0]}'? "
                 "maizeviz --help lists the commands)")
             return EXIT_USAGE
     gui, why = find_gui()
     if gui is None:
         say(f"note: {why}")
-    elif has_screen():
+        return headless_report(rest, main, None)
+    if has_screen():
         try:
             return gui(rest)
         except ImportError as exc:              # Qt present but unusable (a missing libxcb...)
             say(f"note: the desktop app cannot start ({exc}); the headless report follows")
-    else:
-        on = rest[0] if rest and not rest[0].startswith("-") else "the bundled example"
-        say(f"no screen (DISPLAY is not set): the headless report on {on} follows; for the "
-            "window run 'xvfb-run -a maizeviz --screenshot app.png' or use a desktop")
-    if rest and not rest[0].startswith("-"):
-        return _report_on(rest[0])
-    return main(["canopy", str(example_points()), "--tile", "3x3", "--levels"])
-
-
-def _report_on(path: str) -> int:
-    """The headless report on the file the app was asked to open: its canopy at every level
-    for points or a mesh; a missing file or a project (the window's) refused in one line."""
-    if not os.path.isfile(path):
-        say(f"error: {path}: no such file (the app opens points, a canopy mesh or a project)")
-        return EXIT_FAIL
-    if Path(path).suffix.lower() == ".maizeviz":
-        say(f"error: {path} is a project: it opens in the desktop app (without a screen: "
-            f"xvfb-run -a maizeviz {path} --screenshot view.png)")
-        return EXIT_FAIL
-    say(f"note: the same as: maizeviz canopy {path} --levels")
-    return main(["canopy", path, "--levels"])
+            return headless_report(rest, main, None)
+    return headless_report(rest, main)
 
 
 def _say_warnings(message, category, filename, lineno, file=None, line=None) -> None:
@@ -129,14 +117,23 @@ def main(argv: Sequence[str] | None = None) -> int:
     tokens = list(sys.argv[1:] if argv is None else argv)
     first = next((t for t in tokens if t != "--debug"), None)
     if first == "--info":
+        from maizeviz.environment import problems
         from maizeviz.info import report
 
-        print(report())
-        return EXIT_OK
+        bad = problems()                            # MAIZEVIZ_* variables it cannot read
+        for line in bad:
+            say(f"error: {line}")
+        if not bad:
+            print(report())
+        return EXIT_FAIL if bad else EXIT_OK
     if first not in COMMANDS and first not in ("-h", "--help", "--version"):
         return _no_command(tokens)                 # the app, with its own options
     args = build_parser(first if first in COMMANDS else None).parse_args(tokens)
-    debug = args.debug or bool(os.environ.get("MAIZEVIZ_DEBUG"))
+    try:
+        debug = args.debug or switch("MAIZEVIZ_DEBUG")
+    except MaizevizError as exc:
+        say(error_line(exc))
+        return EXIT_FAIL
     try:
         with warnings.catch_warnings():
             warnings.showwarning = _say_warnings

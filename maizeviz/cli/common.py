@@ -51,6 +51,11 @@ FLAGS = {
     "mesh_ids": "--mesh-plant/--mesh-leaf",
     "photosynthesis": "--photosynthesis", "temperature": "--temperature", "co2": "--co2",
     "precision": "--precision",
+    # maizeviz instrument
+    "at_instrument": "--at", "height_cm": "--height", "orientation": "--orientation",
+    "length_cm": "--length", "spacing_cm": "--spacing", "par": "--par",
+    "beam_fraction": "--beam-fraction", "x": "--leaf-x", "absorptivity": "--absorptivity",
+    "view_cap": "--view-cap", "rays": "--rays", "size": "--size",
 }
 
 

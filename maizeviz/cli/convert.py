@@ -1,4 +1,5 @@
-"""``maizeviz convert``: a points file as CSV or as Parquet, the same records."""
+"""``maizeviz convert``: a points file as CSV or as Parquet, the same records; or digitized
+plants to and from OpenAlea's MTG (:mod:`maizeviz.fspm.mtg`)."""
 
 from __future__ import annotations
 
@@ -17,9 +18,13 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description="Read a points file (CSV or Parquet) with every check the other commands "
                     "make, and write its points, as read, to --out: Parquet when its name ends "
                     "in .parquet or .pq (about a third of the CSV's size, read about 20 times "
-                    "faster), CSV otherwise. Lines the reader skips are skipped here too.")
-    p.add_argument("points", help="points file (CSV or Parquet)")
-    p.add_argument("--out", required=True, help="points file to write (.csv, .parquet, .pq)")
+                    "faster), CSV otherwise. Lines the reader skips are skipped here too. An "
+                    "--out ending in .mtg writes the plants as an OpenAlea MTG (plant > stalk "
+                    "+ leaves, each leaf's points and its standard mesh); an .mtg given is "
+                    "read back to its leaves' points.")
+    p.add_argument("points", help="points file (CSV or Parquet), or an MTG (.mtg)")
+    p.add_argument("--out", required=True,
+                   help="file to write (.csv, .parquet, .pq, or .mtg for OpenAlea)")
     p.set_defaults(run=run)
 
 
@@ -28,9 +33,35 @@ def run(args: argparse.Namespace) -> int:
     from maizeviz.io.points import read_points
 
     check_run_paths([("the points file written", args.out)], [("the points file", args.points)])
+    if str(args.out).lower().endswith(".mtg") or str(args.points).lower().endswith(".mtg"):
+        return _mtg(args)
     table = read_points(args.points)
     for problem in table.problems:
         say(f"warning: {problem}")
     write_table(args.out, table)
     say(f"wrote {len(table):,} points to {args.out}")
+    return EXIT_OK
+
+
+def _mtg(args: argparse.Namespace) -> int:
+    """Points to an MTG (fitted leaves, their standard mesh), or an MTG's leaf points to a
+    points file."""
+    if str(args.points).lower().endswith(".mtg"):
+        from maizeviz.fspm.mtg import read_mtg
+        from maizeviz.io.points import write_points
+
+        grids = read_mtg(args.points)
+        write_points(args.out, grids)
+        n = sum(g.shape[0] * g.shape[1] for g in grids)
+        say(f"wrote {n:,} points of {len(grids):,} leaves to {args.out}")
+        return EXIT_OK
+    from maizeviz.fspm.mtg import write_mtg
+    from maizeviz.leaf.fit import read_leaves
+
+    got = read_leaves(args.points)
+    for line in [*got.problems, *(str(e) for e in got.skipped)]:
+        say(f"warning: {line}")
+    write_mtg(args.out, got.leaves)
+    plants = len({lf.plant for lf in got.leaves})
+    say(f"wrote {plants:,} plants, {len(got.leaves):,} leaves to {args.out} (OpenAlea MTG)")
     return EXIT_OK

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import json
 import signal
 import sys
 import threading
@@ -38,62 +39,127 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="a receiver fixed to the stalk: points are re-expressed in its frame")
     p.add_argument("--answer-timeout", type=NUMBER_ARG, default=1.0, metavar="S",
                    help="seconds to wait for each reply of the unit (default 1)")
+    p.add_argument("--live", type=NUMBER_ARG, metavar="S",
+                   help="also ask the unit where the stylus tip is every S seconds (shown with "
+                        "--events json; a poll's answer is never taken for a press)")
+    p.add_argument("--events", choices=("text", "json"), default="text",
+                   help="json: every event (ready, recorded, refused, garbled, control, "
+                        "paused, live, lost, summary...) as one JSON object per line on "
+                        "standard output, for a program driving the recorder (the app)")
+    p.add_argument("--end-with-input", action="store_true",
+                   help="finish (as q) when standard input ends: the program driving the "
+                        "recorder has gone, so no press is taken that nobody sees")
     p.set_defaults(run=run)
 
 
-def run(args: argparse.Namespace) -> int:
+class _Emitter:
+    """Says one event: a JSON line (``--events json``) or, for the technician, its text."""
+
+    def __init__(self, as_json: bool):
+        self.as_json = as_json
+
+    def __call__(self, kind: str, message: str = "", **more) -> None:
+        if self.as_json:
+            print(json.dumps({"kind": kind, "message": message, **more}), flush=True)
+        elif kind in ("note", "warning"):
+            say(f"{kind}: {message}")
+        elif kind in ("lost", "failed"):
+            say(f"error: {message}")
+        elif kind not in ("garbled", "live", "finished", "signal"):
+            print(message, flush=True)
+
+
+def _check(args: argparse.Namespace) -> None:
     check_range(args.answer_timeout, "the answer timeout", 0.01, 600, "answer_timeout", unit="s")
     check_range(args.baud, "the baud rate", 300, 4_000_000, "baud", whole=True)
+    if args.live is not None:
+        check_range(args.live, "the live poll interval", 0.02, 60, "live", unit="s")
     if is_parquet_name(args.out):
         raise MaizevizError(f"{args.out}: a recording is a CSV journal, written point by point; "
                             "record to a .csv file (maizeviz convert then writes it as Parquet)")
     check_run_paths([], [("the serial port", args.port)], appended=[("the recording", args.out)])
-    session = Session(args.out, args.cols, args.resume, args.reference_station)
-    for message in session.messages:
-        say(f"note: {message}")
-    if args.resume:
-        q0 = session.pos
-        say(f"resuming {args.out}: {session.count.points} points on disk, {session.cols} points "
-            f"per cross-section; next point is plant {q0.plant} leaf {q0.leaf} row {q0.row} col "
-            f"{q0.col}")
+
+
+def _connect(args: argparse.Namespace, session: Session, emit: _Emitter) -> FastrakPort:
+    """Open and configure the port; a start that fails leaves no header-only file."""
     port = FastrakPort(args.port, args.baud, args.answer_timeout)
     stations = (1,) if args.reference_station is None else (1, args.reference_station)
+    # SIGTERM while connecting (the app's Stop): give up the port and the file
+    before = signal.signal(signal.SIGTERM, lambda _signum, _frame: port.cancel())
     try:
         config = port.configure(stations)
     except MaizevizError:
-        session.close()
         port.close()
+        if session.discard_if_unused():
+            say(f"note: {args.out} was not kept (nothing was recorded in it)")
         raise
+    finally:
+        signal.signal(signal.SIGTERM, before)
     for w in config.warnings:
-        say(f"warning: {w}")
-    recorder = Recorder(session, port)
-    recorder.start()
+        emit("warning", w)
+    return port
 
-    def read_stdin() -> None:
+
+def _read_controls(recorder: Recorder, end_with_input: bool) -> None:
+    """The technician's controls, one per line of standard input (a thread)."""
+    def read() -> None:
         try:
             for line in sys.stdin:
                 recorder.control(line)
         except (OSError, ValueError):
             pass
+        if end_with_input:                    # the program driving us has gone
+            recorder.control("q")
 
     if sys.stdin is not None and not sys.stdin.closed:
-        threading.Thread(target=read_stdin, daemon=True, name="controls").start()
+        threading.Thread(target=read, daemon=True, name="controls").start()
+
+
+def _loop(recorder: Recorder, emit: _Emitter) -> int:
+    """Handle events until the session ends; returns the exit code."""
+    code = EXIT_OK
+    shown = None
+    while not recorder.finished:
+        for update in recorder.poll(timeout=0.5):
+            emit(update.kind, update.message, code=update.code)
+            code = update.code or code
+        live = recorder.live
+        if emit.as_json and live is not None and live is not shown:
+            shown = live
+            emit("live", "", xyz=list(live.xyz), distance=live.distance,
+                 trustworthy=live.trustworthy, note=live.note)
+    return code
+
+
+def run(args: argparse.Namespace) -> int:
+    _check(args)
+    emit = _Emitter(args.events == "json")
+    session = Session(args.out, args.cols, args.resume, args.reference_station)
+    for message in session.messages:
+        emit("note", message)
+    if args.resume:
+        q0 = session.pos
+        emit("note", f"resuming {args.out}: {session.count.points} points on disk, "
+                     f"{session.cols} points per cross-section; next point is plant {q0.plant} "
+                     f"leaf {q0.leaf} row {q0.row} col {q0.col}")
+    port = _connect(args, session, emit)
+    recorder = Recorder(session, port)
+    recorder.start(live_every=args.live)
+    _read_controls(recorder, args.end_with_input)
     old = signal.signal(signal.SIGTERM, lambda signum, _frame: recorder.signal(signum))
-    print(f"ready on {args.port}: press the stylus; controls n, p, r, u, s, q + Enter", flush=True)
+    if emit.as_json:
+        emit("ready", f"ready on {args.port}", cols=session.cols, points=session.count.points)
+    else:
+        print(f"ready on {args.port}: press the stylus; controls n, p, r, u, s, q + Enter",
+              flush=True)
     code = EXIT_OK
     try:
-        while not recorder.finished:
-            for update in recorder.poll(timeout=0.5):
-                if update.kind in ("lost", "failed"):
-                    say(f"error: {update.message}")
-                elif update.kind in ("recorded", "refused", "control", "said", "paused",
-                                     "resumed", "ignored"):
-                    print(update.message, flush=True)
-                code = update.code or code
+        code = _loop(recorder, emit)
     except KeyboardInterrupt:
         code = 130
     finally:
         signal.signal(signal.SIGTERM, old)
         recorder.close()
-        print(session.summary(), flush=True)
+        emit("summary", session.summary(), points=session.count.points,
+             refused=session.count.refused, garbled=session.count.garbled)
     return code

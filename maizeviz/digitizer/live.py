@@ -11,14 +11,23 @@ A poll's answer looks like a press: same record type, same stations. What tells 
    only while the button is held.
 
 So while a poll is unanswered (its *window*), frames are held back. A frame with the switch
-up is the answer: the frames held before it are presses. When the window closes with only
-switch-down frames held, one of them was the answer (the button was held when the poll
-came): the first is taken as the answer and the rest are presses. Either way a press is
-never dropped and a poll never becomes a point; a press that comes while a window is open is
-reported when the window resolves (at most :attr:`PollSorter.window` later, usually within
-milliseconds when the answer has the switch up). Outside windows every frame is a press, as
-without polling. The one case this cannot sort is a poll's answer that arrives garbled: a
-press in the same window is then taken for the answer (counted in :attr:`PollSorter.unsure`).
+up is the answer: the frames held before it are presses. A switch-down answer means the button
+was held when the poll came, so its press was sent just before it, at the same place (the
+stylus is still while its button is down): once the window's time is up, a held frame within
+:data:`HELD_CM` of the press before it is the answer, and the other frames are presses.
+
+A held frame that repeats no press is a press whose poll has not been answered yet: an answer
+comes late when the unit's side is slow (a simulator on a busy machine), and taking the press
+for the answer would lose it without a word (issue 35, item 1: the app lost 6 of 60 presses
+under CPU load with the old rule, "the first held frame is the answer"). The window then
+stays open for the answer, up to :data:`LATE_ANSWER_S`; if none comes, every held frame is
+handed on as a press (counted in :attr:`PollSorter.unsure`). So a press is never dropped and
+a poll's answer never becomes a point, except in one case: a press at the very place of the
+press before it (within :data:`HELD_CM`), made while a poll's answer is late.
+
+A press that comes while a window is open is reported when the window resolves (usually within
+milliseconds, when the answer has the switch up). Outside windows every frame is a press, as
+without polling.
 """
 
 from __future__ import annotations
@@ -29,6 +38,15 @@ from maizeviz.digitizer.protocol import Record
 
 #: Seconds a poll's answer may take beyond its transmission time.
 ANSWER_SLACK_S = 0.1
+#: Seconds a window holding only presses waits for a late answer before giving up on it.
+LATE_ANSWER_S = 3.0
+#: Centimetres within which a switch-down frame repeats the press before it (a poll's answer
+#: while the button is held): the stylus tip is pressed on the leaf, and hand tremor moves it
+#: about a millimetre; two presses of a recording are centimetres apart.
+HELD_CM = 0.5
+#: Seconds after a press within which a switch-down answer can still repeat it (a button is
+#: held for a fraction of a second).
+HELD_S = 2.0
 
 
 @dataclass(frozen=True)
@@ -72,10 +90,11 @@ class PollSorter:
         self._open_until: float | None = None
         self._held: list[tuple[Record, ...]] = []
         self._frame: list[Record] = []
-        #: Polls whose answer never came (the window closed with nothing held).
+        #: Polls whose answer never came (nothing held for :data:`LATE_ANSWER_S`).
         self.missed = 0
-        #: Windows resolved by taking a switch-down frame for the answer.
+        #: Windows whose answer never came while presses were held (handed on as presses).
         self.unsure = 0
+        self._last_press: tuple[tuple[float, float, float] | None, float] = (None, -1e9)
 
     @property
     def waiting(self) -> bool:
@@ -109,26 +128,59 @@ class PollSorter:
         return out
 
     def tick(self, now: float) -> list:
-        """Close a window whose time is up; returns what that releases."""
+        """Settle a window whose time is up; returns what that releases."""
         if self._open_until is None or now < self._open_until:
             return []
-        held, self._held, self._open_until = self._held, [], None
+        held = self._held
+        late = now >= self._open_until + LATE_ANSWER_S
         if not held:
-            self.missed += 1
-            return []
-        if len(held) > 1:
-            self.unsure += 1
-        # the first held frame came soonest after the poll: take it as the answer
-        return [Live(held[0], now)] + [r for frame in held[1:] for r in frame]
+            if late:                            # the answer never came
+                self._close()
+                self.missed += 1
+            return []                           # (a late answer is not taken for a press)
+        last, when = self._last_press
+        for k, frame in enumerate(held):
+            before = held[k - 1][0].position if k else (last if now - when <= HELD_S else None)
+            if _near(frame[0].position, before):                  # the held button's answer
+                self._close()
+                return self._presses(held[:k] + held[k + 1:], now) + [Live(frame, now)]
+        if not late:
+            return []                           # presses whose poll is answered late: wait
+        self._close()
+        self.unsure += 1
+        return self._presses(held, now)
+
+    def flush(self, now: float) -> list:
+        """The reader stops: frames still held are handed on as presses (none is dropped)."""
+        held = self._held
+        self._close()
+        return self._presses(held, now)
+
+    def _close(self) -> None:
+        self._held, self._open_until = [], None
+
+    def _presses(self, frames, now: float) -> list:
+        """Hand ``frames`` on as presses (remembering the last one's place)."""
+        if frames:
+            self._last_press = (frames[-1][0].position, now)
+        return [r for f in frames for r in f]
 
     def _frame_done(self, frame: tuple[Record, ...], now: float) -> list:
         down = frame[0].stylus != 0
         if self._open_until is None:
             if down:
-                return list(frame)                               # a press, as without polling
+                return self._presses([frame], now)              # a press, as without polling
             return [Live(frame, now)]                            # a late answer: never a press
         if down:
             self._held.append(frame)                             # press or answer: wait
-            return []
-        held, self._held, self._open_until = self._held, [], None
-        return [r for f in held for r in f] + [Live(frame, now)]
+            return self.tick(now)                                # (a late window may settle)
+        held = self._held
+        self._close()
+        return self._presses(held, now) + [Live(frame, now)]
+
+
+def _near(a, b) -> bool:
+    """Two stylus positions (cm) within :data:`HELD_CM` of each other."""
+    if a is None or b is None:
+        return False
+    return sum((float(x) - float(y)) ** 2 for x, y in zip(a, b)) <= HELD_CM ** 2

@@ -241,6 +241,7 @@ class FastrakPort:
                     self.polls += 1
                 data = ser.read(max(1, min(ser.in_waiting, 65536)))
             except (serial.SerialException, OSError, TypeError, AttributeError) as exc:
+                self._flush(callback, sorter)
                 if not self._stop.is_set():
                     callback(PortLost(lost_message(self.port_name, exc)))
                 return
@@ -251,6 +252,14 @@ class FastrakPort:
                 events = [out for ev in events for out in sorter.feed(ev, now)]
                 events += sorter.tick(now)
             for ev in events:
+                callback(ev)
+        self._flush(callback, sorter)
+
+    @staticmethod
+    def _flush(callback, sorter: PollSorter | None) -> None:
+        """Presses the sorter still holds (waiting for a poll's answer) are handed on."""
+        if sorter is not None:
+            for ev in sorter.flush(time.monotonic()):
                 callback(ev)
 
     def stop(self) -> None:

@@ -32,9 +32,12 @@ from maizeviz.errors import MaizevizError
 #: What an update is about: a point recorded, a press refused, a garbled record, a control
 #: applied, a message from elsewhere (the demo), recording paused or resumed, a press not
 #: recorded because paused, the session finished (q), the port lost, a write that failed, a
-#: signal (SIGTERM) received.
+#: signal (SIGTERM) received. A program showing a recorder adds its own (the app's
+#: :mod:`maizeviz_app.digitizing`): recording began, the connection failed, a press far from
+#: the point before it, a short cross-section, the next point's place changed.
 UpdateKind = Literal["recorded", "refused", "garbled", "control", "said", "paused", "resumed",
-                     "ignored", "finished", "lost", "failed", "signal"]
+                     "ignored", "finished", "lost", "failed", "signal", "started",
+                     "unconnected", "jump", "short", "moved"]
 #: The control that pauses or resumes recording (the technician's other controls are the
 #: session's: :data:`maizeviz.digitizer.session.CONTROLS`).
 PAUSE_KEY = "s"

@@ -347,6 +347,8 @@ class Session:
         self._torn_line: tuple | None = None    # (line number, text) found when opening
         self._zeros = 0                         # zero bytes ending the file (a power cut)
         self._size = 0                          # the file's bytes before them
+        self._made = False                      # this session made the file (or its header)
+        self._wrote = False                     # a point or a control line written since
         self._open(resume)
 
     # ---------------------------------------------------------------------- journal
@@ -393,6 +395,7 @@ class Session:
                 self.fd = os.open(self.path, flags, 0o644)
                 if state in ("new", "rewrite"):
                     self._append(HEADER)
+                    self._made = True
                 elif self._zeros:                  # nothing in them: appending must follow
                     os.ftruncate(self.fd, self._size)  # the last line, not a run of zeros
                     os.fsync(self.fd)
@@ -599,6 +602,7 @@ class Session:
     def _write_line(self, values) -> None:
         if self._tail or self._unmarked:
             self._repair()
+        self._wrote = True
         buf = io.StringIO()
         csv.writer(buf).writerow(values)
         self._append(buf.getvalue().encode("utf-8"))
@@ -736,6 +740,20 @@ class Session:
         lock, self._lock = self._lock, None
         if lock is not None:
             release_lock(*lock)
+
+    def discard_if_unused(self) -> bool:
+        """Close the session; if it made the file and wrote nothing after the header (a
+        Connect that failed), remove the file too, so no header-only file is left behind.
+        Returns True when the file was removed."""
+        removed = False
+        if self.fd is not None and self._made and not self._wrote:
+            try:                                # while the lock is still held
+                os.unlink(self.path)
+                removed = True
+            except OSError:
+                pass
+        self.close()
+        return removed
 
     def __enter__(self):
         return self

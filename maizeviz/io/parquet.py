@@ -33,14 +33,14 @@ from pathlib import Path
 import numpy as np
 
 from maizeviz.errors import PointsFileError
-from maizeviz.io.points import (
+from maizeviz.io.points_table import (
     MAX_ID,
     MAX_INDEX,
     MAX_LINES,
     MAX_POINTS,
     REQUIRED,
     PointsTable,
-    parse_points,
+    is_parquet_name,
     shown,
 )
 
@@ -83,9 +83,11 @@ def _pyarrow(source: str):
     return pa, pq
 
 
-def read_points_parquet(path: str | Path, max_points: int = MAX_POINTS,
-                        max_lines: int = MAX_LINES) -> PointsTable:
-    """Read a Parquet points file (see the module docstring).
+def read_parquet_table(path: str | Path, max_points: int = MAX_POINTS,
+                       max_lines: int = MAX_LINES) -> PointsTable | str:
+    """Read a Parquet points file (see the module docstring): its records when they are
+    plain (numbers in range, no status column), else the table as CSV text for the CSV reader
+    (:func:`maizeviz.io.points.read_points_parquet` reads it, so its messages are the CSV's).
 
     Raises
     ------
@@ -112,6 +114,7 @@ def read_points_parquet(path: str | Path, max_points: int = MAX_POINTS,
                               "GB of memory (split the file by plant)")
     if len(set(names)) != len(names):
         raise PointsFileError(f"{source}: columns named alike ('{shown(','.join(names), 80)}')")
+    _check_flat(pf.schema_arrow, source, pa)
     texts = [f.name for f in pf.schema_arrow if f.name.strip().lower() not in REQUIRED
              and _is_text(f.type, pa)]
     try:
@@ -121,17 +124,41 @@ def read_points_parquet(path: str | Path, max_points: int = MAX_POINTS,
     except (pa.ArrowException, OSError) as exc:
         raise PointsFileError(f"{source}: not a readable Parquet file ({exc})") from None
     _check_text_size(table, texts, source)
-    table = table.rename_columns(names)
+    # the points' columns (and status) by their lower-case names; the others keep theirs
+    table = table.rename_columns([n if n in (*REQUIRED, "status") else f.strip()
+                                  for n, f in zip(names, pf.schema_arrow.names)])
     got = _plain(table, pa)
     if got is not None:
         ids, xyz = got
-        extra = {n: [shown(str(v), 10**6) if v is not None else "" for v in
-                     table.column(n).to_pylist()] for n in names if n not in REQUIRED}
+        extra = {n: [_cell(v) for v in table.column(n).to_pylist()]
+                 for n in table.column_names if n not in REQUIRED}
         if not len(ids):
             raise PointsFileError(f"{source}: header only, no points")
         return PointsTable(ids=ids, xyz=xyz, line=np.arange(2, len(ids) + 2, dtype=np.int64),
                            extra=extra, source=source)
-    return _as_csv(table, source, pa, max_points, max_lines)
+    return _as_csv(table, pa, source)
+
+
+def _cell(v) -> str:
+    """An extra column's value as the text a CSV holds: text as it is (blanks, tabs and
+    line ends kept), bytes as UTF-8, a missing value as empty."""
+    if v is None:
+        return ""
+    if isinstance(v, bytes):
+        return v.decode("utf-8", errors="replace")
+    return str(v)
+
+
+def _check_flat(schema, source: str, pa) -> None:
+    """Refuse a column of lists, structs, maps or unions, naming it: a points file's cells
+    are numbers or text (such a column ended in ArrowNotImplementedError when the table was
+    cast to text for the CSV reader's checks)."""
+    for f in schema:
+        t = f.type.value_type if pa.types.is_dictionary(f.type) else f.type
+        if pa.types.is_nested(t) or pa.types.is_union(t):
+            raise PointsFileError(f"{source}: column '{shown(f.name, 40)}' holds {t} values, "
+                                  "not numbers or text: a points file's columns hold one "
+                                  "number or text per record (flatten or drop it)")
 
 
 def _is_text(t, pa) -> bool:
@@ -197,15 +224,19 @@ def _plain(table, pa) -> tuple[np.ndarray, np.ndarray] | None:
     return ids, xyz
 
 
-def _as_csv(table, source: str, pa, max_points: int, max_lines: int) -> PointsTable:
-    """The table read through the CSV reader, so that its messages are the CSV's."""
+def _as_csv(table, pa, source: str) -> str:
+    """The table as CSV text, every column as text."""
     import pyarrow.csv as pacsv
 
     out = io.BytesIO()
-    strings = table.cast(pa.schema([(n, pa.string()) for n in table.column_names]))
+    try:
+        strings = table.cast(pa.schema([(n, pa.string()) for n in table.column_names]))
+    except (pa.ArrowNotImplementedError, pa.ArrowInvalid) as exc:   # a type without text
+        why = shown(str(exc), 80)
+        raise PointsFileError(f"{source}: a column cannot be read as text ({why}): a points "
+                              "file's columns hold numbers or text") from None
     pacsv.write_csv(strings, out, pacsv.WriteOptions(quoting_style="needed"))
-    return parse_points(out.getvalue().decode("utf-8", errors="replace"), source, max_points,
-                        max_lines)
+    return out.getvalue().decode("utf-8", errors="replace")
 
 
 def exact_rounding(values: np.ndarray, decimals: int) -> np.ndarray:
@@ -301,7 +332,6 @@ def write_table(path: str | Path, table: PointsTable, decimals: int | None = Non
     (a CSV then holds each number's shortest text that reads back to it).
     """
     from maizeviz.io.atomic import atomic_open
-    from maizeviz.io.points import is_parquet_name
 
     xyz = table.xyz if decimals is None else exact_rounding(table.xyz, decimals)
     if is_parquet_name(path):
@@ -342,7 +372,8 @@ def parquet_rows(path: str | Path) -> int | None:
 
 def read_rows(path: str | Path, start: int, stop: int) -> PointsTable:
     """The records [start, stop) of a Parquet points file whose records are plain (as
-    :func:`point_chunks` found them), line numbers as :func:`read_points_parquet` gives them.
+    :func:`point_chunks` found them), line numbers as
+    :func:`maizeviz.io.points.read_points_parquet` gives them.
 
     Raises
     ------
@@ -452,8 +483,8 @@ def plant_chunk_bounds(path: str | Path, chunk_points: int = ROW_GROUP_POINTS
 
 def point_chunks(path: str | Path, chunk_points: int = ROW_GROUP_POINTS):
     """The points of a Parquet file in tables of whole plants, about ``chunk_points`` points
-    each, in the file's order (line numbers as :func:`read_points_parquet` gives them; extra
-    columns left out).
+    each, in the file's order (line numbers as
+    :func:`maizeviz.io.points.read_points_parquet` gives them; extra columns left out).
 
     Yields
     ------
@@ -462,7 +493,7 @@ def point_chunks(path: str | Path, chunk_points: int = ROW_GROUP_POINTS):
     Raises
     ------
     PointsFileError
-        As :func:`read_points_parquet`, for the file as a whole.
+        As :func:`read_parquet_table`, for the file as a whole.
     NotStreamable
         A chunk holds records the CSV reader must check, or a plant's records are not
         together in the file.

@@ -32,7 +32,6 @@ import io
 import math
 import warnings
 from array import array
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -40,9 +39,19 @@ import numpy as np
 from maizeviz.errors import PointsFileError
 from maizeviz.io.atomic import atomic_open
 from maizeviz.io.inputs import open_input
+from maizeviz.io.points_table import (  # noqa: F401 - shared names, read from here too
+    MAX_ID,
+    MAX_INDEX,
+    MAX_LINES,
+    MAX_POINTS,
+    PARQUET_SUFFIXES,
+    REQUIRED,
+    PointsTable,
+    is_parquet_name,
+    shown,
+)
 from maizeviz.numbers import number, whole
 
-REQUIRED = ("plant", "leaf", "row", "col", "x", "y", "z")
 ID_COLUMNS = ("plant", "leaf", "row", "col")
 #: The header ``maizeviz record`` writes; a file with exactly this header is a recording.
 JOURNAL_COLUMNS = ("plant", "leaf", "row", "col", "x", "y", "z", "status", "time", "station",
@@ -57,18 +66,6 @@ POINT_STATUSES = ("", RECORDED, "ok")
 #: Longest line read (bytes). A points line is under 100 bytes; 10,000 leaves room for long
 #: extra columns and stops a file without line ends (binary data, one huge field) early.
 MAX_LINE_BYTES = 10_000
-#: Most points read from one file: 20 million is about 18,000 digitized plants of 1,100 points
-#: (a 200 MB file holds about 5 million); they take 1.3 GB while reading.
-MAX_POINTS = 20_000_000
-#: Most lines read from one file (blank, skipped and control lines count): 50 million lines
-#: take a few minutes to read.
-MAX_LINES = 50_000_000
-#: Largest plant or leaf id (absolute value): the largest 32-bit integer, the width the canopy
-#: keeps ids in (segmenters number organs with such ids; ids are never packed together, see
-#: :mod:`maizeviz.ids`).
-MAX_ID = 2**31 - 1
-#: Largest row or col index: a leaf has at most a few hundred cross-sections.
-MAX_INDEX = 10_000
 #: Problem lines and bad-leaf messages kept for the report; the rest are counted.
 MAX_MESSAGES = 1000
 #: Leaves with unreadable lines before the file is taken for something else.
@@ -82,40 +79,6 @@ COLUMNAR_BYTES = 4 << 20
 #: What a block of plain numeric lines may hold, besides its delimiter.
 _NUMERIC = b"0123456789+-.eE \r\n"
 
-
-
-@dataclass(frozen=True)
-class PointsTable:
-    """All readable points of a file, one entry per CSV line.
-
-    Attributes
-    ----------
-    ids : (N, 4) int64
-        plant, leaf, row, col.
-    xyz : (N, 3) float64, cm
-        Coordinates as written (may hold NaN: the grid builder refuses those by position).
-    line : (N,) int64
-        1-based line number in the file, for messages.
-    extra : dict[str, list[str]]
-        Other columns, as text, aligned with ``ids``.
-    problems : list[str]
-        Lines that were skipped, with the reason.
-    bad_leaves : dict[(plant, leaf), list[str]]
-        Leaves with an unreadable coordinate; they are refused by the grid builder.
-    source : str
-        Where the table came from (file name), for messages.
-    """
-
-    ids: np.ndarray
-    xyz: np.ndarray
-    line: np.ndarray
-    extra: dict = field(default_factory=dict)
-    problems: list = field(default_factory=list)
-    bad_leaves: dict = field(default_factory=dict)
-    source: str = "<memory>"
-
-    def __len__(self) -> int:
-        return len(self.line)
 
 
 class _BadValue(ValueError):
@@ -310,17 +273,26 @@ class LineParser:
         if "," not in first:
             self.delimiter = ";" if ";" in first else ("\t" if "\t" in first else ",")
         fields = self._split(text)
-        header = [f.strip().lower() for f in fields]
+        names = [f.strip() for f in fields]
+        header = [n.lower() for n in names]
         missing = [c for c in REQUIRED if c not in header]
         if missing:
             found = shown(",".join(header), 80)
             raise PointsFileError(
                 f"{self.source}: line {lineno}: missing column(s) {', '.join(missing)}; "
                 f"a points file needs the header plant,leaf,row,col,x,y,z (found '{found}')")
+        named = [h for h in header if h]
+        if len(set(named)) != len(named):     # one of them would be lost
+            twice = sorted({h for h in named if named.count(h) > 1})
+            raise PointsFileError(f"{self.source}: line {lineno}: columns named alike "
+                                  f"('{shown(','.join(twice), 80)}'; names are read without "
+                                  "case): rename one")
         self.header = header
         self.header_line = lineno
         self.index = [header.index(name) for name in REQUIRED]
-        self.extra_index = {h: header.index(h) for h in header if h and h not in REQUIRED}
+        # extra columns by their own name (its case kept), their cells kept exactly
+        self.extra_index = {names[k]: k for k, h in enumerate(header)
+                            if h and h not in REQUIRED}
         self.extra = {h: [] for h in self.extra_index}
         self.status_col = header.index("status") if "status" in header else None
         self.journal = tuple(header) == JOURNAL_COLUMNS
@@ -488,7 +460,7 @@ class LineParser:
             except ValueError:
                 return ("bad", ((plant, leaf), f"row {row}, col {col} (line {lineno}): {axis} is "
                         f"not a number ('{shown(value)}')"), lineno)
-        extras = [fields[i].strip() for i in self.extra_index.values()]
+        extras = [fields[i] for i in self.extra_index.values()]
         return ("point", (plant, leaf, row, col, coords, extras), lineno)
 
     def _note(self, text: str) -> None:
@@ -677,16 +649,6 @@ def _numbers(block: bytes, delimiter: str, columns: int, columnar: bool
     return [table.column(k).to_numpy(zero_copy_only=False) for k in range(columns)]
 
 
-def shown(text: str, limit: int = 30) -> str:
-    """Text from a file as it may appear in a one-line message: stripped, shortened, and
-    with line ends and other control characters written as escapes."""
-    text = text.strip()
-    cut = text[:limit]
-    if not cut.isprintable():
-        cut = "".join(c if c.isprintable() else repr(c)[1:-1] for c in cut)
-    return cut + ("..." if len(text) > limit else "")
-
-
 def text_of(fields: list[str], limit: int = 40) -> str:
     """A line's fields joined back, shortened for a message."""
     return shown(",".join(fields), limit)
@@ -734,8 +696,6 @@ def read_points(path: str | Path, max_points: int = MAX_POINTS,
     fh, size = open_regular(path)
     with fh:
         if fh.peek(4)[:4] == b"PAR1":
-            from maizeviz.io.parquet import read_points_parquet
-
             return read_points_parquet(path, max_points, max_lines)
         try:
             zeros = zero_tail(fh, size)
@@ -752,6 +712,25 @@ def read_points(path: str | Path, max_points: int = MAX_POINTS,
             return table
         except OSError as exc:
             raise PointsFileError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+
+
+def read_points_parquet(path: str | Path, max_points: int = MAX_POINTS,
+                        max_lines: int = MAX_LINES) -> PointsTable:
+    """Read a Parquet points file (:mod:`maizeviz.io.parquet`): its plain records as they
+    are, any other table through the CSV reader, so that its messages are the CSV's.
+
+    Raises
+    ------
+    PointsFileError
+        Not a readable Parquet file, a required column missing, more than ``max_points``
+        records (or ``max_lines``), no readable point; and whatever the CSV reader refuses.
+    """
+    from maizeviz.io.parquet import read_parquet_table
+
+    got = read_parquet_table(path, max_points, max_lines)
+    if isinstance(got, PointsTable):
+        return got
+    return parse_points(got, str(path), max_points, max_lines)
 
 
 def parse_points(text: str, source: str = "<memory>", max_points: int = MAX_POINTS,
@@ -789,12 +768,3 @@ def write_points(path: str | Path, grids, decimals: int = 3) -> None:
                     row = row[:1]
                 for c, p in enumerate(row):
                     writer.writerow([g.plant, g.leaf, r, c, *(f"{v:.{decimals}f}" for v in p)])
-
-
-#: Names of points files written as Parquet.
-PARQUET_SUFFIXES = (".parquet", ".pq")
-
-
-def is_parquet_name(path: str | Path) -> bool:
-    """Whether a points file to write at ``path`` is a Parquet file (by its name)."""
-    return Path(path).suffix.lower() in PARQUET_SUFFIXES

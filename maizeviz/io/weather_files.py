@@ -11,8 +11,15 @@ PSM's ``Time Zone``), where they sit in their interval (EPW: its start, as pvlib
 EnergyPlus's hour-ending rows; TMY3: its end, as the file does; PSM: the middle, the
 satellite's instantaneous values), the irradiance columns (W/m2), the air temperature (deg C)
 and the line of each row. A typical year (TMY3, most EPW), whose months come from different
-years, is dated in one year, the first row's (pvlib's ``coerce_year``), so that its rows
-follow each other; a note says so.
+years (earlier or later: a file cut from one may go from July 1991 to August 2003), is
+dated from the first row's year on, so that its rows follow each other; a note says so.
+
+An EPW's LOCATION line is read with the csv module, as the checks read it: a city quoted
+with a comma in it (``"Turin, IT"``) is one field (pvlib alone splits every comma and took
+the place and time zone from the wrong fields); a bare comma, which EnergyPlus would split
+too, is refused naming the fields. A row with fewer values than the format's columns (a
+file cut inside its last row) is refused. A header latitude or longitude that is no finite
+number is named in the place's ``problem``.
 
 A file pvlib cannot read, or a value that is missing (EPW's 9999, TMY3's -9900) or not a
 number, is refused in one line naming the file and the line. Air temperatures that are
@@ -211,9 +218,82 @@ def _read(kind: str, text: str, coerce: int | None):
 
 
 def _typical_year(times) -> bool:
-    """Whether the rows' years go back somewhere (a typical year's months)."""
-    years = np.asarray(times.year)
-    return bool(len(years) > 1 and np.any(np.diff(years) < 0))
+    """Whether the rows' years change other than at a new year (a typical year's months,
+    which come from different years, earlier or later: a file cut across a month boundary
+    may go from July 1991 to August 2003)."""
+    years, months = np.asarray(times.year), np.asarray(times.month)
+    change = np.flatnonzero(np.diff(years) != 0)
+    new_year = (months[change] == 12) & (months[change + 1] == 1) & \
+        (years[change + 1] == years[change] + 1)
+    return bool(len(change) and not np.all(new_year))
+
+
+def _one_year(times, year: int):
+    """A typical year's times dated from ``year`` on: each row in the year of the row before
+    it, the next year where its month and day come before the previous row's (pvlib's
+    ``coerce_year`` puts the last row in the next year, as for a whole year ending at
+    24:00 on 31 December: a cut file's last row went a year ahead)."""
+    import pandas as pd
+
+    out, prev = [], None
+    for t in times:
+        moved = t.replace(year=year)             # 29 February into a common year: refused
+        if prev is not None and moved <= prev:
+            year += 1
+            moved = t.replace(year=year)
+        out.append(moved)
+        prev = moved
+    return pd.DatetimeIndex(out)
+
+
+def _epw_location(text: str, path: Path) -> tuple[str, str]:
+    """(text for pvlib, city) of an EPW: its LOCATION line read with the csv module, as the
+    checks read it. pvlib splits the line at every comma, so a quoted city holding one
+    (``"Turin, IT"``) shifted the place and the time zone by a field; the line handed to
+    pvlib has such commas as blanks, and the city is the csv module's. A bare comma in a
+    name gives the line more fields than an EPW's: refused naming them (EnergyPlus splits
+    every comma too)."""
+    lines = text.lstrip().splitlines()
+    place = next(csv.reader([lines[0]]), [])
+    if len(place) != EPW_LOCATION_FIELDS:
+        extra = ""
+        if len(place) > EPW_LOCATION_FIELDS:
+            names = ", ".join(f"field {k + 1} '{c.strip()[:20]}'" for k, c in
+                              enumerate(place[1:5], 1))
+            extra = (f" ({names}): a comma inside the city, state or country? quote the "
+                     'name ("Turin, IT") or drop the comma')
+        raise WeatherFileError(f"{path}, line 1: the LOCATION line has {len(place)} fields; "
+                               f"an EPW's has {EPW_LOCATION_FIELDS} (LOCATION, city, state, "
+                               "country, source, WMO, latitude, longitude, time zone, "
+                               f"elevation){extra}")
+    if any("," in c for c in place):
+        lines[0] = ",".join(c.replace(",", " ") for c in place)
+        text = "\n".join(lines) + "\n"
+    return text, place[1].strip()
+
+
+def _short_row(text: str, kind: str) -> tuple[int, int, int] | None:
+    """(line, values, columns) of the first data row with fewer values than the format's
+    rows (the header's columns; an EPW's first row): a row cut short, as a file cut while it
+    was written ends. pandas fills the missing cells and reads the cut one as its remaining
+    digits."""
+    skip = _header_lines(kind)
+    width = None
+    for no, line in enumerate(text.splitlines(), 1):
+        if no < skip or not line.strip(" ,\t"):
+            continue
+        try:
+            cells = next(csv.reader([line]), [])
+        except csv.Error:
+            return None                          # the read says what is wrong
+        if no == skip:
+            if kind != "epw":
+                width = len([c for c in cells if c.strip()])
+            continue
+        width = width or len(cells)
+        if len(cells) < width:
+            return no, len(cells), width
+    return None
 
 
 def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable:
@@ -230,22 +310,25 @@ def read_pvlib_file(path: str | Path, kind: str, max_bytes: int) -> WeatherTable
     name = PVLIB_FORMATS[kind]
     if not text.strip():
         raise WeatherFileError(f"{path}: the weather file is empty")
+    city = None
     if kind == "epw":
-        place = next(csv.reader([text.lstrip().splitlines()[0]]), [])
-        if len(place) < EPW_LOCATION_FIELDS:
-            raise WeatherFileError(f"{path}, line 1: the LOCATION line has {len(place)} "
-                                   f"fields; an EPW's has {EPW_LOCATION_FIELDS} (city, state, "
-                                   "country, source, WMO, latitude, longitude, time zone, "
-                                   "elevation)")
+        text, city = _epw_location(text, path)
     if len(text.strip().splitlines()) <= _header_lines(kind):
         raise WeatherFileError(f"{path}: the file ends within the {_header_lines(kind)}-line "
                                f"header of an {name} file: no data rows")
     _check_header_numbers(text, kind, path)
+    short = _short_row(text, kind)
+    if short:
+        raise WeatherFileError(f"{path}, line {short[0]}: {short[1]} values, fewer than the "
+                               f"{short[2]} columns of the file: a row cut short (a file cut "
+                               "while it was written?); complete or delete the row")
     try:
         data, meta = _read(kind, text, None)
+        if city is not None:
+            meta["city"] = city
         if kind != "psm" and _typical_year(data.index):
             year = int(data.index.year[0])
-            data, meta = _read(kind, text, year)
+            data = data.set_axis(_one_year(data.index, year))
             notes.append(f"{path.name}: a typical year (its months come from different "
                          f"years): its rows are dated in {year}")
     except Exception as exc:  # noqa: BLE001 - pvlib and pandas raise many kinds; say where
@@ -297,7 +380,8 @@ def weather_place(path: str | Path) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``latitude``, ``longitude`` [deg], ``altitude`` [m] (None where absent) and ``name``.
+        ``latitude``, ``longitude`` [deg], ``altitude`` [m], ``utc_offset_h`` (the header's
+        time zone, hours east of UTC) (None where absent) and ``name``.
     """
     path = Path(path)
     try:
@@ -311,18 +395,28 @@ def weather_place(path: str | Path) -> dict[str, Any]:
     text = head.decode("latin-1").lstrip("\ufeff\xef\xbb\xbf")
     lines = text.splitlines()[:_header_lines(kind) + 2]     # the header and two rows
     try:
-        _data, meta = _read(kind, "\n".join(lines) + "\n", None)
+        text, city = _epw_location("\n".join(lines) + "\n", path) if kind == "epw" \
+            else ("\n".join(lines) + "\n", None)
+        _data, meta = _read(kind, text, None)
     except Exception:  # noqa: BLE001 - pvlib and pandas raise many kinds; the read says
         return {}
+    if city is not None:
+        meta["city"] = city
     return _place(meta)
 
 
 def _place(meta: dict) -> dict[str, Any]:
     """The place of a pvlib reader's metadata."""
     name = str(meta.get("city") or meta.get("Name") or meta.get("City") or "").strip('" ')
-    return {"latitude": _number(meta, "latitude"), "longitude": _number(meta, "longitude"),
-            "altitude": _number(meta, "altitude"),
-            "name": "" if name.lower() in ("-", "unknown", "none", "nan") else name}
+    place = {"latitude": _number(meta, "latitude"), "longitude": _number(meta, "longitude"),
+             "altitude": _number(meta, "altitude"),
+             "name": "" if name.lower() in ("-", "unknown", "none", "nan") else name}
+    for key in ("latitude", "longitude"):                # a header's NaN, named for the user
+        if place[key] is None and key in meta and str(meta[key]).strip():
+            place.setdefault("problem", f"the header's {key} is '{str(meta[key]).strip()}'")
+    offset = _number(meta, "TZ") if "TZ" in meta else _number(meta, "Time Zone")
+    place["utc_offset_h"] = offset if offset is not None and -14 <= offset <= 14 else None
+    return place
 
 
 def _floats(column, where: str, lines: np.ndarray, times) -> np.ndarray:

@@ -55,8 +55,14 @@ def basis_values(x: np.ndarray, knots: np.ndarray, degree: int
     values : (L, A, degree + 1) float64, summing to 1 over the last axis
     first : (L, A) int64, the control point of ``values[..., 0]``
     n_control : K - degree - 1
+
+    Raises
+    ------
+    ValueError
+        In one line naming the argument, as the compiled loops' (:func:`maizeviz.loops.
+        check_basis`: shapes, a knot count under 2 (degree + 1), knots decreasing).
     """
-    x = np.asarray(x, dtype=np.float64)
+    x, knots, degree = loops.check_basis(x, knots, degree)
     nbatch, npts = x.shape
     nctrl = knots.shape[1] - degree - 1
     span = count_at_most(knots, x) - 1
@@ -92,6 +98,12 @@ def basis_matrix(x: np.ndarray, knots: np.ndarray, degree: int) -> np.ndarray:
     Returns
     -------
     (L, A, K - degree - 1) float64; rows sum to 1.
+
+    Raises
+    ------
+    ValueError
+        In one line naming the argument (:func:`maizeviz.loops.check_basis`), through the
+        compiled loops or numpy alike.
     """
     out = loops.basis_matrix(x, knots, degree)       # the same values in one C pass
     if out is not None:

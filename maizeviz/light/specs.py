@@ -196,6 +196,10 @@ class OpticsSpec:
         Air (leaf) temperature for the leaf model [degC].
     photosynthesis_params : tuple of (str, float)
         The leaf model's parameters that differ from its defaults.
+    c4_temperature : {"collatz", "clm45"}
+        The C4 model's temperature response
+        (:data:`maizeviz.photosynthesis.c4.TEMPERATURE_RESPONSES`); a project saved before it
+        was a choice reads as "clm45", what it computed.
 
     References
     ----------
@@ -216,6 +220,7 @@ class OpticsSpec:
     photosynthesis: str = ""
     temperature_c: float = 25.0
     photosynthesis_params: tuple = ()
+    c4_temperature: str = "collatz"
 
     def leaf_model(self):
         """The leaf model chosen, checked.
@@ -239,7 +244,10 @@ class OpticsSpec:
             raise MaizevizError("photosynthesis works from absorbed PAR, not "
                                 f"{self.band.upper()}", quantity="band")
         check_range(self.temperature_c, "the air temperature (C)", -50, 70, "temperature")
-        return leaf_model(self.photosynthesis, **dict(self.photosynthesis_params))
+        params = dict(self.photosynthesis_params)
+        if self.photosynthesis == "c4":
+            params["temperature_response"] = self.c4_temperature
+        return leaf_model(self.photosynthesis, **params)
 
     def assimilation(self, canopy, light):
         """Gross CO2 assimilation of absorbed light through the chosen leaf model.

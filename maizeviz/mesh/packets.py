@@ -30,7 +30,6 @@ from __future__ import annotations
 import ctypes
 import functools
 import hashlib
-import os
 import threading
 import warnings
 from dataclasses import dataclass
@@ -39,8 +38,10 @@ from pathlib import Path
 import numpy as np
 
 SOURCE = Path(__file__).with_name("_packets.c")
-#: Rays per packet: 8 matches AVX2 (this machine); 16 is Embree's widest.
-DEFAULT_WIDTH = int(os.environ.get("MAIZEVIZ_PACKET_WIDTH", "8"))
+#: Rays per packet: 8 matches AVX2 (this machine); 16 is Embree's widest
+#: (``MAIZEVIZ_PACKET_WIDTH``, read by :func:`maizeviz.environment.whole_number` when the
+#: kernel loads).
+DEFAULT_WIDTH = 8
 #: sizeof(RTCRay16) * 1000 + offsetof(RTCRayHit16, hit), as Embree 4 lays them out.
 _LAYOUT = 768 * 1000 + 768
 
@@ -75,7 +76,10 @@ class Status:
 
 
 def _load() -> tuple[Kernel | None, Status]:
-    if os.environ.get("MAIZEVIZ_PACKETS", "1") == "0":
+    from maizeviz.environment import switch, whole_number
+
+    width = whole_number("MAIZEVIZ_PACKET_WIDTH")    # a bad value refused before anything
+    if not switch("MAIZEVIZ_PACKETS"):
         return None, Status("embreex", "turned off by MAIZEVIZ_PACKETS=0", None)
     try:
         from maizeviz.mesh import _packets as ext
@@ -120,7 +124,7 @@ def _load() -> tuple[Kernel | None, Status]:
             return None, Status("embreex", f"{e.path} has no rtcIntersect{w}/rtcOccluded{w}",
                                 path)
         inter[w], occl[w] = ai, ao
-    width = DEFAULT_WIDTH if DEFAULT_WIDTH in inter else 8
+    width = width if width in inter else DEFAULT_WIDTH
     return Kernel(lib, inter, occl, width), Status("packets", "", path)
 
 

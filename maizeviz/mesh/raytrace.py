@@ -23,6 +23,7 @@ except ImportError as _exc:  # exercised by tests/core/test_packets.py in a subp
 from maizeviz.errors import MaizevizError
 from maizeviz.mesh import packets as _packets
 from maizeviz.mesh.embree_fill import _handles, compact, embree, fill
+from maizeviz.mesh.embree_isa import check_isa, device, requested
 
 #: Why the fast paths are off when embreex's scene object is not laid out as expected.
 _UNREAD = "embreex's EmbreeScene is not laid out as maizeviz reads it (its scene handle)"
@@ -68,7 +69,7 @@ class RayScene:
     """
 
     def __init__(self, vertices, faces, robust: bool = False, by_copy: bool = True,
-                 packets: bool = True, snap_q: float | None = None):
+                 packets: bool = True, snap_q: float | None = None, isa: str | None = None):
         """``vertices`` (V, 3) cm and ``faces`` (F, 3): arrays, or sequences of arrays taken one
         after the other (the faces numbered over all the vertices). ``snap_q``: x and y rounded
         to multiples of it (cm) as Embree's copy is made (a periodic field's grid).
@@ -76,14 +77,17 @@ class RayScene:
         about 20x faster, no transient copy); False, or where that cannot be done, embreex's
         element-by-element ``TriangleMesh`` (the same scene: ``filled_by_copy`` says which was
         used). ``packets``: trace through Embree's ray packets where the kernel is available
-        (``self.packets`` says whether it is used), else embreex's single rays."""
+        (``self.packets`` says whether it is used), else embreex's single rays. ``isa``: the
+        instruction set Embree traces with (:data:`maizeviz.mesh.embree_isa.ISAS`; None:
+        ``MAIZEVIZ_EMBREE_ISA``'s, else the CPU's best)."""
         if EmbreeScene is None:
             raise MaizevizError(no_embreex(_IMPORT_ERROR), quantity="embreex")
         n = len(faces) if isinstance(faces, np.ndarray) else sum(len(f) for f in faces)
         if n == 0:
             raise MaizevizError("the scene is empty: no triangle to trace against")
         self.n_triangles = n
-        self._scene = EmbreeScene(robust=robust)
+        self.isa = check_isa(isa, "the Embree instruction set") or requested()
+        self._scene = EmbreeScene(device(self.isa), robust=robust)
         self.compact = by_copy and compact(self._scene)
         filled = fill(self._scene, vertices, faces, snap_q, share=True) if by_copy else 0
         self.filled_by_copy = bool(filled)

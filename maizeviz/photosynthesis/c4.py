@@ -17,24 +17,50 @@ and the leaf respires ``Rd(T)`` (net assimilation ``A - Rd``). Temperatures act 
 and, for ``Vmax``, a fall at both ends and for ``Rd`` above 55 C::
 
     Vmax(T) = Vmax25 Q10^((T - 25)/10) / ((1 + exp(s1 (T - s2))) (1 + exp(s3 (s4 - T))))
-    Rd(T)   = Rd25   Q10^((T - 25)/10) / (1 + exp(s5 (T - s6)))
+    Rd(T)   = Rd25   Q10^((T - 25)/10) / (1 + exp(1.3 (T - 55)))
     k(T)    = k25    Q10^((T - 25)/10)
 
+Two temperature responses of ``Vmax`` are offered (``temperature_response``):
+
+- ``"collatz"`` (the default): the paper's own (Collatz et al. 1992, appendix B, equation set
+  5B), ``s1 = s3 = 0.3 /C``, upper limit ``s2 = 36 C``, lower ``s4 = 13 C``; BioCro
+  (``collatz_photo``) and JULES (``tupp``/``tlow`` of its C4 grass, Cox 2001) code the same.
+  With maize parameters Vmax is 44.7 umol/m2/s at 35 C and 25.5 at 40 C.
+- ``"clm45"``: the Community Land Model 4.5's (Oleson et al. 2013, section 8.2; Bonan 2019,
+  chapter 11), ``s1 = 0.3 /C`` above ``s2 = 40 C``, ``s3 = 0.2 /C`` below ``s4 = 15 C``: 62.6
+  at 35 C, 54.8 at 40 C; a bright leaf assimilates 1.3-1.9 times the paper's figure between
+  35 and 40 C. maizeviz 0.2 computed with this one;
+  results and projects saved then, which do not name a response, are read as it.
+
 Parameters (Collatz et al. 1992, Table 2, fitted to gas exchange of maize leaves): Vmax 39
-umol/m2/s, alpha 0.04 mol CO2 per mol of absorbed photons, k 0.7 mol/m2/s, theta 0.83, beta
-0.93, Rd 0.8 umol/m2/s, Q10 2; the temperature limits s1 = 0.3 /C above s2 = 40 C, s3 = 0.2 /C
-below s4 = 15 C, s5 = 1.3 /C above s6 = 55 C as the Community Land Model documents them for
-this model (Oleson et al. 2013, section 8.2). Stomata are not modelled: ``ci`` is a fixed share
-of the ambient CO2 (0.4 for C4 leaves, the model's own starting value; ``ci_ratio``).
+umol/m2/s, alpha 0.04, k 0.7 mol/m2/s, theta 0.83, beta 0.93, Rd 0.8 umol/m2/s, Q10 2. Stomata
+are not modelled: ``ci`` is a fixed share of the ambient CO2 (0.4 for C4 leaves, the model's
+own starting value; ``ci_ratio``).
+
+The photon basis of alpha: absorbed photons. The paper's independent variable is the absorbed
+quantum flux (its abstract); maizeviz feeds alpha the PAR each triangle absorbs (from the ray
+tracing), as the land-surface models that carry this model do: JULES
+multiplies its C4 alpha by ``apar = (1 - omega) ipar`` (Cox 2001; ``omega`` the leaf's
+scattering coefficient) and CLM 4.5 by the PAR absorbed by sunlit and shaded leaves (Oleson et
+al. 2013, section 8.1). BioCro's ``c4photo`` applies the same 0.04 to the photon flux incident
+on the leaf (its ``Qp``): with a maize leaf's PAR absorptance of about 0.85 that is a light-
+limited slope 1/0.85 = 1.18 times maizeviz's, about 9 % more gross assimilation over a day.
+The 1992 paper fitted alpha to gas exchange of maize leaves; to reproduce a model that reads it
+on incident light, give ``alpha / absorptance`` (``--alpha``).
 
 References
 ----------
 Collatz, G. J., Ribas-Carbo, M. & Berry, J. A. (1992). Coupled photosynthesis-stomatal
 conductance model for leaves of C4 plants. Australian Journal of Plant Physiology 19, 519-538.
+Collatz, G. J., Ball, J. T., Grivet, C. & Berry, J. A. (1991). Physiological and environmental
+regulation of stomatal conductance, photosynthesis and transpiration. Agricultural and Forest
+Meteorology 54, 107-136.
+Cox, P. M. (2001). Description of the TRIFFID dynamic global vegetation model. Hadley Centre
+Technical Note 24 (the C4 Vmax response as JULES codes it).
 Oleson, K. W. et al. (2013). Technical description of version 4.5 of the Community Land Model
 (CLM). NCAR Technical Note NCAR/TN-503+STR (section 8.2, the C4 temperature functions).
 Bonan, G. (2019). Climate Change and Terrestrial Ecosystem Modeling. Cambridge University
-Press (chapter 11: the same model and temperature functions).
+Press (chapter 11: CLM's form of the model).
 """
 
 from __future__ import annotations
@@ -43,7 +69,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from maizeviz.errors import check_range
+from maizeviz.errors import MaizevizError, check_range
 from maizeviz.photosynthesis.units import PAR_UMOL_PER_J
 
 
@@ -61,6 +87,19 @@ def smaller_root(curvature, a, b):
     den = s + np.sqrt(disc)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(den > 0, 2.0 * a * b / np.where(den > 0, den, 1.0), 0.0)
+
+
+#: The temperature responses of Vmax by name: ``(s1, s2, s3, s4)`` of the module docstring,
+#: steepness above [degC-1], upper limit [degC], steepness below [degC-1], lower limit [degC].
+TEMPERATURE_RESPONSES: dict[str, tuple[float, float, float, float]] = {
+    "collatz": (0.3, 36.0, 0.3, 13.0),   # Collatz et al. 1992, appendix B, eq. set 5B
+    "clm45": (0.3, 40.0, 0.2, 15.0),     # Oleson et al. 2013, CLM 4.5 section 8.2
+}
+#: The temperature response of maizeviz 0.2, which its records do not name.
+LEGACY_TEMPERATURE_RESPONSE = "clm45"
+#: The temperature responses in words, for tables and the app.
+TEMPERATURE_RESPONSE_LABELS = {"collatz": "Collatz et al. 1992",
+                               "clm45": "CLM 4.5 (Oleson et al. 2013)"}
 
 
 @dataclass(frozen=True)
@@ -85,18 +124,17 @@ class C4Leaf:
         Ambient CO2 [umol mol-1].
     ci_ratio : float
         Intercellular over ambient CO2 [-].
-    s1, s2 : float
-        Vmax falls above ``s2`` [degC] with steepness ``s1`` [degC-1].
-    s3, s4 : float
-        Vmax falls below ``s4`` [degC] with steepness ``s3`` [degC-1].
-    s5, s6 : float
-        Rd falls above ``s6`` [degC] with steepness ``s5`` [degC-1].
+    temperature_response : {"collatz", "clm45"}
+        How Vmax falls in heat and cold: the paper's own (default) or CLM 4.5's
+        (:data:`TEMPERATURE_RESPONSES`).
 
     References
     ----------
     Collatz, G. J., Ribas-Carbo, M. & Berry, J. A. (1992). Coupled photosynthesis-stomatal
     conductance model for leaves of C4 plants. Australian Journal of Plant Physiology 19,
     519-538. https://doi.org/10.1071/PP9920519
+    Oleson, K. W. et al. (2013). Technical description of version 4.5 of the Community Land
+    Model (CLM). NCAR/TN-503+STR. https://doi.org/10.5065/D6RR1W7M
     """
 
     vmax: float = 39.0
@@ -108,12 +146,7 @@ class C4Leaf:
     q10: float = 2.0
     co2_ppm: float = 400.0
     ci_ratio: float = 0.4
-    s1: float = 0.3
-    s2: float = 40.0
-    s3: float = 0.2
-    s4: float = 15.0
-    s5: float = 1.3
-    s6: float = 55.0
+    temperature_response: str = "collatz"
 
     name = "c4"
 
@@ -124,6 +157,19 @@ class C4Leaf:
             check_range(getattr(self, field_), f"the C4 model's {field_}", low, high,
                         "photosynthesis")
             object.__setattr__(self, field_, float(getattr(self, field_)))
+        form = str(self.temperature_response).strip().lower()
+        if form not in TEMPERATURE_RESPONSES:
+            raise MaizevizError(f"the C4 model's temperature_response is "
+                                f"'{self.temperature_response}', not one of "
+                                f"{', '.join(TEMPERATURE_RESPONSES)}",
+                                quantity="photosynthesis")
+        object.__setattr__(self, "temperature_response", form)
+
+    @property
+    def label(self) -> str:
+        """The model and its temperature response in words (tables, the app)."""
+        return (f"C4, Collatz et al. 1992 (temperature response: "
+                f"{TEMPERATURE_RESPONSE_LABELS[self.temperature_response]})")
 
     # ------------------------------------------------------------------ temperature
     def _q10(self, temp_c):
@@ -143,8 +189,9 @@ class C4Leaf:
             Vmax(T) [umol CO2 m-2 s-1].
         """
         t = np.asarray(temp_c, dtype=np.float64)
-        return self.vmax * self._q10(t) / ((1.0 + np.exp(self.s1 * (t - self.s2)))
-                                           * (1.0 + np.exp(self.s3 * (self.s4 - t))))
+        s1, s2, s3, s4 = TEMPERATURE_RESPONSES[self.temperature_response]
+        return self.vmax * self._q10(t) / ((1.0 + np.exp(s1 * (t - s2)))
+                                           * (1.0 + np.exp(s3 * (s4 - t))))
 
     def k_at(self, temp_c):
         """Initial slope of the CO2 response at a leaf temperature.
@@ -175,7 +222,8 @@ class C4Leaf:
             Rd(T) [umol CO2 m-2 of leaf s-1].
         """
         t = np.asarray(temp_c, dtype=np.float64)
-        return self.rd * self._q10(t) / (1.0 + np.exp(self.s5 * (t - self.s6)))
+        # the same fall above 55 C in both responses (Collatz et al. 1992, eq. set 5B)
+        return self.rd * self._q10(t) / (1.0 + np.exp(1.3 * (t - 55.0)))
 
     # ------------------------------------------------------------------ assimilation
     def gross_umol(self, q_umol, temp_c=25.0, ci_ppm=None):
@@ -219,11 +267,11 @@ class C4Leaf:
         return self.gross_umol(np.asarray(par_w_m2, dtype=np.float64) * PAR_UMOL_PER_J, temp_c)
 
     def as_dict(self) -> dict[str, float | str]:
-        """The model as a record (its name and parameters).
+        """The model as a record (its name, parameters and temperature response).
 
         Returns
         -------
         dict
-            ``{"model": "c4", ...}``.
+            ``{"model": "c4", "vmax": 39.0, ..., "temperature_response": "collatz"}``.
         """
         return {"model": self.name, **asdict(self)}

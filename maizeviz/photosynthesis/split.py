@@ -41,6 +41,10 @@ class LeafModel(Protocol):
 
     name: str
 
+    @property
+    def label(self) -> str:
+        """The model in words, with its temperature response where it has a choice."""
+
     def gross(self, par_w_m2, temp_c=25.0):
         """Gross assimilation, umol CO2/m2 leaf/s, at absorbed PAR ``par_w_m2`` (W/m2)."""
 
@@ -88,12 +92,27 @@ def leaf_model(name: str = "c4", **params) -> LeafModel:
     return cls(**given)
 
 
+#: Parameters of maizeviz 0.2's C4 records that now come with the temperature response.
+_LEGACY_C4_KEYS = ("s1", "s2", "s3", "s4", "s5", "s6")
+
+
 def model_from_dict(record: dict) -> LeafModel:
-    """The leaf model an :meth:`as_dict` record describes."""
+    """The leaf model an :meth:`as_dict` record describes.
+
+    A C4 record without ``temperature_response`` was written by maizeviz 0.2, which computed
+    with CLM 4.5's response and recorded its constants (``s1``-``s6``): it is read as that
+    (:data:`~maizeviz.photosynthesis.c4.LEGACY_TEMPERATURE_RESPONSE`).
+    """
+    from maizeviz.photosynthesis.c4 import LEGACY_TEMPERATURE_RESPONSE
+
     if not isinstance(record, dict) or not isinstance(record.get("model"), str):
         raise MaizevizError("a photosynthesis record needs its model's name",
                             quantity="photosynthesis")
-    return leaf_model(record["model"], **{k: v for k, v in record.items() if k != "model"})
+    params = {k: v for k, v in record.items() if k != "model"}
+    if str(record["model"]).strip().lower() == "c4":
+        params = {k: v for k, v in params.items() if k not in _LEGACY_C4_KEYS}
+        params.setdefault("temperature_response", LEGACY_TEMPERATURE_RESPONSE)
+    return leaf_model(record["model"], **params)
 
 
 def split_assimilation(model: LeafModel, area_m2, sunlit_m2, direct_w, background_w,
@@ -105,7 +124,8 @@ def split_assimilation(model: LeafModel, area_m2, sunlit_m2, direct_w, backgroun
     ----------
     model : LeafModel
     area_m2 : (F,) float64, triangle areas, m2 (one side)
-    sunlit_m2 : (F,) float64, area in the direct beam, m2 (an estimate: may exceed the area)
+    sunlit_m2 : (F,) float64, area in the direct beam, m2 (at most ``area_m2`` for the
+        gross to stay within the model's light-saturated rate)
     direct_w : (F,) float64, W of PAR absorbed from the direct beam (on the sunlit part)
     background_w : (F,) float64, W of PAR absorbed from everything else (spread evenly)
     temp_c : leaf temperature, C (scalar)
@@ -115,9 +135,10 @@ def split_assimilation(model: LeafModel, area_m2, sunlit_m2, direct_w, backgroun
     (F,) float64, umol CO2/s per triangle
     """
     area = np.asarray(area_m2, dtype=np.float64)
-    # not capped at the area: a triangle's sunlit area is a ray count (noisy), and the result
-    # is linear in it at the beam's exact flux, so its noise averages out over triangles;
-    # capping it would raise the flux of those capped and bias a concave response low
+    # the traced sunlit area is sampled from the triangle, at most its area
+    # (maizeviz.light.trace.sunlit); the result is linear in it at the beam's exact flux, so
+    # its noise averages out over triangles. Not capped here: capping a noisy estimate would
+    # raise the flux of those capped and bias a concave response low
     lit = np.maximum(np.asarray(sunlit_m2, dtype=np.float64), 0.0)
     direct = np.asarray(direct_w, dtype=np.float64)
     # a beam that reached a triangle lit it: no direct flux without sunlit area

@@ -55,6 +55,11 @@ class WofostLeaf:
 
     name = "wofost"
 
+    @property
+    def label(self) -> str:
+        """The model in words (tables, the app)."""
+        return "WOFOST negative exponential (Spitters et al. 1986)"
+
     def __post_init__(self) -> None:
         check_range(self.amax, "WOFOST's AMAX (kg CO2/ha leaf/h)", 0, 500, "photosynthesis")
         check_range(self.eff, "WOFOST's EFF (kg CO2/ha/h per J/m2/s)", 0, 5, "photosynthesis")

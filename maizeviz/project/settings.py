@@ -9,6 +9,7 @@ from typing import Any
 from maizeviz.errors import MaizevizError
 from maizeviz.io.project import ProjectError, get
 from maizeviz.light.specs import DaySpec, OpticsSpec, SkySpec
+from maizeviz.photosynthesis.c4 import LEGACY_TEMPERATURE_RESPONSE
 
 __all__ = ["run_settings", "settings_doc"]
 
@@ -99,7 +100,9 @@ def _optics_spec(stored: dict | None, light, where: str) -> OpticsSpec:
                       tuple((str(r[0]), float(r[1])) for r in
                             get(doc, "photosynthesis_params", list, [], at)
                             if isinstance(r, list) and len(r) == 2 and isinstance(r[0], str)
-                            and isinstance(r[1], (int, float)) and not isinstance(r[1], bool)))
+                            and isinstance(r[1], (int, float)) and not isinstance(r[1], bool)),
+                      # saved before the C4 temperature response was a choice: CLM 4.5's
+                      get(doc, "c4_temperature", str, LEGACY_TEMPERATURE_RESPONSE, at))
     try:
         spec.optics()
         spec.leaf_model()

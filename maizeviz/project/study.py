@@ -181,8 +181,8 @@ def project_layout(opened: Opened, leaves: Sequence[Leaf]) -> CanopyLayout:
     return layout_for(list(leaves), shape)
 
 
-def results_on(opened: Opened, layout: CanopyLayout, leaves: Sequence[Leaf] | None = None
-               ) -> tuple[list[StoredResult], list[str]]:
+def results_on(opened: Opened, layout: CanopyLayout, leaves: Sequence[Leaf] | None = None,
+               exact: bool = False) -> tuple[list[StoredResult], list[str]]:
     """The light results of ``opened`` that belong to the canopy about to be shown, read.
 
     A result is left out, with one note each, when it was traced on other stands than those
@@ -196,6 +196,9 @@ def results_on(opened: Opened, layout: CanopyLayout, leaves: Sequence[Leaf] | No
     opened : from :func:`open_project`
     layout : the layout the project opens with (:func:`project_layout`)
     leaves : the leaves of the project's points; None: per-triangle sizes not checked
+    exact : with ``leaves``, mesh the canopy's plants at each result's level and hold every
+        per-triangle array to its exact triangle count (:func:`canopy_triangles`), not only
+        to the bound (:func:`read_study` does)
 
     Returns
     -------
@@ -205,9 +208,11 @@ def results_on(opened: Opened, layout: CanopyLayout, leaves: Sequence[Leaf] | No
     Raises
     ------
     ProjectError
-        A kept result whose stored data are malformed (one line).
+        A kept result whose stored data are malformed (one line); with ``exact``, a
+        per-triangle array of another length than its canopy's triangles, named.
     """
     here = stands_identity(layout)
+    counts: dict[str, tuple[int, int] | None] = {}
     kept, notes = [], []
     edited = opened.project.layout is not None
     legacy_order = edited and "layout_placements" not in opened.project.arrays
@@ -236,6 +241,10 @@ def results_on(opened: Opened, layout: CanopyLayout, leaves: Sequence[Leaf] | No
                 notes.append(f"{name} holds light for {held:,} triangles, but its canopy has "
                              f"at most {most:,}; left out (compute it again)")
                 continue
+            if exact:
+                if label not in counts:
+                    counts[label] = canopy_triangles(leaves, layout, label)
+                check_triangle_arrays(rec, counts[label], f"{opened.path}: {name}")
         run = run_from_record(rec, opened.path)
         if run is not None:
             kept.append(StoredResult(*run, stands=stands))
@@ -252,6 +261,53 @@ def scene_triangles(leaves: Sequence[Leaf], layout: CanopyLayout, label: str) ->
     except MaizevizError:
         return None
     return layout_cost(leaves, layout, level).count + STALK_TRIANGLES * len(layout.placements)
+
+
+def canopy_triangles(leaves: Sequence[Leaf], layout: CanopyLayout, label: str
+                     ) -> tuple[int, int] | None:
+    """Exactly how many (leaf, stalk) triangles the canopy of ``leaves`` on ``layout`` has at
+    the mesh level labelled ``label`` ("16 triangles", "36 triangles, widths unscaled",
+    "K=4"): its plants meshed (:func:`~maizeviz.canopy.scene.plant_meshes`, as the canopy is
+    built) and a stalk per stand. None for a label that is not a mesh level."""
+    from maizeviz.canopy.scene import plant_meshes
+
+    try:
+        level = parse_level(label.split(",")[0])
+    except MaizevizError:
+        return None
+    placed = {p.plant for p in layout.placements}
+    plants = plant_meshes([lf for lf in leaves if lf.grid.plant in placed], level,
+                          "widths unscaled" not in label)
+    return (sum(len(plants[p.plant].faces) for p in layout.placements if p.plant in plants),
+            STALK_TRIANGLES * len(layout.placements))
+
+
+def check_triangle_arrays(rec: Any, triangles: tuple[int, int] | None, where: str) -> None:
+    """Refuse a record whose per-triangle arrays (:data:`~maizeviz.project.records.
+    PER_TRIANGLE`) do not hold one value per triangle of its canopy (``triangles``: its
+    leaf and stalk triangles; light is stored for the leaves, or the leaves then the stalks
+    where they were traced), naming the array, its length and the ones expected (read from
+    the arrays' headers: nothing is read).
+
+    Raises
+    ------
+    ProjectError
+        One line naming the array.
+    """
+    from maizeviz.project.records import PER_TRIANGLE
+
+    if triangles is None:
+        return
+    leaf, stalk = triangles
+    for name, a in rec.arrays.items():
+        if not name.endswith(PER_TRIANGLE):
+            continue
+        held = int(a.shape[0]) if a.ndim == 1 else -1
+        if held not in (leaf, leaf + stalk):
+            size = f"{held:,} values" if held >= 0 else f"shape {tuple(a.shape)}"
+            raise ProjectError(f"{where}: array '{name}' holds {size}, expected {leaf:,} (one "
+                               f"per leaf triangle of its canopy) or {leaf + stalk:,} (with "
+                               "its stalks); the project is damaged")
 
 
 def check_canopy_fits(leaves: Sequence[Leaf], layout: CanopyLayout, level: Level,
@@ -332,7 +388,7 @@ def read_study(path: str | Path, cache: str | Path | None = None,
     except MaizevizError as exc:
         raise ProjectError(f"{opened.path}: its canopy level: {exc}", quantity="level") from None
     check_canopy_fits(plants.leaves, layout, level, opened.path)
-    results, dropped = results_on(opened, layout, plants.leaves)
+    results, dropped = results_on(opened, layout, plants.leaves, exact=True)
     return Study(opened.path, plants, layout, level.label,
                  get(opened.canopy, "preserve_area", bool, True, opened.path), results,
                  [*opened.notes, *plants.notes, *dropped])

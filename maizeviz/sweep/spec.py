@@ -218,7 +218,8 @@ def photosynthesis_label(ph: tuple | None) -> str:
     name = str(d.pop("model"))
     temp = d.pop("temperature")
     defaults = leaf_model(name).as_dict()
-    return " ".join([name, f"{temp:g} C"] + [f"{k} {v:g}" for k, v in sorted(d.items())
+    return " ".join([name, f"{temp:g} C"] + [f"{k} {v:g}" if isinstance(v, (int, float))
+                                              else f"{k} {v}" for k, v in sorted(d.items())
                                               if defaults.get(k) != v])
 
 
@@ -494,7 +495,9 @@ class _Checker:
 
         params = {k: x for k, x in v.items() if k not in ("model", "temperature")}
         for k, x in params.items():
-            params[k] = self.number(x, f"{where}.{k}", positive=False)
+            # the C4 model's temperature response is a name (collatz, clm45)
+            if k != "temperature_response":
+                params[k] = self.number(x, f"{where}.{k}", positive=False)
         temp = self.number(v.get("temperature", 25.0), f"{where}.temperature",
                            positive=False)
         if not -50 <= temp <= 70:

@@ -97,6 +97,16 @@ def test_light_has_no_import_cycle_and_its_layers_are_a_contract():
                       ["sources"]]
 
 
+@pytest.mark.parametrize("package", ["maizeviz", "maizeviz_app"])
+def test_no_import_cycle_anywhere(package):
+    """No module of the core or the app imports itself back through others (every import
+    counted, in functions and for type checks too): the layer contracts only see the layers
+    they name. The app's actions (building, lighting, studyfiles, exports) import the
+    study's state; the state imports none of them."""
+    cycles = _import_cycles(package)
+    assert cycles == [], "\n".join(" <-> ".join(c) for c in cycles)
+
+
 def test_an_import_cycle_is_found(tmp_path, monkeypatch):
     """The cycle finder above finds a cycle closed by an import inside a function."""
     pkg = tmp_path / "cyclic"

@@ -87,6 +87,9 @@ def test_a_day_in_mol_and_grams(capsys, tmp_path):
     ({"photosynthesis": "c4", "temperature": 99}, "(--temperature)"),
     ({"photosynthesis": "wofost", "eff": -1}, "(--photosynthesis)"),
     ({"photosynthesis": "c4", "co2": "nan"}, "(--photosynthesis)"),
+    ({"c4_temperature": "clm45"}, "--c4-temperature is a parameter of leaf photosynthesis"),
+    ({"photosynthesis": "wofost", "c4_temperature": "clm45"},
+     "--c4-temperature is not a parameter of the wofost"),
 ])
 def test_bad_photosynthesis_options_are_one_line(capsys, extra, says):
     code, out, err = run_cli(capsys, *cli_args(**extra))
@@ -103,12 +106,18 @@ def test_precision_traces_denser_until_the_standard_error_is_met(capsys):
     assert prec["met"] and prec["passes"] >= 2 and prec["density_per_cm2"] > 0.1
     assert ph["canopy_gross_umol_m2_s_se"] / ph["canopy_gross_umol_m2_s"] == pytest.approx(
         prec["relative_se"], rel=1e-9) and prec["relative_se"] <= 0.004
-    assert "precision: relative standard error" in err
+    assert "precision: relative standard error" in err and "bias from the density" in err
+    # the bias check beside the standard error: estimated from halves of the same rays
+    assert prec["bias_met"] and prec["noise_met"]
+    assert prec["relative_bias"] == pytest.approx(
+        ph["canopy_gross_umol_m2_s_bias"] / ph["canopy_gross_umol_m2_s"], rel=1e-9)
+    assert abs(prec["relative_bias"]) + 2 * prec["relative_bias_se"] <= 0.004
     # absorbed light alone: the leaves' absorbed light is the figure
     code, out, err = run_cli(capsys, *cli_args(band="par", density=0.1, precision=0.02))
     rec = json.loads(out)
     assert rec["precision"]["relative_se"] == pytest.approx(
         rec["absorbed"]["absorbed_leaves_se"] / rec["balance"]["absorbed_leaves"], rel=1e-9)
+    assert rec["precision"]["relative_bias"] == 0.0          # linear in the rays: none
 
 
 def test_a_precision_that_cannot_be_met_is_said(capsys, monkeypatch):
@@ -136,3 +145,23 @@ def test_light_left_unresolved_above_one_percent_is_warned(capsys):
     rec = json.loads(out)
     assert rec["balance"]["unresolved"] < 0.01 * rec["balance"]["incident"]
     assert not any("still travelling" in w for w in rec["warnings"])
+
+
+def test_the_c4_temperature_response_is_chosen_and_named(capsys):
+    """At 38 C the paper's response (default) gives less than CLM 4.5's (Vmax 34.8 against
+    60.9 umol/m2/s); the JSON names the response in the parameters and the label, the text
+    table in its heading."""
+    got = {}
+    for form in ("collatz", "clm45"):
+        code, out, err = run_cli(capsys, *cli_args(photosynthesis="c4", temperature=38,
+                                                   c4_temperature=form))
+        assert code == 0, err
+        ph = json.loads(out)["photosynthesis"]
+        assert ph["parameters"]["temperature_response"] == form
+        assert ("Collatz et al. 1992" if form == "collatz" else "CLM 4.5") in ph["label"]
+        got[form] = ph["canopy_gross_umol_m2_s"]
+    assert got["clm45"] > 1.2 * got["collatz"]
+    code, out, err = run_cli(capsys, *[a for a in cli_args(photosynthesis="c4")
+                                       if a != "--json"])
+    assert code == 0, err
+    assert "temperature response: Collatz et al. 1992" in out

@@ -34,7 +34,8 @@ def sessions(draw):
     # the button is released before the next press (the unit ignores one within 333 ms)
     holds = [draw(st.floats(0.0, min(0.3, g - 0.03))) for g in gaps]
     return dict(gaps=gaps, holds=holds,
-                latency=draw(st.lists(st.floats(0.0, 0.03), min_size=1, max_size=20)),
+                latency=draw(st.lists(st.one_of(st.floats(0.0, 0.03), st.floats(0.1, 0.8)),
+                                      min_size=1, max_size=20)),
                 step=draw(st.floats(0.004, 0.02)), every=draw(st.sampled_from([0.02, 0.1, 0.3])),
                 stations=draw(st.sampled_from([(1,), (1, 2)])))
 
@@ -45,7 +46,9 @@ def test_polls_never_become_points_and_no_press_is_lost(s):
     """A model of the unit: press k puts the stylus at x = k and holds the button for a while;
     between presses the stylus moves (x = k + 0.5). Each poll is answered after a latency with
     the button's state at that moment. The reader feeds what arrives to the sorter and ticks
-    it every ``step`` seconds, as the port's reader thread does."""
+    it every ``step`` seconds, as the port's reader thread does. Some answers come late (up to
+    0.8 s, a unit's side starved of CPU), past presses made meanwhile: no press is lost to
+    them (the old rule took a held press for a late answer)."""
     stations, gaps, holds = s["stations"], s["gaps"], s["holds"]
     t_press = np.cumsum([0.2] + gaps[:-1]) if gaps else np.array([])
     end = (t_press[-1] if len(t_press) else 0.0) + 1.0
@@ -63,6 +66,9 @@ def test_polls_never_become_points_and_no_press_is_lost(s):
             sorter.polled(now)
             lat = s["latency"][polls % len(s["latency"])]
             x, down = state(now + lat / 2)
+            # one serial line: a press made after the answer was sent comes after it
+            arrivals = [(max(t, now + lat + 1e-9), k, f) if k < 1e6 and t > now + lat / 2
+                        else (t, k, f) for t, k, f in arrivals]
             arrivals.append((now + lat, 1e6 + polls, _frame(stations, x, down, "poll")))
             polls += 1
         arrivals.sort(key=lambda a: (a[0], a[1]))
@@ -83,7 +89,7 @@ def test_polls_never_become_points_and_no_press_is_lost(s):
     records = [e for e in out if isinstance(e, Record)]
     assert [r.station for r in records] == list(stations) * len(gaps)
     # the sorter only hesitates when the button is down at a poll
-    assert sorter.unsure <= sum(1 for e in lives if e.stylus.stylus)
+    assert sorter.unsure == 0
 
 
 def test_live_position_through_the_pty_while_pressing():

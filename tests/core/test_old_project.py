@@ -92,8 +92,10 @@ def test_the_old_settings_read_as_todays_specs(old, stored):
     assert sky == SkySpec(**doc["results"][1]["meta"]["settings"]["sky"])
     assert day == (DaySpec(**doc["results"][2]["meta"]["settings"]["day"]),
                    SkySpec(**doc["results"][2]["meta"]["settings"]["sky"]))
+    # saved before the C4 temperature response was a choice: read as CLM 4.5's, what it
+    # computed then
     assert absorbed == OpticsSpec(**{**doc["results"][3]["meta"]["settings"]["optics"],
-                                     "ranks": ()})
+                                     "ranks": (), "c4_temperature": "clm45"})
 
 
 def test_the_old_project_saved_again_holds_the_same_records(old, stored, tmp_path):

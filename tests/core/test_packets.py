@@ -1,6 +1,8 @@
 """Embree's ray packets (maizeviz.mesh.packets, the C kernel _packets.c) against embreex's
-single rays, through real Embree: the same triangle and the same float32 distance for every
-ray, coherent or not, in order or in tiles; whole light computations identical either way;
+single rays, through real Embree, under every instruction set Embree accepts on this CPU
+(maizeviz.mesh.embree_isa): the same triangle for every ray and float32 distances within
+maizeviz.mesh.precision's bound, coherent or not, in order or in tiles; whole light
+computations with the same hits either way, heights within the bound;
 the kernel is the extension built at install (nothing compiled or written at run time), the
 Embree library is found in every embreex wheel layout, and every fallback says why, once."""
 
@@ -11,19 +13,23 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from embree_contract import assert_same_blocked, assert_same_hits
 
 import maizeviz.mesh.raytrace as raytrace
 from maizeviz.canopy.layout import layout_for
 from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
-from maizeviz.light.scene.request import LightRequest, Sampling
+from maizeviz.light.scene.request import LightRequest, Sampling, canopy_top
 from maizeviz.light.scene.scenes import light_scene
 from maizeviz.light.sources.sky import make_sky
 from maizeviz.light.sources.sun import Sun
+from maizeviz.light.trace import direct
 from maizeviz.light.trace.diffuse import trace_sky
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.direct import trace_direction, trace_light
 from maizeviz.mesh import packets
+from maizeviz.mesh.embree_isa import supported
 from maizeviz.mesh.levels import parse_level
+from maizeviz.mesh.precision import U32, distance_bound
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.resources import example_points
 
@@ -37,10 +43,14 @@ def canopy():
     return build_canopy(leaves, layout_for(leaves, (3, 3)), parse_level("36"))
 
 
-@pytest.fixture(scope="module")
-def scenes(canopy):
-    both = (RayScene(canopy.vertices, canopy.faces, packets=False),
-            RayScene(canopy.vertices, canopy.faces))
+#: The instruction sets Embree accepts here (each a run of the contract's tests).
+ISAS = supported() or (None,)
+
+
+@pytest.fixture(scope="module", params=ISAS)
+def scenes(canopy, request):
+    both = (RayScene(canopy.vertices, canopy.faces, packets=False, isa=request.param),
+            RayScene(canopy.vertices, canopy.faces, isa=request.param))
     return both
 
 
@@ -77,16 +87,14 @@ def test_packets_give_embreex_hits_ray_for_ray(canopy, scenes):
         assert 0.05 < np.mean(p1 >= 0) < 0.98
         for kwargs in ({}, {"row": row}):
             p2, t2 = packed.first_hit(o, d, t, **kwargs)
-            np.testing.assert_array_equal(p1, p2)
-            np.testing.assert_array_equal(t1, t2)
-            np.testing.assert_array_equal(single.distance(o, d, t), packed.distance(o, d, t,
-                                                                                    **kwargs))
-            np.testing.assert_array_equal(single.occluded(o, d, t), packed.occluded(o, d, t,
-                                                                                    **kwargs))
+            assert_same_hits(canopy.vertices, canopy.faces, o, d, t, (p1, t1), (p2, t2))
+            assert_same_hits(canopy.vertices, canopy.faces, o, d, t, (p1, single.distance(o, d, t)),
+                             (p2, packed.distance(o, d, t, **kwargs)))
+            assert_same_blocked(canopy.vertices, canopy.faces, o, d, t, single.occluded(o, d, t),
+                                packed.occluded(o, d, t, **kwargs), (p1, t1))
         u1 = single.first_hit(o, d)                              # unbounded rays
         u2 = packed.first_hit(o, d)
-        np.testing.assert_array_equal(u1[0], u2[0])
-        np.testing.assert_array_equal(u1[1], u2[1])
+        assert_same_hits(canopy.vertices, canopy.faces, o, d, None, u1, u2)
     k = packets.kernel()
     for width in (4, 8, 16):                                     # every packet width
         for coherent in (False, True):
@@ -95,14 +103,27 @@ def test_packets_give_embreex_hits_ray_for_ray(canopy, scenes):
             np.testing.assert_array_equal(p, single.first_hit(*cases[0][:3])[0])
             b = packets.occluded(k, packed._handle, cases[1][0], s[None], cases[1][2],
                                  coherent=coherent, width=width, row=7)
-            np.testing.assert_array_equal(b, single.occluded(*cases[1][:3]))
+            assert_same_blocked(canopy.vertices, canopy.faces, *cases[1][:3], b, single.occluded(*cases[1][:3]),
+                                single.first_hit(*cases[1][:3]))
 
 
 @needs_kernel
+@pytest.mark.parametrize("isa", ISAS)
 @pytest.mark.parametrize("periodic", [False, True])
-def test_light_is_the_same_through_packets_or_single_rays(canopy, monkeypatch, periodic):
+def test_light_is_the_same_through_packets_or_single_rays(canopy, monkeypatch, periodic, isa):
+    """The same hits, first and second, the same lit sensors and sky shares; each first hit's
+    height within the distance bound times the sun's vertical, plus its float32 rounding."""
+    if isa is not None:
+        monkeypatch.setenv("MAIZEVIZ_EMBREE_ISA", isa)
     req = LightRequest(Sun(28, 200), Sampling(density=2.0, periodic=periodic, threads=2))
     sky = make_sky("soc", 6)
+    beams = []                                  # each path's sun beam, ray by ray
+
+    def keep(*args, **kwargs):
+        beams.append(trace_direction(*args, **kwargs))
+        return beams[-1]
+
+    monkeypatch.setattr(direct, "trace_direction", keep)
     fast = trace_light(canopy, req), trace_sky(canopy, sky, req.sampling)
     monkeypatch.setattr(raytrace._packets, "kernel", lambda: None)
     scene = light_scene(canopy, periodic=periodic)
@@ -111,10 +132,24 @@ def test_light_is_the_same_through_packets_or_single_rays(canopy, monkeypatch, p
                                                             scene=scene)
     np.testing.assert_array_equal(fast[0].first_hits, slow[0].first_hits)
     np.testing.assert_array_equal(fast[0].second_hits, slow[0].second_hits)
-    np.testing.assert_array_equal(fast[0].first_z, slow[0].first_z)
     np.testing.assert_array_equal(fast[0].sensor_lit, slow[0].sensor_lit)
     np.testing.assert_array_equal(fast[1].triangle_share, slow[1].triangle_share)
     np.testing.assert_array_equal(fast[1].maps, slow[1].maps)
+    one, other = beams
+    np.testing.assert_array_equal(one.first_prim, other.first_prim)
+    hit = one.first_prim >= 0
+    np.testing.assert_array_equal(one.first_z[~hit], other.first_z[~hit])     # -inf
+    z = one.first_z[hit].astype(np.float64)
+    down = -np.asarray(one.toward, np.float64)
+    t = (canopy_top(canopy) + 1.0 - z) / -down[2]       # from the rays' start plane
+    tri = canopy.vertices[canopy.faces[one.first_prim[hit]]]
+    edge = np.linalg.norm(tri[:, 1] - tri[:, 0], axis=1) + \
+        np.linalg.norm(tri[:, 2] - tri[:, 0], axis=1)
+    origins = tri[:, 0] - (t + edge)[:, None] * down    # as far as a start can be from v0
+    bound = distance_bound(origins, np.broadcast_to(down, origins.shape), t, tri) * \
+        -down[2] + 2 * U32 * np.abs(z)                  # and z's own float32 rounding
+    gap = np.abs(z - other.first_z[hit])
+    assert np.all(gap <= bound), f"worst gap {np.max(gap / bound):.2f} of the bound"
 
 
 def test_the_kernel_is_the_extension_built_at_install(tmp_path):
@@ -155,8 +190,9 @@ def _fallback(code: str, env: dict | None = None) -> subprocess.CompletedProcess
             "    hit = scenes[1].first_hit(np.array([[0.2, 0.2, 0.0]]), np.array([[0, 0, 1.0]]))\n"
             "print(packets.status().name, scenes[0].packets, int(hit[0][0]))\n"
             "for w in said: print(w.category.__name__, w.message)\n")
+    base = {k: v for k, v in os.environ.items() if k != "MAIZEVIZ_EMBREE_ISA"}
     return subprocess.run([sys.executable, "-c", prog], capture_output=True, text=True,
-                          timeout=300, env={**os.environ, **(env or {})})
+                          timeout=300, env={**base, **(env or {})})
 
 
 def test_without_the_built_kernel_rays_fall_back_and_say_why_once():

@@ -10,8 +10,8 @@ from hypothesis import strategies as st
 
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import PointsFileError
-from maizeviz.io.parquet import exact_rounding, read_points_parquet, write_table
-from maizeviz.io.points import parse_points, read_points, write_points
+from maizeviz.io.parquet import exact_rounding, write_table
+from maizeviz.io.points import parse_points, read_points, read_points_parquet, write_points
 from maizeviz.leaf.grid import build_grids
 from maizeviz.leaf.synth import block_grids
 from maizeviz.resources import example_points

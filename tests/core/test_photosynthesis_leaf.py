@@ -34,10 +34,10 @@ def test_c4_dim_light_slope_is_the_quantum_yield():
 
 
 def test_c4_bright_light_high_co2_saturates_at_vmax_of_t():
-    """Saturating light and CO2: A -> Vmax(T); at 25 C Vmax(25) = 39 / ((1 + e^-4.5)(1 + e^-2))
-    (the two inhibition terms at 25 C)."""
+    """Saturating light and CO2: A -> Vmax(T); at 25 C Vmax(25) = 39 / ((1 + e^-3.3)(1 + e^-3.6))
+    (the two inhibition terms of Collatz et al.'s response at 25 C)."""
     leaf = C4Leaf()
-    vmax25 = 39.0 / ((1 + math.exp(0.3 * (25 - 40))) * (1 + math.exp(0.2 * (15 - 25))))
+    vmax25 = 39.0 / ((1 + math.exp(0.3 * (25 - 36))) * (1 + math.exp(0.3 * (13 - 25))))
     assert float(leaf.vmax_at(25.0)) == pytest.approx(vmax25, rel=1e-12)
     a = leaf.gross_umol(1e7, 25.0, ci_ppm=1e6)
     assert float(a) == pytest.approx(vmax25, rel=1e-3)

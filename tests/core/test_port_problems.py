@@ -9,9 +9,10 @@ import time
 
 import pytest
 
+from maizeviz.digitizer.detect import detect, probe
 from maizeviz.digitizer.port import FastrakPort
 from maizeviz.digitizer.port_problems import DeviceError, holders
-from maizeviz.digitizer.ports import detect, list_serial_ports, probe
+from maizeviz.digitizer.ports import list_serial_ports
 from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import Session
 from maizeviz.digitizer.simulator import FastrakSimulator

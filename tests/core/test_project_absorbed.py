@@ -99,6 +99,15 @@ def test_a_par_records_photosynthesis_comes_back_the_same(traced, tmp_path):
     with pytest.raises(ProjectError, match="unknown photosynthesis model 'c3'") as err:
         run_settings("absorbed", back, doc, "p.maizeviz")
     assert "p.maizeviz" in str(err.value) and "\n" not in str(err.value)
+    # the C4 temperature response is stored; a project saved before it was a choice computed
+    # with CLM 4.5's and reads as that
+    doc = json.loads(json.dumps(settings_doc("absorbed", par)))
+    assert doc["optics"]["c4_temperature"] == "collatz"
+    assert run_settings("absorbed", back, doc, "p").leaf_model().temperature_response == \
+        "collatz"
+    del doc["optics"]["c4_temperature"]
+    old = run_settings("absorbed", back, doc, "p")
+    assert old.c4_temperature == "clm45" and old.leaf_model().temperature_response == "clm45"
 
 
 def _damaged(rec: Record, **change) -> Record:

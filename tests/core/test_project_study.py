@@ -486,14 +486,18 @@ def test_per_triangle_arrays_of_the_wrong_length_are_one_line(points, leaves, tm
         bad = tmp_path / f"short_{name}.maizeviz"
         save_project(bad, replace(project, results=tuple(results)))
         if kind == 0:
-            with pytest.raises(ProjectError, match="first and second hits per triangle do not "
-                                                   "match") as exc:
+            with pytest.raises(ProjectError, match=f"array 'second_hits' holds {short:,} "
+                                                   "values, expected") as exc:
                 study.read_study(bad, tmp_path / "cache")
             assert "\n" not in str(exc.value)
-        else:
-            back = study.read_study(bad, tmp_path / "cache")
-            stored = [r for r in back.results if r.kind == "sky"][0].result
-            for by in ("leaf", "plant"):
+        else:                  # refused at read (issue 35): the array and its length named
+            with pytest.raises(ProjectError, match=f"array 'triangle_share' holds {short:,} "
+                                                   f"values, expected {canopy.n_triangles:,}"):
+                study.read_study(bad, tmp_path / "cache")
+            opened = study.open_project(bad, tmp_path / "cache")
+            stored = [r for r in study.results_on(opened, layout, leaves)[0]
+                      if r.kind == "sky"][0].result
+            for by in ("leaf", "plant"):       # the app's bound lets it through: tables refuse
                 with pytest.raises(MaizevizError, match=f"holds light for {short:,} triangles, "
                                                         "but the canopy has"):
                     stored.table(by, canopy)

@@ -524,3 +524,21 @@ def test_summary_picks_the_cheapest_level_within_tolerance():
         ("z 30.00 az 180.00", "standard"), ("z 60.00 az 180.00", "8 triangles"),
         ("all 2 suns", "K=4")]
     assert s[0]["max_abs_difference"] == pytest.approx(0.02)
+
+
+def test_a_c4_temperature_response_is_an_axis_value_named_in_the_rows(blocks):
+    """``temperature_response`` is the one named (not numeric) parameter a scenario's leaf
+    model takes; the rows' label names it when it is not the default."""
+    from maizeviz.errors import MaizevizError
+    from maizeviz.sweep.spec import photosynthesis_label
+
+    text = SPEC.replace('points = ["b*.csv"]', 'points = ["b0.csv"]').replace(
+        "periodic = true", 'periodic = true\noptics = [{band = "par"}]\nphotosynthesis = '
+        '[{model = "c4", temperature = 38}, {model = "c4", temperature = 38, '
+        'temperature_response = "clm45"}]')
+    spec = load_spec(spec_file(blocks, text, "forms.toml"))
+    labels = {photosynthesis_label(s.photosynthesis) for s in spec.scenarios}
+    assert labels == {"c4 38 C", "c4 38 C temperature_response clm45"}
+    bad = text.replace('"clm45"', '"q10"')
+    with pytest.raises(MaizevizError, match="temperature_response"):
+        load_spec(spec_file(blocks, bad, "bad.toml"))

@@ -30,9 +30,7 @@ def _with_c4(qtbot, window, small_points, vmax=45.0):
     small_light(p, "sun")
     p.periodic.setChecked(True)
     p.optics_box.setChecked(True)
-    w.undo._next_turn()                         # each edit its own turn of the event loop
     p.photo_model.setCurrentIndex(p.photo_model.findData("c4"))
-    w.undo._next_turn()
     p.c4_vmax.setValue(vmax)
     return w, p
 
@@ -64,6 +62,20 @@ def test_settings_defaults_are_the_core_models():
     old.apply_light_doc({k: v for k, v in doc.items() if k not in
                          ("photosynthesis", "wofost_amax")})
     assert old.photosynthesis.model == "none" and old.photosynthesis.amax == 70.0
+    # the C4 temperature response: the paper's by default, kept in the project, and a project
+    # saved before it was a choice reads as CLM 4.5's, what it computed
+    assert s.c4_temperature == C4Leaf().temperature_response == "collatz"
+    study.photosynthesis.model = "c4"
+    study.photosynthesis.c4_temperature = "clm45"
+    assert study.optics_spec().leaf_model().temperature_response == "clm45"
+    doc = study.light_doc()
+    assert doc["c4_temperature"] == "clm45"
+    study.photosynthesis.c4_temperature = "collatz"
+    saved_then = {k: v for k, v in study.light_doc().items() if k != "c4_temperature"}
+    older = StudySettings()
+    older.apply_light_doc(saved_then)
+    assert older.photosynthesis.c4_temperature == "clm45"
+    assert older.optics_spec().leaf_model() == C4Leaf(temperature_response="clm45")
 
 
 def test_a_leaf_model_paints_assimilation_and_a_project_keeps_it(window, qtbot, small_points,
@@ -90,6 +102,8 @@ def test_a_leaf_model_paints_assimilation_and_a_project_keeps_it(window, qtbot, 
     assert total == pytest.approx(g.canopy_gross_umol_m2_s * g.ground_m2,
                                   abs=0.005 * len(plants) + 1e-9)
     assert "C4 leaf, Vmax 45" in p.plants_title.text()
+    assert "temperature response Collatz et al. 1992" in p.plants_title.text()
+    assert p.c4_temperature.isVisibleTo(p) and p.c4_temperature.currentData() == "collatz"
     # the results table says the canopy's figure beside the energy balance
     rows = {r[0]: r[1:] for r in _rows(p.table)}
     assert rows[ASSIMILATION_ROW][0].startswith(f"{g.canopy_gross_umol_m2_s:.2f} ± ")
@@ -147,9 +161,7 @@ def test_the_model_choice_is_undoable_and_wofost_shows_its_parameters(window, qt
                                                                       small_points):
     w, p = _with_c4(qtbot, window, small_points)
     stack = w.undo.stack
-    w.undo._next_turn()
     p.photo_model.setCurrentIndex(p.photo_model.findData("wofost"))
-    w.undo._next_turn()
     assert w.model.settings.photosynthesis.model == "wofost"
     assert stack.undoText() == "photosynthesis wofost"
     assert p.wofost_amax.isVisibleTo(p) and p.wofost_eff.isVisibleTo(p)
@@ -173,3 +185,33 @@ def test_photosynthesis_from_nir_is_one_line_on_the_band(window, qtbot, small_po
     assert "PAR" in sig.args[0] and "internal" not in sig.args[0] and "\n" not in sig.args[0]
     assert "border" in p.band.styleSheet()
     assert w.model.runs.last is None                               # nothing traced
+
+
+def test_a_suns_light_and_carbon_per_plant_and_per_leaf_are_exported(window, qtbot,
+                                                                     small_points, tmp_path):
+    """Issue 37, item 1: after a sun with leaf optics and C4, the panel's Leaves... and
+    Plants... and File's light per leaf / plant write the absorbed light and the gross CO2 of
+    each leaf and plant (they were greyed, and File's said 'no sky or day computed yet')."""
+    import csv
+
+    w, p = _with_c4(qtbot, window, small_points)
+    assert not p.export_buttons["plants"].isEnabled()
+    compute(qtbot, w)
+    g = w.model.runs.last.extra.assimilation
+    assert p.export_buttons["plants"].isEnabled() and p.export_buttons["leaves"].isEnabled()
+    plants_csv, leaves_csv = tmp_path / "plants.csv", tmp_path / "leaves.csv"
+    for what, path in (("plants", plants_csv), ("leaves", leaves_csv)):
+        with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
+            assert w.model.export(what, path)
+    plants = list(csv.DictReader(plants_csv.open()))
+    leaves = list(csv.DictReader(leaves_csv.open()))
+    shown_rows = _rows(p.plants)
+    head = headers(p.plants)
+    assert len(plants) == len(shown_rows)
+    for row, seen in zip(plants, shown_rows):
+        assert f"{float(row['gross_umol_s']):.2f}" == seen[head.index("CO₂ gross µmol/s")]
+        assert float(row["absorbed_w"]) > 0
+    total = sum(float(r["gross_umol_s"]) for r in leaves)
+    assert total == pytest.approx(g.canopy_gross_umol_m2_s * g.ground_m2, rel=1e-6)
+    assert sum(float(r["gross_umol_s"]) for r in plants) == pytest.approx(total, rel=1e-6)
+    assert {r["level"] for r in leaves} == {w.model.runs.last.label}

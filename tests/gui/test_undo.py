@@ -55,7 +55,7 @@ class UndoMachine(RuleBasedStateMachine):
         from maizeviz_app.undo import UndoRecorder
 
         self.model = StudyModel()              # no points: edits build nothing
-        self.recorder = UndoRecorder(self.model)
+        self.recorder = UndoRecorder(self.model, merge_s=0.0)    # every edit a step
         self.model.draft.start(tiled_layout(BASES, (1, 1)), set(BASES))
 
     @initialize()
@@ -64,7 +64,6 @@ class UndoMachine(RuleBasedStateMachine):
         self.at = 0
 
     def _edited(self, made: bool) -> None:
-        self.recorder._next_turn()             # each rule is one turn of the event loop
         if made:
             self.states[self.at + 1:] = [_state(self.model)]
             self.at += 1
@@ -80,7 +79,7 @@ class UndoMachine(RuleBasedStateMachine):
     @rule(key=st.sampled_from(sorted(COLOURS)), data=st.data())
     def set_a_colour(self, key, data):
         group, name = key
-        target = dict(self.recorder._colour_groups())[group]
+        target = self.model.edit_groups()[group]
         value = data.draw(st.sampled_from(COLOURS[key]))
         made = getattr(target, name) != value
         setattr(target, name, value)
@@ -139,37 +138,37 @@ class UndoMachine(RuleBasedStateMachine):
         assert self.recorder.stack.count() == len(self.states) - 1
 
 
-def test_undo_and_redo_against_a_list_of_states(qapp, monkeypatch):
-    import maizeviz_app.undo as undo
-
-    monkeypatch.setattr(undo, "MERGE_S", 0.0)      # steps merge within a turn only
+def test_undo_and_redo_against_a_list_of_states(qapp):
     run_state_machine_as_test(UndoMachine, settings=settings(
         max_examples=60, stateful_step_count=30, deadline=None,
         suppress_health_check=[HealthCheck.too_slow]))
 
 
 def test_one_step_per_action_and_typing_merges(qapp):
+    """The stack mirrors the model's history: a band and the optics it sets are one step;
+    in the window (merge_s) a number typed is one step, and typed back it is none."""
     from maizeviz_app.model import StudyModel
-    from maizeviz_app.undo import UndoRecorder
+    from maizeviz_app.undo import MERGE_S, UndoRecorder
 
     model = StudyModel()
     rec = UndoRecorder(model)
+    assert model.history.merge_s == MERGE_S
     o = model.settings.optics
     o.band = "nir"                                  # the band and the optics it sets
     assert rec.stack.count() == 1 and o.reflectance > 0.3
     assert rec.stack.text(0).startswith("band nir")
     rec.stack.undo()
     assert o.band == "par" and o.reflectance == pytest.approx(0.10)
+    assert model.history.index == 0
     rec.stack.redo()
     assert o.band == "nir" and o.reflectance > 0.3
-    rec._next_turn()
     for v in (1.0, 12.0, 12.5):                     # typed within MERGE_S: one step
         model.settings.sun.zenith_deg = v
-        rec._next_turn()
     assert rec.stack.count() == 2 and rec.stack.text(1) == "sun zenith 12.5"
     model.settings.sun.zenith_deg = 22.34           # typed back: no step at all
-    rec._next_turn()
     assert rec.stack.count() == 1
+    model.history.undo()                            # the history moved: the stack follows
+    assert rec.stack.index() == 0 and rec.stack.canRedo()
 
 
 def test_ctrl_z_from_anywhere_undoes_the_level_and_rebuilds(window, qtbot, small_points):
@@ -264,9 +263,37 @@ def test_a_colour_edit_is_one_step_and_undoing_it_repaints(window, qtbot, small_
     stack.redo()
     assert (view.canopy_mesh.cell_data["light_rgb"] == greys).all()
     # a typed range is one step: the range and its limits together
-    w.undo._next_turn()
+    w.model.history.forget_merging()
     panel.view_editor.show_limits(0.02, 0.5)
     panel.view_editor.range.setCurrentIndex(panel.view_editor.range.findData("fixed"))
     qtbot.waitUntil(lambda: stack.count() == before + 2, timeout=5000)
     stack.undo()
     assert w.model.colour.view.range == "auto" and w.model.colour.view.vmax == 1.0
+
+
+def test_a_value_typed_then_ctrl_z_in_its_spin_box_undoes_it(window, qtbot, small_points):
+    """Typing 30 and Enter in the sun's zenith, then Ctrl+Z with the focus still in that spin
+    box: the study's Undo takes the 30 back (the box's own text undo does not swallow it)."""
+    from PySide6.QtCore import Qt
+    from PySide6.QtWidgets import QApplication
+
+    w = shown(qtbot, window(small_points, tile=1))
+    small_light(w.light_panel, "sun")
+    w.model.history.forget_merging()
+    box = w.light_panel.zenith
+    before = w.model.settings.sun.zenith_deg
+    w.docks["light"].raise_()
+    w.activateWindow()
+    qtbot.waitUntil(lambda: QApplication.activeWindow() is w, timeout=5000)
+    box.setFocus()
+    qtbot.waitUntil(box.hasFocus, timeout=5000)
+    box.selectAll()
+    qtbot.keyClicks(box, "30")
+    qtbot.keyClick(box, Qt.Key_Return)
+    assert w.model.settings.sun.zenith_deg == 30.0
+    assert w.menu_actions["undo"].text().endswith("sun zenith 30")
+    qtbot.keyClick(box, Qt.Key_Z, Qt.ControlModifier)
+    assert w.model.settings.sun.zenith_deg == before
+    assert box.value() == before
+    qtbot.keyClick(box, Qt.Key_Z, Qt.ControlModifier | Qt.ShiftModifier)
+    assert w.model.settings.sun.zenith_deg == 30.0 and box.value() == 30.0

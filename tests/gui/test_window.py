@@ -235,7 +235,7 @@ def test_project_keeps_an_edited_layout(window, qtbot, small_points, tmp_path):
     turned = tuple(replace(p, azimuth_deg=37.5) if i == 4 else p
                    for i, p in enumerate(layout.placements))
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
-        w.layout_panel.applied.emit(replace(layout, placements=turned))
+        w.model.apply_layout(replace(layout, placements=turned))
     path = tmp_path / "edited.maizeviz"
     with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
         w.model.save_project(path)

@@ -5,6 +5,9 @@ settings, and the views follow them)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from contextlib import AbstractContextManager, nullcontext
+
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -35,11 +38,15 @@ def _named(widget: QWidget, name: str, tip: str) -> QWidget:
 class ScaleEditor(QGroupBox):
     """The controls of one :class:`ColourScale`: range (auto, typed, percentile clip), min and
     max, the clip, the colour map, log. In auto and percentile ranges the min and max show the
-    range in use (:meth:`show_limits`), so that switching to a typed range starts from it."""
+    range in use (:meth:`show_limits`), so that switching to a typed range starts from it.
+    ``step()``: a context whose edits are one step of the undo history (a range and its limits
+    together; :meth:`maizeviz_app.history.History.step`)."""
 
-    def __init__(self, title: str, scale: ColourScale, parent=None):
+    def __init__(self, title: str, scale: ColourScale, parent=None,
+                 step: Callable[[], AbstractContextManager] = nullcontext):
         super().__init__(title, parent)
         self.scale = scale
+        self.step = step
         self._shown: tuple[float, float] | None = None
         self.form = form = QFormLayout(self)
         form.setRowWrapPolicy(QFormLayout.RowWrapPolicy.WrapLongRows)
@@ -108,7 +115,7 @@ class ScaleEditor(QGroupBox):
         except ColourError as exc:
             self.note.setText(f"<span style='color:#b3261e'>{exc}</span>")
             return False
-        with self.scale.events.paused():
+        with self.step(), self.scale.events.paused():     # one step, one repaint
             for name, value in changes.items():
                 setattr(self.scale, name, value)
         self._follow()
@@ -170,13 +177,14 @@ class ScaleEditor(QGroupBox):
 
 class ColourPanel(QWidget):
     """The colours of the 3D view and of the heatmaps, over ``settings`` (a
-    :class:`~maizeviz_app.colour.ColourSettings`)."""
+    :class:`~maizeviz_app.colour.ColourSettings`); ``step`` as :class:`ScaleEditor`'s."""
 
-    def __init__(self, settings, parent=None):
+    def __init__(self, settings, parent=None,
+                 step: Callable[[], AbstractContextManager] = nullcontext):
         super().__init__(parent)
         self.settings = settings
         lay = QVBoxLayout(self)
-        self.view_editor = ScaleEditor("3D view", settings.view)
+        self.view_editor = ScaleEditor("3D view", settings.view, step=step)
         self.painting = QComboBox()
         for key, text in PAINTINGS.items():
             self.painting.addItem(text, key)
@@ -189,7 +197,7 @@ class ColourPanel(QWidget):
         self.painting_note.setWordWrap(True)
         self.view_editor.form.addRow(self.painting_note)
         lay.addWidget(self.view_editor)
-        self.heatmap_editor = ScaleEditor("Heatmaps", settings.heatmap)
+        self.heatmap_editor = ScaleEditor("Heatmaps", settings.heatmap, step=step)
         self.shared = QCheckBox("one scale for every height and light")
         _named(self.shared, "one scale for every height and light",
                "the heatmaps of every height and every light shown take one range, so their "

@@ -1,10 +1,13 @@
 """The live digitizer panel, made for a technician in the field with gloves on.
 
-The path of a press: the port's reader thread parses the record into the recorder's queue; a
-50 ms GUI timer drains the queue (:meth:`Recorder.poll`), which writes the point to the journal
-(fsync) before anything shows; then the panel says what happened (a colour band, a beep on
-trouble, ``alert`` for the window's status bar) and :class:`GrowingPlant` re-meshes the leaf
-whose cross-section just finished, in a worker.
+The panel shows a :class:`~maizeviz_app.digitizing.DigitizingSession` and decides nothing: the
+recorder runs in a process of its own (``maizeviz record``, as on the command line), which
+reads the port and writes every press to the journal (fsync) whatever this window is doing;
+a 50 ms GUI timer asks the session what is new on disk and what the recorder said, and the
+panel says it: a beep and the running count for each point on disk, a colour band and a beep
+on trouble (a refused press, a garbled record, a lost port, a press far from the point before
+it, a cross-section ended early), ``alert`` for the window's status bar. :class:`GrowingPlant`
+re-meshes the leaf whose cross-section just finished, in a worker.
 
 While recording, N, P, R, U and S (next leaf, next plant, end row, undo, pause) are
 application-wide shortcuts: they act wherever the focus is, and the connection fields are
@@ -14,22 +17,22 @@ distance from the last point, show under the band (the reader polls the unit ten
 second; see :mod:`maizeviz.digitizer.live`).
 
 The port is chosen from the system's list (:class:`PortPicker`, with *Find FASTRAK*); what goes
-wrong is said in the core's words (:mod:`maizeviz.digitizer.port_problems`), the same line
-``maizeviz record`` prints. Connecting, searching and stopping run in workers (a unit that does
-not answer takes 3 s to give up; stopping joins the reader and closes the port), and so the
-window stays live: Stop leaves the event loop within a few milliseconds, and the plant just
-digitized stays in the view.
+wrong is said in the recorder's words (:mod:`maizeviz.digitizer.port_problems`), the same line
+``maizeviz record`` prints. Connecting and stopping happen in the recorder's process, so the
+window stays live: Stop returns at once (the recorder journals what it holds, then ends), and
+the plant just digitized stays in the view. The session being recorded is remembered
+(QSettings); if the app ended without stopping it (a crash), the next start offers that file
+with *resume* ticked.
 """
 
 from __future__ import annotations
 
-import threading
 import time
 from collections.abc import Callable
 from functools import partial
 from pathlib import Path
 
-from PySide6.QtCore import QEvent, QObject, QSettings, Qt, QThreadPool, QTimer, Signal
+from PySide6.QtCore import QEvent, QObject, QSettings, Qt, QTimer, Signal
 from PySide6.QtGui import QKeySequence, QShortcut
 from PySide6.QtWidgets import (
     QApplication,
@@ -53,26 +56,22 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from maizeviz.digitizer.port import FastrakPort
 from maizeviz.digitizer.recorder import PAUSE_KEY, LiveTip, Recorder, Update
-from maizeviz.digitizer.session import Session
 from maizeviz.errors import MaizevizError
 from maizeviz.resources import example_points
+from maizeviz_app.digitizing import STOP_REASONS, DigitizingSession
 from maizeviz_app.panels.growing_plant import GrowingPlant
 from maizeviz_app.panels.port_picker import PortPicker
-from maizeviz_app.workers import JobRunner
 
 #: The technician's controls: key, button text.
 CONTROLS = (("n", "Next leaf"), ("p", "Next plant"), ("r", "End row"), ("u", "Undo"))
-#: Seconds between the reader's polls for the stylus's live position.
-LIVE_EVERY_S = 0.1
+#: QSettings keys: the session last recorded, and whether it is still open (not stopped).
+LAST_SESSION, SESSION_OPEN = "digitizer/last_session", "digitizer/session_open"
 #: Band colours (background, text) per state.
 BAND = {"idle": ("#dcdcdc", "#202020"), "busy": ("#90caf9", "#102030"),
         "ok": ("#2e7d32", "#ffffff"), "warn": ("#f9a825", "#000000"),
         "error": ("#c62828", "#ffffff")}
 BIG_BUTTON_PX = 56
-STOP_REASONS = {"finished": "finished", "lost": "port lost", "failed": "cannot write",
-                "signal": "stopped"}
 
 
 class StatusBand(QFrame):
@@ -147,24 +146,17 @@ class DigitizerPanel(QWidget):
     #: Ask before the window closes while recording (tests and benchmarks turn it off).
     confirm_close = True
 
-    def __init__(self, viewport=None, parent=None):
+    def __init__(self, viewport=None, parent=None, session: DigitizingSession | None = None):
         super().__init__(parent)
         self._viewport = viewport
-        self.recorder: Recorder | None = None
-        self.sim = None
-        self.beeps = 0
-        self.demo_file = example_points()
-        self.demo_pace = 0.5
-        self._replay: threading.Thread | None = None
-        self._connecting: tuple[FastrakPort, Session] | None = None
-        self._closing = 0                          # sessions whose port is being closed
-        self._connect_pool = QThreadPool(self)
-        self._connect_pool.setMaxThreadCount(1)
-        self._runner = JobRunner(self, pool=self._connect_pool)
-        # stopping has a pool of its own: it must not queue behind a connection attempt
-        self._close_pool = QThreadPool(self)
-        self._close_pool.setMaxThreadCount(1)
-        self._closer = JobRunner(self, pool=self._close_pool)
+        #: The session this panel shows (Qt-free: the recorder's process, what is on disk);
+        #: the window's is the study model's (``StudyModel.digitizing``).
+        self.digitizing = session if session is not None else DigitizingSession()
+        if self.digitizing.demo_file is None:
+            self.digitizing.demo_file = example_points()
+        self.beeps = 0                             # trouble said with a beep
+        self.press_beeps = 0                       # points confirmed with a beep
+        self._why: str | None = None               # why the technician stopped
         self._shortcuts: list[QShortcut] = []
         self._keys = _ControlKeys(self)
         self._settings = QSettings("maizeviz", "maizeviz")
@@ -184,6 +176,15 @@ class DigitizerPanel(QWidget):
 
         self.band = StatusBand()
         lay.addWidget(self.band)
+        self.press_count = QLabel("0 points")
+        self.press_count.setAccessibleName("points on disk")
+        self.press_count.setToolTip("points of this session on disk (each press confirmed with "
+                                    "a beep once it is written)")
+        font = self.press_count.font()
+        font.setPointSize(max(font.pointSize(), 9) + 9)
+        font.setBold(True)
+        self.press_count.setFont(font)
+        lay.addWidget(self.press_count)
         self.live = QLabel("tip: —")
         self.live.setWordWrap(True)
         self.live.setAccessibleName("stylus tip")
@@ -300,6 +301,37 @@ class DigitizerPanel(QWidget):
 
         self.timer = QTimer(self, interval=50)
         self.timer.timeout.connect(self._drain)
+        self._offer_resume()
+
+    @property
+    def demo_file(self):
+        """The points file the Demo replays."""
+        return self.digitizing.demo_file
+
+    @demo_file.setter
+    def demo_file(self, path) -> None:
+        self.digitizing.demo_file = path
+
+    @property
+    def demo_pace(self) -> float:
+        """Seconds between the Demo's presses."""
+        return self.digitizing.demo_pace
+
+    @demo_pace.setter
+    def demo_pace(self, pace: float) -> None:
+        self.digitizing.demo_pace = pace
+
+    def _offer_resume(self) -> None:
+        """A session the app did not stop (it crashed): offer its file, resume ticked."""
+        last = str(self._settings.value(LAST_SESSION, "") or "")
+        still_open = str(self._settings.value(SESSION_OPEN, "false")).lower() == "true"
+        if not (last and still_open and Path(last).is_file()):
+            return
+        self.out_edit.setText(last)
+        self.resume.setChecked(True)
+        self.band.set_state("warn", f"the last session did not end cleanly: Connect continues "
+                                    f"{last} where it stopped (resume is ticked)")
+        self._say(f"last session not stopped (the app ended): {last}; resume is ticked")
 
     def _show_out_path(self, path: str) -> None:
         """The tooltip names the whole path, for one too long for the field."""
@@ -338,6 +370,12 @@ class DigitizerPanel(QWidget):
         QApplication.beep()
         self.beeps += 1
 
+    def _confirm(self) -> None:
+        """A point is on disk: a beep and the running count (the technician's eyes are on the
+        leaf, not the screen)."""
+        QApplication.beep()
+        self.press_beeps += 1
+
     def _loud(self, state: str, text: str) -> None:
         """Trouble the technician must notice without looking: band colour, beep, status bar."""
         self.band.set_state(state, text)
@@ -346,7 +384,7 @@ class DigitizerPanel(QWidget):
 
     def _lock(self, running: bool, connecting: bool = False) -> None:
         busy = running or connecting
-        idle = not busy and not self._closing and not self.ports.busy
+        idle = not busy and not self.digitizing.active and not self.ports.busy
         self.connect_button.setEnabled(idle)
         self.demo_button.setEnabled(idle)
         self.stop_button.setEnabled(busy)
@@ -402,16 +440,18 @@ class DigitizerPanel(QWidget):
         self.plant.viewport = viewport
 
     @property
-    def session(self) -> Session | None:
-        return self.recorder.session if self.recorder is not None else None
+    def session(self) -> DigitizingSession | None:
+        """The session being recorded (its points, position and counts), or None."""
+        d = self.digitizing
+        return d if d.state in ("recording", "stopping") and d.path is not None else None
 
     @property
     def recording(self) -> bool:
-        return self.recorder is not None
+        return self.digitizing.recording
 
     @property
     def paused(self) -> bool:
-        return self.recorder is not None and self._paused
+        return self.recording and self._paused
 
     def _where(self) -> str:
         session = self.session
@@ -424,10 +464,12 @@ class DigitizerPanel(QWidget):
     def _show_counts(self) -> None:
         if self.session is not None:
             self.counts.setText(self.session.summary())
+            n = self.session.count.points
+            self.press_count.setText(f"{n} point{'s' if n != 1 else ''}")
 
     def _show_live(self) -> None:
         """The tip's position and distance (only when a newer answer came: no repaint else)."""
-        tip = self.recorder.live if self.recorder is not None else None
+        tip = self.digitizing.live if self.recording else None
         if tip is None or tip is self._live_shown:
             return
         self._live_shown = tip
@@ -445,7 +487,7 @@ class DigitizerPanel(QWidget):
         self.band.set_state("busy", f"searching {n} port{'s' if n != 1 else ''} for a FASTRAK…")
 
     def _searched(self, results: list) -> None:
-        self._lock(self.recording, self._connecting is not None)
+        self._lock(self.recording, self.digitizing.state == "connecting")
         hit = next((r for r in results if r.found), None)
         if hit is not None:
             self.band.set_state("ok", f"FASTRAK found on {hit.port}: press Connect")
@@ -458,128 +500,68 @@ class DigitizerPanel(QWidget):
 
     # ----------------------------------------------------------------------- session
     def start(self, demo: bool = False) -> None:
-        """Open the session file, then the port (or a simulator) in a worker; recording
-        begins when the unit answered (``started``)."""
-        if self.recording or self._connecting is not None or self._closing or self.ports.busy:
+        """Start the recorder's process on the port (or on the Demo's simulated FASTRAK);
+        recording begins when the unit answered (``started``)."""
+        d = self.digitizing
+        if d.active or self.ports.busy:
             return
         ref = 2 if self.reference.isChecked() else None
+        port = self.port
         try:
-            session = Session(self.out_edit.text(), self.cols.value(), self.resume.isChecked(),
-                              ref)
+            d.start(port, self.out_edit.text(), self.cols.value(), self.resume.isChecked(), ref,
+                    self.baud.value(), demo=demo)
         except MaizevizError as exc:
             self._say(f"error: {exc}")
             self._loud("error", f"cannot record: {exc}")
             return
-        port_name = self.port
-        if demo:
-            from maizeviz.digitizer.simulator import FastrakSimulator
-
-            self.sim = FastrakSimulator(stations=(1, 2) if ref else (1,))
-            port_name = self.sim.path
-            self._say(f"demo: simulated FASTRAK on {port_name}")
-        port = FastrakPort(port_name, self.baud.value(), answer_timeout=1.0)
-        self._connecting = (port, session)
-        self.band.set_state("busy", f"connecting to {port_name} at {self.baud.value()} baud…",
+        self._why = None
+        shown = d.port_name
+        self.band.set_state("busy", f"connecting to {shown} at {self.baud.value()} baud…",
                             "connecting")
         self._lock(False, connecting=True)
-        stations = (1,) if ref is None else (1, ref)
-
-        def connect(job):
-            try:
-                return port.configure(stations)
-            except BaseException:
-                port.close()                    # the worker's port: closed by the worker
-                raise
-
-        self._runner.run("connect", f"connecting to {port_name}", connect,
-                         on_done=lambda cfg: self._connected(port, session, cfg, demo),
-                         on_error=lambda exc: self._not_connected(port, session, exc))
-
-    def _connected(self, port: FastrakPort, session: Session, cfg, demo: bool) -> None:
-        if self._connecting is None or self._connecting[0] is not port:
-            port.close()                                # stopped while connecting: stop() has
-            return                                      # closed the session already
-        self._connecting = None
-        for w in cfg.warnings:
-            self._say(f"warning: {w}")
-        if not demo:
-            self._settings.setValue("port", port.port_name)
-            self._settings.setValue("baud", port.baud)
-        recorder = Recorder(session, port)
-        recorder.start(live_every=LIVE_EVERY_S)
-        self.begin(recorder)
-        if demo:
-            self._start_replay(session.reference_station is not None)
-
-    def _not_connected(self, port: FastrakPort, session: Session, exc: BaseException) -> None:
-        if self._connecting is None or self._connecting[0] is not port:
-            return
-        self._connecting = None
-        session.close()
-        text = str(exc) if isinstance(exc, MaizevizError) else f"{type(exc).__name__}: {exc}"
-        self._say(f"error: {text}")
-        self._close_demo_now()
-        self._lock(False)
-        self._loud("error", f"not connected: {text}")
-        self.band.set_state("error", where="not recording (could not connect)")
-        self.stopped.emit("could not connect")
+        self.timer.start()
 
     def begin(self, recorder: Recorder) -> None:
-        """Drain ``recorder`` from now on (its port, if any, configured and reading)."""
-        self.recorder = recorder
+        """Show an in-process ``recorder`` (scripts and tests driving the controls)."""
+        self.digitizing.attach(recorder)
+        self._why = None
+        self._began()
+        self.timer.start()
+
+    def _began(self) -> None:
+        """Recording began (the recorder answered ready)."""
+        d = self.digitizing
+        if d.sim is None and d.port_name:
+            self._settings.setValue("port", d.port_name)
+            self._settings.setValue("baud", self.baud.value())
+        self._settings.setValue(LAST_SESSION, str(d.path))
+        self._settings.setValue(SESSION_OPEN, "true")
         if self.viewport is not None:
             self.viewport.hide_canopy()
         self.plant.clear()
         self._set_paused(False)
         self._live_shown = None
-        self.live.setText("tip: waiting for the unit…" if recorder.port is not None
-                          else "tip: —")
+        self.live.setText("tip: waiting for the unit…" if d.port_name else "tip: —")
         self._lock(True)
-        self._say(f"recording to {recorder.session.path}")
+        self._say(f"recording to {d.path}")
         self.band.set_state("ok", "recording: press the stylus on the next point",
                             self._where())
         self._show_counts()
-        if recorder.session.history:
-            self.plant.update(recorder.session.history, recorder.session.pos)
-        self.timer.start()
+        if d.history:
+            self.plant.update(d.history, d.pos)
         self.started.emit()
-
-    def _start_replay(self, sway: bool) -> None:
-        from maizeviz.digitizer.replay import replay_points
-
-        recorder = self.recorder
-        assert recorder is not None
-
-        def say(msg):
-            for key in ("n", "p", "q"):
-                if f"type {key} " in msg:
-                    recorder.control(key)
-                    return
-            recorder.say(msg)
-
-        sim, path, pace = self.sim, self.demo_file, self.demo_pace
-
-        def run():
-            try:
-                replay_points(sim, path, pace=pace, sway=sway, say=say, wait=False)
-            except Exception as exc:  # noqa: BLE001 - reported in the panel
-                recorder.say(f"demo stopped: {exc}")
-
-        self._replay = threading.Thread(target=run, name="fastrak-demo", daemon=True)
-        self._replay.start()
 
     def control(self, key: str) -> None:
         """A technician's control (n, p, r, u, q), handled at once."""
-        if self.recorder is not None:
-            self.recorder.control(key)
+        if self.recording:
+            self.digitizing.control(key)
             self._drain()
 
     def toggle_pause(self) -> None:
         """Pause or resume recording (the S key, the Pause button)."""
-        if self.recorder is None:
+        if not self.recording:
             return
-        self._set_paused(not self.paused)
-        self.recorder.pause(self.paused)
+        self.digitizing.pause(not self._paused)
         self._drain()
 
     def _set_paused(self, on: bool) -> None:
@@ -588,133 +570,119 @@ class DigitizerPanel(QWidget):
         self.pause_button.setAccessibleName("Resume" if on else "Pause")
 
     def _drain(self) -> None:
-        """Handle what the reader and the controls queued since the last tick (GUI thread).
+        """Show what the session has new: on disk, and said by the recorder (GUI thread).
 
-        A slot: nothing may escape it, or the process can go down with the journal open.
+        A slot: nothing may escape it (the journal is the recorder's, in its own process,
+        whatever happens here).
         """
-        if self.recorder is None:
+        d = self.digitizing
+        if not d.active:
             return
         try:
-            updates = self.recorder.poll(limit=2000)
+            updates = d.poll()
             changed = False
             for update in updates:
                 self._show_update(update)
-                changed = changed or update.kind in ("recorded", "control")
+                changed = changed or update.kind in ("recorded", "control", "moved")
             if updates:
                 self._show_counts()
                 self.band.where.setText(self._where())
             if changed and self.session is not None:
-                self.plant.update(self.session.history, self.session.pos)
-                self.recorded.emit(self.session.count.points)
+                self.plant.update(d.history, d.pos)
+                self.recorded.emit(d.count.points)
             self._show_live()
         except Exception as exc:  # noqa: BLE001 - see the docstring
             self._say(f"error: {type(exc).__name__}: {exc}")
-            self._loud("error", f"unexpected error, recording stopped: {exc}")
-            self.stop("error")
+            self._loud("error", f"unexpected error in the window ({exc}); the recorder goes on "
+                                "recording: Stop, then Connect with resume")
             return
-        final = self.recorder.final if self.recorder is not None else None
-        if final is not None:
-            self.stop(STOP_REASONS.get(final.kind, final.kind))
+        if d.final is not None:
+            self._finish(d.final)
 
     def _show_update(self, update: Update) -> None:
         kind, text = update.kind, update.message
-        if kind in ("lost", "failed"):
+        if kind == "started":
+            self._began()
+        elif kind == "unconnected":
+            self._say(f"error: {text}")
+            if self._why is None:                     # not given up by the technician
+                self._loud("error", f"not connected: {text}")
+        elif kind in ("lost", "failed"):
             self._say(f"error: {text}")
             self._loud("error", text)
-        elif kind in ("refused", "garbled", "ignored"):
+        elif kind in ("refused", "garbled", "ignored", "jump", "short"):
             self._say(text)
             self._loud("error" if kind == "refused" else "warn", text)
         elif kind == "paused":
+            self._set_paused(True)
             self._say(text)
             self.band.set_state("warn", text)
-        elif kind in ("recorded", "control", "resumed"):
+        elif kind == "recorded":
+            self._confirm()
             self._say(text)
             self.band.set_state("warn" if self.paused else "ok", text)
-        elif text and kind != "finished":
+        elif kind in ("control", "resumed"):
+            if kind == "resumed":
+                self._set_paused(False)
+            self._say(text)
+            self.band.set_state("warn" if self.paused else "ok", text)
+        elif text and kind not in ("finished", "moved"):
             self._say(text)
 
     # ------------------------------------------------------------------------ stopping
     def stop(self, why: str = "stopped", wait: bool = False) -> None:
-        """End the session (or the connection attempt); the journal is already on disk.
+        """End the session (or the connection attempt); every point shown is on disk.
 
-        The GUI thread only lets go: the reader's join, the port's close, the demo's end and
-        the journal's last presses happen in a worker, and ``stopped(why)`` is emitted once
-        they are done. Presses the reader had queued are recorded, not dropped. No frame is
-        drawn for the stop: the plant stays as it was. With ``wait`` (the window is closing)
-        it all happens here and now.
+        The recorder is asked to finish (it journals the presses it holds, then ends) and
+        ``stopped(why)`` is emitted once it has. No frame is drawn for the stop: the plant
+        stays as it was. With ``wait`` (the window is closing) it all happens here and now:
+        the recorder's process, the reader threads and the Demo's simulator end before this
+        returns.
         """
-        self.timer.stop()
-        if wait:                                        # an earlier stop's port closed first
-            self._close_pool.waitForDone(10_000)
-        connecting, self._connecting = self._connecting, None
-        recorder, self.recorder = self.recorder, None
-        sim, self.sim = self.sim, None
-        replay, self._replay = self._replay, None
-        if connecting is not None:                      # the unit had not answered yet:
-            connecting[0].cancel()                      # its worker gives up and closes it
-            connecting[1].close()                       # the journal's lock goes at once
+        d = self.digitizing
         self.ports.stop_search()
-        if recorder is None and connecting is None and sim is None:
+        if not d.active:
             self._lock(False)
             return
-        self._closing += 1
+        if self._why is None:
+            self._why = why
+        if wait:
+            self.timer.stop()
+            for update in d.close():
+                self._show_update(update)
+            self._finish(d.final or Update("finished", "finished"))
+            return
+        d.stop()
         self._lock(False)
         self.band.set_state(self.band.state, where=f"stopping ({why})…")
 
-        def close(job=None):
-            if recorder is not None and recorder.port is not None:
-                recorder.port.close()                   # joins the reader
-            if sim is not None:
-                sim.close()
-            if replay is not None:
-                replay.join(timeout=5)
-            # presses the reader queued before it stopped: recorded, not dropped
-            late = recorder.poll(limit=1_000_000) if recorder is not None else []
-            if recorder is not None:
-                recorder.close()
-            return late
-
-        def done(late):
-            self._stopped(why, recorder, late)
-
-        if wait:
-            done(close())
-            return
-        job = self._closer.run("close", "closing the digitizer", close, on_done=done,
-                               on_error=lambda exc: done([Update("failed", str(exc))]),
-                               supersede=False)
-        if job is None:                                 # the runner is shut: do it here
-            done(close())
-
-    def _stopped(self, why: str, recorder: Recorder | None, late: list[Update]) -> None:
-        self._closing = max(0, self._closing - 1)
-        for update in late:
-            self._show_update(update)
+    def _finish(self, final: Update) -> None:
+        """The recorder has ended: let go of it, say how, and offer the file for resume."""
+        d = self.digitizing
+        why = self._why or STOP_REASONS.get(final.kind, final.kind)
+        self._why = None
+        self.timer.stop()
+        recorded = final.kind != "unconnected"
+        d.release()
         summary = ""
-        if recorder is not None:
-            summary = recorder.session.summary()
+        if recorded:
+            summary = d.summary()
             self._say(summary)
             self.counts.setText(summary)
-            # a press that arrived as the session stopped is recorded and listed, but not
-            # drawn: a frame costs 50-80 ms on software OpenGL, and Stop must not freeze
-        self._lock(self.recording, self._connecting is not None)
-        if self.recording or self._connecting is not None:
-            return                                      # a new session began meanwhile
+            for warning in d.warnings[-3:]:
+                self._say(f"(during the session) {warning}")
+        self._settings.setValue(SESSION_OPEN, "false")
         self._set_paused(False)
-        if recorder is not None and recorder.session.history:
+        if recorded and d.history:
             # Connect again continues this file where it stopped (the journal replays it)
             self.resume.setChecked(True)
+        self._lock(False)
         where = f"not recording ({why})"
         if self.band.state in ("error", "warn") and why != "finished":
             self.band.set_state(self.band.state, where=where)   # keep the trouble in sight
         else:
             self.band.set_state("idle", summary or None, where)
         self.stopped.emit(why)
-
-    def _close_demo_now(self) -> None:
-        sim, self.sim = self.sim, None
-        if sim is not None:
-            sim.close()
 
     def release_view(self) -> None:
         """The view goes back to the canopy: forget the plant (a leaf still being meshed is
@@ -724,7 +692,7 @@ class DigitizerPanel(QWidget):
 
     def may_close(self, parent: QWidget | None = None) -> bool:
         """Ask before the window closes while recording; True when it may close."""
-        if not self.confirm_close or (not self.recording and self._connecting is None):
+        if not self.confirm_close or not self.digitizing.active:
             return True
         session = self.session
         what = (f"A digitizing session is recording into {session.path} "

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from PySide6.QtCore import QPointF, Signal
 
-from maizeviz_app.panels.light import ImageView
+from maizeviz_app.panels.image_view import ImageView
 from maizeviz_app.plots import Heatmap
 
 
@@ -28,7 +28,7 @@ def hover_text(heatmap: Heatmap, px: float, py: float) -> str:
 
 
 class HeatmapView(ImageView):
-    """An :class:`~maizeviz_app.panels.light.ImageView` of a :class:`Heatmap` (or plain RGBA
+    """An :class:`~maizeviz_app.panels.image_view.ImageView` of a :class:`Heatmap` (or plain RGBA
     pixels); ``hovered(text)``: what lies under the mouse ("" off the map or away)."""
 
     hovered = Signal(str)

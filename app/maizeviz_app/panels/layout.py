@@ -11,8 +11,12 @@ anywhere). Plants standing on each other's ground are drawn red and listed. Posi
 exactly as they are until edited (the table only shows them rounded), so applying an unedited
 layout changes nothing.
 
-``applied(layout)`` carries the layout to build: on *Apply*, or after each edit when "3D view
-follows" is on. *Save*/*Load* use the layout file of the README (written atomically).
+In the window, the study decides when the layout is applied
+(:meth:`maizeviz_app.model.StudyModel.apply_draft`: at every edit and undo while its
+``layout_options.follow``, which "3D view follows" shows and sets, else on *Apply*); the panel
+only shows the draft and says ``applied(layout)`` once the study has it. On its own (no study)
+the panel says ``applied(layout)`` itself, on *Apply* or at each edit when "3D view follows"
+is on. *Save*/*Load* use the layout file of the README (written atomically).
 """
 
 from __future__ import annotations
@@ -20,7 +24,7 @@ from __future__ import annotations
 from typing import TypeVar
 
 from PySide6.QtCore import Qt, QTimer, Signal
-from PySide6.QtGui import QKeySequence, QUndoStack
+from PySide6.QtGui import QKeySequence, QShortcut, QUndoStack
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QCheckBox,
@@ -47,12 +51,12 @@ from PySide6.QtWidgets import (
 
 from maizeviz.canopy.layout import LayoutError, load_layout, save_layout
 from maizeviz.errors import MaizevizError
+from maizeviz_app.bind import bind
 from maizeviz_app.layout_draft import LayoutDraft
 from maizeviz_app.options import TILINGS
 from maizeviz_app.panels.field_view import FieldView
 from maizeviz_app.panels.layout_model import PlacementTable, fmt
 
-FOLLOW_DELAY_MS = 400
 #: The rotate buttons' step, degrees.
 ROTATE_STEP_DEG = 15.0
 #: Overlaps listed at most (the field view draws them all).
@@ -100,6 +104,7 @@ class LayoutPanel(QWidget):
             self._recorder = UndoRecorder(None, self, draft=self.model)
             stack = self._recorder.stack
         self.undo_stack = stack
+        self.history = study.history if study is not None else self._recorder.history
         self._said: tuple = ()
         self._applied: tuple | None = None
         self._split = False
@@ -171,12 +176,11 @@ class LayoutPanel(QWidget):
         self.model.edited.connect(self._on_edit)
         self.model.replayed.connect(self._on_edit)
         self.destroyed.connect(lambda *_: self._forget(self.model))
-        self._follow_timer = QTimer(self, singleShot=True, interval=FOLLOW_DELAY_MS)
-        self._follow_timer.timeout.connect(self.apply)
         self._overlap_timer = QTimer(self, singleShot=True, interval=60)
         self._overlap_timer.timeout.connect(self._show_overlaps)
         if study is not None:
-            self.applied.connect(study.apply_layout)
+            bind(self.follow, study.layout_options, "follow")
+            study.layout_changed.connect(self._on_applied)
             study.mesh_opened.connect(self._on_mesh)
             study.points_changed.connect(self._on_points)
         if self.model.base is not None:
@@ -267,7 +271,11 @@ class LayoutPanel(QWidget):
         self.remove_button = _named(QPushButton("Remove"), "Remove", "take the picked plant "
                                     "out of the layout (Delete)")
         self.remove_button.clicked.connect(lambda: self._edit(self.model.remove, self.picked))
-        self.remove_button.setShortcut(QKeySequence(QKeySequence.StandardKey.Delete))
+        # Delete removes the picked plant only while the layout editor has the focus (a
+        # button's shortcut is the whole window's: Delete in the 3D view removed a plant)
+        self.remove_shortcut = QShortcut(QKeySequence(QKeySequence.StandardKey.Delete), self)
+        self.remove_shortcut.setContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+        self.remove_shortcut.activated.connect(self.remove_button.click)
         self.left_button = _named(_tool("⟲"), "rotate left",
                                   f"turn the picked plant {ROTATE_STEP_DEG:g}° about its "
                                   "stalk, counter-clockwise seen from above")
@@ -307,6 +315,12 @@ class LayoutPanel(QWidget):
         self._said = ()
         self._show_state()
 
+    def _on_applied(self, layout) -> None:
+        """The study applied a layout (an edit followed, *Apply*, a script)."""
+        self._applied = tuple(layout.placements)
+        self._show_state()
+        self.applied.emit(layout)
+
     def _on_mesh(self, _path: str) -> None:
         self.setEnabled(False)                  # a mesh file's canopy has no layout to edit
 
@@ -323,8 +337,7 @@ class LayoutPanel(QWidget):
         """A new canopy: its layout, the ids of its digitized plants and their stalk bases
         (cm, for the tiling presets; read from the layout's central tile when it is a tiling
         and they are not given). Clears the undo history."""
-        self._follow_timer.stop()
-        self.undo_stack.clear()
+        self.history.clear()
         self._applied = tuple(layout.placements)
         self._said = ()
         self.model.start(layout, plants, bases)
@@ -468,8 +481,8 @@ class LayoutPanel(QWidget):
 
     def _on_edit(self, *_edit) -> None:
         self._show_state()
-        if self.follow.isChecked():
-            self._follow_timer.start()
+        if self.study is None and self.follow.isChecked():
+            self.apply()                        # in the window, the study applies it
 
     def _on_snap(self, *_args) -> None:
         self.model.snap_cm = self.snap_step.value() if self.snap.isChecked() else 0.0
@@ -521,8 +534,11 @@ class LayoutPanel(QWidget):
 
     # ------------------------------------------------------------------ apply, files
     def apply(self) -> None:
-        """Check the edited layout and hand it on (``applied``); problems go to ``problem``."""
-        self._follow_timer.stop()
+        """Check the edited layout and hand it on: to the study (which says any problem), or
+        on its own as ``applied`` (problems go to ``problem``)."""
+        if self.study is not None:
+            self.study.apply_draft()
+            return
         if self.model.base is None:
             return
         try:

@@ -20,8 +20,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from PySide6.QtCore import QSize, Qt, Signal
-from PySide6.QtGui import QImage, QPixmap
+from PySide6.QtCore import Qt, Signal
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QCheckBox,
@@ -48,6 +47,8 @@ from PySide6.QtWidgets import (
 )
 
 from maizeviz_app.bind import bind, bind_choice
+from maizeviz_app.panels.heatmap_view import HeatmapView
+from maizeviz_app.panels.image_view import ImageView
 from maizeviz_app.runs import MODES, SKIES, LightRuns, Run, level_order  # noqa: F401 - re-exported
 from maizeviz_app.settings import (  # noqa: F401 - re-exported
     DEFAULT_HEIGHTS,
@@ -420,6 +421,14 @@ class LightPanel(QWidget):
                                "CO₂ fixed per absorbed PAR photon (maize: 0.04)", 0.005)
         self.co2 = number("co2_ppm", "CO₂", 0, " ppm", "ambient CO₂ (intercellular: 0.4 of it)",
                           10.0)
+        self.c4_temperature = QComboBox()
+        self.c4_temperature.addItem("Collatz et al. 1992 (the paper's)", "collatz")
+        self.c4_temperature.addItem("CLM 4.5 (maizeviz 0.2)", "clm45")
+        self.c4_temperature.setToolTip(
+            "how the C4 leaf's Rubisco capacity falls in heat and cold: the paper's own "
+            "response (Vmax 44.7 µmol/m²/s at 35 °C, 25.5 at 40 °C) or the Community Land "
+            "Model 4.5's (62.6 and 54.8), which maizeviz 0.2 used (see docs/method.md)")
+        bind(self.c4_temperature, ph, "c4_temperature", "C4 temperature response")
         self.wofost_amax = number("amax", "WOFOST AMAX", 1, " kg CO₂/ha/h",
                                   "assimilation at light saturation (maize: 70)")
         self.wofost_eff = number("eff", "WOFOST EFF", 3, " kg/ha/h per W/m²",
@@ -429,6 +438,7 @@ class LightPanel(QWidget):
         for model, widget, text in (("c4", self.c4_vmax, "Vmax (25 °C)"),
                                     ("c4", self.c4_alpha, "quantum yield α"),
                                     ("c4", self.co2, "CO₂"),
+                                    ("c4", self.c4_temperature, "temperature response"),
                                     ("wofost", self.wofost_amax, "AMAX"),
                                     ("wofost", self.wofost_eff, "EFF")):
             label = QLabel(text)
@@ -723,11 +733,11 @@ class LightPanel(QWidget):
         for what in ("table", "heatmap", "plot", "canopy"):
             self.export_buttons[what].setEnabled(last)
         day = runs.of_kind("day") is not None
-        diffuse = day or runs.of_kind("sky") is not None
         for what in ("steps", "day"):
             self.export_buttons[what].setEnabled(day)
+        per_leaf = runs.with_plants() is not None
         for what in ("leaves", "plants"):
-            self.export_buttons[what].setEnabled(diffuse)
+            self.export_buttons[what].setEnabled(per_leaf)
         if not runs.runs:
             self.show_summary("")
             self.show_plants(None)
@@ -820,50 +830,11 @@ def _model_text(assimilation) -> str:
     if d.get("model") == "wofost":
         what = f"WOFOST, AMAX {d['amax']:g} kg CO₂/ha/h, EFF {d['eff']:g}"
     else:
+        form = {"collatz": "Collatz et al. 1992", "clm45": "CLM 4.5"}.get(
+            str(d.get("temperature_response", "clm45")), "CLM 4.5")
         what = (f"C4 leaf, Vmax {d['vmax']:g} µmol/m²/s, α {d['alpha']:g}, CO₂ "
-                f"{d['co2_ppm']:g} ppm")
+                f"{d['co2_ppm']:g} ppm, temperature response {form}")
     return f"{what}, leaves at {assimilation.temp_c:g} °C"
-
-
-class ImageView(QLabel):
-    """A picture scaled to fit the widget, keeping its aspect (figures drawn elsewhere)."""
-
-    def __init__(self, placeholder: str = "", parent=None):
-        super().__init__(placeholder, parent)
-        self._placeholder = placeholder
-        self._image: QImage | None = None
-        self.setAlignment(Qt.AlignmentFlag.AlignCenter)
-        self.setMinimumSize(160, 120)
-        self.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Ignored)
-        self.setStyleSheet("background: white; color: #666;")
-
-    def set_rgba(self, rgba: np.ndarray | None) -> None:
-        if rgba is None:
-            self._image = None
-            self.clear()
-            self.setText(self._placeholder)         # what will appear here
-            return
-        h, w = rgba.shape[:2]
-        self._image = QImage(np.ascontiguousarray(rgba).data, w, h, 4 * w,
-                             QImage.Format.Format_RGBA8888).copy()
-        self._rescale()
-
-    def image(self) -> QImage | None:
-        return self._image
-
-    def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
-        super().resizeEvent(event)
-        self._rescale()
-
-    def _rescale(self) -> None:
-        if self._image is None:
-            return
-        self.setPixmap(QPixmap.fromImage(self._image).scaled(
-            self.size(), Qt.AspectRatioMode.KeepAspectRatio,
-            Qt.TransformationMode.SmoothTransformation))
-
-    def sizeHint(self) -> QSize:  # noqa: N802
-        return QSize(360, 200)
 
 
 #: What the heatmap selector offers, per light.
@@ -900,8 +871,6 @@ class LightPlots(QWidget):
         top.addWidget(self.height_box)
         top.addStretch(1)
         left.addLayout(top)
-        from maizeviz_app.panels.heatmap_view import HeatmapView
-
         self.heatmap = HeatmapView("compute light to see where it reaches each height")
         left.addWidget(self.heatmap, 1)
         # the value under the mouse (always in place: showing a widget relayouts the dock)

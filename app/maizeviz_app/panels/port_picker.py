@@ -33,7 +33,7 @@ class PortPicker(QWidget):
     -------
     listed(list) : the ports were listed again ([PortInfo])
     searching(int) : a search began over that many ports
-    probed(object) : one port's answer (a :class:`~maizeviz.digitizer.ports.Probe`)
+    probed(object) : one port's answer (a :class:`~maizeviz.digitizer.detect.Probe`)
     searched(list) : the search ended ([Probe]; empty when it was stopped)
     """
 
@@ -131,7 +131,7 @@ class PortPicker(QWidget):
         chosen. Each answer is :attr:`probed`; the end is :attr:`searched`."""
         if self.busy:
             return
-        from maizeviz.digitizer.ports import detect
+        from maizeviz.digitizer.detect import detect
 
         ports = self.candidates()
         cancel = threading.Event()

@@ -24,6 +24,19 @@ PAR is taken as a fixed fraction of shortwave: ``par_umol_per_j`` umol of PAR ph
 shortwave, by default 0.48 (PAR share of global radiation) x 4.57 umol/J (photons per joule of
 daylight PAR, McCree 1972) = 2.1936 umol/J.
 
+PAR's diffuse part on a clear-sky day is not the shortwave's: the sky scatters blue more than
+the near infrared, and the clear-sky model's diffuse share of shortwave (13-14 % on a clear
+summer day) is well below what crop models use for PAR. A clear-sky period splits its PAR as
+WOFOST does (Spitters et al. 1986; PCSE's ``astro`` and ``totass7``): the day's atmospheric
+transmission ``T`` (its shortwave over the extraterrestrial on the horizontal) gives the day's
+diffuse fraction ``FRDIF`` (0.23 above T = 0.75, ``1.33 - 1.46 T`` down to 0.35, ``1 - 2.3 (T -
+0.07)^2`` down to 0.07, 1 below), and each step's diffuse PAR is ``FRDIF T I0 sin(beta)`` times
+the PAR share (``I0`` the extraterrestrial irradiance, ``beta`` the sun's elevation), at most
+the step's PAR; over a whole day the diffuse share of PAR is FRDIF (about 0.26 on a clear
+summer day in Beijing, against the shortwave's 0.135). A weather file's PAR is left as measured
+(or as its shortwave's split, when it has none), and the near infrared keeps the shortwave's
+split.
+
 Angles in degrees: zenith from the vertical, azimuth clockwise from north (as
 :class:`maizeviz.light.sources.sun.Sun`).
 
@@ -39,6 +52,11 @@ References
   Solar Energy 76(5), 577-589.
 - McCree, K.J. (1972). Test of current definitions of photosynthetically active radiation
   against leaf photosynthesis data. Agricultural Meteorology 10, 443-453.
+- Spitters, C.J.T., Toussaint, H.A.J.M. & Goudriaan, J. (1986). Separating the diffuse and
+  direct component of global radiation and its implications for modeling canopy
+  photosynthesis. Part I. Components of incoming radiation. Agricultural and Forest
+  Meteorology 38, 217-229 (the daily relation of the diffuse fraction to the atmospheric
+  transmission, as WOFOST codes it: PCSE 6.0, ``pcse.util.astro``).
 """
 
 from __future__ import annotations
@@ -309,6 +327,9 @@ class Period:
         and diffuse parts are shared as the shortwave's
     temp_air : (n,) float64 deg C or None: air temperature at each step (NaN where the file
         had none), for models of leaf processes; the light does not use it
+    par_diffuse_share : (n,) float64 in [0, 1] or None: the diffuse part of each step's PAR
+        when it is not the shortwave's (a clear-sky period: :func:`par_diffuse_shares`);
+        None: PAR is split as the shortwave is
 
     Integration: step i contributes ``ghi[i] * step_s[i]`` J/m2; every total is the exactly
     rounded sum (math.fsum) of its steps.
@@ -330,6 +351,7 @@ class Period:
     notes: tuple[str, ...] = ()
     par_measured: np.ndarray | None = None
     temp_air: np.ndarray | None = None
+    par_diffuse_share: np.ndarray | None = None
 
     def __reduce__(self):
         # the read-only parameters mapping does not pickle; a period crosses process
@@ -349,7 +371,8 @@ class Period:
         object.__setattr__(self, "parameters", MappingProxyType(dict(self.parameters)))
         object.__setattr__(self, "par_umol_per_j", _check_par_factor(self.par_umol_per_j))
         object.__setattr__(self, "notes", tuple(self.notes))
-        for name, finite in (("par_measured", True), ("temp_air", False)):
+        for name, finite in (("par_measured", True), ("temp_air", False),
+                             ("par_diffuse_share", True)):
             if getattr(self, name) is not None:
                 arr = _frozen(getattr(self, name))
                 if arr.shape != (n,) or (finite and not np.all(np.isfinite(arr))) or \
@@ -358,6 +381,9 @@ class Period:
                 object.__setattr__(self, name, arr)
         if self.par_measured is not None and np.any(self.par_measured < 0):
             raise MaizevizError("period PAR must be >= 0 umol/m2/s")
+        if self.par_diffuse_share is not None and (np.any(self.par_diffuse_share < 0)
+                                                   or np.any(self.par_diffuse_share > 1)):
+            raise MaizevizError("period par_diffuse_share must be in [0, 1]")
         if np.any(self.step_s <= 0) or np.any(self.zenith_deg >= 90):
             raise MaizevizError("period steps must last > 0 s and have the sun above the horizon")
         if np.any(self.dhi < 0) or np.any(self.direct_horizontal < 0):
@@ -398,6 +424,35 @@ class Period:
                 self.ghi > 0, self.ghi, 1.0), 0.0)
 
     @property
+    def _par_direct_share(self) -> np.ndarray:
+        """(n,) the direct part of each step's PAR: the PAR split where the period has one
+        (not for a measured PAR), else the shortwave's."""
+        if self.par_diffuse_share is not None and self.par_measured is None:
+            return 1.0 - self.par_diffuse_share
+        return self._direct_share
+
+    def diffuse_ratio(self, band: str) -> np.ndarray:
+        """(n,) the band's diffuse share of each step over the shortwave's: 1 but for PAR on a
+        period with its own PAR split (:attr:`par_diffuse_share`).
+
+        Parameters
+        ----------
+        band : {"par", "nir"}
+            The waveband.
+
+        Returns
+        -------
+        numpy.ndarray
+            (n,) float64: the band's diffuse irradiance is ``dhi x band share x`` this.
+        """
+        ones = np.ones(self.n_steps)
+        if band != "par" or self.par_diffuse_share is None or self.par_measured is not None:
+            return ones
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.dhi > 0, self.par_diffuse_share * self.ghi
+                            / np.where(self.dhi > 0, self.dhi, 1.0), ones)
+
+    @property
     def step_par_mol_m2(self) -> np.ndarray:
         """(n,) float64, mol/m2: incident PAR during each step."""
         if self.par_measured is not None:
@@ -407,14 +462,14 @@ class Period:
     @property
     def step_direct_par_mol_m2(self) -> np.ndarray:
         """(n,) float64, mol/m2: direct (sun) part of :attr:`step_par_mol_m2`."""
-        if self.par_measured is not None:
-            return self.step_par_mol_m2 * self._direct_share
+        if self.par_measured is not None or self.par_diffuse_share is not None:
+            return self.step_par_mol_m2 * self._par_direct_share
         return self.direct_horizontal * self.step_s * self.par_umol_per_j * 1e-6
 
     @property
     def step_diffuse_par_mol_m2(self) -> np.ndarray:
         """(n,) float64, mol/m2: diffuse (sky) part of :attr:`step_par_mol_m2`."""
-        if self.par_measured is not None:
+        if self.par_measured is not None or self.par_diffuse_share is not None:
             return self.step_par_mol_m2 - self.step_direct_par_mol_m2
         return self.dhi * self.step_s * self.par_umol_per_j * 1e-6
 
@@ -530,10 +585,93 @@ def clear_sky(track: SunTrack, linke_turbidity: float = DEFAULT_LINKE_TURBIDITY,
     else:
         ghi = dni = np.zeros(0)
     direct_h = np.minimum(dni * np.cos(np.radians(track.zenith_deg)), ghi)
+    params["par_split"] = "spitters1986"
+    source += "; PAR's diffuse part by Spitters et al. 1986 (WOFOST)"
+    share = np.zeros(0)
+    if n:
+        transmission = _day_transmission(site, track.times, float(linke_turbidity))
+        share = par_diffuse_shares(track.times, track.zenith_deg, ghi, transmission)
     return Period(times=track.times, step_s=track.step_s, zenith_deg=track.zenith_deg,
                   azimuth_deg=track.azimuth_deg, ghi=ghi, dni=dni, dhi=ghi - direct_h,
                   direct_horizontal=direct_h, start=track.start, end=track.end, source=source,
-                  parameters=params, par_umol_per_j=par, notes=track.notes)
+                  parameters=params, par_umol_per_j=par, notes=track.notes,
+                  par_diffuse_share=share)
+
+
+def diffuse_fraction_spitters(transmission):
+    """The day's diffuse fraction of global radiation from its atmospheric transmission
+    (Spitters et al. 1986, the daily relation as WOFOST codes it: PCSE's ``astro``).
+
+    Parameters
+    ----------
+    transmission : float or numpy.ndarray
+        The day's global radiation over the extraterrestrial on a horizontal plane [-].
+
+    Returns
+    -------
+    numpy.ndarray
+        The diffuse fraction FRDIF [-], in [0.23, 1].
+    """
+    t = np.asarray(transmission, dtype=np.float64)
+    return np.select([t > 0.75, t > 0.35, t > 0.07],
+                     [0.23, 1.33 - 1.46 * t, 1.0 - 2.3 * (t - 0.07) ** 2], 1.0)
+
+
+def _day_transmission(site, times, linke_turbidity: float) -> np.ndarray:
+    """(n,) float64: the atmospheric transmission of each step's whole local day (clear-sky
+    shortwave over the extraterrestrial on the horizontal, the day sampled every 10 minutes),
+    so that a part of a day splits its PAR as the whole day does."""
+    import pandas as pd
+    import pvlib
+
+    dates = np.asarray(times.date)
+    out = np.zeros(len(dates))
+    for d in np.unique(dates):
+        t = pd.date_range(pd.Timestamp(d, tz=times.tz), periods=144, freq="10min") + \
+            pd.Timedelta(minutes=5)
+        pos = site.get_solarposition(t)
+        up = pos["apparent_zenith"].to_numpy(float) < 90.0
+        if not up.any():
+            continue
+        cs = site.get_clearsky(t[up], model="ineichen", solar_position=pos[up],
+                               linke_turbidity=linke_turbidity)
+        top = np.asarray(pvlib.irradiance.get_extra_radiation(t[up]), np.float64) * np.cos(
+            np.radians(pos["apparent_zenith"].to_numpy(float)[up]))
+        out[dates == d] = float(cs["ghi"].to_numpy(float).sum()) / float(top.sum())
+    return out
+
+
+def par_diffuse_shares(times, zenith_deg, ghi, transmission) -> np.ndarray:
+    """The diffuse part of each step's PAR by the standard PAR split (Spitters et al. 1986,
+    as WOFOST uses it; see the module docstring).
+
+    Parameters
+    ----------
+    times : (n,) pandas DatetimeIndex, time-zone aware
+        Middle of each step.
+    zenith_deg : (n,) float64
+        The sun's apparent zenith [deg], < 90.
+    ghi : (n,) float64
+        Global horizontal irradiance [W m-2].
+    transmission : (n,) float64
+        The atmospheric transmission of each step's day [-].
+
+    Returns
+    -------
+    numpy.ndarray
+        (n,) float64 in [0, 1]: diffuse PAR over PAR at each step (1 where there is no light).
+    """
+    import pvlib
+
+    ghi = np.asarray(ghi, np.float64)
+    if not len(ghi):
+        return np.zeros(0)
+    t = np.asarray(transmission, np.float64)
+    top = np.asarray(pvlib.irradiance.get_extra_radiation(times), np.float64) * np.cos(
+        np.radians(np.asarray(zenith_deg, np.float64)))                 # W/m2, horizontal
+    diffuse = diffuse_fraction_spitters(t) * t * top                      # W/m2 of shortwave
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(ghi > 0, np.clip(diffuse / np.where(ghi > 0, ghi, 1.0), 0.0, 1.0), 1.0)
 
 
 def clear_sky_period(date, lat: float, lon: float, tz: str, step_min: float = 30.0,
