@@ -34,13 +34,16 @@ https://doi.org/10.1016/S0304-3800(98)00100-8
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.sparse import csr_array
 
 from maizeviz.light.results.uncertainty import BATCHES
 from maizeviz.light.scene.rays import Tracer
 from maizeviz.light.trace.direct import Sampler
+
+if TYPE_CHECKING:       # scipy.sparse (0.3 s, and numpy.f2py) is imported when sampled
+    from scipy.sparse import csr_array
 
 #: Distance (cm) a sample point is lifted off its triangle toward the sun's side.
 LIFT_CM = 1e-3
@@ -109,6 +112,8 @@ def sunlit_share(smp: Sampler, triangles: np.ndarray, normals: np.ndarray,
     -------
     SunlitShare
     """
+    from scipy.sparse import csr_array
+
     s = np.asarray(toward, np.float64)
     tri = np.asarray(triangles, np.float64)
     nf = len(tri)
