@@ -75,6 +75,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from maizeviz.errors import MaizevizError
+from maizeviz.io.dates import FIRST_YEAR, LAST_YEAR, TIME_UNIT, check_year
 from maizeviz.io.inputs import open_input, read_input
 from maizeviz.io.weather_files import (
     PVLIB_FORMATS,
@@ -88,7 +89,6 @@ from maizeviz.light.sources.clock import check_altitude as _check_altitude
 from maizeviz.light.sources.clock import check_place as _check_place
 from maizeviz.light.sources.clock import local_time
 from maizeviz.light.sources.clock import zone as _time_zone
-from maizeviz.light.sources.dates import FIRST_YEAR, LAST_YEAR, TIME_UNIT, check_year
 from maizeviz.numbers import NUMBER, first_unplain, number
 
 if TYPE_CHECKING:
@@ -817,7 +817,7 @@ def _header(line: int, fields: list, path: Path) -> dict:
 
 def _parse_times(texts: list, lines: list, path: Path, tz):
     """Time texts -> tz-aware DatetimeIndex in microseconds (in ``tz``, or the first row's
-    offset); every local date in the years :func:`~maizeviz.light.sources.dates.check_year` allows."""
+    offset); every local date in the years :func:`~maizeviz.io.dates.check_year` allows."""
     import pandas as pd
 
     zoned = np.array([bool(_ZONE_SUFFIX.search(t)) for t in texts])
