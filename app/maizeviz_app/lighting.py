@@ -325,6 +325,7 @@ def adopt_pending_runs(study: StudyState) -> None:
     title = plot_title(study.runs)
     study.figures.shown_for = dict(shown)
     study.view_light.emit(True)
+    restore_colouring(study)
     if study.draw_figures:
         _draw_project_figures(study, shown, order, curves, title)
     elif study.runner.current("complete") is None:
@@ -403,12 +404,32 @@ def complete_runs(study: StudyState) -> None:
                 run.extra = value
         if study.shown_signature == here:
             study.set_plants_run(light_per_plant_run(study))
+            last = study.runs.last
+            # the results table gains what was computed here (a sun's CO2 row)
+            study.runs_changed.emit(study.runs, run_info(last) if last is not None else "")
             study.view_light.emit(True)
+            restore_colouring(study)
             if study.runner.current("figures") is None:     # else: when they are drawn
                 study.light_shown.emit()
 
     study.runner.run("complete", "light per leaf of the project's results", work,
                     on_done=adopt, on_error=lambda e: study.fail(e, "light"))
+
+
+def restore_colouring(study: StudyState) -> None:
+    """The 3D view coloured as it was when the project was saved (``colouring`` in its view
+    settings), once what it shows is computed: a CO2 colouring waits for the assimilation."""
+    from maizeviz_app.options import COLOURINGS
+
+    wanted = getattr(study, "colouring_to_restore", None)
+    if wanted not in COLOURINGS:
+        return
+    last = study.runs.latest(study.shown_signature, ("sun",))
+    if wanted == "assimilation" and getattr(getattr(last, "extra", None), "assimilation",
+                                            None) is None:
+        return
+    study.colouring_to_restore = None
+    study.view.colouring = wanted
 
 
 def runs_to_complete(runs, here, n: int) -> list:

@@ -384,3 +384,45 @@ def test_a_points_file_with_a_bad_value_is_named_by_its_line(study, tmp_path):
     errors = _errors(study)
     assert errors and "line 2" in errors[-1] and "x is not a number ('abc')" in errors[-1]
     assert "columns" not in errors[-1] and "correct that line" in errors[-1].lower()
+
+
+def test_a_reopened_c4_project_has_its_co2_row_and_colouring(study, points, tmp_path):
+    """Issue 37, item 6: a project saved after a sun with C4, coloured by CO2, reopened
+    without its canopy's gross CO2 row in the results table and coloured by absorbed PAR;
+    both come back now."""
+    from maizeviz_app.model import StudyModel
+    from maizeviz_app.runner import InlineRunner
+    from maizeviz_app.runs import ASSIMILATION_ROW
+
+    m, s = study, study.settings
+    m.open_points(points)
+    s.sampling.heights, s.sampling.density, s.sampling.periodic = "0, 100", 1.0, True
+    s.optics.enabled = True
+    s.photosynthesis.model = "c4"
+    assert m.compute_light() and not _errors(m)
+    m.view.colouring = "assimilation"
+    _, rows = m.runs.table()
+    assert any(r[0] == ASSIMILATION_ROW for r in rows)
+    path = tmp_path / "c4.maizeviz"
+    assert m.save_project(path)
+    runner2 = InlineRunner()
+    try:
+        m2 = StudyModel(tile=1, runner=runner2)
+        tables: list = []
+        m2.runs_changed.connect(lambda runs, info: tables.append(runs.table()[1]))
+        m2.open_project(path)
+        assert m2.runs.of_kind("sun").extra.assimilation is not None
+        assert any(r[0] == ASSIMILATION_ROW for r in tables[-1])
+        assert m2.view.colouring == "assimilation"
+    finally:
+        runner2.shutdown()
+
+
+def test_a_duplicate_is_named_as_a_duplicate_in_the_history(study, points):
+    """Issue 37, item 8: the history named a Duplicate "add plant 1"."""
+    study.open_points(points)
+    assert study.draft.duplicate(0)
+    plant = study.loaded.layout.placements[0].plant
+    assert study.history.undo_text == f"duplicate plant {plant} (row 1)"
+    assert study.draft.add(500.0, 500.0)
+    assert study.history.undo_text.startswith("add plant")
