@@ -115,3 +115,14 @@ def test_the_command_line_reports_stalks_and_leaves_only_is_the_papers(capsys, t
     assert "stalk_sunlit_intercepted_cm2" in plant_csv.read_text().splitlines()[0]
     assert main([*base, "--leaves-only", "--with-stalks"]) != EXIT_OK
     assert "contradict" in capsys.readouterr().err
+
+
+def test_a_stalk_is_no_leaf_area_in_the_canopy_measures(canopy):
+    """--with-stalks lets the stalks shade the ground; leaf area and LAI stay the leaves'."""
+    from maizeviz.canopy.measures import measure_canopy
+
+    leaves = measure_canopy(canopy, 2.0)
+    stalks = measure_canopy(canopy, 2.0, with_stalks=True)
+    assert stalks.leaf_area_m2 == leaves.leaf_area_m2
+    assert stalks.projected_area_m2 == leaves.projected_area_m2
+    assert stalks.ground_cover_m2 >= leaves.ground_cover_m2
