@@ -76,12 +76,14 @@ def build_menus(w) -> dict[str, QAction]:
     acts["export_steps"] = _action(w, results, "Day: time steps (CSV)…",
                                    lambda: w.choose_export("steps"), None,
                                    "the day's light at each time step")
-    acts["export_leaves"] = _action(w, results, "Sky or day: light per leaf (CSV)…",
+    acts["export_leaves"] = _action(w, results, "Light per leaf (CSV)…",
                                     lambda: w.choose_export("leaves"), None,
-                                    "light intercepted and absorbed by each leaf")
-    acts["export_plants"] = _action(w, results, "Sky or day: light per plant (CSV)…",
+                                    "light intercepted or absorbed by each leaf (a sky, a "
+                                    "day, or a sun with leaf optics and its CO2)")
+    acts["export_plants"] = _action(w, results, "Light per plant (CSV)…",
                                     lambda: w.choose_export("plants"), None,
-                                    "light intercepted and absorbed by each plant")
+                                    "light intercepted or absorbed by each plant (a sky, a "
+                                    "day, or a sun with leaf optics and its CO2)")
     acts["export_day"] = _action(w, results, "Day figure (PNG)…",
                                  lambda: w.choose_export("day"), None,
                                  "the day's light and transmission over the hours")
@@ -161,7 +163,17 @@ def build_menus(w) -> dict[str, QAction]:
                                                 "place typed in the Light panel")
 
     h = bar.addMenu("&Help")
-    acts["about"] = _action(w, h, "&About maizeviz", w.about, QKeySequence.StandardKey.HelpContents,
+    acts["docs"] = _action(w, h, "&Documentation", w.open_docs,
+                           QKeySequence.StandardKey.HelpContents,
+                           "the documentation's index: method, commands, this window, "
+                           "validation")
+    acts["shortcuts"] = _action(w, h, "&Keyboard shortcuts", w.show_shortcuts, None,
+                                "every menu command's keys")
+    acts["system_info"] = _action(w, h, "&System information", w.show_system_info, None,
+                                  "what maizeviz --info prints: versions, Embree, the ray "
+                                  "kernel; for a bug report")
+    h.addSeparator()
+    acts["about"] = _action(w, h, "&About maizeviz", w.about, None,
                             "the version, the libraries and where the documentation is")
     return acts
 

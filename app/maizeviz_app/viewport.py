@@ -283,6 +283,8 @@ class Viewport(QtInteractor):
     picked = Signal(object)
     #: A canopy's mesh was put on screen (show_canopy).
     canopy_set = Signal()
+    #: The camera moved by the user or a preset: its pose ((position, focal point, up), cm).
+    camera_moved = Signal(object)
 
     #: A press and release closer than this (pixels) is a click, not a drag of the camera.
     CLICK_PX = 4
@@ -630,6 +632,26 @@ class Viewport(QtInteractor):
         if name == "reset":
             cam.Zoom(1.25)
         self.render()
+        self.camera_moved.emit(self.camera_pose())
+
+    def camera_pose(self):
+        """The camera's position, focal point and view up (cm), as three tuples."""
+        cam = self.camera
+        return tuple(tuple(float(v) for v in vec) for vec in
+                     (cam.GetPosition(), cam.GetFocalPoint(), cam.GetViewUp()))
+
+    def set_camera_pose(self, pose) -> None:
+        """Put the camera at ``pose`` (as :meth:`camera_pose` gives it); nothing when it is
+        there already."""
+        if pose is None or pose == self.camera_pose():
+            return
+        cam = self.camera
+        position, focal, up = pose
+        cam.SetPosition(*position)
+        cam.SetFocalPoint(*focal)
+        cam.SetViewUp(*up)
+        self.renderer.ResetCameraClippingRange()
+        self.render()
 
     # ------------------------------------------------------------------ digitizing
     def hide_canopy(self) -> None:
@@ -762,6 +784,11 @@ class Viewport(QtInteractor):
             return
         self._press = None
         super().mouseReleaseEvent(event)
+        self.camera_moved.emit(self.camera_pose())      # a drag VTK turned the camera by
+
+    def wheelEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        super().wheelEvent(event)
+        self.camera_moved.emit(self.camera_pose())
 
     def _release_held(self) -> None:
         """Hand the held press to VTK (a drag begins)."""

@@ -192,7 +192,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ab.add_argument("--precision", type=NUMBER_ARG, default=None, metavar="REL_SE",
                     help="trace denser until the relative Monte Carlo standard error of the "
                          "leaves' absorbed light (of the canopy's assimilation with "
-                         "--photosynthesis) is at most this (0.005: 0.5 %%)")
+                         "--photosynthesis) is at most this (0.005: 0.5 %%), and so is its bias "
+                         "from the density (estimated from halves of the same rays)")
     ph = p.add_argument_group(
         "photosynthesis from the absorbed PAR (turns absorbed light on; the sun, or a period)")
     ph.add_argument("--photosynthesis", choices=MODELS, default=None,
@@ -682,8 +683,9 @@ def _trace_absorbed_period(job: _Job, lv: _Level) -> None:
                                    progress=Progress(f"absorbed light over the period, "
                                                      f"{lv.label}"))
         if d.assimilation is not None:
-            return (d, d.assimilation.canopy_gross_mol_m2,
-                    d.assimilation.canopy_gross_error_mol_m2 or 0.0)
+            pa, g = d.assimilation, d.assimilation.ground_m2
+            return (d, pa.canopy_gross_mol_m2, pa.canopy_gross_error_mol_m2 or 0.0,
+                    (pa.bias_mol or 0.0) / g, (pa.bias_se_mol or 0.0) / g)
         return d, d.balance.absorbed_leaves, d.absorbed_leaves_error or 0.0
 
     abd = lv.abd = _traced(trace_day, args, lv.rec, job.said)
@@ -715,7 +717,9 @@ def _trace_absorbed_sun(job: _Job, lv: _Level) -> None:
                                seed=args.seed, density=density)
         if job.leaf_model is not None:
             g = assimilate(lv.canopy, a, job.leaf_model, job.temp_c)
-            return a, g.canopy_gross_umol_m2_s, g.canopy_gross_error_umol_m2_s or 0.0
+            return (a, g.canopy_gross_umol_m2_s, g.canopy_gross_error_umol_m2_s or 0.0,
+                    g.canopy_gross_bias_umol_m2_s or 0.0,
+                    (g.bias_se_umol_s or 0.0) / g.ground_m2)
         return a, a.balance.absorbed_leaves, a.absorbed_leaves_error or 0.0
 
     ab = lv.ab = _traced(trace_sun, args, lv.rec, job.said)
@@ -797,6 +801,12 @@ def _warn_unresolved(balance, depth: int, rec: dict[str, Any], said: set[str]) -
             say(f"warning: {w}")
 
 
+def _percent(fraction: float) -> str:
+    """A fraction as a percentage with three significant digits, however small (``:.2%``
+    wrote a target of 1e-6 as "0.00%")."""
+    return f"{100 * fraction:.3g}%"
+
+
 def _traced(trace, args: argparse.Namespace, rec: dict[str, Any], said: set[str]) -> Any:
     """``trace(density)``'s result at ``--density``, or with ``--precision`` at the density
     that meets it (recorded in ``rec["precision"]``, a warning when it cannot be)."""
@@ -804,11 +814,19 @@ def _traced(trace, args: argparse.Namespace, rec: dict[str, Any], said: set[str]
         return trace(args.density)[0]
     result, prec = trace_until(trace, args.density, args.precision)
     rec["precision"] = prec.as_dict()
-    say(f"precision: relative standard error {prec.achieved:.2%} at {prec.density:g} rays "
-        f"per cm2 after {prec.passes} trace{'s' if prec.passes > 1 else ''}")
-    if not prec.met:
-        w = (f"the relative standard error {prec.achieved:.2%} is above the {prec.target:.2%} "
-             f"asked for at the densest tracing allowed ({prec.density:g} rays per cm2)")
+    bias = ("+" if prec.bias >= 0 else "-") + _percent(abs(prec.bias))
+    say(f"precision: relative standard error {_percent(prec.achieved)}, bias from the density "
+        f"{bias} at {prec.density:g} rays per cm2 after {prec.passes} "
+        f"trace{'s' if prec.passes > 1 else ''}")
+    problems = []
+    if not prec.noise_met:
+        problems.append(f"the relative standard error {_percent(prec.achieved)} is above the "
+                        f"{_percent(prec.target)} asked for")
+    if not prec.bias_met:
+        problems.append(f"the bias from the density, {bias} +- {_percent(prec.bias_se)}, "
+                        f"is above the {_percent(prec.target)} asked for")
+    for problem in problems:
+        w = f"{problem} at the densest tracing allowed ({prec.density:g} rays per cm2)"
         said.add(w)
         say(f"warning: {w}")
         rec["warnings"].append(w)
@@ -1175,7 +1193,8 @@ def _print_balance(records: list[dict]) -> None:
             f"{r['absorbed']['sunlit_lai']:.2f}"
         rows.append([r["level"], f"{b['incident']:.2f}", f"{b['absorbed_leaves']:.2f}",
                      f"{b['absorbed_ground']:.2f}", f"{b['reflected_top']:.2f}",
-                     f"{b['escaped_sides'] + b['unresolved']:.2f}", f"{b['closure']:+.4f}",
-                     last])
+                     f"{b['escaped_sides'] + b['unresolved']:.2f}",
+                     f"{b['closure_fraction']:+.2%}", last])
     print(fmt_table(["level", "incident", "leaves", "ground", "reflected", "other",
-                     "closure", "PAR mol/m2" if period else "sunlit LAI"], rows))
+                     "closure (of incident)", "PAR mol/m2" if period else "sunlit LAI"],
+                    rows))

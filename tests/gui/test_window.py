@@ -194,6 +194,27 @@ def test_menus_show_shortcuts_and_about_names_the_paper(window, qtbot):
     assert menus == ["File", "Edit", "View", "Light", "Help"]
     text = about_text()
     assert __version__ in text and "Guo" in text and "Scientia Agricultura Sinica" in text
+    # issue 37 item 8: About promised the libraries and the documentation; it names them
+    import numpy
+    import PySide6
+
+    assert f"numpy {numpy.__version__}" in text and "Embree" in text
+    assert "docs" in text and "Documentation" in text
+    # Help: the documentation, every shortcut, maizeviz --info
+    helps = [a.text().replace("&", "") for a in w.menuBar().actions()[-1].menu().actions()
+             if a.text()]
+    assert helps == ["Documentation", "Keyboard shortcuts", "System information",
+                     "About maizeviz"]
+    from maizeviz_app.main_window import shortcuts_text
+
+    keys = shortcuts_text(w.menu_actions.values())
+    assert "Ctrl+O" in keys and "Ctrl+Shift+3" in keys and "Delete" in keys
+    w.show_system_info()
+    from maizeviz.info import report
+
+    assert w.info_box.detailedText() == report()
+    w.info_box.close()
+    assert PySide6.__version__
 
 
 def test_fits_a_laptop_screen(window, qtbot):

@@ -146,12 +146,14 @@ class DigitizerPanel(QWidget):
     #: Ask before the window closes while recording (tests and benchmarks turn it off).
     confirm_close = True
 
-    def __init__(self, viewport=None, parent=None):
+    def __init__(self, viewport=None, parent=None, session: DigitizingSession | None = None):
         super().__init__(parent)
         self._viewport = viewport
-        #: The session this panel shows (Qt-free: the recorder's process, what is on disk).
-        self.digitizing = DigitizingSession()
-        self.digitizing.demo_file = example_points()
+        #: The session this panel shows (Qt-free: the recorder's process, what is on disk);
+        #: the window's is the study model's (``StudyModel.digitizing``).
+        self.digitizing = session if session is not None else DigitizingSession()
+        if self.digitizing.demo_file is None:
+            self.digitizing.demo_file = example_points()
         self.beeps = 0                             # trouble said with a beep
         self.press_beeps = 0                       # points confirmed with a beep
         self._why: str | None = None               # why the technician stopped

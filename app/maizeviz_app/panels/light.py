@@ -733,11 +733,11 @@ class LightPanel(QWidget):
         for what in ("table", "heatmap", "plot", "canopy"):
             self.export_buttons[what].setEnabled(last)
         day = runs.of_kind("day") is not None
-        diffuse = day or runs.of_kind("sky") is not None
         for what in ("steps", "day"):
             self.export_buttons[what].setEnabled(day)
+        per_leaf = runs.with_plants() is not None
         for what in ("leaves", "plants"):
-            self.export_buttons[what].setEnabled(diffuse)
+            self.export_buttons[what].setEnabled(per_leaf)
         if not runs.runs:
             self.show_summary("")
             self.show_plants(None)
