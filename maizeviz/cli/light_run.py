@@ -470,7 +470,7 @@ def _trace_level(job: _Job, canopy: Canopy, canopy_s: float) -> dict[str, Any]:
     if job.sun is None:
         _without_sun(lv)
     rec["stalks"], stalk_rows = stalk_record(canopy, engine.with_stalks, lv.res, lv.sky_res,
-                                             lv.ab or lv.abd, lv.per_res)
+                                             lv.ab or lv.abd, lv.per_res, args.periodic)
     _write_outputs(args, canopy, lv.label, job.n_levels, lv.res, lv.sky_res, lv.per_res,
                    lv.tables, lv.plant_extra, stalk_rows)
     if args.export:
