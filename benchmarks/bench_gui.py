@@ -339,6 +339,7 @@ def gui_child(levels: list[str], repeat: int = 1) -> None:
     out.update(edit_part(window, spin, gaps, shown))
     out.update(stop_gaps(window, gaps, spin, repeat))
     if "K4" in levels:
+        out.update(rotation_part(window, spin, shown))
         out.update(pick_and_mesh_file(window, spin, gaps, shown))
     window.close()
     print(json.dumps(out), flush=True)
@@ -467,6 +468,42 @@ def _leaf_pixels(view, n: int):
         if len(out) == n:
             return out
     return out
+
+
+def rotation_part(window, spin, shown, frames: int = 40) -> dict:
+    """Turning the camera at K = 4, as a drag does (4 deg a frame): each frame's time drawn
+    whole, and with the lighter drawing a moving camera gets (every k-th triangle; the whole
+    canopy again once it stops); the frames over 200 ms are the stalls."""
+    from maizeviz.mesh.levels import COMPLEXITY_STOPS
+
+    window.canopy_panel.slider.setValue(COMPLEXITY_STOPS.index("K4"))
+    spin(TIMEOUT_S, lambda: shown[-1].startswith("K=4") and window.runner.current("build") is None)
+    spin(1.0)
+    view = window.viewport
+
+    def turn() -> list[float]:
+        out = []
+        for _ in range(frames):
+            t0 = time.perf_counter()
+            view.camera.azimuth += 4.0
+            view.render()
+            spin(0.001)
+            out.append(1000 * (time.perf_counter() - t0))
+        return out
+
+    whole = turn()
+    moving = view.start_moving()
+    light = turn()
+    t0 = time.perf_counter()
+    view.stop_moving()
+    back_ms = 1000 * (time.perf_counter() - t0)
+    return {"rotation_triangles": view.canopy_mesh.n_cells,
+            "rotation_frame_ms_whole": {"median": statistics.median(whole), "max": max(whole),
+                                        "over_200": sum(t > 200 for t in whole)},
+            "rotation_frame_ms_moving": {"median": statistics.median(light), "max": max(light),
+                                         "over_200": sum(t > 200 for t in light),
+                                         "lighter": moving},
+            "rotation_stop_to_whole_ms": back_ms}
 
 
 def pick_and_mesh_file(window, spin, gaps, shown, clicks: int = 15) -> dict:
@@ -655,7 +692,7 @@ def main() -> None:
                       "layout_edit_event_loop_max_gap_ms_900_plants": 200,
                       "pick_ms": 50, "mesh_file_event_loop_max_gap_ms": 200,
                       "stop_event_loop_max_gap_ms": 50, "stop_event_loop_max_gap_ms_demo": 50,
-                      "digitizer_presses_lost": 0}
+                      "digitizer_presses_lost": 0, "rotation_frame_ms_moving_over_200": 0}
     if args.json:
         print(json.dumps(out, indent=1))
         return None

@@ -91,6 +91,7 @@ class MainWindow(QMainWindow):
     def __init__(self, points: str | Path | None = None, tile: int = 3):
         super().__init__()
         self.setWindowTitle("maizeviz")
+        self.setAcceptDrops(True)          # points, projects and meshes dropped open
         self._closing = False
         self._settings = QSettings("maizeviz", "maizeviz")
         self.runner = JobRunner(self)
@@ -574,6 +575,46 @@ class MainWindow(QMainWindow):
     def about(self) -> None:
         QMessageBox.about(self, "About maizeviz", about_text())
 
+    def save_window_image(self, path: str | Path) -> bool:
+        """The whole window as it is on screen (panels, figures, the 3D view) as a PNG."""
+        ok = self.grab().save(str(path), "PNG")
+        self.say(f"saved the window as {path}" if ok else
+                 f"error: {path}: the image cannot be written", error=not ok)
+        return ok
+
+    def choose_window_image(self) -> None:
+        from PySide6.QtWidgets import QFileDialog
+
+        path, _ = QFileDialog.getSaveFileName(self, "Save the window as an image",
+                                              str(Path(self.folder()) / "maizeviz.png"),
+                                              "PNG (*.png)")
+        if path:
+            self.save_window_image(path)
+
+    # ------------------------------------------------------------------ drops
+    def dragEnterEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if self._dropped_path(event.mimeData()) is not None:
+            event.acceptProposedAction()
+
+    def dropEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        """A points file, a project or a canopy mesh dropped on the window opens as File >
+        Open would open it (unsaved work asked about first)."""
+        path = self._dropped_path(event.mimeData())
+        if path is not None:
+            event.acceptProposedAction()
+            self.open_any(path)
+
+    @staticmethod
+    def _dropped_path(mime) -> str | None:
+        """The first local file of a drop that maizeviz opens, None for anything else."""
+        if not mime.hasUrls():
+            return None
+        for url in mime.urls():
+            path = url.toLocalFile()
+            if path and Path(path).suffix.lower() in OPENABLE:
+                return path
+        return None
+
     def show_shortcuts(self) -> None:
         """Help > Keyboard shortcuts: every menu action's keys."""
         QMessageBox.information(self, "Keyboard shortcuts",
@@ -630,14 +671,19 @@ class MainWindow(QMainWindow):
         super().closeEvent(event)
 
 
+#: What a file dropped on the window may be: points, a project, a canopy mesh.
+OPENABLE = (".csv", ".txt", ".parquet", ".pq", ".maizeviz", ".ply", ".obj")
+
+
 def about_text() -> str:
     """What the Help menu's About says: the version, what maizeviz does, the paper, the
     libraries it runs on (with their versions) and where its documentation is."""
     from maizeviz.info import info
 
     d = info()
-    libs = {**d["packages"], **{k: v for k, v in d["optional"].items()  # type: ignore[attr-defined]
-                                if v and v != "not installed"}}
+    packages: dict[str, Any] = dict(d["packages"])            # type: ignore[call-overload]
+    optional: dict[str, Any] = dict(d["optional"])            # type: ignore[call-overload]
+    libs = {**packages, **{k: v for k, v in optional.items() if v and v != "not installed"}}
     libraries = ", ".join(f"{name} {version}" for name, version in libs.items())
     docs = docs_folder()
     where = (f"<a href='{docs.as_uri()}'>{docs}</a> (Help &gt; Documentation)" if docs else

@@ -87,6 +87,9 @@ def build_menus(w) -> dict[str, QAction]:
     acts["export_day"] = _action(w, results, "Day figure (PNG)…",
                                  lambda: w.choose_export("day"), None,
                                  "the day's light and transmission over the hours")
+    acts["window_image"] = _action(w, f, "Save &window as image…", w.choose_window_image,
+                                   None, "the whole window, panels and figures as they are "
+                                         "on screen, as a PNG")
     acts["view_image"] = _action(w, f, "Save view as &image…", w.view_link.choose_image,
                                  "Ctrl+Alt+S", "the 3D view as a PNG of a chosen width, with "
                                                "its colour key")
@@ -130,6 +133,32 @@ def build_menus(w) -> dict[str, QAction]:
         act.setChecked(name == "leaf")
         group.addAction(act)
         acts[f"colour_{name}"] = act
+    from maizeviz_app.probe import KINDS
+    from maizeviz_app.view_state import OTHERS
+
+    v.addSeparator()
+    for (kind, text), keys in zip(KINDS.items(), ("Ctrl+M", "Ctrl+Shift+M")):
+        def toggle_probe(k=kind):
+            probe = w.model.probe
+            probe.start("" if probe.kind == k else k)
+        act = _action(w, v, text, toggle_probe, keys,
+                      "click two points on the canopy: their distance" if kind == "distance"
+                      else "click the corners of a polygon on the canopy: its area (and its "
+                           "shadow's)")
+        act.setCheckable(True)
+        acts[f"measure_{kind}"] = act
+
+    others = v.addMenu("&Selection")
+    others.menuAction().setStatusTip("how the other plants are drawn while one is selected")
+    others_group = QActionGroup(w)
+    for name, text in OTHERS.items():
+        act = _action(w, others, text,
+                      lambda n=name: setattr(w.model.view, "others", n), None,
+                      f"while a plant is selected: {text.lower()}")
+        act.setCheckable(True)
+        act.setChecked(name == w.model.view.others)
+        others_group.addAction(act)
+        acts[f"others_{name}"] = act
     v.addSeparator()
     acts["finer"] = _action(w, v, "&Finer mesh", lambda: w.step_level(-1), "Ctrl+[",
                           "the next finer mesh level (more triangles a leaf)")

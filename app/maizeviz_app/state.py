@@ -32,6 +32,7 @@ from maizeviz_app.figures import Figures
 from maizeviz_app.history import DraftEdit, History, watch
 from maizeviz_app.layout_draft import Change, LayoutDraft
 from maizeviz_app.messages import user_message
+from maizeviz_app.probe import Probe
 from maizeviz_app.runner import InlineRunner, Runner, describe_internal
 from maizeviz_app.runs import LightRuns, Run
 from maizeviz_app.selection import Selection
@@ -216,8 +217,10 @@ class StudyState:
         #: the colouring a project was saved with, restored once its results are complete
         self.colouring_to_restore: str | None = None
         self.selection = Selection()
+        self.probe = Probe()           # a distance or area probe (View > Measure)
         self.history = History()
         self._watch_history()
+        self.settings.together = self.history.step      # settings.set: one step
         self.view_light.connect(self._light_colouring)
         self.canopy_changed.connect(lambda _built: self._check_colouring())
 

@@ -36,6 +36,33 @@ class ViewLink:
         state = self.window.model.view
         viewport.camera_moved.connect(lambda pose: setattr(state, "pose", pose))
         state.events.pose.connect(lambda pose, *_: viewport.set_camera_pose(pose))
+        viewport.set_others(state.others)
+        state.events.others.connect(lambda mode, *_: self._others(mode))
+        self.window.model.probe.changed.connect(self._probe)
+
+    def _probe(self) -> None:
+        """The probe's points drawn, what it measures said; the menu follows."""
+        probe = self.window.model.probe
+        if self.view is not None:
+            self.view.show_probe(probe.points, closed=probe.kind == "area")
+        text = probe.text()
+        if text:
+            self.window.say(text, status_only=len(probe.points) < 2)
+        acts = getattr(self.window, "menu_actions", {})
+        for kind in ("distance", "area"):
+            act = acts.get(f"measure_{kind}")
+            if act is not None:
+                act.setChecked(probe.kind == kind)
+
+    def _others(self, mode: str) -> None:
+        """The others than the selection drawn as the view state says; the menu follows."""
+        if self.view is not None:
+            self.view.set_others(mode)
+        acts = getattr(self.window, "menu_actions", {})
+        for name in ("shown", "faded", "hidden"):
+            act = acts.get(f"others_{name}")
+            if act is not None:
+                act.setChecked(mode == name)
 
     @property
     def view(self) -> Any:

@@ -13,6 +13,12 @@ from psygnal import SignalGroup, evented
 
 from maizeviz_app.options import CAMERA_ALIASES, CAMERAS, COLOURINGS
 
+#: How the plants other than the selection are drawn, and what the View menu calls it.
+OTHERS = {"shown": "Others shown", "faded": "Others faded (the selection seen through them)",
+          "hidden": "Others hidden (the selection alone)"}
+#: The opacity of the faded others.
+FADED_OPACITY = 0.15
+
 #: A camera's position, focal point and view up (cm).
 Pose = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
 
@@ -29,6 +35,9 @@ class ViewState:
         assimilation, with a leaf model)
     camera : the camera preset last asked for, a key of :data:`maizeviz_app.options.CAMERAS`
         (asking for it again frames the canopy again: :meth:`ask_camera`)
+    others : how the plants other than the selected one are drawn while one is selected:
+        ``shown`` (as they are), ``faded`` (nearly transparent: the selection seen through
+        them) or ``hidden`` (the selection alone); a key of :data:`OTHERS`
     pose : ((3,), (3,), (3,)) float, cm, or None
         Where the camera is: its position, the point it looks at and its up direction, as
         the view last reported it (after a preset, a drag or a wheel turn); set by a script,
@@ -41,6 +50,7 @@ class ViewState:
     colouring: str = "leaf"
     camera: str = "reset"
     pose: Pose | None = None
+    others: str = "shown"
 
     def ask_camera(self, name: str) -> None:
         """Point the camera by preset ``name`` (earlier names understood), even when it is
