@@ -16,7 +16,6 @@ maizeviz says it again on first use and in ``maizeviz --info``.
 """
 
 import hashlib
-import os
 import sys
 from pathlib import Path
 
