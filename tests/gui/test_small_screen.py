@@ -234,4 +234,4 @@ def test_the_c4_plants_table_shows_its_co2_columns_on_a_laptop(laptop, qtbot):
     qtbot.wait(200)
     assert p.plants.columnCount() == 8
     assert p.plants.horizontalScrollBar().maximum() == 0
-    assert not [c for c in _cut(w.docks["light"].widget().widget())]
+    assert not _cut(w.docks["light"].widget().widget())
