@@ -201,7 +201,7 @@ def _absorbed_table_job(what: str, path: str, run, model: StudyState):
             keys = ["instance", "plant", "leaf"] if kind == "leaf" else ["instance"]
             carbon = assimilation.table(kind, canopy)
             new = [c for c in carbon.columns if c not in frame.columns or c in keys]
-            frame = frame.merge(carbon[new], on=keys, how="left")
+            frame = frame.merge(carbon[new], on=keys, how="outer")
         frame.insert(0, "level", label)
         write_rows(path, frame.to_dict("records"))
         return path

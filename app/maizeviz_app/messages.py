@@ -36,7 +36,8 @@ def user_message(exc: BaseException, doing: str = "") -> str:
     if isinstance(exc, MaizevizError):
         text = _CLASS_PREFIX.sub("", str(exc)).strip() or "the input cannot be used"
         if isinstance(exc, PointsFileError) or doing in ("open points", "open project"):
-            if doing == "open points" and _AT_LINE.search(text):
+            if doing == "open points" and "no leaf could be reconstructed" in text and \
+                    _AT_LINE.search(text):
                 # the file has the columns: a value on a line is wrong, not the layout
                 advice = ("correct that line and open the file again; the previous canopy "
                           "stays open")

@@ -166,9 +166,10 @@ def test_subplots_json_equals_the_whole_field_traced_at_once(capsys, tmp_path, b
     order = [2, 0, 3, 1]
     plants_a, plants_b = tmp_path / "a.csv", tmp_path / "b.csv"
     capsys.readouterr()
+    # sub-plots trace the leaves alone (the paper's canopy): the whole field likewise
     assert main(["light", str(block_parquet), "--triangles", "36", *SUN, "--density", "1",
                  "--heights", ",".join(map(str, heights)), "--plant-light", str(plants_a),
-                 "--json"]) == 0
+                 "--leaves-only", "--json"]) == 0
     whole = json.loads(capsys.readouterr().out)
     assert main(["subplots", str(block_parquet), *SUN, "--parts", "3x2", "--workers", "2",
                  "--heights", ",".join(str(heights[k]) for k in order),

@@ -200,7 +200,7 @@ def test_a_period_with_par_and_temperature_survives_a_project(tmp_path):
     w = read_weather(_csv(tmp_path, "p.csv", "time,ghi,par,temp_air", _day_rows()))
     p = weather_period(w, 39.9, 116.4)
     arrays = {f"period_{k}": np.asarray(getattr(p, k), np.float64)
-              for k in (*_PERIOD_ARRAYS, *_PERIOD_OPTIONAL)}
+              for k in (*_PERIOD_ARRAYS, *_PERIOD_OPTIONAL) if getattr(p, k) is not None}
     meta = {"period": {"times": [t.isoformat() for t in p.times], "tz": "UTC+08:00",
                        "start": p.start.isoformat(), "end": p.end.isoformat(),
                        "source": p.source, "parameters": dict(p.parameters),
