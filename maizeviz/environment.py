@@ -1,7 +1,7 @@
 """The environment variables maizeviz reads, each parsed here with the checks its options get.
 
 Every ``MAIZEVIZ_*`` variable the code reads is listed in :data:`VARIABLES` and read through
-:func:`switch` or :func:`whole_number`, when it is used (not at import: a module imported
+:func:`switch`, :func:`whole_number` or :func:`word`, when it is used (not at import: a module imported
 for something else does not fail on a variable it never uses). A value that is not what the
 variable takes is refused in one line naming the variable, its value and what it takes, as
 an option's value is (``MAIZEVIZ_FIELD_POINTS=1e3`` was ``int('1e3')``'s traceback at
@@ -14,6 +14,8 @@ import).
 ``MAIZEVIZ_PACKETS``       0 turns the ray-packet kernel off (embreex's single rays)
 ``MAIZEVIZ_LOOPS``         0 turns the compiled loops off (numpy does their work)
 ``MAIZEVIZ_DEBUG``         1 shows the traceback of an internal error on the command line
+``MAIZEVIZ_EMBREE_ISA``    the instruction set Embree traces with (sse2, sse4.2, avx, avx2,
+                           avx512; unset or empty: the CPU's best)
 =========================  ===========================================================
 
 A switch takes 0 or 1 (and no, off, false, yes, on, true, any case); unset or empty is its
@@ -40,21 +42,24 @@ class Variable:
 
     Attributes
     ----------
-    kind : {"switch", "whole"}
-    default : bool or int
+    kind : {"switch", "whole", "word"}
+    default : bool, int or None
     meaning : str
         What it sets, in words.
     low : int
         Smallest whole number taken.
     choices : tuple of int
         The only whole numbers taken (empty: any from ``low`` on).
+    words : dict of str to str
+        A word variable's words, any case, each to the value it stands for.
     """
 
     kind: str
-    default: bool | int
+    default: bool | int | None
     meaning: str
     low: int = 0
     choices: tuple[int, ...] = ()
+    words: dict[str, str] | None = None
 
 
 #: Every environment variable maizeviz reads.
@@ -67,6 +72,10 @@ VARIABLES: dict[str, Variable] = {
     "MAIZEVIZ_PACKETS": Variable("switch", True, "the ray-packet kernel"),
     "MAIZEVIZ_LOOPS": Variable("switch", True, "the compiled loops"),
     "MAIZEVIZ_DEBUG": Variable("switch", False, "tracebacks of internal errors"),
+    "MAIZEVIZ_EMBREE_ISA": Variable(
+        "word", None, "the instruction set Embree traces with",
+        words={"sse2": "sse2", "sse4.2": "sse4.2", "sse42": "sse4.2", "avx": "avx",
+               "avx2": "avx2", "avx512": "avx512", "avx-512": "avx512"}),
 }
 
 _ON = ("1", "yes", "on", "true")
@@ -117,7 +126,7 @@ def whole_number(name: str) -> int:
     """
     var = _variable(name, "whole")
     if name not in os.environ:
-        return int(var.default)
+        return int(var.default or 0)
     raw = os.environ[name]
     takes = f"takes one of {', '.join(map(str, var.choices))}" if var.choices else \
         f"takes a whole number >= {var.low:,} (digits only)"
@@ -130,13 +139,37 @@ def whole_number(name: str) -> int:
     return value
 
 
+def word(name: str) -> str | None:
+    """The value of a word variable (any case, blanks around ignored): the value its word
+    stands for; None when unset or empty.
+
+    Raises
+    ------
+    EnvironmentVariableError
+        A word the variable does not take.
+    """
+    var = _variable(name, "word")
+    raw = os.environ.get(name, "")
+    if not raw.strip():
+        return None
+    words = var.words or {}
+    value = words.get(raw.strip().lower())
+    if value is None:
+        raise _refuse(name, raw, f"takes one of {', '.join(sorted(set(words.values())))}")
+    return value
+
+
+#: The reader of each kind of variable.
+READERS = {"switch": switch, "whole": whole_number, "word": word}
+
+
 def problems() -> list[str]:
     """One line for each ``MAIZEVIZ_*`` variable set to a value it does not take (for
     ``--info``)."""
     out = []
     for name, var in VARIABLES.items():
         try:
-            (switch if var.kind == "switch" else whole_number)(name)
+            READERS[var.kind](name)
         except EnvironmentVariableError as exc:
             out.append(str(exc))
     return out

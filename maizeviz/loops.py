@@ -10,7 +10,8 @@ same floating-point operations element by element in one pass and leaves the sum
 The loops are built when maizeviz is installed (``setup.py``, the extension module
 ``maizeviz._loops``). Where they are not (no C compiler at install, a module built from
 another ``_loops.c``), :func:`grid_twice_areas` returns None and numpy does the work: the same
-numbers, slower. ``MAIZEVIZ_LOOPS=0`` in the environment turns them off.
+numbers, slower, said once a process (a RuntimeWarning, and ``maizeviz --info``).
+``MAIZEVIZ_LOOPS=0`` in the environment turns them off without a word.
 
 The B-spline basis of every surface fit and sample (The NURBS Book A2.2: a span search and
 the Cox-de Boor recurrence, a dozen numpy passes over (L, A) arrays) is here too, point by
@@ -31,6 +32,8 @@ from __future__ import annotations
 import ctypes
 import functools
 import hashlib
+import threading
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -56,7 +59,8 @@ def _loaded() -> tuple[ctypes.CDLL | None, str]:
     try:
         from maizeviz import _loops as ext
     except ImportError:
-        return None, "not built when maizeviz was installed (no C compiler?)"
+        return None, ("not built when maizeviz was installed (no C compiler?): reinstall "
+                      "maizeviz with a C compiler to build them")
     if SOURCE.is_file() and \
             hashlib.sha256(SOURCE.read_bytes()).hexdigest() != ext.source_sha256:
         return None, ("built from another _loops.c: rebuild it (pip install -e . or "
@@ -73,6 +77,26 @@ def _loaded() -> tuple[ctypes.CDLL | None, str]:
     lib.mz_basis_matrix.restype = ctypes.c_int
     lib.mz_basis_matrix.argtypes = [p, p, i64, i64, i64, i64, p]
     return lib, ""
+
+
+_warned = threading.Lock()
+_said = False
+
+
+def warn_fallback() -> None:
+    """Say once a process that numpy does the compiled loops' work, and why (not when
+    ``MAIZEVIZ_LOOPS=0`` turned them off: a choice)."""
+    global _said
+    why = _loaded()[1]
+    if not why or why.startswith("turned off"):
+        return
+    with _warned:
+        if _said:
+            return
+        _said = True
+    warnings.warn(f"maizeviz: computing surface bases, reference areas and splitting with "
+                  f"numpy (the same numbers, slower): the compiled loops were {why}",
+                  RuntimeWarning, stacklevel=4)
 
 
 def available() -> bool:
@@ -207,6 +231,7 @@ def grid_twice_areas(vertices: np.ndarray, rel_tol: float,
     v = check_grids(vertices, out)
     lib = _lib()
     if lib is None:
+        warn_fallback()
         return None
     nl, a, b = v.shape[:3]
     q = (a - 1) * (b - 1)
@@ -254,6 +279,7 @@ def chord_errors(coords: tuple[np.ndarray, ...], leaf: np.ndarray, line: np.ndar
     (x, y, z), idx = check_chords(coords, leaf, line, lo, hi)
     lib = _lib()
     if lib is None:
+        warn_fallback()
         return None
     nl, m, n = x.shape
     out = np.empty(len(idx[0]))
@@ -283,6 +309,8 @@ def basis_matrix(x: np.ndarray, knots: np.ndarray, degree: int) -> np.ndarray | 
     """
     x, k, degree = check_basis(x, knots, degree)
     lib = _lib()
+    if lib is None:
+        warn_fallback()
     if lib is None or degree > 15:
         return None
     nl, na = x.shape

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import ctypes
 import functools
-import os
 
 from maizeviz.errors import MaizevizError
 
@@ -49,8 +48,11 @@ def check_isa(value: str | None, where: str = ENV) -> str | None:
 
 
 def requested() -> str | None:
-    """The instruction set ``MAIZEVIZ_EMBREE_ISA`` names (checked), or None."""
-    return check_isa(os.environ.get(ENV))
+    """The instruction set ``MAIZEVIZ_EMBREE_ISA`` names (checked, as every variable, by
+    :mod:`maizeviz.environment`), or None."""
+    from maizeviz.environment import word
+
+    return word(ENV)
 
 
 def _new(lib, isa: str) -> int:

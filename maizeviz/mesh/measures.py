@@ -114,6 +114,7 @@ def grid_areas(vertices: np.ndarray, rel_tol: float = 1e-9) -> np.ndarray:
                 total += t.sum(axis=1)
             out[s:s + step] = 0.5 * total
         return out
+    loops.warn_fallback()                              # once a process, unless turned off
     work = _AreaBuffers(min(step, nl), a, b)
     for s in range(0, nl, step):
         out[s:s + step] = _grid_areas(vertices[s:s + step], rel_tol, work)

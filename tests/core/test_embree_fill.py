@@ -3,6 +3,7 @@ same hits, triangle by triangle, on the bundled canopy (real Embree, no mock).""
 
 import numpy as np
 import pytest
+from embree_contract import assert_same_hits
 from embreex.rtcore_scene import EmbreeScene
 
 from maizeviz.canopy.layout import layout_for
@@ -13,8 +14,6 @@ from maizeviz.mesh.embree_isa import device, requested
 from maizeviz.mesh.levels import parse_level
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.resources import example_points
-
-from embree_contract import assert_same_hits
 
 
 @pytest.fixture(scope="module")

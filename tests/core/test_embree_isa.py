@@ -28,7 +28,7 @@ def test_the_variable_is_checked_when_a_scene_is_made(monkeypatch):
     v = np.array([[0, 0, 1.0], [1, 0, 1], [0, 1, 1]])
     f = np.array([[0, 1, 2]])
     monkeypatch.setenv("MAIZEVIZ_EMBREE_ISA", "pentium")
-    with pytest.raises(MaizevizError, match="MAIZEVIZ_EMBREE_ISA: 'pentium'"):
+    with pytest.raises(MaizevizError, match="MAIZEVIZ_EMBREE_ISA='pentium' in the environment"):
         RayScene(v, f)
     monkeypatch.setenv("MAIZEVIZ_EMBREE_ISA", supported()[0])
     assert RayScene(v, f).isa == supported()[0]

@@ -38,7 +38,8 @@ def test_the_engine_traces_what_trace_light_traces(small):
     """The façade's sun equals the core's trace on a fresh scene, number for number."""
     engine = mv.LightEngine(small, density=0.5, heights_cm=(0, 100))
     got = engine.sun(zenith=30.0, azimuth=150.0)
-    want = trace_light(small, LightRequest(Sun(30.0, 150.0), Sampling((0.0, 100.0), 0.5)))
+    want = trace_light(small, LightRequest(Sun(30.0, 150.0), Sampling((0.0, 100.0), 0.5)),
+                       with_stalks=True)            # the engine's default: stalks take light
     assert np.array_equal(got.transmission, want.transmission)
     assert np.array_equal(got.first_hits, want.first_hits)
     table = got.table()
@@ -69,8 +70,10 @@ def test_per_plant_tables_sum_the_per_leaf_tables(small):
     leaves, plants = light.table("leaf", small), light.table("plant", small)
     by_plant = leaves.groupby("plant")["sunlit_area_cm2"].sum()
     assert np.allclose(plants.set_index("plant")["sunlit_area_cm2"], by_plant)
+    # the engine's results know their canopy; one without it asks for it
+    assert light.table("leaf").equals(leaves) and light.canopy is small
     with pytest.raises(mv.MaizevizError, match="needs the canopy"):
-        light.table("leaf")
+        light.with_canopy(None).table("leaf")
     with pytest.raises(mv.MaizevizError, match="height, leaf, plant"):
         light.table("tile", small)
 

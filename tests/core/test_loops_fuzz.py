@@ -13,12 +13,11 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from test_loops import _same, without_loops
 
 from maizeviz import loops
 from maizeviz.leaf import nurbs
 from maizeviz.mesh import measures, simplify
-
-from test_loops import _same, without_loops
 
 pytestmark = pytest.mark.skipif(not loops.available(),
                                 reason="the compiled loops were not built at install")

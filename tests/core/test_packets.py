@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from embree_contract import assert_same_blocked, assert_same_hits
 
 import maizeviz.mesh.raytrace as raytrace
 from maizeviz.canopy.layout import layout_for
@@ -22,15 +23,13 @@ from maizeviz.light.scene.request import LightRequest, Sampling, canopy_top
 from maizeviz.light.scene.scenes import light_scene
 from maizeviz.light.sources.sky import make_sky
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.diffuse import trace_sky
 from maizeviz.light.trace import direct
+from maizeviz.light.trace.diffuse import trace_sky
 from maizeviz.light.trace.direct import trace_direction, trace_light
 from maizeviz.mesh import packets
 from maizeviz.mesh.embree_isa import supported
 from maizeviz.mesh.levels import parse_level
 from maizeviz.mesh.precision import U32, distance_bound
-
-from embree_contract import assert_same_blocked, assert_same_hits
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.resources import example_points
 

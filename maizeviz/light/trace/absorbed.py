@@ -23,7 +23,6 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.sparse import csr_array
 
 from maizeviz.canopy.layout import stands_identity
 from maizeviz.canopy.scene import Canopy
@@ -127,6 +126,8 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
         leaf_optics = opt.per_triangle(rank)
         kept = 1.0 - (leaf_optics[0] + leaf_optics[1])
     absorbed, sunlit, direct_t = np.zeros(nf), np.zeros(nf), np.zeros(nf)
+    from scipy.sparse import csr_array  # 0.3 s to import, pulls numpy.f2py: when used
+
     empty = csr_array((BATCHES, nf))
     absorbed_b, direct_b, sunlit_b = empty, empty, empty
     sun_dir = None
@@ -179,9 +180,11 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
         seconds["scatter"] += secs["scatter"]
         report(progress, len(beams) + 1, len(beams) + 1, "absorbed light")
     incident = direct_w_m2 * (sun is not None) + diffuse_w_m2
-    balance = Balance(float(incident), float(absorbed.sum()) / area_m2,
-                      *(float(parts[k]) / area_m2 for k in ("ground", "top", "sides",
-                                                             "unresolved")))
+    leaves = canopy.n_triangles                  # the stalks' triangles follow, if traced
+    balance = Balance(float(incident), float(absorbed[:leaves].sum()) / area_m2,
+                      float(parts["ground"]) / area_m2, float(parts["top"]) / area_m2,
+                      float(parts["sides"]) / area_m2, float(parts["unresolved"]) / area_m2,
+                      float(absorbed[leaves:].sum()) / area_m2)
     return AbsorbedLight(opt.band, opt, incident, balance, absorbed, sunlit, smp.rect, smp.n,
                          len(beams) + (n_sky if sky_per_ray else 0), depth, threshold, seed,
                          events, smp.periodic, canopy.level, seconds,
@@ -283,7 +286,7 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
     ub = unit.balance
     parts = {k: getattr(ub, k) * float(np.sum(diffuse_w * step_s))
              for k in ("absorbed_leaves", "absorbed_ground", "reflected_top",
-                       "escaped_sides", "unresolved")}
+                       "escaped_sides", "unresolved", "absorbed_stalks")}
     leaves_w = ub.absorbed_leaves * diffuse_w
     seconds = dict(unit.seconds)
     direct_w = (np.asarray(period.ghi, np.float64) - np.asarray(period.dhi, np.float64)
@@ -311,7 +314,7 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
     balance = Balance(float(np.sum(incident_w * step_s)) * 1e-6,
                       *(float(parts[k]) * 1e-6 for k in ("absorbed_leaves", "absorbed_ground",
                                                    "reflected_top", "escaped_sides",
-                                                   "unresolved")))
+                                                   "unresolved", "absorbed_stalks")))
     return AbsorbedPeriod(optics.band, optics, period, balance, joules, leaves_w, incident_w,
                           unit.rect, unit.rays, unit.depth, unit.seed, unit.periodic,
                           unit.level, seconds,

@@ -40,15 +40,18 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.sparse import csr_array
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.ids import groups
 from maizeviz.light.results.uncertainty import BATCHES
 from maizeviz.light.scene.rays import Tracer
 from maizeviz.light.trace.direct import Sampler
+
+if TYPE_CHECKING:       # scipy.sparse (0.3 s, and numpy.f2py) is imported when sampled
+    from scipy.sparse import csr_array
 
 #: Distance (cm) a sample point is lifted off its triangle toward the sun's side.
 LIFT_CM = 1e-3
@@ -239,6 +242,8 @@ def sunlit_share(smp: Sampler, canopy: Canopy, normals: np.ndarray, toward: np.n
     -------
     SunlitShare
     """
+    from scipy.sparse import csr_array
+
     s = np.asarray(toward, np.float64)
     nf = len(normals)
     geo = geometry(canopy, nf)
