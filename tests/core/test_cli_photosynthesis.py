@@ -129,7 +129,8 @@ def test_a_precision_that_cannot_be_met_is_said(capsys, monkeypatch):
     rec = json.loads(out)
     assert code == 0 and not rec["precision"]["met"]
     assert rec["precision"]["density_per_cm2"] == 0.5
-    assert any("above the 0.001% asked for" in w for w in rec["warnings"]), rec["warnings"]
+    assert any("standard error" in w and "asked for" in w for w in rec["warnings"]), \
+        rec["warnings"]
     code, out, err = run_cli(capsys, *cli_args(photosynthesis="c4", precision=0))
     assert code != 0 and "(--precision)" in err
 

@@ -81,6 +81,8 @@ def test_black_leaves_absorb_what_the_direct_light_intercepts(homogeneous):
     rays_se = math.sqrt(rays_w.sum() * per_ray * sun.transmission[0])
     se = math.hypot(got.batches.error(), rays_se)
     assert abs(got.triangle_absorbed_w.sum() - rays_w.sum()) < 4 * se
+    # matched to the rays' total (the grid's, less noisy): equal up to rounding
+    assert got.triangle_absorbed_w.sum() == pytest.approx(rays_w.sum(), rel=1e-12)
     z = homogeneous.vertices[homogeneous.faces][:, :, 2].mean(axis=1)
     layer = np.digitize(z, [40.0, 60.0, 80.0, 100.0])
     for k in range(5):

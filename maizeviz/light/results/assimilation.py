@@ -217,13 +217,13 @@ class Assimilation(TriangleResult):
 
     @property
     def canopy_gross_bias_umol_m2_s(self) -> float | None:
-        """Estimated bias of the canopy's gross assimilation from the ray density.
+        """Estimated bias of :attr:`canopy_gross_umol_m2_s` from the density of the rays.
 
         Returns
         -------
         float or None
-            The bias of :attr:`canopy_gross_umol_m2_s` [umol CO2 m-2 ground s-1] (negative:
-            low; None: no batches).
+            [umol CO2 m-2 of ground s-1], negative when the figure is low; None without
+            batches.
         """
         return None if self.bias_umol_s is None else self.bias_umol_s / self.ground_m2
 
