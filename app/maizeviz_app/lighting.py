@@ -404,9 +404,8 @@ def complete_runs(study: StudyState) -> None:
                 run.extra = value
         if study.shown_signature == here:
             study.set_plants_run(light_per_plant_run(study))
-            last = study.runs.last
-            # the results table gains what was computed here (a sun's CO2 row)
-            study.runs_changed.emit(study.runs, run_info(last) if last is not None else "")
+            # the results table gains what was computed here (a sun's CO2 row), its text kept
+            study.runs_changed.emit(study.runs, study.runs_info)
             study.view_light.emit(True)
             restore_colouring(study)
             if study.runner.current("figures") is None:     # else: when they are drawn

@@ -216,6 +216,8 @@ class StudyState:
         self.view = ViewState()
         #: the colouring a project was saved with, restored once its results are complete
         self.colouring_to_restore: str | None = None
+        #: what the last result added said it was (the light panel's text)
+        self.runs_info = ""
         self.selection = Selection()
         self.probe = Probe()           # a distance or area probe (View > Measure)
         self.history = History()
@@ -375,6 +377,7 @@ class StudyState:
         if run.signature[0] != self.serial:
             return False
         dropped = self.runs.add(run, settings, sampling)
+        self.runs_info = info
         self.runs_changed.emit(self.runs, info)
         if not saved:
             self._set_modified(True)
