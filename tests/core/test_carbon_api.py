@@ -99,7 +99,7 @@ def test_a_users_mypy_sees_the_carbon_types(tmp_path, request):
 
     script = tmp_path / "user_carbon.py"
     script.write_text(USER_SCRIPT)
-    cache = request.config.cache.mkdir("mypy-user-carbon")
+    cache = tmp_path / "mypy-cache"         # pytest's cache may be off (-p no:cacheprovider)
     out, err, _ = api.run([str(script), "--follow-imports", "silent", "--cache-dir",
                            str(cache), "--python-version", "3.11"])
     revealed = re.findall(r'Revealed type is "([^"]+)"', out)

@@ -89,7 +89,8 @@ def test_c4_temperature_responses():
 
 
 @settings(max_examples=200, deadline=None)
-@given(q=st.floats(0, 4000), t=st.floats(-5, 55), ci=st.floats(0, 2000),
+@given(q=st.floats(0, 4000, allow_subnormal=False), t=st.floats(-5, 55),
+       ci=st.floats(0, 2000, allow_subnormal=False),
        theta=st.floats(0.05, 1.0), beta=st.floats(0.05, 1.0))
 def test_c4_is_bounded_by_each_limit_and_grows_with_light_and_co2(q, t, ci, theta, beta):
     leaf = C4Leaf(theta=theta, beta=beta)
