@@ -44,11 +44,22 @@ Run under a display (``xvfb-run -a -s "-screen 0 1366x768x24" python benchmarks/
   press's own frame is the recording's). Target: under 50 ms. ``stop_idle_max_gap_ms`` is the
   same timer over the 0.4 s (0.1 s for the Demo) just before each Stop: what the machine's
   load alone does to the event loop at that moment. Stops are repeated ``max(5, N)`` times.
+- ``digitizer_presses_lost``, ``digitizer_press_to_disk_worst_s`` (and ``_median_s``): the
+  promise of the digitizer under load. A scripted technician in another process
+  (:mod:`maizeviz.digitizer.technician`) presses a simulated FASTRAK ``--presses`` times (200),
+  0.35-0.5 s apart, asking for N/P before each new leaf, into the window's digitizer (the
+  recorder in its own process) while one ``while True: pass`` burner per core runs; lost is
+  the presses the unit accepted that are not in the file (target 0), the latency is from the
+  unit's acceptance to the journal line's time stamp (written just before its fsync).
+  ``digitizer_order_ok``: every point at its plant/leaf/row/col, in order.
+  ``digitizer_press_to_window_worst_s``: from the acceptance to the window's count showing
+  it (the window lags under load; the file does not wait for it).
 - ``view_px``: the 3D view's size in pixels (the window is 1366 x 740, docks as on a first start).
 - ``anchor_s``: a fixed numpy workload timed in the same run (these machines are shared and
   noisy; compare runs through it); ``anchor_end_s`` the same after the GUI part.
 
     python benchmarks/bench_gui.py [--json] [--levels K4,K2,K1,standard,36,16,8,4] [--repeat N]
+                                   [--presses N] [--only digitizer]
 """
 
 from __future__ import annotations
@@ -328,6 +339,7 @@ def gui_child(levels: list[str], repeat: int = 1) -> None:
     out.update(edit_part(window, spin, gaps, shown))
     out.update(stop_gaps(window, gaps, spin, repeat))
     if "K4" in levels:
+        out.update(rotation_part(window, spin, shown))
         out.update(pick_and_mesh_file(window, spin, gaps, shown))
     window.close()
     print(json.dumps(out), flush=True)
@@ -458,6 +470,42 @@ def _leaf_pixels(view, n: int):
     return out
 
 
+def rotation_part(window, spin, shown, frames: int = 40) -> dict:
+    """Turning the camera at K = 4, as a drag does (4 deg a frame): each frame's time drawn
+    whole, and with the lighter drawing a moving camera gets (every k-th triangle; the whole
+    canopy again once it stops); the frames over 200 ms are the stalls."""
+    from maizeviz.mesh.levels import COMPLEXITY_STOPS
+
+    window.canopy_panel.slider.setValue(COMPLEXITY_STOPS.index("K4"))
+    spin(TIMEOUT_S, lambda: shown[-1].startswith("K=4") and window.runner.current("build") is None)
+    spin(1.0)
+    view = window.viewport
+
+    def turn() -> list[float]:
+        out = []
+        for _ in range(frames):
+            t0 = time.perf_counter()
+            view.camera.azimuth += 4.0
+            view.render()
+            spin(0.001)
+            out.append(1000 * (time.perf_counter() - t0))
+        return out
+
+    whole = turn()
+    moving = view.start_moving()
+    light = turn()
+    t0 = time.perf_counter()
+    view.stop_moving()
+    back_ms = 1000 * (time.perf_counter() - t0)
+    return {"rotation_triangles": view.canopy_mesh.n_cells,
+            "rotation_frame_ms_whole": {"median": statistics.median(whole), "max": max(whole),
+                                        "over_200": sum(t > 200 for t in whole)},
+            "rotation_frame_ms_moving": {"median": statistics.median(light), "max": max(light),
+                                         "over_200": sum(t > 200 for t in light),
+                                         "lighter": moving},
+            "rotation_stop_to_whole_ms": back_ms}
+
+
 def pick_and_mesh_file(window, spin, gaps, shown, clicks: int = 15) -> dict:
     """Clicks on leaves of the K = 4 canopy, then the K = 4 canopy opened from a PLY."""
     import tempfile
@@ -515,6 +563,91 @@ def pick_and_mesh_file(window, spin, gaps, shown, clicks: int = 15) -> dict:
     return out
 
 
+def digitizer_child(presses: int) -> None:
+    """In a display: the window's digitizer under CPU burners (see ``digitizer_...``)."""
+    import csv
+    import tempfile
+
+    os.environ["XDG_CONFIG_HOME"] = os.environ.get("BENCH_CONFIG", "/tmp/maizeviz-bench-cfg")
+    app = _app()  # noqa: F841  (keeps the QApplication alive)
+    import numpy as np
+    from maizeviz_app.main_window import MainWindow
+    from PySide6.QtCore import QCoreApplication
+
+    from maizeviz.digitizer.technician import Technician
+    from maizeviz.io.points import read_points
+    from maizeviz.resources import example_points
+
+    def spin(seconds: float, until=None) -> bool:
+        end = time.perf_counter() + seconds
+        while time.perf_counter() < end:
+            QCoreApplication.processEvents()
+            if until is not None and until():
+                return True
+            time.sleep(0.002)
+        return until is None
+
+    window = MainWindow(str(example_points()), 3)
+    window.confirm_unsaved = False
+    window.resize(1366, 740)
+    window.show()
+    assert spin(TIMEOUT_S, lambda: window.digitizer is not None), "no digitizer"
+    panel = window.digitizer
+    panel.confirm_close = False
+    window.workspaces.show("digitize")
+    burners = [subprocess.Popen([sys.executable, "-c", "while True: pass"])
+               for _ in range(os.cpu_count() or 1)]
+    tech = Technician(presses, (0.35, 0.5), seed=1)
+    shown: dict[int, float] = {}
+    out = Path(tempfile.mkdtemp(prefix="maizeviz-bench-load-")) / "load.csv"
+    try:
+        panel.ports.set_port(tech.wait_port())
+        panel.out_edit.setText(str(out))
+        panel.cols.setValue(5)
+        panel.start()
+        assert spin(TIMEOUT_S, lambda: panel.recording), "no connection"
+        d = panel.digitizing
+        panel.recorded.connect(lambda n: shown.setdefault(n - 1, time.time()))
+        tech.follow(panel.control, lambda: (d.pos.plant, d.pos.leaf), lambda: d.count.points,
+                    lambda s: spin(s), timeout=presses * 2.0)
+        stopped: list[str] = []
+        panel.stopped.connect(stopped.append)
+        panel.stop_button.click()
+        assert spin(TIMEOUT_S, lambda: bool(stopped)), "no stop"
+    finally:
+        tech.close()
+        for b in burners:
+            b.kill()
+            b.wait()
+    pts = read_points(out)
+    with open(out, newline="") as fh:
+        stamps = [float(r["time"]) for r in csv.DictReader(fh) if r["status"] == "recorded"]
+    pressed = [tech.pressed[k] for k in sorted(tech.pressed)]
+    n = min(len(stamps), len(pressed))
+    lat = [stamps[k] - pressed[k] for k in range(n)]
+    to_window = [shown[k] - tech.pressed[k] for k in shown if k in tech.pressed]
+    order = len(pts) == len(tech.ids) and bool(np.array_equal(pts.ids, tech.ids))
+    window.close()
+    print(json.dumps({"digitizer_presses": len(pressed),
+                      "digitizer_presses_lost": len(pressed) - len(pts),
+                      "digitizer_order_ok": order,
+                      "digitizer_press_to_disk_worst_s": max(lat, default=None),
+                      "digitizer_press_to_disk_median_s": statistics.median(lat) if lat else None,
+                      "digitizer_press_to_window_worst_s": max(to_window, default=None),
+                      "digitizer_burners": len(burners)}), flush=True)
+
+
+def digitizer_part(presses: int) -> dict:
+    env = dict(os.environ, BENCH_CONFIG=f"/tmp/maizeviz-bench-{os.getpid()}-digitizer")
+    proc = subprocess.run([sys.executable, __file__, "--child", "digitizer", "--presses",
+                           str(presses)], stdout=subprocess.PIPE, text=True, env=env,
+                          timeout=TIMEOUT_S + presses * 2)
+    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith("{")]
+    if proc.returncode != 0 or not lines:
+        raise SystemExit(f"the digitizer run failed (exit {proc.returncode})")
+    return json.loads(lines[-1])
+
+
 def gui_part(levels: list[str], repeat: int = 1) -> dict:
     env = dict(os.environ, BENCH_CONFIG=f"/tmp/maizeviz-bench-{os.getpid()}-gui")
     proc = subprocess.run([sys.executable, __file__, "--child", "gui", "--levels",
@@ -531,27 +664,35 @@ def main() -> None:
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--levels", default=STOPS)
     ap.add_argument("--repeat", type=int, default=1, help="visit the levels this many times")
-    ap.add_argument("--child", choices=("startup", "gui"), help=argparse.SUPPRESS)
+    ap.add_argument("--presses", type=int, default=200,
+                    help="stylus presses of the digitizer's load run (default 200)")
+    ap.add_argument("--only", choices=("digitizer",), help="run only this part")
+    ap.add_argument("--child", choices=("startup", "gui", "digitizer"), help=argparse.SUPPRESS)
     args = ap.parse_args()
     levels = [lv for lv in args.levels.split(",") if lv]
     if args.child == "startup":
         return startup_child()
     if args.child == "gui":
         return gui_child(levels, args.repeat)
+    if args.child == "digitizer":
+        return digitizer_child(args.presses)
     if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         raise SystemExit("needs a display: xvfb-run -a -s \"-screen 0 1366x768x24\" python "
                          "benchmarks/bench_gui.py")
     out = {"anchor_s": min(matmul_anchor() for _ in range(3))}
-    out.update(gil_part())
-    out.update(startup_part())
-    out.update(gui_part(levels, args.repeat))
+    if args.only != "digitizer":
+        out.update(gil_part())
+        out.update(startup_part())
+        out.update(gui_part(levels, args.repeat))
+    out.update(digitizer_part(args.presses))
     out["anchor_end_s"] = min(matmul_anchor() for _ in range(3))     # the load may have changed
     out["targets"] = {"gil_max_block_ms": 100, "idle_renders_per_s": 0, "renders_per_canopy": 1,
                       "event_loop_max_gap_ms_at_36_and_below": 200,
                       "event_loop_max_gap_ms_at_K4": 200, "first_window_s": 3,
                       "layout_edit_event_loop_max_gap_ms_900_plants": 200,
                       "pick_ms": 50, "mesh_file_event_loop_max_gap_ms": 200,
-                      "stop_event_loop_max_gap_ms": 50, "stop_event_loop_max_gap_ms_demo": 50}
+                      "stop_event_loop_max_gap_ms": 50, "stop_event_loop_max_gap_ms_demo": 50,
+                      "digitizer_presses_lost": 0, "rotation_frame_ms_moving_over_200": 0}
     if args.json:
         print(json.dumps(out, indent=1))
         return None

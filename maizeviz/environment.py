@@ -1,7 +1,7 @@
 """The environment variables maizeviz reads, each parsed here with the checks its options get.
 
 Every ``MAIZEVIZ_*`` variable the code reads is listed in :data:`VARIABLES` and read through
-:func:`switch` or :func:`whole_number`, when it is used (not at import: a module imported
+:func:`switch`, :func:`whole_number` or :func:`word`, when it is used (not at import: a module imported
 for something else does not fail on a variable it never uses). A value that is not what the
 variable takes is refused in one line naming the variable, its value and what it takes, as
 an option's value is (``MAIZEVIZ_FIELD_POINTS=1e3`` was ``int('1e3')``'s traceback at
@@ -14,8 +14,8 @@ import).
 ``MAIZEVIZ_PACKETS``       0 turns the ray-packet kernel off (embreex's single rays)
 ``MAIZEVIZ_LOOPS``         0 turns the compiled loops off (numpy does their work)
 ``MAIZEVIZ_DEBUG``         1 shows the traceback of an internal error on the command line
-``MAIZEVIZ_EMBREE_ISA``    the instruction set Embree traces with (sse2, sse4.2, avx, avx2
-                           or avx512; the CPU's best)
+``MAIZEVIZ_EMBREE_ISA``    the instruction set Embree traces with (sse2, sse4.2, avx, avx2,
+                           avx512; unset or empty: the CPU's best)
 =========================  ===========================================================
 
 A switch takes 0 or 1 (and no, off, false, yes, on, true, any case); unset or empty is its
@@ -43,23 +43,23 @@ class Variable:
     Attributes
     ----------
     kind : {"switch", "whole", "word"}
-    default : bool or int
+    default : bool, int or None
     meaning : str
         What it sets, in words.
     low : int
         Smallest whole number taken.
     choices : tuple of int
         The only whole numbers taken (empty: any from ``low`` on).
-    words : tuple of str
-        The words a "word" variable takes (lower case).
+    words : dict of str to str
+        A word variable's words, any case, each to the value it stands for.
     """
 
     kind: str
-    default: bool | int | str
+    default: bool | int | None
     meaning: str
     low: int = 0
     choices: tuple[int, ...] = ()
-    words: tuple[str, ...] = ()
+    words: dict[str, str] | None = None
 
 
 #: Every environment variable maizeviz reads.
@@ -72,8 +72,10 @@ VARIABLES: dict[str, Variable] = {
     "MAIZEVIZ_PACKETS": Variable("switch", True, "the ray-packet kernel"),
     "MAIZEVIZ_LOOPS": Variable("switch", True, "the compiled loops"),
     "MAIZEVIZ_DEBUG": Variable("switch", False, "tracebacks of internal errors"),
-    "MAIZEVIZ_EMBREE_ISA": Variable("word", "", "the instruction set Embree traces with",
-                                    words=("sse2", "sse4.2", "avx", "avx2", "avx512")),
+    "MAIZEVIZ_EMBREE_ISA": Variable(
+        "word", None, "the instruction set Embree traces with",
+        words={"sse2": "sse2", "sse4.2": "sse4.2", "sse42": "sse4.2", "avx": "avx",
+               "avx2": "avx2", "avx512": "avx512", "avx-512": "avx512"}),
 }
 
 _ON = ("1", "yes", "on", "true")
@@ -137,22 +139,28 @@ def whole_number(name: str) -> int:
     return value
 
 
-def word(name: str) -> str:
-    """The value of a word variable, in lower case: its default when unset or empty.
+def word(name: str) -> str | None:
+    """The value of a word variable (any case, blanks around ignored): the value its word
+    stands for; None when unset or empty.
 
     Raises
     ------
     EnvironmentVariableError
-        A word it does not take.
+        A word the variable does not take.
     """
     var = _variable(name, "word")
     raw = os.environ.get(name, "")
-    text = raw.strip().lower()
-    if not text:
-        return str(var.default)
-    if text not in var.words:
-        raise _refuse(name, raw, f"takes one of {', '.join(var.words)}")
-    return text
+    if not raw.strip():
+        return None
+    words = var.words or {}
+    value = words.get(raw.strip().lower())
+    if value is None:
+        raise _refuse(name, raw, f"takes one of {', '.join(sorted(set(words.values())))}")
+    return value
+
+
+#: The reader of each kind of variable.
+READERS = {"switch": switch, "whole": whole_number, "word": word}
 
 
 def problems() -> list[str]:
@@ -161,7 +169,7 @@ def problems() -> list[str]:
     out = []
     for name, var in VARIABLES.items():
         try:
-            {"switch": switch, "whole": whole_number, "word": word}[var.kind](name)
+            READERS[var.kind](name)
         except EnvironmentVariableError as exc:
             out.append(str(exc))
     return out

@@ -140,8 +140,8 @@ def _set_range(widget: QDoubleSpinBox | QSpinBox, group: Any, name: str) -> None
 
 def bind_text(box: QComboBox, group: Any, name: str) -> None:
     """An editable combo box's text (a choice or what is typed) bound to ``group.<name>``,
-    both ways (the digitizer's serial port: listed ports, or one typed)."""
-    box.currentTextChanged.connect(lambda v: _set(group, name, v.strip()))
+    both ways (the digitizer's serial port: listed ports, or one typed); the box starts with
+    the field's value."""
 
     def follow(value: Any, *_old: Any) -> None:
         if box.currentText().strip() != value:
@@ -151,6 +151,8 @@ def bind_text(box: QComboBox, group: Any, name: str) -> None:
                     box.setCurrentIndex(k)
                 box.setEditText(value)
 
+    follow(getattr(group, name))
+    box.currentTextChanged.connect(lambda v: _set(group, name, v.strip()))
     getattr(group.events, name).connect(follow)
     box.destroyed.connect(lambda *_: _disconnect(group, name, follow))
 

@@ -21,7 +21,7 @@ from PySide6.QtWidgets import (
 )
 
 #: Version of the saved dock layout; bump when docks change so an old layout is not applied.
-STATE_VERSION = 4
+STATE_VERSION = 5
 
 
 def scrolled(widget: QWidget) -> QScrollArea:

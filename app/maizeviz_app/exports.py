@@ -137,16 +137,19 @@ def _plot_job(path: str, model: StudyState):
 
 
 def _diffuse_job(what: str, path: str, model: StudyState):
-    """The day's steps CSV and figure, the per-leaf and per-plant CSV of the last sky or
-    day (the day when both)."""
+    """The day's steps CSV and figure (the last day's); the per-leaf and per-plant CSV of the
+    latest result with light per leaf: a sky, a day, or a sun traced with leaf optics (its
+    absorbed light, and its CO2 assimilation with a leaf model)."""
     day = model.runs.of_kind("day")
-    run = day if day is not None else model.runs.of_kind("sky")
     if what in ("steps", "day") and day is None:
         raise MaizevizError("no day computed yet: choose Day in the light panel and "
                             "compute the day's light first")
+    run = day if what in ("steps", "day") else model.runs.with_plants()
     if run is None:
-        raise MaizevizError("no sky or day computed yet: choose Sky or Day in the light "
-                            "panel and compute first")
+        raise MaizevizError("no light per leaf computed yet: compute a sky, a day, or a sun "
+                            "with leaf optics first")
+    if run.kind == "sun":
+        return _absorbed_table_job(what, path, run, model)
     light, extra, label = run.result, run.extra, run.label
     if what == "steps":
         def work(job):
@@ -177,3 +180,29 @@ def _diffuse_job(what: str, path: str, model: StudyState):
         write_rows(path, rows if what == "leaves" else plant_light(rows))
         return path
     return write_table, ()
+
+
+def _absorbed_table_job(what: str, path: str, run, model: StudyState):
+    """The light each leaf or plant absorbed in a sun traced with leaf optics, with its
+    gross CO2 assimilation when a leaf model was chosen (the tables of ``maizeviz light
+    --leaf-light / --plant-light``)."""
+    canopy, label = model.canopy, run.label
+    if canopy is None or run.signature != model.shown_signature:
+        raise MaizevizError(f"the light per leaf of the sun on {label} is computed against "
+                            f"its canopy: show level {label} first")
+    light, assimilation = run.extra.light, run.extra.assimilation
+
+    def work(job):
+        from maizeviz.io.atomic import write_rows
+
+        kind = "leaf" if what == "leaves" else "plant"
+        frame = light.table(kind, canopy)
+        if assimilation is not None:
+            keys = ["instance", "plant", "leaf"] if kind == "leaf" else ["instance"]
+            carbon = assimilation.table(kind, canopy)
+            new = [c for c in carbon.columns if c not in frame.columns or c in keys]
+            frame = frame.merge(carbon[new], on=keys, how="left")
+        frame.insert(0, "level", label)
+        write_rows(path, frame.to_dict("records"))
+        return path
+    return work, ()

@@ -19,6 +19,7 @@ import numpy as np
 from maizeviz.canopy.layout import CanopyLayout, layout_for
 from maizeviz.canopy.measures import CanopyMeasures, measure_canopy
 from maizeviz.canopy.scene import Canopy, build_canopy
+from maizeviz.errors import PointsFileError
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.light.engine import LightEngine
 from maizeviz.light.results.direct import LightResult
@@ -60,6 +61,13 @@ def load_points(path: str, tile: tuple[int, int] = (3, 3), row_spacing: float = 
                 layout: CanopyLayout | None = None) -> Loaded:
     """Read, grid and fit a points file; lay it out as ``layout`` or tiled ``tile`` times."""
     found = read_leaves(path)
+    if not found.leaves:
+        # what the command line says before 'no leaf could be processed': why, with its line
+        first = [str(e) for e in found.skipped] + list(found.problems)
+        more = len(first) - 1
+        raise PointsFileError(f"{shown_name or path}: no leaf could be reconstructed"
+                              + (f": {first[0]}" if first else "")
+                              + (f" (and {more:,} more)" if more > 0 else ""))
     if layout is None:
         layout = layout_for(found.leaves, tile, row_spacing, plant_spacing)
     return Loaded(str(path), found.leaves, found.skipped, layout,

@@ -296,9 +296,9 @@ class LayoutDraft:
                               f"has {', '.join(map(str, sorted(self.plants)))})")
 
     def add(self, x: float, y: float, plant: int | None = None,
-            azimuth_deg: float = 0.0) -> bool:
+            azimuth_deg: float = 0.0, text: str = "") -> bool:
         """A new placement at (x, y) cm (snapped) standing ``plant`` (default: the
-        lowest digitized plant id)."""
+        lowest digitized plant id); ``text`` names the edit (default "add plant N")."""
         if self.base is None:
             raise LayoutError("no layout to edit yet: open a points file first")
         if len(self.placements) >= MAX_PLANTS:
@@ -309,7 +309,7 @@ class LayoutDraft:
         new = Placement(int(plant), self._coordinate(self._snap(x), "x"),
                         self._coordinate(self._snap(y), "y"), float(azimuth_deg) % 360.0)
         after = Snapshot(self.base, tuple(self.placements) + (new,), self.tiling, self.source)
-        return self._whole(after, f"add plant {plant}")
+        return self._whole(after, text or f"add plant {plant}")
 
     def row_end(self, index: int) -> tuple[float, float]:
         """The place one plant spacing beyond the end of placement ``index``'s row (the
@@ -324,7 +324,8 @@ class LayoutDraft:
         """A copy of placement ``index`` (the same plant, turned the same) at the end of its
         row (:meth:`row_end`, snapped)."""
         p = self.placements[self._index(index)]
-        return self.add(*self.row_end(index), p.plant, p.azimuth_deg)
+        return self.add(*self.row_end(index), p.plant, p.azimuth_deg,
+                        text=f"duplicate plant {p.plant} (row {index + 1})")
 
     def remove(self, index: int) -> bool:
         """Take placement ``index`` out of the layout (the last one stays: a canopy has a

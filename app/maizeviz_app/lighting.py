@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from maizeviz.errors import MaizevizError
-from maizeviz_app.runs import MODES, Run, day_summary, plot_title, run_info
+from maizeviz_app.runs import MODES, Run, day_summary, plot_title, run_info, run_warnings
 from maizeviz_app.settings import InputProblem
 
 if TYPE_CHECKING:
@@ -66,15 +66,10 @@ def compute_light(study: StudyState) -> bool:
         return False
     if not study.affordable([_light_costs(study.built, mode, args, heights, optics)], "light"):
         return False
-    from maizeviz_app import plots
-
     canopy, label = study.canopy, study.built.label
     signature = study.signature(label)
     sampling_key = study.settings.sampling_key(heights)
-    runs = study.runs.copy()
     key, runner = study.canopy_key, study.runner
-    first = max(study.figures.shown_index, 0)
-    look = plots.Look.of(study.colour, study.figures.shown_for)
 
     def work(job):
         out = runner.light_process.call(op, key, canopy, args, job)
@@ -92,11 +87,7 @@ def compute_light(study: StudyState) -> bool:
                       painting=painting)
         else:
             run = Run(label, signature, out.light, None, mode, out)
-        maps = plots.heatmap_images(run.result, first=first, check=job.check, kind=mode,
-                                    look=look.sharing(mode, run.result))
-        runs.add(run, compared, sampling_key)
-        plot = plots.rgba(plots.transmission_figure(runs.curves(), plot_title(runs)))
-        return run, compared, sampling_key, maps, plot
+        return run, compared, sampling_key
 
     study.light_running.emit(f"{RUNNING_TEXT[mode]} on {label}…")
     study.runner.run("light", f"{mode} light on {label}", work,
@@ -127,9 +118,10 @@ def _light_failed(study: StudyState, exc: BaseException, mode: str = "sun") -> N
     study.fail(exc, "light", mode)
 
 def _lit(study: StudyState, out) -> None:
-    """A light result: table, summary, plants, figures and colours change together;
-    nothing shown is dropped unless a new comparison starts."""
-    run, compared, sampling_key, maps, plot = out
+    """A light result: table, summary, plants and colours change together, then its figures
+    (when drawn, :attr:`StudyState.draw_figures`); nothing shown is dropped unless a new
+    comparison starts."""
+    run, compared, sampling_key = out
     study.light_running.emit("")
     if run.signature[0] != study.serial:
         return
@@ -148,11 +140,7 @@ def _lit(study: StudyState, out) -> None:
         study.set_plants_run(None)
     f = study.figures
     f.keep_only({k for k in f.shown_for if study.runs.of_kind(k) is not None} | {run.kind})
-    f.set_maps(run.kind, run, maps)
-    if study.colour.shared:                     # the others' scale includes this run
-        f.restyle(keep=run.kind)
-    f.set_plot(plot)
-    for w in r.warnings:
+    for w in run_warnings(run):
         study.say(f"{'note' if 'sun never rises' in w else 'warning'}: {w}")
     if study.shown_signature == run.signature:
         study.view_light.emit(True)
@@ -163,7 +151,41 @@ def _lit(study: StudyState, out) -> None:
         study.say(f"{run.name}: transmission "
                  + ", ".join(f"{t:.3f}" for t in run.transmission) + " at "
                  + ", ".join(f"{h:g}" for h in r.heights_cm) + " cm", status_only=True)
-    study.light_shown.emit()
+    if study.draw_figures:
+        draw_figures(study, run)                # light_shown once they are drawn
+    else:
+        study.light_shown.emit()
+
+
+def draw_figures(study: StudyState, run: Run) -> None:
+    """The figures of a new light result, drawn in a job of their own (matplotlib, 0.3-1 s a
+    figure): its heatmap at the height shown (the others when asked for,
+    :func:`draw_heatmap`) and the transmission plot of every result compared; then
+    ``light_shown``. Only where they are shown (:attr:`StudyState.draw_figures`)."""
+    from maizeviz_app import plots
+
+    f = study.figures
+    first = max(f.shown_index, 0)
+    look = plots.Look.of(study.colour, f.shown_for).sharing(run.kind, run.result)
+    curves, title = study.runs.curves(), plot_title(study.runs)
+
+    def work(job):
+        maps = plots.heatmap_images(run.result, first=first, check=job.check, kind=run.kind,
+                                    look=look)
+        return maps, plots.rgba(plots.transmission_figure(curves, title))
+
+    def done(out) -> None:
+        maps, plot = out
+        if study.runs.of_kind(run.kind) is run:         # else: a newer result has its own
+            f.set_maps(run.kind, run, maps)
+            if study.colour.shared:             # the others' scale includes this run
+                f.restyle(keep=run.kind)
+            f.set_plot(plot)
+        study.light_shown.emit()
+
+    study.runner.run("figures", "drawing the light figures", work, on_done=done,
+                     on_error=lambda e: study.fail(e, "light"))
+
 
 def draw_heatmap(study: StudyState, kind: str, index: int) -> None:
     """The heatmap of another height of a result shown, drawn in a job."""
@@ -213,11 +235,23 @@ def _sun_found(study: StudyState, sun) -> None:
     study.say(f"sun at {sun.when}: zenith {sun.zenith_deg:.2f}°, azimuth "
              f"{sun.azimuth_deg:.2f}°")
 
+def offset_zone(hours: float | None) -> str | None:
+    """The IANA zone of a fixed UTC offset of whole hours ("Etc/GMT-1" is UTC+01:00: the
+    Etc names count west), "UTC" for 0; None for no offset or one of part hours (no IANA
+    name holds it)."""
+    if hours is None or hours != int(hours) or not -14 <= hours <= 12:
+        return None
+    h = int(hours)
+    return "UTC" if h == 0 else f"Etc/GMT{-h:+d}"
+
+
 def choose_weather(study: StudyState, path: str) -> None:
     """A weather file chosen: the day's source becomes it and, when its header names a place
-    (EPW, TMY3, PSM), the day's latitude and longitude become that place, in one step of the
-    undo history (read in a job: pvlib's first import takes seconds). A sun traced away from
-    where the file was measured would not match its irradiance."""
+    (EPW, TMY3, PSM), the day's latitude and longitude become that place, and its time zone
+    the file's own (the fixed offset its times are written in), in one step of the undo
+    history (read in a job: pvlib's first import takes seconds). A sun traced away from
+    where the file was measured would not match its irradiance, and dates and clock times
+    are read in the file's zone."""
     def work(job, p):
         from maizeviz.io.weather_files import weather_place
 
@@ -229,9 +263,14 @@ def choose_weather(study: StudyState, path: str) -> None:
         if lat is not None and lon is not None and -90 <= lat <= 90 and -180 <= lon <= 180:
             values.update(latitude=float(lat), longitude=float(lon))
             named = f", {place['name']}" if place.get("name") else ""
-            study.say(f"place: latitude {lat:g}, longitude {lon:g}{named} (the header of "
-                      f"{Path(path).name})")
-        study.settings.set("day", values)
+            zone = offset_zone(place.get("utc_offset_h"))
+            if zone is not None:
+                values["tz"] = zone
+            clock = f", time zone {zone}" if zone is not None else ""
+            study.say(f"place: latitude {lat:g}, longitude {lon:g}{named}{clock} (the header "
+                      f"of {Path(path).name})")
+        with study.history.step(f"weather file {Path(path).name}"):
+            study.settings.set("day", values)
 
     study.runner.run("weather", f"reading the place of {Path(path).name}", work, path,
                      on_done=done, on_error=lambda e: study.fail(e, "weather", "day"))
@@ -244,7 +283,7 @@ def adopt_pending_runs(study: StudyState) -> None:
     shown are computed against it, the others' when their level is shown)."""
     if not study.pending_runs or study.built is None:
         return
-    from maizeviz_app import jobs, plots
+    from maizeviz_app import jobs
 
     pending, study.pending_runs = study.pending_runs, []
     absorbed = {s.label: s for s in pending if s.kind == "absorbed"}
@@ -285,6 +324,20 @@ def adopt_pending_runs(study: StudyState) -> None:
     curves = study.runs.curves()
     title = plot_title(study.runs)
     study.figures.shown_for = dict(shown)
+    study.view_light.emit(True)
+    restore_colouring(study)
+    if study.draw_figures:
+        _draw_project_figures(study, shown, order, curves, title)
+    elif study.runner.current("complete") is None:
+        study.light_shown.emit()
+
+
+def _draw_project_figures(study: StudyState, shown: dict, order: list, curves, title: str
+                          ) -> None:
+    """The heatmaps of a project's results shown (``shown``: light -> run, drawn in
+    ``order``) and the transmission plot, in a job; then ``light_shown``."""
+    from maizeviz_app import plots
+
     results = [(k, shown[k].result) for k in order]
     look = plots.Look.of(study.colour, shown)
 
@@ -303,15 +356,12 @@ def adopt_pending_runs(study: StudyState) -> None:
             study.light_shown.emit()
 
     study.runner.run("figures", "drawing the light figures", work, on_done=done,
-                    on_error=lambda e: study.fail(e, "light"))
-    study.view_light.emit(True)
+                     on_error=lambda e: study.fail(e, "light"))
+
 
 def light_per_plant_run(study: StudyState) -> Run | None:
-    """The latest result with light per plant to show: a sky's, a day's or a sun's
-    absorbed light (once computed against its canopy)."""
-    runs = [r for r in study.runs.in_order()
-            if r.kind != "sun" or getattr(r.extra, "plant_rows", None) is not None]
-    return runs[-1] if runs else None
+    """The latest result with light per plant to show (:meth:`LightRuns.with_plants`)."""
+    return study.runs.with_plants()
 
 def complete_runs(study: StudyState) -> None:
     """Results read from a project that were traced on the canopy shown get what the
@@ -354,12 +404,32 @@ def complete_runs(study: StudyState) -> None:
                 run.extra = value
         if study.shown_signature == here:
             study.set_plants_run(light_per_plant_run(study))
+            last = study.runs.last
+            # the results table gains what was computed here (a sun's CO2 row)
+            study.runs_changed.emit(study.runs, run_info(last) if last is not None else "")
             study.view_light.emit(True)
+            restore_colouring(study)
             if study.runner.current("figures") is None:     # else: when they are drawn
                 study.light_shown.emit()
 
     study.runner.run("complete", "light per leaf of the project's results", work,
                     on_done=adopt, on_error=lambda e: study.fail(e, "light"))
+
+
+def restore_colouring(study: StudyState) -> None:
+    """The 3D view coloured as it was when the project was saved (``colouring`` in its view
+    settings), once what it shows is computed: a CO2 colouring waits for the assimilation."""
+    from maizeviz_app.options import COLOURINGS
+
+    wanted = getattr(study, "colouring_to_restore", None)
+    if wanted not in COLOURINGS:
+        return
+    last = study.runs.latest(study.shown_signature, ("sun",))
+    if wanted == "assimilation" and getattr(getattr(last, "extra", None), "assimilation",
+                                            None) is None:
+        return
+    study.colouring_to_restore = None
+    study.view.colouring = wanted
 
 
 def runs_to_complete(runs, here, n: int) -> list:

@@ -43,6 +43,11 @@ class LinkedSelection(QObject):
 
     # ------------------------------------------------------------------ in
     def _on_pick(self, pick) -> None:
+        probe = self.model.probe
+        if probe.on:                        # a probe under way takes the clicks
+            if pick is not None:
+                probe.add(pick.point)
+            return
         if pick is None:
             self.model.selection.clear()
         else:

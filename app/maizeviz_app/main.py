@@ -138,7 +138,7 @@ def _digitize_screenshot_flow(app, window, path: str, code: dict, points: int = 
 
     def recorded(n: int) -> None:
         panel = window.digitizer
-        if n == points:
+        if n >= points and not panel.paused:    # (two points can show in one tick)
             panel.toggle_pause()
             panel.plant.wait()
             QTimer.singleShot(1500, shoot)

@@ -31,7 +31,8 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from PySide6.QtCore import QSettings, Qt, QTimer, Signal
+from PySide6.QtCore import QSettings, Qt, QTimer, QUrl, Signal
+from PySide6.QtGui import QDesktopServices, QKeySequence
 from PySide6.QtWidgets import QLabel, QMainWindow, QMessageBox, QStackedWidget, QUndoView
 
 from maizeviz import __version__
@@ -90,10 +91,12 @@ class MainWindow(QMainWindow):
     def __init__(self, points: str | Path | None = None, tile: int = 3):
         super().__init__()
         self.setWindowTitle("maizeviz")
+        self.setAcceptDrops(True)          # points, projects and meshes dropped open
         self._closing = False
         self._settings = QSettings("maizeviz", "maizeviz")
         self.runner = JobRunner(self)
         self.model = StudyModel(tile, self.runner)
+        self.model.draw_figures = True    # the window shows them (a script draws none)
         self.undo = UndoRecorder(self.model, self)
         self.viewport: Viewport | None = None
         self.view_link = ViewLink(self)
@@ -180,6 +183,11 @@ class MainWindow(QMainWindow):
 
         self.colour_panel = ColourPanel(m.colour, step=m.history.step)
         self.plots.heatmap.limits_shown.connect(self.colour_panel.heatmap_editor.show_limits)
+        from maizeviz_app.panels.instruments import InstrumentsPanel
+
+        self.instruments_panel = InstrumentsPanel(canopy=lambda: m.canopy)
+        self.instruments_panel.failed.connect(lambda text: self.say(f"error: {text}"))
+        m.built_shown.connect(lambda _label: self.instruments_panel.refresh())
         self.messages = docks.messages_widget()
         self.history = QUndoView(self.undo.stack)
         self.history.setEmptyLabel("the study as opened")
@@ -189,7 +197,9 @@ class MainWindow(QMainWindow):
                                              "light": ("Light", self.light_panel),
                                              "layout": ("Layout", None),
                                              "digitizer": ("Digitizer", None),
-                                             "colour": ("Colour", self.colour_panel)},
+                                             "colour": ("Colour", self.colour_panel),
+                                             "instruments": ("Instruments",
+                                                             self.instruments_panel)},
                                       self.plots, self.messages, self.history)
 
     def _wire_figures(self) -> None:
@@ -307,6 +317,7 @@ class MainWindow(QMainWindow):
             self.viewport = Viewport(self._centre)
             self.viewport.set_colour_scale(self.model.colour.view)
             self.viewport.limits_shown.connect(self.colour_panel.view_editor.show_limits)
+            self.view_link.attach(self.viewport)
             from maizeviz_app.linked import LinkedSelection
 
             self.linked = LinkedSelection(self.model, self.viewport, self.light_panel.plants,
@@ -321,22 +332,39 @@ class MainWindow(QMainWindow):
 
             gc.freeze()       # start-up objects out of the collector's way: shorter pauses
 
+    def _restore_connection(self) -> None:
+        """The digitizer's port and baud of the last connection (QSettings) into the study's
+        settings; a stored value the settings refuse leaves the default."""
+        from maizeviz_app.settings import InputProblem
+
+        for name in ("port", "baud"):
+            stored = self._settings.value(name)
+            if stored is None:
+                continue
+            try:
+                value = int(str(stored)) if name == "baud" else str(stored)
+                self.model.apply_settings("digitizer", {name: value})
+            except (InputProblem, ValueError):
+                pass                             # the default stays
+
     def _make_late_panels(self) -> None:
         from maizeviz_app.panels.digitizer import DigitizerPanel
         from maizeviz_app.panels.layout import LayoutPanel
 
         self.layout_panel = LayoutPanel(self.model, self.undo.stack)
         self.layout_panel.problem.connect(self.say)
-        self.digitizer = DigitizerPanel(self.viewport)
+        self.digitizer = DigitizerPanel(self.viewport, session=self.model.digitizing)
         self.digitizer.alert.connect(lambda text: self.say(text, error=True, status_only=True))
         self.digitizer.stopped.connect(self.view_link.digitizing_stopped)
         self.digitizer.started.connect(self.view_link.digitizing_started)
-        # the study's digitizer settings start as the panel remembered them, then follow it
+        # the study's digitizer settings are the connection last used (the window keeps it);
+        # the panel's port and baud show them and set them
         d, settings = self.digitizer, self.model.settings.digitizer
-        with self.model.quietly():
-            self.model.settings.set("digitizer", {"port": d.port, "baud": d.baud.value()})
+        self._restore_connection()
         bind(d.baud, settings, "baud")
         bind_text(d.ports.box, settings, "port")
+        d.ports.baud = settings.baud            # what Find FASTRAK probes at, as the box
+        settings.events.baud.connect(lambda baud, *_: setattr(d.ports, "baud", baud))
         self.docks["layout"].setWidget(docks.scrolled(self.layout_panel))
         self.docks["digitizer"].setWidget(docks.scrolled(self.digitizer))
         name_controls(self)
@@ -547,6 +575,72 @@ class MainWindow(QMainWindow):
     def about(self) -> None:
         QMessageBox.about(self, "About maizeviz", about_text())
 
+    def save_window_image(self, path: str | Path) -> bool:
+        """The whole window as it is on screen (panels, figures, the 3D view) as a PNG."""
+        ok = self.grab().save(str(path), "PNG")
+        self.say(f"saved the window as {path}" if ok else
+                 f"error: {path}: the image cannot be written", error=not ok)
+        return ok
+
+    def choose_window_image(self) -> None:
+        from PySide6.QtWidgets import QFileDialog
+
+        path, _ = QFileDialog.getSaveFileName(self, "Save the window as an image",
+                                              str(Path(self.folder()) / "maizeviz.png"),
+                                              "PNG (*.png)")
+        if path:
+            self.save_window_image(path)
+
+    # ------------------------------------------------------------------ drops
+    def dragEnterEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if self._dropped_path(event.mimeData()) is not None:
+            event.acceptProposedAction()
+
+    def dropEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        """A points file, a project or a canopy mesh dropped on the window opens as File >
+        Open would open it (unsaved work asked about first)."""
+        path = self._dropped_path(event.mimeData())
+        if path is not None:
+            event.acceptProposedAction()
+            self.open_any(path)
+
+    @staticmethod
+    def _dropped_path(mime) -> str | None:
+        """The first local file of a drop that maizeviz opens, None for anything else."""
+        if not mime.hasUrls():
+            return None
+        for url in mime.urls():
+            path = url.toLocalFile()
+            if path and Path(path).suffix.lower() in OPENABLE:
+                return path
+        return None
+
+    def show_shortcuts(self) -> None:
+        """Help > Keyboard shortcuts: every menu action's keys."""
+        QMessageBox.information(self, "Keyboard shortcuts",
+                                shortcuts_text(self.menu_actions.values()))
+
+    def show_system_info(self) -> None:
+        """Help > System information: ``maizeviz --info``, selectable, for a bug report."""
+        from maizeviz.info import report
+
+        box = QMessageBox(self)
+        box.setWindowTitle("System information")
+        box.setText("What <code>maizeviz --info</code> prints: paste it into a bug report.")
+        box.setDetailedText(report())
+        box.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        box.open()
+        self.info_box = box
+
+    def open_docs(self) -> None:
+        """Help > Documentation: the docs folder's index in the system's viewer."""
+        docs = docs_folder()
+        if docs is None:
+            self.model.say("note: the documentation is in the docs/ folder of maizeviz's "
+                           "source; this installation has no copy")
+            return
+        QDesktopServices.openUrl(QUrl.fromLocalFile(str(docs / "README.md")))
+
     def closeEvent(self, event) -> None:  # noqa: N802 - Qt's name
         """Stop the reader, cancel and wait for the jobs, kill the core processes, save the
         window's geometry and docks, close the 3D view explicitly. Unsaved work is asked
@@ -567,6 +661,7 @@ class MainWindow(QMainWindow):
             import sys
 
             print(f"maizeviz: the digitizer did not stop cleanly: {exc}", file=sys.stderr)
+        self.instruments_panel.shutdown()
         self.runner.shutdown(10.0)
         self._end_threads()
         self.workspaces.save()
@@ -576,9 +671,53 @@ class MainWindow(QMainWindow):
         super().closeEvent(event)
 
 
+#: What a file dropped on the window may be: points, a project, a canopy mesh.
+OPENABLE = (".csv", ".txt", ".parquet", ".pq", ".maizeviz", ".ply", ".obj")
+
+
 def about_text() -> str:
+    """What the Help menu's About says: the version, what maizeviz does, the paper, the
+    libraries it runs on (with their versions) and where its documentation is."""
+    from maizeviz.info import info
+
+    d = info()
+    libs = {**d["packages"], **{k: v for k, v in d["optional"].items()  # type: ignore[attr-defined]
+                                if v and v != "not installed"}}
+    libraries = ", ".join(f"{name} {version}" for name, version in libs.items())
+    docs = docs_folder()
+    where = (f"<a href='{docs.as_uri()}'>{docs}</a> (Help &gt; Documentation)" if docs else
+             "the docs/ folder of maizeviz's source")
     return (f"<h3>maizeviz {__version__}</h3>"
             "<p>Digitized maize plants: NURBS leaf surfaces through every digitized point, "
-            "meshes of chosen complexity, canopies and direct light.</p>"
-            f"<p>It implements the method of: {PAPER}</p>"
-            "<p>See docs/method.md for what is computed and how far it follows the paper.</p>")
+            "meshes of chosen complexity, canopies, and light: sun, sky and whole days with "
+            "leaf optics and scattering, the leaves' CO₂ assimilation, virtual field "
+            "instruments.</p>"
+            f"<p>It implements, and goes beyond, the method of: {PAPER}</p>"
+            f"<p><b>Libraries</b>: {libraries}; Embree {d['embree']} (embreex "
+            f"{d['embreex']}), ray kernel: {d['kernel']}.</p>"
+            f"<p><b>Documentation</b>: {where}; method.md says what is computed and how far "
+            "it follows the paper, cli.md every command, app.md this window.</p>")
+
+
+def docs_folder() -> Path | None:
+    """The documentation beside the installed package (a source checkout or an editable
+    install), or None."""
+    import maizeviz
+
+    here = Path(maizeviz.__file__).resolve().parents[1] / "docs"
+    return here if (here / "README.md").is_file() else None
+
+
+def shortcuts_text(actions) -> str:
+    """Every menu action with a keyboard shortcut, as an HTML table (Help > Keyboard
+    shortcuts)."""
+    rows = []
+    for act in actions:
+        keys = act.shortcut().toString(QKeySequence.SequenceFormat.NativeText)
+        if keys:
+            rows.append((act.text().replace("&", "").rstrip("…"), keys))
+    rows.sort(key=lambda r: r[0].lower())
+    body = "".join(f"<tr><td>{name}</td><td><b>{keys}</b></td></tr>" for name, keys in rows)
+    return ("<table cellspacing='6'>" + body + "</table><p>Ctrl+Z and Ctrl+Shift+Z undo and "
+            "redo from anywhere in the window; Delete removes the plant picked in the layout "
+            "editor.</p>")

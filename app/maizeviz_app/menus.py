@@ -76,15 +76,20 @@ def build_menus(w) -> dict[str, QAction]:
     acts["export_steps"] = _action(w, results, "Day: time steps (CSV)…",
                                    lambda: w.choose_export("steps"), None,
                                    "the day's light at each time step")
-    acts["export_leaves"] = _action(w, results, "Sky or day: light per leaf (CSV)…",
+    acts["export_leaves"] = _action(w, results, "Light per leaf (CSV)…",
                                     lambda: w.choose_export("leaves"), None,
-                                    "light intercepted and absorbed by each leaf")
-    acts["export_plants"] = _action(w, results, "Sky or day: light per plant (CSV)…",
+                                    "light intercepted or absorbed by each leaf (a sky, a "
+                                    "day, or a sun with leaf optics and its CO2)")
+    acts["export_plants"] = _action(w, results, "Light per plant (CSV)…",
                                     lambda: w.choose_export("plants"), None,
-                                    "light intercepted and absorbed by each plant")
+                                    "light intercepted or absorbed by each plant (a sky, a "
+                                    "day, or a sun with leaf optics and its CO2)")
     acts["export_day"] = _action(w, results, "Day figure (PNG)…",
                                  lambda: w.choose_export("day"), None,
                                  "the day's light and transmission over the hours")
+    acts["window_image"] = _action(w, f, "Save &window as image…", w.choose_window_image,
+                                   None, "the whole window, panels and figures as they are "
+                                         "on screen, as a PNG")
     acts["view_image"] = _action(w, f, "Save view as &image…", w.view_link.choose_image,
                                  "Ctrl+Alt+S", "the 3D view as a PNG of a chosen width, with "
                                                "its colour key")
@@ -128,6 +133,32 @@ def build_menus(w) -> dict[str, QAction]:
         act.setChecked(name == "leaf")
         group.addAction(act)
         acts[f"colour_{name}"] = act
+    from maizeviz_app.probe import KINDS
+    from maizeviz_app.view_state import OTHERS
+
+    v.addSeparator()
+    for (kind, text), keys in zip(KINDS.items(), ("Ctrl+M", "Ctrl+Shift+M")):
+        def toggle(k=kind):
+            probe = w.model.probe
+            probe.start("" if probe.kind == k else k)
+        act = _action(w, v, text, toggle, keys,
+                      "click two points on the canopy: their distance" if kind == "distance"
+                      else "click the corners of a polygon on the canopy: its area (and its "
+                           "shadow's)")
+        act.setCheckable(True)
+        acts[f"measure_{kind}"] = act
+
+    others = v.addMenu("&Selection")
+    others.menuAction().setStatusTip("how the other plants are drawn while one is selected")
+    others_group = QActionGroup(w)
+    for name, text in OTHERS.items():
+        act = _action(w, others, text,
+                      lambda n=name: setattr(w.model.view, "others", n), None,
+                      f"while a plant is selected: {text.lower()}")
+        act.setCheckable(True)
+        act.setChecked(name == w.model.view.others)
+        others_group.addAction(act)
+        acts[f"others_{name}"] = act
     v.addSeparator()
     acts["finer"] = _action(w, v, "&Finer mesh", lambda: w.step_level(-1), "Ctrl+[",
                           "the next finer mesh level (more triangles a leaf)")
@@ -161,7 +192,17 @@ def build_menus(w) -> dict[str, QAction]:
                                                 "place typed in the Light panel")
 
     h = bar.addMenu("&Help")
-    acts["about"] = _action(w, h, "&About maizeviz", w.about, QKeySequence.StandardKey.HelpContents,
+    acts["docs"] = _action(w, h, "&Documentation", w.open_docs,
+                           QKeySequence.StandardKey.HelpContents,
+                           "the documentation's index: method, commands, this window, "
+                           "validation")
+    acts["shortcuts"] = _action(w, h, "&Keyboard shortcuts", w.show_shortcuts, None,
+                                "every menu command's keys")
+    acts["system_info"] = _action(w, h, "&System information", w.show_system_info, None,
+                                  "what maizeviz --info prints: versions, Embree, the ray "
+                                  "kernel; for a bug report")
+    h.addSeparator()
+    acts["about"] = _action(w, h, "&About maizeviz", w.about, None,
                             "the version, the libraries and where the documentation is")
     return acts
 

@@ -26,6 +26,7 @@ ADVICE = {
            "2005-08-01 12:00 39.9 116.4 Asia/Shanghai",
 }
 
+_AT_LINE = re.compile(r"\bline \d")
 _CLASS_PREFIX = re.compile(r"^(?:[A-Za-z_][\w.]*\.)?[A-Z]\w*(?:Error|Exception|Warning): ")
 
 
@@ -35,6 +36,10 @@ def user_message(exc: BaseException, doing: str = "") -> str:
     if isinstance(exc, MaizevizError):
         text = _CLASS_PREFIX.sub("", str(exc)).strip() or "the input cannot be used"
         if isinstance(exc, PointsFileError) or doing in ("open points", "open project"):
+            if doing == "open points" and _AT_LINE.search(text):
+                # the file has the columns: a value on a line is wrong, not the layout
+                advice = ("correct that line and open the file again; the previous canopy "
+                          "stays open")
             return _join(text, advice)
         return _join(text, advice if doing in ("save project", "export") else "")
     if isinstance(exc, MemoryError):

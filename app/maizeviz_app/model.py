@@ -25,6 +25,7 @@ can be driven and checked without a window::
 
 from __future__ import annotations
 
+from functools import cached_property
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -35,6 +36,7 @@ from maizeviz_app.state import COLOUR_GROUPS, UNDOABLE, StudyState  # noqa: F401
 
 if TYPE_CHECKING:
     from maizeviz.canopy.layout import CanopyLayout
+    from maizeviz_app.digitizing import DigitizingSession
 
 
 class StudyModel(StudyState):
@@ -58,6 +60,14 @@ class StudyModel(StudyState):
         events.preserve_area.connect(self._canopy_setting)
         self.draft.edited.connect(self._draft_moved)
         self.draft.replayed.connect(self._draft_moved)
+
+    @cached_property
+    def digitizing(self) -> DigitizingSession:
+        """The digitizing session (the recorder's process, what is on disk, the counts and
+        warnings); the digitizer panel shows it (:mod:`maizeviz_app.digitizing`)."""
+        from maizeviz_app.digitizing import DigitizingSession
+
+        return DigitizingSession()
 
     def _canopy_setting(self, *_values: Any) -> None:
         if not self.applying:

@@ -148,6 +148,14 @@ class LightRuns:
     def of_kind(self, kind: str) -> Run | None:
         return self.latest(None, (kind,))
 
+    def with_plants(self) -> Run | None:
+        """The latest result with light per leaf and per plant: a sky's, a day's, or a sun's
+        traced with leaf optics (absorbed light, and its CO2 assimilation with a leaf model)
+        once computed against its canopy."""
+        runs = [r for r in self.in_order()
+                if r.kind != "sun" or getattr(r.extra, "plant_rows", None) is not None]
+        return runs[-1] if runs else None
+
     def heights(self) -> tuple[float, ...]:
         if self.last is None:
             return ()
@@ -281,7 +289,20 @@ def run_info(run: Run) -> str:
         info = (f"{r.n_steps} time steps and the sky ({sky}); {r.rays:,} rays per "
                 f"direction; level {run.label}; Embree scene {build}, tracing "
                 f"{secs.get('trace', 0):.2f} s")
-    return info + "".join(f"\n⚠ {w}" for w in r.warnings if "sun never rises" not in w)
+    return info + "".join(f"\n⚠ {w}" for w in run_warnings(run) if "sun never rises" not in w)
+
+
+def run_warnings(run: Run) -> list[str]:
+    """What the command line warns of a result: the light's own warnings, then those of its
+    CO2 assimilation (a leaf model's, e.g. leaves outside the rays' reach on an edited
+    layout, whose assimilation is understated)."""
+    out = list(run.result.warnings)
+    assimilation = getattr(run.extra, "assimilation", None)
+    for w in getattr(assimilation, "warnings", ()):
+        text = f"CO₂ assimilation: {w}"
+        if text not in out:
+            out.append(text)
+    return out
 
 
 def day_summary(light) -> str:
@@ -294,14 +315,23 @@ def day_summary(light) -> str:
     where = "the ground" if h[low] == 0 else f"{h[low]:g} cm"
     t_low = float(light.par_transmitted_mol_m2[low])
     share = f" ({light.transmission_by_height[low]:.1%})" if frac is not None else ""
-    span = (f"{p.start:%Y-%m-%d}" if (p.end - p.start).total_seconds() == 86400 and
-            p.start.hour == 0 and p.start.minute == 0 else
-            f"{p.start:%Y-%m-%d %H:%M} to {p.end:%H:%M}")
-    return (f"{span}: PAR incident {light.par_incident_mol_m2:.1f} mol/m² (direct "
+    return (f"{period_span(p)}: PAR incident {light.par_incident_mol_m2:.1f} mol/m² (direct "
             f"{light.par_direct_mol_m2:.1f}, diffuse {light.par_diffuse_mol_m2:.1f}); "
             f"intercepted {light.par_intercepted_mol_m2:.1f} mol/m²"
             + (f" ({frac:.1%})" if frac is not None else "")
             + f"; transmitted to {where} {t_low:.2f} mol/m²{share}\n{p.source}")
+
+
+def period_span(p) -> str:
+    """A period's span in words: its date for one whole day, else its start and end (the
+    end's date too when it is not the start's: a three-day weather file is "2021-07-01
+    00:00 to 2021-07-04 00:00", not "to 00:00")."""
+    if (p.end - p.start).total_seconds() == 86400 and p.start.hour == 0 and \
+            p.start.minute == 0:
+        return f"{p.start:%Y-%m-%d}"
+    if p.end.date() == p.start.date():
+        return f"{p.start:%Y-%m-%d %H:%M} to {p.end:%H:%M}"
+    return f"{p.start:%Y-%m-%d %H:%M} to {p.end:%Y-%m-%d %H:%M}"
 
 
 def day_title(light, label: str) -> str:

@@ -32,10 +32,12 @@ from maizeviz_app.figures import Figures
 from maizeviz_app.history import DraftEdit, History, watch
 from maizeviz_app.layout_draft import Change, LayoutDraft
 from maizeviz_app.messages import user_message
+from maizeviz_app.probe import Probe
 from maizeviz_app.runner import InlineRunner, Runner, describe_internal
 from maizeviz_app.runs import LightRuns, Run
 from maizeviz_app.selection import Selection
 from maizeviz_app.settings import StudySettings, field_names
+from maizeviz_app.view_state import ViewState
 
 if TYPE_CHECKING:
     from maizeviz.canopy.layout import CanopyLayout
@@ -97,6 +99,10 @@ class StudyState:
         Light results (sun, sky, day) per level, compared while they share their sampling.
     figures : Figures
         The heatmaps and the transmission plot of the results shown.
+    draw_figures : bool
+        Draw the figures of each light result (in a job of their own, after it): the window
+        sets it, since it shows them; a script leaves it off and pays nothing for them
+        (an export draws the figure it writes).
     summary : str
         The day's totals in two lines (empty: no day computed).
     plants_run : Run or None
@@ -124,6 +130,10 @@ class StudyState:
         ``from_file``: a canopy read from a mesh file); None: nothing is drawn (no window).
     colour : ColourSettings
         How the 3D view and the heatmaps colour light (evented; saved in a project).
+    view : ViewState
+        What the 3D view colours the canopy by and the camera preset asked (evented; the
+        viewport renders it): the study picks the light once computed and falls back to the
+        leaves when the canopy shown has none (:meth:`colour_view_by`).
     selection : Selection
         The plant or leaf selected (evented; the 3D view and the plants table follow it).
 
@@ -138,8 +148,8 @@ class StudyState:
     build_pending(text) : what is being built ('': nothing, or not built: ``text`` says why).
     runs_changed(runs, info) : a light result added (``info``: what was traced), or cleared.
     light_running(text) : a light computation started ('' : none runs any more).
-    light_added(run) : a new light result is in the table and figures (``light_shown``
-        follows once its figures are drawn).
+    light_added(run) : a new light result is in the table (``light_shown`` follows once
+        its figures are drawn, when they are).
     light_shown() : the light results shown are complete (table, figures, colours).
     view_light(colour) : the light to paint on the canopy shown changed (``colour``: switch
         the view's colouring to light).
@@ -183,6 +193,7 @@ class StudyState:
         self.measures_rows: dict[str, dict] = {}
         self.runs = LightRuns()
         self.figures = Figures()
+        self.draw_figures = False               # the window sets it: it shows them
         self.draft = LayoutDraft()
         self.layout_options = LayoutOptions()
         self.layout_notes: tuple[str, ...] = ()     # the layout's notes already said
@@ -202,9 +213,15 @@ class StudyState:
         self.mesher: Callable[..., Any] | None = None
         self.applying = 0                       # settings being set by the model itself
         self.colour = ColourSettings()
+        self.view = ViewState()
+        #: the colouring a project was saved with, restored once its results are complete
+        self.colouring_to_restore: str | None = None
         self.selection = Selection()
+        self.probe = Probe()           # a distance or area probe (View > Measure)
         self.history = History()
         self._watch_history()
+        self.view_light.connect(self._light_colouring)
+        self.canopy_changed.connect(lambda _built: self._check_colouring())
 
     # ------------------------------------------------------------------ reading
     @property
@@ -391,6 +408,51 @@ class StudyState:
         """Set a settings group from the model itself (see :meth:`quietly`)."""
         with self.quietly():
             self.settings.set(name, values)
+
+    # ------------------------------------------------------------------ the view
+    def can_colour(self, what: str) -> bool:
+        """Whether the canopy shown can be coloured by ``what`` (light and assimilation need
+        a result of it: a sun's classes or light per leaf; a leaf model's CO2)."""
+        ViewState.check_colouring(what)
+        if what in ("plant", "leaf"):
+            return True
+        run = self.runs.latest(self.shown_signature) if self.built is not None else None
+        if run is None:
+            return False
+        if what == "light":
+            return run.classes is not None or \
+                getattr(run.extra, "leaf_value", None) is not None
+        return getattr(run.extra, "gross_value", None) is not None
+
+    def colour_view_by(self, what: str) -> bool:
+        """Colour the canopy shown by ``what`` (the View menu, a script); False, and said
+        why, when the canopy shown has no such result."""
+        if not self.can_colour(what):
+            self.say("no CO₂ assimilation for the canopy shown: trace a sun with leaf optics "
+                     "(PAR) and a photosynthesis model in the Light panel"
+                     if what == "assimilation" else
+                     "no light result for the canopy shown: compute direct light first "
+                     "(Ctrl+L)")
+            return False
+        self.view.colouring = what
+        return True
+
+    def _light_colouring(self, colour: bool) -> None:
+        """New light on the canopy shown: coloured by it (``colour``) unless by its CO2."""
+        if colour and self.view.colouring != "assimilation" and self.can_colour("light"):
+            self.view.colouring = "light"
+        else:
+            self._check_colouring()
+
+    def _check_colouring(self) -> None:
+        """A colouring the canopy shown cannot have falls back: CO2 to light, light to the
+        leaves."""
+        what = self.view.colouring
+        if what == "assimilation" and not self.can_colour(what):
+            what = "light"
+        if what == "light" and not self.can_colour(what):
+            what = "leaf"
+        self.view.colouring = what
 
     # ------------------------------------------------------------------ history
     def edit_groups(self) -> dict[str, Any]:

@@ -63,6 +63,8 @@ def _project_read(study: StudyState, out) -> None:
         study.colour.update_from_doc(opened.view, opened.path)
     study.project_layout = opened.project.layout is not None
     study.pending_runs = list(runs)
+    # what the 3D view was coloured by when saved, shown once the results are complete
+    study.colouring_to_restore = opened.view.get("colouring")
     building.points_loaded(study, loaded, opened.project.points_csv, opened.path,
                        opened.project.points_path)
 
@@ -82,7 +84,7 @@ def save_project(study: StudyState, path: str | Path) -> bool:
     layout = loaded.layout if study.layout_edited else None   # else: the tiling, exactly
     canopy = dict(study.settings.canopy_doc(), tile=study.tile_n)
     light = study.settings.light_doc()
-    view = study.colour.to_doc()
+    view = {**study.colour.to_doc(), "colouring": study.view.colouring}
     runs = []
     sun_settings = study.runs.settings.get("sun")
     optics = sun_settings[2] if isinstance(sun_settings, tuple) and \

@@ -1,5 +1,7 @@
-"""The 3D view kept in step with the study: the canopy built is shown, coloured by the light
-last computed on it; the View menu's colourings and cameras act on it. From the start of a
+"""The 3D view kept in step with the study: the canopy built is shown, coloured as the study's
+view state says (:class:`maizeviz_app.view_state.ViewState`: the light last computed on it,
+once there is some), pointed by the camera preset it asks for; the View menu's colourings and
+cameras set that state. From the start of a
 digitizing session the view is the digitizer's (the plant being digitized): a canopy built
 meanwhile waits, and comes back in the Analyse workspace once the session has stopped
 (:mod:`maizeviz_app.workspaces`).
@@ -25,6 +27,42 @@ class ViewLink:
         m.view_light.connect(self.light_to_view)
         m.light_added.connect(self._painted)
         m.colour.events.painting.connect(lambda _p: self.light_to_view())
+        m.view.events.colouring.connect(lambda *_: self.render_colouring())
+        m.view.events.camera.connect(lambda name, *_: self._point(name))
+
+    def attach(self, viewport) -> None:
+        """The viewport made: the camera's pose goes both ways between it and the study's
+        view state."""
+        state = self.window.model.view
+        viewport.camera_moved.connect(lambda pose: setattr(state, "pose", pose))
+        state.events.pose.connect(lambda pose, *_: viewport.set_camera_pose(pose))
+        viewport.set_others(state.others)
+        state.events.others.connect(lambda mode, *_: self._others(mode))
+        self.window.model.probe.changed.connect(self._probe)
+
+    def _probe(self) -> None:
+        """The probe's points drawn, what it measures said; the menu follows."""
+        probe = self.window.model.probe
+        if self.view is not None:
+            self.view.show_probe(probe.points, closed=probe.kind == "area")
+        text = probe.text()
+        if text:
+            self.window.say(text, status_only=len(probe.points) < 2)
+        acts = getattr(self.window, "menu_actions", {})
+        for kind in ("distance", "area"):
+            act = acts.get(f"measure_{kind}")
+            if act is not None:
+                act.setChecked(probe.kind == kind)
+
+    def _others(self, mode: str) -> None:
+        """The others than the selection drawn as the view state says; the menu follows."""
+        if self.view is not None:
+            self.view.set_others(mode)
+        acts = getattr(self.window, "menu_actions", {})
+        for name in ("shown", "faded", "hidden"):
+            act = acts.get(f"others_{name}")
+            if act is not None:
+                act.setChecked(mode == name)
 
     @property
     def view(self) -> Any:
@@ -82,8 +120,13 @@ class ViewLink:
             self.view.set_assimilation_values(gross, *assimilation_legend(run))
         else:
             self.view.set_assimilation_values(None)
-        if colour and run is not None and self.view.colouring != "assimilation":
-            self.colour_by("light")
+        self.render_colouring()
+
+    def render_colouring(self) -> None:
+        """The view coloured as the study's view state says (once the view holds what that
+        colouring needs; else as it can until then)."""
+        if self.view is not None and not (self.digitizing or self.away):
+            self.view.colour_by(self.window.model.view.colouring)
         self.sync_colour_actions()
 
     def _painted(self, run) -> None:
@@ -121,27 +164,23 @@ class ViewLink:
         self.window.saved.emit(str(written))
 
     def camera(self, name: str) -> None:
-        if self.view is not None:
+        """View > a camera preset: the study's view state asks for it."""
+        self.window.model.view.ask_camera(name)
+
+    def _point(self, name: str) -> None:
+        if self.view is not None and not (self.digitizing or self.away):
             self.view.camera_preset(name)
 
     def colour_by(self, what: str) -> None:
-        if self.view is None:
-            return
-        if not self.view.colour_by(what):
-            self.window.say("no CO₂ assimilation for the canopy shown: trace a sun with leaf "
-                            "optics (PAR) and a photosynthesis model in the Light panel"
-                            if what == "assimilation" else
-                            "no light result for the canopy shown: compute direct light first "
-                            "(Ctrl+L)")
+        """View > a colouring: the study's (which says why when the canopy shown has none)."""
+        self.window.model.colour_view_by(what)
         self.sync_colour_actions()
 
     def sync_colour_actions(self) -> None:
-        if self.view is None:
-            return
         for name in COLOURINGS:
             act = self.window.menu_actions.get(f"colour_{name}")
             if act is not None:
-                act.setChecked(self.view.colouring == name)
+                act.setChecked(self.window.model.view.colouring == name)
 
     def digitizing_started(self) -> None:
         self.away = True

@@ -31,7 +31,7 @@ import time
 
 import numpy as np
 import pyvista as pv
-from PySide6.QtCore import QPointF, QRectF, Qt, Signal
+from PySide6.QtCore import QPointF, QRectF, Qt, QTimer, Signal
 from PySide6.QtGui import QColor, QFont, QImage, QLinearGradient, QPainter, QPen
 from PySide6.QtWidgets import QWidget
 from pyvistaqt import QtInteractor
@@ -283,6 +283,8 @@ class Viewport(QtInteractor):
     picked = Signal(object)
     #: A canopy's mesh was put on screen (show_canopy).
     canopy_set = Signal()
+    #: The camera moved by the user or a preset: its pose ((position, focal point, up), cm).
+    camera_moved = Signal(object)
 
     #: A press and release closer than this (pixels) is a click, not a drag of the camera.
     CLICK_PX = 4
@@ -306,6 +308,10 @@ class Viewport(QtInteractor):
         self.key = Legend(self)
         self.key.move(10, 10)
         self.key.hide()
+        # the field's axes and a scale bar, painted by Qt from the camera after each frame
+        from maizeviz_app.view_overlay import ViewOverlay
+
+        self.overlay = ViewOverlay(self)
         self.canopy_mesh: pv.PolyData | None = None
         self.colouring = "leaf"
         #: What the "light" colouring shows: "classes" (a sun) or "values" (a sky, a day).
@@ -326,6 +332,13 @@ class Viewport(QtInteractor):
         self._press: tuple[float, float] | None = None
         self._held = None                       # a left press not yet handed to VTK
         self.info = InfoCard(self)
+        self._moving = False                    # the lighter canopy drawn (the camera moves)
+        self._moving_source = None
+        self._moving_mtime = -1
+        self._moving_mesh = None
+        self._rest = QTimer(self)
+        self._rest.setSingleShot(True)
+        self._rest.timeout.connect(self.stop_moving)
         self.info.hide()
         #: The (low, high) the light values' colours span, once painted.
         self.shown_limits: tuple[float, float] | None = None
@@ -342,6 +355,11 @@ class Viewport(QtInteractor):
 
     def _on_frame(self, *_args) -> None:
         self.render_count += 1
+        cam = self.renderer.GetActiveCamera()
+        if hasattr(self, "overlay"):
+                self.overlay.update_from(
+                cam.GetPosition(), cam.GetFocalPoint(), cam.GetViewUp(), cam.GetViewAngle(),
+                cam.GetParallelScale() if cam.GetParallelProjection() else None)
         self.rendered.emit(self.render_count)
 
     # ------------------------------------------------------------------ canopy
@@ -630,6 +648,26 @@ class Viewport(QtInteractor):
         if name == "reset":
             cam.Zoom(1.25)
         self.render()
+        self.camera_moved.emit(self.camera_pose())
+
+    def camera_pose(self):
+        """The camera's position, focal point and view up (cm), as three tuples."""
+        cam = self.camera
+        return tuple(tuple(float(v) for v in vec) for vec in
+                     (cam.GetPosition(), cam.GetFocalPoint(), cam.GetViewUp()))
+
+    def set_camera_pose(self, pose) -> None:
+        """Put the camera at ``pose`` (as :meth:`camera_pose` gives it); nothing when it is
+        there already."""
+        if pose is None or pose == self.camera_pose():
+            return
+        cam = self.camera
+        position, focal, up = pose
+        cam.SetPosition(*position)
+        cam.SetFocalPoint(*focal)
+        cam.SetViewUp(*up)
+        self.renderer.ResetCameraClippingRange()
+        self.render()
 
     # ------------------------------------------------------------------ digitizing
     def hide_canopy(self) -> None:
@@ -730,6 +768,7 @@ class Viewport(QtInteractor):
     # ------------------------------------------------------------------ picking
     def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().resizeEvent(event)
+        self.overlay.place()
         if self.info.isVisible():
             self.info.set_lines(self.info.text().splitlines())
 
@@ -762,12 +801,69 @@ class Viewport(QtInteractor):
             return
         self._press = None
         super().mouseReleaseEvent(event)
+        self.stop_moving()
+        self.camera_moved.emit(self.camera_pose())      # a drag VTK turned the camera by
+
+    def wheelEvent(self, event) -> None:  # noqa: N802 - Qt's name
+        if self.start_moving() or self._moving:
+            self._rest.start(self.MOVING_REST_MS)
+        super().wheelEvent(event)
+        self.camera_moved.emit(self.camera_pose())
 
     def _release_held(self) -> None:
         """Hand the held press to VTK (a drag begins)."""
         held, self._held = self._held, None
         if held is not None:
+            self.start_moving()
             super().mousePressEvent(held)
+
+    # A lighter drawing while the camera moves (ParaView's level of detail): a drag or a wheel
+    # turn draws every k-th triangle of a canopy above MOVING_TRIANGLES, coloured as the
+    # canopy; the whole canopy is drawn again once the camera stops (the release, or
+    # MOVING_REST_MS after the last wheel step).
+    MOVING_TRIANGLES = 40_000
+    MOVING_REST_MS = 250
+
+    def start_moving(self) -> bool:
+        """Draw the lighter canopy until :meth:`stop_moving` (False: the canopy is light
+        enough, hidden, or not there)."""
+        canopy, mesh = self._canopy_actor, self.canopy_mesh
+        if canopy is None or mesh is None or self._moving or not canopy.GetVisibility() or \
+                mesh.n_cells <= 1.5 * self.MOVING_TRIANGLES:
+            return False
+        lod = self._moving_actor(mesh)
+        lod.GetMapper().ShallowCopy(canopy.GetMapper())     # the colours, as drawn now
+        lod.GetMapper().SetInputData(self._moving_mesh)
+        lod.SetProperty(canopy.GetProperty())
+        lod.SetVisibility(True)
+        canopy.SetVisibility(False)
+        self._moving = True
+        return True
+
+    def stop_moving(self) -> None:
+        """The whole canopy drawn again (the camera stopped)."""
+        if not self._moving:
+            return
+        self._moving = False
+        self._rest.stop()
+        self.actors["canopy_moving"].SetVisibility(False)
+        if self._canopy_actor is not None:
+            self._canopy_actor.SetVisibility(True)
+        self.render()
+
+    def _moving_actor(self, mesh):
+        """The lighter canopy's actor, its mesh remade when the canopy's changed: every k-th
+        triangle (cell data kept, so it colours as the canopy)."""
+        if self._moving_source is not mesh or self._moving_mtime != mesh.GetMTime():
+            k = int(np.ceil(mesh.n_cells / self.MOVING_TRIANGLES))
+            self._moving_mesh = _every_kth(mesh, k)
+            self._moving_source, self._moving_mtime = mesh, mesh.GetMTime()
+        actor = self.actors.get("canopy_moving")
+        if actor is None:
+            actor = self.add_mesh(self._moving_mesh, name="canopy_moving", render=False,
+                                  reset_camera=False, pickable=False, show_scalar_bar=False)
+            actor.SetVisibility(False)
+        return actor
 
     def pick_at(self, x: float, y: float) -> Pick | None:
         """What of the canopy is under the widget point (``x``, ``y``), None if nothing."""
@@ -795,14 +891,68 @@ class Viewport(QtInteractor):
             part = part_mesh(self.canopy_mesh, instance, leaf)
         actor = self.actors.get("selection")
         if part is None:
+            changed = self._draw_others(False)
             if actor is not None and actor.GetVisibility():
                 actor.SetVisibility(False)
+                changed = True
+            if changed:
                 self.render()
             return False
         actor = self._highlight_actor()
         actor.mapper.dataset = part
         actor.SetVisibility(True)
+        self._draw_others(True)
         self.render()
+        return True
+
+    PROBE = "#ff6f00"
+
+    def show_probe(self, points, closed: bool = False) -> None:
+        """The probe's points (k, 3) cm and the line through them (closed: a polygon); none:
+        nothing drawn."""
+        for name in ("probe_points", "probe_line"):
+            if name in self.actors:
+                self.remove_actor(name, render=False)
+        pts = np.asarray(points, np.float64).reshape(-1, 3)
+        if len(pts):
+            self.add_mesh(pv.PolyData(pts), name="probe_points", color=self.PROBE,
+                          point_size=9, style="points", pickable=False, reset_camera=False,
+                          render=False, lighting=False)
+        if len(pts) >= 2:
+            order = list(range(len(pts))) + ([0] if closed and len(pts) >= 3 else [])
+            line = pv.PolyData(pts, lines=np.array([len(order), *order]))
+            self.add_mesh(line, name="probe_line", color=self.PROBE, line_width=3,
+                          pickable=False, reset_camera=False, render=False, lighting=False)
+        self.render()
+
+    def set_others(self, mode: str) -> None:
+        """How the plants other than the selection are drawn while there is one: "shown",
+        "faded" (the selection seen through them) or "hidden" (the selection alone)."""
+        from maizeviz_app.view_state import OTHERS
+
+        if mode not in OTHERS:
+            raise ValueError(f"unknown mode {mode}; one of {', '.join(OTHERS)}")
+        self.others = mode
+        actor = self.actors.get("selection")
+        if self._draw_others(actor is not None and bool(actor.GetVisibility())):
+            self.render()
+
+    def _draw_others(self, selected: bool) -> bool:
+        """The canopy drawn as :attr:`others` says (as it is without a selection); whether
+        anything changed."""
+        from maizeviz_app.view_state import FADED_OPACITY
+
+        actor = self._canopy_actor
+        if actor is None:
+            return False
+        mode = getattr(self, "others", "shown") if selected else "shown"
+        visible = mode != "hidden"
+        opacity = FADED_OPACITY if mode == "faded" else 1.0
+        prop = actor.GetProperty()
+        if bool(actor.GetVisibility()) == visible and prop.GetOpacity() == opacity:
+            return False
+        actor.SetVisibility(visible)
+        prop.SetOpacity(opacity)
         return True
 
     def _highlight_actor(self):
@@ -837,6 +987,21 @@ class Viewport(QtInteractor):
         except AttributeError:
             pass
         super().close()
+
+
+def _every_kth(mesh: pv.PolyData, k: int) -> pv.PolyData:
+    """Every ``k``-th triangle of ``mesh``, its points and cell data kept (the lighter
+    canopy a moving camera draws)."""
+    if not mesh.is_all_triangles:
+        return mesh.extract_cells(np.arange(0, mesh.n_cells, k)).extract_surface(
+            algorithm="dataset_surface")
+    faces = mesh.faces.reshape(-1, 4)[::k]
+    out = pv.PolyData(mesh.points, faces=faces.ravel())
+    for name in mesh.cell_data:
+        out.cell_data[name] = np.asarray(mesh.cell_data[name])[::k]
+    if mesh.cell_data.active_scalars_name:
+        out.cell_data.active_scalars_name = mesh.cell_data.active_scalars_name
+    return out
 
 
 def _card(widget: QWidget) -> QPainter:

@@ -41,7 +41,7 @@ from maizeviz.canopy.layout import MAX_COORD_CM, CanopyLayout, Placement
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.ids import groups
-from maizeviz.io.mesh_canopy import CARRIED, MeshData, read_mesh
+from maizeviz.io.mesh_data import CARRIED, MeshData
 from maizeviz.numbers import number
 
 #: cm per unit of a mesh file.
@@ -147,11 +147,12 @@ def _field_coordinates(mesh: MeshData, unit: str | None, up: str, src: str) -> n
     if up not in UP_AXES:
         raise MaizevizError(f"the up axis must be z or y, got '{up}'", quantity="up")
     v = mesh.vertices
-    used = np.zeros(len(v), bool)
-    used[mesh.faces.ravel()] = True
     height_axis = 2 if up == "z" else 1
-    h = float(np.ptp(v[used, height_axis])) if used.any() else 0.0
     if unit is None:
+        used = np.zeros(len(v), bool)
+        used[mesh.faces.ravel()] = True
+        heights = v[:, height_axis] if used.all() else v[used, height_axis]
+        h = float(np.ptp(heights)) if len(heights) else 0.0
         if h < GUESS_MIN_HEIGHT:
             raise MaizevizError(
                 f"{src}: the mesh is {h:.4g} units tall: in cm that is not a maize canopy; if "
@@ -169,10 +170,10 @@ def _field_coordinates(mesh: MeshData, unit: str | None, up: str, src: str) -> n
         out = v.copy() if scale != 1.0 else v
     if scale != 1.0:
         out = out * scale
-    big = np.flatnonzero(np.abs(out).max(axis=1) > MAX_COORD_CM) if len(out) else \
-        np.zeros(0, np.int64)
-    if len(big):
-        i = int(big[0])
+    # a column's extremes first: the rows are looked at only when one is too far
+    if len(out) and any(max(-out[:, k].min(), out[:, k].max()) > MAX_COORD_CM
+                        for k in range(3)):
+        i = int(np.flatnonzero(np.abs(out).max(axis=1) > MAX_COORD_CM)[0])
         raise MaizevizError(f"{src}: {mesh.where_vertex(i)} lies {np.abs(out[i]).max():.4g} cm "
                             f"from the origin, beyond {MAX_COORD_CM / 100:g} m: not a field plot "
                             "(is the unit right?)", quantity="mesh_unit")
@@ -184,8 +185,16 @@ def _distinct(a: np.ndarray) -> np.ndarray:
     come leaf by leaf)."""
     if not len(a):
         return a
-    starts = np.flatnonzero(np.concatenate([[True], a[1:] != a[:-1]]))
-    return np.unique(a[starts])
+    return np.unique(a[_run_starts(a)])
+
+
+def _run_starts(*columns: np.ndarray) -> np.ndarray:
+    """(R,) intp: where a run of equal rows of the columns (each (n,), n > 0) starts."""
+    new = np.zeros(len(columns[0]), bool)
+    new[0] = True
+    for c in columns:
+        new[1:] |= c[1:] != c[:-1]
+    return np.flatnonzero(new)
 
 
 def _mix(h: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -195,16 +204,42 @@ def _mix(h: np.ndarray, v: np.ndarray) -> np.ndarray:
         return h ^ (h >> np.uint64(31))
 
 
+def _not_alone(key: np.ndarray) -> np.ndarray:
+    """(m,) intp, ascending: the entries of ``key`` (n,) uint64 that may share their value with
+    another entry (all that do, and a few that do not).
+
+    Two rounds of a hash table: an entry alone in its slot (the key's top bits, then, of those
+    left, its low bits) has a value no other entry has. An entry written to a slot holds it,
+    whichever wins: the slot's other entries and the holder are kept. Each round touches each
+    key once, where sorting the keys compares each twenty times (at K = 4 a third of the
+    time, leaving a twentieth of the keys)."""
+    keep = np.arange(len(key))
+    for extra, top in ((2, True), (1, False)):
+        if len(key) < 2:
+            return keep[:0]
+        bits = max(int(len(key) - 1).bit_length() + extra, 4)
+        slot = (key >> np.uint64(64 - bits)) if top else key & np.uint64((1 << bits) - 1)
+        slot = slot.astype(np.intp)
+        table = np.empty(1 << bits, np.int32)       # read only where written
+        mine = np.arange(len(key), dtype=np.int32)
+        table[slot] = mine
+        holder = table[slot]
+        shared = holder != mine
+        shared[holder[shared]] = True
+        keep, key = keep[shared], key[shared]
+    return keep
+
+
 def repeated_triangles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     """(T,) bool: the triangles whose three corners (by position, in any order and either
     orientation) are those of an earlier triangle.
 
     vertices : (V, 3) float64; faces : (T, 3) int64. A surface written twice (a file
     concatenated with itself, a double-sided export) would otherwise count its area, and
-    intercept its light, twice. Each triangle is first given a 64-bit hash of its corners'
-    coordinates, in any order: a repeated triangle has the hash of the one it repeats, so a
-    mesh whose hashes all differ (the usual case) has none, found with one sort of the
-    hashes; otherwise the rows are sorted and compared exactly.
+    intercept its light, twice. Each vertex is given a 64-bit hash of its coordinates, each
+    triangle the sum of its corners' hashes (the same in any order): a repeated triangle has
+    the sum of the one it repeats. The triangles whose sum no other has (:func:`_not_alone`,
+    the usual case is all of them) are done with; the few others are compared exactly.
     """
     out = np.zeros(len(faces), dtype=bool)
     if len(faces) < 2:
@@ -213,22 +248,28 @@ def repeated_triangles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     at = np.zeros(len(vertices), np.uint64)
     for k in range(3):
         at = _mix(at, bits[:, k])
-    corner = np.sort(at[faces], axis=1)
-    key = np.zeros(len(faces), np.uint64)
-    for k in range(3):
-        key = _mix(key, corner[:, k])
-    key.sort()
-    if not np.any(key[1:] == key[:-1]):
+    ft = np.ascontiguousarray(faces.T)
+    with np.errstate(over="ignore"):
+        key = at[ft[0]] + at[ft[1]]
+        key += at[ft[2]]
+    cand = _not_alone(key)
+    if len(cand) < 2:
         return out
-    # vertices by position: their coordinates' bit patterns (-0.0 made 0.0) grouped as int64
-    # columns, whose sort releases the GIL (np.unique(axis=0) sorts rows as one structured
-    # type: 3 s holding it for the K = 4 canopy's 1.4 M vertices, and the app's window with it)
-    bits = np.ascontiguousarray(np.asarray(vertices, dtype=np.float64) + 0.0).view(np.int64)
-    _, same = groups(bits[:, 0], bits[:, 1], bits[:, 2])
-    corners = np.sort(same.reshape(-1)[faces], axis=1)
+    ranked = np.sort(key[cand])
+    twin = np.isin(key[cand], ranked[1:][ranked[1:] == ranked[:-1]])
+    cand = cand[twin]
+    if not len(cand):
+        return out
+    # the corners by position: their coordinates' bit patterns (-0.0 made 0.0) grouped as
+    # int64 columns, whose sort releases the GIL (np.unique(axis=0) sorts rows as one
+    # structured type, holding it)
+    used, local = np.unique(faces[cand].reshape(-1), return_inverse=True)
+    pos = np.ascontiguousarray(np.asarray(vertices, dtype=np.float64)[used] + 0.0).view(np.int64)
+    _, same = groups(pos[:, 0], pos[:, 1], pos[:, 2])
+    corners = np.sort(same[local.reshape(-1)].reshape(-1, 3), axis=1)
     order = np.lexsort(corners.T[::-1])                # stable: the first of equals first
-    ranked = corners[order]
-    out[order[1:][np.all(ranked[1:] == ranked[:-1], axis=1)]] = True
+    ranked_c = corners[order]
+    out[cand[order[1:][np.all(ranked_c[1:] == ranked_c[:-1], axis=1)]]] = True
     return out
 
 
@@ -255,37 +296,47 @@ def _split(vertices: np.ndarray, faces: np.ndarray, is_leaf: np.ndarray
     other vertex (also those no face uses: the file's vertices come back as they were)."""
     if is_leaf.all():
         return vertices, faces, np.empty((0, 3)), np.empty((0, 3), np.int64)
-    stalk_f = faces[~is_leaf]
-    leaf_f = faces[is_leaf]
-    used_by_leaf = np.zeros(len(vertices), bool)
-    used_by_leaf[leaf_f.ravel()] = True
+    n_leaf = int(is_leaf.sum())
+    if is_leaf[:n_leaf].all():                    # the leaves first, as maizeviz writes them
+        leaf_f, stalk_f = faces[:n_leaf], faces[n_leaf:]
+    else:
+        leaf_f = faces.take(np.flatnonzero(is_leaf), axis=0)
+        stalk_f = faces.take(np.flatnonzero(~is_leaf), axis=0)
     in_stalk = np.zeros(len(vertices), bool)
     in_stalk[stalk_f.ravel()] = True
-    stalk_only = in_stalk & ~used_by_leaf
-    keep_leaf = ~stalk_only
-    first_gone = int(np.argmax(stalk_only)) if stalk_only.any() else len(vertices)
-    if first_gone == len(vertices) or keep_leaf[first_gone:].sum() == 0:
+    if len(leaf_f) and leaf_f.max() < stalk_f.min():
+        stalk_only = in_stalk                     # no leaf reaches the stalks' vertices
+    else:
+        used_by_leaf = np.zeros(len(vertices), bool)
+        used_by_leaf[leaf_f.ravel()] = True
+        stalk_only = in_stalk & ~used_by_leaf
+    gone = np.flatnonzero(stalk_only)
+    if not len(gone) or gone[0] + len(gone) == len(vertices):
         # the stalks' own vertices come after every leaf vertex (as maizeviz writes them):
         # the leaves' numbers stay
+        leaf_v = vertices[:len(vertices) - len(gone)]
         leaf_faces = leaf_f
     else:
-        new_leaf = np.cumsum(keep_leaf) - 1
-        leaf_faces = new_leaf[leaf_f]
+        keep_leaf = ~stalk_only
+        leaf_v = vertices[keep_leaf]
+        leaf_faces = (np.cumsum(keep_leaf) - 1)[leaf_f]
     # a vertex both organs use is copied into the stalk's vertices
     new_stalk = np.cumsum(in_stalk) - 1
-    stalk = (vertices[in_stalk], new_stalk[stalk_f])
-    return vertices[keep_leaf], leaf_faces, *stalk
+    return leaf_v, leaf_faces, vertices[in_stalk], new_stalk[stalk_f]
 
 
-def _areas_centres(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Areas (F,) cm2 and centroids seen from above (F, 2) cm of triangles ``f`` (F, 3) of
-    vertices ``v`` (V, 3) cm, a coordinate at a time from contiguous columns (at K = 4 a
-    seventh of the time of gathering the triangles whole and crossing their edges)."""
+def _areas_centres(v: np.ndarray, f: np.ndarray, centres: bool = True
+                   ) -> tuple[np.ndarray, np.ndarray | None]:
+    """Areas (F,) cm2 and centroids seen from above (F, 2) cm (None unless ``centres``) of
+    triangles ``f`` (F, 3) of vertices ``v`` (V, 3) cm, a coordinate at a time from contiguous
+    columns (at K = 4 a seventh of the time of gathering the triangles whole and crossing
+    their edges)."""
     vt, ft = np.ascontiguousarray(v.T), np.ascontiguousarray(f.T)
-    e1, e2, centre = [], [], np.empty((len(f), 2))
+    e1, e2 = [], []
+    centre = np.empty((len(f), 2)) if centres else None
     for k in range(3):
         a, b, d = (vt[k][ft[j]] for j in range(3))
-        if k < 2:
+        if centre is not None and k < 2:
             centre[:, k] = (a + b + d) / 3.0
         b -= a
         d -= a
@@ -297,14 +348,16 @@ def _areas_centres(v: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return 0.5 * np.sqrt(cross2), centre
 
 
-def _positions(n: int, centre: np.ndarray, area: np.ndarray, leaf_inst: np.ndarray,
+def _positions(n: int, centre: np.ndarray | None, area: np.ndarray, leaf_inst: np.ndarray,
                stalk_v: np.ndarray, stalk_f: np.ndarray, stalk_inst: np.ndarray) -> np.ndarray:
     """(P, 2) cm: the mean of each plant's stalk vertices, or its leaves' area-weighted centre
-    (``centre``, ``area``: of each leaf triangle)."""
-    weight = np.bincount(leaf_inst, area, n)
-    count = np.bincount(leaf_inst, minlength=n).astype(np.float64)
+    (``centre``, ``area``: of each leaf triangle; ``centre`` None: every plant has a
+    stalk)."""
     out = np.zeros((n, 2))
-    for k in range(2):
+    if centre is not None:
+        weight = np.bincount(leaf_inst, area, n)
+        count = np.bincount(leaf_inst, minlength=n).astype(np.float64)
+    for k in range(2 if centre is not None else 0):
         wsum = np.bincount(leaf_inst, area * centre[:, k], n)
         plain = np.bincount(leaf_inst, centre[:, k], n)
         out[:, k] = np.where(weight > 0, wsum / np.where(weight > 0, weight, 1),
@@ -361,7 +414,14 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
         raise MaizevizError(f"{source}: no leaf triangle: all {mesh.n_triangles:,} have leaf id "
                             "0 (a stalk or another organ that is not a leaf)")
     leaf_v, leaf_f, stalk_v, stalk_f = _split(verts, mesh.faces, is_leaf)
-    area, centre = _areas_centres(leaf_v, leaf_f)
+    plants = _distinct(mesh.plant)
+    runs = _run_starts(mesh.plant)
+    inst = np.repeat(np.searchsorted(plants, mesh.plant[runs]).astype(np.int32),
+                     np.diff(runs, append=len(mesh.plant)))
+    leaf_inst, stalk_inst = inst[is_leaf], inst[~is_leaf]
+    # a plant's place is its stalk's: the leaves' centres only for plants without one
+    stalked = np.bincount(stalk_inst, minlength=len(plants)) > 0
+    area, centre = _areas_centres(leaf_v, leaf_f, centres=not stalked.all())
     flat = int((area == 0).sum())
     if flat == n_leaf:
         raise MaizevizError(f"{source}: all {n_leaf:,} leaf triangles are degenerate (no area: "
@@ -370,11 +430,9 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
         t = int(np.flatnonzero(is_leaf)[int(np.flatnonzero(area == 0)[0])])
         notes.append(f"{source}: {flat:,} of the {n_leaf:,} leaf triangles have no area (first: "
                      f"{mesh.where_triangle(t)}); kept, they receive no light")
-    plants = _distinct(mesh.plant)
-    inst = np.searchsorted(plants, mesh.plant).astype(np.int32)
-    leaf_inst, stalk_inst = inst[is_leaf], inst[~is_leaf]
     leaf_ids = mesh.leaf[is_leaf].astype(np.int32)
-    pairs, _ = groups(leaf_inst, leaf_ids)
+    heads = _run_starts(leaf_inst, leaf_ids)            # a file's faces come leaf by leaf
+    pairs, _ = groups(leaf_inst[heads], leaf_ids[heads])
     leaves_per = np.bincount(pairs[:, 0], minlength=len(plants)).astype(np.int32)
     xy = _positions(len(plants), centre, area, leaf_inst, stalk_v, stalk_f, stalk_inst)
     del centre
@@ -455,6 +513,8 @@ def read_mesh_canopy(path: str | Path, unit: str | None = None, up: str = "z",
     notes : list of str
         What was decided (one line each).
     """
+    from maizeviz.io.mesh_canopy import read_mesh  # the parsers (plyfile): when a mesh is read
+
     mesh = read_mesh(path, plant_property, leaf_property)
     canopy, notes = canopy_from_mesh(mesh, unit, up, field, str(path))
     return canopy, mesh, notes

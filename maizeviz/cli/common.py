@@ -15,10 +15,8 @@ from maizeviz.canopy.scene import Canopy
 from maizeviz.cost import Cost, check, layout_cost
 from maizeviz.errors import LeafError, MaizevizError
 from maizeviz.io.atomic import file_tag
-from maizeviz.io.mesh_canopy import is_mesh_path
-from maizeviz.io.meshfile import check_mesh_path
+from maizeviz.io.mesh_data import MESH_SUFFIXES
 from maizeviz.io.points import shown
-from maizeviz.io.project import SUFFIX as PROJECT_SUFFIX
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.mesh.levels import Level, parse_levels
 from maizeviz.numbers import NUMBER_ARG as NUMBER_ARG
@@ -138,6 +136,8 @@ def check_export(path: str | None, levels: list[Level]) -> None:
         return
     if len(levels) > 1:
         raise MaizevizError("--export writes one level: use it with --interp or --triangles")
+    from maizeviz.io.meshfile import check_mesh_path  # the writers: when a mesh is written
+
     check_mesh_path(path)
 
 
@@ -254,7 +254,7 @@ def canopy_setup(args: argparse.Namespace) -> tuple[list[Leaf], list[LeafError],
 
 def is_mesh(path: str | Path) -> bool:
     """Whether ``path`` names a mesh file (.ply, .obj) to trace as it is."""
-    return is_mesh_path(path)
+    return Path(path).suffix.lower() in MESH_SUFFIXES
 
 
 def input_name(path: str | Path) -> str:
@@ -311,7 +311,9 @@ def mesh_setup(args: argparse.Namespace) -> Canopy:
 
 def is_project(path: str | Path) -> bool:
     """Whether ``path`` names a ``.maizeviz`` project (by its name, as the app's File menu)."""
-    return Path(path).suffix.lower() == PROJECT_SUFFIX
+    from maizeviz.io.project import SUFFIX  # zipfile and hashlib: when a project is read
+
+    return Path(path).suffix.lower() == SUFFIX
 
 
 def _project_setup(args: argparse.Namespace) -> tuple[list[Leaf], list[LeafError], CanopyLayout]:

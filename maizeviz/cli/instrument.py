@@ -30,6 +30,7 @@ from maizeviz.cli.common import (
     suffixed,
 )
 from maizeviz.errors import MaizevizError
+from maizeviz.instruments.sight import default_place
 from maizeviz.mesh.levels import CANOPY_LEVELS
 
 #: The subcommand.
@@ -141,19 +142,6 @@ def _positions(args: argparse.Namespace) -> list[tuple[float, float]]:
     return out
 
 
-def default_position(canopy: Canopy) -> tuple[float, float]:
-    """Where an instrument is held unless told: between the rows and between the plants, next
-    to the plant nearest the plot's middle (half a row spacing across, half a plant spacing
-    along), as one holds it in a plot: not against a stalk."""
-    lay = canopy.layout
-    x0, y0, x1, y1 = lay.bounds
-    cx, cy = (x0 + x1) / 2.0, (y0 + y1) / 2.0
-    if not lay.placements:
-        return cx, cy
-    near = min(lay.placements, key=lambda p: (p.x - cx) ** 2 + (p.y - cy) ** 2)
-    return near.x + lay.row_spacing / 2.0, near.y + lay.plant_spacing / 2.0
-
-
 def _canopy(args: argparse.Namespace) -> tuple[Canopy, int, list]:
     """The canopy of the options (one level), the leaves reconstructed and those skipped."""
     check_input_options(args)
@@ -226,7 +214,7 @@ def run(args: argparse.Namespace) -> int:
     _check_settings(args)
     positions = _positions(args)
     canopy, n_leaves, skipped = _canopy(args)
-    positions = positions or [default_position(canopy)]
+    positions = positions or [default_place(canopy)]
     t0 = time.perf_counter()
     sight = Sight.of(canopy, args.periodic, not args.leaves_only)
     if args.instrument == "ceptometer":

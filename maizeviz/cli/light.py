@@ -42,6 +42,7 @@ from maizeviz.cli.common import (
     say,
     say_estimate,
 )
+from maizeviz.cli.stalk_light import stalk_line, stalk_record, with_stalk_columns
 from maizeviz.cost import check, light_costs, mesh_cost
 from maizeviz.errors import LeafError, MaizevizError, check_range
 from maizeviz.io.atomic import file_tag, make_folder, write_rows
@@ -146,7 +147,11 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="rays leaving the plot sideways re-enter on the other side (infinite field)")
     p.add_argument("--threads", type=WHOLE_ARG, default=os.cpu_count() or 1,
                    help="tracing threads (default: all cores)")
-    p.add_argument("--with-stalks", action="store_true", help="stalks intercept light too")
+    p.add_argument("--leaves-only", action="store_true",
+                   help="stalks take no light (the paper's canopy); by default they intercept "
+                        "and scatter light like any organ, their share reported apart")
+    p.add_argument("--with-stalks", action="store_true",
+                   help="stalks take light (the default; kept for older scripts)")
     p.add_argument("--check", action="store_true",
                    help="print Beer-Lambert exp(-G L(h)/cos theta) from the mesh beside each value")
     p.add_argument("--json", action="store_true", help="print JSON instead of tables")
@@ -187,7 +192,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     ab.add_argument("--precision", type=NUMBER_ARG, default=None, metavar="REL_SE",
                     help="trace denser until the relative Monte Carlo standard error of the "
                          "leaves' absorbed light (of the canopy's assimilation with "
-                         "--photosynthesis) is at most this (0.005: 0.5 %%)")
+                         "--photosynthesis) is at most this (0.005: 0.5 %%), and so is its bias "
+                         "from the density (estimated from halves of the same rays)")
     ph = p.add_argument_group(
         "photosynthesis from the absorbed PAR (turns absorbed light on; the sun, or a period)")
     ph.add_argument("--photosynthesis", choices=MODELS, default=None,
@@ -439,6 +445,7 @@ class _Level:
     sky_res: SkyLight | None = None
     per_res: PeriodLight | None = None
     ab: AbsorbedLight | None = None
+    abd: Any = None                     # the period's AbsorbedPeriod
     asm: Any = None                     # the sun's Assimilation, with a leaf model
 
 
@@ -575,7 +582,10 @@ def _trace_level(job: _Job, canopy: Canopy, canopy_s: float) -> dict[str, Any]:
     """One level: its engine, then each light asked for, its outputs written; its record."""
     args = job.args
     sampling = Sampling(job.heights, args.density, job.rect, args.periodic, args.threads)  # type: ignore[arg-type]
-    engine = LightEngine(canopy, sampling, with_stalks=args.with_stalks)
+    if args.leaves_only and args.with_stalks:
+        raise MaizevizError("--leaves-only and --with-stalks contradict each other: stalks "
+                            "take light by default, --leaves-only leaves them out")
+    engine = LightEngine(canopy, sampling, with_stalks=not args.leaves_only)
     engine.scene()
     rec: dict[str, Any] = {"level": canopy.level, "triangles": canopy.n_triangles,
                            "heights_cm": [float(h) for h in job.heights],
@@ -595,8 +605,10 @@ def _trace_level(job: _Job, canopy: Canopy, canopy_s: float) -> dict[str, Any]:
         _trace_absorbed_sun(job, lv)
     if job.sun is None:
         _without_sun(lv)
+    rec["stalks"], stalk_rows = stalk_record(canopy, engine.with_stalks, lv.res, lv.sky_res,
+                                             lv.ab or lv.abd, lv.per_res)
     _write_outputs(args, canopy, lv.label, job.n_levels, lv.res, lv.sky_res, lv.per_res,
-                   lv.tables, lv.plant_extra)
+                   lv.tables, lv.plant_extra, stalk_rows)
     if args.export:
         path = export_canopy(args.export, canopy,
                              light_cells(canopy, lv.res, lv.sky_res, lv.per_res, lv.ab,
@@ -671,11 +683,12 @@ def _trace_absorbed_period(job: _Job, lv: _Level) -> None:
                                    progress=Progress(f"absorbed light over the period, "
                                                      f"{lv.label}"))
         if d.assimilation is not None:
-            return (d, d.assimilation.canopy_gross_mol_m2,
-                    d.assimilation.canopy_gross_error_mol_m2 or 0.0)
+            pa, g = d.assimilation, d.assimilation.ground_m2
+            return (d, pa.canopy_gross_mol_m2, pa.canopy_gross_error_mol_m2 or 0.0,
+                    (pa.bias_mol or 0.0) / g, (pa.bias_se_mol or 0.0) / g)
         return d, d.balance.absorbed_leaves, d.absorbed_leaves_error or 0.0
 
-    abd = _traced(trace_day, args, lv.rec, job.said)
+    abd = lv.abd = _traced(trace_day, args, lv.rec, job.said)
     _warn_unresolved(abd.balance, abd.depth, lv.rec, job.said)
     lv.rec["balance"] = dict(abd.balance.as_dict(), units="MJ/m2 of ground")
     lv.rec["balance_se"] = abd.balance_errors
@@ -704,7 +717,9 @@ def _trace_absorbed_sun(job: _Job, lv: _Level) -> None:
                                seed=args.seed, density=density)
         if job.leaf_model is not None:
             g = assimilate(lv.canopy, a, job.leaf_model, job.temp_c)
-            return a, g.canopy_gross_umol_m2_s, g.canopy_gross_error_umol_m2_s or 0.0
+            return (a, g.canopy_gross_umol_m2_s, g.canopy_gross_error_umol_m2_s or 0.0,
+                    g.canopy_gross_bias_umol_m2_s or 0.0,
+                    (g.bias_se_umol_s or 0.0) / g.ground_m2)
         return a, a.balance.absorbed_leaves, a.absorbed_leaves_error or 0.0
 
     ab = lv.ab = _traced(trace_sun, args, lv.rec, job.said)
@@ -786,6 +801,12 @@ def _warn_unresolved(balance, depth: int, rec: dict[str, Any], said: set[str]) -
             say(f"warning: {w}")
 
 
+def _percent(fraction: float) -> str:
+    """A fraction as a percentage with three significant digits, however small (``:.2%``
+    wrote a target of 1e-6 as "0.00%")."""
+    return f"{100 * fraction:.3g}%"
+
+
 def _traced(trace, args: argparse.Namespace, rec: dict[str, Any], said: set[str]) -> Any:
     """``trace(density)``'s result at ``--density``, or with ``--precision`` at the density
     that meets it (recorded in ``rec["precision"]``, a warning when it cannot be)."""
@@ -793,11 +814,19 @@ def _traced(trace, args: argparse.Namespace, rec: dict[str, Any], said: set[str]
         return trace(args.density)[0]
     result, prec = trace_until(trace, args.density, args.precision)
     rec["precision"] = prec.as_dict()
-    say(f"precision: relative standard error {prec.achieved:.2%} at {prec.density:g} rays "
-        f"per cm2 after {prec.passes} trace{'s' if prec.passes > 1 else ''}")
-    if not prec.met:
-        w = (f"the relative standard error {prec.achieved:.2%} is above the {prec.target:.2%} "
-             f"asked for at the densest tracing allowed ({prec.density:g} rays per cm2)")
+    bias = ("+" if prec.bias >= 0 else "-") + _percent(abs(prec.bias))
+    say(f"precision: relative standard error {_percent(prec.achieved)}, bias from the density "
+        f"{bias} at {prec.density:g} rays per cm2 after {prec.passes} "
+        f"trace{'s' if prec.passes > 1 else ''}")
+    problems = []
+    if not prec.noise_met:
+        problems.append(f"the relative standard error {_percent(prec.achieved)} is above the "
+                        f"{_percent(prec.target)} asked for")
+    if not prec.bias_met:
+        problems.append(f"the bias from the density, {bias} +- {_percent(prec.bias_se)}, "
+                        f"is above the {_percent(prec.target)} asked for")
+    for problem in problems:
+        w = f"{problem} at the densest tracing allowed ({prec.density:g} rays per cm2)"
         said.add(w)
         say(f"warning: {w}")
         rec["warnings"].append(w)
@@ -947,7 +976,8 @@ def _check_paths(args: argparse.Namespace, labels: list[str], sun: bool,
 def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_levels: int,
                    res: LightResult | None, sky: SkyLight | None, pl: PeriodLight | None,
                    tables: list[list[dict]],
-                   plant_extra: dict[int, dict[str, float]] | None = None) -> None:
+                   plant_extra: dict[int, dict[str, float]] | None = None,
+                   stalk_rows: list[dict] | None = None) -> None:
     if args.heatmaps:
         folder = make_folder(args.heatmaps)
         n = 0
@@ -980,7 +1010,8 @@ def _write_outputs(args: argparse.Namespace, canopy: Canopy, label: str, n_level
             plants = plant_light(rows)
             for r in plants:            # standard errors do not add: computed per plant
                 r.update((plant_extra or {}).get(int(r["instance"]), {}))
-            write_rows(level_path(args.plant_light, label, n_levels), plants)
+            write_rows(level_path(args.plant_light, label, n_levels),
+                       with_stalk_columns(plants, stalk_rows or []))
 
 
 # ------------------------------------------------------------------------------ tables
@@ -996,6 +1027,9 @@ def _print_tables(records: list[dict], sun: Sun | None, heights: tuple[float, ..
             _print_period(r, len(records) > 1)
     if "balance" in r0:
         _print_balance(records)
+    line = stalk_line(records)
+    if line:
+        print(line)
     if r0.get("photosynthesis"):
         _print_photosynthesis(records)
     print()
@@ -1159,7 +1193,8 @@ def _print_balance(records: list[dict]) -> None:
             f"{r['absorbed']['sunlit_lai']:.2f}"
         rows.append([r["level"], f"{b['incident']:.2f}", f"{b['absorbed_leaves']:.2f}",
                      f"{b['absorbed_ground']:.2f}", f"{b['reflected_top']:.2f}",
-                     f"{b['escaped_sides'] + b['unresolved']:.2f}", f"{b['closure']:+.4f}",
-                     last])
+                     f"{b['escaped_sides'] + b['unresolved']:.2f}",
+                     f"{b['closure_fraction']:+.2%}", last])
     print(fmt_table(["level", "incident", "leaves", "ground", "reflected", "other",
-                     "closure", "PAR mol/m2" if period else "sunlit LAI"], rows))
+                     "closure (of incident)", "PAR mol/m2" if period else "sunlit LAI"],
+                    rows))

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import queue
 import signal
 import sys
 import threading
@@ -53,20 +54,43 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 class _Emitter:
-    """Says one event: a JSON line (``--events json``) or, for the technician, its text."""
+    """Says one event: a JSON line (``--events json``) or, for the technician, its text.
+
+    JSON lines are written by a thread of their own: a program that reads them slowly (a
+    frozen window) or not at all (it has died) must never hold up the journal, so the loop that
+    writes each press to disk never waits on standard output.
+    """
 
     def __init__(self, as_json: bool):
         self.as_json = as_json
+        self._lines: queue.Queue = queue.Queue()
+        self._writer: threading.Thread | None = None
+        if as_json:
+            self._writer = threading.Thread(target=self._write, name="events", daemon=True)
+            self._writer.start()
 
     def __call__(self, kind: str, message: str = "", **more) -> None:
         if self.as_json:
-            print(json.dumps({"kind": kind, "message": message, **more}), flush=True)
+            self._lines.put(json.dumps({"kind": kind, "message": message, **more}))
         elif kind in ("note", "warning"):
             say(f"{kind}: {message}")
         elif kind in ("lost", "failed"):
             say(f"error: {message}")
         elif kind not in ("garbled", "live", "finished", "signal"):
             print(message, flush=True)
+
+    def _write(self) -> None:
+        while (line := self._lines.get()) is not None:
+            try:
+                print(line, flush=True)
+            except (OSError, ValueError):          # nobody reads any more: keep recording
+                return
+
+    def close(self, timeout: float = 5.0) -> None:
+        """Write what is queued (up to ``timeout`` s)."""
+        if self._writer is not None:
+            self._lines.put(None)
+            self._writer.join(timeout)
 
 
 def _check(args: argparse.Namespace) -> None:
@@ -134,6 +158,13 @@ def _loop(recorder: Recorder, emit: _Emitter) -> int:
 def run(args: argparse.Namespace) -> int:
     _check(args)
     emit = _Emitter(args.events == "json")
+    try:
+        return _record(args, emit)
+    finally:
+        emit.close()
+
+
+def _record(args: argparse.Namespace, emit: _Emitter) -> int:
     session = Session(args.out, args.cols, args.resume, args.reference_station)
     for message in session.messages:
         emit("note", message)

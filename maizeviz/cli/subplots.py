@@ -41,7 +41,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--density", type=NUMBER_ARG, default=1.0,
                    help="rays per cm2 of the sample rectangle (default 1)")
     p.add_argument("--rect", metavar="X0,Y0,X1,Y1", help="sample rectangle, cm (default: the "
-                                                           "field)")
+                                                           "central tile, as light's)")
     p.add_argument("--plant-light", metavar="CSV", help="write the light of every plant")
     p.add_argument("--workers", type=WHOLE_ARG, metavar="N",
                    help="worker processes of a local Dask cluster (default: one per core)")
@@ -51,6 +51,25 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--connect-timeout", type=NUMBER_ARG, default=CONNECT_TIMEOUT_S, metavar="S")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")
     p.set_defaults(run=run)
+
+
+def _field(field_leaves, args: argparse.Namespace, progress):
+    """The field surveyed plant chunk by plant chunk; a file that cannot be (records the
+    CSV reader must check, a plant's records apart: it ended in NotStreamable) refused in
+    one line naming the file and what reads it."""
+    from maizeviz.io.parquet import NotStreamable
+
+    try:
+        return field_leaves(args.points, args.strict, progress=progress)
+    except NotStreamable as exc:
+        why = str(exc).removeprefix(str(args.points)).lstrip(": ") or (
+            "its records need the CSV reader's checks (a missing value, a text cell or a "
+            "status column)")
+        raise MaizevizError(
+            f"{args.points}: {why}: sub-plots read a Parquet file plant by plant on every "
+            "worker, which needs each plant's records together as plain numbers; 'maizeviz "
+            "light' reads it whole, 'maizeviz convert' writes its checked records to a new "
+            "file") from None
 
 
 def run(args: argparse.Namespace) -> int:
@@ -88,7 +107,7 @@ def run(args: argparse.Namespace) -> int:
         raise MaizevizError(f"{args.points}: sub-plots read a Parquet points file, plant by "
                             "plant, on every worker (maizeviz convert writes one)")
     sun = Sun(args.sun_zenith, args.sun_azimuth)
-    field = FieldLeaves(args.points, args.strict, progress=Progress("reading the field"))
+    field = _field(FieldLeaves, args, Progress("reading the field"))
     layout = layout_for(field, parse_shape(args.tile or "1x1", "tile"),  # type: ignore[arg-type]
                         args.row_spacing,
                         args.plant_spacing,

@@ -134,3 +134,16 @@ class Sight:
                     prim[hit] = resolve(prim[hit], None)
             out[a + hit] = prim[hit]
         return out
+
+
+def default_place(canopy: Canopy) -> tuple[float, float]:
+    """Where an instrument is held unless told (x, y) cm: between the rows and between the
+    plants, next to the plant nearest the plot's middle (half a row spacing across, half a
+    plant spacing along), as one holds it in a plot: not against a stalk."""
+    lay = canopy.layout
+    x0, y0, x1, y1 = lay.bounds
+    cx, cy = (x0 + x1) / 2.0, (y0 + y1) / 2.0
+    if not lay.placements:
+        return cx, cy
+    near = min(lay.placements, key=lambda p: (p.x - cx) ** 2 + (p.y - cy) ** 2)
+    return near.x + lay.row_spacing / 2.0, near.y + lay.plant_spacing / 2.0

@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import base64
 from pathlib import Path
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
@@ -123,9 +122,18 @@ def _b64(arr: np.ndarray) -> str:
     return base64.b64encode(np.uint64(len(raw)).tobytes() + raw).decode("ascii")
 
 
+def _quoteattr(text: str) -> str:
+    """``text`` as an XML attribute value, quotes included (xml.sax.saxutils, which imports
+    urllib.request and with it http, email and ssl, imported only when a VTK file is
+    written)."""
+    from xml.sax.saxutils import quoteattr
+
+    return quoteattr(text)
+
+
 def _xml_array(name: str | None, a: np.ndarray, components: int = 1) -> str:
     a, (_, _, vtk_type) = _typed(a)
-    named = f" Name={quoteattr(name)}" if name is not None else ""
+    named = f" Name={_quoteattr(name)}" if name is not None else ""
     comps = f' NumberOfComponents="{components}"' if components > 1 else ""
     return (f'<DataArray type="{vtk_type}"{named}{comps} format="binary">'
             f'{_b64(a.astype(a.dtype.newbyteorder("<")))}</DataArray>')
@@ -146,7 +154,7 @@ def _write_xml(path: Path, pts: np.ndarray, faces: np.ndarray, cells: CellData,
         piece = f'NumberOfPoints="{len(pts)}" NumberOfCells="{n}"'
         types = _xml_array("types", np.full(n, 5, np.uint8))             # 5: VTK_TRIANGLE
         topology = f"<Cells>\n        {conn}\n        {offs}\n        {types}\n      </Cells>"
-    scalars = f" Scalars={quoteattr(next(iter(cells)))}" if cells else ""
+    scalars = f" Scalars={_quoteattr(next(iter(cells)))}" if cells else ""
     arrays = "\n        ".join(_xml_array(k, a) for k, a in cells.items())
     fields = "".join("\n    " + _xml_array(k, v).replace(
         "<DataArray ", f'<DataArray NumberOfTuples="{len(v)}" ', 1) for k, v in field.items())

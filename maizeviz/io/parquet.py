@@ -114,6 +114,7 @@ def read_parquet_table(path: str | Path, max_points: int = MAX_POINTS,
                               "GB of memory (split the file by plant)")
     if len(set(names)) != len(names):
         raise PointsFileError(f"{source}: columns named alike ('{shown(','.join(names), 80)}')")
+    _check_flat(pf.schema_arrow, source, pa)
     texts = [f.name for f in pf.schema_arrow if f.name.strip().lower() not in REQUIRED
              and _is_text(f.type, pa)]
     try:
@@ -123,17 +124,41 @@ def read_parquet_table(path: str | Path, max_points: int = MAX_POINTS,
     except (pa.ArrowException, OSError) as exc:
         raise PointsFileError(f"{source}: not a readable Parquet file ({exc})") from None
     _check_text_size(table, texts, source)
-    table = table.rename_columns(names)
+    # the points' columns (and status) by their lower-case names; the others keep theirs
+    table = table.rename_columns([n if n in (*REQUIRED, "status") else f.strip()
+                                  for n, f in zip(names, pf.schema_arrow.names)])
     got = _plain(table, pa)
     if got is not None:
         ids, xyz = got
-        extra = {n: [shown(str(v), 10**6) if v is not None else "" for v in
-                     table.column(n).to_pylist()] for n in names if n not in REQUIRED}
+        extra = {n: [_cell(v) for v in table.column(n).to_pylist()]
+                 for n in table.column_names if n not in REQUIRED}
         if not len(ids):
             raise PointsFileError(f"{source}: header only, no points")
         return PointsTable(ids=ids, xyz=xyz, line=np.arange(2, len(ids) + 2, dtype=np.int64),
                            extra=extra, source=source)
-    return _as_csv(table, pa)
+    return _as_csv(table, pa, source)
+
+
+def _cell(v) -> str:
+    """An extra column's value as the text a CSV holds: text as it is (blanks, tabs and
+    line ends kept), bytes as UTF-8, a missing value as empty."""
+    if v is None:
+        return ""
+    if isinstance(v, bytes):
+        return v.decode("utf-8", errors="replace")
+    return str(v)
+
+
+def _check_flat(schema, source: str, pa) -> None:
+    """Refuse a column of lists, structs, maps or unions, naming it: a points file's cells
+    are numbers or text (such a column ended in ArrowNotImplementedError when the table was
+    cast to text for the CSV reader's checks)."""
+    for f in schema:
+        t = f.type.value_type if pa.types.is_dictionary(f.type) else f.type
+        if pa.types.is_nested(t) or pa.types.is_union(t):
+            raise PointsFileError(f"{source}: column '{shown(f.name, 40)}' holds {t} values, "
+                                  "not numbers or text: a points file's columns hold one "
+                                  "number or text per record (flatten or drop it)")
 
 
 def _is_text(t, pa) -> bool:
@@ -199,12 +224,17 @@ def _plain(table, pa) -> tuple[np.ndarray, np.ndarray] | None:
     return ids, xyz
 
 
-def _as_csv(table, pa) -> str:
+def _as_csv(table, pa, source: str) -> str:
     """The table as CSV text, every column as text."""
     import pyarrow.csv as pacsv
 
     out = io.BytesIO()
-    strings = table.cast(pa.schema([(n, pa.string()) for n in table.column_names]))
+    try:
+        strings = table.cast(pa.schema([(n, pa.string()) for n in table.column_names]))
+    except (pa.ArrowNotImplementedError, pa.ArrowInvalid) as exc:   # a type without text
+        why = shown(str(exc), 80)
+        raise PointsFileError(f"{source}: a column cannot be read as text ({why}): a points "
+                              "file's columns hold numbers or text") from None
     pacsv.write_csv(strings, out, pacsv.WriteOptions(quoting_style="needed"))
     return out.getvalue().decode("utf-8", errors="replace")
 

@@ -273,17 +273,26 @@ class LineParser:
         if "," not in first:
             self.delimiter = ";" if ";" in first else ("\t" if "\t" in first else ",")
         fields = self._split(text)
-        header = [f.strip().lower() for f in fields]
+        names = [f.strip() for f in fields]
+        header = [n.lower() for n in names]
         missing = [c for c in REQUIRED if c not in header]
         if missing:
             found = shown(",".join(header), 80)
             raise PointsFileError(
                 f"{self.source}: line {lineno}: missing column(s) {', '.join(missing)}; "
                 f"a points file needs the header plant,leaf,row,col,x,y,z (found '{found}')")
+        named = [h for h in header if h]
+        if len(set(named)) != len(named):     # one of them would be lost
+            twice = sorted({h for h in named if named.count(h) > 1})
+            raise PointsFileError(f"{self.source}: line {lineno}: columns named alike "
+                                  f"('{shown(','.join(twice), 80)}'; names are read without "
+                                  "case): rename one")
         self.header = header
         self.header_line = lineno
         self.index = [header.index(name) for name in REQUIRED]
-        self.extra_index = {h: header.index(h) for h in header if h and h not in REQUIRED}
+        # extra columns by their own name (its case kept), their cells kept exactly
+        self.extra_index = {names[k]: k for k, h in enumerate(header)
+                            if h and h not in REQUIRED}
         self.extra = {h: [] for h in self.extra_index}
         self.status_col = header.index("status") if "status" in header else None
         self.journal = tuple(header) == JOURNAL_COLUMNS
@@ -451,7 +460,7 @@ class LineParser:
             except ValueError:
                 return ("bad", ((plant, leaf), f"row {row}, col {col} (line {lineno}): {axis} is "
                         f"not a number ('{shown(value)}')"), lineno)
-        extras = [fields[i].strip() for i in self.extra_index.values()]
+        extras = [fields[i] for i in self.extra_index.values()]
         return ("point", (plant, leaf, row, col, coords, extras), lineno)
 
     def _note(self, text: str) -> None:

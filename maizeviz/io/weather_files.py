@@ -380,7 +380,8 @@ def weather_place(path: str | Path) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``latitude``, ``longitude`` [deg], ``altitude`` [m] (None where absent) and ``name``.
+        ``latitude``, ``longitude`` [deg], ``altitude`` [m], ``utc_offset_h`` (the header's
+        time zone, hours east of UTC) (None where absent) and ``name``.
     """
     path = Path(path)
     try:
@@ -413,6 +414,8 @@ def _place(meta: dict) -> dict[str, Any]:
     for key in ("latitude", "longitude"):                # a header's NaN, named for the user
         if place[key] is None and key in meta and str(meta[key]).strip():
             place.setdefault("problem", f"the header's {key} is '{str(meta[key]).strip()}'")
+    offset = _number(meta, "TZ") if "TZ" in meta else _number(meta, "Time Zone")
+    place["utc_offset_h"] = offset if offset is not None and -14 <= offset <= 14 else None
     return place
 
 

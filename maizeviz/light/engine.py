@@ -71,8 +71,9 @@ class LightEngine:
         Sensor heights [cm], ray density [cm-2], sample rectangle [cm], periodic field and
         threads shared by every request (default: ``Sampling()``).
     with_stalks : bool
-        Stalks intercept light too (their triangles follow the leaves' in per-triangle
-        results).
+        Stalks intercept and scatter light like any organ (the default; their triangles
+        follow the leaves' in per-triangle results, their share is reported apart:
+        :mod:`maizeviz.light.results.stalks`); False: the paper's leaves-only canopy.
     **fields
         Fields of :class:`~maizeviz.light.scene.request.Sampling` replacing the sampling's:
         ``heights_cm``, ``density``, ``rect``, ``periodic``, ``threads``
@@ -96,7 +97,7 @@ class LightEngine:
     """
 
     def __init__(self, canopy: Canopy, sampling: Sampling | None = None, *,
-                 with_stalks: bool = False, **fields):
+                 with_stalks: bool = True, **fields):
         self.canopy = canopy
         self.sampling = self._sampling(sampling or Sampling(), fields)
         self.with_stalks = bool(with_stalks)

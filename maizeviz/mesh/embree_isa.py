@@ -24,19 +24,17 @@ from __future__ import annotations
 import ctypes
 import functools
 
-from maizeviz.environment import VARIABLES, word
 from maizeviz.errors import MaizevizError
 
-#: The environment variable naming one of :data:`ISAS` (unset or empty: the CPU's best),
-#: read by :func:`maizeviz.environment.word`.
-ENV = "MAIZEVIZ_EMBREE_ISA"
 #: The instruction sets an Embree 4 release build (as embreex's wheels vendor it) carries
 #: kernels for, lowest first, as its configuration string spells them.
-ISAS = VARIABLES[ENV].words
+ISAS = ("sse2", "sse4.2", "avx", "avx2", "avx512")
+#: The environment variable naming one of :data:`ISAS` (unset or empty: the CPU's best).
+ENV = "MAIZEVIZ_EMBREE_ISA"
 _PTR = ctypes.sizeof(ctypes.c_void_p)
 
 
-def check_isa(value: str | None, where: str = "the Embree instruction set") -> str | None:
+def check_isa(value: str | None, where: str = ENV) -> str | None:
     """``value`` as one of :data:`ISAS` (lower case; ``sse42`` read as ``sse4.2``), None for
     None or an empty text; else a MaizevizError naming ``where``."""
     if value is None or not value.strip():
@@ -50,10 +48,11 @@ def check_isa(value: str | None, where: str = "the Embree instruction set") -> s
 
 
 def requested() -> str | None:
-    """The instruction set ``MAIZEVIZ_EMBREE_ISA`` names, or None (unset or empty); a word it
-    does not take is refused in one line as every variable is
-    (:class:`maizeviz.environment.EnvironmentVariableError`)."""
-    return word(ENV) or None
+    """The instruction set ``MAIZEVIZ_EMBREE_ISA`` names (checked, as every variable, by
+    :mod:`maizeviz.environment`), or None."""
+    from maizeviz.environment import word
+
+    return word(ENV)
 
 
 def _new(lib, isa: str) -> int:

@@ -124,7 +124,8 @@ def split_assimilation(model: LeafModel, area_m2, sunlit_m2, direct_w, backgroun
     ----------
     model : LeafModel
     area_m2 : (F,) float64, triangle areas, m2 (one side)
-    sunlit_m2 : (F,) float64, area in the direct beam, m2 (an estimate: may exceed the area)
+    sunlit_m2 : (F,) float64, area in the direct beam, m2 (at most ``area_m2`` for the
+        gross to stay within the model's light-saturated rate)
     direct_w : (F,) float64, W of PAR absorbed from the direct beam (on the sunlit part)
     background_w : (F,) float64, W of PAR absorbed from everything else (spread evenly)
     temp_c : leaf temperature, C (scalar)
@@ -134,9 +135,10 @@ def split_assimilation(model: LeafModel, area_m2, sunlit_m2, direct_w, backgroun
     (F,) float64, umol CO2/s per triangle
     """
     area = np.asarray(area_m2, dtype=np.float64)
-    # not capped at the area: a triangle's sunlit area is a ray count (noisy), and the result
-    # is linear in it at the beam's exact flux, so its noise averages out over triangles;
-    # capping it would raise the flux of those capped and bias a concave response low
+    # the traced sunlit area is sampled from the triangle, at most its area
+    # (maizeviz.light.trace.sunlit); the result is linear in it at the beam's exact flux, so
+    # its noise averages out over triangles. Not capped here: capping a noisy estimate would
+    # raise the flux of those capped and bias a concave response low
     lit = np.maximum(np.asarray(sunlit_m2, dtype=np.float64), 0.0)
     direct = np.asarray(direct_w, dtype=np.float64)
     # a beam that reached a triangle lit it: no direct flux without sunlit area

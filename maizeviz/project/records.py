@@ -42,7 +42,7 @@ ABSORBED_KIND = "light_absorbed"
 KINDS = {SUN_KIND: "sun", SKY_KIND: "sky", DAY_KIND: "day", ABSORBED_KIND: "absorbed"}
 #: Balance fields of an absorbed-light record, W/m2 of ground.
 _BALANCE = ("incident", "absorbed_leaves", "absorbed_ground", "reflected_top",
-            "escaped_sides", "unresolved")
+            "escaped_sides", "unresolved", "absorbed_stalks")
 #: Arrays of a Sky, under the record's prefix.
 _SKY_ARRAYS = ("zenith_deg", "azimuth_deg", "solid_angle_sr", "weights")
 #: Arrays of a Period (each (n,) float64), stored as ``period_<name>``.
@@ -204,7 +204,10 @@ def absorbed_record(label: str, light, settings: dict | None = None) -> Record:
                        "ground_reflectance": float(o.ground_reflectance),
                        "ranks": [[int(r), float(a), float(b)] for r, a, b in o.ranks]},
             "irradiance_w_m2": float(light.irradiance_w_m2),
-            "balance": {k: float(getattr(light.balance, k)) for k in _BALANCE},
+            # absorbed_stalks only where stalks absorbed: a leaves-only result is written as
+            # before they took light
+            "balance": {k: float(getattr(light.balance, k)) for k in _BALANCE
+                        if k != "absorbed_stalks" or light.balance.absorbed_stalks},
             "rect": _floats(light.rect), "rays": int(light.rays),
             "directions": int(light.directions), "depth": int(light.depth),
             "threshold": float(light.threshold), "seed": int(light.seed),
@@ -606,7 +609,10 @@ def absorbed_from_record(rec: Record, where: str) -> tuple[str, Any, dict | None
                          _number(optics, "ground_reflectance", where, what, 0, 1), band,
                          _ranks(optics, at)),
             _number(m, "irradiance_w_m2", where, what, 0),
-            Balance(*(_number(balance, k, where, what) for k in _BALANCE)),
+            # absorbed_stalks: 0 in projects saved before stalks took light
+            Balance(*(_number(balance, k, where, what,
+                              default=0.0 if k == "absorbed_stalks" else ...)
+                      for k in _BALANCE)),
             absorbed, sunlit, (rect[0], rect[1], rect[2], rect[3]),
             get(m, "rays", int, where=at), get(m, "directions", int, where=at),
             get(m, "depth", int, where=at), _number(m, "threshold", where, what, 0, 1),

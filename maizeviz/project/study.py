@@ -212,7 +212,7 @@ def results_on(opened: Opened, layout: CanopyLayout, leaves: Sequence[Leaf] | No
         per-triangle array of another length than its canopy's triangles, named.
     """
     here = stands_identity(layout)
-    counts: dict[str, int | None] = {}
+    counts: dict[str, tuple[int, int] | None] = {}
     kept, notes = [], []
     edited = opened.project.layout is not None
     legacy_order = edited and "layout_placements" not in opened.project.arrays

@@ -1,5 +1,5 @@
-"""Absorbed light over a period (a day), with scattering: black leaves absorb exactly the
-PAR the day intercepts, the balance closes, and the command line reports MJ/m2 and mol/m2."""
+"""Absorbed light over a period (a day), with scattering: black leaves absorb the PAR the
+day intercepts (within the standard error of the sunlit share sampled from each triangle), the balance closes, and the command line reports MJ/m2 and mol/m2."""
 
 import json
 
@@ -21,12 +21,20 @@ def engine():
     return mv.LightEngine(canopy, density=0.3, heights_cm=(0.0, 100.0), periodic=True)
 
 
+def intercepts_what_the_day_does(black, day) -> bool:
+    """Black leaves' absorbed PAR (the direct beam sampled from each triangle) is the PAR the
+    day's rays intercept, within 4 of its standard errors."""
+    se = black.absorbed_leaves_error * 4.57                          # MJ -> mol of PAR
+    return abs(black.absorbed_leaves_mol_m2 - day.par_intercepted_mol_m2) < 4 * se
+
+
 def test_black_leaves_absorb_the_par_the_day_intercepts(engine):
     day = engine.day(**DAY)
     black = engine.absorbed_day(optics=Optics(0, 0, 0), **DAY)
-    assert black.absorbed_leaves_mol_m2 == pytest.approx(day.par_intercepted_mol_m2, rel=1e-12)
+    assert intercepts_what_the_day_does(black, day)
     assert black.balance.incident * 4.57 == pytest.approx(day.par_incident_mol_m2, rel=1e-12)
-    assert black.balance.reflected_top == 0.0 and black.balance.closure == pytest.approx(0.0)
+    assert black.balance.reflected_top == 0.0
+    assert abs(black.balance.closure) < 4 * black.absorbed_leaves_error / black.balance.incident
 
 
 def test_the_days_balance_closes_and_tables_add_up(engine):
@@ -49,7 +57,7 @@ def test_the_days_balance_closes_and_tables_add_up(engine):
 
 def test_a_day_at_altitude_with_its_par_factor_absorbs_what_it_intercepts(engine):
     """absorbed_day takes the period's altitude and PAR factor as day does: black leaves
-    absorb exactly the PAR the same day intercepts, PAR and NIR together are the shortwave,
+    absorb the PAR the same day intercepts, PAR and NIR together are the shortwave,
     and the higher site brings more light."""
     high = dict(DAY, altitude=1500.0, par_factor=2.0)
     day = engine.day(**high)
@@ -57,7 +65,7 @@ def test_a_day_at_altitude_with_its_par_factor_absorbs_what_it_intercepts(engine
     assert dict(black.period.parameters)["altitude_m"] == 1500.0
     assert black.period.par_umol_per_j == 2.0
     np.testing.assert_array_equal(black.period.ghi, day.period.ghi)
-    assert black.absorbed_leaves_mol_m2 == pytest.approx(day.par_intercepted_mol_m2, rel=1e-12)
+    assert intercepts_what_the_day_does(black, day)
     assert black.balance.incident * 4.57 == pytest.approx(day.par_incident_mol_m2, rel=1e-12)
     nir = engine.absorbed_day(band="nir", optics=Optics(0, 0, 0, "nir"), **high)
     shortwave_mj = float(np.sum(day.period.ghi * day.period.step_s)) * 1e-6
@@ -97,7 +105,7 @@ def test_a_perez_day_moves_the_circumsolar_light_to_the_sun(engine):
     day = engine.day(sky="perez", **DAY)
     assert perez.balance.incident == pytest.approx(soc.balance.incident, rel=1e-12)
     assert perez.balance.absorbed_leaves != soc.balance.absorbed_leaves
-    assert perez.absorbed_leaves_mol_m2 == pytest.approx(day.par_intercepted_mol_m2, rel=1e-9)
+    assert intercepts_what_the_day_does(perez, day)
 
 
 @pytest.mark.parametrize("extra, says", [

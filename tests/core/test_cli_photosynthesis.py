@@ -106,12 +106,18 @@ def test_precision_traces_denser_until_the_standard_error_is_met(capsys):
     assert prec["met"] and prec["passes"] >= 2 and prec["density_per_cm2"] > 0.1
     assert ph["canopy_gross_umol_m2_s_se"] / ph["canopy_gross_umol_m2_s"] == pytest.approx(
         prec["relative_se"], rel=1e-9) and prec["relative_se"] <= 0.004
-    assert "precision: relative standard error" in err
+    assert "precision: relative standard error" in err and "bias from the density" in err
+    # the bias check beside the standard error: estimated from halves of the same rays
+    assert prec["bias_met"] and prec["noise_met"]
+    assert prec["relative_bias"] == pytest.approx(
+        ph["canopy_gross_umol_m2_s_bias"] / ph["canopy_gross_umol_m2_s"], rel=1e-9)
+    assert abs(prec["relative_bias"]) + 2 * prec["relative_bias_se"] <= 0.004
     # absorbed light alone: the leaves' absorbed light is the figure
     code, out, err = run_cli(capsys, *cli_args(band="par", density=0.1, precision=0.02))
     rec = json.loads(out)
     assert rec["precision"]["relative_se"] == pytest.approx(
         rec["absorbed"]["absorbed_leaves_se"] / rec["balance"]["absorbed_leaves"], rel=1e-9)
+    assert rec["precision"]["relative_bias"] == 0.0          # linear in the rays: none
 
 
 def test_a_precision_that_cannot_be_met_is_said(capsys, monkeypatch):

@@ -4,6 +4,7 @@ header, line and cells, the options as typed."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -290,3 +291,248 @@ def test_a_projects_per_triangle_array_of_another_length_is_refused_at_read(
             f"canopy) or {n + stalks:,}")
     assert said in msg and "\n" not in msg, msg
     assert "first_hits" in msg if name == "first_hits" else name in msg
+
+
+# ------------------------------------------------------------------------------ extra columns
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+#: Text a cell may hold: any character but NUL (a zero byte marks a binary file) and the
+#: surrogates (no UTF-8 for them).
+CELL = st.text(st.characters(exclude_categories=("Cs",), exclude_characters="\x00"),
+               max_size=12)
+
+
+def _points_rows(n: int):
+    """n points of one 2 x ceil(n/2) leaf grid: (plant, leaf, row, col, x, y, z)."""
+    return [(1, 1, k % 2, k // 2, 0.5 * k, 1.0 + k, 10.0 + k) for k in range(n)]
+
+
+@settings(max_examples=60, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture,
+                                 HealthCheck.too_slow])
+@given(texts=st.lists(st.tuples(CELL, CELL), min_size=4, max_size=8))
+def test_extra_columns_survive_convert_both_ways_exactly(tmp_path, texts):
+    """Blanks, tabs, newlines, quotes, commas: the CSV reader stripped blanks and tabs, the
+    Parquet path wrote a newline as the two characters \\n (convert and back: 384 records
+    of 7,650 changed)."""
+    import csv
+
+    from maizeviz.io.points import read_points
+
+    src = tmp_path / "p.csv"
+    with open(src, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow(["plant", "leaf", "row", "col", "x", "y", "z", "Note", "operator"])
+        for row, (a, b) in zip(_points_rows(len(texts)), texts):
+            w.writerow([*row, a, b])
+    want = {"Note": [a for a, _ in texts], "operator": [b for _, b in texts]}
+    assert read_points(src).extra == want
+    pq_path, back = tmp_path / "o.parquet", tmp_path / "back.csv"
+    for out, source in ((pq_path, src), (back, pq_path)):
+        if out.exists():
+            out.unlink()
+        assert main(["convert", str(source), "--out", str(out)]) == EXIT_OK
+        assert read_points(out).extra == want, out.name
+
+
+def _parquet(tmp_path, name: str, columns: dict) -> Path:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    out = tmp_path / name
+    pq.write_table(pa.table(columns), out)
+    return out
+
+
+def _plain_columns(n: int = 8) -> dict:
+    rows = _points_rows(n)
+    return {name: [r[k] for r in rows] for k, name in
+            enumerate(("plant", "leaf", "row", "col", "x", "y", "z"))}
+
+
+@pytest.mark.parametrize("how", ["x as list", "nested extra with a NaN x", "struct extra"])
+def test_a_parquet_column_of_lists_or_structs_is_one_line(tmp_path, capsys, how):
+    """It ended in ArrowNotImplementedError (the table cast to text)."""
+    cols = _plain_columns()
+    if how == "x as list":
+        cols["x"] = [[v] for v in cols["x"]]
+    elif how == "nested extra with a NaN x":
+        cols["x"][3] = math.nan
+        cols["tags"] = [[1.0, 2.0]] * len(cols["x"])
+    else:
+        cols["who"] = [{"name": "a", "n": k} for k in range(len(cols["x"]))]
+    path = _parquet(tmp_path, "nested.parquet", cols)
+    code = main(["leaf", str(path)])
+    err = capsys.readouterr().err
+    assert code == EXIT_FAIL and "Traceback" not in err and "internal error" not in err, err
+    last = err.strip().splitlines()[-1]
+    assert last.startswith("error:") and "not numbers or text" in last, err
+
+
+@pytest.mark.parametrize("how", ["nan x", "null plant", "text cell", "status column",
+                                 "interleaved plants"])
+def test_subplots_on_a_parquet_file_needing_the_csv_checks_is_one_line(tmp_path, capsys, how):
+    """It ended in NotStreamable (an internal error) where light reads the file."""
+    lines = Path(B).read_text().splitlines()
+    rows = [ln.split(",") for ln in lines[1:] if ln[:1].isdigit()]
+    cols = {name: [float(r[k]) if k >= 4 else int(r[k]) for r in rows] for k, name in
+            enumerate(("plant", "leaf", "row", "col", "x", "y", "z"))}
+    if how == "nan x":
+        cols["x"][5] = math.nan
+    elif how == "null plant":
+        cols["plant"] = [None if k == 5 else v for k, v in enumerate(cols["plant"])]
+    elif how == "text cell":
+        cols["y"] = [str(v) for v in cols["y"]]
+    elif how == "status column":
+        cols["status"] = ["ok"] * len(cols["x"])
+    else:
+        order = sorted(range(len(cols["x"])), key=lambda k: (k % 2, k))
+        cols = {n: [v[k] for k in order] for n, v in cols.items()}
+    path = _parquet(tmp_path, "f.parquet", cols)
+    code = main(["subplots", str(path), "--parts", "1x1", "--level", "16", "--sun-zenith",
+                 "30", "--sun-azimuth", "180", "--workers", "1"])
+    err = capsys.readouterr().err
+    assert code == EXIT_FAIL and "internal error" not in err, err
+    last = err.strip().splitlines()[-1]
+    assert last.startswith("error:") and str(path) in last and "'maizeviz light'" in last, err
+
+
+# ------------------------------------------------------------------------------ the class
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _variables_read() -> dict[str, list[str]]:
+    """Every MAIZEVIZ_* name in the package's and the app's code (comments and docstrings
+    too: a name documented is a name someone sets), with the files naming it."""
+    import re
+
+    found: dict[str, list[str]] = {}
+    for folder in ("maizeviz", "app", "scripts"):
+        for path in sorted((ROOT / folder).rglob("*")):
+            if path.suffix not in (".py", ".sh", ".c") or ".venv" in path.parts:
+                continue
+            for name in set(re.findall(r"\bMAIZEVIZ_[A-Z][A-Z0-9_]*", path.read_text(
+                    encoding="utf-8", errors="replace"))):
+                found.setdefault(name, []).append(str(path.relative_to(ROOT)))
+    return found
+
+
+def test_every_environment_variable_read_has_a_checked_parser():
+    """The class behind MAIZEVIZ_FIELD_POINTS=abc's traceback: every variable is in
+    maizeviz.environment, read through its readers, and nothing else reads one."""
+    import re
+
+    from maizeviz import environment
+    from maizeviz.mesh.embree_isa import ISAS
+
+    found = _variables_read()
+    assert set(found) <= set(environment.VARIABLES), \
+        f"read without a parser in maizeviz/environment.py: {set(found) - set(environment.VARIABLES)}"
+    assert set(environment.VARIABLES) <= set(found) - {"MAIZEVIZ_"}
+    # nothing reads one around the module: no os.environ / getenv of a MAIZEVIZ_ name
+    direct = re.compile(r"(environ\.get|environ\[|getenv)\(?\s*[\"']MAIZEVIZ_")
+    for folder in ("maizeviz", "app"):
+        for path in (ROOT / folder).rglob("*.py"):
+            if path.name == "environment.py":
+                continue
+            text = path.read_text(encoding="utf-8")
+            assert not direct.search(text), f"{path} reads a MAIZEVIZ_ variable itself"
+    assert set(environment.VARIABLES["MAIZEVIZ_EMBREE_ISA"].words.values()) == set(ISAS)
+    assert set(environment.READERS) == {v.kind for v in environment.VARIABLES.values()}
+
+
+@settings(max_examples=80, deadline=None)
+@given(name=st.sampled_from(sorted(__import__("maizeviz.environment").environment.VARIABLES)),
+       value=st.text(st.characters(exclude_categories=("Cs",), exclude_characters="\x00"),
+                     max_size=10))
+def test_any_value_of_any_variable_is_its_value_or_one_line(name, value):
+    import os
+
+    from maizeviz import environment
+
+    var = environment.VARIABLES[name]
+    old = os.environ.get(name)
+    os.environ[name] = value
+    try:
+        got = environment.READERS[var.kind](name)
+    except environment.EnvironmentVariableError as exc:
+        msg = str(exc)
+        assert msg.startswith(f"{name}=") and "\n" not in msg and exc.quantity == name
+    else:
+        if var.kind == "whole":
+            assert isinstance(got, int) and got >= var.low
+            assert not var.choices or got in var.choices
+        elif var.kind == "switch":
+            assert isinstance(got, bool)
+        else:
+            assert got is None or got in var.words.values()
+    finally:
+        if old is None:
+            os.environ.pop(name, None)
+        else:
+            os.environ[name] = old
+
+
+# ------------------------------------------------------------------------------ smaller
+def test_info_lists_the_declared_dependencies_as_declared():
+    """--info omitted plyfile and listed pyarrow (required) as optional."""
+    import re
+    import tomllib
+
+    from maizeviz.info import OPTIONAL, REQUIRED
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+
+    def names(reqs):
+        out = []
+        for r in reqs:
+            name, extras = re.match(r"\s*([A-Za-z0-9._-]+)(\[[^\]]*\])?", r).groups()
+            out.append(name)
+            if extras:                                  # dask[distributed]: distributed too
+                out += [e.strip() for e in extras[1:-1].split(",")]
+        return out
+
+    required = names(project["dependencies"])
+    extras = project["optional-dependencies"]
+    optional = [n for n in names(extras["gui"] + extras["sweep"]) if n not in required]
+    assert len(set(REQUIRED)) == len(REQUIRED) and set(REQUIRED) == set(required)
+    assert len(set(OPTIONAL)) == len(OPTIONAL) and set(OPTIONAL) == set(optional)
+    info = _headless("--info")
+    assert "plyfile" in info.stdout, info.stdout
+
+
+def test_subplots_help_says_rect_defaults_to_the_central_tile():
+    """It said 'the field'; the code and docs/cli.md take the central tile."""
+    import contextlib
+    import io
+
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), pytest.raises(SystemExit):
+        main(["subplots", "--help"])
+    text = " ".join(out.getvalue().split())
+    assert "(default: the central tile" in text and "(default: the field)" not in text
+
+
+def test_a_precision_beyond_reach_says_the_target_in_enough_digits(capsys):
+    """--precision 1e-6 stopped at 1,024 rays/cm2 with '0.00% asked for'."""
+    code = main(["light", B, "--triangles", "4", "--heights", "0", "--sun-zenith", "30",
+                 "--sun-azimuth", "180", "--precision", "1e-6", "--rect", "60,30,70,40"])
+    err = capsys.readouterr().err
+    assert code == EXIT_OK, err
+    assert "above the 0.0001% asked for" in err and "0.00%" not in err, err
+
+
+def test_the_docs_say_what_meshio_reads_of_a_legacy_vtk(tmp_path):
+    """docs/cli.md said meshio reads the plot and period from a legacy .vtk; meshio 5.3.5
+    drops its FIELD data (VTK and pyvista read it)."""
+    import meshio
+    import pyvista
+
+    path = tmp_path / "c.vtk"
+    assert main(["canopy", B, "--triangles", "4", "--export", str(path)]) == EXIT_OK
+    assert "field_cm" in pyvista.read(path).field_data
+    dropped = "field_cm" not in meshio.read(path).field_data
+    row = next(ln for ln in (ROOT / "docs" / "cli.md").read_text().splitlines()
+               if ln.startswith("| `.vtk` (legacy VTK"))
+    assert ("meshio's legacy reader drops FIELD data" in row) == dropped, row

@@ -309,7 +309,8 @@ def test_wrong_port_then_right_port_without_resume(sim, tmp_path):
                           str(tmp_path / "no-such-port"), "--out", str(out), "--cols", "3"],
                          capture_output=True, text=True, timeout=30)
     assert bad.returncode == 1 and "no serial port" in bad.stderr
-    assert out.read_bytes() == HEADER                   # the failed start left its header
+    assert not out.exists()                             # a failed start leaves no file
+    assert "was not kept (nothing was recorded in it)" in bad.stderr
     assert not lock_path(out).exists()
     r = Recorder(sim.path, out)                          # no --resume, no fight
     r.expect("ready")

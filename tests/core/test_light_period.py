@@ -147,7 +147,10 @@ def test_cli_day_prints_the_period_and_writes_every_file(block, tmp_path, capsys
     assert 0.5 < p["fraction_intercepted"] < 1
     tb = p["transmission_by_height"]
     assert tb["heights_cm"] == [0.0, 100.0, 300.0] and tb["fraction"][2] == 1.0
-    assert p["par_intercepted_mol_m2"] + tb["par_mol_m2"][0] == pytest.approx(
+    # leaves, stalks (on by default) and the ground take the whole of it
+    stalks = data["stalks"]["par_intercepted_mol_m2"]
+    assert stalks > 0
+    assert p["par_intercepted_mol_m2"] + stalks + tb["par_mol_m2"][0] == pytest.approx(
         p["par_incident_mol_m2"], rel=1e-9)
     d = data["diffuse"]
     assert d["directions"] == 6 and math.fsum(d["weights"]) == 1.0

@@ -665,14 +665,14 @@ def test_degenerate_triangles_are_kept_and_said(tmp_path):
     assert any("2 of the 6 leaf triangles have no area (first: face 5" in n for n in notes)
 
 
-def test_stalks_intercept_only_when_asked(tmp_path, capsys):
-    """Leaf 0 is the stalk: out of the leaves, in the light only with --with-stalks."""
+def test_stalks_intercept_unless_leaves_only(tmp_path, capsys):
+    """Leaf 0 is the stalk: out of the leaves, in the light unless --leaves-only."""
     verts = np.vstack([V[:8], [[20, 0, 0], [30, 0, 0], [30, 10, 0.5], [20, 10, 0.5]]])
     faces = F[:4] + [[8, 9, 10], [8, 10, 11]]
     p = write_ply(tmp_path / "s.ply", verts, faces,
                   {"plant": [3, 3, 7, 7, 7, 7], "leaf": [2, 2, 5, 5, 0, 0]})
     runs = []
-    for extra in ([], ["--with-stalks"]):
+    for extra in (["--leaves-only"], []):
         assert main(["light", str(p), "--mesh-unit", "cm", "--sun-zenith", "0",
                      "--sun-azimuth", "0", "--heights", "0", "--density", "4", "--json",
                      *extra]) == EXIT_OK

@@ -44,6 +44,25 @@ def _errors(model) -> list[str]:
     return [t for t in model.said_lines if t.startswith("error")]
 
 
+def test_a_script_draws_no_figure(points):
+    """compute_light in a script draws no heatmap or plot: matplotlib is not even imported
+    (the window sets draw_figures, since it shows them)."""
+    code = ("import sys\n"
+            "from maizeviz_app.model import StudyModel\n"
+            "from maizeviz_app.runner import InlineRunner\n"
+            "if __name__ == '__main__':\n"
+            "    r = InlineRunner(); m = StudyModel(tile=1, runner=r)\n"
+            f"    m.open_points({str(points)!r})\n"
+            "    m.settings.sampling.heights = '0, 100'\n"
+            "    ok = m.compute_light() and m.runs.of_kind('sun') is not None\n"
+            "    r.shutdown()\n"
+            "    bad = sorted(n for n in sys.modules if n.split('.')[0] == 'matplotlib')\n"
+            "    print(ok, bad[:3]); sys.exit(0 if ok and not bad else 1)\n")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stdout + proc.stderr[-3000:]
+
+
 def test_the_model_and_its_actions_run_without_qt():
     code = ("import sys, maizeviz_app.model, maizeviz_app.runner, maizeviz_app.settings; "
             "m = maizeviz_app.model.StudyModel(runner=maizeviz_app.runner.InlineRunner()); "
@@ -82,7 +101,15 @@ def test_a_whole_study_through_the_model(study, points, tmp_path):
                                     sampling=s.sampling_spec())
     np.testing.assert_array_equal(run.transmission, own.transmission)
     assert run.classes is not None and len(run.classes) == m.canopy.n_triangles
-    assert m.modified and m.figures.plot is not None and len(m.figures.maps["sun"]) == 3
+    assert m.modified and m.figures.plot is None and not m.figures.maps   # none drawn
+    m.draw_figures = True                                      # as the window draws them
+    shown = []
+    m.light_shown.connect(lambda: shown.append(m.figures.plot))
+    assert m.compute_light() and not _errors(m)
+    assert shown and shown[-1] is not None and len(m.figures.maps["sun"]) == 3
+    assert m.figures.maps["sun"][0][1] is not None             # the height shown drawn
+    np.testing.assert_array_equal(m.runs.of_kind("sun").transmission, run.transmission)
+    run = m.runs.of_kind("sun")
     # ---- a day: PAR transmitted between 0 and 1, never less light higher up
     s.light.mode = "day"
     s.day.step_min, s.day.start, s.day.end = 120.0, "10:00", "14:00"
@@ -185,19 +212,25 @@ def test_the_scripting_example_of_docs_app_runs(tmp_path):
 WEATHER = __import__("pathlib").Path(__file__).parents[1] / "data" / "weather"
 
 
-@pytest.mark.parametrize("name, lat, lon", [("pvgis_tmy_45N_8E_july.epw", 45.0, 8.0),
-                                            ("tmy3_703165_july.csv", 55.317, -160.517),
-                                            ("psm3_401182_july.csv", 40.53, -108.54)])
-def test_a_weather_file_chosen_brings_its_place(study, name, lat, lon):
+@pytest.mark.parametrize("name, lat, lon, tz", [
+    ("pvgis_tmy_45N_8E_july.epw", 45.0, 8.0, "Etc/GMT-1"),
+    ("tmy3_703165_july.csv", 55.317, -160.517, "Etc/GMT+9"),
+    ("psm3_401182_july.csv", 40.53, -108.54, "Etc/GMT+7")])
+def test_a_weather_file_chosen_brings_its_place_and_zone(study, name, lat, lon, tz):
     """Choosing an EPW, TMY3 or PSM file sets the day's place to its header's (the app's
-    default place is Beijing: a sun traced there would not match the file's irradiance)."""
+    default place is Beijing: a sun traced there would not match the file's irradiance), and
+    its time zone to the header's (issue 37 item 2: it kept Beijing's, and the day then warned
+    about a zone the user never typed); one undo step puts all back."""
     day = study.settings.day
+    before = (day.latitude, day.longitude, day.tz)
     assert (day.latitude, day.longitude) != (lat, lon)
     study.choose_weather(str(WEATHER / name))
     assert day.source == "weather" and day.weather.endswith(name)
-    assert (day.latitude, day.longitude) == (lat, lon)
+    assert (day.latitude, day.longitude, day.tz) == (lat, lon, tz)
     assert any(t.startswith(f"place: latitude {lat:g}, longitude {lon:g}")
-               for t in study.said_lines)
+               and f"time zone {tz}" in t for t in study.said_lines)
+    study.history.undo()
+    assert (day.latitude, day.longitude, day.tz) == before
 
 
 def test_a_weather_csv_keeps_the_place_set(study, tmp_path):
@@ -242,12 +275,22 @@ def test_a_whole_study_with_c4_edits_and_named_undo_steps(study, points, tmp_pat
     assert m.compute_light() and not _errors(m)
     first = _numbers(m.runs.of_kind("sun"))
     assert first["canopy"] > 0 and len(first["plants"]) == len(m.loaded.layout.placements)
+    # ---- the view's state: coloured by the new light, then by its CO2 when asked
+    assert m.view.colouring == "light"
+    assert m.colour_view_by("assimilation") and m.view.colouring == "assimilation"
+    cameras = []
+    m.view.events.camera.connect(lambda name, *_: cameras.append(name))
+    m.view.ask_camera("top")
+    m.view.ask_camera("top")                                  # asked again: framed again
+    assert cameras == ["top", "top"] and m.view.camera == "top"
     assert sum(p[2] for p in first["plants"]) > 0
     # ---- the layout edited as the panel edits it: the model applies it and rebuilds
     placements = m.loaded.layout.placements
     with m.history.step("turn the first plant"):
         assert m.draft.turn(0, 90.0)
     assert m.loaded.layout.placements[0].azimuth_deg == 90.0 and not m.runs.runs
+    assert m.view.colouring == "leaf"                         # no light on this canopy
+    assert not m.colour_view_by("light") and "no light result" in m.said_lines[-1]
     assert m.built.serial == m.serial and m.canopy.layout.placements[0].azimuth_deg == 90.0
     # ---- undo the edit and the level, by their names; redo them
     assert m.history.undo_text == "turn the first plant"
@@ -294,3 +337,92 @@ def test_a_whole_study_with_c4_edits_and_named_undo_steps(study, points, tmp_pat
         assert back["canopy"] == pytest.approx(edited["canopy"], rel=1e-12)
     finally:
         runner2.shutdown()
+
+
+def test_a_removed_plant_then_sun_and_c4_warns_as_the_command_line_does(points):
+    """Issue 37, item 3: on a tiled field edited so that its sample rectangle (the central
+    tile) is no longer a tile of a periodic field, the command line warns that the
+    assimilation of leaves outside the rays' reach is understated; the study says it too,
+    and the light panel's text carries it."""
+    from maizeviz_app.model import StudyModel
+    from maizeviz_app.runner import InlineRunner
+    from maizeviz_app.runs import run_info
+
+    runner = InlineRunner()
+    m = StudyModel(tile=3, runner=runner)
+    said: list[str] = []
+    m.said.connect(lambda text, error, status_only: said.append(text))
+    m.said_lines = said                                   # type: ignore[attr-defined]
+    s = m.settings
+    s.canopy.level = "8"
+    m.open_points(points)
+    s.sampling.heights, s.sampling.density, s.sampling.periodic = "0, 100", 1.0, True
+    s.optics.enabled = True
+    s.photosynthesis.model = "c4"
+    assert m.compute_light() and not _errors(m)
+    run = m.runs.of_kind("sun")
+    assert not run.extra.assimilation.warnings
+    with m.history.step("remove a plant"):
+        assert m.draft.remove(0)
+    assert m.compute_light()
+    run = m.runs.of_kind("sun")
+    expected = run.extra.assimilation.warnings
+    assert expected and "understated" in expected[0]       # the core's own warning
+    said_now = [t for t in said if t.startswith("warning: CO₂ assimilation:")]
+    assert said_now and expected[0] in said_now[-1]
+    assert expected[0] in run_info(run)
+    runner.shutdown()
+
+
+def test_a_points_file_with_a_bad_value_is_named_by_its_line(study, tmp_path):
+    """Issue 37, item 4: a points CSV whose x is 'abc' was refused by asking for the columns
+    the file has; the study names line 2 and the value, as the command line does, and asks
+    for that line to be corrected."""
+    path = tmp_path / "abc.csv"
+    path.write_text("plant,leaf,row,col,x,y,z\n1,1,0,0,abc,2,3\n1,1,0,1,1,2,3\n")
+    study.open_points(path)
+    errors = _errors(study)
+    assert errors and "line 2" in errors[-1] and "x is not a number ('abc')" in errors[-1]
+    assert "columns" not in errors[-1] and "correct that line" in errors[-1].lower()
+
+
+def test_a_reopened_c4_project_has_its_co2_row_and_colouring(study, points, tmp_path):
+    """Issue 37, item 6: a project saved after a sun with C4, coloured by CO2, reopened
+    without its canopy's gross CO2 row in the results table and coloured by absorbed PAR;
+    both come back now."""
+    from maizeviz_app.model import StudyModel
+    from maizeviz_app.runner import InlineRunner
+    from maizeviz_app.runs import ASSIMILATION_ROW
+
+    m, s = study, study.settings
+    m.open_points(points)
+    s.sampling.heights, s.sampling.density, s.sampling.periodic = "0, 100", 1.0, True
+    s.optics.enabled = True
+    s.photosynthesis.model = "c4"
+    assert m.compute_light() and not _errors(m)
+    m.view.colouring = "assimilation"
+    _, rows = m.runs.table()
+    assert any(r[0] == ASSIMILATION_ROW for r in rows)
+    path = tmp_path / "c4.maizeviz"
+    assert m.save_project(path)
+    runner2 = InlineRunner()
+    try:
+        m2 = StudyModel(tile=1, runner=runner2)
+        tables: list = []
+        m2.runs_changed.connect(lambda runs, info: tables.append(runs.table()[1]))
+        m2.open_project(path)
+        assert m2.runs.of_kind("sun").extra.assimilation is not None
+        assert any(r[0] == ASSIMILATION_ROW for r in tables[-1])
+        assert m2.view.colouring == "assimilation"
+    finally:
+        runner2.shutdown()
+
+
+def test_a_duplicate_is_named_as_a_duplicate_in_the_history(study, points):
+    """Issue 37, item 8: the history named a Duplicate "add plant 1"."""
+    study.open_points(points)
+    assert study.draft.duplicate(0)
+    plant = study.loaded.layout.placements[0].plant
+    assert study.history.undo_text == f"duplicate plant {plant} (row 1)"
+    assert study.draft.add(500.0, 500.0)
+    assert study.history.undo_text.startswith("add plant")

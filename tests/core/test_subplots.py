@@ -58,7 +58,9 @@ def split(canopy, sun, parts, density):
 def test_sub_plots_add_up_to_the_whole_field(canopy, zenith, azimuth, parts):
     density = 0.5
     sun = Sun(zenith, azimuth)
-    whole = LightEngine(canopy, heights_cm=HEIGHTS, density=density).sun(sun, classes=True)
+    # sub-plots trace the leaves (the paper's canopy): the whole field traced leaves-only
+    whole = LightEngine(canopy, heights_cm=HEIGHTS, density=density,
+                        with_stalks=False).sun(sun, classes=True)
     expect = whole_counts(canopy, whole.first_hits, whole.second_hits, whole.transmission,
                           whole.rays)
     got, sizes = split(canopy, sun, parts, density)
@@ -110,7 +112,8 @@ def test_on_dask_workers_each_building_its_plants_from_the_file(tmp_path, capsys
     level = parse_level("36")
     canopy = canopy_of(field, layout, level)
     sun = Sun(30.0, 160.0)
-    whole = LightEngine(canopy, heights_cm=HEIGHTS, density=0.5).sun(sun, classes=True)
+    whole = LightEngine(canopy, heights_cm=HEIGHTS, density=0.5,
+                        with_stalks=False).sun(sun, classes=True)
     expect = whole_counts(canopy, whole.first_hits, whole.second_hits, whole.transmission,
                           whole.rays)
     with dask_client(workers=2) as (client, _):

@@ -156,7 +156,7 @@ def test_other_tilings_and_stalks(leaves):
 
 def test_the_engine_traces_the_block_and_says_so(tiled):
     c, whole, _ = tiled
-    eng = LightEngine(c, periodic=True, density=1.0)
+    eng = LightEngine(c, periodic=True, density=1.0, with_stalks=False)   # as ``whole``
     assert isinstance(eng.scene(), BlockScene)
     sun = eng.sun(zenith=30, azimuth=200)
     ref = trace_light(c, LightRequest(Sun(30, 200), Sampling(density=1.0, periodic=True)),

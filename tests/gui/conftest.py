@@ -4,6 +4,7 @@ Panels are tested as widgets over their models on a small canopy (two synthetic 
 tests drive the whole window on the bundled example.
 """
 
+import gc
 import os
 import tempfile
 import threading
@@ -100,6 +101,8 @@ def viewport(qtbot):
     qtbot.wait(100)
     yield v
     v.close()
+    del v
+    gc.collect()        # the view finalized on the GUI thread, not in a later thread's collection
 
 
 @pytest.fixture(autouse=True)

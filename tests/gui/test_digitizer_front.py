@@ -74,7 +74,9 @@ def _failed_connect(qtbot, panel, port, out):
         panel.connect_button.click()
     assert stopped.args == ["could not connect"]
     assert panel.band.state == "error" and panel.connect_button.isEnabled()
+    assert not out.exists() and not out.with_name(f".{out.name}.lock").exists()   # no junk
     Session(out, 3).close()                   # the journal is free, and still holds no point
+    out.unlink()
     return panel.band.message.text()
 
 

@@ -1,6 +1,8 @@
 """The digitizer panel as a technician with gloves uses it: a real (simulated) FASTRAK on a pty,
 the panel's reader and timer, the journal on disk, the 3D view of the growing plant."""
 
+import gc
+
 import numpy as np
 import pytest
 from PySide6.QtCore import Qt
@@ -25,6 +27,11 @@ def viewport(qtbot):
     qtbot.waitExposed(vp)
     yield vp
     vp.close()
+    # collected here, on the GUI thread: a view left to the cyclic collector was finalized
+    # (its OpenGL context destroyed) in whatever thread ran the next collection, such as a
+    # later window's warm-up thread, and the process aborted
+    del vp
+    gc.collect()
 
 
 @pytest.fixture

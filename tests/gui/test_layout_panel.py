@@ -341,3 +341,30 @@ def test_every_layout_control_has_a_name_and_a_tip(panel):
     for c in controls:
         assert c.toolTip(), c
         assert c.accessibleName(), c
+
+
+def test_delete_removes_a_plant_only_from_the_layout_editor(window, two_plants, qtbot):
+    """Issue 37, item 5: with a plant picked in the Layout panel and the focus in the 3D view,
+    Delete removed a plant (the Remove button's shortcut was the whole window's); now Delete
+    acts where the focus is: in the layout editor it removes the picked plant."""
+    w = window(two_plants, tile=1)
+    qtbot.waitSignal(w.canopy_shown, timeout=120_000).wait()
+    from PySide6.QtWidgets import QApplication
+
+    w.show()
+    qtbot.waitExposed(w)
+    w.activateWindow()
+    qtbot.waitUntil(lambda: QApplication.activeWindow() is w, timeout=5000)
+    panel = w.layout_panel
+    panel.select(0)
+    assert panel.rows.rowCount() == 2
+    view = w.viewport
+    view.setFocus()
+    qtbot.waitUntil(view.hasFocus, timeout=2000)
+    qtbot.keyClick(view, Qt.Key.Key_Delete)
+    qtbot.wait(200)
+    assert panel.rows.rowCount() == 2                    # nothing removed from the 3D view
+    panel.view.setFocus()
+    qtbot.waitUntil(panel.view.hasFocus, timeout=2000)
+    qtbot.keyClick(panel.view, Qt.Key.Key_Delete)
+    qtbot.waitUntil(lambda: panel.rows.rowCount() == 1, timeout=2000)

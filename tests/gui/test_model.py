@@ -6,6 +6,7 @@ from __future__ import annotations
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 from maizeviz_app.jobs import load_points
 from maizeviz_app.model import StudyModel
@@ -159,7 +160,34 @@ def test_the_digitizer_connection_is_a_setting_of_the_study(window, qtbot):
     assert settings.port == d.port and settings.baud == d.baud.value()
     settings.port, settings.baud = "/dev/ttyS7", 9600          # set by a script: shown
     assert d.port == "/dev/ttyS7" and d.baud.value() == 9600
+    assert d.ports.baud == 9600                                 # Find FASTRAK probes at it
     d.ports.box.setEditText("/dev/ttyUSB3")                     # typed: the study's
     d.baud.setValue(38400)
     assert (settings.port, settings.baud) == ("/dev/ttyUSB3", 38400)
     assert w.undo.stack.count() == 0                            # not an edit of the study
+
+
+def test_the_view_renders_the_studys_view_state(window, qtbot, small_points):
+    """The colouring and the camera are the study's (view_state.py): the View menu sets them,
+    the viewport renders them; a script setting them moves the view, a drag of the view
+    moves the study's pose."""
+    from PySide6.QtCore import QPoint, Qt
+
+    w = shown(qtbot, window(small_points, tile=1))
+    view, state = w.viewport, w.model.view
+    w.menu_actions["colour_plant"].trigger()                    # the menu sets the state
+    assert state.colouring == "plant" and view.colouring == "plant"
+    state.colouring = "leaf"                                    # a script: the view follows
+    assert view.colouring == "leaf" and w.menu_actions["colour_leaf"].isChecked()
+    w.view_link.camera("top")
+    assert state.camera == "top" and state.pose == view.camera_pose()
+    top = state.pose
+    position, focal, _up = top
+    moved = ((position[0] + 50.0, position[1], position[2]), focal, (0.0, 1.0, 0.0))
+    state.pose = moved                                          # a script moves the camera
+    np.testing.assert_allclose(view.camera_pose()[0], moved[0])
+    centre = QPoint(view.width() // 2, view.height() // 2)      # a drag turns it: the study's
+    qtbot.mousePress(view, Qt.LeftButton, pos=centre)
+    qtbot.mouseMove(view, centre + QPoint(60, 20))
+    qtbot.mouseRelease(view, Qt.LeftButton, pos=centre + QPoint(60, 20))
+    assert state.pose == view.camera_pose() and state.pose != moved

@@ -185,3 +185,33 @@ def test_photosynthesis_from_nir_is_one_line_on_the_band(window, qtbot, small_po
     assert "PAR" in sig.args[0] and "internal" not in sig.args[0] and "\n" not in sig.args[0]
     assert "border" in p.band.styleSheet()
     assert w.model.runs.last is None                               # nothing traced
+
+
+def test_a_suns_light_and_carbon_per_plant_and_per_leaf_are_exported(window, qtbot,
+                                                                     small_points, tmp_path):
+    """Issue 37, item 1: after a sun with leaf optics and C4, the panel's Leaves... and
+    Plants... and File's light per leaf / plant write the absorbed light and the gross CO2 of
+    each leaf and plant (they were greyed, and File's said 'no sky or day computed yet')."""
+    import csv
+
+    w, p = _with_c4(qtbot, window, small_points)
+    assert not p.export_buttons["plants"].isEnabled()
+    compute(qtbot, w)
+    g = w.model.runs.last.extra.assimilation
+    assert p.export_buttons["plants"].isEnabled() and p.export_buttons["leaves"].isEnabled()
+    plants_csv, leaves_csv = tmp_path / "plants.csv", tmp_path / "leaves.csv"
+    for what, path in (("plants", plants_csv), ("leaves", leaves_csv)):
+        with qtbot.waitSignal(w.saved, timeout=TIMEOUT):
+            assert w.model.export(what, path)
+    plants = list(csv.DictReader(plants_csv.open()))
+    leaves = list(csv.DictReader(leaves_csv.open()))
+    shown_rows = _rows(p.plants)
+    head = headers(p.plants)
+    assert len(plants) == len(shown_rows)
+    for row, seen in zip(plants, shown_rows):
+        assert f"{float(row['gross_umol_s']):.2f}" == seen[head.index("CO₂ gross µmol/s")]
+        assert float(row["absorbed_w"]) > 0
+    total = sum(float(r["gross_umol_s"]) for r in leaves)
+    assert total == pytest.approx(g.canopy_gross_umol_m2_s * g.ground_m2, rel=1e-6)
+    assert sum(float(r["gross_umol_s"]) for r in plants) == pytest.approx(total, rel=1e-6)
+    assert {r["level"] for r in leaves} == {w.model.runs.last.label}

@@ -227,3 +227,52 @@ def test_selection_changes_once_and_describes_a_leaf_with_the_tables_numbers(sma
         assert f"sunlit share {share:.2f}" in lines[2]
     assert describe(c, "36 triangles", [run], len(c.layout.placements), 1) == []
     assert "stalk" in describe(c, "36 triangles", [run], 0, 0)[0]
+
+
+def test_a_selected_plant_seen_through_the_others_or_alone(window, qtbot, small_points):
+    """Issue 37's conventions: while a plant is selected, the others drawn as the study's
+    view state says (View > Selection): shown, faded (the selection seen through them) or
+    hidden (the selection alone); without a selection the canopy is drawn whole again."""
+    from maizeviz_app.view_state import FADED_OPACITY
+
+    w = shown(qtbot, window(small_points, tile=1))
+    view, model = w.viewport, w.model
+    canopy = view.actors["canopy"]
+    model.selection.select(0, -1)
+    assert view.actors["selection"].GetVisibility()
+    assert canopy.GetVisibility() and canopy.GetProperty().GetOpacity() == 1.0
+    w.menu_actions["others_faded"].trigger()
+    assert model.view.others == "faded"
+    assert canopy.GetProperty().GetOpacity() == FADED_OPACITY and canopy.GetVisibility()
+    model.view.others = "hidden"                     # a script, as the menu does
+    assert not canopy.GetVisibility() and w.menu_actions["others_hidden"].isChecked()
+    assert view.actors["selection"].GetVisibility()
+    model.selection.select(-1, -1)                   # nothing selected: the canopy whole
+    assert canopy.GetVisibility() and canopy.GetProperty().GetOpacity() == 1.0
+    model.selection.select(1, -1)                    # the mode holds for the next selection
+    assert not canopy.GetVisibility()
+    model.view.others = "shown"
+    assert canopy.GetVisibility() and canopy.GetProperty().GetOpacity() == 1.0
+
+
+def test_view_measure_takes_the_clicks_and_says_the_distance(window, qtbot, small_points):
+    """View > Measure distance: the clicks on the canopy go to the probe (not the selection),
+    its points and line are drawn, the distance is said; the same entry again stops it."""
+    from maizeviz_app.picking import Pick
+
+    w = shown(qtbot, window(small_points, tile=1))
+    view, model = w.viewport, w.model
+    said: list[str] = []
+    w.model.said.connect(lambda text, *_: said.append(text))
+    w.statusBar().messageChanged.connect(said.append)
+    w.menu_actions["measure_distance"].trigger()
+    assert model.probe.kind == "distance" and w.menu_actions["measure_distance"].isChecked()
+    view.picked.emit(Pick(0, 0, 1, 1, (10.0, 0.0, 50.0)))
+    view.picked.emit(Pick(1, 0, 1, 2, (10.0, 30.0, 90.0)))
+    assert model.selection.empty                        # the clicks measured, not selected
+    assert "probe_line" in view.actors and "probe_points" in view.actors
+    assert any(t.startswith("distance 50.0 cm") for t in said), said
+    w.menu_actions["measure_distance"].trigger()
+    assert not model.probe.on and "probe_line" not in view.actors
+    view.picked.emit(Pick(1, 0, 1, 2, (10.0, 30.0, 90.0)))
+    assert not model.selection.empty                    # selecting again

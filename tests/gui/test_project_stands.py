@@ -30,7 +30,7 @@ def test_an_edited_layouts_sky_light_stays_on_its_plants(window, qtbot, small_po
     turned = tuple(replace(p, azimuth_deg=90.0) if i == 4 else p
                    for i, p in enumerate(tiled.placements))
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
-        w.layout_panel.applied.emit(replace(tiled, placements=turned))
+        w.model.apply_layout(replace(tiled, placements=turned))
     panel = w.light_panel
     panel.set_mode("sky")
     panel.heights.setText("0, 100, 200")

@@ -195,6 +195,12 @@ def test_ctrl_z_from_anywhere_undoes_the_level_and_rebuilds(window, qtbot, small
     assert w.model.settings.canopy.level == "36" and w.canopy_panel.level == "36"
     assert w.model.canopy.n_triangles > n8                        # rebuilt, as an edit would
     assert w.canopy_panel.level_label.text() == "showing: at most 36 triangles per leaf"
+    # the level shown is the one row highlighted (issue 37 item 8: Ctrl held by Ctrl+Z
+    # added it to the row of the level undone)
+    picked = {i.row() for i in w.canopy_panel.table.selectionModel().selectedRows()}
+    levels = [w.canopy_panel.table.item(r, 0).text()
+              for r in range(w.canopy_panel.table.rowCount())]
+    assert len(picked) == 1 and "36" in levels[picked.pop()]
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT,
                           check_params_cb=lambda label: label == "8 triangles"):
         qtbot.keyClick(w.light_panel.table, Qt.Key_Z,

@@ -95,3 +95,30 @@ def test_a_chosen_width_keeps_the_views_shape(window, qtbot, small_points, tmp_p
     w.view_link.save_image(path, width)
     image = QImage(str(path))
     assert (image.width(), image.height()) == (width, height_for(w.viewport, width))
+
+
+def test_a_figure_opens_in_a_zoomable_window_of_its_own(window, qtbot, small_points, tmp_path):
+    """Issue 37: figures readable at laptop size: a double-click on the heatmap or the
+    transmission plot opens it at its own pixels (the dock shows it scaled down), zoomable
+    by buttons and keys, and saves it as a PNG."""
+    from maizeviz_app.panels.image_view import ImageView
+    from PySide6.QtCore import Qt
+
+    w = shown(qtbot, window(small_points, tile=1))
+    small_light(w.light_panel, "sun")
+    compute(qtbot, w)
+    view = next(v for v in w.findChildren(ImageView) if "transmission" in v.window_title)
+    qtbot.waitUntil(lambda: view.image() is not None, timeout=120_000)
+    assert view.pixmap().width() <= view.image().width()     # the dock: scaled to fit
+    qtbot.mouseDClick(view, Qt.MouseButton.LeftButton)
+    fig = view.figure_window
+    assert fig is not None and fig.isVisible()
+    assert fig.picture.pixmap().size() == view.image().size()  # its own pixels at 100 %
+    fig.set_zoom(fig.zoom * 1.25)
+    assert fig.picture.pixmap().width() == round(view.image().width() * 1.25) or \
+        abs(fig.picture.pixmap().width() - view.image().width() * 1.25) <= 1
+    assert fig.zoom_label.text() == "125%"
+    out = tmp_path / "plot.png"
+    assert fig.save(out)
+    assert QImage(str(out)).size() == view.image().size()
+    fig.close()

@@ -156,3 +156,35 @@ def test_stalks_of_different_sizes(small_canopy):
     plants = np.array([p.plant for p in canopy.layout.placements])
     np.testing.assert_array_equal(np.asarray(mesh.cell_data["plant"])[stalks], plants[inst])
     assert np.all(np.asarray(mesh.cell_data["leaf"])[stalks] == 0)
+
+
+def test_a_moving_camera_draws_a_lighter_canopy_and_the_whole_one_when_it_stops(
+        window, qtbot, small_points):
+    """Rotation without stalls at K = 4 (issue 37): while the camera moves (a drag, a wheel
+    turn) the view draws every k-th triangle, coloured as the canopy; once it stops, the
+    whole canopy again. Shown here with the threshold lowered to this small canopy's size."""
+    from PySide6.QtCore import QPoint, QPointF, Qt
+    from PySide6.QtGui import QWheelEvent
+    from test_light_modes import shown
+
+    w = shown(qtbot, window(small_points, tile=1))
+    view = w.viewport
+    n = view.canopy_mesh.n_cells
+    view.MOVING_TRIANGLES = n // 4
+    canopy = view.actors["canopy"]
+    assert view.start_moving()
+    lod = view.actors["canopy_moving"]
+    assert lod.GetVisibility() and not canopy.GetVisibility()
+    k = int(np.ceil(n / view.MOVING_TRIANGLES))
+    assert lod.mapper.dataset.n_cells == len(range(0, n, k))
+    assert lod.GetMapper().GetArrayName() == canopy.GetMapper().GetArrayName()
+    assert lod.GetMapper().GetLookupTable() is canopy.GetMapper().GetLookupTable()
+    view.stop_moving()
+    assert canopy.GetVisibility() and not lod.GetVisibility()
+    # a wheel turn: lighter at once, whole again once the wheel rests
+    wheel = QWheelEvent(QPointF(50, 50), QPointF(view.mapToGlobal(QPoint(50, 50))),
+                        QPoint(0, 0), QPoint(0, 120), Qt.MouseButton.NoButton,
+                        Qt.KeyboardModifier.NoModifier, Qt.ScrollPhase.NoScrollPhase, False)
+    view.wheelEvent(wheel)
+    assert lod.GetVisibility() and not canopy.GetVisibility()
+    qtbot.waitUntil(lambda: canopy.GetVisibility() and not lod.GetVisibility(), timeout=5000)

@@ -194,6 +194,27 @@ def test_menus_show_shortcuts_and_about_names_the_paper(window, qtbot):
     assert menus == ["File", "Edit", "View", "Light", "Help"]
     text = about_text()
     assert __version__ in text and "Guo" in text and "Scientia Agricultura Sinica" in text
+    # issue 37 item 8: About promised the libraries and the documentation; it names them
+    import numpy
+    import PySide6
+
+    assert f"numpy {numpy.__version__}" in text and "Embree" in text
+    assert "docs" in text and "Documentation" in text
+    # Help: the documentation, every shortcut, maizeviz --info
+    helps = [a.text().replace("&", "") for a in w.menuBar().actions()[-1].menu().actions()
+             if a.text()]
+    assert helps == ["Documentation", "Keyboard shortcuts", "System information",
+                     "About maizeviz"]
+    from maizeviz_app.main_window import shortcuts_text
+
+    keys = shortcuts_text(w.menu_actions.values())
+    assert "Ctrl+O" in keys and "Ctrl+Shift+3" in keys and "Delete" in keys
+    w.show_system_info()
+    from maizeviz.info import report
+
+    assert w.info_box.detailedText() == report()
+    w.info_box.close()
+    assert PySide6.__version__
 
 
 def test_fits_a_laptop_screen(window, qtbot):
@@ -282,3 +303,40 @@ def test_the_view_is_on_screen_in_a_window_of_its_own(window, qtbot, small_point
     assert 0.01 < drawn.mean() < 0.9                      # something drawn, not all black
     leafy = (rgb[:, 1] > 1.3 * rgb[:, 2] + 10) & (rgb[:, 1] >= rgb[:, 0] - 10)   # leaf rank
     assert leafy.sum() >= 20
+
+
+def test_the_window_saved_as_an_image_and_a_file_dropped_on_it(window, qtbot, two_plants,
+                                                               tmp_path):
+    """Issue 37's conventions: the whole window (panels and the 3D view) saved as a PNG; a
+    points file dropped on the window opens it; the 3D view carries the field's axes and a
+    scale bar of a round length, recomputed from the camera."""
+    from PySide6.QtCore import QMimeData, QPoint, Qt, QUrl
+    from PySide6.QtGui import QDropEvent, QImage
+    from test_light_modes import shown
+
+    w = shown(qtbot, window(two_plants, tile=1))
+    w.show()
+    qtbot.waitExposed(w)
+    out = tmp_path / "window.png"
+    assert w.save_window_image(out)
+    image = QImage(str(out))
+    assert image.size() == w.size()
+    # the view's scale bar: a round length, drawn as long as it is at the focal point
+    bar = w.viewport.overlay.bar
+    w.viewport.render()
+    qtbot.waitUntil(lambda: bar.px > 0, timeout=5000)
+    assert bar.cm in {m * 10.0 ** k for m in (1, 2, 5) for k in range(-1, 4)}
+    assert 10 < bar.px <= bar.width()
+    triad = w.viewport.overlay.triad.axes
+    assert triad.shape == (3, 2) and abs(triad).max() > 0.5
+    # a dropped points file opens (a project or a mesh likewise), an unknown file does not
+    other = tmp_path / "other.csv"
+    other.write_bytes(two_plants.read_bytes())
+    mime = QMimeData()
+    mime.setUrls([QUrl.fromLocalFile(str(tmp_path / "notes.docx")), QUrl.fromLocalFile(str(other))])
+    assert w._dropped_path(mime) == str(other)
+    drop = QDropEvent(QPoint(50, 50), Qt.DropAction.CopyAction, mime, Qt.MouseButton.LeftButton,
+                      Qt.KeyboardModifier.NoModifier)
+    with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
+        w.dropEvent(drop)
+    assert w.model.loaded.path == str(other)

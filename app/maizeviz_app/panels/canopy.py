@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from PySide6.QtCore import Qt, QTimer, Signal
+from PySide6.QtCore import QItemSelectionModel, Qt, QTimer, Signal
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QCheckBox,
@@ -113,6 +113,7 @@ class CanopyPanel(QWidget):
         self.table.verticalHeader().setVisible(False)
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
+        self.table.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
         self.table.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
         self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         lay.addWidget(self.table, 1)
@@ -213,4 +214,8 @@ class CanopyPanel(QWidget):
                 self.table.setItem(r, c, item)
         self.table.resizeRowsToContents()
         shown = list(self.rows).index(values[0])
-        self.table.selectRow(shown)
+        # the level shown alone: selectRow follows the keyboard's modifiers, and with Ctrl
+        # held (Ctrl+Z undoing a level) it added the row to the last one
+        flags = QItemSelectionModel.SelectionFlag
+        self.table.selectionModel().select(
+            self.table.model().index(shown, 0), flags.ClearAndSelect | flags.Rows)

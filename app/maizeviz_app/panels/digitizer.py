@@ -130,13 +130,21 @@ class _ControlKeys(QObject):
 class DigitizerPanel(QWidget):
     """Connect to a FASTRAK (or a simulated one), record presses, show the plant growing.
 
+    Parameters
+    ----------
+    viewport : the 3D view the plant grows in, or None
+    session : the :class:`DigitizingSession` to show (the window's is the study model's);
+        a new one if None
+
     Signals
     -------
-    started : recording began (the port is configured, the reader runs)
-    recorded(int) : points recorded so far
+    started : recording began (the recorder's process configured the unit and reads it)
+    recorded(int) : points on disk so far (emitted when the window sees them)
     alert(str) : something went wrong (refused point, garbled record, lost port, write
-        failure, no connection, a press while paused); for the window's status bar
-    stopped(str) : the session ended and its port and journal are closed, and why
+        failure, no connection, a press while paused, a jump, a short section); for the
+        window's status bar
+    stopped(str) : the session ended (the recorder's process has exited, its journal
+        closed), and why
     """
 
     started = Signal()
@@ -146,12 +154,14 @@ class DigitizerPanel(QWidget):
     #: Ask before the window closes while recording (tests and benchmarks turn it off).
     confirm_close = True
 
-    def __init__(self, viewport=None, parent=None):
+    def __init__(self, viewport=None, parent=None, session: DigitizingSession | None = None):
         super().__init__(parent)
         self._viewport = viewport
-        #: The session this panel shows (Qt-free: the recorder's process, what is on disk).
-        self.digitizing = DigitizingSession()
-        self.digitizing.demo_file = example_points()
+        #: The session this panel shows (Qt-free: the recorder's process, what is on disk);
+        #: the window's is the study model's (``StudyModel.digitizing``).
+        self.digitizing = session if session is not None else DigitizingSession()
+        if self.digitizing.demo_file is None:
+            self.digitizing.demo_file = example_points()
         self.beeps = 0                             # trouble said with a beep
         self.press_beeps = 0                       # points confirmed with a beep
         self._why: str | None = None               # why the technician stopped

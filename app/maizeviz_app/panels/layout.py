@@ -24,7 +24,7 @@ from __future__ import annotations
 from typing import TypeVar
 
 from PySide6.QtCore import Qt, QTimer, Signal
-from PySide6.QtGui import QKeySequence, QUndoStack
+from PySide6.QtGui import QKeySequence, QShortcut, QUndoStack
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QCheckBox,
@@ -271,7 +271,11 @@ class LayoutPanel(QWidget):
         self.remove_button = _named(QPushButton("Remove"), "Remove", "take the picked plant "
                                     "out of the layout (Delete)")
         self.remove_button.clicked.connect(lambda: self._edit(self.model.remove, self.picked))
-        self.remove_button.setShortcut(QKeySequence(QKeySequence.StandardKey.Delete))
+        # Delete removes the picked plant only while the layout editor has the focus (a
+        # button's shortcut is the whole window's: Delete in the 3D view removed a plant)
+        self.remove_shortcut = QShortcut(QKeySequence(QKeySequence.StandardKey.Delete), self)
+        self.remove_shortcut.setContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+        self.remove_shortcut.activated.connect(self.remove_button.click)
         self.left_button = _named(_tool("⟲"), "rotate left",
                                   f"turn the picked plant {ROTATE_STEP_DEG:g}° about its "
                                   "stalk, counter-clockwise seen from above")

@@ -733,11 +733,11 @@ class LightPanel(QWidget):
         for what in ("table", "heatmap", "plot", "canopy"):
             self.export_buttons[what].setEnabled(last)
         day = runs.of_kind("day") is not None
-        diffuse = day or runs.of_kind("sky") is not None
         for what in ("steps", "day"):
             self.export_buttons[what].setEnabled(day)
+        per_leaf = runs.with_plants() is not None
         for what in ("leaves", "plants"):
-            self.export_buttons[what].setEnabled(diffuse)
+            self.export_buttons[what].setEnabled(per_leaf)
         if not runs.runs:
             self.show_summary("")
             self.show_plants(None)
@@ -872,6 +872,7 @@ class LightPlots(QWidget):
         top.addStretch(1)
         left.addLayout(top)
         self.heatmap = HeatmapView("compute light to see where it reaches each height")
+        self.heatmap.window_title = "maizeviz: heatmap"
         left.addWidget(self.heatmap, 1)
         # the value under the mouse (always in place: showing a widget relayouts the dock)
         self.hover = QLabel(" ")
@@ -880,6 +881,7 @@ class LightPlots(QWidget):
         left.addWidget(self.hover)
         lay.addLayout(left, 1)
         self.transmission = ImageView("transmission by height appears here")
+        self.transmission.window_title = "maizeviz: transmission by height"
         lay.addWidget(self.transmission, 1)
         self._maps: dict[str, list[tuple[float, np.ndarray | None]]] = {}
 

@@ -41,8 +41,10 @@ class Balance:
     """Where the incident light went, W/m2 of sample ground (or, for a period, MJ/m2 or mol/m2
     as the result says).
 
-    incident = absorbed_leaves + absorbed_ground + reflected_top + escaped_sides + unresolved,
-    within Monte Carlo noise (``closure``).
+    incident = absorbed_leaves + absorbed_stalks + absorbed_ground + reflected_top
+    + escaped_sides + unresolved, within Monte Carlo noise (``closure_fraction``, a fraction
+    of the incident light). The stalks absorb where they were traced
+    (``LightEngine(..., with_stalks=True)``, the default), else 0.
     """
 
     incident: float
@@ -51,19 +53,42 @@ class Balance:
     reflected_top: float
     escaped_sides: float = 0.0
     unresolved: float = 0.0
+    absorbed_stalks: float = 0.0
+
+    @property
+    def closure_fraction(self) -> float:
+        """How far the parts miss the incident light, as a fraction of it.
+
+        Returns
+        -------
+        float
+            (sum of the parts) / incident - 1 [-]: 0 up to Monte Carlo noise (0 without
+            incident light). Not in the balance's units: a fraction of the incident.
+        """
+        parts = (self.absorbed_leaves + self.absorbed_stalks + self.absorbed_ground
+                 + self.reflected_top + self.escaped_sides + self.unresolved)
+        return parts / self.incident - 1.0 if self.incident else 0.0
 
     @property
     def closure(self) -> float:
-        """(sum of the parts) / incident - 1: 0 up to Monte Carlo noise."""
-        parts = (self.absorbed_leaves + self.absorbed_ground + self.reflected_top
-                 + self.escaped_sides + self.unresolved)
-        return parts / self.incident - 1.0 if self.incident else 0.0
+        """The same as :attr:`closure_fraction` (its name in maizeviz 0.2), a fraction of the
+        incident light [-]."""
+        return self.closure_fraction
 
     def as_dict(self) -> dict[str, float]:
+        """The balance as the command line's JSON carries it.
+
+        Returns
+        -------
+        dict
+            The parts in the balance's units, and ``closure_fraction``, a fraction of the
+            incident light [-].
+        """
         return {"incident": self.incident, "absorbed_leaves": self.absorbed_leaves,
+                "absorbed_stalks": self.absorbed_stalks,
                 "absorbed_ground": self.absorbed_ground, "reflected_top": self.reflected_top,
                 "escaped_sides": self.escaped_sides, "unresolved": self.unresolved,
-                "closure": self.closure}
+                "closure_fraction": self.closure_fraction}
 
 
 def _fraction_absorbed(self) -> float:
@@ -102,7 +127,8 @@ class AbsorbedLight:
         (F,) float64 power absorbed by each scene triangle (leaves, then stalks) from the
         light falling on the sample rectangle [W].
     triangle_sunlit_cm2 : numpy.ndarray
-        (F,) float64 area of each triangle in the direct beam [cm2] (0 for a sky).
+        (F,) float64 area of each triangle in the direct beam [cm2] (0 for a sky), sampled
+        from the triangle (:mod:`maizeviz.light.trace.sunlit`): at most its area.
     rect : (x0, y0, x1, y1) tuple of float
         The sample rectangle [cm].
     rays : int
@@ -125,7 +151,8 @@ class AbsorbedLight:
         Time spent [s]: "trace" (primary beams), "scatter", "build".
     triangle_direct_w : numpy.ndarray or None
         (F,) float64 the part of ``triangle_absorbed_w`` the sun's direct beam deposited [W]
-        (on the sunlit area; the rest came from the sky and scattered light).
+        (its sunlit area at the beam's absorbed flux on its orientation: at most what its
+        whole area would absorb; the rest came from the sky and scattered light).
     batches : Batches or None
         The per-batch shares of independent batches of rays, the standard errors' source.
     sun_direction : (3,) tuple of float or None
@@ -230,7 +257,6 @@ class AbsorbedLight:
         frame = pd.DataFrame(rows)
         if frame.empty:
             return frame
-        frame["sunlit_area_cm2"] = np.minimum(frame["sunlit_area_cm2"], frame["leaf_area_cm2"])
         if kind == "plant":
             frame = _per_plant(frame, ("absorbed_w", "sunlit_area_cm2"))
         if self.batches is not None:

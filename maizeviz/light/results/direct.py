@@ -64,6 +64,9 @@ class LightResult(TracedLight):
     sensor_offset_cm : numpy.ndarray or None
         (H, 2) float64, where each plane's grid sits relative to the ground grid's cell
         centres [cm] (:meth:`sensor_xy`).
+    n_leaf_triangles : int or None
+        The canopy's leaf triangles: ids from this one on in ``first_hits`` and
+        ``second_hits`` are stalks; None: every triangle is a leaf.
 
     See Also
     --------
@@ -80,6 +83,7 @@ class LightResult(TracedLight):
     density: float = 0.0
     sensor_lit: np.ndarray | None = None
     sensor_offset_cm: np.ndarray | None = None
+    n_leaf_triangles: int | None = None
 
     @property
     def density_per_cm2(self) -> float:
@@ -97,7 +101,24 @@ class LightResult(TracedLight):
         """
         if self.first_hits is None:
             return None
-        return float(self.first_hits.sum() * self.ray_area_cm2 / self.rect_area_cm2)
+        leaves = self.first_hits[:self.n_leaf_triangles]
+        return float(leaves.sum() * self.ray_area_cm2 / self.rect_area_cm2)
+
+    @property
+    def stalk_intercepted_fraction(self) -> float | None:
+        """Share of the rectangle's direct sunlight whose first hit is a stalk.
+
+        Returns
+        -------
+        float or None
+            In [0, 1] (0 where stalks were not traced); None without hit classes.
+        """
+        if self.first_hits is None:
+            return None
+        if self.n_leaf_triangles is None:
+            return 0.0
+        stalks = self.first_hits[self.n_leaf_triangles:]
+        return float(stalks.sum() * self.ray_area_cm2 / self.rect_area_cm2)
 
     @cached_property
     def ground_xy(self) -> np.ndarray:

@@ -8,7 +8,7 @@ import numpy as np
 from maizeviz.canopy.layout import CanopyLayout
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
-from maizeviz.ids import group_rows, groups
+from maizeviz.ids import groups
 from maizeviz.light.scene.rays import Rect
 from maizeviz.mesh.tessellate import triangle_areas_normals
 
@@ -169,18 +169,23 @@ def leaf_sums(canopy: Canopy, columns: dict[str, np.ndarray], rect: Rect | None 
     for v in cols.values():
         any_light |= v != 0
     touched = np.unique(leaf_of[any_light])
-    order, starts = group_rows(leaf_of, len(keys))
+    n_keys = len(keys)
+    # per leaf at once (bincounts): its area over its copies, its plant, the columns' sums
+    pairs, _ = groups(leaf_of, canopy.face_instance)
+    copies = np.bincount(pairs[:, 0], minlength=n_keys)
+    leaf_area = np.bincount(leaf_of, weights=area[:nf], minlength=n_keys)
+    first = np.full(n_keys, nf, np.int64)
+    np.minimum.at(first, leaf_of, np.arange(nf))
+    sums = {k: np.bincount(leaf_of, weights=v, minlength=n_keys) for k, v in cols.items()}
+    places = canopy.layout.placements
     rows: list[LightRow] = []
     for k in touched:
-        idx = order[starts[k]:starts[k + 1]]
-        inst, leaf = (int(v) for v in keys[k])
-        copies = len(np.unique(canopy.face_instance[idx]))
-        row: LightRow = {"instance": inst + 1, "plant": int(canopy.face_plant[idx[0]]),
-                         "leaf": leaf, "x_cm": canopy.layout.placements[inst].x,
-                         "y_cm": canopy.layout.placements[inst].y,
-                         "leaf_area_cm2": float(area[idx].sum()) / copies}
-        for k, v in cols.items():
-            row[k] = float(v[idx].sum())
+        inst, leaf = (int(x) for x in keys[k])
+        row: LightRow = {"instance": inst + 1, "plant": int(canopy.face_plant[first[k]]),
+                         "leaf": leaf, "x_cm": places[inst].x, "y_cm": places[inst].y,
+                         "leaf_area_cm2": float(leaf_area[k]) / int(copies[k])}
+        for name, total in sums.items():
+            row[name] = float(total[k])
         rows.append(row)
     return rows
 

@@ -101,7 +101,8 @@ def errors_by(canopy: Canopy, batches, col: str, rect, periodic: bool,
         part = pd.DataFrame(leaf_sums(canopy, {col: b}, rect, periodic))
         parts.append(part.groupby(key)[col].sum() if not part.empty
                      else pd.Series(dtype=float))
-    keys = sorted(set().union(*(p.index for p in parts)))
-    per = np.array([[p.get(k, 0.0) for k in keys] for p in parts], dtype=np.float64)
+    table = pd.concat(parts, axis=1).fillna(0.0).sort_index()     # keys x batches
+    keys = table.index.tolist()
+    per = table.to_numpy(dtype=np.float64).T
     se = np.asarray(batch_error(per)) if keys else np.zeros(0)
     return dict(zip(keys, se.tolist()))

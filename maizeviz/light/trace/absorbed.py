@@ -23,7 +23,6 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.sparse import csr_array
 
 from maizeviz.canopy.layout import stands_identity
 from maizeviz.canopy.scene import Canopy
@@ -37,6 +36,7 @@ from maizeviz.light.sources.sun import Sun
 from maizeviz.light.trace.direct import Sampler
 from maizeviz.light.trace.optics import Optics, band_share
 from maizeviz.light.trace.scatter import scatter_beam, scatter_sky
+from maizeviz.light.trace.sunlit import sunlit_share
 from maizeviz.progress import ProgressCallback, report
 
 if TYPE_CHECKING:
@@ -126,6 +126,8 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
         leaf_optics = opt.per_triangle(rank)
         kept = 1.0 - (leaf_optics[0] + leaf_optics[1])
     absorbed, sunlit, direct_t = np.zeros(nf), np.zeros(nf), np.zeros(nf)
+    from scipy.sparse import csr_array  # 0.3 s to import, pulls numpy.f2py: when used
+
     empty = csr_array((BATCHES, nf))
     absorbed_b, direct_b, sunlit_b = empty, empty, empty
     sun_dir = None
@@ -140,18 +142,21 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
         absorbed += tally.per_triangle(nf, kept * per_ray)
         absorbed_b = absorbed_b + tally.per_batch(nf, kept * per_ray)
         if k == 0 and sun is not None and direct_w_m2 > 0:
-            # cm2 of leaf a ray's beam covers: its footprint across the beam over the
-            # cosine of the leaf's tilt to it
-            first = (np.concatenate(tally.first_hits) if tally.first_hits
-                     else np.zeros(0, dtype=np.int64))
-            lit = np.unique(first)
-            factor = np.zeros(nf)
-            factor[lit] = smp.ray_area_cm2 * toward[2] / np.maximum(
-                np.abs(normals[lit] @ toward), 1e-6)
-            sunlit = tally.sunlit(nf, factor)
-            direct_b = tally.per_batch(nf, kept * per_ray, first=True)
-            direct_t = np.asarray(direct_b.sum(axis=0)).ravel()
-            sunlit_b = tally.per_batch(nf, factor, first=True)
+            # the direct beam each triangle absorbs: its sampled sunlit share of what its
+            # whole area intercepts at the beam's flux (bounded by construction, see
+            # .sunlit), in place of the primary rays' deposits, which the scattering still
+            # starts from
+            share = sunlit_share(smp, _scene_triangles(canopy, nf), normals, toward,
+                                 seed + 7919 * k)
+            area = _scene_areas(canopy, nf)                                   # cm2
+            whole = kept * irradiance / toward[2] * np.abs(normals @ toward) * area * 1e-4
+            absorbed += share.fraction * whole - _first_deposits(tally, nf, kept * per_ray)
+            absorbed_b = absorbed_b - tally.per_batch(nf, kept * per_ray, first=True) \
+                + share.batches * whole
+            sunlit = share.fraction * area
+            direct_b = csr_array(share.batches * whole)
+            direct_t = share.fraction * whole
+            sunlit_b = csr_array(share.batches * area)
             sun_dir = (float(toward[0]), float(toward[1]), float(toward[2]))
         for name in parts:
             parts[name] += getattr(tally, name) * per_ray
@@ -176,15 +181,38 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
         seconds["scatter"] += secs["scatter"]
         report(progress, len(beams) + 1, len(beams) + 1, "absorbed light")
     incident = direct_w_m2 * (sun is not None) + diffuse_w_m2
-    balance = Balance(float(incident), float(absorbed.sum()) / area_m2,
-                      *(float(parts[k]) / area_m2 for k in ("ground", "top", "sides",
-                                                             "unresolved")))
+    leaves = canopy.n_triangles                  # the stalks' triangles follow, if traced
+    balance = Balance(float(incident), float(absorbed[:leaves].sum()) / area_m2,
+                      float(parts["ground"]) / area_m2, float(parts["top"]) / area_m2,
+                      float(parts["sides"]) / area_m2, float(parts["unresolved"]) / area_m2,
+                      float(absorbed[leaves:].sum()) / area_m2)
     return AbsorbedLight(opt.band, opt, incident, balance, absorbed, sunlit, smp.rect, smp.n,
                          len(beams) + (n_sky if sky_per_ray else 0), depth, threshold, seed,
                          events, smp.periodic, canopy.level, seconds,
                          triangle_direct_w=direct_t,
                          batches=Batches(absorbed_b, direct_b, sunlit_b, parts_b / area_m2),
                          sun_direction=sun_dir, stands=stands_identity(canopy.layout))
+
+
+def _scene_triangles(canopy: Canopy, nf: int) -> np.ndarray:
+    """(F, 3, 3) float64 cm: corners of the scene's triangles, leaves then stalks (``nf``
+    of them)."""
+    tri = canopy.vertices[canopy.faces]
+    if nf > len(tri):
+        tri = np.concatenate([tri, canopy.stalk_vertices[canopy.stalk_faces]])
+    return tri[:nf]
+
+
+def _scene_areas(canopy: Canopy, nf: int) -> np.ndarray:
+    """(F,) float64 cm2: one-sided areas of the scene's triangles (leaves then stalks)."""
+    tri = _scene_triangles(canopy, nf)
+    return 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+
+
+def _first_deposits(tally, nf: int, weight) -> np.ndarray:
+    """(F,) float64: what the primary rays deposited on the triangles they hit first."""
+    ids = np.concatenate(tally.first_hits) if tally.first_hits else np.empty(0, np.int64)
+    return np.bincount(ids, minlength=nf) * weight         # as Tally.per_triangle counts them
 
 
 def period_temperatures(period: Period, temperature_c) -> np.ndarray:
@@ -274,7 +302,7 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
     ub = unit.balance
     parts = {k: getattr(ub, k) * float(np.sum(diffuse_w * step_s))
              for k in ("absorbed_leaves", "absorbed_ground", "reflected_top",
-                       "escaped_sides", "unresolved")}
+                       "escaped_sides", "unresolved", "absorbed_stalks")}
     leaves_w = ub.absorbed_leaves * diffuse_w
     seconds = dict(unit.seconds)
     direct_w = (np.asarray(period.ghi, np.float64) - np.asarray(period.dhi, np.float64)
@@ -302,7 +330,7 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
     balance = Balance(float(np.sum(incident_w * step_s)) * 1e-6,
                       *(float(parts[k]) * 1e-6 for k in ("absorbed_leaves", "absorbed_ground",
                                                    "reflected_top", "escaped_sides",
-                                                   "unresolved")))
+                                                   "unresolved", "absorbed_stalks")))
     return AbsorbedPeriod(optics.band, optics, period, balance, joules, leaves_w, incident_w,
                           unit.rect, unit.rays, unit.depth, unit.seed, unit.periodic,
                           unit.level, seconds,
@@ -323,6 +351,7 @@ class _Carbon:
                 raise TypeError("photosynthesis over a period needs the canopy")
             n = canopy.n_triangles
             self.mol, self.mol_b = np.zeros(n), np.zeros((BATCHES, n))
+            self.bias, self.bias_se = 0.0, 0.0
 
     def add(self, k: int, light: AbsorbedLight | None) -> None:
         if self.model is None:
@@ -346,6 +375,10 @@ class _Carbon:
         self.mol += a.triangle_gross_umol_s * self.step_s[k] * 1e-6
         if a.triangle_batches is not None:
             self.mol_b += a.triangle_batches * self.step_s[k] * 1e-6
+        if a.bias_umol_s is not None:
+            # the steps share the sky's rays: their biases' spreads add up, not in quadrature
+            self.bias += a.bias_umol_s * self.step_s[k] * 1e-6
+            self.bias_se += (a.bias_se_umol_s or 0.0) * self.step_s[k] * 1e-6
         self.step_gross[k] = a.canopy_gross_umol_m2_s
 
     def result(self):
@@ -356,4 +389,4 @@ class _Carbon:
         x0, y0, x1, y1 = self.unit.rect
         return PeriodAssimilation(self.model.as_dict(), self.temps.copy(), self.mol,
                                   self.mol_b, (x1 - x0) * (y1 - y0) * 1e-4, self.step_gross,
-                                  self.unit.rect, self.unit.periodic)
+                                  self.unit.rect, self.unit.periodic, self.bias, self.bias_se)

@@ -451,4 +451,5 @@ def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | 
                        seconds=seconds, warnings=tuple(warnings), level=canopy.level,
                        density=req.density, sensor_lit=tr.sensor_lit,
                        sensor_offset_cm=tr.sensor_offset_cm, periodic=req.periodic,
-                       stands=stands_identity(canopy.layout))
+                       stands=stands_identity(canopy.layout),
+                       n_leaf_triangles=canopy.n_triangles)
