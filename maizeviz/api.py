@@ -5,11 +5,11 @@ These functions are what ``import maizeviz as mv`` offers (``mv.read_points``,
 core with the app's and the command line's defaults; the stages themselves
 (:mod:`maizeviz.leaf`, :mod:`maizeviz.canopy`, :mod:`maizeviz.light`) take every option.
 
-References
-----------
-Espana, M. L., Baret, F., Aries, F., Chelle, M., Andrieu, B. & Prevot, L. (1999). Modeling
-maize canopy 3D architecture: application to reflectance simulation. Ecological Modelling
-122, 25-43 (the digitized maize canopy and its mesh levels).
+The method, the 81-plant canopy and its mesh levels (Table 2) are those of the study maizeviz
+implements: Guo, X., Zhao, C., Xiao, B., Lu, S. & Li, C., *Study on maize leaf morphological
+modeling and mesh simplification of surface* (also in Chinese: Xiao, B., Guo, X., Wang, J.,
+Zheng, W. & Wang, D. (2007), Scientia Agricultura Sinica 40(4), 693-697). docs/method.md
+gives the reference in full and how far it is verified.
 """
 
 from __future__ import annotations
@@ -127,11 +127,11 @@ def build_canopy(plants: LeavesFromFile | list, layout: CanopyLayout | None = No
         ``vertices`` (V, 3) float64 [cm], ``faces`` (F, 3) int64, ``n_triangles``, ``layout``,
         ``level`` (its label).
 
-    References
-    ----------
-    Espana, M. L., Baret, F., Aries, F., Chelle, M., Andrieu, B. & Prevot, L. (1999).
-    Modeling maize canopy 3D architecture: application to reflectance simulation. Ecological
-    Modelling 122, 25-43 (Table 2: the mesh levels). https://doi.org/10.1016/S0304-3800(99)00070-8
+    Notes
+    -----
+    The mesh levels are Table 2's of the study maizeviz implements (Guo, Zhao, Xiao, Lu & Li,
+    *Study on maize leaf morphological modeling and mesh simplification of surface*; the
+    package's text gives the reference).
     """
     leaves = _leaves(plants)
     if layout is None:

@@ -126,7 +126,7 @@ def whole_number(name: str) -> int:
     """
     var = _variable(name, "whole")
     if name not in os.environ:
-        return int(var.default)
+        return int(var.default or 0)
     raw = os.environ[name]
     takes = f"takes one of {', '.join(map(str, var.choices))}" if var.choices else \
         f"takes a whole number >= {var.low:,} (digits only)"

@@ -681,8 +681,9 @@ def about_text() -> str:
     from maizeviz.info import info
 
     d = info()
-    libs = {**d["packages"], **{k: v for k, v in d["optional"].items()  # type: ignore[attr-defined]
-                                if v and v != "not installed"}}
+    packages: dict[str, Any] = dict(d["packages"])            # type: ignore[call-overload]
+    optional: dict[str, Any] = dict(d["optional"])            # type: ignore[call-overload]
+    libs = {**packages, **{k: v for k, v in optional.items() if v and v != "not installed"}}
     libraries = ", ".join(f"{name} {version}" for name, version in libs.items())
     docs = docs_folder()
     where = (f"<a href='{docs.as_uri()}'>{docs}</a> (Help &gt; Documentation)" if docs else

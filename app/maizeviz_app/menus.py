@@ -138,10 +138,10 @@ def build_menus(w) -> dict[str, QAction]:
 
     v.addSeparator()
     for (kind, text), keys in zip(KINDS.items(), ("Ctrl+M", "Ctrl+Shift+M")):
-        def toggle(k=kind):
+        def toggle_probe(k=kind):
             probe = w.model.probe
             probe.start("" if probe.kind == k else k)
-        act = _action(w, v, text, toggle, keys,
+        act = _action(w, v, text, toggle_probe, keys,
                       "click two points on the canopy: their distance" if kind == "distance"
                       else "click the corners of a polygon on the canopy: its area (and its "
                            "shadow's)")

@@ -20,6 +20,8 @@ refuse a value that cannot be used with an :class:`InputProblem` naming the fiel
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING, Any, ClassVar
 
@@ -314,6 +316,9 @@ class StudySettings:
         self.optics = OpticsSettings()
         self.photosynthesis = PhotosynthesisSettings()
         self.digitizer = DigitizerSettings()
+        #: A context several fields set by :meth:`set` change inside (the study's
+        #: ``history.step``: one undo step; by default nothing).
+        self.together: Callable[[], AbstractContextManager] = nullcontext
         # the PAR defaults are the dataclass's (a test holds them equal to the core's)
         self.optics.events.band.connect(self._band_defaults)
 
@@ -337,11 +342,13 @@ class StudySettings:
 
     def set(self, name: str, values: dict[str, Any]) -> None:
         """Set fields of group ``name`` in declaration order (a band before the optics it
-        sets), each checked (:meth:`check`)."""
+        sets), each checked (:meth:`check`), as one change: inside :attr:`together` (the
+        study's undo history makes them one step)."""
         group = self.groups[name]
-        for f in field_names(group):
-            if f in values:
-                setattr(group, f, self.check(name, f, values[f]))
+        checked = {f: self.check(name, f, values[f]) for f in field_names(group) if f in values}
+        with self.together():
+            for f, value in checked.items():
+                setattr(group, f, value)
 
     def check(self, name: str, key: str, value: Any) -> Any:
         """``value`` for field ``key`` of group ``name``, of the field's type and within its

@@ -220,6 +220,7 @@ class StudyState:
         self.probe = Probe()           # a distance or area probe (View > Measure)
         self.history = History()
         self._watch_history()
+        self.settings.together = self.history.step      # settings.set: one step
         self.view_light.connect(self._light_colouring)
         self.canopy_changed.connect(lambda _built: self._check_colouring())
 

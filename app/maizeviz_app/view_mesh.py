@@ -4,7 +4,7 @@ pyvista is imported once the view is ready).
 A frame of millions of triangles stalls software OpenGL: above the view's budget
 (:data:`maizeviz_app.viewport.VIEW_BUDGET`) the plants around the sampled tile are drawn at the
 display level (36 triangles a leaf), and a canopy read from a mesh file is drawn within the
-same budget (:mod:`maizeviz_app.mesh_view`), while light, tables and exports keep every
+same budget (:mod:`maizeviz_app.mesh_file_view`), while light, tables and exports keep every
 triangle.
 """
 
@@ -24,7 +24,7 @@ def view_mesh(job, canopy, coarse: Callable[[], Any] | None, ready: threading.Ev
     while not ready.wait(0.05):                 # pyvista still loading at start-up
         job.check()
     if from_file:
-        from maizeviz_app.mesh_view import mesh_polydata
+        from maizeviz_app.mesh_file_view import mesh_polydata
 
         return mesh_polydata(canopy)
     from maizeviz_app.viewport import VIEW_BUDGET, canopy_polydata, display_polydata

@@ -851,13 +851,14 @@ class Viewport(QtInteractor):
             self._canopy_actor.SetVisibility(True)
         self.render()
 
-    def _moving_actor(self, mesh):
+    def _moving_actor(self, mesh: pv.PolyData):
         """The lighter canopy's actor, its mesh remade when the canopy's changed: every k-th
         triangle (cell data kept, so it colours as the canopy)."""
-        if self._moving_source is not mesh or self._moving_mtime != mesh.GetMTime():
+        mtime = int(mesh.GetMTime())
+        if self._moving_source is not mesh or self._moving_mtime != mtime:
             k = int(np.ceil(mesh.n_cells / self.MOVING_TRIANGLES))
             self._moving_mesh = _every_kth(mesh, k)
-            self._moving_source, self._moving_mtime = mesh, mesh.GetMTime()
+            self._moving_source, self._moving_mtime = mesh, mtime
         actor = self.actors.get("canopy_moving")
         if actor is None:
             actor = self.add_mesh(self._moving_mesh, name="canopy_moving", render=False,

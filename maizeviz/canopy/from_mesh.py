@@ -358,6 +358,7 @@ def _positions(n: int, centre: np.ndarray | None, area: np.ndarray, leaf_inst: n
         weight = np.bincount(leaf_inst, area, n)
         count = np.bincount(leaf_inst, minlength=n).astype(np.float64)
     for k in range(2 if centre is not None else 0):
+        assert centre is not None
         wsum = np.bincount(leaf_inst, area * centre[:, k], n)
         plain = np.bincount(leaf_inst, centre[:, k], n)
         out[:, k] = np.where(weight > 0, wsum / np.where(weight > 0, weight, 1),

@@ -101,17 +101,22 @@ def ground_cover(canopy: Canopy, resolution: float = COVER_RESOLUTION_CM,
 
 def measure_canopy(canopy: Canopy, cover_resolution: float = COVER_RESOLUTION_CM,
                    with_stalks: bool = False, scene: RayScene | None = None) -> CanopyMeasures:
-    """Table 2 measures of a canopy; stalks count only ``with_stalks``.
+    """Table 2 measures of a canopy; the stalks shade the ground in the cover only
+    ``with_stalks``.
+
+    A stalk is not leaf area: the leaf area, its projection and the LAI are the leaves' in
+    both cases (with ``with_stalks`` they counted the stalks' surface too, about 11 m2 for the
+    paper's 81 plants).
 
     ``scene`` is the canopy's plain Embree scene (the leaves, and the stalks when
     ``with_stalks``; not a periodic one), to spare building it again for the ground cover.
     """
-    verts, faces = canopy.vertices, canopy.faces
+    area, normals = triangle_areas_normals(canopy.vertices, canopy.faces)
+    cover_src = canopy
     if with_stalks:
-        faces = np.vstack([faces, canopy.stalk_faces + len(verts)])
-        verts = np.vstack([verts, canopy.stalk_vertices])
-    area, normals = triangle_areas_normals(verts, faces)
-    cover_src = canopy if not with_stalks else _with(canopy, verts, faces)
+        cover_src = _with(canopy, np.vstack([canopy.vertices, canopy.stalk_vertices]),
+                          np.vstack([canopy.faces,
+                                     canopy.stalk_faces + len(canopy.vertices)]))
     return CanopyMeasures(
         level=canopy.level, plants=canopy.n_plants, leaves=canopy.n_leaves,
         triangles=canopy.n_triangles, leaf_area_m2=float(area.sum()) / 1e4,

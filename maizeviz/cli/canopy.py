@@ -50,7 +50,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     add_canopy_options(p)
     add_level_options(p, CANOPY_LEVELS)
     p.add_argument("--with-stalks", action="store_true",
-                   help="count stalk cylinders in the measures (they are always in exports)")
+                   help="stalk cylinders shade the ground in the ground cover (never leaf "
+                        "area nor LAI; they are always in exports)")
     p.add_argument("--cover-resolution", type=NUMBER_ARG, default=0.5, metavar="CM",
                    help="pixel edge of the vertical-ray grid measuring ground cover (default 0.5)")
     p.add_argument("--json", action="store_true", help="print JSON instead of a table")

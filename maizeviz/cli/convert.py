@@ -62,6 +62,13 @@ def _mtg(args: argparse.Namespace) -> int:
     for line in [*got.problems, *(str(e) for e in got.skipped)]:
         say(f"warning: {line}")
     write_mtg(args.out, got.leaves)
+    from maizeviz.io.points import read_points
+
+    dropped = list(read_points(args.points).extra)     # said, not lost without a word
+    if dropped:
+        say(f"note: an MTG holds the fitted leaves, not the records: the column(s) "
+            f"{', '.join(dropped[:6])}{'...' if len(dropped) > 6 else ''} of {args.points} are "
+            "not in it (a Parquet or CSV --out keeps them)")
     plants = len({lf.plant for lf in got.leaves})
     say(f"wrote {plants:,} plants, {len(got.leaves):,} leaves to {args.out} (OpenAlea MTG)")
     return EXIT_OK

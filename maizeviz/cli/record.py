@@ -114,8 +114,7 @@ def _connect(args: argparse.Namespace, session: Session, emit: _Emitter) -> Fast
         config = port.configure(stations)
     except MaizevizError:
         port.close()
-        if session.discard_if_unused():
-            say(f"note: {args.out} was not kept (nothing was recorded in it)")
+        session.discard_if_unused()          # (the error stays the one line said)
         raise
     finally:
         signal.signal(signal.SIGTERM, before)

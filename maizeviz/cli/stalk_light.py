@@ -1,6 +1,6 @@
 """The stalks' share of a level's light for ``maizeviz light``: apart from the leaves, in the
-JSON record (``stalks``: totals and a row per plant), the printed tables and the plant CSV
-(``stalk_*`` columns). The leaf CSV and every leaf and plant sum stay the leaves' own, so that
+JSON record (``stalks``: the field's totals), the printed tables and the plant CSV (``stalk_*``
+columns, a plant's own stalk). The leaf CSV and every leaf and plant sum stay the leaves' own, so that
 leaf rows still add up to plant rows and to the canopy's leaf totals."""
 
 from __future__ import annotations
@@ -15,12 +15,14 @@ from maizeviz.mesh.tessellate import triangle_areas_normals
 
 
 def stalk_record(canopy: Canopy, with_stalks: bool, res: Any, sky: Any, ab: Any,
-                 period: Any = None) -> tuple[dict[str, Any], list[dict]]:
+                 period: Any = None, periodic: bool = False
+                 ) -> tuple[dict[str, Any], list[dict]]:
     """The stalks' record of one level and their rows (one per plant whose stalk took light).
 
     ``res``, ``sky``, ``ab``, ``period``: the level's sun (LightResult), sky (SkyLight),
     absorbed light (AbsorbedLight or AbsorbedPeriod) and period (PeriodLight), each None when
-    not traced.
+    not traced; ``periodic``: rays wrapped across the plot (a plant's copies are reported as
+    one, as its leaves are).
     """
     ns = len(canopy.stalk_faces)
     traced = bool(with_stalks and ns)
@@ -48,11 +50,11 @@ def stalk_record(canopy: Canopy, with_stalks: bool, res: Any, sky: Any, ab: Any,
             columns["absorbed_w"] = per
         else:
             columns["absorbed_mj"] = ab.triangle_absorbed_j * 1e-6
-    rows = stalk_rows(canopy, columns) if traced else []
-    # by place, not by the order the stands were listed in (a project and its layout file
-    # list them differently): the same field gives the same record
-    rec["plants"] = sorted(({k: v for k, v in r.items() if k != "instance"} for r in rows),
-                           key=lambda r: (r["x_cm"], r["y_cm"], r["plant"]))
+    # per plant in the --plant-light table only, as the leaves' rows: the record holds what
+    # the field took, the same whatever names its plants (a project, its layout file, its
+    # exported mesh number and place them differently)
+    rect = next((r.rect for r in (res, sky, period, ab) if r is not None), None)
+    rows = stalk_rows(canopy, columns, rect, periodic) if traced else []
     return rec, rows
 
 

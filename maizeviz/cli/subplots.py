@@ -108,7 +108,7 @@ def run(args: argparse.Namespace) -> int:
                             "plant, on every worker (maizeviz convert writes one)")
     sun = Sun(args.sun_zenith, args.sun_azimuth)
     field = _field(FieldLeaves, args, Progress("reading the field"))
-    layout = layout_for(field, parse_shape(args.tile or "1x1", "tile"),  # type: ignore[arg-type]
+    layout = layout_for(field, parse_shape(args.tile or "1x1", "tile"),
                         args.row_spacing,
                         args.plant_spacing,
                         parse_shape(args.block, "block") if args.block else None, args.layout)

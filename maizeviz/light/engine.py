@@ -24,6 +24,7 @@ import threading
 import time
 from dataclasses import fields as dataclass_fields
 from dataclasses import replace
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -53,6 +54,10 @@ from maizeviz.light.trace.optics import SHORTWAVE_SHARE, Optics, optics_for
 from maizeviz.light.trace.scatter import DEFAULT_DEPTH, DEFAULT_THRESHOLD
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback
+
+if TYPE_CHECKING:
+    from maizeviz.light.results.assimilation import Assimilation
+    from maizeviz.photosynthesis.split import LeafModel
 
 
 class LightEngine:
@@ -213,7 +218,7 @@ class LightEngine:
         result = trace_light(self.canopy, LightRequest(sun, smp, classes),
                              progress, self.with_stalks, scene)
         result.seconds["build"] = build_s
-        return result
+        return result.with_canopy(self.canopy)
 
     def sky(self, sky: Sky | str = "soc", directions: int = 46, split: str = "auto", *,
             sampling: Sampling | None = None, progress: ProgressCallback | None = None,
@@ -258,6 +263,7 @@ class LightEngine:
         scene, build_s = self._scene_and_build(smp.periodic)
         light = trace_sky(self.canopy, sky_obj, smp, progress, self.with_stalks, scene, bin_cm)
         light.seconds["build"] = build_s
+        light = light.with_canopy(self.canopy)
         self._sky = (_sky_key(sky_obj, smp, bin_cm), light)
         return light
 
@@ -343,7 +349,7 @@ class LightEngine:
         light.seconds["build"] = build_s
         if light.sky is not None:
             self._sky = (_sky_key(sky_obj, smp, bin_cm), light.sky)
-        return light
+        return light.with_canopy(self.canopy)
 
     def kept_sky(self, sky: Sky, sampling: Sampling | None = None,
                  bin_cm: float = 5.0) -> SkyLight | None:
@@ -471,10 +477,10 @@ class LightEngine:
             sky_obj = sky if isinstance(sky, Sky) else make_sky(sky, directions)
         return absorbed_light(self.canopy, smp, self._normals(), opt, sun, direct,
                               diffuse_w_m2, sky_obj, depth, threshold, seed, smp_req.threads,
-                              progress, build_s, sky_passes)
+                              progress, build_s, sky_passes).with_canopy(self.canopy)
 
-    def photosynthesis(self, sun: Sun | None = None, *, model="c4",
-                       temperature_c: float = 25.0, **absorbed):
+    def photosynthesis(self, sun: Sun | None = None, *, model: LeafModel | str = "c4",
+                       temperature_c: float = 25.0, **absorbed: Any) -> Assimilation:
         """Gross CO2 assimilation of the leaves under one sun (and sky).
 
         Absorbed PAR (:meth:`absorbed`, same keywords) through a leaf model, each triangle's
@@ -496,7 +502,7 @@ class LightEngine:
         -------
         Assimilation
             ``canopy_gross_umol_m2_s`` (per m2 of ground), ``canopy_gross_kg_co2_ha_h``, their
-            standard errors; ``table("plant", canopy)`` as a DataFrame.
+            standard errors; ``table("plant")`` as a DataFrame (it knows its canopy).
 
         References
         ----------
@@ -510,9 +516,9 @@ class LightEngine:
         https://doi.org/10.1016/0168-1923(86)90061-4
         """
         from maizeviz.light.results.assimilation import assimilate
-        from maizeviz.photosynthesis.split import leaf_model
+        from maizeviz.photosynthesis.split import as_leaf_model
 
-        leaf = leaf_model(model) if isinstance(model, str) else model
+        leaf = as_leaf_model(model)
         light = self.absorbed(sun, band="par", **absorbed)
         return assimilate(self.canopy, light, leaf, temperature_c)
 
@@ -526,8 +532,9 @@ class LightEngine:
                      step_min: float = 30.0, start: str | None = None,
                      end: str | None = None, altitude: float = 0.0,
                      linke: float = DEFAULT_LINKE_TURBIDITY,
-                     par_factor: float = DEFAULT_PAR_UMOL_PER_J, photosynthesis=None,
-                     temperature_c=25.0, **fields) -> AbsorbedPeriod:
+                     par_factor: float = DEFAULT_PAR_UMOL_PER_J,
+                     photosynthesis: LeafModel | str | None = None,
+                     temperature_c: float | np.ndarray = 25.0, **fields: Any) -> AbsorbedPeriod:
         """Light absorbed with scattering over a period (a day), in one band.
 
         Each step's sun with the band's share of its direct irradiance, and the diffuse part
@@ -580,7 +587,7 @@ class LightEngine:
             Linke turbidity of the clear sky [-].
         par_factor : float
             PAR photons per joule of shortwave [umol J-1].
-        photosynthesis : LeafModel, optional
+        photosynthesis : LeafModel or {"c4", "wofost"}, optional
             Also the leaves' gross CO2 assimilation at every step (PAR only,
             :func:`maizeviz.light.results.assimilation.assimilate`), added up over the period
             (``AbsorbedPeriod.assimilation``).
@@ -606,6 +613,7 @@ class LightEngine:
         from functools import partial
 
         from maizeviz.light.sources.irradiance import clear_sky_period
+        from maizeviz.photosynthesis.split import as_leaf_model
 
         if period is None:
             if date is None or lat is None or lon is None:
@@ -615,8 +623,9 @@ class LightEngine:
         opt = optics if optics is not None else optics_for(band)
         one = partial(self.absorbed, band=opt.band, optics=opt, directions=directions,
                       depth=depth, threshold=threshold, seed=seed, sampling=sampling, **fields)
-        return absorbed_period(period, opt, sky, one, progress, self.canopy, photosynthesis,
-                               temperature_c)
+        leaf = None if photosynthesis is None else as_leaf_model(photosynthesis)
+        return absorbed_period(period, opt, sky, one, progress, self.canopy, leaf,
+                               temperature_c).with_canopy(self.canopy)
 
     def _normals(self):
         """Unit normals (F, 3) of the scene's leaf triangles, then its stalks' if traced

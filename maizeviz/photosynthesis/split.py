@@ -92,6 +92,33 @@ def leaf_model(name: str = "c4", **params) -> LeafModel:
     return cls(**given)
 
 
+def as_leaf_model(model: LeafModel | str) -> LeafModel:
+    """A leaf model, or the model a name gives with its defaults.
+
+    Parameters
+    ----------
+    model : LeafModel or {"c4", "wofost"}
+        A model (returned as it is), or its name (:func:`leaf_model`).
+
+    Returns
+    -------
+    LeafModel
+        The model.
+
+    Raises
+    ------
+    MaizevizError
+        An unknown name, or something that is neither a name nor a leaf model.
+    """
+    if isinstance(model, str):
+        return leaf_model(model)
+    if not callable(getattr(model, "gross", None)):
+        raise MaizevizError(f"a leaf model is a name ({', '.join(MODELS)}) or a model from "
+                            f"maizeviz.leaf_model(...), not {type(model).__name__}",
+                            quantity="photosynthesis")
+    return model
+
+
 #: Parameters of maizeviz 0.2's C4 records that now come with the temperature response.
 _LEGACY_C4_KEYS = ("s1", "s2", "s3", "s4", "s5", "s6")
 

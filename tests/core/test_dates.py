@@ -8,7 +8,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from maizeviz.light.sources.dates import FIRST_YEAR, LAST_YEAR
+from maizeviz.io.dates import FIRST_YEAR, LAST_YEAR
 from maizeviz.light.sources.irradiance import WeatherFileError, read_weather, sun_track
 from maizeviz.light.sources.sun import sun_at
 

@@ -70,8 +70,10 @@ def test_per_plant_tables_sum_the_per_leaf_tables(small):
     leaves, plants = light.table("leaf", small), light.table("plant", small)
     by_plant = leaves.groupby("plant")["sunlit_area_cm2"].sum()
     assert np.allclose(plants.set_index("plant")["sunlit_area_cm2"], by_plant)
+    # the engine's results know their canopy; one without it asks for it
+    assert light.table("leaf").equals(leaves) and light.canopy is small
     with pytest.raises(mv.MaizevizError, match="needs the canopy"):
-        light.table("leaf")
+        light.with_canopy(None).table("leaf")
     with pytest.raises(mv.MaizevizError, match="height, leaf, plant"):
         light.table("tile", small)
 

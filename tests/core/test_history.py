@@ -104,6 +104,21 @@ def test_merging_by_time_is_explicit_and_typing_back_is_no_step():
     assert h.texts == ["sun zenith 5", "sun zenith 6"]
 
 
+def test_settings_set_together_are_one_step():
+    """settings.set (a weather file and its source, a sky split and its directions, the sun
+    from a place) is one step; a value refused sets none of them."""
+    from maizeviz_app.settings import InputProblem
+
+    model = _model()
+    model.settings.set("sun", {"zenith_deg": 12.0, "azimuth_deg": 200.0})
+    assert model.history.texts == ["sun zenith 12 and 1 more"]
+    with pytest.raises(InputProblem):
+        model.settings.set("sun", {"zenith_deg": 13.0, "azimuth_deg": 9999.0})
+    assert model.settings.sun.zenith_deg == 12.0 and len(model.history.steps) == 1
+    model.history.undo()
+    assert (model.settings.sun.zenith_deg, model.settings.sun.azimuth_deg) == (22.34, 166.95)
+
+
 def test_the_models_own_changes_are_no_step_and_opening_clears():
     model = _model()
     model.apply_settings("sun", {"zenith_deg": 12.0})  # the model itself (a project read)

@@ -9,9 +9,9 @@ import pvlib
 import pytest
 
 from maizeviz.errors import MaizevizError
+from maizeviz.io.weather_csv import MAX_IRRADIANCE_W_M2
 from maizeviz.light.sources.irradiance import (
     DEFAULT_PAR_UMOL_PER_J,
-    MAX_IRRADIANCE_W_M2,
     WeatherFileError,
     clear_sky,
     clear_sky_period,

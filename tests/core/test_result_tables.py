@@ -55,11 +55,26 @@ def test_every_result_tables_its_summary_leaves_and_plants(traced):
                 pytest.approx(leaves[value].sum(), rel=1e-12), name
 
 
+def test_every_result_knows_its_canopy_and_a_pickled_one_leaves_it_behind(traced):
+    """The engine's results table their leaves without the canopy passed back; a result that
+    crossed a process boundary (pickled) carries no canopy and takes one again."""
+    import pickle
+
+    canopy, results = traced
+    for r in results:
+        name = type(r).__name__
+        assert r.canopy is canopy, name
+        assert r.table("leaf").equals(r.table("leaf", canopy)), name
+        back = pickle.loads(pickle.dumps(r))
+        assert back.canopy is None and back.with_canopy(canopy).table("plant").equals(
+            r.table("plant")), name
+
+
 def test_every_result_refuses_alike(traced):
     canopy, results = traced
     for r in results:
         with pytest.raises(mv.MaizevizError, match="needs the canopy") as info:
-            r.table("plant")
+            r.with_canopy(None).table("plant")
         assert info.value.quantity == "canopy"
         with pytest.raises(mv.MaizevizError, match="a light table is by") as info:
             r.table("tree", canopy)

@@ -104,14 +104,30 @@ def test_the_command_line_reports_stalks_and_leaves_only_is_the_papers(capsys, t
     off = json.loads(capsys.readouterr().out)
     assert on["stalks"]["traced"] and not off["stalks"]["traced"]
     assert on["stalks"]["sun_intercepted_fraction"] > 0
-    assert off["stalks"]["plants"] == []
     assert on["transmission"][0] <= off["transmission"][0]
     assert on["sunlit_intercepted_fraction"] + on["stalks"]["sun_intercepted_fraction"] + \
         on["transmission"][0] == pytest.approx(1.0, abs=1e-12)
     leaf_lines = leaf_csv.read_text().splitlines()
     leaf_col = leaf_lines[0].split(",").index("leaf")
     assert all(r.split(",")[leaf_col] != "0" for r in leaf_lines[1:])   # leaves only
-    assert all(r["leaf"] == 0 and r["stalk_area_cm2"] > 0 for r in on["stalks"]["plants"])
+    plants = plant_csv.read_text().splitlines()
+    col = plants[0].split(",").index("stalk_sunlit_intercepted_cm2")
+    lit = [float(r.split(",")[col]) for r in plants[1:]]
+    assert sum(v > 0 for v in lit) > 0
+    assert sum(lit) / ((on["rect_cm"][2] - on["rect_cm"][0]) * (on["rect_cm"][3] -
+                       on["rect_cm"][1])) == pytest.approx(
+        on["stalks"]["sun_intercepted_fraction"], rel=1e-9)
     assert "stalk_sunlit_intercepted_cm2" in plant_csv.read_text().splitlines()[0]
     assert main([*base, "--leaves-only", "--with-stalks"]) != EXIT_OK
     assert "contradict" in capsys.readouterr().err
+
+
+def test_a_stalk_is_no_leaf_area_in_the_canopy_measures(canopy):
+    """--with-stalks lets the stalks shade the ground; leaf area and LAI stay the leaves'."""
+    from maizeviz.canopy.measures import measure_canopy
+
+    leaves = measure_canopy(canopy, 2.0)
+    stalks = measure_canopy(canopy, 2.0, with_stalks=True)
+    assert stalks.leaf_area_m2 == leaves.leaf_area_m2
+    assert stalks.projected_area_m2 == leaves.projected_area_m2
+    assert stalks.ground_cover_m2 >= leaves.ground_cover_m2

@@ -88,7 +88,7 @@ def test_a_large_mesh_file_is_drawn_within_the_budget(window, qtbot, small_point
     """A mesh file over the view's budget: the plants nearest the centre drawn with the
     file's triangles, the others simplified per leaf, each drawn triangle keeping its leaf;
     a sun's light per leaf paints them all."""
-    import maizeviz_app.mesh_view as mesh_view
+    import maizeviz_app.mesh_file_view as mesh_file_view
     import maizeviz_app.viewport as viewport_mod
 
     from maizeviz.canopy.export import export_canopy
@@ -100,7 +100,7 @@ def test_a_large_mesh_file_is_drawn_within_the_budget(window, qtbot, small_point
     ply = tmp_path / "field.ply"
     export_canopy(str(ply), w.model.canopy)
     monkeypatch.setattr(viewport_mod, "VIEW_BUDGET", 20_000)
-    monkeypatch.setattr(mesh_view, "DRAWN", 12_000)
+    monkeypatch.setattr(mesh_file_view, "DRAWN", 12_000)
     with qtbot.waitSignal(w.canopy_shown, timeout=TIMEOUT):
         w.open_mesh(ply, "cm", "z")
     c, mesh = w.model.canopy, w.viewport.canopy_mesh

@@ -215,3 +215,23 @@ def test_a_long_status_line_is_shortened_in_the_middle_and_whole_in_its_tooltip(
         assert bar.toolTip().endswith(long)
     w.say("a short line", status_only=True)
     assert bar.currentMessage() == "a short line" and bar.toolTip() == ""
+
+
+def test_the_c4_plants_table_shows_its_co2_columns_on_a_laptop(laptop, qtbot):
+    """Issue 37, item 7: at 1366 x 768 the plants table of a sun with C4 hid its CO2 columns
+    behind a sideways scroll; its headers now take a word a line and every column shows."""
+    from test_light_modes import compute, small_light
+
+    w = laptop
+    p = w.light_panel
+    small_light(p, "sun")
+    p.periodic.setChecked(True)
+    p.optics_box.setChecked(True)
+    p.photo_model.setCurrentIndex(p.photo_model.findData("c4"))
+    compute(qtbot, w)
+    w.docks["light"].raise_()
+    qtbot.waitUntil(lambda: p.plants.isVisible(), timeout=TIMEOUT)
+    qtbot.wait(200)
+    assert p.plants.columnCount() == 8
+    assert p.plants.horizontalScrollBar().maximum() == 0
+    assert not _cut(w.docks["light"].widget().widget())

@@ -7,7 +7,8 @@ from maizeviz.digitizer.recorder import Recorder
 from maizeviz.digitizer.session import Session
 
 TIMEOUT = 120_000
-ANALYSE = {"canopy", "light", "layout", "colour", "results", "messages", "history"}
+ANALYSE = {"canopy", "light", "layout", "colour", "instruments", "results", "messages",
+           "history"}
 
 
 def _open(w):

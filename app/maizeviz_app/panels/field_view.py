@@ -242,9 +242,6 @@ class FieldView(QGraphicsView):
             if 0 <= i < len(self.items_):
                 self.items_[i].setBrush(QBrush(self._colour(i)))
 
-    def is_overlapping(self, index: int) -> bool:
-        return index in self._overlapping
-
     def select(self, index: int) -> None:
         """Show placement ``index`` as the picked one (-1: none)."""
         old = self._picked

@@ -120,9 +120,8 @@ class FigureWindow(QDialog):
         lay.addLayout(buttons)
         for keys, factor in ((QKeySequence.StandardKey.ZoomIn, ZOOM_STEP),
                              (QKeySequence.StandardKey.ZoomOut, 1 / ZOOM_STEP)):
-            QShortcut(QKeySequence(keys), self,
-                      activated=lambda f=factor: self.set_zoom(self.zoom * f))
-        QShortcut(QKeySequence("Ctrl+0"), self, activated=lambda: self.set_zoom(1.0))
+            QShortcut(QKeySequence(keys), self, lambda f=factor: self.set_zoom(self.zoom * f))
+        QShortcut(QKeySequence("Ctrl+0"), self, lambda: self.set_zoom(1.0))
         self.set_zoom(1.0)
         screen = self.screen().availableGeometry() if self.screen() else None
         w, h = image.width() + 40, image.height() + 80
@@ -147,8 +146,9 @@ class FigureWindow(QDialog):
             super().wheelEvent(event)
 
     def save(self, path: str) -> bool:
-        """Write the figure (its own pixels) as a PNG."""
-        return self.image.save(str(path), "PNG")
+        """Write the figure (its own pixels) as a PNG (``.png`` added when missing)."""
+        path = str(path) if str(path).lower().endswith(".png") else f"{path}.png"
+        return self.image.save(path)
 
     def choose_save(self) -> None:
         path, _ = QFileDialog.getSaveFileName(self, "Save the figure", "figure.png",

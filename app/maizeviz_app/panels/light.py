@@ -762,7 +762,7 @@ class LightPanel(QWidget):
         if run.kind == "sun":
             band = run.extra.light.band.upper()
             header = ["stand", "plant", "x, y cm", f"{band} absorbed W", "W/m² leaf",
-                      "sunlit m² leaf"]
+                      "sunlit m²"]
             keys = ("absorbed_w", "absorbed_w_m2_leaf", "sunlit_area_cm2")
             fmt = "{:.2f}"
             title = f"{band} each plant absorbs, with scattering"
@@ -789,7 +789,9 @@ class LightPanel(QWidget):
             self.plants_title.setText(f"share of the sky's diffuse light each plant "
                                       f"intercepts ({run.label})")
         t.setColumnCount(len(header))
-        t.setHorizontalHeaderLabels(header)
+        # a header of several words on two lines: the table fits a laptop's dock (1366 x 768)
+        # without hiding the CO2 columns behind a sideways scroll
+        t.setHorizontalHeaderLabels([_two_lines(h) for h in header])
         t.setRowCount(len(rows))
         for r, row in enumerate(rows):
             vals = [str(row["instance"]), str(row["plant"]),
@@ -802,6 +804,7 @@ class LightPanel(QWidget):
                 item = QTableWidgetItem(text)
                 item.setTextAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
                 t.setItem(r, c, item)
+        t.resizeColumnsToContents()
         t.resizeRowsToContents()
         shown = min(len(rows), 9)
         h = t.horizontalHeader().sizeHint().height() + 2 * t.frameWidth()
@@ -821,6 +824,12 @@ class LightPanel(QWidget):
         if t.horizontalScrollBar().isVisible() or t.columnCount() > 4:
             h += t.horizontalScrollBar().sizeHint().height()
         t.setFixedHeight(max(h, head + 30))
+
+
+def _two_lines(header: str) -> str:
+    """A column header of several words a word a line ("CO₂\ngross\nµmol/s"), as the
+    canopy panel's; short ones as they are."""
+    return header if len(header) <= 8 else header.replace(" ", "\n")
 
 
 def _model_text(assimilation) -> str:

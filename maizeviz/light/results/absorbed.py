@@ -10,11 +10,12 @@ period (:class:`AbsorbedPeriod`); PAR also in photons, 4.57 umol per J of PAR
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Self
 
 import numpy as np
 
 from maizeviz.canopy.scene import Canopy
+from maizeviz.light.results.on_triangles import TriangleResult
 from maizeviz.light.results.per_leaf import LightRow, leaf_sums
 from maizeviz.light.results.traced import TableBy, table_kind
 from maizeviz.light.results.uncertainty import Batches, errors_by
@@ -22,6 +23,8 @@ from maizeviz.light.results.uncertainty import Batches, errors_by
 if TYPE_CHECKING:
     import pandas as pd
 
+    from maizeviz.light.results.assimilation import PeriodAssimilation
+    from maizeviz.light.sources.irradiance import Period
     from maizeviz.light.trace.optics import Optics  # with the tracing that uses them
 
 
@@ -91,6 +94,15 @@ class Balance:
                 "closure_fraction": self.closure_fraction}
 
 
+def _leaves_error(result: AbsorbedLight | AbsorbedPeriod) -> float | None:
+    """The standard error of the leaves' absorbed light in the balance's units: the batches'
+    error of the triangles' total, scaled as the balance scales that total."""
+    total = result.triangle_total
+    if result.batches is None or total <= 0:
+        return None if result.batches is None else 0.0
+    return float(result.triangle_total_error or 0.0) * result.balance.absorbed_leaves / total
+
+
 def _fraction_absorbed(self) -> float:
     """Share of the incident light the leaves absorb."""
     b = self.balance
@@ -107,7 +119,7 @@ def _per_plant(frame, sums: tuple[str, ...]):
 
 
 @dataclass(frozen=True)
-class AbsorbedLight:
+class AbsorbedLight(TriangleResult):
     """Light absorbed by the leaves (and the ground) in one band, with scattering.
 
     From :meth:`maizeviz.light.engine.LightEngine.absorbed`.
@@ -159,6 +171,9 @@ class AbsorbedLight:
         Unit vector toward the sun traced, field coordinates (None without a sun).
     stands : dict or None
         ``{"n", "sha256"}``, the identity of the stands of the canopy it was traced on.
+    canopy : Canopy or None
+        The canopy it was traced on (keyword-only; :class:`TriangleResult`): tables per leaf
+        and plant use it.
 
     References
     ----------
@@ -190,6 +205,12 @@ class AbsorbedLight:
 
     fraction_absorbed = property(_fraction_absorbed)
 
+    def _triangle_values(self) -> np.ndarray:
+        return self.triangle_absorbed_w
+
+    def _triangle_batches(self) -> Any:
+        return None if self.batches is None else self.batches.absorbed
+
     @property
     def absorbed_leaves_error(self) -> float | None:
         """Monte Carlo standard error of ``balance.absorbed_leaves``, from batches of rays.
@@ -199,10 +220,7 @@ class AbsorbedLight:
         float or None
             [W m-2 of ground]; None when the result was not traced in batches.
         """
-        total = float(self.triangle_absorbed_w.sum())
-        if self.batches is None or total <= 0:
-            return None if self.batches is None else 0.0
-        return self.batches.error() * self.balance.absorbed_leaves / total
+        return _leaves_error(self)
 
     @property
     def balance_errors(self) -> dict[str, float] | None:
@@ -231,7 +249,8 @@ class AbsorbedLight:
             in and out of the direct beam), and for PAR ``absorbed_umol_s`` [umol s-1]
             (4.57 umol per J of PAR).
         canopy : Canopy, optional
-            The canopy the light was traced on; needed by leaf and plant.
+            The canopy the light was traced on (default: the result's own, ``canopy``);
+            needed by leaf and plant.
 
         Returns
         -------
@@ -245,6 +264,7 @@ class AbsorbedLight:
         """
         import pandas as pd
 
+        canopy = self._on(canopy)
         kind = table_kind(by, "balance", canopy)
         if kind == "balance":
             return pd.DataFrame([{"band": self.band, **self.balance.as_dict()}])
@@ -301,7 +321,7 @@ class AbsorbedLight:
 
 
 @dataclass(frozen=True)
-class AbsorbedPeriod:
+class AbsorbedPeriod(TriangleResult):
     """Light absorbed by the leaves (and the ground) in one band over a period, with scattering.
 
     From :meth:`maizeviz.light.engine.LightEngine.absorbed_day`: each time step's sun traced
@@ -344,6 +364,9 @@ class AbsorbedPeriod:
         The leaves' gross CO2 assimilation over the period, when a leaf model was asked for.
     stands : dict or None
         ``{"n", "sha256"}``, the identity of the stands of the canopy it was traced on.
+    canopy : Canopy or None
+        The canopy it was traced on (keyword-only; :class:`TriangleResult`): tables per leaf
+        and plant use it.
 
     References
     ----------
@@ -354,7 +377,7 @@ class AbsorbedPeriod:
 
     band: str
     optics: Optics
-    period: Any
+    period: Period
     balance: Balance
     triangle_absorbed_j: np.ndarray
     step_absorbed_leaves_w_m2: np.ndarray
@@ -367,10 +390,34 @@ class AbsorbedPeriod:
     level: str = ""
     seconds: dict[str, float] = field(default_factory=dict)
     batches: Batches | None = None
-    assimilation: Any = None
+    assimilation: PeriodAssimilation | None = None
     stands: dict | None = None
 
     fraction_absorbed = property(_fraction_absorbed)
+
+    def _triangle_values(self) -> np.ndarray:
+        return self.triangle_absorbed_j
+
+    def _triangle_batches(self) -> Any:
+        return None if self.batches is None else self.batches.absorbed
+
+    def with_canopy(self, canopy: Canopy | None) -> Self:
+        """The same result, and its assimilation, knowing the canopy they were computed on.
+
+        Parameters
+        ----------
+        canopy : Canopy or None
+            The canopy it was traced on.
+
+        Returns
+        -------
+        AbsorbedPeriod
+            A copy holding ``canopy``.
+        """
+        from dataclasses import replace
+
+        carbon = None if self.assimilation is None else self.assimilation.with_canopy(canopy)
+        return replace(self, canopy=canopy, assimilation=carbon)
 
     @property
     def absorbed_leaves_error(self) -> float | None:
@@ -381,10 +428,7 @@ class AbsorbedPeriod:
         float or None
             [MJ m-2 of ground]; None when the result was not traced in batches.
         """
-        total = float(self.triangle_absorbed_j.sum())
-        if self.batches is None or total <= 0:
-            return None if self.batches is None else 0.0
-        return self.batches.error() * self.balance.absorbed_leaves / total
+        return _leaves_error(self)
 
     @property
     def balance_errors(self) -> dict[str, float] | None:
@@ -425,7 +469,8 @@ class AbsorbedPeriod:
             "leaf" or "plant": ``absorbed_mj`` [MJ], ``absorbed_mj_m2_leaf`` [MJ m-2 of leaf],
             and for PAR ``absorbed_mol`` [mol].
         canopy : Canopy, optional
-            The canopy the light was traced on; needed by leaf and plant.
+            The canopy the light was traced on (default: the result's own, ``canopy``);
+            needed by leaf and plant.
 
         Returns
         -------
@@ -439,6 +484,7 @@ class AbsorbedPeriod:
         """
         import pandas as pd
 
+        canopy = self._on(canopy)
         kind = table_kind(by, "balance", canopy)
         if kind == "balance":
             return pd.DataFrame([{"band": self.band, "unit": "MJ/m2",

@@ -31,21 +31,27 @@ Standard errors come from the independent batches of rays the absorbed light was
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.ids import groups
-from maizeviz.photosynthesis.split import LeafModel, model_from_dict, split_assimilation
+from maizeviz.light.results.on_triangles import TriangleResult
+from maizeviz.photosynthesis.split import (
+    LeafModel,
+    as_leaf_model,
+    model_from_dict,
+    split_assimilation,
+)
 from maizeviz.photosynthesis.units import CO2_G_PER_MOL, KG_HA_H_PER_UMOL_M2_S
 
 if TYPE_CHECKING:
     import pandas as pd
 
     from maizeviz.canopy.scene import Canopy
-    from maizeviz.light.results.absorbed import AbsorbedLight
     from maizeviz.light.results.traced import TableBy
+    from maizeviz.light.results.uncertainty import Batches
 
 
 #: Height band (cm) over which the background light of a leaf's triangles is pooled.
@@ -127,7 +133,7 @@ def _fold(values: np.ndarray, slot: np.ndarray | None, n_slots: int) -> np.ndarr
 
 
 @dataclass(frozen=True)
-class Assimilation:
+class Assimilation(TriangleResult):
     """Gross CO2 assimilation of the leaves under one traced light.
 
     Parameters
@@ -159,6 +165,9 @@ class Assimilation:
         :func:`assimilate`); None without batches.
     bias_se_umol_s : float or None
         Its spread over the halvings of the batches it was estimated from [umol CO2 s-1].
+    canopy : Canopy or None
+        The canopy it was computed on (keyword-only; :class:`TriangleResult`): tables per leaf
+        and plant use it.
 
     References
     ----------
@@ -184,10 +193,16 @@ class Assimilation:
     bias_umol_s: float | None = None
     bias_se_umol_s: float | None = None
 
+    def _triangle_values(self) -> np.ndarray:
+        return self.triangle_gross_umol_s
+
+    def _triangle_batches(self) -> np.ndarray | None:
+        return self.triangle_batches
+
     @property
     def canopy_gross_umol_m2_s(self) -> float:
         """Canopy gross assimilation, umol CO2 per m2 of ground per s."""
-        return float(self.triangle_gross_umol_s.sum()) / self.ground_m2
+        return self.triangle_total / self.ground_m2
 
     @property
     def canopy_gross_kg_co2_ha_h(self) -> float:
@@ -197,11 +212,8 @@ class Assimilation:
     @property
     def canopy_gross_error_umol_m2_s(self) -> float | None:
         """Monte Carlo standard error of :attr:`canopy_gross_umol_m2_s` (None: no batches)."""
-        if self.triangle_batches is None:
-            return None
-        from maizeviz.light.results.uncertainty import batch_error
-
-        return float(batch_error(self.triangle_batches.sum(axis=1))) / self.ground_m2
+        se = self.triangle_total_error
+        return None if se is None else se / self.ground_m2
 
     @property
     def canopy_gross_bias_umol_m2_s(self) -> float | None:
@@ -264,7 +276,8 @@ class Assimilation:
             numbers). "leaf" or "plant": ``gross_umol_s`` [umol CO2 s-1], its standard error
             ``gross_umol_s_se``, ``gross_umol_m2_leaf_s`` [umol CO2 m-2 of leaf s-1].
         canopy : Canopy, optional
-            The canopy the light was traced on; needed by leaf and plant.
+            The canopy the light was traced on (default: the result's own, ``canopy``);
+            needed by leaf and plant.
 
         Returns
         -------
@@ -272,11 +285,11 @@ class Assimilation:
             One row, or one per leaf or plant.
         """
         return _table(self, self.triangle_gross_umol_s, self.triangle_batches, "gross_umol_s",
-                      "gross_umol_m2_leaf_s", self.rect, self.periodic, by, canopy)
+                      "gross_umol_m2_leaf_s", self.rect, self.periodic, by, self._on(canopy))
 
 
 @dataclass(frozen=True)
-class PeriodAssimilation:
+class PeriodAssimilation(TriangleResult):
     """Gross CO2 assimilation of the leaves over a period (a day, a weather file).
 
     Each time step's light through the leaf model at that step's temperature, times the step.
@@ -305,6 +318,9 @@ class PeriodAssimilation:
         the rays [mol CO2] (negative: low), the steps' added up.
     bias_se_mol : float or None
         Its spread over the halvings of the batches, the steps' added up [mol CO2].
+    canopy : Canopy or None
+        The canopy it was computed on (keyword-only; :class:`TriangleResult`): tables per leaf
+        and plant use it.
 
     References
     ----------
@@ -324,6 +340,12 @@ class PeriodAssimilation:
     bias_mol: float | None = None
     bias_se_mol: float | None = None
 
+    def _triangle_values(self) -> np.ndarray:
+        return self.triangle_gross_mol
+
+    def _triangle_batches(self) -> np.ndarray | None:
+        return self.triangle_batches
+
     @property
     def canopy_gross_mol_m2(self) -> float:
         """Gross CO2 assimilation over the period per m2 of ground.
@@ -333,7 +355,7 @@ class PeriodAssimilation:
         float
             [mol CO2 m-2].
         """
-        return float(self.triangle_gross_mol.sum()) / self.ground_m2
+        return self.triangle_total / self.ground_m2
 
     @property
     def canopy_gross_g_m2(self) -> float:
@@ -355,11 +377,8 @@ class PeriodAssimilation:
         float or None
             [mol CO2 m-2]; None without batches.
         """
-        if self.triangle_batches is None:
-            return None
-        from maizeviz.light.results.uncertainty import batch_error
-
-        return float(batch_error(self.triangle_batches.sum(axis=1))) / self.ground_m2
+        se = self.triangle_total_error
+        return None if se is None else se / self.ground_m2
 
     def as_dict(self) -> dict[str, Any]:
         """The figures the command line's JSON carries.
@@ -395,7 +414,8 @@ class PeriodAssimilation:
             numbers). "leaf" or "plant": ``gross_mol`` [mol CO2] over the period,
             ``gross_mol_se``, ``gross_g_co2`` [g], ``gross_mol_m2_leaf`` [mol m-2 of leaf].
         canopy : Canopy, optional
-            The canopy the light was traced on; needed by leaf and plant.
+            The canopy the light was traced on (default: the result's own, ``canopy``);
+            needed by leaf and plant.
 
         Returns
         -------
@@ -403,7 +423,7 @@ class PeriodAssimilation:
             One row, or one per leaf or plant.
         """
         frame = _table(self, self.triangle_gross_mol, self.triangle_batches, "gross_mol",
-                       "gross_mol_m2_leaf", self.rect, self.periodic, by, canopy)
+                       "gross_mol_m2_leaf", self.rect, self.periodic, by, self._on(canopy))
         if by is not None and by != "canopy" and not frame.empty:
             frame["gross_g_co2"] = frame["gross_mol"] * CO2_G_PER_MOL
         return frame
@@ -441,7 +461,30 @@ def _table(result, values: np.ndarray, batches: np.ndarray | None, col: str,
     return frame
 
 
-def assimilate(canopy: Canopy, light: AbsorbedLight, model: LeafModel,
+class AbsorbedPar(Protocol):
+    """What :func:`assimilate` reads of absorbed PAR: an
+    :class:`~maizeviz.light.results.absorbed.AbsorbedLight` (named by its members, so that the
+    absorbed results may name the assimilation they carry without an import circle)."""
+
+    @property
+    def band(self) -> str: ...
+    @property
+    def rect(self) -> tuple[float, float, float, float]: ...
+    @property
+    def periodic(self) -> bool: ...
+    @property
+    def rays(self) -> int: ...
+    @property
+    def triangle_absorbed_w(self) -> np.ndarray: ...
+    @property
+    def triangle_direct_w(self) -> np.ndarray | None: ...
+    @property
+    def triangle_sunlit_cm2(self) -> np.ndarray: ...
+    @property
+    def batches(self) -> Batches | None: ...
+
+
+def assimilate(canopy: Canopy, light: AbsorbedPar, model: LeafModel | str,
                temp_c: float = 25.0, pool_cm: float = POOL_CM,
                pool_rays: float = POOL_RAYS) -> Assimilation:
     """Gross assimilation of the canopy's leaves under absorbed PAR ``light`` (a sun, a sky,
@@ -451,7 +494,8 @@ def assimilate(canopy: Canopy, light: AbsorbedLight, model: LeafModel,
     ----------
     canopy : the canopy ``light`` was traced on
     light : AbsorbedLight in the PAR band
-    model : a leaf model (:func:`maizeviz.photosynthesis.split.leaf_model`)
+    model : a leaf model (:func:`maizeviz.photosynthesis.split.leaf_model`), or its name
+        ("c4", "wofost": its default parameters)
     temp_c : leaf temperature, C (the air's: leaves are taken at air temperature)
     pool_cm : height band (cm) over which a leaf's background light is pooled (0: each
         triangle its own)
@@ -465,6 +509,7 @@ def assimilate(canopy: Canopy, light: AbsorbedLight, model: LeafModel,
     from maizeviz.errors import check_range
     from maizeviz.mesh.tessellate import triangle_areas_normals
 
+    model = as_leaf_model(model)
     if light.band != "par":
         raise MaizevizError("photosynthesis needs absorbed PAR, not "
                             f"{light.band.upper()}", quantity="band")
@@ -547,7 +592,7 @@ def assimilate(canopy: Canopy, light: AbsorbedLight, model: LeafModel,
                         float(model.respiration(temp_c)), float(area_s.sum()),
                         light.rect, light.periodic, tuple(warnings),
                         None if bias is None else float(bias.mean()),
-                        None if bias is None else float(bias.std(ddof=1)))
+                        None if bias is None else float(bias.std(ddof=1)), canopy=canopy)
 
 
 def _covers_plot(canopy: Canopy, rect, periodic: bool) -> bool:

@@ -26,6 +26,9 @@ class LightResult(TracedLight):
 
     Parameters
     ----------
+    canopy : Canopy or None
+        The canopy it was traced on (keyword-only; the engine's results hold it): tables per
+        leaf and plant use it.
     heights_cm : numpy.ndarray
         (H,) float64 heights of the sensor planes [cm].
     rect : (x0, y0, x1, y1) tuple of float

@@ -15,7 +15,7 @@ import numpy as np
 
 from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
-from maizeviz.light.results.per_leaf import LightRow
+from maizeviz.light.results.per_leaf import LightRow, tile_representatives
 from maizeviz.mesh.tessellate import triangle_areas_normals
 
 
@@ -47,8 +47,12 @@ def stalk_part(canopy: Canopy, values: np.ndarray, what: str) -> np.ndarray:
     return values[nf:]
 
 
-def stalk_rows(canopy: Canopy, columns: dict[str, np.ndarray]) -> list[LightRow]:
-    """Per plant whose stalk took light: the columns summed over its stalk's triangles.
+def stalk_rows(canopy: Canopy, columns: dict[str, np.ndarray],
+               rect: tuple[float, float, float, float] | None = None,
+               periodic: bool = False) -> list[LightRow]:
+    """Per plant whose stalk took light: the columns summed over its stalk's triangles (and,
+    as the leaf rows are, over the copies of its plant in a tile-periodic field sampled on
+    ``rect``: :func:`~maizeviz.light.results.per_leaf.tile_representatives`).
 
     Parameters
     ----------
@@ -57,6 +61,10 @@ def stalk_rows(canopy: Canopy, columns: dict[str, np.ndarray]) -> list[LightRow]
     columns : dict of str to numpy.ndarray
         Name -> (F + G,) float64 per scene triangle, leaves then stalks (a column of length
         F, traced without stalks, gives nothing).
+    rect : (x0, y0, x1, y1) tuple of float, optional
+        The sample rectangle [cm].
+    periodic : bool
+        Rays wrapped across the plot.
 
     Returns
     -------
@@ -69,11 +77,13 @@ def stalk_rows(canopy: Canopy, columns: dict[str, np.ndarray]) -> list[LightRow]
     ns = len(canopy.stalk_faces)
     if not ns or not parts or any(len(v) != ns for v in parts.values()):
         return []
-    inst = stalk_placements(canopy)
+    own = stalk_placements(canopy)
+    rep = tile_representatives(canopy.layout, rect, periodic)
+    inst = rep[own]                                  # a copy's light goes to its plant
     area, _ = triangle_areas_normals(canopy.stalk_vertices, canopy.stalk_faces)
     n = max(canopy.n_plants, 1)
     sums = {k: np.bincount(inst, weights=v, minlength=n) for k, v in parts.items()}
-    areas = np.bincount(inst, weights=area, minlength=n)
+    areas = np.bincount(own, weights=area, minlength=n)     # one stalk's, not its copies
     rows: list[LightRow] = []
     for i in np.flatnonzero(np.any([s != 0 for s in sums.values()], axis=0)):
         p = canopy.layout.placements[i]

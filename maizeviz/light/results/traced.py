@@ -17,6 +17,7 @@ import numpy as np
 
 from maizeviz.errors import MaizevizError
 from maizeviz.light.results.maps import TransmissionMap
+from maizeviz.light.results.on_triangles import OnCanopy
 from maizeviz.light.results.per_leaf import LightRow, plant_light
 from maizeviz.light.scene.rays import Rect
 
@@ -68,7 +69,7 @@ def table_kind(by: str | None, summary: str, canopy: Canopy | None) -> str:
 
 
 @dataclass(frozen=True, eq=False, kw_only=True)
-class TracedLight:
+class TracedLight(OnCanopy):
     """The fields every light result shares (keyword-only in the results' constructors).
 
     Attributes
@@ -82,6 +83,8 @@ class TracedLight:
     periodic : bool, rays and sensor paths wrapped across the plot
     stands : ``{"n", "sha256"}``, the identity of the stands of the canopy it was traced on
         (:func:`maizeviz.canopy.layout.stands_identity`), or None where not known
+    canopy : Canopy or None, the canopy it was traced on (:class:`OnCanopy`): the per-leaf
+        and per-plant tables use it when none is given
     """
 
     heights_cm: np.ndarray
@@ -140,7 +143,8 @@ class TracedLight:
             result's values there), per leaf or per plant (the light each intercepts, areas
             [cm2], PAR [mol]).
         canopy : Canopy, optional
-            The canopy the light was traced on; needed by leaf and plant.
+            The canopy the light was traced on (default: the result's own, ``canopy``);
+            needed by leaf and plant.
 
         Returns
         -------
@@ -154,6 +158,7 @@ class TracedLight:
         """
         import pandas as pd
 
+        canopy = self._on(canopy)
         kind = table_kind(by, "height", canopy)
         if kind == "height":
             return pd.DataFrame({"height_cm": np.asarray(self.heights_cm, dtype=np.float64),

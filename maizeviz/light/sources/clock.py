@@ -25,7 +25,7 @@ import math
 import numbers
 
 from maizeviz.errors import MaizevizError
-from maizeviz.light.sources.dates import TIME_UNIT
+from maizeviz.io.dates import TIME_UNIT
 
 
 def zone(tz) -> _dt.tzinfo:

@@ -36,7 +36,7 @@ from maizeviz.light.sources.sun import Sun
 from maizeviz.light.trace.direct import Sampler
 from maizeviz.light.trace.optics import Optics, band_share
 from maizeviz.light.trace.scatter import scatter_beam, scatter_sky
-from maizeviz.light.trace.sunlit import sunlit_share
+from maizeviz.light.trace.sunlit import geometry, sunlit_share
 from maizeviz.progress import ProgressCallback, report
 
 if TYPE_CHECKING:
@@ -146,9 +146,8 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
             # whole area intercepts at the beam's flux (bounded by construction, see
             # .sunlit), in place of the primary rays' deposits, which the scattering still
             # starts from
-            share = sunlit_share(smp, _scene_triangles(canopy, nf), normals, toward,
-                                 seed + 7919 * k)
-            area = _scene_areas(canopy, nf)                                   # cm2
+            share = sunlit_share(smp, canopy, normals, toward, seed + 7919 * k)
+            area = geometry(canopy, nf).area_cm2
             whole = kept * irradiance / toward[2] * np.abs(normals @ toward) * area * 1e-4
             absorbed += share.fraction * whole - _first_deposits(tally, nf, kept * per_ray)
             absorbed_b = absorbed_b - tally.per_batch(nf, kept * per_ray, first=True) \
@@ -192,21 +191,6 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
                          triangle_direct_w=direct_t,
                          batches=Batches(absorbed_b, direct_b, sunlit_b, parts_b / area_m2),
                          sun_direction=sun_dir, stands=stands_identity(canopy.layout))
-
-
-def _scene_triangles(canopy: Canopy, nf: int) -> np.ndarray:
-    """(F, 3, 3) float64 cm: corners of the scene's triangles, leaves then stalks (``nf``
-    of them)."""
-    tri = canopy.vertices[canopy.faces]
-    if nf > len(tri):
-        tri = np.concatenate([tri, canopy.stalk_vertices[canopy.stalk_faces]])
-    return tri[:nf]
-
-
-def _scene_areas(canopy: Canopy, nf: int) -> np.ndarray:
-    """(F,) float64 cm2: one-sided areas of the scene's triangles (leaves then stalks)."""
-    tri = _scene_triangles(canopy, nf)
-    return 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
 
 
 def _first_deposits(tally, nf: int, weight) -> np.ndarray:

@@ -8,14 +8,19 @@ lit is hit 0 or 1 times, and the only unbiased reading of one hit is ``1 / e`` o
 alone can be both unbiased and at most the area: with ``h`` in {0, 1} of mean ``e f``,
 ``E[T(h)] = f`` for every sunlit fraction ``f`` forces ``T(1) = 1 / e``.
 
-So the sunlit area is sampled from the triangle itself, as Helios samples each element's
+So the sunlit area is sampled from the leaves themselves, as Helios samples each element's
 direct light (Bailey 2018) and Caribu gives each triangle its own irradiance (Chelle & Andrieu
-1998): points drawn uniformly on the triangle, at least one and about as many as forward rays
-would hit it fully lit (:func:`samples_per_triangle`), each asked whether its path toward the
-sun is clear (an occlusion query, wrapped across the plot in a periodic field). The sunlit
-fraction is the share of clear points: in [0, 1] by construction, unbiased, and the direct
-beam a triangle absorbs is that fraction of what its whole area would intercept, at the beam's
-exact flux on its orientation.
+1998). Points are drawn on the triangles, each asked whether its path toward the sun is clear
+(an occlusion query, wrapped across the plot in a periodic field); the sunlit fraction is the
+share of clear points, in [0, 1] by construction and unbiased, and the direct beam a triangle
+absorbs is that fraction of what its whole area would intercept, at the beam's exact flux on
+its orientation. A triangle that forward rays would hit at least once fully lit gets its own
+points, about as many as those rays (:func:`samples_per_triangle`). Smaller ones, which no
+number of rays at this density resolves, are taken together with their neighbours of the same
+leaf, in mesh order, into patches that would get about one ray (:func:`patches`): a patch's
+points are spread over its triangles in proportion to the beam each would intercept, and its
+fraction stands for each of them. The leaf's figures stay unbiased and bounded, and a mesh of
+millions of triangles costs about as many points as rays, not one per triangle.
 
 A point counts only for the light falling on the sample rectangle, as the forward rays do:
 its path traced down to the ground (wrapped into the plot in a periodic field) must land in the
@@ -33,14 +38,20 @@ https://doi.org/10.1016/S0304-3800(98)00100-8
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy.sparse import csr_array
 
+from maizeviz.canopy.scene import Canopy
+from maizeviz.ids import groups
 from maizeviz.light.results.uncertainty import BATCHES
 from maizeviz.light.scene.rays import Tracer
 from maizeviz.light.trace.direct import Sampler
+
+if TYPE_CHECKING:       # scipy.sparse (0.3 s, and numpy.f2py) is imported when sampled
+    from scipy.sparse import csr_array
 
 #: Distance (cm) a sample point is lifted off its triangle toward the sun's side.
 LIFT_CM = 1e-3
@@ -68,10 +79,83 @@ class SunlitShare:
     points: int
 
 
+@dataclass(frozen=True)
+class Geometry:
+    """What the sampling needs of a scene's triangles (leaves, then stalks), computed once per
+    canopy (:func:`geometry`).
+
+    Attributes
+    ----------
+    area_cm2 : (F,) float64
+        One-sided areas [cm2].
+    centre : (F, 3) float64
+        Centroids [cm].
+    radius_cm : (F,) float64
+        Farthest corner from the centroid [cm].
+    group : (F,) intp
+        The leaf (or stalk of a plant) each belongs to; patches never cross it.
+    box : (G, 6) float64
+        Each group's box of its triangles' centroids, ``xmin, xmax, ymin, ymax, zmin, zmax``,
+        widened by its largest radius [cm].
+    """
+
+    area_cm2: np.ndarray
+    centre: np.ndarray
+    radius_cm: np.ndarray
+    group: np.ndarray
+    box: np.ndarray
+
+
+_KEPT: dict[int, tuple[weakref.ref, int, Geometry]] = {}
+
+
+def geometry(canopy: Canopy, n_triangles: int) -> Geometry:
+    """The :class:`Geometry` of the scene's ``n_triangles`` triangles (the canopy's leaves,
+    then its stalks when traced), kept while the canopy lives."""
+    kept = _KEPT.get(id(canopy))
+    if kept is not None and kept[0]() is canopy and kept[1] == n_triangles:
+        return kept[2]
+    tri = scene_triangles(canopy, n_triangles)
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    centre = tri.mean(axis=1)
+    radius = np.linalg.norm(tri - centre[:, None, :], axis=2).max(axis=1)
+    nl = canopy.n_triangles
+    inst = np.zeros(n_triangles, np.int64)
+    leaf = np.full(n_triangles, -1, np.int64)               # stalks: -1 of their plant
+    inst[:nl], leaf[:nl] = canopy.face_instance, canopy.face_leaf
+    if n_triangles > nl and getattr(canopy, "stalk_instance", None) is not None:
+        inst[nl:] = np.asarray(canopy.stalk_instance)[:n_triangles - nl]
+    _, group = groups(inst, leaf)
+    order = np.argsort(group, kind="stable")
+    starts = np.flatnonzero(np.r_[True, np.diff(group[order]) != 0])
+    c = centre[order]
+    r = np.maximum.reduceat(radius[order], starts)[:, None] if len(order) else np.zeros((0, 1))
+    box = np.hstack([np.minimum.reduceat(c, starts) - r, np.maximum.reduceat(c, starts) + r]
+                    )[:, [0, 3, 1, 4, 2, 5]] if len(order) else np.zeros((0, 6))
+    geo = Geometry(area, centre, radius, group, box)
+    for key in [k for k, v in _KEPT.items() if v[0]() is None]:
+        del _KEPT[key]
+    _KEPT[id(canopy)] = (weakref.ref(canopy), n_triangles, geo)
+    return geo
+
+
+def scene_triangles(canopy: Canopy, n_triangles: int, which=None) -> np.ndarray:
+    """(n, 3, 3) float64 cm: corners of the scene's triangles ``which`` (default all
+    ``n_triangles``: the canopy's leaves, then its stalks)."""
+    nl = canopy.n_triangles
+    idx = np.arange(n_triangles) if which is None else np.asarray(which, np.int64)
+    out = np.empty((len(idx), 3, 3))
+    leaf = idx < nl
+    out[leaf] = canopy.vertices[canopy.faces[idx[leaf]]]
+    if not leaf.all():
+        out[~leaf] = canopy.stalk_vertices[canopy.stalk_faces[idx[~leaf] - nl]]
+    return out
+
+
 def samples_per_triangle(area_cm2: np.ndarray, cos_beam: np.ndarray, ray_area_cm2: float,
                          toward_z: float) -> np.ndarray:
-    """(F,) int64: sample points per triangle, the forward rays that would hit it fully lit
-    (its area across the beam over one ray's), rounded up, at least 1.
+    """(F,) float64: the forward rays that would hit each triangle fully lit: its area across
+    the beam over one ray's.
 
     Parameters
     ----------
@@ -84,22 +168,71 @@ def samples_per_triangle(area_cm2: np.ndarray, cos_beam: np.ndarray, ray_area_cm
     toward_z : float
         Vertical component of the unit vector toward the sun [-].
     """
-    expected = area_cm2 * cos_beam / (ray_area_cm2 * max(toward_z, 1e-9))
-    return np.maximum(1, np.ceil(np.minimum(expected, 1e6))).astype(np.int64)
+    return area_cm2 * cos_beam / (ray_area_cm2 * max(toward_z, 1e-9))
 
 
-def sunlit_share(smp: Sampler, triangles: np.ndarray, normals: np.ndarray,
-                 toward: np.ndarray, seed: int) -> SunlitShare:
+def patches(group: np.ndarray, expected: np.ndarray) -> np.ndarray:
+    """(n,) intp: the patch of each triangle, numbered from 0: consecutive triangles (in the
+    order given) of one ``group`` whose ``expected`` rays add up to about one; a triangle
+    expecting one or more rays is (nearly always) a patch of its own."""
+    n = len(group)
+    if not n:
+        return np.zeros(0, np.intp)
+    cum = np.cumsum(expected)
+    new = np.ones(n, dtype=bool)
+    new[1:] = group[1:] != group[:-1]
+    start = np.maximum.accumulate(np.where(new, np.arange(n), 0))
+    base = cum[start] - expected[start]                   # the group's sum before it
+    bucket = np.floor(cum - base - 0.5 * expected).astype(np.int64)
+    _, patch = groups(np.cumsum(new), bucket)
+    return patch
+
+
+def _overlaps(lo_v: np.ndarray, hi_v: np.ndarray, lo: float, hi: float,
+              start: float | None, period: float) -> np.ndarray:
+    """(n,) bool: whether each interval [``lo_v``, ``hi_v``] meets [``lo``, ``hi``]; with a
+    ``period`` (a periodic field starting at ``start``), any of its copies."""
+    if start is None:
+        return (hi_v >= lo) & (lo_v <= hi)
+    a = start + np.mod(lo_v - start, period)
+    b = a + (hi_v - lo_v)
+    meets = hi_v - lo_v >= period
+    for k in (-period, 0.0, period):
+        meets |= (b + k >= lo) & (a + k <= hi)
+    return meets
+
+
+def _near_rect(smp: Sampler, geo: Geometry, shift: np.ndarray) -> np.ndarray:
+    """(F,) bool: the triangles whose beam may land in the sample rectangle (in a periodic
+    field, wrapped across the plot): those of the groups whose box, carried down the beam to
+    the ground, meets it."""
+    x0, y0, x1, y1 = smp.rect
+    bx0, by0, bx1, by1 = smp.bounds
+    if smp.periodic and np.allclose((x0, y0, x1, y1), smp.bounds):
+        return np.ones(len(geo.group), dtype=bool)         # every beam lands in the plot
+    box = geo.box
+    near = np.ones(len(box), dtype=bool)
+    for axis, (lo, hi, start, period) in enumerate(((x0, x1, bx0, bx1 - bx0),
+                                                    (y0, y1, by0, by1 - by0))):
+        low = box[:, 2 * axis] - np.maximum(shift[axis] * box[:, 4], shift[axis] * box[:, 5])
+        high = box[:, 2 * axis + 1] - np.minimum(shift[axis] * box[:, 4],
+                                                 shift[axis] * box[:, 5])
+        near &= _overlaps(low, high, lo, hi, start if smp.periodic else None, period)
+    return near[geo.group]
+
+
+def sunlit_share(smp: Sampler, canopy: Canopy, normals: np.ndarray, toward: np.ndarray,
+                 seed: int) -> SunlitShare:
     """Sample the sunlit share of every triangle (see the module docstring).
 
     Parameters
     ----------
     smp : Sampler
         The scene, sample rectangle, density, plot and field of the forward trace.
-    triangles : (F, 3, 3) float64
-        Corners of the scene's triangles (leaves, then stalks), in its ids [cm].
+    canopy : Canopy
+        The canopy of the scene.
     normals : (F, 3) float64
-        Their unit normals.
+        Unit normals of the scene's triangles (leaves, then stalks), in its ids.
     toward : (3,) float64
         Unit vector toward the sun, ``z > 0``.
     seed : int
@@ -109,43 +242,77 @@ def sunlit_share(smp: Sampler, triangles: np.ndarray, normals: np.ndarray,
     -------
     SunlitShare
     """
+    from scipy.sparse import csr_array
+
     s = np.asarray(toward, np.float64)
-    tri = np.asarray(triangles, np.float64)
-    nf = len(tri)
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    nf = len(normals)
+    geo = geometry(canopy, nf)
     cos = np.abs(normals @ s)
-    n_t = samples_per_triangle(area, cos, smp.ray_area_cm2, float(s[2]))
-    owner = np.repeat(np.arange(nf), n_t)
+    weight = geo.area_cm2 * cos                          # the beam each would intercept
+    # the triangles whose beam may land in the rectangle (their centre's, within their size)
+    shift = s[:2] / s[2]
+    near = _near_rect(smp, geo, shift)
+    tri_ids = np.flatnonzero(near & (weight > 0))
+    expected = samples_per_triangle(geo.area_cm2[tri_ids], cos[tri_ids], smp.ray_area_cm2,
+                                    float(s[2]))
+    patch = patches(geo.group[tri_ids], expected)
+    order = np.argsort(patch, kind="stable")
+    tri_ids, patch, expected = tri_ids[order], patch[order], expected[order]
+    n_p = int(patch[-1]) + 1 if len(patch) else 0
+    w = weight[tri_ids]
+    w_patch = np.bincount(patch, weights=w, minlength=n_p)
+    first = np.searchsorted(patch, np.arange(n_p))
+    cum_w = np.cumsum(w) - w                                    # before each triangle
+    points = np.maximum(1, np.ceil(np.minimum(
+        np.bincount(patch, weights=expected, minlength=n_p), 1e6))).astype(np.int64)
+    owner = np.repeat(np.arange(n_p), points)                   # the patch of each point
+    total = len(owner)
     rng = np.random.default_rng([seed, 0x5A17])
     # dealt into equal batches at random, as the forward rays are (scatter_beam): with the
     # batches' sizes fixed, their spread is the points' clear-or-shaded noise alone
-    batch = rng.permutation(len(owner)) % BATCHES
-    lit = np.zeros(len(owner), dtype=bool)
+    batch = rng.permutation(total) % BATCHES
+    lit = np.zeros(total, dtype=bool)
     tracer = Tracer(smp.scene, s, smp.bounds, smp.periodic)
     x0, y0, x1, y1 = smp.rect
     bx0, by0, bx1, by1 = smp.bounds
-    for a in range(0, len(owner), CHUNK_POINTS):
-        b = min(a + CHUNK_POINTS, len(owner))
-        t = owner[a:b]
-        # uniform points on each triangle (the square-root map of two uniforms)
+    rank = np.arange(total) - np.repeat(np.cumsum(points) - points, points)
+    for a in range(0, total, CHUNK_POINTS):
+        b = min(a + CHUNK_POINTS, total)
+        p_of = owner[a:b]
+        # stratified along the patch's intercepted beam: which triangle, then where on it
+        u = (rank[a:b] + rng.random(b - a)) / points[p_of]
+        target = cum_w[first[p_of]] + u * w_patch[p_of]
+        k = np.clip(np.searchsorted(cum_w, target, side="right") - 1, first[p_of],
+                    np.append(first[1:], len(patch))[p_of] - 1)
+        t = tri_ids[k]
+        tri = scene_triangles(canopy, nf, t)
         r1, r2 = np.sqrt(rng.random(b - a)), rng.random(b - a)
-        p = ((1 - r1)[:, None] * tri[t, 0] + (r1 * (1 - r2))[:, None] * tri[t, 1]
-             + (r1 * r2)[:, None] * tri[t, 2])
+        pt = ((1 - r1)[:, None] * tri[:, 0] + (r1 * (1 - r2))[:, None] * tri[:, 1]
+              + (r1 * r2)[:, None] * tri[:, 2])
         # where the beam through the point lands: it counts for the rectangle's light only
-        q = p[:, :2] - s[:2] * (p[:, 2] / s[2])[:, None]
+        g = pt[:, :2] - shift[None, :] * pt[:, 2:3]
         if smp.periodic:
-            q[:, 0] = bx0 + np.mod(q[:, 0] - bx0, bx1 - bx0)
-            q[:, 1] = by0 + np.mod(q[:, 1] - by0, by1 - by0)
-        inside = (q[:, 0] >= x0) & (q[:, 0] < x1) & (q[:, 1] >= y0) & (q[:, 1] < y1)
-        idx = np.flatnonzero(inside & (cos[t] > 0))
-        if not len(idx):
+            g[:, 0] = bx0 + np.mod(g[:, 0] - bx0, bx1 - bx0)
+            g[:, 1] = by0 + np.mod(g[:, 1] - by0, by1 - by0)
+        inside = np.flatnonzero((g[:, 0] >= x0) & (g[:, 0] < x1) & (g[:, 1] >= y0)
+                                & (g[:, 1] < y1))
+        if not len(inside):
             continue
-        side = np.sign(normals[t[idx]] @ s)[:, None] * normals[t[idx]]
-        org = p[idx] + LIFT_CM * side
+        n = normals[t[inside]]
+        org = pt[inside] + LIFT_CM * np.sign(n @ s)[:, None] * n
         length = np.maximum((smp.top - org[:, 2]) / s[2], 0.0)
-        lit[a + idx] = ~np.asarray(tracer.occluded(org, length), dtype=bool)
-    weight = lit / n_t[owner]
-    rows = csr_array((weight[lit], (batch[lit], owner[lit])), shape=(BATCHES, nf))
-    rows.sum_duplicates()
-    fraction = np.bincount(owner, weights=lit, minlength=nf) / n_t       # clear / drawn
-    return SunlitShare(fraction, rows, len(owner))
+        lit[a + inside] = ~np.asarray(tracer.occluded(org, length), dtype=bool)
+    fraction_p = np.bincount(owner, weights=lit, minlength=n_p) / np.maximum(points, 1)
+    fraction = np.zeros(nf)
+    fraction[tri_ids] = fraction_p[patch]
+    # each batch's share of each patch's fraction, standing for each of its triangles
+    keys, cnt = np.unique(batch[lit] * n_p + owner[lit], return_counts=True)
+    kb, kp = keys // max(n_p, 1), keys % max(n_p, 1)
+    sizes = np.bincount(patch, minlength=n_p)[kp]
+    rows = np.repeat(kb, sizes)
+    starts = np.repeat(first[kp] - (np.cumsum(sizes) - sizes), sizes)
+    cols = tri_ids[starts + np.arange(int(sizes.sum()))]
+    vals = np.repeat(cnt / points[kp], sizes)
+    share = csr_array((vals, (rows, cols)), shape=(BATCHES, nf))
+    share.sum_duplicates()
+    return SunlitShare(fraction, share, total)
