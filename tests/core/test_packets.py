@@ -82,29 +82,30 @@ def test_packets_give_embreex_hits_ray_for_ray(canopy, scenes):
     cases = [(down_org, np.tile(-s, (n, 1)), length, 200),      # sunlight, a grid
              (org, np.tile(s, (n, 1)), length, 200),            # sensors toward the sun
              (rand_org, rand_dir, rng.uniform(0, 400, n), 0)]   # scattered light
+    v, f = canopy.vertices, canopy.faces
     for o, d, t, row in cases:
         p1, t1 = single.first_hit(o, d, t)
         assert 0.05 < np.mean(p1 >= 0) < 0.98
+        u1 = single.first_hit(o, d)                              # unbounded rays
         for kwargs in ({}, {"row": row}):
             p2, t2 = packed.first_hit(o, d, t, **kwargs)
-            assert_same_hits(canopy.vertices, canopy.faces, o, d, t, (p1, t1), (p2, t2))
-            assert_same_hits(canopy.vertices, canopy.faces, o, d, t, (p1, single.distance(o, d, t)),
+            assert_same_hits(v, f, o, d, t, (p1, t1), (p2, t2))
+            assert_same_hits(v, f, o, d, t, (p1, single.distance(o, d, t)),
                              (p2, packed.distance(o, d, t, **kwargs)))
-            assert_same_blocked(canopy.vertices, canopy.faces, o, d, t, single.occluded(o, d, t),
-                                packed.occluded(o, d, t, **kwargs), (p1, t1))
-        u1 = single.first_hit(o, d)                              # unbounded rays
-        u2 = packed.first_hit(o, d)
-        assert_same_hits(canopy.vertices, canopy.faces, o, d, None, u1, u2)
+            assert_same_blocked(v, f, o, d, t, single.occluded(o, d, t),
+                                packed.occluded(o, d, t, **kwargs), u1)
+        assert_same_hits(v, f, o, d, None, u1, packed.first_hit(o, d))
     k = packets.kernel()
+    sun, sensors = cases[0][:3], cases[1][:3]
+    sun_hits, sensor_hits = single.first_hit(*sun), single.first_hit(sensors[0], sensors[1])
     for width in (4, 8, 16):                                     # every packet width
         for coherent in (False, True):
-            p, t = packets.intersect(k, packed._handle, cases[0][0], -s[None], cases[0][2],
-                                     coherent=coherent, width=width, row=200)
-            np.testing.assert_array_equal(p, single.first_hit(*cases[0][:3])[0])
-            b = packets.occluded(k, packed._handle, cases[1][0], s[None], cases[1][2],
+            got = packets.intersect(k, packed._handle, sun[0], -s[None], sun[2],
+                                    coherent=coherent, width=width, row=200)
+            assert_same_hits(v, f, *sun, sun_hits, got)
+            b = packets.occluded(k, packed._handle, sensors[0], s[None], sensors[2],
                                  coherent=coherent, width=width, row=7)
-            assert_same_blocked(canopy.vertices, canopy.faces, *cases[1][:3], b, single.occluded(*cases[1][:3]),
-                                single.first_hit(*cases[1][:3]))
+            assert_same_blocked(v, f, *sensors, b, single.occluded(*sensors), sensor_hits)
 
 
 @needs_kernel
