@@ -35,7 +35,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "core"))
 from anchors import report  # noqa: E402
+from square_leaves import spherical_normals, square_corners  # noqa: E402
 
 from maizeviz.fspm.caribu import CaribuScene  # noqa: E402
 from maizeviz.io.canestra import encode_label, write_can, write_light, write_opt, write_pattern  # noqa: E402
@@ -48,13 +50,8 @@ def homogeneous(lai: float, leaf_cm: float, seed: int = 1) -> dict[str, np.ndarr
     side = leaf_cm / 100.0
     n = int(round(lai / side ** 2))
     c = np.column_stack([rng.random(n), rng.random(n), 0.1 + rng.random(n)])
-    nrm = rng.normal(size=(n, 3))
-    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
-    a = np.cross(nrm, [0.0, 0.0, 1.0])
-    a /= np.linalg.norm(a, axis=1)[:, None]
-    b = np.cross(nrm, a)
-    p = [c + (sa * a + sb * b) * side / 2 for sa, sb in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
-    tris = np.stack([np.stack([p[0], p[1], p[2]], 1), np.stack([p[0], p[2], p[3]], 1)], 1)
+    p = square_corners(c, spherical_normals(rng, n), side)
+    tris = np.stack([p[:, [0, 1, 2]], p[:, [0, 2, 3]]], 1)          # (n, 2, 3, 3)
     return {encode_label(1, True, 1 + i // 999, 1 + i % 999): tris[i] for i in range(n)}
 
 

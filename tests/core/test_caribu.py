@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 import pytest
+from square_leaves import spherical_normals, square_corners
 
 from maizeviz.fspm.caribu import CaribuScene, CaribuSceneError
 from maizeviz.io.canestra import encode_label, write_can, write_light, write_opt, write_pattern
@@ -26,13 +27,8 @@ def homogeneous(lai: float, side_m: float, seed: int = 3) -> dict:
     rng = np.random.default_rng(seed)
     n = int(round(lai / side_m ** 2))
     c = np.column_stack([rng.random(n), rng.random(n), 0.1 + rng.random(n)])
-    nrm = rng.normal(size=(n, 3))
-    nrm /= np.linalg.norm(nrm, axis=1)[:, None]
-    a = np.cross(nrm, [0.0, 0.0, 1.0])
-    a /= np.linalg.norm(a, axis=1)[:, None]
-    b = np.cross(nrm, a)
-    p = [c + (sa * a + sb * b) * side_m / 2 for sa, sb in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
-    tris = np.stack([np.stack([p[0], p[1], p[2]], 1), np.stack([p[0], p[2], p[3]], 1)], 1)
+    p = square_corners(c, spherical_normals(rng, n), side_m)
+    tris = np.stack([p[:, [0, 1, 2]], p[:, [0, 2, 3]]], 1)          # (n, 2, 3, 3)
     return {i: tris[i] for i in range(n)}
 
 

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from square_leaves import spherical_normals, square_corners
 
 from maizeviz.canopy.layout import layout_from_dict
 from maizeviz.canopy.scene import Canopy
@@ -35,15 +36,7 @@ def leaves(lai: float, side: float, width: float, seed: int) -> Canopy:
     n = max(4, int(round(lai * width * width / side**2)))
     centre = np.column_stack([rng.uniform(0, width, n), rng.uniform(0, width, n),
                               rng.uniform(20.0, 120.0, n)])
-    normal = rng.normal(size=(n, 3))
-    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
-    helper = np.where(np.abs(normal[:, :1]) > 0.9, [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])
-    t1 = np.cross(normal, helper)
-    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
-    t2 = np.cross(normal, t1)
-    h = side / 2
-    corners = np.stack([centre - h * t1 - h * t2, centre + h * t1 - h * t2,
-                        centre + h * t1 + h * t2, centre - h * t1 + h * t2], axis=1)
+    corners = square_corners(centre, spherical_normals(rng, n), side)
     plant = (centre[:, 0] >= width / 2).astype(int) * 2 + (centre[:, 1] >= width / 2)
     order = np.argsort(plant, kind="stable")                 # triangles grouped by plant
     corners, plant = corners[order], plant[order]

@@ -9,6 +9,7 @@ import math
 import numpy as np
 import pytest
 from scipy import stats
+from square_leaves import spherical_normals, square_corners
 
 from maizeviz.canopy.layout import layout_from_dict
 from maizeviz.canopy.scene import Canopy
@@ -43,15 +44,7 @@ def patches(lai, width, height=(20.0, 120.0), side=2.0, seed=1):
     n = int(round(lai * width * width / side**2))
     centre = np.column_stack([rng.uniform(0, width, n), rng.uniform(0, width, n),
                               rng.uniform(*height, n)])
-    normal = rng.normal(size=(n, 3))
-    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
-    helper = np.where(np.abs(normal[:, :1]) > 0.9, [[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]])
-    t1 = np.cross(normal, helper)
-    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
-    t2 = np.cross(normal, t1)
-    h = side / 2
-    corners = np.stack([centre - h * t1 - h * t2, centre + h * t1 - h * t2,
-                        centre + h * t1 + h * t2, centre - h * t1 + h * t2], axis=1)
+    corners = square_corners(centre, spherical_normals(rng, n), side)
     v = corners.reshape(-1, 3)
     base = 4 * np.arange(n)[:, None]
     f = np.vstack([np.hstack([base, base + 1, base + 2]), np.hstack([base, base + 2, base + 3])])
