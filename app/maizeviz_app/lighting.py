@@ -420,7 +420,7 @@ def restore_colouring(study: StudyState) -> None:
     settings), once what it shows is computed: a CO2 colouring waits for the assimilation."""
     from maizeviz_app.options import COLOURINGS
 
-    wanted = getattr(study, "colouring_to_restore", None)
+    wanted = study.colouring_to_restore
     if wanted not in COLOURINGS:
         return
     last = study.runs.latest(study.shown_signature, ("sun",))

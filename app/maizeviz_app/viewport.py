@@ -300,18 +300,18 @@ class Viewport(QtInteractor):
                                 light_type="scene light", intensity=0.45))
         self.setMinimumSize(320, 200)
         self.render_count = 0
-        self.ren_win.AddObserver("EndEvent", self._on_frame)
         self.set_background("#e4edf5")          # a gradient costs a full-screen pass per frame
-        # no orientation triad, no VTK scalar bar, no 3D text: each is a render pass or text
-        # layout at every frame (60-80 ms each on llvmpipe); the ground carries the axes and
-        # cm labels in its texture and the legend is a Qt widget drawn once per colouring
+        # no VTK orientation triad, scalar bar or 3D text: each is a render pass or text
+        # layout at every frame (60-80 ms each on llvmpipe); the ground carries the cm labels
+        # in its texture, the legend is a Qt widget drawn once per colouring, and the axes and
+        # scale bar are Qt's too, painted from the camera after each frame
         self.key = Legend(self)
         self.key.move(10, 10)
         self.key.hide()
-        # the field's axes and a scale bar, painted by Qt from the camera after each frame
         from maizeviz_app.view_overlay import ViewOverlay
 
         self.overlay = ViewOverlay(self)
+        self.ren_win.AddObserver("EndEvent", self._on_frame)
         self.canopy_mesh: pv.PolyData | None = None
         self.colouring = "leaf"
         #: What the "light" colouring shows: "classes" (a sun) or "values" (a sky, a day).
@@ -332,6 +332,8 @@ class Viewport(QtInteractor):
         self._press: tuple[float, float] | None = None
         self._held = None                       # a left press not yet handed to VTK
         self.info = InfoCard(self)
+        #: how the plants other than the selection are drawn (set_others)
+        self.others = "shown"
         self._moving = False                    # the lighter canopy drawn (the camera moves)
         self._moving_source = None
         self._moving_mtime = -1
@@ -946,7 +948,7 @@ class Viewport(QtInteractor):
         actor = self._canopy_actor
         if actor is None:
             return False
-        mode = getattr(self, "others", "shown") if selected else "shown"
+        mode = self.others if selected else "shown"
         visible = mode != "hidden"
         opacity = FADED_OPACITY if mode == "faded" else 1.0
         prop = actor.GetProperty()

@@ -138,6 +138,12 @@ def _opt_files(paths, labels) -> tuple[dict, dict]:
     return material, soil
 
 
+def _area_weighted(pairs) -> float:
+    """The area-weighted mean of (value, area) pairs (0 for no area), as Caribu's ``_wsum``."""
+    total = sum(a for _, a in pairs)
+    return sum(e * a for e, a in pairs if a > 0) / total if total > 0 else 0.0
+
+
 def _aggregate(values, indices, fun):
     out = {}
     for key, group in groupby(sorted(zip(indices, values), key=lambda x: x[0]),
@@ -435,10 +441,7 @@ class CaribuScene:
                     aggregated[band][key] = _aggregate(area.tolist(), groups, sum)
                 else:
                     aggregated[band][key] = _aggregate(
-                        list(zip(out[key].tolist(), area.tolist())), groups,
-                        lambda pairs: (sum(e * a for e, a in pairs if a > 0)
-                                       / sum(a for _, a in pairs)) if sum(
-                            a for _, a in pairs) > 0 else 0.0)
+                        list(zip(out[key].tolist(), area.tolist())), groups, _area_weighted)
         if simplify and len(raw) == 1:
             band = next(iter(raw))
             return raw[band], aggregated[band]
