@@ -18,7 +18,8 @@ from importlib.metadata import PackageNotFoundError, version
 #: them to it: plyfile was missing and pyarrow, required, was listed as optional).
 REQUIRED = ("numpy", "scipy", "pandas", "pvlib", "embreex", "meshio", "plyfile", "matplotlib",
             "pyserial", "pyarrow")
-OPTIONAL = ("PySide6", "pyvista", "pyvistaqt", "psygnal", "dask", "distributed", "tqdm")
+OPTIONAL = ("PySide6", "pyvista", "pyvistaqt", "psygnal", "dask", "distributed", "tqdm",
+            "pydantic")
 
 
 def _version(name: str) -> str:

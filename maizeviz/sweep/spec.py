@@ -46,7 +46,6 @@ results on disk can be matched to scenarios whatever the files are called.
 from __future__ import annotations
 
 import fnmatch
-import glob
 import hashlib
 import itertools
 import json
@@ -55,18 +54,17 @@ import os
 import tomllib
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
-from datetime import date, datetime
-from datetime import time as dtime
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import maizeviz
-from maizeviz.errors import MaizevizError
 from maizeviz.io.inputs import read_input, refuse_zero_tail
-from maizeviz.light.scene.request import MAX_HEIGHTS
 from maizeviz.light.specs import OpticsSpec
 from maizeviz.sweep import compute
 from maizeviz.sweep.errors import SweepSpecError
+
+if TYPE_CHECKING:                  # the schema needs pydantic (the sweep extra): read when used
+    from maizeviz.sweep.schema import Canopy, Exclude
 
 #: Largest sweep file (bytes): a hand-written or generated file is far smaller.
 MAX_SPEC_BYTES = 4 * 2**20
@@ -74,26 +72,6 @@ MAX_SPEC_BYTES = 4 * 2**20
 MAX_SCENARIOS = 10_000
 #: More combinations than this are refused outright: split the sweep.
 HARD_MAX_SCENARIOS = 1_000_000
-
-DEFAULT_HEIGHTS = (0.0, 50.0, 100.0, 150.0, 200.0, 225.0)
-
-CANOPY_KEYS = ("points", "tile", "row_spacing", "plant_spacing", "block", "layout", "level",
-               "preserve_area", "cover_resolution")
-LIGHT_KEYS = ("sun", "density", "heights", "periodic", "rect", "optics", "photosynthesis")
-TOP_KEYS = ("canopy", "light", "exclude")
-AXES = ("points", "tile", "row_spacing", "plant_spacing", "layout", "level", "preserve_area",
-        "sun", "density", "periodic", "optics", "photosynthesis")
-#: Keys of an optics table (:class:`maizeviz.light.specs.OpticsSpec`); "black" (or false) is
-#: the black leaves of interception.
-OPTICS_KEYS = ("band", "reflectance", "transmittance", "ground_reflectance", "direct_w_m2",
-               "diffuse_w_m2", "depth", "seed", "ranks")
-#: Most scatterings a sweep follows.
-MAX_DEPTH = 50
-#: Largest irradiance of a band, W/m2 (as the command line's --irradiance and --diffuse).
-MAX_IRRADIANCE = 5000.0
-SUN_ANGLE_KEYS = ("zenith", "azimuth")
-SUN_PLACE_KEYS = ("date", "time", "solar_noon", "lat", "lon", "tz", "altitude")
-
 
 def version_tag() -> str:
     """maizeviz major.minor: results of other patch releases are reused, not of others."""
@@ -299,251 +277,24 @@ class SweepSpec:
         return list(out.values())
 
 
-# ------------------------------------------------------------------------------- checking
-class _Checker:
-    """Converts and checks values, naming ``source: key`` in every message."""
+# ------------------------------------------------------------------------------- listing
+def _fail(source: str, where: str, msg: str) -> NoReturn:
+    raise SweepSpecError(f"{source}: {where}: {msg}")
 
-    def __init__(self, source: str, base: Path):
-        self.source = source
-        self.base = base
 
-    def fail(self, where: str, msg: str) -> NoReturn:
-        raise SweepSpecError(f"{self.source}: {where}: {msg}")
+def _shown(path: str, base: Path) -> str:
+    """A path as listings show it: relative to the sweep file's folder."""
+    try:
+        return os.path.relpath(path, base)
+    except ValueError:  # pragma: no cover - another drive on Windows
+        return path
 
-    def known(self, table: dict, known: tuple, where: str):
-        for k in table:
-            if k == "exclude" and where in ("canopy", "light"):
-                raise SweepSpecError(f"{self.source}: '{where}.exclude': exclude belongs at the "
-                                     "top of the file, before [canopy], or in [[exclude]] tables")
-            if k not in known:
-                name = f"{where}.{k}" if where else k
-                raise SweepSpecError(f"{self.source}: unknown key '{name}' (known"
-                                     f"{' in ' + where if where else ''}: {', '.join(known)})")
 
-    def axis(self, section: dict, key: str, where: str, convert, default=None) -> list:
-        name = f"{where}.{key}"
-        if key not in section:
-            if default is None:
-                self.fail(name, "is missing")
-            return list(default)
-        raw = section[key]
-        values = raw if isinstance(raw, list) else [raw]
-        if not values:
-            self.fail(name, "is empty: give at least one value")
-        out: list[Any] = []
-        seen: dict[str, int] = {}
-        for i, v in enumerate(values):
-            item = f"{name}[{i}]" if isinstance(raw, list) else name
-            c = convert(v, item)
-            token = json.dumps(c, sort_keys=True, default=str)
-            if token in seen:
-                self.fail(item, f"repeats {name}[{seen[token]}]")
-            seen[token] = i
-            out.append(c)
-        return out
-
-    # converters: (value, where) -> canonical value
-    def number(self, v, where, positive=True, minimum=None):
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
-            self.fail(where, f"must be a number, got {json.dumps(v, default=str)}")
-        try:
-            finite = math.isfinite(v)
-        except OverflowError:                              # an integer such as 10**400
-            self.fail(where, "must be a number, got an integer too large for one")
-        if not finite:
-            self.fail(where, f"must be a number, got {json.dumps(v, default=str)}")
-        if positive and v <= 0:
-            self.fail(where, f"must be > 0, got {v}")
-        if minimum is not None and v < minimum:
-            self.fail(where, f"must be >= {minimum:g}, got {v}")
-        return float(v)
-
-    def boolean(self, v, where):
-        if not isinstance(v, bool):
-            self.fail(where, f"must be true or false, got {json.dumps(v, default=str)}")
-        return v
-
-    def shape(self, v, where):
-        """A tile count or, for ``canopy.block``, a block shape, checked as the canopy does."""
-        if not isinstance(v, str):
-            self.fail(where, f"must be a string such as \"3x3\", got {json.dumps(v, default=str)}")
-        quantity = "block" if where.endswith("block") else "tile"
-        try:
-            shape = compute.parse_tile(v, quantity)
-        except MaizevizError:
-            self.fail(where, f"must look like 3x3 (whole numbers >= 1), got '{v}'")
-        try:
-            return compute.check_shape(shape, quantity)
-        except MaizevizError as exc:
-            self.fail(where, str(exc))
-
-    def spacing(self, v, where):
-        """A row or plant spacing in cm, checked as the canopy does."""
-        value = self.number(v, where)
-        try:
-            return compute.check_spacing(
-                value, "plant spacing" if "plant_spacing" in where else "row spacing")
-        except MaizevizError as exc:
-            self.fail(where, str(exc))
-
-    def level(self, v, where):
-        if isinstance(v, bool) or not isinstance(v, (str, int)):
-            self.fail(where, f"must be a level name such as \"K4\", \"standard\" or \"36\", "
-                             f"got {json.dumps(v, default=str)}")
-        try:
-            return compute.level_label(v)
-        except (MaizevizError, ValueError) as exc:         # the core has raised both
-            self.fail(where, str(exc))
-
-    def text(self, v, where):
-        if not isinstance(v, str) or not v.strip():
-            self.fail(where, f"must be a non-empty string, got {json.dumps(v, default=str)}")
-        return v
-
-    def sun_table(self, v, where) -> dict:
-        if not isinstance(v, dict):
-            self.fail(where, "must be a table such as {zenith = 30, azimuth = 180} or {date = "
-                             "\"2005-08-01\", time = \"12:00\", lat = 39.9, lon = 116.4, tz = "
-                             "\"Asia/Shanghai\"}")
-        self.known(v, SUN_ANGLE_KEYS + SUN_PLACE_KEYS, where)
-        t = {}
-        for k, x in v.items():
-            if isinstance(x, (date, datetime, dtime)):
-                x = x.isoformat()                       # TOML date and time literals
-            t[k] = x
-        angles = [k for k in t if k in SUN_ANGLE_KEYS]
-        place = [k for k in t if k in SUN_PLACE_KEYS]
-        if angles and place:
-            self.fail(where, "give either zenith and azimuth or a place and time, not both")
-        if angles:
-            for k in SUN_ANGLE_KEYS:
-                if k not in t:
-                    self.fail(f"{where}.{k}", "is missing")
-                t[k] = self.number(t[k], f"{where}.{k}", positive=False)
-        else:
-            self._sun_place(t, where)
-        return t
-
-    def _sun_place(self, t: dict, where: str) -> None:
-        """A sun given by a place and time: date, lat and lon, and a time or solar noon,
-        each checked (in place)."""
-        for k in ("date", "lat", "lon"):
-            if k not in t:
-                self.fail(f"{where}.{k}", "is missing (a sun from a place needs date, lat, "
-                                          "lon and time or solar_noon)")
-        for k in ("date", "time", "tz"):
-            if k in t:
-                t[k] = self.text(t[k], f"{where}.{k}")
-        for k in ("lat", "lon", "altitude"):
-            if k in t:
-                t[k] = self.number(t[k], f"{where}.{k}", positive=False)
-        if "solar_noon" in t:
-            t["solar_noon"] = self.boolean(t["solar_noon"], f"{where}.solar_noon")
-        if "time" not in t and not t.get("solar_noon"):
-            self.fail(f"{where}.time", "is missing (or set solar_noon = true)")
-
-    def optics(self, v, where) -> OpticsSpec | None:
-        """Leaf optics: "black" or false (interception), or a table of OPTICS_KEYS."""
-        if v is False or (isinstance(v, str) and v.lower() in ("black", "none")):
-            return None
-        if not isinstance(v, dict):
-            self.fail(where, 'must be "black" or a table such as {band = "par", reflectance = '
-                             '0.1, transmittance = 0.05, ground_reflectance = 0.1}')
-        self.known(v, OPTICS_KEYS, where)
-        t: dict[str, Any] = {}
-        if "band" in v:
-            t["band"] = self.text(v["band"], f"{where}.band").lower()
-        for k in ("reflectance", "transmittance", "ground_reflectance", "direct_w_m2",
-                  "diffuse_w_m2"):
-            if k in v:
-                t[k] = self.number(v[k], f"{where}.{k}", positive=False, minimum=0)
-                if k.endswith("_w_m2") and t[k] > MAX_IRRADIANCE:
-                    self.fail(f"{where}.{k}", f"must be from 0 to {MAX_IRRADIANCE:g} W/m2, got "
-                                              f"{t[k]:g}")
-        for k in ("depth", "seed"):
-            if k in v:
-                x = v[k]
-                if isinstance(x, bool) or not isinstance(x, int) or not 0 <= x <= (
-                        MAX_DEPTH if k == "depth" else 2**31 - 1):
-                    self.fail(f"{where}.{k}", f"must be a whole number from 0 to "
-                                              f"{MAX_DEPTH if k == 'depth' else 2**31 - 1}, "
-                                              f"got {x!r}")
-                t[k] = x
-        if "ranks" in v:
-            rows = v["ranks"]
-            if not isinstance(rows, list) or not all(
-                    isinstance(r, list) and len(r) == 3 for r in rows):
-                self.fail(f"{where}.ranks", "must be a list of [rank, reflectance, "
-                                            "transmittance], such as [[1, 0.12, 0.06]]")
-            t["ranks"] = tuple(tuple(r) for r in rows)
-        spec = OpticsSpec(**t)
-        try:
-            spec.optics()
-        except MaizevizError as exc:
-            self.fail(where, str(exc))
-        return spec
-
-    def photosynthesis(self, v, where) -> tuple | None:
-        """A leaf model: "none" or false, or a table {model = "c4" or "wofost", temperature
-        = C, and the model's parameters}; as sorted (key, value) pairs."""
-        if v is False or (isinstance(v, str) and v.lower() == "none"):
-            return None
-        if not isinstance(v, dict) or not isinstance(v.get("model"), str):
-            self.fail(where, 'must be "none" or a table such as {model = "c4", temperature '
-                             '= 30}')
-        from maizeviz.photosynthesis.split import leaf_model
-
-        params = {k: x for k, x in v.items() if k not in ("model", "temperature")}
-        for k, x in params.items():
-            # the C4 model's temperature response is a name (collatz, clm45)
-            if k != "temperature_response":
-                params[k] = self.number(x, f"{where}.{k}", positive=False)
-        temp = self.number(v.get("temperature", 25.0), f"{where}.temperature",
-                           positive=False)
-        if not -50 <= temp <= 70:
-            self.fail(f"{where}.temperature", f"must be from -50 to 70 C, got {temp:g}")
-        try:
-            model = leaf_model(str(v["model"]), **params)
-        except MaizevizError as exc:
-            self.fail(where, str(exc))
-        return tuple(sorted({**model.as_dict(), "temperature": temp}.items()))
-
-    def sun(self, v, where) -> SunSpec:
-        t = self.sun_table(v, where)
-        try:
-            z, a, when = compute.resolve_sun(t)
-        except MaizevizError as exc:
-            self.fail(where, str(exc))
-        return SunSpec(z, a, when or None, tuple(sorted(t.items())))
-
-    def files(self, v, where) -> list[str]:
-        """Absolute paths of the files a path or glob names (relative to the sweep file)."""
-        pattern = self.text(v, where)
-        full = Path(os.path.expanduser(pattern))
-        if not full.is_absolute():
-            full = self.base / full
-        if any(c in pattern for c in "*?["):
-            found = sorted(p for p in glob.glob(str(full), recursive=True) if os.path.isfile(p))
-            if not found:
-                self.fail(where, f"'{pattern}' matches no file (in {full.parent})")
-            return [str(Path(p).resolve()) for p in found]
-        if full.is_dir():
-            self.fail(where, f"{pattern}: is a folder, not a file")
-        if not full.is_file():
-            self.fail(where, f"{pattern}: no such file (looked for {full})")
-        return [str(full.resolve())]
-
-    def shown(self, path: str) -> str:
-        try:
-            return os.path.relpath(path, self.base)
-        except ValueError:  # pragma: no cover - another drive on Windows
-            return path
-
-    def sha(self, path: str, where: str) -> str:
-        try:
-            return compute.file_sha256(path)
-        except OSError as exc:
-            self.fail(where, f"{self.shown(path)}: cannot be read ({exc.strerror or exc})")
+def _sha(path: str, source: str, base: Path, where: str) -> str:
+    try:
+        return compute.file_sha256(path)
+    except OSError as exc:
+        _fail(source, where, f"{_shown(path, base)}: cannot be read ({exc.strerror or exc})")
 
 
 def read_toml(path) -> tuple[dict, str]:
@@ -579,39 +330,29 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
         also for more than ``max_scenarios`` scenarios unless ``yes``.
     """
     doc, _ = read_toml(path)
+    try:
+        from maizeviz.sweep.schema import validate
+    except ImportError as exc:
+        raise SweepSpecError(f"reading a sweep file needs pydantic ({exc}): pip install "
+                             "'maizeviz[sweep]'") from None
     source = str(path)
-    ck = _Checker(source, Path(path).resolve().parent)
-    canopy, light = _sections(ck, doc, source)
-
-    # --- canopy axes
-    points = _points_axis(ck, canopy)
-    arrangements = _arrangements(ck, canopy)
-    levels = ck.axis(canopy, "level", "canopy", ck.level)
-    preserve = ck.axis(canopy, "preserve_area", "canopy", ck.boolean, [True])
-    cover = 0.5
-    if "cover_resolution" in canopy:
-        cover = ck.number(canopy["cover_resolution"], "canopy.cover_resolution")
-
-    # --- light axes
-    suns = ck.axis(light, "sun", "light", ck.sun)
-    densities = ck.axis(light, "density", "light", ck.number, [4.0])
-    periodic = ck.axis(light, "periodic", "light", ck.boolean, [False])
-    optics = ck.axis(light, "optics", "light", ck.optics, [None])
-    photosynthesis = ck.axis(light, "photosynthesis", "light", ck.photosynthesis, [None])
-    heights = _heights(ck, light)
-    rect = _rect(ck, light)
-
-    # --- exclude
-    excludes = doc.get("exclude", [])
-    if not isinstance(excludes, list) or not all(isinstance(e, dict) for e in excludes):
-        ck.fail("exclude", "must be a list of tables such as [{level = \"K4\", density = 16}]")
-    matchers = [_matcher(ck, e, f"exclude[{i}]") for i, e in enumerate(excludes)]
+    base = Path(path).resolve().parent
+    sweep = validate(doc, source, base)
+    canopy, light = sweep.canopy, sweep.light
+    points = _points_axis(canopy, source, base)
+    arrangements = _arrangements(canopy, source, base)
+    matchers = [_matcher(e) for e in sweep.exclude]
+    levels, preserve, cover = canopy.level, canopy.preserve_area, canopy.cover_resolution
+    suns = [SunSpec(*s) for s in light.sun]
+    densities, periodic = light.density, light.periodic
+    optics, photosynthesis = light.optics, light.photosynthesis
+    heights, rect = light.heights, light.rect
 
     axes: list[list[Any]] = [points, arrangements, levels, preserve, densities, periodic, suns,
                              optics, photosynthesis]
     _check_combinations(source, math.prod(len(a) for a in axes), max_scenarios,
                         yes or bool(matchers))
-    scenarios, excluded = _scenarios(ck, axes, matchers, heights, rect, cover)
+    scenarios, excluded = _scenarios(source, axes, matchers, heights, rect, cover)
     if not scenarios:
         raise SweepSpecError(f"{source}: exclude drops every scenario: nothing to run")
     if len(scenarios) > max_scenarios and not yes:
@@ -623,88 +364,37 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
     return SweepSpec(source, document, tuple(scenarios), excluded, fingerprint)
 
 
-def _sections(ck: _Checker, doc: dict, source: str) -> tuple[dict, dict]:
-    """The file's [canopy] and [light] tables, each checked for unknown keys."""
-    ck.known(doc, TOP_KEYS, "")
-    for sec in ("canopy", "light"):
-        if sec not in doc:
-            raise SweepSpecError(f"{source}: the [{sec}] table is missing")
-        if not isinstance(doc[sec], dict):
-            raise SweepSpecError(f"{source}: '{sec}' must be a table ([{sec}])")
-    canopy, light = doc["canopy"], doc["light"]
-    ck.known(canopy, CANOPY_KEYS, "canopy")
-    ck.known(light, LIGHT_KEYS, "light")
-    return canopy, light
-
-
-def _points_axis(ck: _Checker, canopy: dict) -> list[PointsFile]:
+def _points_axis(canopy: Canopy, source: str, base: Path) -> list[PointsFile]:
     """The points files (globs expanded), each once, hashed; two of the same content
     refused."""
     points: list[PointsFile] = []
     by_sha: dict[str, str] = {}
-    for i, group in enumerate(ck.axis(canopy, "points", "canopy", ck.files)):
+    for i, group in enumerate(canopy.points):
         for p in group:
             if any(q.path == p for q in points):
                 continue                                  # two patterns naming one file
-            sha = ck.sha(p, f"canopy.points[{i}]")
+            sha = _sha(p, source, base, f"canopy.points[{i}]")
             if sha in by_sha:
-                ck.fail(f"canopy.points[{i}]", f"{ck.shown(p)} has the same content as "
-                        f"{by_sha[sha]}: keep one of them")
-            by_sha[sha] = ck.shown(p)
-            points.append(PointsFile(ck.shown(p), p, sha))
+                _fail(source, f"canopy.points[{i}]", f"{_shown(p, base)} has the same content "
+                      f"as {by_sha[sha]}: keep one of them")
+            by_sha[sha] = _shown(p, base)
+            points.append(PointsFile(_shown(p, base), p, sha))
     return points
 
 
-def _arrangements(ck: _Checker, canopy: dict) -> list[Arrangement]:
+def _arrangements(canopy: Canopy, source: str, base: Path) -> list[Arrangement]:
     """The tilings (tile x row spacing x plant spacing, with a block) and layout files."""
-    tiling_given = any(k in canopy for k in ("tile", "row_spacing", "plant_spacing", "block"))
+    given = canopy.model_fields_set
     arrangements = []
-    if tiling_given or "layout" not in canopy:
-        tiles = ck.axis(canopy, "tile", "canopy", ck.shape, [(1, 1)])
-        rows = ck.axis(canopy, "row_spacing", "canopy", ck.spacing, [60.0])
-        plants = ck.axis(canopy, "plant_spacing", "canopy", ck.spacing, [30.0])
-        block = None
-        if "block" in canopy:
-            block = ck.shape(canopy["block"], "canopy.block")
-        arrangements += [Arrangement(t, r, p, block) for t in tiles for r in rows for p in plants]
-    if "layout" in canopy:
-        for i, group in enumerate(ck.axis(canopy, "layout", "canopy", ck.files)):
-            for p in group:
-                arrangements.append(Arrangement(layout=ck.shown(p), layout_path=p,
-                                                layout_sha256=ck.sha(p, f"canopy.layout[{i}]")))
+    if given & {"tile", "row_spacing", "plant_spacing", "block"} or "layout" not in given:
+        arrangements += [Arrangement(t, r, p, canopy.block) for t in canopy.tile
+                         for r in canopy.row_spacing for p in canopy.plant_spacing]
+    for i, group in enumerate(canopy.layout):
+        for p in group:
+            arrangements.append(Arrangement(layout=_shown(p, base), layout_path=p,
+                                            layout_sha256=_sha(p, source, base,
+                                                               f"canopy.layout[{i}]")))
     return arrangements
-
-
-def _heights(ck: _Checker, light: dict) -> tuple[float, ...]:
-    """``light.heights``: a list of at most MAX_HEIGHTS heights >= 0 cm, none twice."""
-    if "heights" not in light:
-        return DEFAULT_HEIGHTS
-    raw = light["heights"]
-    if not isinstance(raw, list):
-        ck.fail("light.heights", "must be a list of heights in cm, such as [0, 50, 100]")
-    if not raw:
-        ck.fail("light.heights", "is empty: give at least one height")
-    if len(raw) > MAX_HEIGHTS:
-        ck.fail("light.heights", f"holds {len(raw):,} heights; at most {MAX_HEIGHTS:,}")
-    heights = tuple(ck.number(h, f"light.heights[{i}]", positive=False, minimum=0)
-                    for i, h in enumerate(raw))
-    for i, h in enumerate(heights):
-        if h in heights[:i]:
-            ck.fail(f"light.heights[{i}]", f"height {h + 0.0:g} cm is given twice")
-    return heights
-
-
-def _rect(ck: _Checker, light: dict) -> tuple[float, ...] | None:
-    """``light.rect``: [x0, y0, x1, y1] cm with x1 > x0 and y1 > y0, or None."""
-    if "rect" not in light:
-        return None
-    raw = light["rect"]
-    if not isinstance(raw, list) or len(raw) != 4:
-        ck.fail("light.rect", "must be [x0, y0, x1, y1] in cm")
-    rect = tuple(ck.number(v, f"light.rect[{i}]", positive=False) for i, v in enumerate(raw))
-    if rect[2] <= rect[0] or rect[3] <= rect[1]:
-        ck.fail("light.rect", f"must have x1 > x0 and y1 > y0, got {list(rect)}")
-    return rect
 
 
 def _check_combinations(source: str, total: int, max_scenarios: int, allowed: bool) -> None:
@@ -718,7 +408,7 @@ def _check_combinations(source: str, total: int, max_scenarios: int, allowed: bo
                              "confirm with --yes, or narrow the axes")
 
 
-def _scenarios(ck: _Checker, axes: list[list[Any]], matchers: list, heights, rect,
+def _scenarios(source: str, axes: list[list[Any]], matchers: list, heights, rect,
                cover: float) -> tuple[list[Scenario], int]:
     """Every combination of the axes the excludes keep, as scenarios, and how many were
     excluded; an exclude that matches nothing is refused."""
@@ -742,44 +432,14 @@ def _scenarios(ck: _Checker, axes: list[list[Any]], matchers: list, heights, rec
                                   lv, pa, sun, dens, per, heights, rect, cover, opt, ph))
     for i, u in enumerate(used):
         if not u:
-            ck.fail(f"exclude[{i}]", "matches no scenario (a typo in a value?)")
+            _fail(source, f"exclude[{i}]", "matches no scenario (a typo in a value?)")
     return scenarios, excluded
 
 
-def _matcher(ck: _Checker, entry: dict, where: str) -> Callable[[dict[str, Any]], bool]:
-    """A predicate over a scenario's axis values for one ``exclude`` entry."""
-    ck.known(entry, AXES, where)
-    if not entry:
-        ck.fail(where, "is empty: name at least one axis value")
-    wants: list[tuple[str, Any]] = []
-    for key, v in entry.items():
-        w = f"{where}.{key}"
-        want: Any
-        if key in ("points", "layout"):
-            want = ck.text(v, w)                           # a name or a glob
-        elif key == "tile":
-            want = ck.shape(v, w)
-        elif key in ("row_spacing", "plant_spacing"):
-            want = ck.spacing(v, w)
-        elif key == "density":
-            want = ck.number(v, w)
-        elif key == "level":
-            want = ck.level(v, w)
-        elif key in ("preserve_area", "periodic"):
-            want = ck.boolean(v, w)
-        elif key == "optics":
-            want = ck.optics(v, w)
-        elif key == "photosynthesis":
-            want = ck.photosynthesis(v, w)
-        else:                                              # sun: every key given must agree
-            if not isinstance(v, dict) or not v:
-                ck.fail(w, "must be a table of sun keys, such as {zenith = 30}")
-            ck.known(v, SUN_ANGLE_KEYS + SUN_PLACE_KEYS, w)
-            want = {k: (x.isoformat() if isinstance(x, (date, datetime, dtime)) else
-                        ck.number(x, f"{w}.{k}", positive=False)
-                        if isinstance(x, int) and not isinstance(x, bool) else x)
-                    for k, x in v.items()}
-        wants.append((key, want))
+def _matcher(entry: Exclude) -> Callable[[dict[str, Any]], bool]:
+    """A predicate over a scenario's axis values for one ``exclude`` entry (a sun: every key
+    given must agree)."""
+    wants = [(k, v.given() if k == "sun" else v) for k, v in entry.given().items()]
     return lambda vals: all(_matches(vals, key, want) for key, want in wants)
 
 
