@@ -2,6 +2,7 @@
 
 The data flow, one module per step::
 
+    schema.py   the sweep file's keys, types, units, ranges and defaults, declared once
     spec.py     sweep file (TOML) -> checked scenarios, each with a content key and a group
     run.py      groups -> Dask tasks on a LocalCluster or a scheduler; results as they finish
     compute.py  on a worker: leaves (cached) -> canopy -> measures -> Embree scene -> suns
@@ -10,5 +11,5 @@ The data flow, one module per step::
     summary.py  cheapest mesh level within a transmission tolerance of the finest
     command.py  ``maizeviz sweep SPEC --out DIR``
 
-Needs the ``sweep`` extra: ``dask[distributed]``, ``pyarrow``, ``tqdm``.
+Needs the ``sweep`` extra: ``dask[distributed]``, ``pyarrow``, ``tqdm``, ``pydantic``.
 """

@@ -18,18 +18,19 @@ Defaults are those of ``maizeviz canopy`` and ``maizeviz light``::
     [light]
     sun = [{zenith = 30, azimuth = 180},                # required; angles in degrees, or
            {date = "2005-08-01", time = "12:00", lat = 39.9, lon = 116.4, tz = "Asia/Shanghai"},
-           {date = "2005-08-01", solar_noon = true, lat = 39.9, lon = 116.4, tz = "Asia/Shanghai"}]
-    density = [4]                  # rays per cm2 (default 4)
+           {date = "2005-08-01", solar_noon = true, lat = 39.9, lon = 116.4, altitude = 50}]
+                                   # a place (deg N, deg E, m) and a local time (tz: UTC)
+    density = [4, 16]              # rays per cm2 (default 4)
     heights = [0, 50, 100, 150, 200, 225]   # cm; not an axis: every scenario reports all
     periodic = true                # rays leaving the plot re-enter it (default false)
     rect = [0, 0, 180, 90]         # sample rectangle x0, y0, x1, y1 in cm (default: centre tile)
     optics = ["black",             # leaf optics: "black" (interception only, the default) or
-              {band = "par"},      # a table: absorbed light with scattering, each key optional:
-              {band = "nir", reflectance = 0.45, transmittance = 0.40, ground_reflectance = 0.25,
-               direct_w_m2 = 520, diffuse_w_m2 = 0, depth = 20, seed = 0,
-               ranks = [[1, 0.5, 0.35], [2, 0.48, 0.38]]}]   # [rank, rho, tau] per leaf rank
-                                   # (NIR leaves scatter 85 %: depth 20 leaves 0.2 % of it
-                                   # unresolved on the bundled canopy, depth 3 left 28 %)
+              {band = "par"},      # a table: absorbed light with scattering, each key optional
+              {band = "nir", reflectance = 0.45, transmittance = 0.40, ground_reflectance = 0.25, depth = 20},
+              {band = "par", direct_w_m2 = 520, diffuse_w_m2 = 60, seed = 1, ranks = [[1, 0.12, 0.06]]}]
+                                   # ranks: [rank, rho, tau] per leaf rank. NIR leaves scatter
+                                   # 85 %: depth 20 leaves 0.2 % of it unresolved on the bundled
+                                   # canopy, depth 3 left 28 %
     photosynthesis = ["none",      # gross CO2 assimilation of scenarios with PAR optics:
                       {model = "c4", temperature = 30, co2_ppm = 400},   # "none", or a leaf
                       {model = "wofost", amax = 70, eff = 0.45}]         # model and its keys
@@ -37,6 +38,9 @@ Defaults are those of ``maizeviz canopy`` and ``maizeviz light``::
     [[exclude]]                    # partial scenarios to drop (or, before [canopy]:
     level = "K4"                   # exclude = [{level = "K4", density = 16}])
     density = 16
+
+An inline table (``{...}``) stays on one line (TOML 1.0). The schema, every key's type, unit,
+range and default, is declared in :mod:`maizeviz.sweep.schema`.
 
 Each scenario has a stable key: a hash of everything that determines its numbers (the points
 and layout files by content, not by name; every parameter; maizeviz's major.minor version), so
@@ -353,6 +357,9 @@ def load_spec(path, yes: bool = False, max_scenarios: int = MAX_SCENARIOS) -> Sw
     _check_combinations(source, math.prod(len(a) for a in axes), max_scenarios,
                         yes or bool(matchers))
     scenarios, excluded = _scenarios(source, axes, matchers, heights, rect, cover)
+    if not scenarios and not excluded:   # every leaf model, and no PAR optics to feed one
+        _fail(source, "light.photosynthesis", "a leaf model needs PAR optics (optics = "
+              "[{band = \"par\"}]) and none is given: add them, or \"none\"")
     if not scenarios:
         raise SweepSpecError(f"{source}: exclude drops every scenario: nothing to run")
     if len(scenarios) > max_scenarios and not yes:
