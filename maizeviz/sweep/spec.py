@@ -50,6 +50,7 @@ results on disk can be matched to scenarios whatever the files are called.
 from __future__ import annotations
 
 import fnmatch
+import functools
 import hashlib
 import itertools
 import json
@@ -240,18 +241,29 @@ def optics_label(optics: OpticsSpec | None) -> str:
     return text
 
 
-def _scenario_inputs(points, arr, level, preserve, sun, density, periodic, heights, rect,
-                     cover, optics=None, photosynthesis=None) -> tuple[dict, dict]:
-    group = {"points_sha256": points.sha256, **arr.canonical(), "level": level,
-             "preserve_area": preserve, "cover_resolution": cover, "maizeviz": version_tag()}
+@functools.lru_cache(maxsize=256)
+def _optics_inputs(optics: OpticsSpec) -> dict:
+    """An optics axis value's fields (once per value: a sweep lists it in many scenarios)."""
+    return asdict(optics)
+
+
+def _group_inputs(points, arr, level, preserve, cover) -> dict:
+    """What determines a group's canopy (its key's inputs)."""
+    return {"points_sha256": points.sha256, **arr.canonical(), "level": level,
+            "preserve_area": preserve, "cover_resolution": cover, "maizeviz": version_tag()}
+
+
+def _scenario_inputs(group, sun, density, periodic, heights, rect, optics=None,
+                     photosynthesis=None) -> dict:
+    """What determines a scenario's numbers (its key's inputs): its group's, and the rest."""
     full = dict(group, sun_zenith_deg=sun.zenith_deg, sun_azimuth_deg=sun.azimuth_deg,
                 sun_when=sun.when, density=density, periodic=periodic, heights_cm=list(heights),
                 rect_cm=list(rect) if rect else None)
     if optics is not None:              # black leaves keep the keys they always had
-        full["optics"] = asdict(optics)
+        full["optics"] = _optics_inputs(optics)
     if photosynthesis is not None:      # so do scenarios without photosynthesis
         full["photosynthesis"] = dict(photosynthesis)
-    return group, full
+    return full
 
 
 @dataclass(frozen=True)
@@ -421,8 +433,10 @@ def _scenarios(source: str, axes: list[list[Any]], matchers: list, heights, rect
     excluded; an exclude that matches nothing is refused."""
     scenarios: list[Scenario] = []
     used, excluded = [False] * len(matchers), 0
+    par = {opt: opt is not None and opt.optics().band == "par" for opt in axes[7]}
+    groups: dict[tuple, tuple[dict, str]] = {}      # inputs and key, by canopy
     for pf, arr, lv, pa, dens, per, sun, opt, ph in itertools.product(*axes):
-        if ph is not None and (opt is None or opt.optics().band != "par"):
+        if ph is not None and not par[opt]:
             continue                    # photosynthesis is of PAR absorbed: not of this optics
         values = {"points": pf, "arrangement": arr, "level": lv, "preserve_area": pa,
                   "density": dens, "periodic": per, "sun": sun, "optics": opt,
@@ -433,10 +447,13 @@ def _scenarios(source: str, axes: list[list[Any]], matchers: list, heights, rect
                 used[i] = True
             excluded += 1
             continue
-        group, full = _scenario_inputs(pf, arr, lv, pa, sun, dens, per, heights, rect, cover,
-                                       opt, ph)
-        scenarios.append(Scenario(len(scenarios), _digest(full)[:24], _digest(group)[:24], pf, arr,
-                                  lv, pa, sun, dens, per, heights, rect, cover, opt, ph))
+        if (pf, arr, lv, pa) not in groups:
+            group = _group_inputs(pf, arr, lv, pa, cover)
+            groups[pf, arr, lv, pa] = group, _digest(group)[:24]
+        group, group_key = groups[pf, arr, lv, pa]
+        full = _scenario_inputs(group, sun, dens, per, heights, rect, opt, ph)
+        scenarios.append(Scenario(len(scenarios), _digest(full)[:24], group_key, pf, arr, lv, pa,
+                                  sun, dens, per, heights, rect, cover, opt, ph))
     for i, u in enumerate(used):
         if not u:
             _fail(source, f"exclude[{i}]", "matches no scenario (a typo in a value?)")
