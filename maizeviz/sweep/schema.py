@@ -239,7 +239,7 @@ class Table(BaseModel):
     def _known_keys(cls, data: Any) -> Any:
         if not isinstance(data, dict):
             raise _fail(f"must be {cls.example}")
-        for k in data:
+        for k in data if cls.model_config.get("extra") == "forbid" else ():
             if k not in cls.model_fields:
                 raise PydanticCustomError("unknown_key", "unknown key",
                                           {"key": k, "known": list(cls.model_fields)})
@@ -328,13 +328,6 @@ class LeafModelTable(Table):
     model: Text
     temperature: Annotated[Number, _within(-50, 70, "C")] = 25.0
     temperature_response: Text | None = None
-
-    @model_validator(mode="before")
-    @classmethod
-    def _known_keys(cls, data: Any) -> Any:            # the model knows its parameters
-        if not isinstance(data, dict):
-            raise _fail(f"must be {cls.example}")
-        return data
 
 
 def _named_off(*names: str):
