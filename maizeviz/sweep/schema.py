@@ -87,8 +87,7 @@ def _distinct(values: list) -> list:
     for i, v in enumerate(values):
         j = seen.setdefault(_token(v), i)
         if j != i:
-            raise PydanticCustomError("repeat", "repeats {axis}[{first}]",
-                                      {"at": i, "first": j, "axis": ""})
+            raise PydanticCustomError("repeat", "repeats item {first}", {"at": i, "first": j})
     return values
 
 
@@ -514,7 +513,7 @@ def _line(source: str, err: ErrorDetails, doc: dict) -> str:
         message = MESSAGES[kind].format(got=_shown(err.get("input")), **ctx)
     else:                                          # this schema's own refusals
         message = err["msg"]
-    return f"{source}: {path or 'the file'}: {' '.join(message.split())}"
+    return f"{source}: {path or 'the file'}: {message}"
 
 
 def validate(doc: dict, source: str, base: Path) -> SweepFile:
@@ -543,4 +542,5 @@ def validate(doc: dict, source: str, base: Path) -> SweepFile:
         return SweepFile.model_validate(doc, context={"base": str(base)})
     except ValidationError as exc:
         first = exc.errors(include_url=False)[0]
-        raise SweepSpecError(_line(source, first, doc)) from None
+        # one line, whatever the file's keys and values hold (TOML keys may be "a\nb")
+        raise SweepSpecError(" ".join(_line(source, first, doc).split())) from None

@@ -370,3 +370,13 @@ def test_without_pydantic_a_sweep_file_is_one_line_away(folder):
     assert len(lines) == 1 and re.fullmatch(r"error: reading a sweep file needs pydantic "
                                             r"\(.*\): pip install 'maizeviz\[sweep\]'",
                                             lines[0]), proc.stderr
+
+
+def test_a_key_holding_a_line_break_is_named_on_one_line(folder):
+    """TOML's quoted keys may hold any character; the refusal stays one line."""
+    file = folder / "newline.toml"
+    file.write_text('[canopy]\n"a\\nb" = 1\n')
+    with pytest.raises(SweepSpecError, match=r"unknown key 'canopy.a b' \(known in canopy: "
+                                             r"points, ") as info:
+        load_spec(file)
+    assert "\n" not in str(info.value)
