@@ -9,8 +9,8 @@ import math
 import time
 from pathlib import Path
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.field import canopy_of
-from maizeviz.canopy.scene import Canopy
 from maizeviz.cli.common import (
     NUMBER_ARG,
     WHOLE_ARG,

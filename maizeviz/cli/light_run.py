@@ -16,10 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.export import export_canopy
 from maizeviz.canopy.field import canopy_of
 from maizeviz.canopy.from_mesh import MESH_LEVEL
-from maizeviz.canopy.scene import Canopy
 from maizeviz.cli.common import (
     Progress,
     canopy_setup,
