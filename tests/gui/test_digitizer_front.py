@@ -18,7 +18,6 @@ from maizeviz.io.points import read_points
 TIMEOUT = 20_000
 
 
-
 @pytest.fixture
 def sim():
     s = FastrakSimulator(press_gap_s=0.0, noise_cm=0.0)
