@@ -320,6 +320,28 @@ def test_any_valid_file_loads_and_reads_the_same_written_otherwise(folder, doc):
     assert sorted(s.key for s in load_spec(other, yes=True).scenarios) == sorted(keys)
 
 
+@SETTINGS
+@given(doc=valid_sweep(), key=st.sampled_from(["level", "density", "periodic", "preserve_area"]),
+       data=st.data())
+def test_an_exclude_drops_exactly_the_scenarios_holding_its_value(folder, doc, key, data):
+    if expected_count(doc) == 0:
+        return
+    table = doc["canopy"] if key in doc["canopy"] else doc["light"]
+    value = data.draw(st.sampled_from(table[key]), label="excluded")
+    file = folder / "excluded.toml"
+    file.write_text(dump({**doc, "exclude": [{key: value}]}))
+    if len(table[key]) == 1:
+        with pytest.raises(SweepSpecError, match=r"exclude drops every scenario"):
+            load_spec(file, yes=True)
+        return
+    spec = load_spec(file, yes=True)
+    count = expected_count(doc)
+    assert spec.excluded == count // len(table[key])
+    assert len(spec.scenarios) == count - spec.excluded
+    kept = {getattr(s, key) for s in spec.scenarios}
+    assert len(kept) == len(table[key]) - 1
+
+
 # ---------------------------------------------------------- the documented examples
 def _keys(obj, out: set) -> set:
     if isinstance(obj, dict):
