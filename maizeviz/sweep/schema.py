@@ -259,15 +259,16 @@ class SunKeys(Table):
                               "\"Asia/Shanghai\"}")
     ANGLES: ClassVar[tuple[str, ...]] = ("zenith", "azimuth")
 
-    zenith: Annotated[Number, _within(0, 90, "degrees")] | None = None
-    azimuth: Number | None = None                              # degrees clockwise from north
-    date: TimeText | None = None
-    time: TimeText | None = None
-    solar_noon: Bool | None = None
-    lat: Number | None = None
-    lon: Number | None = None
-    tz: Text | None = None
-    altitude: Number | None = None
+    zenith: Annotated[Number, _within(0, 90, "degrees")] | None = Field(
+        None, description="deg from the vertical")
+    azimuth: Number | None = Field(None, description="deg clockwise from north")
+    date: TimeText | None = Field(None, description="local date, 2005-08-01")
+    time: TimeText | None = Field(None, description="local clock time, 12:00")
+    solar_noon: Bool | None = Field(None, description="the sun at its highest that day")
+    lat: Number | None = Field(None, description="deg north")
+    lon: Number | None = Field(None, description="deg east")
+    tz: Text | None = Field(None, description="IANA time zone (default UTC)")
+    altitude: Number | None = Field(None, description="m above sea level (default 0)")
 
 
 class SunTable(SunKeys):
@@ -303,16 +304,20 @@ class OpticsTable(Table):
     example: ClassVar[str] = ('"black" or a table such as {band = "par", reflectance = 0.1, '
                               'transmittance = 0.05, ground_reflectance = 0.1}')
 
-    band: Annotated[str, BeforeValidator(_text), AfterValidator(str.lower)] = "par"
-    reflectance: Fraction | None = None
-    transmittance: Fraction | None = None
-    ground_reflectance: Fraction | None = None
-    direct_w_m2: Irradiance | None = None
-    diffuse_w_m2: Irradiance = 0.0
-    depth: Annotated[int, Strict(), _within(0, MAX_DEPTH, whole=True)] | None = None
-    seed: Annotated[int, Strict(), _within(0, MAX_SEED, whole=True)] = 0
-    #: (rank, reflectance, transmittance) per leaf rank, numbers as given
-    ranks: Annotated[tuple, BeforeValidator(_ranks)] = ()
+    band: Annotated[str, BeforeValidator(_text), AfterValidator(str.lower)] = Field(
+        "par", description='waveband, "par" or "nir"')
+    reflectance: Fraction | None = Field(None, description="leaf, fraction (band's default)")
+    transmittance: Fraction | None = Field(None, description="leaf, fraction (band's default)")
+    ground_reflectance: Fraction | None = Field(None, description="soil, fraction")
+    direct_w_m2: Irradiance | None = Field(None, description="W/m2 on the horizontal (default "
+                                                             "the band's share of 1000)")
+    diffuse_w_m2: Irradiance = Field(0.0, description="W/m2 from an overcast sky")
+    depth: Annotated[int, Strict(), _within(0, MAX_DEPTH, whole=True)] | None = Field(
+        None, description="scatterings followed per ray")
+    seed: Annotated[int, Strict(), _within(0, MAX_SEED, whole=True)] = Field(
+        0, description="of the Monte Carlo scattering")
+    ranks: Annotated[tuple, BeforeValidator(_ranks)] = Field(
+        (), description="[rank, reflectance, transmittance] per leaf rank, numbers as given")
 
 
 class LeafModelTable(Table):
@@ -324,9 +329,9 @@ class LeafModelTable(Table):
     example: ClassVar[str] = '"none" or a table such as {model = "c4", temperature = 30}'
     __pydantic_extra__: dict[str, Number]
 
-    model: Text
-    temperature: Annotated[Number, _within(-50, 70, "C")] = 25.0
-    temperature_response: Text | None = None
+    model: Text = Field(description='"c4" or "wofost"')
+    temperature: Annotated[Number, _within(-50, 70, "C")] = Field(25.0, description="air, C")
+    temperature_response: Text | None = Field(None, description='C4: "collatz" or "clm45"')
 
 
 def _named_off(*names: str):
@@ -393,15 +398,18 @@ class Canopy(Table):
 
     example: ClassVar[str] = "a table ([canopy])"
 
-    points: Axis[Files]                              # required; globs, relative to the file
-    tile: Axis[Tile] = [(1, 1)]                      # copies of the digitized block
-    row_spacing: Axis[RowSpacing] = [60.0]           # cm
-    plant_spacing: Axis[PlantSpacing] = [30.0]       # cm
-    block: Block | None = None                       # rows x plants (default: inferred)
-    layout: Axis[Files] = []                         # layout files
-    level: Axis[Level]                               # required; as the app's slider names them
-    preserve_area: Axis[Bool] = [True]
-    cover_resolution: Positive = 0.5                 # cm, the ground-cover pixel; not an axis
+    points: Axis[Files] = Field(description="points files; globs, relative to the file")
+    tile: Axis[Tile] = Field([(1, 1)], description="AxB copies of the digitized block")
+    row_spacing: Axis[RowSpacing] = Field([60.0], description="cm between rows")
+    plant_spacing: Axis[PlantSpacing] = Field([30.0], description="cm between plants of a row")
+    block: Block | None = Field(None, description="rows x plants of the block (default: "
+                                                  "inferred); not an axis")
+    layout: Axis[Files] = Field([], description="layout files, besides or instead of tilings")
+    level: Axis[Level] = Field(description="mesh levels, as the app's slider names them")
+    preserve_area: Axis[Bool] = Field([True], description="below the standard mesh, keep the "
+                                                          "smooth leaf area")
+    cover_resolution: Positive = Field(0.5, description="cm, the ground-cover pixel; not an "
+                                                        "axis")
 
 
 class Light(Table):
@@ -410,13 +418,17 @@ class Light(Table):
 
     example: ClassVar[str] = "a table ([light])"
 
-    sun: Axis[Sun]                                   # required
-    density: Axis[Positive] = [4.0]                  # rays per cm2
-    heights: Heights = DEFAULT_HEIGHTS               # cm; every scenario reports all
-    periodic: Axis[Bool] = [False]
-    rect: Rect | None = None
-    optics: Axis[Optics] = [None]
-    photosynthesis: Axis[LeafModel] = [None]
+    sun: Axis[Sun] = Field(description="suns: angles, or a place and a time")
+    density: Axis[Positive] = Field([4.0], description="rays per cm2")
+    heights: Heights = Field(DEFAULT_HEIGHTS, description="cm above the ground; not an axis: "
+                                                          "every scenario reports all")
+    periodic: Axis[Bool] = Field([False], description="rays leaving the plot re-enter it")
+    rect: Rect | None = Field(None, description="sample rectangle x0, y0, x1, y1 in cm "
+                                                "(default: the centre tile); not an axis")
+    optics: Axis[Optics] = Field([None], description='leaf optics: "black" (interception) or '
+                                                     'a table')
+    photosynthesis: Axis[LeafModel] = Field([None], description='"none" or a leaf model, of '
+                                                                'PAR scenarios')
 
 
 class Exclude(Table):

@@ -368,6 +368,19 @@ def test_the_modules_example_file_reads_and_shows_every_key(folder):
     assert declared - shown == set()
 
 
+def test_every_key_of_the_schema_says_what_it_is_and_its_unit():
+    from maizeviz.sweep.schema import LeafModelTable
+
+    for table in (Canopy, Light, SunKeys, OpticsTable, LeafModelTable):
+        for name, field in table.model_fields.items():
+            assert field.description, f"{table.__name__}.{name}"
+    units = {Canopy: ("row_spacing", "plant_spacing", "cover_resolution"),
+             Light: ("density", "heights", "rect"), SunKeys: ("zenith", "azimuth", "altitude")}
+    for table, names in units.items():
+        for name in names:
+            assert re.search(r"\b(cm|cm2|deg|m)\b", table.model_fields[name].description), name
+
+
 def test_the_docs_example_file_reads(folder):
     text = (ROOT / "docs" / "sweep.md").read_text()
     block = re.search(r"```toml\n(.*?)```", text, re.S).group(1)
