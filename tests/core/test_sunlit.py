@@ -9,7 +9,7 @@ from test_leaf_invariants import leaves
 
 from maizeviz.light.engine import LightEngine
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.direct import sampler
+from maizeviz.light.trace.beam import sampler
 from maizeviz.light.trace.optics import Optics
 from maizeviz.light.trace.scatter import scatter_beam
 from maizeviz.light.trace.sunlit import geometry, sunlit_share
