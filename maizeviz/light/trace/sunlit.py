@@ -242,6 +242,28 @@ def _near_rect(smp: Sampler, geo: Geometry, shift: np.ndarray) -> np.ndarray:
     return near[geo.group]
 
 
+def _near_triangles(smp: Sampler, geo: Geometry, shift: np.ndarray) -> np.ndarray:
+    """(n,) intp, ascending: the triangles whose beam may land in the sample rectangle. Of
+    those of the groups near it (:func:`_near_rect`), each triangle whose points, within
+    ``radius`` of its centre in x, y and z, land within ``radius (1 + |shift|)`` of where its
+    centre's beam lands, in each axis, which must meet the rectangle (in a periodic field,
+    wrapped across the plot)."""
+    ids = np.flatnonzero(_near_rect(smp, geo, shift))
+    x0, y0, x1, y1 = smp.rect
+    bx0, by0, bx1, by1 = smp.bounds
+    if not len(ids) or smp.periodic and np.allclose((x0, y0, x1, y1), smp.bounds):
+        return ids
+    c, r = geo.centre[ids], geo.radius_cm[ids]
+    keep = np.ones(len(ids), dtype=bool)
+    for axis, (lo, hi, start, period) in enumerate(((x0, x1, bx0, bx1 - bx0),
+                                                    (y0, y1, by0, by1 - by0))):
+        land = c[:, axis] - shift[axis] * c[:, 2]
+        reach = r * (1.0 + abs(shift[axis]))
+        keep &= _overlaps(land - reach, land + reach, lo, hi,
+                          start if smp.periodic else None, period)
+    return ids[keep]
+
+
 def sunlit_share(smp: Sampler, canopy: Canopy, normals: np.ndarray, toward: np.ndarray,
                  seed: int, hits: np.ndarray | None = None,
                  cos_beam: np.ndarray | None = None) -> SunlitShare:
@@ -277,7 +299,7 @@ def sunlit_share(smp: Sampler, canopy: Canopy, normals: np.ndarray, toward: np.n
     geo = geometry(canopy, nf)
     # the triangles whose beam may land in the rectangle (their centre's, within their size)
     shift = s[:2] / s[2]
-    tri_ids = np.flatnonzero(_near_rect(smp, geo, shift))
+    tri_ids = _near_triangles(smp, geo, shift)
     cos = np.abs(normals[tri_ids] @ s) if cos_beam is None else cos_beam[tri_ids]
     w = geo.area_cm2[tri_ids] * cos                      # the beam each would intercept
     lit_side = w > 0
