@@ -169,10 +169,12 @@ def draw_figures(study: StudyState, run: Run) -> None:
     look = plots.Look.of(study.colour, f.shown_for).sharing(run.kind, run.result)
     curves, title = study.runs.curves(), plot_title(study.runs)
 
+    canvas, plot_canvas = f.canvases.get("heatmap"), f.canvases.get("plot")
+
     def work(job):
         maps = plots.heatmap_images(run.result, first=first, check=job.check, kind=run.kind,
-                                    look=look)
-        return maps, plots.rgba(plots.transmission_figure(curves, title))
+                                    look=look, canvas=canvas)
+        return maps, plots.rgba(plots.transmission_figure(curves, title, canvas=plot_canvas))
 
     def done(out) -> None:
         maps, plot = out
@@ -197,13 +199,34 @@ def draw_heatmap(study: StudyState, kind: str, index: int) -> None:
     result = run.result
     height = float(result.heights_cm[index])
     look = plots.Look.of(study.colour, study.figures.shown_for)
+    canvas = study.figures.canvases.get("heatmap")
 
     def done(rgba) -> None:
         study.figures.set_map(kind, run, index, rgba)
 
     study.runner.run("heatmap", f"drawing the heatmap at {height:g} cm",
-                     lambda job: plots.heatmap_image(result, height, kind=kind, look=look),
+                     lambda job: plots.heatmap_image(result, height, kind=kind, look=look,
+                                                     canvas=canvas),
                      on_done=done, on_error=lambda e: study.fail(e, "light"))
+
+
+def refit_figures(study: StudyState, which: str) -> None:
+    """Where the ``heatmap`` or the ``plot`` is shown changed size: the maps are drawn again
+    when shown (the one shown at once), the plot in a job, each for its new canvas."""
+    f = study.figures
+    if which == "heatmap":
+        if f.maps:
+            f.restyle(keep=None)
+        return
+    if f.plot is None or not study.runs.runs:
+        return
+    from maizeviz_app import plots
+
+    curves, title, canvas = study.runs.curves(), plot_title(study.runs), f.canvases.get("plot")
+    study.runner.run("plot", "drawing the transmission plot",
+                     lambda job: plots.rgba(plots.transmission_figure(curves, title,
+                                                                      canvas=canvas)),
+                     on_done=f.set_plot, on_error=lambda e: study.fail(e, "light"))
 
 def sun_from_place(study: StudyState) -> None:
     """Sun angles from the date, time and place of ``settings.sun.place`` (pvlib, in a
@@ -340,11 +363,13 @@ def _draw_project_figures(study: StudyState, shown: dict, order: list, curves, t
 
     results = [(k, shown[k].result) for k in order]
     look = plots.Look.of(study.colour, shown)
+    canvas = study.figures.canvases.get("heatmap")
+    plot_canvas = study.figures.canvases.get("plot")
 
     def work(job):
-        maps = [(k, plots.heatmap_images(r, check=job.check, kind=k, look=look))
+        maps = [(k, plots.heatmap_images(r, check=job.check, kind=k, look=look, canvas=canvas))
                 for k, r in results]
-        plot = plots.rgba(plots.transmission_figure(curves, title))
+        plot = plots.rgba(plots.transmission_figure(curves, title, canvas=plot_canvas))
         return maps, plot
 
     def done(out):

@@ -235,3 +235,43 @@ def test_the_c4_plants_table_shows_its_co2_columns_on_a_laptop(laptop, qtbot):
     assert p.plants.columnCount() == 8
     assert p.plants.horizontalScrollBar().maximum() == 0
     assert not _cut(w.docks["light"].widget().widget())
+
+
+def _cap_height_px(font_px: float) -> float:
+    """The height of a capital (an H) of matplotlib's default font drawn ``font_px`` tall."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextPath
+
+    return font_px * TextPath((0, 0), "H", size=1, prop=FontProperties()).get_extents().height
+
+
+def test_the_docked_heatmaps_text_is_readable_on_a_laptop(laptop, qtbot):
+    """Issue 37, item 7: at 1366 x 768 the docked heatmap's title, axis labels and colour-bar
+    text were drawn at 64 dpi on a 512 px figure and shrunk into a 448 x 168 view: capitals
+    2 px tall. Each light's map (a sun with C4, a sky, a day) is now drawn at the view's own
+    pixels and dpi, every text at least 11 px and its capitals 8.5 px (at 96 dpi)."""
+    from test_light_modes import compute, small_light
+
+    w = laptop
+    p = w.light_panel
+    small_light(p, "sun")
+    p.periodic.setChecked(True)
+    p.optics_box.setChecked(True)
+    p.photo_model.setCurrentIndex(p.photo_model.findData("c4"))
+    compute(qtbot, w)
+    for mode in ("sky", "day"):
+        small_light(p, mode)
+        compute(qtbot, w)
+    plots, view = w.plots, w.plots.heatmap
+    assert plots.source.count() == 3
+    for i in range(3):
+        plots.source.setCurrentIndex(i)
+        qtbot.waitUntil(lambda: view.heatmap is not None, timeout=TIMEOUT)
+        image = view.image()
+        scale = min(view.width() / image.width(), view.height() / image.height())
+        shown_px = view.heatmap.font_px * scale * 96 / view.logicalDpiY()
+        assert shown_px >= 11 and _cap_height_px(shown_px) >= 8.5, \
+            (plots.source.currentText(), view.heatmap.font_px, scale)
+    # the transmission plot too is drawn at its view's pixels (not shrunk)
+    plot = plots.transmission
+    assert abs(plot.image().width() - plot.width()) <= 0.05 * plot.width()
