@@ -370,7 +370,7 @@ def edit_part(window, spin, gaps, shown: list) -> dict:
     panel.rows_box.setValue(30)
     panel.per_row_box.setValue(30)
     spin(0.5)
-    draft = panel.model
+    draft = panel.draft
 
     def timed(name: str, action) -> None:
         gaps.start()

@@ -2,7 +2,7 @@
 
 The instruments look from points inside or under the canopy toward the sky: a line of sight is
 open (a gap) when no leaf (or stalk) lies on it before it leaves the canopy's top. They trace
-on the light engine's own scenes (:func:`maizeviz.light.scene.scenes.light_scene`, or a
+on the light engine's own scenes (:func:`maizeviz.light.scene.embree_scenes.light_scene`, or a
 :class:`~maizeviz.light.engine.LightEngine`'s kept ones), open or periodic: in a periodic field
 a line of sight that leaves the plot sideways goes on through the next copy of it
 (:func:`maizeviz.light.scene.periodic.trace_wrapped`), as the engine's sunlight does.
@@ -14,10 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.errors import MaizevizError
+from maizeviz.light.scene.embree_scenes import light_scene
 from maizeviz.light.scene.request import canopy_top
-from maizeviz.light.scene.scenes import light_scene
 from maizeviz.mesh.raytrace import RayScene
 
 #: Lines of sight traced per call into Embree (bounds memory: about 100 bytes each).

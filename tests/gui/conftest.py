@@ -78,8 +78,8 @@ def small_points(tmp_path_factory):
 @pytest.fixture(scope="session")
 def small_canopy(small_points):
     """The two plants at 36 triangles per leaf, tiled 1x1."""
+    from maizeviz.canopy.build import build_canopy
     from maizeviz.canopy.layout import layout_for
-    from maizeviz.canopy.scene import build_canopy
     from maizeviz.leaf.fit import read_leaves
     from maizeviz.mesh.levels import parse_level
 
