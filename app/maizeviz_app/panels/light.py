@@ -142,6 +142,13 @@ class LightPanel(QWidget):
                                  "as in a field that goes on (off: an isolated plot)")
         bind(self.periodic, s.sampling, "periodic")
         form.addRow(self.periodic)
+        self.stalks = QCheckBox("stalks take light")
+        self.stalks.setAccessibleName("stalks take light")
+        self.stalks.setToolTip("the stalks intercept and scatter light as the leaves do (off: "
+                               "the leaves alone, as the paper's canopy and maizeviz light "
+                               "--leaves-only)")
+        bind(self.stalks, s.light, "stalks")
+        form.addRow(self.stalks)
         lay.addLayout(form)
         # ---- compute, cancel, progress, problems
         buttons = QHBoxLayout()
@@ -229,7 +236,8 @@ class LightPanel(QWidget):
             lay.addLayout(line)
         lay.addStretch(1)
         self.fields: dict[str, Any] = {"heights": self.heights, "density": self.density,
-                                       "periodic": self.periodic, "rect": self.heights,
+                                       "periodic": self.periodic, "stalks": self.stalks,
+                                       "rect": self.heights,
                                        "threads": self.density}
         self.mode_fields: dict[str, dict[str, Any]] = {
             "sun": {"band": self.band, "reflectance": self.reflectance,
@@ -280,6 +288,7 @@ class LightPanel(QWidget):
 
     def _widget_of(self, name: str):
         return {"heights": self.heights, "density": self.density, "periodic": self.periodic,
+                "stalks": self.stalks,
                 "zenith_deg": self.zenith, "azimuth_deg": self.azimuth, "place": self.place,
                 "kind": self.sky_kind, "directions": self.sky_n, "date": self.day_date,
                 "latitude": self.lat, "longitude": self.lon, "tz": self.tz,

@@ -40,7 +40,7 @@ def transmission_map(result: LightResult, height: float, bin_cm: float = 5.0) ->
 
 
 def heatmap_figure(tmap: TransmissionMap, result: LightResult | None = None,
-                   width_in: float = 8.0, dpi: int = 110, title: str | None = None,
+                   width_in: float = 8.0, dpi: float = 110, title: str | None = None,
                    what: str = "direct-light transmission", *, vmin: float = 0.0,
                    vmax: float = 1.0, cmap: str = "viridis", log: bool = False,
                    fit: tuple[float, float] | None = None, font_pt: float = 9.5) -> Figure:
@@ -68,8 +68,10 @@ def heatmap_figure(tmap: TransmissionMap, result: LightResult | None = None,
         fig = Figure(figsize=(width_in, width_in * aspect * 0.8 + 0.2 * width_in), dpi=dpi)
         small, fonts = False, {"title": 9.0}
     else:
-        fig = Figure(figsize=fit, dpi=dpi, layout="constrained")
-        fig.get_layout_engine().set(w_pad=2 / 72, h_pad=2 / 72)
+        from matplotlib.layout_engine import ConstrainedLayoutEngine
+
+        fig = Figure(figsize=fit, dpi=dpi,
+                     layout=ConstrainedLayoutEngine(w_pad=2 / 72, h_pad=2 / 72))
         small = fit[1] < FULL_TITLE_IN or fit[0] < FULL_TITLE_IN
         fonts = {"title": font_pt, "label": font_pt, "ticks": font_pt}
     ax = fig.add_subplot()
@@ -186,7 +188,7 @@ def result_map(result: AnyLight, height: float, kind: str = "sun",
 
 
 def result_figure(result: AnyLight, height: float, kind: str = "sun", bin_cm: float = 5.0,
-                  width_in: float = 8.0, dpi: int = 110,
+                  width_in: float = 8.0, dpi: float = 110,
                   tmap: TransmissionMap | None = None, **colours) -> Figure:
     """The figure of one height of a light result (:func:`result_map`, or ``tmap`` when
     already made), titled by :func:`map_title`; ``colours``: :func:`heatmap_figure`'s
