@@ -29,10 +29,15 @@ def find(root, name: str, kind=None):
 
 
 def _cut(widget) -> list[str]:
-    """What a panel shows cut: a label, button or check box narrower than its text, a field
-    narrower than its text, a combo narrower than its choice."""
+    """What a panel shows cut: a label, button or check box narrower than its text, a
+    wrapped label lower than its lines, a field narrower than its text, a combo narrower
+    than its choice."""
     cut = []
     for c in widget.findChildren(QLabel) + widget.findChildren(QAbstractButton):
+        if isinstance(c, QLabel) and c.isVisible() and c.wordWrap() and c.text() and \
+                c.heightForWidth(c.width()) > c.height() + 1:       # wrapped, lines cut off
+            cut.append(f"QLabel {c.text()!r}: {c.height()} px high < "
+                       f"{c.heightForWidth(c.width())}")
         if not c.isVisible() or (isinstance(c, QLabel) and (c.wordWrap() or c.pixmap()
                                                             and not c.pixmap().isNull())):
             continue
@@ -275,3 +280,78 @@ def test_the_docked_heatmaps_text_is_readable_on_a_laptop(laptop, qtbot):
     # the transmission plot too is drawn at its view's pixels (not shrunk)
     plot = plots.transmission
     assert abs(plot.image().width() - plot.width()) <= 0.05 * plot.width()
+
+
+def _sun_c4_sky_day(w, qtbot):
+    """A sun with C4, a sky and a day computed on the laptop's window (the Day page shown)."""
+    from test_light_modes import compute, small_light
+
+    p = w.light_panel
+    small_light(p, "sun")
+    p.periodic.setChecked(True)
+    p.optics_box.setChecked(True)
+    p.photo_model.setCurrentIndex(p.photo_model.findData("c4"))
+    compute(qtbot, w)
+    for mode in ("sky", "day"):
+        small_light(p, mode)
+        compute(qtbot, w)
+
+
+def test_the_day_page_takes_its_own_room_and_its_sky_shows(laptop, qtbot):
+    """Issue 37, item 7: the light panel's pages stood in a stack as tall as its tallest
+    page (the sun's with optics and C4, 527 px), so at 1366 x 768 the Day page (279 px) sat
+    in a gap and the sky it needs was cut by the dock's bottom edge. The page shown alone
+    takes room: neither squashed below its minimum nor stretched past its size, and the
+    sky's group shows whole in the dock, unscrolled."""
+    from PySide6.QtCore import QPoint
+
+    w = laptop
+    _sun_c4_sky_day(w, qtbot)
+    p = w.light_panel
+    w.docks["light"].raise_()
+    p.set_mode("day")
+    qtbot.wait(200)
+    area = w.docks["light"].widget()
+    area.verticalScrollBar().setValue(0)
+    qtbot.wait(100)
+    page = p.pages.currentWidget()
+    assert page is p.pages.widget(1) and page.isVisible()
+    assert page.minimumSizeHint().height() <= page.height() <= page.sizeHint().height() + 2, \
+        (page.minimumSizeHint(), page.size(), page.sizeHint())
+    bottom = p.sky_box.mapTo(area.widget(), QPoint(0, p.sky_box.height())).y()
+    assert p.sky_box.isVisible() and bottom <= area.viewport().height(), \
+        (bottom, area.viewport().height())
+    assert not _fits(w, "light")
+
+
+def test_the_layout_state_and_apply_show_in_a_laptops_dock(laptop, qtbot):
+    """Issue 37, item 7: at 1366 x 768 the Layout panel asked for the height its splitter was
+    given (60 % and 40 % of the panel's own, 740 px), taller than its dock (652 px): the state
+    line ("1 plant edited · not applied yet") and Apply stood below the bottom edge, cut.
+    They now show in the dock unscrolled; the state wraps (never cut) down to the
+    narrowest dock and tells the whole of it in its tooltip."""
+    from PySide6.QtCore import QPoint, Qt
+
+    w = laptop
+    _sun_c4_sky_day(w, qtbot)
+    w.docks["layout"].raise_()
+    w.model.layout_options.follow = False
+    panel = w.layout_panel
+    panel.draft.move(0, 40.0, 20.0)                     # an edit: the state says so
+    qtbot.wait(300)
+    assert panel.state.text() == "1 plant edited · not applied yet"
+    assert "Apply" in panel.state.toolTip()
+    area = w.docks["layout"].widget()
+    area.verticalScrollBar().setValue(0)
+    qtbot.wait(100)
+    for shown in (panel.state, panel.apply_button):
+        bottom = shown.mapTo(area.widget(), QPoint(0, shown.height())).y()
+        assert shown.isVisible() and bottom <= area.viewport().height(), \
+            (shown.text(), bottom, area.viewport().height())
+    for width in (480, 300):
+        w.resizeDocks([w.docks["layout"]], [width], Qt.Orientation.Horizontal)
+        qtbot.wait(200)
+        label = panel.state
+        assert label.heightForWidth(label.width()) <= label.height() + 1, \
+            (width, label.size(), label.heightForWidth(label.width()))
+        assert not [c for c in _cut(panel) if "edited" in c]

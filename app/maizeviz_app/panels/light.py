@@ -39,7 +39,6 @@ from PySide6.QtWidgets import (
     QRadioButton,
     QSizePolicy,
     QSpinBox,
-    QStackedWidget,
     QTableWidget,
     QTableWidgetItem,
     QVBoxLayout,
@@ -84,6 +83,45 @@ def _time_zones() -> list[str]:
         return ["UTC", "Asia/Shanghai", "Europe/Paris", "America/Chicago"]
 
 
+class PageStack(QWidget):
+    """Pages shown one at a time, of which only the one shown takes room (a column whose
+    other pages are hidden). A QStackedWidget is as tall as its tallest page (its layout's
+    height for a width is the tallest's: the sun's with its optics open, 527 px), so the
+    day's page (279 px) stood in a gap that pushed the sky it needs below a laptop's dock."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self._column = QVBoxLayout(self)
+        self._column.setContentsMargins(0, 0, 0, 0)
+        self._pages: list[QWidget] = []
+        self._current = -1
+
+    def addWidget(self, page: QWidget) -> int:  # noqa: N802 - QStackedWidget's name
+        self._pages.append(page)
+        self._column.addWidget(page)
+        if self._current < 0:
+            self._current = 0
+        page.setVisible(len(self._pages) - 1 == self._current)
+        return len(self._pages) - 1
+
+    def count(self) -> int:
+        return len(self._pages)
+
+    def widget(self, index: int) -> QWidget | None:
+        return self._pages[index] if 0 <= index < len(self._pages) else None
+
+    def currentIndex(self) -> int:  # noqa: N802 - QStackedWidget's name
+        return self._current
+
+    def currentWidget(self) -> QWidget | None:  # noqa: N802 - QStackedWidget's name
+        return self.widget(self._current)
+
+    def setCurrentIndex(self, index: int) -> None:  # noqa: N802 - QStackedWidget's name
+        self._current = index
+        for k, page in enumerate(self._pages):
+            page.setVisible(k == index)
+
+
 class LightPanel(QWidget):
     """The light settings of ``study`` (a :class:`~maizeviz_app.model.StudyModel`; its
     ``settings``, bound both ways) and its results table (its runs fill it). Without a study
@@ -119,7 +157,7 @@ class LightPanel(QWidget):
             modes.addWidget(b, 1)
         self.mode_group = bind_choice(self.mode_buttons, s.light, "mode")
         lay.addLayout(modes)
-        self.pages = QStackedWidget()
+        self.pages = PageStack()
         self.pages.addWidget(self._sun_page())
         self.pages.addWidget(self._day_page())
         self.pages.addWidget(QWidget())               # the sky needs only the sky group
@@ -639,12 +677,6 @@ class LightPanel(QWidget):
 
     def _show_mode(self, mode: str) -> None:
         page = {"sun": 0, "day": 1, "sky": 2}[mode]
-        for k in range(self.pages.count()):
-            # only the page shown takes room: the sun page is short, the day page tall
-            policy = QSizePolicy.Policy.Preferred if k == page else QSizePolicy.Policy.Ignored
-            widget = self.pages.widget(k)
-            if widget is not None:
-                widget.setSizePolicy(QSizePolicy.Policy.Preferred, policy)
         self.pages.setCurrentIndex(page)
         self.pages.setVisible(mode != "sky")
         self.sky_box.setVisible(mode != "sun")
@@ -652,7 +684,6 @@ class LightPanel(QWidget):
                               "diffuse part of the day: the sky it comes from")
         self.compute_button.setText(COMPUTE_TEXT[mode])
         self.compute_button.setAccessibleName(COMPUTE_TEXT[mode])
-        self.pages.adjustSize()
         self._sync_sky_kind()
 
     def _sync_sky_kind(self) -> None:
