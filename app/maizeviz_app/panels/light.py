@@ -861,7 +861,10 @@ class LightPanel(QWidget):
         head = max(t.horizontalHeader().height(), t.horizontalHeader().sizeHint().height())
         h = head + 2 * t.frameWidth()
         h += sum(t.rowHeight(r) for r in range(t.rowCount()))
-        if t.horizontalScrollBar().isVisible() or t.columnCount() > 4:
+        # the sideways scroll bar, when the columns are wider than the table (it may not be
+        # shown yet), must not hide the last row
+        if t.horizontalScrollBar().isVisible() or t.columnCount() > 4 or \
+                t.horizontalHeader().length() > t.viewport().width():
             h += t.horizontalScrollBar().sizeHint().height()
         t.setFixedHeight(max(h, head + 30))
 
