@@ -344,10 +344,10 @@ def test_the_layout_state_and_apply_show_in_a_laptops_dock(laptop, qtbot):
     area = w.docks["layout"].widget()
     area.verticalScrollBar().setValue(0)
     qtbot.wait(100)
-    for shown in (panel.state, panel.apply_button):
-        bottom = shown.mapTo(area.widget(), QPoint(0, shown.height())).y()
-        assert shown.isVisible() and bottom <= area.viewport().height(), \
-            (shown.text(), bottom, area.viewport().height())
+    for part in (panel.state, panel.apply_button):
+        bottom = part.mapTo(area.widget(), QPoint(0, part.height())).y()
+        assert part.isVisible() and bottom <= area.viewport().height(), \
+            (part.text(), bottom, area.viewport().height())
     for width in (480, 300):
         w.resizeDocks([w.docks["layout"]], [width], Qt.Orientation.Horizontal)
         qtbot.wait(200)

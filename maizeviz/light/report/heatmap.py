@@ -88,9 +88,16 @@ def heatmap_figure(tmap: TransmissionMap, result: LightResult | None = None,
     import textwrap
 
     head = f"{what} at {tmap.height_cm:g} cm: {tmap.total:.3f}"
-    chars = 95 if fit is None else max(int(fit[0] * 72 / (0.55 * font_pt)), 20)
-    ax.set_title(head + ("\n" + "\n".join(textwrap.wrap(title, chars))
-                         if title and not small else ""), fontsize=fonts["title"])
+    if fit is None:
+        ax.set_title(head + ("\n" + "\n".join(textwrap.wrap(title, 95)) if title else ""),
+                     fontsize=fonts["title"])
+    else:
+        # over the whole figure (the map and its colour bar sit to one side of it), wrapped
+        # to the figure's width at the font's size
+        chars = max(int(fit[0] * 72 / (0.55 * font_pt)), 20)
+        lines = textwrap.wrap(head, chars) + \
+            (textwrap.wrap(title, chars) if title and not small else [])
+        fig.suptitle("\n".join(lines), fontsize=fonts["title"])
     bar = fig.colorbar(im, ax=ax, shrink=0.8 if fit is None else 1.0,
                        label="transmission" if small else
                        "transmission (fraction of the light reaching this height)",
