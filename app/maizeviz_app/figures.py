@@ -49,8 +49,9 @@ class Figures:
         forgotten; None maps: that light's forgotten).
     map_drawn(kind, index, rgba) : one height's heatmap drawn after it was asked for.
     plot_changed(rgba) : the transmission plot (None: none).
-    restyled(keep) : the maps of every light but ``keep`` are to be drawn again (the scale
-        they share took in a new result).
+    restyled(keep, hold) : the maps of every light but ``keep`` are to be drawn again (the
+        scale they share took in a new result); with ``hold`` the map shown stays in view
+        until it is (the same map for a canvas of another size).
     canvas_changed(which) : where the ``heatmap`` or the ``plot`` is shown changed size: it
         is to be drawn again for its new :class:`Canvas`.
 
@@ -63,7 +64,7 @@ class Figures:
     maps_changed = Signal(str)
     map_drawn = Signal(str, int, object)
     plot_changed = Signal(object)
-    restyled = Signal(object)
+    restyled = Signal(object, bool)
     canvas_changed = Signal(str)
 
     def __init__(self) -> None:
@@ -122,12 +123,13 @@ class Figures:
         self.map_drawn.emit(kind, index, rgba)
         return True
 
-    def restyle(self, keep: str | None = None) -> None:
-        """Forget the maps of every light but ``keep`` (drawn again when shown)."""
+    def restyle(self, keep: str | None = None, hold: bool = False) -> None:
+        """Forget the maps of every light but ``keep`` (drawn again when shown; with
+        ``hold``, the one shown stays in view until then)."""
         for kind, maps in self.maps.items():
             if kind != keep:
                 self.maps[kind] = [(h, None) for h, _ in maps]
-        self.restyled.emit(keep)
+        self.restyled.emit(keep, hold)
 
     def set_plot(self, rgba: np.ndarray | None) -> None:
         self.plot = rgba

@@ -217,7 +217,7 @@ def refit_figures(study: StudyState, which: str) -> None:
     f = study.figures
     if which == "heatmap":
         if f.maps:
-            f.restyle(keep=None)
+            f.restyle(keep=None, hold=True)     # the old size shown until the new drawn
         return
     if f.plot is None or not study.runs.runs:
         return

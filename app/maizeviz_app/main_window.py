@@ -217,7 +217,7 @@ class MainWindow(QMainWindow):
             f.shown_kind, f.shown_index = plots.kind, plots.height_box.currentIndex()
 
         f.maps_changed.connect(maps_changed)
-        f.restyled.connect(lambda keep: plots.redraw(keep=keep))
+        f.restyled.connect(lambda keep, hold: plots.redraw(keep=keep, hold=hold))
         colour = self.model.colour                  # new colours: the maps drawn again
         colour.heatmap.events.connect(lambda _info: self._restyle())
         colour.events.shared.connect(lambda _on: self._restyle())

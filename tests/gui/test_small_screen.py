@@ -355,3 +355,28 @@ def test_the_layout_state_and_apply_show_in_a_laptops_dock(laptop, qtbot):
         assert label.heightForWidth(label.width()) <= label.height() + 1, \
             (width, label.size(), label.heightForWidth(label.width()))
         assert not [c for c in _cut(panel) if "edited" in c]
+
+
+def test_the_docked_heatmap_is_drawn_again_for_its_new_size(laptop, qtbot):
+    """A bigger window: once the resize settles, the heatmap shown is drawn again for its
+    view's new pixels (its texts keep their points), the old one in view meanwhile."""
+    from test_light_modes import compute, small_light
+
+    w = laptop
+    small_light(w.light_panel, "sun")
+    compute(qtbot, w)
+    view = w.plots.heatmap
+    qtbot.waitUntil(lambda: view.heatmap is not None, timeout=TIMEOUT)
+    before, font_px = view.image().size(), view.heatmap.font_px
+    assert abs(before.width() - view.width()) <= 0.05 * view.width()
+    emptied = []
+    w.resize(1920, 1052)
+
+    def redrawn() -> bool:
+        image = view.image()
+        emptied.append(image is None)
+        return image is not None and image.width() > 1.2 * before.width() and \
+            abs(image.width() - view.width()) <= 0.05 * view.width()
+
+    qtbot.waitUntil(redrawn, timeout=TIMEOUT)
+    assert not any(emptied) and view.heatmap.font_px == pytest.approx(font_px)

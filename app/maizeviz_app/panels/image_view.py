@@ -100,9 +100,12 @@ class ImageView(QLabel):
     def _rescale(self) -> None:
         if self._image is None:
             return
-        self.setPixmap(QPixmap.fromImage(self._image).scaled(
-            self.size(), Qt.AspectRatioMode.KeepAspectRatio,
-            Qt.TransformationMode.SmoothTransformation))
+        ratio = self.devicePixelRatioF()            # a figure drawn for device pixels
+        pixmap = QPixmap.fromImage(self._image).scaled(
+            self.size() * ratio, Qt.AspectRatioMode.KeepAspectRatio,
+            Qt.TransformationMode.SmoothTransformation)
+        pixmap.setDevicePixelRatio(ratio)
+        self.setPixmap(pixmap)
 
     def sizeHint(self) -> QSize:  # noqa: N802
         return QSize(360, 200)

@@ -984,13 +984,14 @@ class LightPlots(QWidget):
         if gone:
             self._fill_sources(None)
 
-    def redraw(self, keep: str | None = None) -> None:
-        """The colours changed: every map (but those of the light ``keep``) is drawn again
-        when shown (the one shown now is asked for at once, by ``heatmap_needed``)."""
+    def redraw(self, keep: str | None = None, hold: bool = False) -> None:
+        """The colours (or the view's size) changed: every map (but those of the light
+        ``keep``) is drawn again when shown (the one shown now is asked for at once, by
+        ``heatmap_needed``; with ``hold`` it stays in view until its new drawing comes)."""
         for kind, maps in self._maps.items():
             if kind != keep:
                 self._maps[kind] = [(h, None) for h, _ in maps]
-        self._show_height(self.height_box.currentIndex())
+        self._show_height(self.height_box.currentIndex(), hold)
 
     def set_heatmap(self, index: int, rgba: np.ndarray, kind: str = "sun") -> None:
         """A height's figure, drawn after it was asked for."""
@@ -1000,7 +1001,7 @@ class LightPlots(QWidget):
             if kind == self.kind and index == self.height_box.currentIndex():
                 self.heatmap.set_rgba(rgba)
 
-    def _show_height(self, index: int) -> None:
+    def _show_height(self, index: int, hold: bool = False) -> None:
         kind = self.kind
         maps = self._maps.get(kind, []) if kind is not None else []
         if len(maps) != self.height_box.count():          # another light chosen: its heights
@@ -1008,9 +1009,11 @@ class LightPlots(QWidget):
             return
         if 0 <= index < len(maps):
             rgba = maps[index][1]
-            self.heatmap.set_rgba(rgba)
+            if rgba is not None or not hold:
+                self.heatmap.set_rgba(rgba)
             if rgba is None:
-                self.heatmap.setText("drawing…")
+                if not hold:
+                    self.heatmap.setText("drawing…")
                 self.heatmap_needed.emit(kind, index)
         else:
             self.heatmap.set_rgba(None)
