@@ -218,6 +218,9 @@ class LightEngine:
         result = trace_light(self.canopy, LightRequest(sun, smp, classes),
                              progress, self.with_stalks, scene)
         result.seconds["build"] = build_s
+        if result.first_hits is not None:
+            result = _with_sampled_sunlit(self.canopy, scene, result, self._normals(),
+                                          self.with_stalks)
         return result.with_canopy(self.canopy)
 
     def sky(self, sky: Sky | str = "soc", directions: int = 46, split: str = "auto", *,
@@ -643,6 +646,32 @@ class LightEngine:
                                                                  c.stalk_faces)[1]])
         self._normals_kept = normals
         return normals
+
+
+#: Seed of the points a sun's sunlit areas are sampled from (the same tables every run).
+SUNLIT_SEED = 0
+
+
+def _with_sampled_sunlit(canopy: Canopy, scene: RayScene, result: LightResult,
+                         normals: np.ndarray, with_stalks: bool) -> LightResult:
+    """``result`` with the sunlit area of every scene triangle sampled from the triangle
+    toward the sun (:func:`~maizeviz.light.trace.sunlit.sunlit_share`, as the absorbed
+    light's direct beam): bounded by each triangle's area and unbiased, where the rays'
+    count over a small or grazing triangle is unbiased but unbounded (the hit-class tables
+    clipped it, which biased their sums low)."""
+    from time import perf_counter
+
+    from maizeviz.light.trace.direct import sampler
+    from maizeviz.light.trace.sunlit import geometry, sunlit_share
+
+    t0 = perf_counter()
+    smp = sampler(canopy, scene, result.rect, result.density, result.heights_cm,
+                  result.periodic, with_stalks)
+    share = sunlit_share(smp, canopy, normals, np.asarray(result.direction, np.float64),
+                         SUNLIT_SEED)
+    sunlit = share.fraction * geometry(canopy, len(normals)).area_cm2
+    seconds = dict(result.seconds, sunlit=perf_counter() - t0)
+    return replace(result, triangle_sunlit_cm2=sunlit, seconds=seconds)
 
 
 def _sky_key(sky: Sky, s: Sampling, bin_cm: float) -> tuple:
