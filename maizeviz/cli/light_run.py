@@ -493,6 +493,8 @@ def _trace_sun(job: _Job, lv: _Level) -> None:
     lv.rec.update(sun_record(res, job.sun, lv.canopy, job.args, job.heights))
     lv.rec["seconds"].update(trace=res.seconds["trace"],
                              second_hits=res.seconds.get("second", 0.0))
+    if "sunlit" in res.seconds:                 # the leaf tables' sampled sunlit areas
+        lv.rec["seconds"]["sunlit"] = res.seconds["sunlit"]
     if job.want_rows:
         lv.tables.append(res.leaf_rows(lv.canopy))
 
