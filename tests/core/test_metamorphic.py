@@ -490,8 +490,8 @@ def test_mesh_faces_in_any_order_trace_the_same(tmp_path_factory, block_mesh, se
     # the sunlit area is sampled from points drawn on the triangles in mesh order: the same
     # estimate drawn again, within the sample's error (a leaf of A cm2 sampled with n points
     # has a variance of at most A^2 / 4n; with n >= A, one point per cm2 at 1 ray per cm2, the
-    # two sums' difference has at most 2 sum(A) / 4: 770 cm2 x 4 here, where 120 of 32,500
-    # was the most seen)
+    # two sums' difference a variance of at most 2 sum(A) / 4; 4 of its standard errors are
+    # 770 cm2 here, where 120 of 32,500 was the most seen)
     sunlit = [(float(row["sunlit_area_cm2"]), float(b[2][key]["sunlit_area_cm2"]),
                float(row["leaf_area_cm2"])) for key, row in a[2].items()]
     x, y, area = (np.array(c) for c in zip(*sunlit))
