@@ -20,8 +20,8 @@ from pathlib import Path
 
 from anchors import matmul_anchor
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import plant_bases, tiled_layout
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.io.points import read_points
 from maizeviz.leaf.fit import fit_leaves
 from maizeviz.leaf.grid import build_grids

@@ -27,18 +27,18 @@ import os
 import time
 from pathlib import Path
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import plant_bases, tiled_layout
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.io.points import read_points
 from maizeviz.leaf.fit import fit_leaves
 from maizeviz.leaf.grid import build_grids
+from maizeviz.light.scene.embree_scenes import light_scene
 from maizeviz.light.scene.request import LightRequest, Sampling
-from maizeviz.light.scene.scenes import light_scene
 from maizeviz.light.sources.irradiance import clear_sky_period
 from maizeviz.light.sources.sky import make_sky
 from maizeviz.light.sources.sun import sun_at
-from maizeviz.light.trace.diffuse import trace_period
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
+from maizeviz.light.trace.directions import trace_period
 from maizeviz.mesh.levels import parse_level
 
 ROOT = Path(__file__).resolve().parents[1]

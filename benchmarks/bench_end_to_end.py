@@ -44,11 +44,11 @@ import numpy as np
 from anchors import matmul_anchor, report
 from bench_scene import timed_build
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.engine import LightEngine
-from maizeviz.light.scene.scenes import light_scene
+from maizeviz.light.scene.embree_scenes import light_scene
 from maizeviz.light.sources.sun import sun_at
 from maizeviz.mesh.levels import parse_level
 from maizeviz.resources import example_points

@@ -174,13 +174,12 @@ def _app():
     return QApplication.instance() or QApplication([sys.argv[0]])
 
 
-def startup_child() -> None:
-    """Launched as a new process: print when the window is exposed and when the first canopy
-    is on screen (the parent times from the launch)."""
+def _window():
+    """A child process's QApplication and window: the app on the bundled example at a
+    laptop's size, shown (hold the application while the window lives)."""
     os.environ["XDG_CONFIG_HOME"] = os.environ.get("BENCH_CONFIG", "/tmp/maizeviz-bench-cfg")
-    app = _app()  # noqa: F841  (keeps the QApplication alive)
+    app = _app()
     from maizeviz_app.main_window import MainWindow
-    from PySide6.QtCore import QTimer
 
     from maizeviz.resources import example_points
 
@@ -188,6 +187,29 @@ def startup_child() -> None:
     window.confirm_unsaved = False          # the benchmark closes with results unsaved
     window.resize(1366, 740)
     window.show()
+    return app, window
+
+
+def _spin(seconds: float, until=None) -> bool:
+    """Run the event loop for up to ``seconds``; True once ``until()`` is (or, without it,
+    when the time is up)."""
+    from PySide6.QtCore import QCoreApplication
+
+    end = time.perf_counter() + seconds
+    while time.perf_counter() < end:
+        QCoreApplication.processEvents()
+        if until is not None and until():
+            return True
+        time.sleep(0.002)
+    return until is None
+
+
+def startup_child() -> None:
+    """Launched as a new process: print when the window is exposed and when the first canopy
+    is on screen (the parent times from the launch)."""
+    from PySide6.QtCore import QTimer
+
+    app, window = _window()
     said = {"window": False}
 
     def poll() -> None:
@@ -259,27 +281,10 @@ class GapTimer:
 
 def gui_child(levels: list[str], repeat: int = 1) -> None:
     """In a display: idle renders, renders per canopy, slider latency and gaps per level."""
-    os.environ["XDG_CONFIG_HOME"] = os.environ.get("BENCH_CONFIG", "/tmp/maizeviz-bench-cfg")
-    app = _app()  # noqa: F841  (keeps the QApplication alive)
-    from maizeviz_app.main_window import MainWindow
-    from PySide6.QtCore import QCoreApplication
-
     from maizeviz.mesh.levels import COMPLEXITY_STOPS
-    from maizeviz.resources import example_points
 
-    def spin(seconds: float, until=None) -> bool:
-        end = time.perf_counter() + seconds
-        while time.perf_counter() < end:
-            QCoreApplication.processEvents()
-            if until is not None and until():
-                return True
-            time.sleep(0.002)
-        return until is None
-
-    window = MainWindow(str(example_points()), 3)
-    window.confirm_unsaved = False          # the benchmark closes with results unsaved
-    window.resize(1366, 740)
-    window.show()
+    spin = _spin
+    app, window = _window()
     shown: list[str] = []
     window.canopy_shown.connect(shown.append)
     assert spin(TIMEOUT_S, lambda: bool(shown)), "no first canopy"
@@ -370,7 +375,7 @@ def edit_part(window, spin, gaps, shown: list) -> dict:
     panel.rows_box.setValue(30)
     panel.per_row_box.setValue(30)
     spin(0.5)
-    draft = panel.model
+    draft = panel.draft
 
     def timed(name: str, action) -> None:
         gaps.start()
@@ -568,29 +573,13 @@ def digitizer_child(presses: int) -> None:
     import csv
     import tempfile
 
-    os.environ["XDG_CONFIG_HOME"] = os.environ.get("BENCH_CONFIG", "/tmp/maizeviz-bench-cfg")
-    app = _app()  # noqa: F841  (keeps the QApplication alive)
     import numpy as np
-    from maizeviz_app.main_window import MainWindow
-    from PySide6.QtCore import QCoreApplication
 
     from maizeviz.digitizer.technician import Technician
     from maizeviz.io.points import read_points
-    from maizeviz.resources import example_points
 
-    def spin(seconds: float, until=None) -> bool:
-        end = time.perf_counter() + seconds
-        while time.perf_counter() < end:
-            QCoreApplication.processEvents()
-            if until is not None and until():
-                return True
-            time.sleep(0.002)
-        return until is None
-
-    window = MainWindow(str(example_points()), 3)
-    window.confirm_unsaved = False
-    window.resize(1366, 740)
-    window.show()
+    spin = _spin
+    app, window = _window()
     assert spin(TIMEOUT_S, lambda: window.digitizer is not None), "no digitizer"
     panel = window.digitizer
     panel.confirm_close = False

@@ -27,15 +27,15 @@ from pathlib import Path
 import numpy as np
 from anchors import best
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import plant_bases, tiled_layout
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.io.points import read_points
 from maizeviz.leaf.fit import fit_leaves
 from maizeviz.leaf.grid import build_grids
 from maizeviz.light.scene.rays import ray_grid
 from maizeviz.light.scene.request import LightRequest, Sampling
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
 from maizeviz.mesh.levels import parse_level
 from maizeviz.mesh.raytrace import RayScene
 

@@ -47,13 +47,13 @@ from pathlib import Path
 import numpy as np
 from anchors import best, report
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
+from maizeviz.light.scene.embree_scenes import light_scene
 from maizeviz.light.scene.rays import Tracer, ray_grid
-from maizeviz.light.scene.scenes import light_scene
 from maizeviz.light.sources.sun import sun_at
-from maizeviz.light.trace.direct import sampler, trace_direction
+from maizeviz.light.trace.beam import sampler, trace_direction
 from maizeviz.mesh import packets
 from maizeviz.mesh.levels import parse_level
 from maizeviz.mesh.raytrace import RayScene

@@ -95,10 +95,10 @@ def main(argv=None) -> int:
     ap.add_argument("--interp", type=int, default=4, help="mesh level K (default 4)")
     args = ap.parse_args(argv)
 
+    from maizeviz.canopy.build import build_canopy
     from maizeviz.canopy.export import export_canopy
     from maizeviz.canopy.from_mesh import read_mesh_canopy
     from maizeviz.canopy.layout import layout_for
-    from maizeviz.canopy.scene import build_canopy
     from maizeviz.io.mesh_canopy import read_mesh
     from maizeviz.leaf.fit import read_leaves
     from maizeviz.mesh.levels import Level

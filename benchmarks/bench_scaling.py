@@ -31,13 +31,13 @@ import time
 import numpy as np
 from anchors import best
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
+from maizeviz.light.scene.embree_scenes import light_scene
 from maizeviz.light.scene.request import Sampling
-from maizeviz.light.scene.scenes import light_scene
 from maizeviz.light.sources.sky import Sky, make_sky
-from maizeviz.light.trace.diffuse import trace_sky
+from maizeviz.light.trace.directions import trace_sky
 from maizeviz.mesh.levels import parse_level
 from maizeviz.resources import example_points
 

@@ -36,8 +36,8 @@ import argparse
 import json
 import time
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.engine import LightEngine
 from maizeviz.light.trace.optics import DEFAULT_OPTICS, Optics

@@ -24,8 +24,8 @@ import numpy as np
 from embreex.mesh_construction import TriangleMesh
 from embreex.rtcore_scene import EmbreeScene
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.mesh.embree_fill import fill
 from maizeviz.mesh.levels import parse_level

@@ -40,8 +40,8 @@ def main():
     ap.add_argument("--oracle-leaves", type=int, default=1500)
     args = ap.parse_args()
 
+    from maizeviz.canopy.build import build_canopy
     from maizeviz.canopy.layout import layout_for, parse_shape
-    from maizeviz.canopy.scene import build_canopy
     from maizeviz.io.points import write_points
     from maizeviz.leaf.fit import read_leaves
     from maizeviz.leaf.synth import block_grids

@@ -33,6 +33,15 @@ if TYPE_CHECKING:  # what a user's type checker sees (at run time the names load
     from maizeviz.canopy.export import export_canopy as export_canopy
     from maizeviz.canopy.from_mesh import read_mesh_canopy as read_mesh_canopy
     from maizeviz.errors import MaizevizError as MaizevizError
+    from maizeviz.instruments.analyser import AnalyserPosition as AnalyserPosition
+    from maizeviz.instruments.analyser import AnalyserReadings as AnalyserReadings
+    from maizeviz.instruments.analyser import read_analyser as read_analyser
+    from maizeviz.instruments.ceptometer import CeptometerReadings as CeptometerReadings
+    from maizeviz.instruments.ceptometer import Probe as Probe
+    from maizeviz.instruments.ceptometer import read_ceptometer as read_ceptometer
+    from maizeviz.instruments.hemiphoto import Hemiphoto as Hemiphoto
+    from maizeviz.instruments.hemiphoto import hemiphoto as hemiphoto
+    from maizeviz.instruments.sight import Sight as Sight
     from maizeviz.light.engine import LightEngine as LightEngine
     from maizeviz.light.results.absorbed import AbsorbedLight as AbsorbedLight
     from maizeviz.light.results.absorbed import AbsorbedPeriod as AbsorbedPeriod
@@ -95,6 +104,16 @@ _EXPORTS = {
     "leaf_model": "maizeviz.photosynthesis.split",
     "C4Leaf": "maizeviz.photosynthesis.c4",
     "WofostLeaf": "maizeviz.photosynthesis.wofost",
+    # virtual field instruments (docs/instruments.md)
+    "Sight": "maizeviz.instruments.sight",
+    "Probe": "maizeviz.instruments.ceptometer",
+    "read_ceptometer": "maizeviz.instruments.ceptometer",
+    "CeptometerReadings": "maizeviz.instruments.ceptometer",
+    "AnalyserPosition": "maizeviz.instruments.analyser",
+    "read_analyser": "maizeviz.instruments.analyser",
+    "AnalyserReadings": "maizeviz.instruments.analyser",
+    "hemiphoto": "maizeviz.instruments.hemiphoto",
+    "Hemiphoto": "maizeviz.instruments.hemiphoto",
     "MaizevizError": "maizeviz.errors",
 }
 

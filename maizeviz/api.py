@@ -16,11 +16,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from maizeviz.canopy.build import Canopy
+from maizeviz.canopy.build import build_canopy as _build_canopy
 from maizeviz.canopy.layout import CanopyLayout, layout_for
 from maizeviz.canopy.measures import CanopyMeasures
 from maizeviz.canopy.measures import measure_canopy as _measure_canopy
-from maizeviz.canopy.scene import Canopy
-from maizeviz.canopy.scene import build_canopy as _build_canopy
 from maizeviz.leaf.fit import LeavesFromFile, read_leaves
 from maizeviz.mesh.levels import parse_level
 from maizeviz.progress import ProgressCallback

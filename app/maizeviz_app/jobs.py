@@ -16,9 +16,9 @@ from typing import Any
 
 import numpy as np
 
+from maizeviz.canopy.build import Canopy, build_canopy
 from maizeviz.canopy.layout import CanopyLayout, layout_for
 from maizeviz.canopy.measures import CanopyMeasures, measure_canopy
-from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.errors import PointsFileError
 from maizeviz.leaf.fit import Leaf, read_leaves
 from maizeviz.light.engine import LightEngine

@@ -65,7 +65,7 @@ WARM_STAGES = (
     ("view", ("pyvista", "pyvistaqt", "maizeviz_app.viewport", "maizeviz_app.panels.layout",
               "maizeviz_app.panels.digitizer")),
     ("rest", ("matplotlib.figure", "matplotlib.backends.backend_agg", "maizeviz_app.plots",
-              "maizeviz.light.report.heatmap", "maizeviz.canopy.export", "maizeviz_app.project",
+              "maizeviz.light.report.heatmap", "maizeviz.canopy.export", "maizeviz_app.saved_state",
               "scipy.spatial")))
 #: The jobs the status bar names while they run (and Cancel stops).
 SHOWN_JOBS = ("load", "build", "light", "open", "save", "export")

@@ -252,7 +252,7 @@ class DigitizerSettings:
 
 
 #: Light settings in a project file: key -> (group, field). The keys are those of maizeviz
-#: 0.2 onwards (maizeviz_app.project.LIGHT_SETTINGS checks their types), so old projects open.
+#: 0.2 onwards (maizeviz_app.saved_state.LIGHT_SETTINGS checks their types), so old projects open.
 LIGHT_DOC = {
     "mode": ("light", "mode"),
     "zenith_deg": ("sun", "zenith_deg"), "azimuth_deg": ("sun", "azimuth_deg"),

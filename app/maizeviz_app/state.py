@@ -40,10 +40,10 @@ from maizeviz_app.settings import StudySettings, field_names
 from maizeviz_app.view_state import ViewState
 
 if TYPE_CHECKING:
+    from maizeviz.canopy.build import Canopy
     from maizeviz.canopy.layout import CanopyLayout
-    from maizeviz.canopy.scene import Canopy
     from maizeviz_app.jobs import Built, Loaded
-    from maizeviz_app.project import StoredRun
+    from maizeviz_app.saved_state import StoredRun
 
 #: Settings groups whose edits are undoable (the digitizer's connection is not an edit of the
 #: study; the tiling is set by opening, not edited).
@@ -229,7 +229,7 @@ class StudyState:
     # ------------------------------------------------------------------ reading
     @property
     def canopy(self) -> Canopy | None:
-        """The canopy on screen (:class:`maizeviz.canopy.scene.Canopy`) or None."""
+        """The canopy on screen (:class:`maizeviz.canopy.build.Canopy`) or None."""
         return self.built.canopy if self.built is not None else None
 
     @property

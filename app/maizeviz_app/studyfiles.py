@@ -22,7 +22,7 @@ def open_project(study: StudyState, path: str | Path) -> None:
     """Read a project in a job: its points, layout, settings and light results (which
     join the comparison once the canopy is built). The current canopy stays if the
     project cannot be used."""
-    from maizeviz_app import jobs, project
+    from maizeviz_app import jobs, saved_state
     from maizeviz_app.settings import StudySettings
 
     path = str(path)
@@ -34,17 +34,17 @@ def open_project(study: StudyState, path: str | Path) -> None:
         from maizeviz.project import study as stored
 
         opened = stored.open_project(path, cache)
-        tile, level, preserve = project.canopy_settings(opened)
-        light = project.light_settings(opened)
+        tile, level, preserve = saved_state.canopy_settings(opened)
+        light = saved_state.light_settings(opened)
         StudySettings().apply_light_doc(light)      # each value checked before any change
-        project.view_settings(opened)
+        saved_state.view_settings(opened)
         found = jobs.load_points(opened.points_path, (tile, tile),
                                  shown_name=opened.shown_name)
         layout = stored.restore_layout(opened, found.plants) or found.layout
         stored.check_canopy_fits(found.leaves, layout, parse_level(level), path)
         results, dropped = stored.results_on(opened, layout, found.leaves)
         opened.notes.extend(dropped)
-        runs = [project.stored_run(r, path) for r in results]
+        runs = [saved_state.stored_run(r, path) for r in results]
         loaded = replace(found, layout=layout)
         return opened, loaded, (tile, level, preserve), light, runs
 
@@ -78,7 +78,7 @@ def save_project(study: StudyState, path: str | Path) -> bool:
     if study.loaded is None:
         study.say("error: nothing to save yet: open a points file first", error=True)
         return False
-    from maizeviz_app import project
+    from maizeviz_app import saved_state
 
     loaded, data, origin = study.loaded, study.points_bytes, study.points_origin
     layout = loaded.layout if study.layout_edited else None   # else: the tiling, exactly
@@ -91,14 +91,14 @@ def save_project(study: StudyState, path: str | Path) -> bool:
         len(sun_settings) == 3 else None
     for r in study.runs.in_order():
         runs.append((r.label, r.result,
-                     project.settings_doc(r.kind, study.runs.settings.get(r.kind))))
+                     saved_state.settings_doc(r.kind, study.runs.settings.get(r.kind))))
         if r.balance is not None:              # the sun's absorbed light beside it
-            runs.append((r.label, r.extra.light, project.settings_doc("absorbed",
+            runs.append((r.label, r.extra.light, saved_state.settings_doc("absorbed",
                                                                        optics)))
     path = str(path)
 
     def work(job):
-        from maizeviz.io.project import save_project
+        from maizeviz.io.archive import save_project
         from maizeviz.project.study import make_project
 
         # the runs were all traced on the layout shown (a layout edit clears them)

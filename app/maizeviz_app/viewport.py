@@ -57,7 +57,7 @@ _PLANT_COLOURS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564
 
 
 def canopy_polydata(canopy) -> pv.PolyData:
-    """One mesh of a :class:`~maizeviz.canopy.scene.Canopy`'s leaves and stalks (float32
+    """One mesh of a :class:`~maizeviz.canopy.build.Canopy`'s leaves and stalks (float32
     vertices, cm) with the cell data listed in the module docstring, its ground made too
     (:func:`ground_for`). Safe off the GUI thread."""
     _prepare_ground(canopy.layout)

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.layout import field_period
-from maizeviz.canopy.scene import Canopy
 from maizeviz.io.meshfile import write_mesh
 
 

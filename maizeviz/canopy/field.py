@@ -12,8 +12,8 @@ time, whole plants per chunk (:func:`maizeviz.io.parquet.point_chunks`):
    with workers, the chunks' bounds are read from the plant column alone
    (:func:`~maizeviz.io.parquet.plant_chunk_bounds`) and each chunk surveyed on a process;
 2. the build (:meth:`FieldLeaves.canopy`): each chunk's grids are built again, fitted and
-   meshed at the level (:func:`~maizeviz.canopy.scene.plant_meshes`), the chunk's leaves let
-   go; the plants' meshes are then placed (:func:`~maizeviz.canopy.scene.place_plants`).
+   meshed at the level (:func:`~maizeviz.canopy.build.plant_meshes`), the chunk's leaves let
+   go; the plants' meshes are then placed (:func:`~maizeviz.canopy.build.place_plants`).
 
 Leaves are gridded, fitted and meshed alone or in batches alike (every stage works leaf by
 leaf, whatever the batch), so the canopy is the one the whole file read at once gives, to the
@@ -29,8 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
+from maizeviz.canopy.build import Canopy, PlantMesh, place_plants, plant_meshes
 from maizeviz.canopy.layout import CanopyLayout
-from maizeviz.canopy.scene import Canopy, PlantMesh, place_plants, plant_meshes
 from maizeviz.errors import LeafError
 from maizeviz.io.parquet import (
     NotStreamable,
@@ -224,7 +224,7 @@ class FieldLeaves:
     def canopy(self, layout: CanopyLayout, level: Level, preserve_area: bool = True,
                progress: ProgressCallback | None = None) -> Canopy:
         """The canopy of the plants ``layout`` places, meshed at ``level``: the canopy
-        :func:`~maizeviz.canopy.scene.build_canopy` makes of the same leaves."""
+        :func:`~maizeviz.canopy.build.build_canopy` makes of the same leaves."""
         placed = {p.plant for p in layout.placements}
         meshes = self.plant_meshes(level, preserve_area, placed, progress)
         return place_plants(meshes, layout, level.label)
@@ -333,11 +333,11 @@ def _mesh_rows(path: str, start: int, stop: int, level: Level, preserve_area: bo
 
 def canopy_of(leaves, layout: CanopyLayout, level: Level, preserve_area: bool = True,
               progress: ProgressCallback | None = None) -> Canopy:
-    """:func:`~maizeviz.canopy.scene.build_canopy` of a list of fitted leaves, or
+    """:func:`~maizeviz.canopy.build.build_canopy` of a list of fitted leaves, or
     :meth:`FieldLeaves.canopy` of a field: what the commands build a canopy with."""
     if isinstance(leaves, FieldLeaves):
         return leaves.canopy(layout, level, preserve_area, progress)
-    from maizeviz.canopy.scene import build_canopy
+    from maizeviz.canopy.build import build_canopy
 
     return build_canopy(leaves, layout, level, preserve_area, progress)
 

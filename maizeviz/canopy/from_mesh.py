@@ -37,8 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.layout import MAX_COORD_CM, CanopyLayout, Placement
-from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.ids import groups
 from maizeviz.io.mesh_data import CARRIED, MeshData

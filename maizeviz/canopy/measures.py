@@ -6,7 +6,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.errors import check_range
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.mesh.tessellate import triangle_areas_normals

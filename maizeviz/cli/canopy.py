@@ -6,6 +6,7 @@ import argparse
 import json
 import time
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.export import export_canopy
 from maizeviz.canopy.field import canopy_of
 from maizeviz.canopy.layout import CanopyLayout, save_layout
@@ -16,7 +17,6 @@ from maizeviz.canopy.measures import (
     measure_canopy,
     table2_row,
 )
-from maizeviz.canopy.scene import Canopy
 from maizeviz.cli.common import (
     NUMBER_ARG,
     Progress,

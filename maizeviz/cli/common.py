@@ -9,9 +9,9 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.from_mesh import UNITS, UP_AXES, read_mesh_canopy
 from maizeviz.canopy.layout import CanopyLayout, check_tile, layout_for, parse_shape
-from maizeviz.canopy.scene import Canopy
 from maizeviz.cost import Cost, check, layout_cost
 from maizeviz.errors import LeafError, MaizevizError
 from maizeviz.io.atomic import file_tag
@@ -311,7 +311,7 @@ def mesh_setup(args: argparse.Namespace) -> Canopy:
 
 def is_project(path: str | Path) -> bool:
     """Whether ``path`` names a ``.maizeviz`` project (by its name, as the app's File menu)."""
-    from maizeviz.io.project import SUFFIX  # zipfile and hashlib: when a project is read
+    from maizeviz.io.archive import SUFFIX  # zipfile and hashlib: when a project is read
 
     return Path(path).suffix.lower() == SUFFIX
 

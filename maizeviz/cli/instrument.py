@@ -9,8 +9,8 @@ import math
 import time
 from pathlib import Path
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.field import canopy_of
-from maizeviz.canopy.scene import Canopy
 from maizeviz.cli.common import (
     NUMBER_ARG,
     WHOLE_ARG,
@@ -29,6 +29,7 @@ from maizeviz.cli.common import (
     say,
     suffixed,
 )
+from maizeviz.cli.sun_options import add_sun_options, sun_from_options
 from maizeviz.errors import MaizevizError
 from maizeviz.instruments.sight import default_place
 from maizeviz.mesh.levels import CANOPY_LEVELS
@@ -55,21 +56,6 @@ def _common(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true", help="print JSON instead of tables")
 
 
-def _sun_options(p: argparse.ArgumentParser) -> None:
-    sun = p.add_argument_group("sun (explicit angles, or place + date + time through pvlib)")
-    sun.add_argument("--sun-zenith", type=NUMBER_ARG, metavar="DEG", help="zenith angle, degrees")
-    sun.add_argument("--sun-azimuth", type=NUMBER_ARG, metavar="DEG",
-                     help="azimuth, degrees clockwise from north")
-    sun.add_argument("--date", help="YYYY-MM-DD")
-    sun.add_argument("--time", help="local clock time HH:MM")
-    sun.add_argument("--solar-noon", action="store_true", help="the true solar noon of --date")
-    sun.add_argument("--lat", type=NUMBER_ARG, help="latitude, degrees north")
-    sun.add_argument("--lon", type=NUMBER_ARG, help="longitude, degrees east")
-    sun.add_argument("--tz", default=None, help="time zone, e.g. Asia/Shanghai (default UTC)")
-    sun.add_argument("--altitude", type=NUMBER_ARG, default=0.0, metavar="M",
-                     help="site altitude, m (default 0)")
-
-
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         NAME, help="read a virtual ceptometer, canopy analyser or hemispherical camera",
@@ -80,7 +66,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     cep = kinds.add_parser("ceptometer", help="a line ceptometer (LP-80 style): PAR per "
                            "sensor, tau, intercepted fraction, LAI")
     _common(cep)
-    _sun_options(cep)
+    add_sun_options(cep)
     cep.add_argument("--orientation", default="across", metavar="ALONG|ACROSS|DEG",
                      help="the probe along the rows, across them, or an azimuth in degrees "
                           "clockwise from the rows' direction (default across)")
@@ -159,22 +145,6 @@ def _canopy(args: argparse.Namespace) -> tuple[Canopy, int, list]:
     return canopy, len(leaves), skipped
 
 
-def _sun(args: argparse.Namespace):
-    from maizeviz.light.sources.sun import Sun, sun_at
-
-    explicit = args.sun_zenith is not None or args.sun_azimuth is not None
-    if explicit:
-        if args.sun_zenith is None or args.sun_azimuth is None:
-            raise MaizevizError("give both --sun-zenith and --sun-azimuth")
-        return Sun(args.sun_zenith, args.sun_azimuth)
-    if args.date is None or args.lat is None or args.lon is None or \
-            not (args.time or args.solar_noon):
-        raise MaizevizError("where is the sun? give --sun-zenith and --sun-azimuth, or --date, "
-                            "--time (or --solar-noon), --lat, --lon and --tz")
-    return sun_at(args.date, args.time, args.lat, args.lon, args.tz, args.solar_noon,
-                  args.altitude)
-
-
 def _check_settings(args: argparse.Namespace) -> None:
     """Refuse the instrument's settings before the canopy is built."""
     from maizeviz.instruments.analyser import check_view_cap
@@ -210,7 +180,7 @@ def _check_settings(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace) -> int:
     from maizeviz.instruments.sight import Sight
 
-    sun = _sun(args) if args.instrument == "ceptometer" else None    # before the canopy
+    sun = sun_from_options(args) if args.instrument == "ceptometer" else None    # before the canopy
     _check_settings(args)
     positions = _positions(args)
     canopy, n_leaves, skipped = _canopy(args)

@@ -15,6 +15,7 @@ import os
 
 from maizeviz.cli.common import NUMBER_ARG, WHOLE_ARG, add_canopy_options, add_level_options
 from maizeviz.cli.light_run import PEREZ, run
+from maizeviz.cli.sun_options import add_altitude_option, add_sun_options
 from maizeviz.light.sources.irradiance import DEFAULT_LINKE_TURBIDITY, DEFAULT_PAR_UMOL_PER_J
 from maizeviz.light.sources.sky import SKY_KINDS
 from maizeviz.light.trace.optics import BANDS
@@ -36,17 +37,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                     "timings.")
     add_canopy_options(p)
     add_level_options(p, CANOPY_LEVELS)
-    sun = p.add_argument_group("sun (explicit angles, or place + date + time through pvlib)")
-    sun.add_argument("--sun-zenith", type=NUMBER_ARG, metavar="DEG", help="zenith angle, degrees")
-    sun.add_argument("--sun-azimuth", type=NUMBER_ARG, metavar="DEG",
-                     help="azimuth, degrees clockwise from north (field y = north by default)")
-    sun.add_argument("--date", help="YYYY-MM-DD")
-    sun.add_argument("--time", help="local clock time HH:MM (or HH:MM+08:00 with its offset)")
-    sun.add_argument("--solar-noon", action="store_true", help="the true solar noon of --date")
-    sun.add_argument("--lat", type=NUMBER_ARG, help="latitude, degrees north")
-    sun.add_argument("--lon", type=NUMBER_ARG, help="longitude, degrees east")
-    sun.add_argument("--tz", default=None,
-                     help="time zone, e.g. Asia/Shanghai (default UTC, or the offset of --time)")
+    add_sun_options(p, altitude=False)
     sky = p.add_argument_group("diffuse sky")
     sky.add_argument("--sky", choices=[*sorted(SKY_KINDS), PEREZ],
                      help="soc: standard overcast (radiance (1 + 2 cos zenith)/3), uoc: uniform "
@@ -71,8 +62,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                           "period (and, EPW/TMY3/PSM, the time zone and the place)")
     per.add_argument("--linke-turbidity", type=NUMBER_ARG, default=None, metavar="T",
                      help=f"Linke turbidity of the clear sky (default {DEFAULT_LINKE_TURBIDITY:g})")
-    per.add_argument("--altitude", type=NUMBER_ARG, default=0.0, metavar="M",
-                     help="site altitude, m (clear sky and sun positions; default 0)")
+    add_altitude_option(per)
     per.add_argument("--par-factor", type=NUMBER_ARG, default=None, metavar="UMOL_PER_J",
                      help=f"umol of PAR per J of shortwave (default 0.48 x 4.57 = "
                           f"{DEFAULT_PAR_UMOL_PER_J:.4g})")

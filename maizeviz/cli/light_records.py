@@ -10,7 +10,7 @@ from typing import Any
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.cli.common import fmt_table, say
 from maizeviz.cli.stalk_light import stalk_line
 from maizeviz.light.report.beer_lambert import BeerLambert, beer_lambert, beer_lambert_sky, clumping

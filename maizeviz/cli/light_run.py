@@ -16,10 +16,10 @@ from typing import Any
 
 import numpy as np
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.export import export_canopy
 from maizeviz.canopy.field import canopy_of
 from maizeviz.canopy.from_mesh import MESH_LEVEL
-from maizeviz.canopy.scene import Canopy
 from maizeviz.cli.common import (
     Progress,
     canopy_setup,
@@ -51,6 +51,7 @@ from maizeviz.cli.light_records import (
     warn_unresolved,
 )
 from maizeviz.cli.stalk_light import stalk_record, with_stalk_columns
+from maizeviz.cli.sun_options import WHERE_IS_THE_SUN, sun_from_options, sun_place_given
 from maizeviz.cost import check, light_costs, mesh_cost
 from maizeviz.errors import LeafError, MaizevizError, check_range
 from maizeviz.io.atomic import file_tag, make_folder, write_rows
@@ -77,7 +78,7 @@ from maizeviz.light.sources.irradiance import (
 )
 from maizeviz.light.sources.perez import PEREZ_MODELS
 from maizeviz.light.sources.sky import Sky, make_sky
-from maizeviz.light.sources.sun import Sun, sun_at
+from maizeviz.light.sources.sun import Sun
 from maizeviz.light.trace.optics import optics_for, read_optics_table
 from maizeviz.light.trace.precision import check_precision
 from maizeviz.light.trace.scatter import DEFAULT_DEPTH
@@ -171,30 +172,15 @@ def _check_options(args: argparse.Namespace) -> None:
 def sun_from(args: argparse.Namespace) -> Sun | None:
     """The single sun of the command line: explicit angles, or a place and time through pvlib;
     None when only a sky or a period is asked for."""
-    explicit = args.sun_zenith is not None or args.sun_azimuth is not None
-    place = any(v is not None for v in (args.date, args.time, args.lat, args.lon)) or args.solar_noon
     if _period_asked(args):
         return None
-    if explicit and place:
-        raise MaizevizError("give either --sun-zenith/--sun-azimuth or a place and time, not both")
-    if explicit:
-        if args.sun_zenith is None or args.sun_azimuth is None:
-            raise MaizevizError("give both --sun-zenith and --sun-azimuth")
-        return Sun(args.sun_zenith, args.sun_azimuth)
-    if not place:
+    explicit = args.sun_zenith is not None or args.sun_azimuth is not None
+    if not explicit and not sun_place_given(args):
         if args.sky is not None:
             return None
-        raise MaizevizError("where is the sun? give --sun-zenith and --sun-azimuth, or --date, "
-                            "--time (or --solar-noon), --lat, --lon and --tz; or --sky soc for "
-                            "an overcast sky, or --day for a whole day")
-    if args.date is None or args.lat is None or args.lon is None:
-        raise MaizevizError("a sun from a place needs --date, --lat and --lon (and --time or "
-                            "--solar-noon, --tz)")
-    if not args.time and not args.solar_noon:
-        raise MaizevizError("give --time HH:MM or --solar-noon for one sun, or --day (or "
-                            "--from/--to) for a period")
-    return sun_at(args.date, args.time, args.lat, args.lon, args.tz, args.solar_noon,
-                  args.altitude)
+        raise MaizevizError(WHERE_IS_THE_SUN + "; or --sky soc for an overcast sky, or --day "
+                            "for a whole day")
+    return sun_from_options(args)
 
 
 def period_from(args: argparse.Namespace) -> Period | None:

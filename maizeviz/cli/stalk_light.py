@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.light.results.stalks import stalk_part, stalk_rows
 from maizeviz.mesh.tessellate import triangle_areas_normals
 

@@ -449,8 +449,8 @@ class CaribuScene:
 
     def _trace(self, tri: np.ndarray, groups: list, direct: bool, infinite: bool,
                screen_size: int, split_face: bool) -> dict[str, dict[str, np.ndarray]]:
-        from maizeviz.light.scene.scenes import light_scene
-        from maizeviz.light.trace.direct import Sampler
+        from maizeviz.light.scene.embree_scenes import light_scene
+        from maizeviz.light.trace.beam import Sampler
         from maizeviz.light.trace.optics import Optics
         from maizeviz.light.trace.scatter import scatter_beam
 
@@ -587,8 +587,8 @@ def _union(rect, verts: np.ndarray) -> tuple[float, float, float, float]:
 
 def _canopy(verts: np.ndarray, faces: np.ndarray, plot):
     """A one-plant canopy of the scene's triangles (cm), for the light's scene builder."""
+    from maizeviz.canopy.build import Canopy
     from maizeviz.canopy.layout import CanopyLayout, Placement
-    from maizeviz.canopy.scene import Canopy
 
     if plot is None:
         lo, hi = verts[:, :2].min(axis=0), verts[:, :2].max(axis=0)

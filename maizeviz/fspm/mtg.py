@@ -90,8 +90,8 @@ def mtg_text(leaves, level=None) -> str:
     str
         The file's text.
     """
+    from maizeviz.canopy.build import plant_tops
     from maizeviz.canopy.layout import plant_bases
-    from maizeviz.canopy.scene import plant_tops
 
     if not leaves:
         raise MaizevizError("no leaf to write as an MTG")

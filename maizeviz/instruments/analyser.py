@@ -122,10 +122,13 @@ class AnalyserPosition:
 
     Parameters
     ----------
-    x, y : float, cm, field coordinates
-    height_cm : float, cm above the ground
-    heading_deg : float, deg, the azimuth the view cap is centred on, clockwise from the
-        field's +y axis (the rows' direction)
+    x, y : float
+        The optic's place in field coordinates (x across the rows, y along them) [cm].
+    height_cm : float
+        The optic's height above the ground [cm].
+    heading_deg : float
+        The azimuth the view cap is centred on, clockwise from the field's +y axis (the
+        rows' direction) [deg].
     """
 
     x: float
@@ -176,16 +179,23 @@ def ring_directions(ring: int, n: int, heading_deg: float, cap_deg: float,
 class AnalyserReadings:
     """What the analyser read: the reading above and those below, ring by ring.
 
-    Attributes
+    Parameters
     ----------
     positions : tuple of AnalyserPosition
-    above : (5,) float64, each ring's reading above the canopy (sky radiance relative to the
-        zenith's, times sr, over the ring's sector)
-    below : (P, 5) float64, the same at each position
+        Where the readings below were taken.
+    above : numpy.ndarray
+        (5,) float64 each ring's reading above the canopy: sky radiance relative to the
+        zenith's, times the solid angle of the ring's sector.
+    below : numpy.ndarray
+        (P, 5) float64 the same at each position below.
     view_cap_deg : float
-    sky : str, "uoc" or "soc"
-    rays_per_ring : int, lines of sight per ring and position
+        Azimuth seen, centred on each position's heading [deg].
+    sky : str
+        Sky radiance weighting the lines of sight: "uoc" or "soc".
+    rays_per_ring : int
+        Lines of sight per ring and position.
     notes : list of str
+        What the user should know about these readings.
     """
 
     positions: tuple[AnalyserPosition, ...]
@@ -219,15 +229,24 @@ class AnalyserReadings:
 
     @property
     def mta_deg(self) -> float:
-        """Mean tilt angle [deg] of the ellipsoidal distribution fitting the contact numbers
-        (NaN when a ring sees no gap)."""
+        """Mean tilt angle of the ellipsoidal distribution fitting the contact numbers [deg].
+
+        NaN when a ring sees no gap.
+        """
         k = self.contact
         if not np.all(np.isfinite(k)) or np.all(k == 0):
             return math.nan
         return mean_tilt_deg(fit_ellipsoidal(k)[0])
 
     def rings(self) -> list[dict]:
-        """One record a ring: its edges, centre, weight, above, mean below, T, K."""
+        """The readings ring by ring.
+
+        Returns
+        -------
+        list of dict
+            One record a ring: its edges and centre [deg], weight, reading above, mean
+            reading below, transmission T and contact number K.
+        """
         t, k = self.transmission, self.contact
         return [{"ring": i + 1, "from_deg": RING_EDGES_DEG[i][0], "to_deg": RING_EDGES_DEG[i][1],
                  "centre_deg": RING_CENTRES_DEG[i], "weight": RING_WEIGHTS[i],
@@ -237,8 +256,14 @@ class AnalyserReadings:
                 for i in range(5)]
 
     def as_dict(self) -> dict:
-        """A JSON-ready record: settings, rings, LAI and MTA, and each position's gap
-        fractions."""
+        """A JSON-ready record of the readings.
+
+        Returns
+        -------
+        dict
+            The settings, the rings, LAI and mean tilt angle, and each position's gap
+            fractions.
+        """
         lai, mta = self.lai, self.mta_deg
         return {"instrument": "analyser", "view_cap_deg": self.view_cap_deg, "sky": self.sky,
                 "rays_per_ring": self.rays_per_ring,
@@ -252,7 +277,13 @@ class AnalyserReadings:
                 "notes": list(self.notes)}
 
     def table(self):
-        """One row a ring (a pandas DataFrame): :meth:`rings`."""
+        """The readings as a table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row a ring, as :meth:`rings`.
+        """
         import pandas as pd
 
         return pd.DataFrame(self.rings())
@@ -269,8 +300,9 @@ def read_analyser(sight: Sight, positions: Sequence[AnalyserPosition], *,
         The canopy's lines of sight (:meth:`Sight.of`).
     positions : sequence of AnalyserPosition
         Where the readings below are taken (their mean makes T_i, as the instrument's).
-    view_cap_deg : float, deg
-        Azimuth seen: 45, 90, 180, 270 or 360 (no cap), centred on each position's heading.
+    view_cap_deg : float
+        Azimuth seen: 45, 90, 180, 270 or 360 (no cap), centred on each position's heading
+        [deg].
     sky : {"uoc", "soc"}
         Sky radiance weighting the lines of sight (uniform: T_i is the ring's gap fraction).
     rays_per_ring : int
@@ -282,6 +314,8 @@ def read_analyser(sight: Sight, positions: Sequence[AnalyserPosition], *,
     Returns
     -------
     AnalyserReadings
+        Each ring's reading above and below, its transmission and contact number, the LAI
+        by Miller's integral and the mean tilt angle.
     """
     positions = tuple(positions)
     if not positions:

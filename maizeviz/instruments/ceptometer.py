@@ -78,17 +78,17 @@ class Probe:
 
     Parameters
     ----------
-    x, y : float, cm
-        The probe's middle, in field coordinates (x across the rows, y along them).
-    height_cm : float, cm
-        Height of the sensors above the ground.
-    azimuth_deg : float, deg
+    x, y : float
+        The probe's middle, in field coordinates (x across the rows, y along them) [cm].
+    height_cm : float
+        Height of the sensors above the ground [cm].
+    azimuth_deg : float
         The bar's direction, clockwise from the rows' direction (+y): 0 along the rows, 90
-        across them (:func:`probe_azimuth` reads "along" and "across").
-    length_cm : float, cm
-        Length of the sensor bar (80 for the LP-80).
-    spacing_cm : float, cm
-        Distance between neighbouring sensors (1 for the LP-80).
+        across them (:func:`probe_azimuth` reads "along" and "across") [deg].
+    length_cm : float
+        Length of the sensor bar (80 for the LP-80) [cm].
+    spacing_cm : float
+        Distance between neighbouring sensors (1 for the LP-80) [cm].
     """
 
     x: float
@@ -128,7 +128,13 @@ class Probe:
         return np.array([math.sin(a), math.cos(a)])
 
     def sensors(self) -> np.ndarray:
-        """Sensor centres (n, 3) cm: evenly spaced, centred on (x, y), at ``height_cm``."""
+        """The sensors' centres: evenly spaced along the bar, centred on (x, y).
+
+        Returns
+        -------
+        numpy.ndarray
+            (n, 3) float sensor centres at ``height_cm`` [cm].
+        """
         n = self.n_sensors
         s = (np.arange(n) - (n - 1) / 2.0) * self.spacing_cm
         out = np.empty((n, 3))
@@ -196,20 +202,32 @@ def lp80_lai(tau: float, zenith_deg: float, beam_fraction: float, x: float = 1.0
 class CeptometerReadings:
     """What a ceptometer read at a set of probe positions under one sun and sky.
 
-    Attributes
+    Parameters
     ----------
     probes : tuple of Probe
-    sensors_cm : (P, n, 3) float64, cm, every probe's sensor centres
-    par_umol : (P, n) float64, umol m-2 s-1, PAR read by each sensor
-    sunlit : (P, n) bool, the sensor sees the sun
-    sky_seen : (P, n) float64 in [0, 1], share of the sky's diffuse PAR the sensor sees
-    above_umol : float, umol m-2 s-1, PAR above the canopy (beam + diffuse, horizontal)
-    beam_fraction : float, the beam's share of ``above_umol``
+        The probe positions read.
+    sensors_cm : numpy.ndarray
+        (P, n, 3) float64 every probe's sensor centres [cm].
+    par_umol : numpy.ndarray
+        (P, n) float64 PAR read by each sensor [umol m-2 s-1].
+    sunlit : numpy.ndarray
+        (P, n) bool, the sensor sees the sun.
+    sky_seen : numpy.ndarray
+        (P, n) float64 in [0, 1], the share of the sky's diffuse PAR the sensor sees.
+    above_umol : float
+        PAR above the canopy, beam and diffuse on a horizontal surface [umol m-2 s-1].
+    beam_fraction : float
+        The beam's share of ``above_umol``.
     sun : Sun
-    x : float, ellipsoidal leaf angle distribution parameter of the inversion
-    absorptivity : float, leaf PAR absorptivity of the inversion
-    sky : str, the sky's description
+        The sun read under.
+    x : float
+        Ellipsoidal leaf angle distribution parameter of the LAI inversion.
+    absorptivity : float
+        Leaf PAR absorptivity of the LAI inversion.
+    sky : str
+        The sky's description.
     notes : list of str
+        What the user should know about these readings.
     """
 
     probes: tuple[Probe, ...]
@@ -247,7 +265,14 @@ class CeptometerReadings:
                         self.beam_fraction, self.x, self.absorptivity)
 
     def as_dict(self) -> dict:
-        """A JSON-ready record: the settings, the summary and every sensor's reading."""
+        """A JSON-ready record of the readings.
+
+        Returns
+        -------
+        dict
+            The settings, the summary (tau, intercepted fraction, LAI) and every sensor's
+            reading, probe by probe.
+        """
         lai = self.lai
         return {
             "instrument": "ceptometer",
@@ -269,8 +294,14 @@ class CeptometerReadings:
         }
 
     def table(self):
-        """One row per sensor: probe, sensor, x, y, z [cm], PAR [umol m-2 s-1], sunlit, sky
-        seen (a pandas DataFrame)."""
+        """The readings as a table.
+
+        Returns
+        -------
+        pandas.DataFrame
+            One row per sensor: probe, sensor, x, y, z [cm], PAR [umol m-2 s-1], sunlit and
+            the share of the sky seen.
+        """
         import pandas as pd
 
         p, n = self.par_umol.shape
@@ -298,16 +329,16 @@ def read_ceptometer(sight: Sight, probes: Sequence[Probe], sun: Sun, *,
         averages its below-canopy readings.
     sun : Sun
         The sun's angles.
-    par_umol : float, umol m-2 s-1
-        PAR on a horizontal surface above the canopy (the reading above).
+    par_umol : float
+        PAR on a horizontal surface above the canopy (the reading above) [umol m-2 s-1].
     beam_fraction : float
         The beam's share of ``par_umol`` (the rest comes from the sky), in [0, 1].
     sky : {"soc", "uoc"}
         Radiance distribution of the diffuse part (:func:`~maizeviz.light.sources.sky.make_sky`).
     directions : int
         Sky directions traced (46: den Dulk's turtle).
-    north_deg : float, deg
-        Angle from north to the field's +y axis, clockwise (the layout's).
+    north_deg : float
+        Angle from north to the field's +y axis, clockwise (the layout's) [deg].
     x : float
         Ellipsoidal leaf angle distribution parameter of the LAI inversion (1: spherical).
     absorptivity : float
@@ -316,6 +347,7 @@ def read_ceptometer(sight: Sight, probes: Sequence[Probe], sun: Sun, *,
     Returns
     -------
     CeptometerReadings
+        PAR per sensor, tau, the intercepted fraction and the instrument's LAI.
     """
     probes = tuple(probes)
     if not probes:

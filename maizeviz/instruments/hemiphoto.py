@@ -47,15 +47,22 @@ MIN_SIZE, MAX_SIZE = 16, 8192
 class Hemiphoto:
     """One hemispherical photograph.
 
-    Attributes
+    Parameters
     ----------
-    x, y, height_cm : float, cm, where the lens is
-    image : (S, S, 3) uint8, the photograph (RGB)
-    zenith_deg : (S, S) float64, deg, each pixel's zenith angle (> 90 outside the image circle)
-    sky : (S, S) bool, pixels that see the sky
-    stalk : (S, S) bool, pixels that see a stalk
-    ring_edges_deg : tuple of (lo, hi) deg, the zenith rings of :attr:`gap_fraction`
+    x, y, height_cm : float
+        Where the lens is, in field coordinates [cm].
+    image : numpy.ndarray
+        (S, S, 3) uint8, the photograph (RGB).
+    zenith_deg : numpy.ndarray
+        (S, S) float64 each pixel's zenith angle, above 90 outside the image circle [deg].
+    sky : numpy.ndarray
+        (S, S) bool, the pixels that see the sky.
+    stalk : numpy.ndarray
+        (S, S) bool, the pixels that see a stalk.
+    ring_edges_deg : tuple of (float, float)
+        The zenith rings (lo, hi) of :attr:`gap_fraction` [deg].
     notes : list of str
+        What the user should know about this photograph.
     """
 
     x: float
@@ -69,7 +76,13 @@ class Hemiphoto:
     notes: list[str] = field(default_factory=list)
 
     def ring_pixels(self) -> np.ndarray:
-        """(R,) pixels whose centre lies in each ring."""
+        """How many pixels each zenith ring holds.
+
+        Returns
+        -------
+        numpy.ndarray
+            (R,) int, the pixels whose centre lies in each ring.
+        """
         return np.array([np.count_nonzero((self.zenith_deg >= lo) & (self.zenith_deg < hi))
                          for lo, hi in self.ring_edges_deg])
 
@@ -90,7 +103,18 @@ class Hemiphoto:
         return float(np.count_nonzero(self.sky & inside) / np.count_nonzero(inside))
 
     def save_png(self, path: str | Path) -> Path:
-        """Write the photograph as a PNG; returns its path."""
+        """Write the photograph as a PNG (atomically: a whole file or none).
+
+        Parameters
+        ----------
+        path : str or Path
+            The file to write.
+
+        Returns
+        -------
+        pathlib.Path
+            The path written.
+        """
         import matplotlib.image as mpimg
 
         from maizeviz.io.atomic import atomic_path
@@ -101,7 +125,14 @@ class Hemiphoto:
         return path
 
     def as_dict(self) -> dict:
-        """A JSON-ready record (the image itself is not in it)."""
+        """A JSON-ready record of the photograph.
+
+        Returns
+        -------
+        dict
+            The lens's place, the image's size, its openness and each ring's gap fraction
+            (the image itself is not in it).
+        """
         return {"instrument": "hemiphoto", "x_cm": self.x, "y_cm": self.y,
                 "height_cm": self.height_cm, "size_px": int(self.image.shape[0]),
                 "openness": self.openness,
@@ -150,20 +181,22 @@ def hemiphoto(sight: Sight, x: float, y: float, height_cm: float = 0.0, *, size:
     ----------
     sight : Sight
         The canopy's lines of sight (:meth:`Sight.of`).
-    x, y, height_cm : float, cm
-        The lens's position.
+    x, y, height_cm : float
+        The lens's position in field coordinates [cm].
     size : int
         Pixels a side (16 to 8192).
     colour : bool
         Leaves green and stalks brown; False: every plant pixel black.
-    north_deg : float, deg
-        Angle from north to the field's +y axis, clockwise (the layout's).
-    rings : sequence of (lo, hi) deg
-        Zenith rings of the gap fractions (default the canopy analyser's five).
+    north_deg : float
+        Angle from north to the field's +y axis, clockwise (the layout's) [deg].
+    rings : sequence of (float, float)
+        Zenith rings (lo, hi) of the gap fractions (default the canopy analyser's five)
+        [deg].
 
     Returns
     -------
     Hemiphoto
+        The photograph, which pixels see the sky or a stalk, and each ring's gap fraction.
     """
     for name, v in (("x", x), ("y", y), ("height_cm", height_cm)):
         if not math.isfinite(float(v)):

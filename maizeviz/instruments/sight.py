@@ -2,7 +2,7 @@
 
 The instruments look from points inside or under the canopy toward the sky: a line of sight is
 open (a gap) when no leaf (or stalk) lies on it before it leaves the canopy's top. They trace
-on the light engine's own scenes (:func:`maizeviz.light.scene.scenes.light_scene`, or a
+on the light engine's own scenes (:func:`maizeviz.light.scene.embree_scenes.light_scene`, or a
 :class:`~maizeviz.light.engine.LightEngine`'s kept ones), open or periodic: in a periodic field
 a line of sight that leaves the plot sideways goes on through the next copy of it
 (:func:`maizeviz.light.scene.periodic.trace_wrapped`), as the engine's sunlight does.
@@ -14,10 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.errors import MaizevizError
+from maizeviz.light.scene.embree_scenes import light_scene
 from maizeviz.light.scene.request import canopy_top
-from maizeviz.light.scene.scenes import light_scene
 from maizeviz.mesh.raytrace import RayScene
 
 #: Lines of sight traced per call into Embree (bounds memory: about 100 bytes each).
@@ -53,8 +53,27 @@ class Sight:
     @classmethod
     def of(cls, canopy: Canopy, periodic: bool = False, with_stalks: bool = True,
            scene: RayScene | None = None) -> Sight:
-        """The sight of ``canopy``: its scene built here, or ``scene`` (a light engine's,
-        built with the same ``periodic`` and ``with_stalks``)."""
+        """The sight of a canopy, its scene built here or given.
+
+        Parameters
+        ----------
+        canopy : Canopy
+            The canopy the instrument stands in.
+        periodic : bool
+            Lines of sight leaving the plot sideways go on through the next copy of it (an
+            infinite field).
+        with_stalks : bool
+            Stalks block lines of sight too (when the canopy has them).
+        scene : RayScene, optional
+            A light engine's scene of the same canopy, built with the same ``periodic`` and
+            ``with_stalks`` (:meth:`maizeviz.light.engine.LightEngine.scene`); built here when
+            None.
+
+        Returns
+        -------
+        Sight
+            What lies on lines of sight toward the sky in ``canopy``.
+        """
         stalks = with_stalks and len(canopy.stalk_faces) > 0
         if scene is None:
             scene = light_scene(canopy, stalks, periodic)
@@ -67,8 +86,21 @@ class Sight:
                    bool(periodic), canopy.n_triangles)
 
     def reach(self, origins: np.ndarray, toward: np.ndarray) -> np.ndarray:
-        """Length (N,) cm of each line of sight from ``origins`` (N, 3) cm along unit vectors
-        ``toward`` (N, 3) (z > 0) up to the height :attr:`top`; 0 for origins above it."""
+        """How far each line of sight goes before it is above everything that stands.
+
+        Parameters
+        ----------
+        origins : numpy.ndarray
+            (N, 3) float sensor positions [cm].
+        toward : numpy.ndarray
+            (N, 3) float unit vectors toward the sky (z > 0).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) float length of each line of sight up to the height :attr:`top` [cm]; 0 for
+            origins above it.
+        """
         return np.maximum(self.top - origins[:, 2], 0.0) / toward[:, 2]
 
     def _check(self, origins: np.ndarray, toward: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -86,12 +118,19 @@ class Sight:
         return o, np.ascontiguousarray(d)
 
     def open(self, origins: np.ndarray, toward: np.ndarray) -> np.ndarray:
-        """Whether each line of sight reaches the sky: (N,) bool.
+        """Whether each line of sight reaches the sky.
 
         Parameters
         ----------
-        origins : (N, 3) float, cm
-        toward : (N, 3) or (3,) float, unit vectors toward the sky (z > 0)
+        origins : numpy.ndarray
+            (N, 3) float sensor positions [cm].
+        toward : numpy.ndarray
+            (N, 3) or (3,) float unit vectors toward the sky (z > 0).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) bool, True where nothing lies on the line of sight.
         """
         o, d = self._check(origins, toward)
         out = np.empty(len(o), dtype=bool)
@@ -109,8 +148,21 @@ class Sight:
         return trace_wrapped(self.scene, wrap, o, d, length, any_hit=True)
 
     def first(self, origins: np.ndarray, toward: np.ndarray) -> np.ndarray:
-        """The canopy triangle first met on each line of sight: (N,) int64, -1 where the sky
-        is seen (ids from :attr:`n_leaf_triangles` on are stalks)."""
+        """The canopy triangle first met on each line of sight.
+
+        Parameters
+        ----------
+        origins : numpy.ndarray
+            (N, 3) float sensor positions [cm].
+        toward : numpy.ndarray
+            (N, 3) or (3,) float unit vectors toward the sky (z > 0).
+
+        Returns
+        -------
+        numpy.ndarray
+            (N,) int64 canopy triangle ids, -1 where the sky is seen (ids from
+            :attr:`n_leaf_triangles` on are stalks).
+        """
         from maizeviz.light.scene.periodic import Wrap, trace_wrapped
 
         o, d = self._check(origins, toward)

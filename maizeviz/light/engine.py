@@ -1,7 +1,7 @@
 """One light engine over a canopy: its Embree scenes built once, every sun, sky and day traced
 on them.
 
-A scene (:func:`~maizeviz.light.scene.scenes.light_scene`) costs about as much as tracing one
+A scene (:func:`~maizeviz.light.scene.embree_scenes.light_scene`) costs about as much as tracing one
 sun, and is the same for every direction traced through the canopy; an engine builds it when a
 request first needs it (one for an open field, one with the overhanging leaves copied for a
 periodic field) and keeps it. The command line, the sweep's workers and the app's core process
@@ -28,12 +28,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.light.results.absorbed import AbsorbedLight, AbsorbedPeriod
 from maizeviz.light.results.diffuse import PeriodLight, SkyLight
 from maizeviz.light.results.direct import LightResult
+from maizeviz.light.scene.embree_scenes import light_scene
 from maizeviz.light.scene.request import LightRequest, Sampling
-from maizeviz.light.scene.scenes import light_scene
 from maizeviz.light.sources.irradiance import (
     DEFAULT_LINKE_TURBIDITY,
     DEFAULT_PAR_UMOL_PER_J,
@@ -42,14 +42,14 @@ from maizeviz.light.sources.irradiance import (
 from maizeviz.light.sources.perez import PEREZ_MODELS, perez_split
 from maizeviz.light.sources.sky import Sky, make_sky
 from maizeviz.light.sources.sun import Sun, sun_at
-from maizeviz.light.trace.absorbed import (
+from maizeviz.light.trace.absorption import (
     SKY_PASSES,
     absorbed_light,
     absorbed_period,
     check_absorbed,
 )
-from maizeviz.light.trace.diffuse import trace_period, trace_sky
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
+from maizeviz.light.trace.directions import trace_period, trace_sky
 from maizeviz.light.trace.optics import SHORTWAVE_SHARE, Optics, optics_for
 from maizeviz.light.trace.scatter import DEFAULT_DEPTH, DEFAULT_THRESHOLD
 from maizeviz.mesh.raytrace import RayScene
@@ -391,7 +391,7 @@ class LightEngine:
         """Light absorbed by leaves and ground in one band, with scattering.
 
         The sun's direct beam and, when ``diffuse_w_m2`` > 0, the diffuse light of a sky, each
-        followed through the canopy (:func:`maizeviz.light.trace.absorbed.absorbed_light`).
+        followed through the canopy (:func:`maizeviz.light.trace.absorption.absorbed_light`).
 
         Parameters
         ----------
@@ -457,7 +457,7 @@ class LightEngine:
         https://doi.org/10.1016/j.ecolmodel.2017.11.022
         """
         from maizeviz.light.scene.request import check_sampling
-        from maizeviz.light.trace.direct import sampler
+        from maizeviz.light.trace.beam import sampler
 
         opt = optics if optics is not None else optics_for(band)
         if sun is None:
@@ -543,7 +543,7 @@ class LightEngine:
         Each step's sun with the band's share of its direct irradiance, and the diffuse part
         spread over ``sky``, traced once per W m-2 and scaled by each step's diffuse irradiance
         (the transport is linear in the light put in;
-        :func:`maizeviz.light.trace.absorbed.absorbed_period`).
+        :func:`maizeviz.light.trace.absorption.absorbed_period`).
 
         Parameters
         ----------

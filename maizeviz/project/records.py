@@ -1,4 +1,4 @@
-"""Light results to and from project records (:mod:`maizeviz.io.project`).
+"""Light results to and from project records (:mod:`maizeviz.io.archive`).
 
 A sun result (:class:`~maizeviz.light.results.direct.LightResult`) is stored as a ``light``
 record (the only kind of maizeviz 0.2's projects), a sky result (:class:`~maizeviz.light.results.diffuse.SkyLight`) is stored as a ``light_sky`` record,
@@ -7,7 +7,7 @@ Period` and the sky light of its diffuse part) as a ``light_day`` record: JSON m
 (numbers, text, times as ISO 8601 with their UTC offset, the time zone's name) and numeric
 arrays; no pickle. Reading checks every size, type and value before the objects are made
 through their constructors (so :class:`~maizeviz.light.sources.sky.Sky` and ``Period`` validate
-themselves too); anything wrong is a :class:`~maizeviz.io.project.ProjectError` naming it.
+themselves too); anything wrong is a :class:`~maizeviz.io.archive.ProjectError` naming it.
 
 Each record may also hold the settings of that light as JSON (``settings``: the sky chosen, the
 day's date and place), so a reopened comparison goes on as if the runs had just been made, and
@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from maizeviz.errors import MaizevizError
-from maizeviz.io.project import ProjectError, Record, get, get_numbers
+from maizeviz.io.archive import ProjectError, Record, get, get_numbers
 from maizeviz.light.scene.request import MAX_RAYS
 from maizeviz.light.sources.clock import zone as iana_zone
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 from typing import Any
 
 from maizeviz.errors import MaizevizError
-from maizeviz.io.project import ProjectError, get
+from maizeviz.io.archive import ProjectError, get
 from maizeviz.light.specs import DaySpec, OpticsSpec, SkySpec
 from maizeviz.photosynthesis.c4 import LEGACY_TEMPERATURE_RESPONSE
 

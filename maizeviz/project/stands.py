@@ -34,7 +34,7 @@ from maizeviz.canopy.layout import (
     placements_array,
 )
 from maizeviz.canopy.layout import stands_identity as stands_identity
-from maizeviz.io.project import ProjectError
+from maizeviz.io.archive import ProjectError
 
 
 def layout_parts(layout: CanopyLayout) -> tuple[dict, dict[str, np.ndarray]]:

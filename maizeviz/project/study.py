@@ -20,13 +20,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from maizeviz.canopy.build import STALK_TRIANGLES
 from maizeviz.canopy.layout import CanopyLayout
-from maizeviz.canopy.scene import STALK_TRIANGLES
 from maizeviz.cost import check, layout_cost
 from maizeviz.errors import MaizevizError
+from maizeviz.io.archive import Project, ProjectError, Record, get, load_project
 from maizeviz.io.atomic import remove_leftovers
 from maizeviz.io.hashing import checked_copy, same_content
-from maizeviz.io.project import Project, ProjectError, Record, get, load_project
 from maizeviz.leaf.fit import Leaf
 from maizeviz.mesh.levels import Level, parse_level
 from maizeviz.project.records import KINDS, per_triangle, run_from_record, run_record
@@ -269,9 +269,9 @@ def canopy_triangles(leaves: Sequence[Leaf], layout: CanopyLayout, label: str
                      ) -> tuple[int, int] | None:
     """Exactly how many (leaf, stalk) triangles the canopy of ``leaves`` on ``layout`` has at
     the mesh level labelled ``label`` ("16 triangles", "36 triangles, widths unscaled",
-    "K=4"): its plants meshed (:func:`~maizeviz.canopy.scene.plant_meshes`, as the canopy is
+    "K=4"): its plants meshed (:func:`~maizeviz.canopy.build.plant_meshes`, as the canopy is
     built) and a stalk per stand. None for a label that is not a mesh level."""
-    from maizeviz.canopy.scene import plant_meshes
+    from maizeviz.canopy.build import plant_meshes
 
     try:
         level = parse_level(label.split(",")[0])
@@ -428,8 +428,8 @@ def save_study(path: str | Path, points: str | Path, layout: CanopyLayout,
         A result traced on other stands than ``layout``'s (its per-plant light would be read
         back on other plants), before anything is written.
     """
+    from maizeviz.io.archive import MAX_MEMBER_BYTES, save_project
     from maizeviz.io.inputs import read_input
-    from maizeviz.io.project import MAX_MEMBER_BYTES, save_project
 
     here = stands_identity(layout)
     for k, r in enumerate(results):

@@ -29,10 +29,10 @@ from collections import OrderedDict
 from dataclasses import dataclass, field
 from typing import Any
 
+from maizeviz.canopy.build import Canopy, build_canopy
 from maizeviz.canopy.layout import check_block, check_tile, layout_for, parse_shape
 from maizeviz.canopy.layout import check_spacing as _core_check_spacing
 from maizeviz.canopy.measures import measure_canopy
-from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.cost import Cost, cover_cost, layout_cost, light_cost
 from maizeviz.errors import MaizevizError
 from maizeviz.io.hashing import sha256_stream

@@ -83,8 +83,8 @@ def build_part(points: str, layout: CanopyLayout, placements: np.ndarray, level:
                preserve_area: bool):
     """On a worker: the canopy of the placements ``placements`` of ``layout`` (their plants
     read from ``points``, plant by plant) and the whole layout's index of each."""
+    from maizeviz.canopy.build import place_plants
     from maizeviz.canopy.field import FieldLeaves
-    from maizeviz.canopy.scene import place_plants
 
     sub = replace(layout, placements=tuple(layout.placements[i] for i in placements))
     field = FieldLeaves(points, survey=False)        # the client surveyed it

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from maizeviz_app.jobs import absorbed_of
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.io.points import write_points
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.leaf.synth import block_grids

@@ -304,7 +304,7 @@ def test_a_users_mypy_sees_the_facades_real_types(wheel_env):
     revealed = re.findall(r'Revealed type is "([^"]+)"', out.stdout)
     assert revealed[0].startswith("def (path: str | pathlib.Path") and \
         revealed[0].endswith("-> maizeviz.leaf.fit.LeavesFromFile"), out.stdout
-    assert revealed[1:] == ["maizeviz.canopy.scene.Canopy",
+    assert revealed[1:] == ["maizeviz.canopy.build.Canopy",
                             "maizeviz.light.results.direct.LightResult",
                             "maizeviz.light.results.diffuse.PeriodLight",
                             "maizeviz.light.results.absorbed.Balance",

@@ -61,8 +61,8 @@ def test_tables_add_up_and_tiles_fold_to_the_whole_field():
     """A 2 x 2 tiling of one block in a periodic field sampled on one tile gives, per plant,
     what the same field sampled over its whole plot gives (the same light per triangle up to
     the rays' noise), and leaf rows sum to plant rows sum to the canopy."""
+    from maizeviz.canopy.build import Canopy
     from maizeviz.canopy.layout import layout_from_dict
-    from maizeviz.canopy.scene import Canopy
 
     base = patches(3.0, 60.0, seed=9)
     # the same block tiled 2 x 2 as four plants standing in a 120 x 120 plot

@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import (
     LayoutError,
     layout_from_dict,
@@ -17,7 +18,6 @@ from maizeviz.canopy.layout import (
     union_area,
 )
 from maizeviz.canopy.measures import ground_cover, measure_canopy
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
 from maizeviz.leaf.fit import fit_leaves

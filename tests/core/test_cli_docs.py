@@ -87,9 +87,9 @@ def written(args: list[str]) -> list[str]:
 # ------------------------------------------------------------------------------ stand-ins
 def make_stand_ins(folder: Path) -> None:
     """The bundled data standing in for the page's files (see the module's text)."""
+    from maizeviz.canopy.build import build_canopy
     from maizeviz.canopy.export import canopy_cells
     from maizeviz.canopy.layout import layout_for
-    from maizeviz.canopy.scene import build_canopy
     from maizeviz.io.meshfile import write_mesh
     from maizeviz.leaf.fit import read_leaves
     from maizeviz.mesh.levels import Level

@@ -6,8 +6,8 @@ from dataclasses import replace
 
 import pytest
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for, layout_to_dict
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.mesh.levels import parse_level

@@ -2,8 +2,8 @@
 
 import pytest
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.cli import EXIT_FAIL, main
 from maizeviz.cost import (
     BYTES_PER_TRIANGLE,

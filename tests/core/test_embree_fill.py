@@ -6,8 +6,8 @@ import pytest
 from embree_contract import assert_same_hits
 from embreex.rtcore_scene import EmbreeScene
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.mesh.embree_fill import fill
 from maizeviz.mesh.embree_isa import device, requested

@@ -10,7 +10,7 @@ import maizeviz as mv
 from maizeviz.light.engine import LightEngine
 from maizeviz.light.scene.request import LightRequest, Sampling
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
 
 
 def test_import_maizeviz_loads_no_numpy_qt_or_embree():

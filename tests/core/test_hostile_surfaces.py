@@ -235,14 +235,14 @@ def test_a_bad_environment_variable_is_one_line_when_used(tmp_path, name, value)
 @pytest.fixture(scope="module")
 def traced_project(tmp_path_factory):
     """The bundled block's 2 x 2 tiling at 16 triangles with a sun, a sky and a day."""
+    from maizeviz.canopy.build import build_canopy
     from maizeviz.canopy.layout import layout_for
-    from maizeviz.canopy.scene import build_canopy
     from maizeviz.leaf.fit import read_leaves
     from maizeviz.light.scene.request import LightRequest, Sampling
     from maizeviz.light.sources.sky import make_sky
     from maizeviz.light.sources.sun import Sun
-    from maizeviz.light.trace.diffuse import trace_sky
-    from maizeviz.light.trace.direct import trace_light
+    from maizeviz.light.trace.beam import trace_light
+    from maizeviz.light.trace.directions import trace_sky
     from maizeviz.mesh.levels import parse_level
     from maizeviz.project.study import save_study
 
@@ -267,7 +267,7 @@ def test_a_projects_per_triangle_array_of_another_length_is_refused_at_read(
     the result was 'traced on another canopy'."""
     from dataclasses import replace
 
-    from maizeviz.io.project import ProjectError, load_project, save_project
+    from maizeviz.io.archive import ProjectError, load_project, save_project
     from maizeviz.project.study import read_study
 
     path, n, stalks = traced_project
@@ -544,9 +544,9 @@ def test_the_docs_say_what_meshio_reads_of_a_legacy_vtk(tmp_path):
 def reader_samples(tmp_path_factory, small_points):
     """A small valid file for each reader: (reader, path)."""
     from maizeviz.canopy.layout import layout_for, save_layout
+    from maizeviz.io.archive import load_project
     from maizeviz.io.mesh_canopy import read_mesh
     from maizeviz.io.points import read_points
-    from maizeviz.io.project import load_project
     from maizeviz.leaf.fit import read_leaves
     from maizeviz.project.study import save_study
 

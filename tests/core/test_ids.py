@@ -133,7 +133,7 @@ def test_mesh_leaf_ids_beyond_9999_read_export_and_come_back(tmp_path):
     from maizeviz.canopy.from_mesh import read_mesh_canopy
     from maizeviz.light.scene.request import LightRequest, Sampling
     from maizeviz.light.sources.sun import Sun
-    from maizeviz.light.trace.direct import trace_light
+    from maizeviz.light.trace.beam import trace_light
     from tests.core.test_mesh_canopy import write_ply
 
     leaves = [1, 9_999, 10_000, 10_003, BIG]

@@ -16,8 +16,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from square_leaves import spherical_normals, square_corners
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.layout import layout_from_dict
-from maizeviz.canopy.scene import Canopy
 from maizeviz.light.engine import LightEngine
 from maizeviz.light.results.assimilation import assimilate
 from maizeviz.light.trace.optics import Optics

@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.layout import layout_from_dict
-from maizeviz.canopy.scene import Canopy
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
 from maizeviz.light.report.beer_lambert import beer_lambert
@@ -18,7 +18,7 @@ from maizeviz.light.report.heatmap import transmission_map
 from maizeviz.light.scene.rays import ray_grid
 from maizeviz.light.scene.request import LightRequest, Sampling
 from maizeviz.light.sources.sun import Sun, sun_at
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
 
 BLOCK = str(Path(__file__).resolve().parents[2] / "maizeviz/resources/block3x3.csv")
 
@@ -282,7 +282,7 @@ def test_heights_above_canopy_fine_and_empty_canopy_refused():
 
 
 def test_threads_give_the_same_answer_and_cancel_works(monkeypatch):
-    import maizeviz.light.trace.direct as tr
+    import maizeviz.light.trace.beam as tr
     monkeypatch.setattr(tr, "CHUNK", 1000)
     rng = np.random.default_rng(1)
     c = canopy_of([(x, y, 10, h) for x, y, h in zip(rng.uniform(0, 90, 80), rng.uniform(0, 90, 80),
@@ -361,8 +361,8 @@ def test_cli_light_bad_input(capsys, argv, says):
 def test_occlusion_queries_agree_with_nearest_hits(periodic):
     """The tracer's occlusion mode (sensor planes) and its nearest-hit mode (ground rays) see
     the same triangles along the same paths, wrapped or not."""
+    from maizeviz.light.scene.embree_scenes import light_scene
     from maizeviz.light.scene.rays import Tracer
-    from maizeviz.light.scene.scenes import light_scene
 
     c = _random_squares(7, n=120)
     scene = light_scene(c)
@@ -383,7 +383,7 @@ def test_occlusion_queries_agree_with_nearest_hits(periodic):
 def test_sensor_planes_by_occlusion_and_by_the_ray_family_agree(monkeypatch, periodic):
     """A sensor's path to the sun is asked either as an occlusion query or as the first hit of
     the ray of the same family through it; both give the same planes."""
-    import maizeviz.light.trace.direct as tr
+    import maizeviz.light.trace.beam as tr
 
     c = _random_squares(9, n=150)
     heights = (0.0, 20.0, 55.5, 100.0, 140.0, 400.0)
@@ -405,7 +405,7 @@ def test_a_rectangle_of_whole_periods_answers_every_plane_by_its_ground_rays(mon
     for any sensor: the family ray through a sensor is one of the rectangle's ground rays
     moved by whole periods. The same sensors, ray for ray, as the family's box; within 2 rays
     of a query per sensor (a path asked from its two ends); the same first and second hits."""
-    import maizeviz.light.trace.direct as tr
+    import maizeviz.light.trace.beam as tr
 
     calls = {"occluded": 0}
     occluded = tr.Tracer.occluded
@@ -441,7 +441,7 @@ def test_a_rectangle_of_whole_periods_answers_every_plane_by_its_ground_rays(mon
 def test_a_leaf_overhanging_a_periodic_plot_shades_the_opposite_edge():
     """A leaf hanging 20 cm over the east edge of a periodic 100 cm plot stands, in the
     infinite field, 20 cm inside its west edge too: its light is counted on the leaf itself."""
-    from maizeviz.light.scene.scenes import light_scene
+    from maizeviz.light.scene.embree_scenes import light_scene
 
     c = canopy_of([(90, 40, 30, 50)])                       # x 90..120 over the edge at 100
     req = LightRequest(Sun(0, 0), Sampling((0, 60), 4, (0, 0, 100, 100), periodic=True))

@@ -18,14 +18,14 @@ from test_light_sky import random_leaves
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
 from maizeviz.light.engine import LightEngine
+from maizeviz.light.scene.embree_scenes import light_scene
 from maizeviz.light.scene.request import LightRequest, Sampling
-from maizeviz.light.scene.scenes import light_scene
 from maizeviz.light.sources.irradiance import Period, clear_sky_period
 from maizeviz.light.sources.perez import PEREZ_MODELS, perez_split
 from maizeviz.light.sources.sky import make_sky
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.diffuse import trace_period, trace_sky
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
+from maizeviz.light.trace.directions import trace_period, trace_sky
 from maizeviz.mesh.tessellate import triangle_areas_normals
 from maizeviz.project.records import day_from_record, day_record
 

@@ -11,13 +11,13 @@ from test_light_sky import random_leaves
 
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
+from maizeviz.light.scene.embree_scenes import light_scene
 from maizeviz.light.scene.request import LightRequest, Sampling
-from maizeviz.light.scene.scenes import light_scene
 from maizeviz.light.sources.irradiance import clear_sky_period
 from maizeviz.light.sources.sky import make_sky
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.diffuse import trace_period, trace_sky
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
+from maizeviz.light.trace.directions import trace_period, trace_sky
 
 BEIJING = dict(lat=39.9, lon=116.4, tz="Asia/Shanghai")
 HEIGHTS = (0.0, 60.0, 200.0)

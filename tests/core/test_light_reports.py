@@ -6,8 +6,8 @@ import pickle
 import numpy as np
 import pytest
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.io.atomic import write_rows
 from maizeviz.io.points import write_points
 from maizeviz.leaf.fit import read_leaves
@@ -17,7 +17,7 @@ from maizeviz.light.results.per_leaf import plant_light
 from maizeviz.light.scene.request import Sampling
 from maizeviz.light.sources.irradiance import WeatherFileError, clear_sky_period, read_weather
 from maizeviz.light.sources.sky import make_sky
-from maizeviz.light.trace.diffuse import trace_period
+from maizeviz.light.trace.directions import trace_period
 from maizeviz.mesh.levels import parse_level
 
 

@@ -19,16 +19,16 @@ import math
 import numpy as np
 import pytest
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.layout import layout_from_dict
-from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.light.report.beer_lambert import beer_lambert_sky
+from maizeviz.light.scene.embree_scenes import light_scene
 from maizeviz.light.scene.request import LightRequest, Sampling
-from maizeviz.light.scene.scenes import light_scene
 from maizeviz.light.sources.sky import analytic_diffuse_transmission, make_sky
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.diffuse import trace_sky
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
+from maizeviz.light.trace.directions import trace_sky
 
 SIDE = 200.0
 

@@ -12,8 +12,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from maizeviz import loops
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf import nurbs
 from maizeviz.leaf.fit import fit_leaves
 from maizeviz.leaf.synth import LeafShape, block_grids, leaf_points

@@ -14,10 +14,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.export import canopy_cells, export_canopy
 from maizeviz.canopy.from_mesh import canopy_from_mesh, read_mesh_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.cli import EXIT_FAIL, EXIT_OK, main
 from maizeviz.errors import MaizevizError
 from maizeviz.io.mesh_canopy import MeshFileError, parse_group_name, read_mesh

@@ -226,7 +226,7 @@ def test_the_carried_period_is_used_only_when_the_triangles_repeat_with_it(tmp_p
     """The light reads the sensors over a carried period only after checking it: a mesh one
     of whose leaves moved by a millimetre in one tile keeps the plot as its period."""
     from maizeviz.io.meshfile import write_mesh
-    from maizeviz.light.scene.scenes import light_scene
+    from maizeviz.light.scene.embree_scenes import light_scene
 
     path = tmp_path / "c.ply"
     assert main(["canopy", B, "--tile", "3x3", "--triangles", "8", "--export",

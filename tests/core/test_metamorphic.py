@@ -15,15 +15,15 @@ import pytest
 from hypothesis import Phase, given, settings
 from hypothesis import strategies as st
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.layout import layout_from_dict
-from maizeviz.canopy.scene import Canopy
 from maizeviz.cli import main
 from maizeviz.light.scene.request import LightRequest, Sampling
 from maizeviz.light.sources.irradiance import clear_sky_period
 from maizeviz.light.sources.sky import make_sky
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.diffuse import trace_period, trace_sky
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
+from maizeviz.light.trace.directions import trace_period, trace_sky
 from tests.core.test_mesh_canopy import write_obj, write_ply
 
 BLOCK = str(Path(__file__).resolve().parents[2] / "maizeviz/resources/block3x3.csv")
@@ -133,9 +133,9 @@ def test_day_transmission_follows_its_height_whatever_the_order():
 def block_mesh(tmp_path_factory):
     """The bundled block's canopy at 36 triangles a leaf, exported as PLY and read back:
     (vertices (V, 3) cm, faces (T, 3), plant (T,), leaf (T,))."""
+    from maizeviz.canopy.build import build_canopy
     from maizeviz.canopy.export import export_canopy
     from maizeviz.canopy.layout import layout_for
-    from maizeviz.canopy.scene import build_canopy
     from maizeviz.io.mesh_canopy import read_mesh
     from maizeviz.leaf.fit import read_leaves
     from maizeviz.mesh.levels import Level

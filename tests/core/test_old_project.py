@@ -105,7 +105,7 @@ def test_the_old_project_saved_again_holds_the_same_records(old, stored, tmp_pat
     project = study.make_project(opened.project.points_path, opened.project.points_csv,
                                  s.layout, s.layout, opened.canopy, opened.light,
                                  [(r.label, r.result, r.settings) for r in s.results])
-    from maizeviz.io.project import save_project
+    from maizeviz.io.archive import save_project
 
     save_project(again, project)
     with zipfile.ZipFile(again) as zf:

@@ -16,16 +16,16 @@ import pytest
 from embree_contract import assert_same_blocked, assert_same_hits
 
 import maizeviz.mesh.raytrace as raytrace
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
+from maizeviz.light.scene.embree_scenes import light_scene
 from maizeviz.light.scene.request import LightRequest, Sampling, canopy_top
-from maizeviz.light.scene.scenes import light_scene
 from maizeviz.light.sources.sky import make_sky
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace import direct
-from maizeviz.light.trace.diffuse import trace_sky
-from maizeviz.light.trace.direct import trace_direction, trace_light
+from maizeviz.light.trace import beam
+from maizeviz.light.trace.beam import trace_direction, trace_light
+from maizeviz.light.trace.directions import trace_sky
 from maizeviz.mesh import packets
 from maizeviz.mesh.embree_isa import supported
 from maizeviz.mesh.levels import parse_level
@@ -124,7 +124,7 @@ def test_light_is_the_same_through_packets_or_single_rays(canopy, monkeypatch, p
         beams.append(trace_direction(*args, **kwargs))
         return beams[-1]
 
-    monkeypatch.setattr(direct, "trace_direction", keep)
+    monkeypatch.setattr(beam, "trace_direction", keep)
     fast = trace_light(canopy, req), trace_sky(canopy, sky, req.sampling)
     monkeypatch.setattr(raytrace._packets, "kernel", lambda: None)
     scene = light_scene(canopy, periodic=periodic)

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.results.painting import (
     MIN_RAYS,
@@ -18,7 +18,7 @@ from maizeviz.light.results.painting import (
 from maizeviz.light.results.per_leaf import tile_representatives
 from maizeviz.light.scene.request import LightRequest, Sampling
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
 from maizeviz.mesh.levels import parse_level
 
 

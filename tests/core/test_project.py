@@ -11,7 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from maizeviz.errors import MaizevizError
-from maizeviz.io.project import (
+from maizeviz.io.archive import (
     PROJECT_FORMAT,
     Project,
     ProjectError,

@@ -9,10 +9,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
+from maizeviz.io.archive import ProjectError, Record, load_project, save_project
 from maizeviz.io.points import write_points
-from maizeviz.io.project import ProjectError, Record, load_project, save_project
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.leaf.synth import block_grids
 from maizeviz.light.engine import LightEngine

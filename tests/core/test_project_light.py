@@ -10,12 +10,12 @@ import zipfile
 import numpy as np
 import pytest
 from maizeviz_app.jobs import DaySpec, SkySpec
-from maizeviz_app.project import settings_doc, stored_run
+from maizeviz_app.saved_state import settings_doc, stored_run
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
+from maizeviz.io.archive import ProjectError, Record, load_project, save_project
 from maizeviz.io.points import write_points
-from maizeviz.io.project import ProjectError, Record, load_project, save_project
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.leaf.synth import block_grids
 from maizeviz.light.report.tables import leaf_values, write_steps
@@ -23,8 +23,8 @@ from maizeviz.light.scene.request import LightRequest, Sampling
 from maizeviz.light.sources.irradiance import clear_sky_period
 from maizeviz.light.sources.sky import make_sky
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.diffuse import trace_period, trace_sky
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
+from maizeviz.light.trace.directions import trace_period, trace_sky
 from maizeviz.mesh.levels import parse_level
 from maizeviz.project import study
 from maizeviz.project.records import DAY_KIND, SKY_KIND, run_from_record, run_record

@@ -15,16 +15,16 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import CanopyLayout, Placement, layout_for, layout_to_dict
-from maizeviz.canopy.scene import build_canopy
+from maizeviz.io.archive import Project, ProjectError, load_project, save_project
 from maizeviz.io.hashing import sha256_file
 from maizeviz.io.points import write_points
-from maizeviz.io.project import Project, ProjectError, load_project, save_project
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.leaf.synth import block_grids
 from maizeviz.light.scene.request import Sampling
 from maizeviz.light.sources.sky import make_sky
-from maizeviz.light.trace.diffuse import trace_sky
+from maizeviz.light.trace.directions import trace_sky
 from maizeviz.mesh.levels import parse_level
 from maizeviz.project import study
 
@@ -207,7 +207,7 @@ def test_a_nul_or_a_5000_digit_number_is_one_line_naming_the_field(points, tmp_p
     _with_json(path, change)
     with pytest.raises(ProjectError) as err:
         opened = study.open_project(path, tmp_path)
-        from maizeviz.io.project import get
+        from maizeviz.io.archive import get
         get(opened.canopy, "tile", int, where=opened.path)   # as the window reads it
     text = str(err.value)
     assert field in text and "\n" not in text and text.startswith(str(path))
@@ -216,7 +216,7 @@ def test_a_nul_or_a_5000_digit_number_is_one_line_naming_the_field(points, tmp_p
 OPEN_HUGE = """
 import resource, sys
 resource.setrlimit(resource.RLIMIT_AS, (2 * 2**30, 2 * 2**30))   # listing the pairs needs more
-from maizeviz.io.project import ProjectError
+from maizeviz.io.archive import ProjectError
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.mesh.levels import parse_level
 from maizeviz.project import study
@@ -423,7 +423,7 @@ def test_save_study_refuses_a_result_traced_on_other_stands(points, leaves, tmp_
     from maizeviz.errors import MaizevizError
     from maizeviz.light.scene.request import LightRequest
     from maizeviz.light.sources.sun import Sun
-    from maizeviz.light.trace.direct import trace_light
+    from maizeviz.light.trace.beam import trace_light
 
     shown = layout_for(leaves, (2, 2))
     other = edited(leaves, (2, 2), 3, 0, 2)              # the same 16 plants, two turned
@@ -450,7 +450,7 @@ def test_a_day_refuses_a_sky_traced_on_other_stands(points, leaves):
     per triangle belong to other plants."""
     from maizeviz.errors import MaizevizError
     from maizeviz.light.sources.irradiance import clear_sky_period
-    from maizeviz.light.trace.diffuse import trace_period
+    from maizeviz.light.trace.directions import trace_period
 
     sky = trace_sky(build_canopy(leaves, edited(leaves, (2, 2), 3, 0, 2), LEVEL),
                     make_sky("soc", 16), SAMPLING)
@@ -468,7 +468,7 @@ def test_per_triangle_arrays_of_the_wrong_length_are_one_line(points, leaves, tm
     from maizeviz.errors import MaizevizError
     from maizeviz.light.scene.request import LightRequest
     from maizeviz.light.sources.sun import Sun
-    from maizeviz.light.trace.direct import trace_light
+    from maizeviz.light.trace.beam import trace_light
 
     layout = layout_for(leaves, (2, 2))
     canopy = build_canopy(leaves, layout, LEVEL)

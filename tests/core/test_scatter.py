@@ -11,8 +11,8 @@ import pytest
 from scipy import stats
 from square_leaves import spherical_normals, square_corners
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.layout import layout_from_dict
-from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.light.engine import LightEngine
 from maizeviz.light.results.uncertainty import BATCHES

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import maizeviz as mv
-from maizeviz.io.project import ProjectError
+from maizeviz.io.archive import ProjectError
 from maizeviz.light.specs import DaySpec, SkySpec
 from maizeviz.project.settings import run_settings, settings_doc
 from maizeviz.project.study import StoredResult

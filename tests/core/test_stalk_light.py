@@ -18,8 +18,8 @@ import json
 import numpy as np
 import pytest
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.cli import EXIT_OK, main
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.engine import LightEngine

@@ -6,8 +6,8 @@ by ray families and by occlusion queries."""
 import numpy as np
 import pytest
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import fit_leaves
 from maizeviz.leaf.synth import block_grids
 from maizeviz.light.engine import LightEngine

@@ -7,20 +7,20 @@ is traced whole."""
 import numpy as np
 import pytest
 
+from maizeviz.canopy.build import build_canopy
 from maizeviz.canopy.layout import layout_for, layout_from_dict, layout_to_dict
-from maizeviz.canopy.scene import build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.engine import LightEngine
 from maizeviz.light.report.heatmap import transmission_map
+from maizeviz.light.scene.embree_scenes import BlockScene, CanopyScene, light_scene
 from maizeviz.light.scene.periodic import Wrap, trace_wrapped
 from maizeviz.light.scene.request import LightRequest, Sampling
-from maizeviz.light.scene.scenes import BlockScene, CanopyScene, light_scene
 from maizeviz.light.scene.tiling import block_tiling
 from maizeviz.light.sources.irradiance import clear_sky_period
 from maizeviz.light.sources.sky import make_sky
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.diffuse import trace_period, trace_sky
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
+from maizeviz.light.trace.directions import trace_period, trace_sky
 from maizeviz.mesh.levels import parse_level
 from maizeviz.resources import example_points
 

@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
+from maizeviz.canopy.build import Canopy, build_canopy
 from maizeviz.canopy.layout import layout_for, layout_from_dict
-from maizeviz.canopy.scene import Canopy, build_canopy
 from maizeviz.leaf.fit import read_leaves
 from maizeviz.light.results.per_leaf import NOT_TRACED
 from maizeviz.light.scene.request import LightRequest, Sampling
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.direct import trace_light
+from maizeviz.light.trace.beam import trace_light
 from maizeviz.mesh.levels import Level
 from maizeviz.resources import example_points
 

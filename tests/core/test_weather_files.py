@@ -194,7 +194,7 @@ def test_a_period_with_par_and_temperature_survives_a_project(tmp_path):
     """A day's period on a weather file with PAR and air temperature, stored as a project
     stores it (maizeviz.project.records: the period's arrays and metadata) and read back:
     the same arrays, the same PAR."""
-    from maizeviz.io.project import Record
+    from maizeviz.io.archive import Record
     from maizeviz.project.records import _PERIOD_ARRAYS, _PERIOD_OPTIONAL, _period
 
     w = read_weather(_csv(tmp_path, "p.csv", "time,ghi,par,temp_air", _day_rows()))

@@ -78,8 +78,8 @@ def small_points(tmp_path_factory):
 @pytest.fixture(scope="session")
 def small_canopy(small_points):
     """The two plants at 36 triangles per leaf, tiled 1x1."""
+    from maizeviz.canopy.build import build_canopy
     from maizeviz.canopy.layout import layout_for
-    from maizeviz.canopy.scene import build_canopy
     from maizeviz.leaf.fit import read_leaves
     from maizeviz.mesh.levels import parse_level
 
@@ -128,3 +128,30 @@ def two_plants(tmp_path):
     path = tmp_path / "two_plants.csv"
     write_points(path, block_grids(1, 2, seed=3))
     return path
+
+
+@pytest.fixture
+def make_panel(qtbot):
+    """Make digitizer panels (``make_panel(viewport=None)``), each a real widget shown at a
+    laptop's dock size once its port list is read; each stopped, with its port search, when
+    the test ends."""
+    from maizeviz_app.panels.digitizer import DigitizerPanel
+
+    made = []
+
+    def make(viewport=None):
+        panel = DigitizerPanel(viewport)
+        qtbot.addWidget(panel)
+        panel.resize(460, 760)
+        panel.show()
+        qtbot.waitExposed(panel)
+        panel.ports.wait()
+        qtbot.wait(10)                  # the port list's queued signal delivered
+        made.append(panel)
+        return panel
+
+    yield make
+    for panel in made:
+        panel.stop("test over", wait=True)
+        panel.ports.stop_search()
+        panel.ports.wait()

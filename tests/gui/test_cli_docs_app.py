@@ -25,9 +25,9 @@ APP = [c for c in doc_commands() if kind_of(c) == "app"]
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory):
     import maizeviz as mv
+    from maizeviz.canopy.build import build_canopy
     from maizeviz.canopy.export import export_canopy
     from maizeviz.canopy.layout import layout_for
-    from maizeviz.canopy.scene import build_canopy
     from maizeviz.leaf.fit import read_leaves
     from maizeviz.mesh.levels import Level
 

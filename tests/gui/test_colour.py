@@ -211,7 +211,7 @@ def test_heatmaps_take_the_scale_share_it_and_tell_the_value_under_the_mouse(sma
     from maizeviz.light.report.heatmap import transmission_map
     from maizeviz.light.scene.request import LightRequest, Sampling
     from maizeviz.light.sources.sun import Sun
-    from maizeviz.light.trace.direct import trace_light
+    from maizeviz.light.trace.beam import trace_light
 
     result = trace_light(small_canopy, LightRequest(Sun(30.0, 160.0),
                                                     Sampling((0.0, 60.0), 1.0), classes=True))

@@ -14,28 +14,6 @@ TIMEOUT = 20_000
 
 
 @pytest.fixture
-def make_panel(qtbot):
-    from maizeviz_app.panels.digitizer import DigitizerPanel
-
-    made = []
-
-    def make():
-        panel = DigitizerPanel(None)
-        qtbot.addWidget(panel)
-        panel.resize(460, 760)
-        panel.show()
-        qtbot.waitExposed(panel)
-        made.append(panel)
-        return panel
-
-    yield make
-    for panel in made:
-        panel.stop("test over", wait=True)
-        panel.ports.stop_search()
-        panel.ports.wait()
-
-
-@pytest.fixture
 def sim():
     s = FastrakSimulator(press_gap_s=0.0, noise_cm=0.0)
     yield s

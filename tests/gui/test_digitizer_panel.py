@@ -35,26 +35,6 @@ def viewport(qtbot):
 
 
 @pytest.fixture
-def make_panel(qtbot):
-    from maizeviz_app.panels.digitizer import DigitizerPanel
-
-    made = []
-
-    def make(viewport=None):
-        panel = DigitizerPanel(viewport)
-        qtbot.addWidget(panel)
-        panel.resize(420, 700)
-        panel.show()
-        qtbot.waitExposed(panel)
-        made.append(panel)
-        return panel
-
-    yield make
-    for panel in made:
-        panel.stop("test over", wait=True)
-
-
-@pytest.fixture
 def sim():
     from maizeviz.digitizer.simulator import FastrakSimulator
 

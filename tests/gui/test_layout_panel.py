@@ -80,18 +80,18 @@ def test_drag_moves_a_plant_in_the_document_and_undo_restores_it_exactly(panel, 
     for k in range(1, 6):
         qtbot.mouseMove(view.viewport(), start + QPoint(8 * k, 0))
     qtbot.mouseRelease(view.viewport(), Qt.LeftButton, pos=start + QPoint(40, 0))
-    p = panel.model.placements[0]
+    p = panel.draft.placements[0]
     assert p.x - BASES[1][0] == pytest.approx(40 / scale, abs=1.5 / scale)
     assert p.y == pytest.approx(BASES[1][1], abs=1.5 / scale)
-    assert panel.model.placements[1] == panel.layout_.placements[1]
+    assert panel.draft.placements[1] == panel.layout_.placements[1]
     xs = [r["x"] for r in panel.document()["rows"]]
     assert p.x in xs and BASES[1][0] not in xs
     assert panel.undo_stack.count() == 1 and "1 plant edited" in panel.state.text()
     panel.undo_action.trigger()
-    assert panel.model.placements == list(panel.layout_.placements)
+    assert panel.draft.placements == list(panel.layout_.placements)
     assert view.items_[0].pos() == QPointF(*BASES[1])
     panel.redo_action.trigger()
-    assert panel.model.placements[0] == p
+    assert panel.draft.placements[0] == p
 
 
 def test_wheel_turns_a_plant_and_its_steps_are_one_undo(panel, qtbot):
@@ -101,12 +101,12 @@ def test_wheel_turns_a_plant_and_its_steps_are_one_undo(panel, qtbot):
         ev = QWheelEvent(at, QPointF(view.viewport().mapToGlobal(at.toPoint())), QPoint(0, 0),
                          QPoint(0, 120), Qt.NoButton, Qt.NoModifier, Qt.NoScrollPhase, False)
         QApplication.sendEvent(view.viewport(), ev)
-    assert panel.model.placements[1].azimuth_deg == 15.0
+    assert panel.draft.placements[1].azimuth_deg == 15.0
     assert view.items_[1].arrow.rotation() == 15.0
     assert panel.rows.data(panel.rows.index(1, 3)) == "15.0"
     assert panel.undo_stack.count() == 1
     panel.undo_action.trigger()
-    assert panel.model.placements[1].azimuth_deg == 0.0
+    assert panel.draft.placements[1].azimuth_deg == 0.0
 
 
 def test_knob_turns_a_plant(panel, qtbot):
@@ -118,23 +118,23 @@ def test_knob_turns_a_plant(panel, qtbot):
     qtbot.mousePress(view.viewport(), Qt.LeftButton, pos=knob)
     qtbot.mouseMove(view.viewport(), up)
     qtbot.mouseRelease(view.viewport(), Qt.LeftButton, pos=up)
-    assert panel.model.placements[0].azimuth_deg == 90.0  # counter-clockwise from east
-    assert (panel.model.placements[0].x, panel.model.placements[0].y) == BASES[1]
+    assert panel.draft.placements[0].azimuth_deg == 90.0  # counter-clockwise from east
+    assert (panel.draft.placements[0].x, panel.draft.placements[0].y) == BASES[1]
 
 
 def test_keys_undo_and_redo_table_edits(panel, qtbot):
     panel.rows.setData(panel.rows.index(0, 1), "20")
     panel.rows.setData(panel.rows.index(1, 2), "1")
-    assert [p.plant for p in panel.model.placements] == [1, 1]
+    assert [p.plant for p in panel.draft.placements] == [1, 1]
     panel.activateWindow()
     panel.table.setFocus()
     qtbot.waitUntil(panel.table.hasFocus)
     qtbot.keyClick(panel.table, Qt.Key_Z, Qt.ControlModifier)
-    assert [p.plant for p in panel.model.placements] == [1, 2]
+    assert [p.plant for p in panel.draft.placements] == [1, 2]
     qtbot.keyClick(panel.table, Qt.Key_Z, Qt.ControlModifier)
-    assert panel.model.placements[0].y == BASES[1][1]
+    assert panel.draft.placements[0].y == BASES[1][1]
     qtbot.keyClick(panel.table, Qt.Key_Z, Qt.ControlModifier | Qt.ShiftModifier)
-    assert panel.model.placements[0].y == 20.0
+    assert panel.draft.placements[0].y == 20.0
     assert panel.rows.data(panel.rows.index(0, 1)) == "20.0"
 
 
@@ -153,19 +153,19 @@ def test_bad_cells_are_refused_with_the_cell_named(panel, qtbot):
 def test_tiling_change_asks_before_discarding_edits(panel, qtbot):
     assert panel.tiling.currentData() == 1 and panel.tiling.isEnabled()
     panel.rows.setData(panel.rows.index(0, 3), "45")
-    edited = list(panel.model.placements)
+    edited = list(panel.draft.placements)
     _answer(QMessageBox.Cancel)
     assert not panel.set_tiling(3)                       # cancelled: nothing changed
-    assert panel.model.placements == edited and panel.tiling.currentData() == 1
+    assert panel.draft.placements == edited and panel.tiling.currentData() == 1
     _answer(QMessageBox.Discard)
     assert panel.set_tiling(3)
-    assert len(panel.model.placements) == 18 and panel.tiling.currentData() == 3
-    assert panel.model.edits() == 0 and len(panel.view.items_) == 18
+    assert len(panel.draft.placements) == 18 and panel.tiling.currentData() == 3
+    assert panel.draft.edits() == 0 and len(panel.view.items_) == 18
     panel.undo_action.trigger()                          # the edits come back, exactly
-    assert panel.model.placements == edited and panel.tiling.currentData() == 1
+    assert panel.draft.placements == edited and panel.tiling.currentData() == 1
     # no edits, no question
     panel.undo_action.trigger()
-    assert panel.set_tiling(5) and len(panel.model.placements) == 50
+    assert panel.set_tiling(5) and len(panel.draft.placements) == 50
 
 
 def test_edits_follow_into_the_3d_view_and_save(panel, qtbot, tmp_path):
@@ -186,10 +186,10 @@ def test_edits_follow_into_the_3d_view_and_save(panel, qtbot, tmp_path):
     other.write_text(json.dumps(doc))
     _answer(QMessageBox.Discard)
     assert panel.load(other)
-    assert [(p.plant, p.x, p.y) for p in panel.model.placements] == [(2, 10.5, 20.25)]
+    assert [(p.plant, p.x, p.y) for p in panel.draft.placements] == [(2, 10.5, 20.25)]
     assert panel.tiling.currentData() is None
     panel.undo_action.trigger()
-    assert len(panel.model.placements) == 2
+    assert len(panel.draft.placements) == 2
 
 
 def test_layout_editor_in_the_window_turns_a_plant(window, two_plants, qtbot):
@@ -197,7 +197,7 @@ def test_layout_editor_in_the_window_turns_a_plant(window, two_plants, qtbot):
     qtbot.waitSignal(w.canopy_shown, timeout=120_000).wait()
     panel = w.layout_panel
     assert panel.rows.rowCount() == 2
-    first = panel.model.placements[0].plant
+    first = panel.draft.placements[0].plant
     before = w.model.canopy.vertices[w.model.canopy.faces[w.model.canopy.face_plant == first]].copy()
     with qtbot.waitSignal(w.canopy_shown, timeout=120_000):
         panel.rows.setData(panel.rows.index(0, 3), "90")      # the 3D view follows
@@ -260,7 +260,7 @@ def test_a_plant_put_onto_another_is_red_and_listed_until_moved(panel, qtbot):
     assert panel.rows.rowCount() == 3 and panel.picked == 2
     qtbot.wait(100)
     assert panel.overlaps.isHidden()
-    a = panel.model.placements[0]
+    a = panel.draft.placements[0]
     assert panel.rows.setData(panel.rows.index(2, 0), str(a.x + 2.0))
     assert panel.rows.setData(panel.rows.index(2, 1), str(a.y + 1.0))   # onto plant 1
     qtbot.waitUntil(lambda: not panel.overlaps.isHidden(), timeout=2000)
@@ -284,7 +284,7 @@ def test_the_overlap_note_counts_its_pairs_in_words(panel, qtbot):
     said: list[str] = []
     panel.problem.connect(said.append)
     panel.follow.setChecked(False)                    # applied on Apply only
-    a = panel.model.placements[0]
+    a = panel.draft.placements[0]
     for k in (1, 2):                                  # a copy of plant 1 beside it, twice
         panel.select(0)
         panel.duplicate_button.click()
@@ -311,12 +311,12 @@ def test_one_plant_is_one_plant_in_the_summary(panel, qtbot):
 def test_add_rotate_and_snap(panel, qtbot):
     panel.select(1)
     panel.add_button.click()                                  # beyond the end of the row
-    new = panel.model.placements[-1]
+    new = panel.draft.placements[-1]
     assert (new.x, new.y) == (BASES[2][0], BASES[2][1] + 30.0) and panel.picked == 2
     panel.left_button.click()
     panel.left_button.click()
     panel.right_button.click()
-    assert panel.model.placements[2].azimuth_deg == 15.0
+    assert panel.draft.placements[2].azimuth_deg == 15.0
     panel.snap.setChecked(True)
     panel.snap_step.setValue(10.0)
     view = panel.view
@@ -325,7 +325,7 @@ def test_add_rotate_and_snap(panel, qtbot):
     qtbot.mousePress(view.viewport(), Qt.LeftButton, pos=start)
     qtbot.mouseMove(view.viewport(), start + QPoint(37, 0))
     qtbot.mouseRelease(view.viewport(), Qt.LeftButton, pos=start + QPoint(37, 0))
-    p = panel.model.placements[0]
+    p = panel.draft.placements[0]
     assert p.x % 10.0 == 0 and p.y % 10.0 == 0 and p.x != BASES[1][0]
     assert view.items_[0].pos() == QPointF(p.x, p.y)          # the disc sits where it snapped
     assert panel.undo_stack.count() == 5

@@ -244,7 +244,7 @@ def test_project_keeps_the_light_mode_and_its_settings(window, qtbot, small_poin
 
 def test_a_project_without_light_modes_opens_in_sun_mode(window, qtbot, small_points,
                                                          tmp_path):
-    from maizeviz.io.project import Project, save_project
+    from maizeviz.io.archive import Project, save_project
 
     path = tmp_path / "old.maizeviz"
     save_project(path, Project(small_points.read_bytes(), str(small_points), None,

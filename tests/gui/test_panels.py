@@ -151,7 +151,7 @@ def test_figures_are_the_core_heatmap_and_a_level_comparison(small_canopy):
 
     from maizeviz.light.scene.request import LightRequest, Sampling
     from maizeviz.light.sources.sun import Sun
-    from maizeviz.light.trace.direct import trace_light
+    from maizeviz.light.trace.beam import trace_light
 
     result = trace_light(small_canopy, LightRequest(Sun(22.3, 167.0), Sampling((0.0, 100.0), 0.5),
                                                     classes=True))

@@ -204,7 +204,7 @@ def test_selection_changes_once_and_describes_a_leaf_with_the_tables_numbers(sma
     from maizeviz.light.results.painting import sun_painting
     from maizeviz.light.scene.request import LightRequest, Sampling
     from maizeviz.light.sources.sun import Sun
-    from maizeviz.light.trace.direct import trace_light
+    from maizeviz.light.trace.beam import trace_light
 
     sel = Selection()
     seen = []

@@ -58,13 +58,13 @@ def test_an_edited_layouts_sky_light_stays_on_its_plants(window, qtbot, small_po
 
 def test_results_of_other_stands_are_left_out_with_one_line(window, qtbot, small_points,
                                                             tmp_path):
+    from maizeviz.canopy.build import build_canopy
     from maizeviz.canopy.layout import layout_for
-    from maizeviz.canopy.scene import build_canopy
-    from maizeviz.io.project import save_project
+    from maizeviz.io.archive import save_project
     from maizeviz.leaf.fit import read_leaves
     from maizeviz.light.scene.request import Sampling
     from maizeviz.light.sources.sky import make_sky
-    from maizeviz.light.trace.diffuse import trace_sky
+    from maizeviz.light.trace.directions import trace_sky
     from maizeviz.mesh.levels import parse_level
     from maizeviz.project.study import make_project
 

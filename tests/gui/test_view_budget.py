@@ -69,8 +69,8 @@ def test_a_dense_tile_draws_the_plants_nearest_its_centre_within_the_fine_budget
     from maizeviz_app.building import DISPLAY_LEVEL
     from maizeviz_app.viewport import display_polydata, sample_plants
 
+    from maizeviz.canopy.build import build_canopy
     from maizeviz.canopy.layout import layout_for
-    from maizeviz.canopy.scene import build_canopy
     from maizeviz.leaf.fit import read_leaves
     from maizeviz.mesh.levels import parse_level
 

@@ -125,7 +125,7 @@ def test_a_vertex_shared_by_two_leaves_is_split(small_canopy):
     per vertex are those of each triangle."""
     from maizeviz_app.viewport import canopy_polydata
 
-    from maizeviz.canopy.scene import Canopy
+    from maizeviz.canopy.build import Canopy
 
     square = np.array([[0, 0, 10], [10, 0, 10], [10, 10, 12], [0, 10, 12]], float)
     faces = np.array([[0, 1, 2], [0, 2, 3]])                  # sharing the edge 0-2

@@ -130,7 +130,7 @@ def test_project_round_trip(window, qtbot, small_points, tmp_path):
 ])
 def test_bad_projects_are_refused_and_the_canopy_stays(window, qtbot, small_points, tmp_path,
                                                        damage, message):
-    from maizeviz.io.project import Project, save_project
+    from maizeviz.io.archive import Project, save_project
 
     path = tmp_path / "p.maizeviz"
     save_project(path, Project(small_points.read_bytes(), str(small_points)))

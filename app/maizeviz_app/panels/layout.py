@@ -98,10 +98,10 @@ class LayoutPanel(QWidget):
         from maizeviz_app.undo import UndoRecorder
 
         self.study = study
-        self.model: LayoutDraft = study.draft if study is not None else LayoutDraft()
+        self.draft: LayoutDraft = study.draft if study is not None else LayoutDraft()
         shared = stack is not None
         if stack is None:                       # a history of the panel's own
-            self._recorder = UndoRecorder(None, self, draft=self.model)
+            self._recorder = UndoRecorder(None, self, draft=self.draft)
             stack = self._recorder.stack
         self.undo_stack = stack
         self.history = study.history if study is not None else self._recorder.history
@@ -132,13 +132,13 @@ class LayoutPanel(QWidget):
         self.view.setAccessibleName("field seen from above")
         self.view.setToolTip("drag a plant to move it; the wheel or the arrow's knob turns it; "
                              "the wheel elsewhere zooms, a double click fits the field")
-        self.view.moved.connect(lambda i, x, y: self._edit(self.model.move, i, x, y))
-        self.view.turned.connect(lambda i, az, wheel: self._edit(self.model.turn, i, az, wheel))
+        self.view.moved.connect(lambda i, x, y: self._edit(self.draft.move, i, x, y))
+        self.view.turned.connect(lambda i, az, wheel: self._edit(self.draft.turn, i, az, wheel))
         self.view.picked.connect(self._on_picked)
         self.table = QTableView()
         _named(self.table, "plant positions", "each plant's position (cm), digitized plant "
                "and turn (°); type to edit (exactly: the table shows values rounded)")
-        self.rows = PlacementTable(self.model, self.problem.emit, self)
+        self.rows = PlacementTable(self.draft, self.problem.emit, self)
         self.table.setModel(self.rows)
         self.table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
         self.table.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
@@ -172,10 +172,10 @@ class LayoutPanel(QWidget):
         lay.addLayout(row)
 
         self._sync_buttons()
-        self.model.changed.connect(self._on_changed)
-        self.model.edited.connect(self._on_edit)
-        self.model.replayed.connect(self._on_edit)
-        self.destroyed.connect(lambda *_: self._forget(self.model))
+        self.draft.changed.connect(self._on_changed)
+        self.draft.edited.connect(self._on_edit)
+        self.draft.replayed.connect(self._on_edit)
+        self.destroyed.connect(lambda *_: self._forget(self.draft))
         self._overlap_timer = QTimer(self, singleShot=True, interval=60)
         self._overlap_timer.timeout.connect(self._show_overlaps)
         if study is not None:
@@ -183,7 +183,7 @@ class LayoutPanel(QWidget):
             study.layout_changed.connect(self._on_applied)
             study.mesh_opened.connect(self._on_mesh)
             study.points_changed.connect(self._on_points)
-        if self.model.base is not None:
+        if self.draft.base is not None:
             self._on_changed(-1)
 
     def _forget(self, draft: LayoutDraft) -> None:
@@ -267,10 +267,10 @@ class LayoutPanel(QWidget):
                                        "a copy of the picked plant (the same plant, turned "
                                        "the same) at the end of its row")
         self.duplicate_button.clicked.connect(
-            lambda: self._edit(self.model.duplicate, self.picked, select_new=True))
+            lambda: self._edit(self.draft.duplicate, self.picked, select_new=True))
         self.remove_button = _named(QPushButton("Remove"), "Remove", "take the picked plant "
                                     "out of the layout (Delete)")
-        self.remove_button.clicked.connect(lambda: self._edit(self.model.remove, self.picked))
+        self.remove_button.clicked.connect(lambda: self._edit(self.draft.remove, self.picked))
         # Delete removes the picked plant only while the layout editor has the focus (a
         # button's shortcut is the whole window's: Delete in the 3D view removed a plant)
         self.remove_shortcut = QShortcut(QKeySequence(QKeySequence.StandardKey.Delete), self)
@@ -280,12 +280,12 @@ class LayoutPanel(QWidget):
                                   f"turn the picked plant {ROTATE_STEP_DEG:g}° about its "
                                   "stalk, counter-clockwise seen from above")
         self.left_button.clicked.connect(
-            lambda: self._edit(self.model.rotate, self.picked, ROTATE_STEP_DEG))
+            lambda: self._edit(self.draft.rotate, self.picked, ROTATE_STEP_DEG))
         self.right_button = _named(_tool("⟳"), "rotate right",
                                    f"turn the picked plant {ROTATE_STEP_DEG:g}° about its "
                                    "stalk, clockwise seen from above")
         self.right_button.clicked.connect(
-            lambda: self._edit(self.model.rotate, self.picked, -ROTATE_STEP_DEG))
+            lambda: self._edit(self.draft.rotate, self.picked, -ROTATE_STEP_DEG))
         for b in (self.add_button, self.duplicate_button, self.remove_button,
                   self.left_button, self.right_button):
             bar.addWidget(b)
@@ -326,11 +326,11 @@ class LayoutPanel(QWidget):
 
     @property
     def layout_(self):
-        return self.model.base
+        return self.draft.base
 
     @property
     def plants(self) -> set[int]:
-        return self.model.plants
+        return self.draft.plants
 
     def show_layout(self, layout, plants: set[int],
                     bases: dict[int, tuple[float, float]] | None = None) -> None:
@@ -340,27 +340,27 @@ class LayoutPanel(QWidget):
         self.history.clear()
         self._applied = tuple(layout.placements)
         self._said = ()
-        self.model.start(layout, plants, bases)
+        self.draft.start(layout, plants, bases)
 
     def document(self) -> dict:
         """The edited layout as a layout document (schema 1)."""
-        return self.model.document()
+        return self.draft.document()
 
     def edited_layout(self):
         """The edited layout, checked (raises LayoutError naming the problem)."""
-        return self.model.layout()
+        return self.draft.layout()
 
     # ------------------------------------------------------------------ showing
     def _on_changed(self, index: int) -> None:
-        base = self.model.base
+        base = self.draft.base
         if index >= 0:
-            self.view.update_plant(index, self.model.placements[index])
+            self.view.update_plant(index, self.draft.placements[index])
         else:
             picked = self.picked
-            self.view.show_layout(base, self.model.placements)
+            self.view.show_layout(base, self.draft.placements)
             self._fill_tilings()
             self._fill_parameters()
-            if 0 <= picked < len(self.model.placements):
+            if 0 <= picked < len(self.draft.placements):
                 self.select(picked)
         self._overlap_timer.start()
         self._sync_buttons()
@@ -369,21 +369,21 @@ class LayoutPanel(QWidget):
             return
         x0, y0, x1, y1 = base.bounds
         self.info.setText(
-            f"{_count(len(self.model.placements), 'plant')} on "
+            f"{_count(len(self.draft.placements), 'plant')} on "
             f"{fmt(base.ground_area_cm2 / 1e4, 2)} m², "
             f"field x {fmt(x0, 0)}..{fmt(x1, 0)} cm, y {fmt(y0, 0)}..{fmt(y1, 0)} cm; rows "
             f"{base.row_spacing:g} cm apart, plants {base.plant_spacing:g} cm")
         self._show_state()
 
     def _show_state(self) -> None:
-        edits = self.model.edits()
-        applied = self._applied == tuple(self.model.placements)
+        edits = self.draft.edits()
+        applied = self._applied == tuple(self.draft.placements)
         self.state.setText(f"{edits} plant{'s' if edits != 1 else ''} edited"
                            + ("" if applied else " · not applied yet"))
 
     def _show_overlaps(self) -> None:
         """Plants standing on each other's ground: red in the view and the table, listed."""
-        pairs = self.model.overlaps()
+        pairs = self.draft.overlaps()
         involved = {i for i, j, _d in pairs} | {j for i, j, _d in pairs}
         self.view.set_overlapping(involved)
         self.rows.overlapping = involved
@@ -391,7 +391,7 @@ class LayoutPanel(QWidget):
             self.rows.dataChanged.emit(self.rows.index(0, 0),
                                        self.rows.index(self.rows.rowCount() - 1, 3))
         self.overlaps.clear()
-        ps = self.model.placements
+        ps = self.draft.placements
         for i, j, d in pairs[:OVERLAPS_LISTED]:
             item = QListWidgetItem(f"plants {ps[i].plant} and {ps[j].plant} (rows {i + 1} "
                                    f"and {j + 1}) stand {d:.1f} cm apart")
@@ -408,7 +408,7 @@ class LayoutPanel(QWidget):
     def _fill_tilings(self) -> None:
         self.tiling.blockSignals(True)
         self.tiling.clear()
-        block = self.model.block()
+        block = self.draft.block()
         for n in TILINGS:
             if block is None:
                 break
@@ -418,12 +418,12 @@ class LayoutPanel(QWidget):
             elif n == 3 and block == (3, 3):
                 text += " (the paper)"
             self.tiling.addItem(text, n)
-        current = self.model.tiling
+        current = self.draft.tiling
         if current is not None and current[0] == current[1] and current[0] in TILINGS \
                 and block is not None:
             self.tiling.setCurrentIndex(TILINGS.index(current[0]))
         else:
-            self.tiling.addItem(self.model.source or ("from a layout file" if current is None
+            self.tiling.addItem(self.draft.source or ("from a layout file" if current is None
                                                       else f"{current[0]} x {current[1]} "
                                                       "tiles"), None)
             self.tiling.setCurrentIndex(self.tiling.count() - 1)
@@ -432,21 +432,21 @@ class LayoutPanel(QWidget):
 
     def _fill_parameters(self) -> None:
         """The parameter fields say the layout shown: its rows x plants and spacings."""
-        base = self.model.base
+        base = self.draft.base
         if base is None:
             return
-        rows, per_row = self.model.grid()
+        rows, per_row = self.draft.grid()
         self.rows_box.setValue(rows)
         self.per_row_box.setValue(per_row)
         self.row_spacing_box.setValue(base.row_spacing)
         self.plant_spacing_box.setValue(base.plant_spacing)
 
     def _sync_buttons(self) -> None:
-        picked = 0 <= self.picked < len(self.model.placements)
+        picked = 0 <= self.picked < len(self.draft.placements)
         for b in (self.duplicate_button, self.remove_button, self.left_button,
                   self.right_button):
             b.setEnabled(picked)
-        self.add_button.setEnabled(self.model.base is not None)
+        self.add_button.setEnabled(self.draft.base is not None)
 
     # ------------------------------------------------------------------ picking
     @property
@@ -476,7 +476,7 @@ class LayoutPanel(QWidget):
             self.problem.emit(f"layout: {exc}")
             return False
         if done and select_new:
-            self.select(len(self.model.placements) - 1)
+            self.select(len(self.draft.placements) - 1)
         return bool(done)
 
     def _on_edit(self, *_edit) -> None:
@@ -485,36 +485,36 @@ class LayoutPanel(QWidget):
             self.apply()                        # in the window, the study applies it
 
     def _on_snap(self, *_args) -> None:
-        self.model.snap_cm = self.snap_step.value() if self.snap.isChecked() else 0.0
+        self.draft.snap_cm = self.snap_step.value() if self.snap.isChecked() else 0.0
 
     def add_plant(self) -> bool:
         """A new plant (the lowest digitized plant id) one plant spacing beyond the end of
         the picked plant's row (or of the last row); it is picked."""
-        ps = self.model.placements
-        if self.model.base is None or not ps:
+        ps = self.draft.placements
+        if self.draft.base is None or not ps:
             return False
         at = self.picked if 0 <= self.picked < len(ps) else \
             max(range(len(ps)), key=lambda i: ps[i].x)
-        return self._edit(self.model.add, *self.model.row_end(at), select_new=True)
+        return self._edit(self.draft.add, *self.draft.row_end(at), select_new=True)
 
     def lay_out(self) -> bool:
         """Rows x plants at the spacings typed (asks first over edits)."""
         if not self._replace_ok("The new rows x plants replace every plant position"):
             return False
-        return self._edit(self.model.regular, self.rows_box.value(), self.per_row_box.value(),
+        return self._edit(self.draft.regular, self.rows_box.value(), self.per_row_box.value(),
                           self.row_spacing_box.value(), self.plant_spacing_box.value())
 
     def set_tiling(self, n: int) -> bool:
         """Tile the digitized block ``n`` x ``n`` times; asks first when it would replace
         edited positions. Returns whether the tiling changed."""
-        if self.model.block() is None or self.model.tiling == (n, n) or \
+        if self.draft.block() is None or self.draft.tiling == (n, n) or \
                 not self._replace_ok("The new tiling replaces every plant position"):
             self._fill_tilings()
             return False
-        return self._edit(self.model.tile, n)
+        return self._edit(self.draft.tile, n)
 
     def _replace_ok(self, what: str) -> bool:
-        edits = self.model.edits()
+        edits = self.draft.edits()
         return not edits or self._confirm(
             f"{what}: your edits to {edits} plant{'s' if edits != 1 else ''} will be gone "
             "(Undo brings them back).")
@@ -539,7 +539,7 @@ class LayoutPanel(QWidget):
         if self.study is not None:
             self.study.apply_draft()
             return
-        if self.model.base is None:
+        if self.draft.base is None:
             return
         try:
             new = self.edited_layout()
@@ -557,13 +557,13 @@ class LayoutPanel(QWidget):
     def load(self, path) -> bool:
         """Replace the layout with a layout file (undoable; asks first over edits)."""
         try:
-            new = load_layout(path, self.model.plants)
+            new = load_layout(path, self.draft.plants)
         except LayoutError as exc:
             self.problem.emit(str(exc))
             return False
         if not self._replace_ok("The layout file replaces every plant position"):
             return False
-        return self._edit(self.model.replace_layout, new, None, "load layout file")
+        return self._edit(self.draft.replace_layout, new, None, "load layout file")
 
     def save(self, path) -> bool:
         """Write the edited layout as a layout file (atomically)."""

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.light.sources.sky import Sky
 from maizeviz.light.sources.sun import Sun
 from maizeviz.mesh.tessellate import triangle_areas_normals

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.light.report.tables import leaf_values
 
 #: The arrays a light export may hold: name -> what it is, with its unit.

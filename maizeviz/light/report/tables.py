@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.ids import groups
 from maizeviz.io.atomic import atomic_open
 from maizeviz.light.results.diffuse import PeriodLight

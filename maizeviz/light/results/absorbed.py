@@ -1,5 +1,5 @@
 """Light absorbed by the leaves and the ground, with scattering, as traced by
-:mod:`maizeviz.light.trace.absorbed`: the energy balance (:class:`Balance`), the power or
+:mod:`maizeviz.light.trace.absorption`: the energy balance (:class:`Balance`), the power or
 energy each triangle absorbed, and tables per leaf and per plant.
 
 Units: W and W/m2 of sample ground for one instant (:class:`AbsorbedLight`), J and MJ/m2 over a
@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Any, Self
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.light.results.on_triangles import TriangleResult
 from maizeviz.light.results.per_leaf import LightRow, leaf_sums
 from maizeviz.light.results.traced import TableBy, table_kind

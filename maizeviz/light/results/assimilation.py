@@ -49,7 +49,7 @@ from maizeviz.photosynthesis.units import CO2_G_PER_MOL, KG_HA_H_PER_UMOL_M2_S
 if TYPE_CHECKING:
     import pandas as pd
 
-    from maizeviz.canopy.scene import Canopy
+    from maizeviz.canopy.build import Canopy
     from maizeviz.light.results.traced import TableBy
     from maizeviz.light.results.uncertainty import Batches
 

@@ -1,5 +1,5 @@
 """Diffuse light under a sky and light over a period, as traced by
-:mod:`maizeviz.light.trace.diffuse`: transmission by height and binned over each sensor plane,
+:mod:`maizeviz.light.trace.directions`: transmission by height and binned over each sensor plane,
 the light each triangle intercepts, and (for a period) PAR doses per time step and summed."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from functools import cached_property
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.light.results.maps import TransmissionMap
 from maizeviz.light.results.per_leaf import LightRow, leaf_sums
 from maizeviz.light.results.traced import MappedLight
@@ -23,7 +23,7 @@ from maizeviz.light.sources.sky import Sky
 class SkyLight(MappedLight):
     """Diffuse light under a sky.
 
-    From :func:`~maizeviz.light.trace.diffuse.trace_sky` (``LightEngine.sky``): every
+    From :func:`~maizeviz.light.trace.directions.trace_sky` (``LightEngine.sky``): every
     direction of the sky traced like the sun, weighted by its share of the horizontal
     diffuse irradiance.
 
@@ -136,7 +136,7 @@ class SkyLight(MappedLight):
 class PeriodLight(MappedLight):
     """Light over a period (a day), PAR doses in mol per m2 of ground.
 
-    From :func:`~maizeviz.light.trace.diffuse.trace_period` (``LightEngine.day``): the sun
+    From :func:`~maizeviz.light.trace.directions.trace_period` (``LightEngine.day``): the sun
     traced at every time step, the sky once.
 
     Parameters

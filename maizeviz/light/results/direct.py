@@ -1,5 +1,5 @@
 """A sun's direct light through a canopy, as traced by
-:func:`~maizeviz.light.trace.direct.trace_light`: transmission on the sensor planes, where each
+:func:`~maizeviz.light.trace.beam.trace_light`: transmission on the sensor planes, where each
 ground ray first met a leaf, and the hit classes per triangle."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ from functools import cached_property
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.light.results.per_leaf import LightRow, leaf_light, triangle_light
 from maizeviz.light.results.traced import TracedLight
 from maizeviz.light.scene.rays import ray_grid
@@ -20,7 +20,7 @@ from maizeviz.light.sources.sun import Sun
 class LightResult(TracedLight):
     """A sun's direct light through a canopy.
 
-    From :func:`~maizeviz.light.trace.direct.trace_light` (``LightEngine.sun``):
+    From :func:`~maizeviz.light.trace.beam.trace_light` (``LightEngine.sun``):
     transmission on the sensor planes, where each ground ray first met a leaf, and the hit
     classes per triangle.
 

@@ -25,7 +25,7 @@ import numpy as np
 from maizeviz.light.results.uncertainty import batch_error
 
 if TYPE_CHECKING:
-    from maizeviz.canopy.scene import Canopy
+    from maizeviz.canopy.build import Canopy
 
 
 @dataclass(frozen=True, eq=False)

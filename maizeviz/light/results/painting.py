@@ -26,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.ids import groups
 from maizeviz.light.results.direct import LightResult

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.layout import CanopyLayout
-from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.ids import groups
 from maizeviz.light.scene.rays import Rect

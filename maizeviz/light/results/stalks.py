@@ -1,6 +1,6 @@
 """Light taken by the stalks, reported apart from the leaves.
 
-A canopy's stalks (one tube per plant, :func:`~maizeviz.canopy.scene.stalk_mesh`) intercept
+A canopy's stalks (one tube per plant, :func:`~maizeviz.canopy.build.stalk_mesh`) intercept
 and scatter light like any organ when traced (``LightEngine(..., with_stalks=True)``, the
 default; ``--leaves-only`` on the command line leaves them out, the paper's canopy). Per-triangle
 results then hold the canopy's F leaf triangles followed by its G stalk triangles; the leaf
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.light.results.per_leaf import LightRow, tile_representatives
 from maizeviz.mesh.tessellate import triangle_areas_normals

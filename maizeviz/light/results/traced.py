@@ -24,7 +24,7 @@ from maizeviz.light.scene.rays import Rect
 if TYPE_CHECKING:
     import pandas as pd
 
-    from maizeviz.canopy.scene import Canopy
+    from maizeviz.canopy.build import Canopy
 
 #: What :meth:`TracedLight.table` tabulates.
 TABLES = ("height", "leaf", "plant")

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
-    from maizeviz.canopy.scene import Canopy
+    from maizeviz.canopy.build import Canopy
 
 #: Independent batches the primary rays are dealt into.
 BATCHES = 8

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.errors import MaizevizError, check_range
 from maizeviz.light.scene.rays import Rect, check_density, check_rect, ray_count
 from maizeviz.light.sources.sun import Sun

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.light.scene.periodic import Wrap, overhang_copies, snap
 
 

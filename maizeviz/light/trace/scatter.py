@@ -3,7 +3,7 @@ direction of a sky) through the canopy, leaves and ground reflecting and transmi
 :class:`~maizeviz.light.trace.optics.Optics` say.
 
 The beam's rays are the ground rays of the direct-light computation
-(:func:`~maizeviz.light.trace.direct.trace_direction`): a regular grid over the sample
+(:func:`~maizeviz.light.trace.beam.trace_direction`): a regular grid over the sample
 rectangle, each ray carrying the beam's power over its footprint. Each ray is followed:
 
 - at a leaf it deposits the share ``1 - reflectance - transmittance`` of what it carries on
@@ -46,7 +46,7 @@ import numpy as np
 
 from maizeviz.light.results.uncertainty import BATCHES
 from maizeviz.light.scene.rays import ray_grid
-from maizeviz.light.trace.direct import Sampler, trace_direction
+from maizeviz.light.trace.beam import Sampler, trace_direction
 from maizeviz.light.trace.optics import Optics
 from maizeviz.progress import ProgressCallback, ordered_map, report
 

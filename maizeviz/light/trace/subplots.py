@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.light.scene.rays import Rect, Tracer, grid_shape, sensor_offsets
 from maizeviz.light.trace.hits import SECOND_HIT_EPS, SunRays, lattice_first_hits
 from maizeviz.mesh.raytrace import RayScene
@@ -140,11 +140,11 @@ def sub_canopy(canopy: Canopy, placements: np.ndarray) -> tuple[Canopy, np.ndarr
 
 def family_used(shape: tuple[int, int], rect: Rect, heights: np.ndarray, top: float,
                 s: np.ndarray) -> bool:
-    """Whether :func:`~maizeviz.light.trace.direct.trace_direction` answers the sensor planes
+    """Whether :func:`~maizeviz.light.trace.beam.trace_direction` answers the sensor planes
     of an open field by ray families (else by an occlusion query per sensor): its decision,
     made from the shifted rectangles' union area (coordinate compression) instead of a mask
     of the whole lattice."""
-    from maizeviz.light.trace.direct import OCCLUSION_COST
+    from maizeviz.light.trace.beam import OCCLUSION_COST
 
     planes = _planes(heights, top)
     if not planes:
@@ -176,7 +176,7 @@ def _planes(heights: np.ndarray, top: float) -> list[int]:
 
 
 def _shifts(shape: tuple[int, int], rect: Rect, heights: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """r_k as :func:`~maizeviz.light.trace.direct._lattice_shifts` computes them (every plane)."""
+    """r_k as :func:`~maizeviz.light.trace.beam._lattice_shifts` computes them (every plane)."""
     x0, y0, x1, y1 = rect
     cell = np.array([(x1 - x0) / shape[0], (y1 - y0) / shape[1]])
     t = np.asarray(heights, np.float64)[:, None] * (s[:2] / s[2]) / cell
@@ -227,7 +227,7 @@ def trace_window(canopy: Canopy, placement: np.ndarray, n_placements: int, windo
 
     Returns the window's :class:`WindowCounts`.
     """
-    from maizeviz.light.scene.scenes import light_scene
+    from maizeviz.light.scene.embree_scenes import light_scene
 
     s = np.asarray(toward, dtype=np.float64)
     heights = np.asarray(heights_cm, dtype=np.float64)
@@ -329,7 +329,7 @@ def whole_counts(canopy: Canopy, first_hits: np.ndarray, second_hits: np.ndarray
 
 def default_top(canopy: Canopy) -> float:
     """The top plane (cm) of a canopy's rays: 1 cm above its highest triangle, as
-    :func:`~maizeviz.light.trace.direct.sampler` sets it."""
+    :func:`~maizeviz.light.trace.beam.sampler` sets it."""
     from maizeviz.light.scene.request import canopy_top
 
     return canopy_top(canopy) + 1.0

@@ -44,11 +44,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.ids import groups
 from maizeviz.light.results.uncertainty import BATCHES
 from maizeviz.light.scene.rays import Tracer
-from maizeviz.light.trace.direct import Sampler
+from maizeviz.light.trace.beam import Sampler
 
 if TYPE_CHECKING:       # scipy.sparse (0.3 s, and numpy.f2py) is imported when sampled
     from scipy.sparse import csr_array

@@ -1,7 +1,7 @@
 """Diffuse light from the sky and light over a day or a period, on one Embree scene.
 
 Every direction, a sky element or the sun at a time step, is traced exactly like the sun of
-:func:`~maizeviz.light.trace.direct.trace_light`: parallel rays landing on the ground rectangle
+:func:`~maizeviz.light.trace.beam.trace_light`: parallel rays landing on the ground rectangle
 (first hits: light intercepted per triangle) and sensor planes at each height (transmission),
 with the same periodic wrap. The scene is built once and shared by every direction; directions
 run in parallel on ``threads`` threads (Embree releases the GIL), and ``progress(done, total)``
@@ -49,8 +49,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.layout import stands_identity
-from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import MaizevizError
 from maizeviz.light.results.diffuse import PeriodLight, SkyLight
 from maizeviz.light.results.maps import bin_edges, binned, binned_grid
@@ -64,7 +64,7 @@ from maizeviz.light.scene.request import (
 from maizeviz.light.sources.irradiance import Period
 from maizeviz.light.sources.perez import DiffuseSplit
 from maizeviz.light.sources.sky import Sky
-from maizeviz.light.trace.direct import Sampler, sampler, scene_for, trace_direction
+from maizeviz.light.trace.beam import Sampler, sampler, scene_for, trace_direction
 from maizeviz.mesh.raytrace import RayScene
 from maizeviz.progress import ProgressCallback, ordered_map, report
 
@@ -204,7 +204,7 @@ def trace_sky(canopy: Canopy, sky: Sky, sampling: Sampling | LightRequest,
         a :class:`LightRequest` whose sun is ignored)
     progress : ``progress(done, total)`` after each direction; returning ``False`` cancels
         with InterruptedError
-    scene : the canopy's scene from :func:`~maizeviz.light.scene.scenes.light_scene` (same
+    scene : the canopy's scene from :func:`~maizeviz.light.scene.embree_scenes.light_scene` (same
         ``with_stalks`` and ``periodic``); built here when not given
     bin_cm : bin edge of the maps, cm
 

@@ -36,12 +36,12 @@ from typing import TypeVar
 
 import numpy as np
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.layout import stands_identity
-from maizeviz.canopy.scene import Canopy
 from maizeviz.light.results.direct import LightResult
+from maizeviz.light.scene.embree_scenes import scene_for
 from maizeviz.light.scene.rays import Rect, Tracer, ray_grid, sensor_offsets
 from maizeviz.light.scene.request import LightRequest, canopy_top, check_request
-from maizeviz.light.scene.scenes import scene_for
 from maizeviz.light.trace.hits import (
     SunRays,
     first_hits,
@@ -426,7 +426,7 @@ def trace_light(canopy: Canopy, req: LightRequest, progress: ProgressCallback | 
     ----------
     progress : called after each chunk of rays; returning ``False`` cancels with
         :class:`InterruptedError`
-    scene : the canopy's scene from :func:`~maizeviz.light.scene.scenes.light_scene` (same
+    scene : the canopy's scene from :func:`~maizeviz.light.scene.embree_scenes.light_scene` (same
         ``with_stalks`` and ``periodic``), to trace several suns on one scene; built here when
         not given
     """

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from maizeviz.canopy.scene import Canopy
+from maizeviz.canopy.build import Canopy
 from maizeviz.light.scene.periodic import (
     ANCHOR_CM,
     COPY_MARGIN_CM,

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import Any, NamedTuple
 
-from maizeviz.io.project import ProjectError, get
+from maizeviz.io.archive import ProjectError, get
 from maizeviz.project.settings import run_settings, settings_doc  # noqa: F401 - re-exported
 from maizeviz.project.study import CANOPY, LIGHT, Opened, StoredResult
 

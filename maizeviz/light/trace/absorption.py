@@ -24,8 +24,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.layout import stands_identity
-from maizeviz.canopy.scene import Canopy
 from maizeviz.errors import check_range
 from maizeviz.light.results.absorbed import AbsorbedLight, AbsorbedPeriod, Balance
 from maizeviz.light.results.uncertainty import BATCHES, Batches
@@ -33,7 +33,7 @@ from maizeviz.light.sources.irradiance import Period
 from maizeviz.light.sources.perez import PEREZ_MODELS, perez_split
 from maizeviz.light.sources.sky import Sky
 from maizeviz.light.sources.sun import Sun
-from maizeviz.light.trace.direct import Sampler
+from maizeviz.light.trace.beam import Sampler
 from maizeviz.light.trace.optics import Optics, band_share
 from maizeviz.light.trace.scatter import scatter_beam, scatter_sky
 from maizeviz.light.trace.sunlit import geometry, sunlit_share
@@ -69,7 +69,7 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
     canopy : Canopy
         The canopy of the scene (its north, leaf ranks and mesh level).
     smp : Sampler
-        The scene, sample rectangle, density and field (:func:`~.direct.sampler`).
+        The scene, sample rectangle, density and field (:func:`~.beam.sampler`).
     normals : (F, 3) float64
         Unit normals of the scene's leaf triangles, then its stalks' if traced.
     optics : Optics
