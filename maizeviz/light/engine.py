@@ -661,7 +661,7 @@ def _with_sampled_sunlit(canopy: Canopy, scene: RayScene, result: LightResult,
     clipped it, which biased their sums low)."""
     from time import perf_counter
 
-    from maizeviz.light.trace.direct import sampler
+    from maizeviz.light.trace.beam import sampler
     from maizeviz.light.trace.sunlit import geometry, sunlit_share
 
     t0 = perf_counter()

@@ -66,7 +66,7 @@ def test_the_sampled_sunlit_area_comes_back_with_a_project(tmp_path):
     from dataclasses import replace
 
     from maizeviz.canopy.layout import layout_for
-    from maizeviz.io.project import ProjectError, load_project, save_project
+    from maizeviz.io.archive import ProjectError, load_project, save_project
     from maizeviz.leaf.fit import read_leaves
     from maizeviz.project.study import read_study, save_study
 

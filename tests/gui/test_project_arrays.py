@@ -24,7 +24,7 @@ def lit_window(window, qtbot, small_points):
 
 def _damaged(path, out, name, damage):
     """The project at ``path`` with its sun's array ``name`` damaged, written to ``out``."""
-    from maizeviz.io.project import load_project, save_project
+    from maizeviz.io.archive import load_project, save_project
 
     project = load_project(path)
     rec = project.results[0]
