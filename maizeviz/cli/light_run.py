@@ -472,7 +472,7 @@ def _trace_sun(job: _Job, lv: _Level) -> None:
     """The sun: transmission by height and, for the tables, its hit classes."""
     assert job.sun is not None
     res = lv.engine.sun(job.sun, classes=job.want_rows or job.n_levels == 1
-                        or bool(job.args.export),
+                        or bool(job.args.export), sunlit=job.want_rows,
                         progress=Progress(f"tracing {lv.label}"))
     lv.res = res
     lv.warnings += res.warnings

@@ -156,7 +156,7 @@ class LightEngine:
     def sun(self, sun: Sun | None = None, *, date: str | None = None, time: str | None = None,
             lat: float | None = None, lon: float | None = None, tz: str | None = None,
             solar_noon: bool = False, altitude: float = 0.0, zenith: float | None = None,
-            azimuth: float | None = None, classes: bool = True,
+            azimuth: float | None = None, classes: bool = True, sunlit: bool = True,
             sampling: Sampling | None = None,
             progress: ProgressCallback | None = None, **fields) -> LightResult:
         """Direct sunlight: transmission by height and the hit classes of one sun.
@@ -185,6 +185,11 @@ class LightEngine:
             The sun's azimuth, clockwise from north [deg] (default 180 with ``zenith``).
         classes : bool
             Also trace second hits and per-triangle counts (the hit classes).
+        sunlit : bool
+            With the hit classes, also sample each triangle's sunlit area from the triangle
+            toward the sun, for the leaf and plant tables (bounded and unbiased; about the
+            trace's time again); False: the tables read the rays' count capped at each leaf's
+            area (the command line samples only for ``--leaf-light`` or ``--plant-light``).
         sampling : Sampling, optional
             Instead of the engine's.
         progress : callable, optional
@@ -218,7 +223,7 @@ class LightEngine:
         result = trace_light(self.canopy, LightRequest(sun, smp, classes),
                              progress, self.with_stalks, scene)
         result.seconds["build"] = build_s
-        if result.first_hits is not None:
+        if sunlit and result.first_hits is not None:
             result = _with_sampled_sunlit(self.canopy, scene, result, self._normals(),
                                           self.with_stalks)
         return result.with_canopy(self.canopy)
