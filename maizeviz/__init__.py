@@ -22,7 +22,7 @@ neither numpy nor Embree until a name is asked for.
 import importlib as _importlib
 from typing import TYPE_CHECKING
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 if TYPE_CHECKING:  # what a user's type checker sees (at run time the names load on first use)
     from maizeviz.api import build_canopy as build_canopy

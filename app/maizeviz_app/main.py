@@ -63,6 +63,15 @@ def run(argv: Sequence[str] | None = None) -> int:
         from maizeviz.resources import example_points
 
         points = str(example_points())
+    if args.screenshot:
+        from maizeviz.errors import MaizevizError
+        from maizeviz.io.outputs import check_run_paths
+
+        try:                                    # before any work: a folder that is not there
+            check_run_paths([("the screenshot", args.screenshot)], [("the input", points)])
+        except MaizevizError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            return 1
     window = MainWindow(points, DEFAULT_TILE if args.tile is None else args.tile)
     if args.workspace:
         window.workspaces.show(args.workspace)
@@ -87,7 +96,9 @@ def _ends(app, window, path: str, code: dict, before=None):
     from PySide6.QtCore import QTimer
 
     def shoot() -> None:
-        window.grab().save(path)
+        if not window.grab().save(path):
+            fail(f"{path}: the screenshot could not be written")
+            return
         print(f"saved {path}")
         if before is not None:
             before()

@@ -86,15 +86,18 @@ def _no_command(argv: list[str]) -> int:
     from maizeviz.main_command import main_parser
 
     rest = [a for a in argv if a != "--debug"]
-    named = main_parser().parse_args(rest).points     # a bad option: usage, exit 2
+    # a mistyped command, not a file to open: said before the app's own parser, which would
+    # only see a second file (``maizeviz lihgt points.csv``: "unrecognized arguments")
+    named = rest[0] if rest else None
     if named and not named.startswith("-") and not Path(named).exists():
         import difflib
 
         close = difflib.get_close_matches(named.lower(), list(COMMANDS), n=1, cutoff=0.6)
-        if close:                               # a mistyped command, not a file to open
+        if close:
             say(f"error: unknown command '{named}' (did you mean '{close[0]}'? "
                 "maizeviz --help lists the commands)")
             return EXIT_USAGE
+    main_parser().parse_args(rest)                     # a bad option: usage, exit 2
     gui, why = find_gui()
     if gui is None:
         say(f"note: {why}")

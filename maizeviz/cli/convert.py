@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from maizeviz.cli.common import EXIT_OK, say
+from maizeviz.cli.common import EXIT_OK, leaves_summary, say
 from maizeviz.io.outputs import check_run_paths
 
 #: The subcommand.
@@ -59,8 +59,10 @@ def _mtg(args: argparse.Namespace) -> int:
     from maizeviz.leaf.fit import read_leaves
 
     got = read_leaves(args.points)
-    for line in [*got.problems, *(str(e) for e in got.skipped)]:
+    for line in got.problems:
         say(f"warning: {line}")
+    if not got.leaves:                  # nothing to write: said as the other commands say it
+        return leaves_summary(0, list(got.skipped))
     write_mtg(args.out, got.leaves)
     from maizeviz.io.points import read_points
 
@@ -71,4 +73,5 @@ def _mtg(args: argparse.Namespace) -> int:
             "not in it (a Parquet or CSV --out keeps them)")
     plants = len({lf.plant for lf in got.leaves})
     say(f"wrote {plants:,} plants, {len(got.leaves):,} leaves to {args.out} (OpenAlea MTG)")
-    return EXIT_OK
+    # a leaf left out is said and exits 3, as every command that fits leaves does
+    return leaves_summary(len(got.leaves), list(got.skipped))

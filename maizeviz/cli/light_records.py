@@ -242,6 +242,7 @@ def print_tables(records: list[dict], sun: Sun | None, heights: tuple[float, ...
     cols += ["trace s"] if sun is not None else []
     cols += ["sky s"] if "sky" in r0["seconds"] else []
     cols += ["period s"] if "period" in r0["seconds"] else []
+    cols += ["absorbed s"] if "scatter" in r0["seconds"] else []
     cols += ["scene+trace vs first"]
     rows = []
     for r in records:
@@ -253,6 +254,8 @@ def print_tables(records: list[dict], sun: Sun | None, heights: tuple[float, ...
             row.append(f"{sec['sky']:.2f}")
         if "period" in sec:
             row.append(f"{sec['period']:.2f}")
+        if "scatter" in r0["seconds"]:
+            row.append(f"{sec.get('scatter', 0.0):.2f}")
         row.append(f"{_cost(r) / t_ref:.0%}" if t_ref > 0 else "")
         rows.append(row)
     print(fmt_table(cols, rows))
@@ -261,7 +264,7 @@ def print_tables(records: list[dict], sun: Sun | None, heights: tuple[float, ...
 def _cost(r: dict) -> float:
     sec = r["seconds"]
     return (sec["scene"] + sec.get("trace", 0.0) + sec.get("sky", 0.0)
-            + sec.get("period", 0.0))
+            + sec.get("period", 0.0) + sec.get("scatter", 0.0))
 
 
 def _print_sun(records: list[dict], sun: Sun, heights: tuple[float, ...],
@@ -392,6 +395,9 @@ def _print_balance(records: list[dict]) -> None:
     print(f"\nabsorbed {ab['band'].upper()} with scattering (leaf reflectance "
           f"{o['reflectance']:g}, transmittance {o['transmittance']:g}, ground "
           f"{o['ground_reflectance']:g}), {ab['units']}{measured}:")
+    # the stalks' share is a column of the balance when any level traced them: without it
+    # the row's parts did not add up to its incident light, though its closure was 0.01 %
+    stalks = any(r["balance"].get("absorbed_stalks") for r in records)
     rows = []
     for r in records:
         b = r["balance"]
@@ -399,10 +405,11 @@ def _print_balance(records: list[dict]) -> None:
         last = ("-" if mol is None else f"{mol:.2f}") if period else \
             f"{r['absorbed']['sunlit_lai']:.2f}"
         rows.append([r["level"], f"{b['incident']:.2f}", f"{b['absorbed_leaves']:.2f}",
+                     *([f"{b.get('absorbed_stalks', 0.0):.2f}"] if stalks else []),
                      f"{b['absorbed_ground']:.2f}", f"{b['reflected_top']:.2f}",
                      f"{b['escaped_sides'] + b['unresolved']:.2f}",
                      f"{b['closure_fraction']:+.2%}", last])
-    print(fmt_table(["level", "incident", "leaves", "ground", "reflected", "other",
-                     "closure (of incident)", "PAR mol/m2" if period else "sunlit LAI"],
-                    rows))
+    print(fmt_table(["level", "incident", "leaves", *(["stalks"] if stalks else []), "ground",
+                     "reflected", "other", "closure (of incident)",
+                     "PAR mol/m2" if period else "sunlit LAI"], rows))
 

@@ -87,7 +87,8 @@ def stalk_line(records: list[dict]) -> str | None:
         if "par_intercepted_mol_m2" in s:
             said.append(f"{s['par_intercepted_mol_m2']:.3f} mol/m2 of PAR over the period")
         if "absorbed" in s:
-            said.append(f"absorb {s['absorbed']:.4g} (balance units)")
+            units = (r.get("balance") or {}).get("units", "W/m2 of ground")
+            said.append(f"absorb {s['absorbed']:.4g} {units}")
         if said:
             parts.append(f"{r['level']}: " + ", ".join(said))
     if not parts:

@@ -344,4 +344,20 @@ def read_analyser(sight: Sight, positions: Sequence[AnalyserPosition], *,
             above[ring] += float(radiance.sum()) / len(positions)
         if pos.height_cm >= sight.top:
             notes.append(f"position {p_i + 1} is above the canopy")
+        if sight.outside(pos.x, pos.y):
+            notes.append(sight.outside_note(f"position {p_i + 1}", pos.x, pos.y))
+    notes += _closed_rings(below.mean(axis=0) / above)
     return AnalyserReadings(positions, above, below, cap, sky, int(rays_per_ring), notes)
+
+
+def _closed_rings(transmission: np.ndarray) -> list[str]:
+    """Notes for rings that saw no sky at any position: their contact number is infinite and
+    so is Miller's LAI."""
+    closed = [i for i in range(5) if transmission[i] == 0]
+    if not closed:
+        return []
+    names = ", ".join(f"{i + 1} ({RING_EDGES_DEG[i][0]:g}-{RING_EDGES_DEG[i][1]:g} deg)"
+                      for i in closed)
+    return [f"ring{'s' if len(closed) > 1 else ''} {names} saw no sky at any position: the "
+            "contact number is infinite and so is the LAI; add positions or lines of sight, "
+            "or widen the view cap"]

@@ -368,6 +368,8 @@ def read_ceptometer(sight: Sight, probes: Sequence[Probe], sun: Sun, *,
     notes = []
     if np.all(flat[:, 2] >= sight.top):
         notes.append("every sensor is above the canopy: nothing is intercepted")
+    notes += [sight.outside_note(f"probe {i + 1}", p.x, p.y)
+              for i, p in enumerate(probes) if sight.outside(p.x, p.y)]
     sunlit = np.ones(len(flat), dtype=bool)
     seen = np.ones(len(flat))
     if beam_fraction > 0:

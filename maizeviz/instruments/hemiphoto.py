@@ -227,5 +227,7 @@ def hemiphoto(sight: Sight, x: float, y: float, height_cm: float = 0.0, *, size:
     notes = []
     if height_cm >= sight.top:
         notes.append("the lens is above the canopy: the photograph is all sky")
+    if sight.outside(x, y):
+        notes.append(sight.outside_note("the lens", x, y))
     return Hemiphoto(float(x), float(y), float(height_cm), image, zen, sky, stalk, ring_edges,
                      notes)

@@ -85,6 +85,42 @@ class Sight:
         return cls(scene, canopy.layout.bounds, canopy_top(canopy, stalks) + SKY_MARGIN_CM,
                    bool(periodic), canopy.n_triangles)
 
+    def outside(self, x: float, y: float) -> bool:
+        """Whether a place is off the plot of an open field (where nothing stands around it).
+
+        Parameters
+        ----------
+        x, y : float
+            The place in field coordinates [cm].
+
+        Returns
+        -------
+        bool
+            True when the field is open (not periodic) and (x, y) lies outside its plot.
+        """
+        x0, y0, x1, y1 = self.bounds
+        return not self.periodic and not (x0 <= x <= x1 and y0 <= y <= y1)
+
+    def outside_note(self, what: str, x: float, y: float) -> str:
+        """What to tell the user of an instrument held off the plot of an open field.
+
+        Parameters
+        ----------
+        what : str
+            The instrument's part, as the note names it ("probe 1", "the lens").
+        x, y : float
+            Where it is held, in field coordinates [cm].
+
+        Returns
+        -------
+        str
+            One line naming the place, the plot's extent and the likely slip (units).
+        """
+        x0, y0, x1, y1 = self.bounds
+        return (f"{what} at ({x:g}, {y:g}) cm is outside the plot (x {x0:.1f} to {x1:.1f}, "
+                f"y {y0:.1f} to {y1:.1f} cm): it reads the open sky beside the field (positions "
+                "are in cm; --periodic repeats the plot)")
+
     def reach(self, origins: np.ndarray, toward: np.ndarray) -> np.ndarray:
         """How far each line of sight goes before it is above everything that stands.
 

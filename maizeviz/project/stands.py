@@ -70,7 +70,7 @@ def layout_from_parts(doc: dict, arrays: Mapping[str, Any], plants: set[int],
                       where: str) -> CanopyLayout:
     """The layout a project stored, validated like a layout file against the plants read, its
     stands in the order they were saved (projects without ``layout_placements``, from
-    maizeviz 0.3 and older: in the document's order)."""
+    maizeviz 0.1: in the document's order)."""
     layout = layout_from_dict(doc, plants, f"{where}: layout")
     stands = arrays.get("layout_placements")
     if stands is not None:

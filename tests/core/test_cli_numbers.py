@@ -146,3 +146,10 @@ def test_a_mistyped_command_is_a_usage_error_not_the_app(capsys, tmp_path, monke
         assert main([typo]) == EXIT_USAGE
         err = capsys.readouterr().err
         assert f"unknown command '{typo}'" in err and f"did you mean '{meant}'" in err
+    # with its file and options after it, as typed in earnest (it was argparse's
+    # "unrecognized arguments: points.csv", naming the file, not the typo)
+    (tmp_path / "points.csv").write_text("plant,leaf,row,col,x,y,z\n")
+    assert main(["lihgt", "points.csv", "--sun-zenith", "30"]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert "unknown command 'lihgt'" in err and "did you mean 'light'" in err
+    assert err.count("\n") == 1

@@ -241,3 +241,33 @@ def test_bad_settings_are_one_line_naming_them(sight, make, words):
         make(sight)
     msg = str(info.value)
     assert words in msg and "\n" not in msg
+
+
+def test_an_instrument_off_an_open_plot_says_so(canopy):
+    """A place typed in mm or m lands beside the field: the reading is the open sky's, and it
+    was given without a word (tau 1, LAI 0)."""
+    open_field = Sight.of(canopy, periodic=False)
+    far = 10 * SIDE
+    cep = read_ceptometer(open_field, [Probe(far, far)], Sun(30, 180))
+    assert cep.tau == 1.0 and any("outside the plot" in n for n in cep.notes)
+    ana = read_analyser(open_field, [AnalyserPosition(far, 50.0)], rays_per_ring=50)
+    assert any("position 1" in n and "outside the plot" in n for n in ana.notes)
+    photo = hemiphoto(open_field, 50.0, -far, 0.0, size=16)
+    assert any("outside the plot" in n for n in photo.notes)
+    inside = read_ceptometer(open_field, [Probe(SIDE / 2, SIDE / 2)], Sun(30, 180))
+    assert not any("outside" in n for n in inside.notes)
+    periodic = read_ceptometer(Sight.of(canopy, periodic=True), [Probe(far, far)], Sun(30, 180))
+    assert not any("outside" in n for n in periodic.notes)       # the plot repeats there
+
+
+def test_a_ring_that_sees_no_sky_is_named_beside_its_infinite_lai(sight):
+    """A ring that saw no gap made LAI inf with no note saying why. One line of sight a ring
+    under LAI 2 finds leaves in the low rings (gap about exp(-1 / cos 68 deg) = 0.07 in
+    ring 5); 2000 find gaps in every ring."""
+    one = read_analyser(sight, [AnalyserPosition(SIDE / 2, SIDE / 2)], rays_per_ring=1)
+    closed = [i + 1 for i in range(5) if one.transmission[i] == 0]
+    named = [n for n in one.notes if "saw no sky" in n]
+    assert closed and math.isinf(one.lai) and len(named) == 1
+    assert all(f"{i} (" in named[0] for i in closed)
+    many = read_analyser(sight, [AnalyserPosition(SIDE / 2, SIDE / 2)])
+    assert math.isfinite(many.lai) and not any("saw no sky" in n for n in many.notes)

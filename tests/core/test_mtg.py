@@ -136,3 +136,21 @@ def test_convert_to_an_mtg_and_back_gives_the_same_leaves(tmp_path, capsys):
     before = capsys.readouterr().out
     assert main(["leaf", str(tmp_path / "back.csv"), "--json"]) == 0
     assert capsys.readouterr().out == before
+
+
+def test_a_leaf_left_out_of_the_mtg_exits_3_as_the_other_commands(tmp_path, capsys):
+    """A NaN in one leaf: the MTG holds the others, the leaf is named as skipped and the exit
+    is 3 (some skipped), as ``maizeviz canopy`` gives for the same file; it was a warning
+    and exit 0."""
+    from maizeviz.cli import EXIT_PARTIAL, main
+
+    lines = mv.example_points().read_text().splitlines()
+    lines[5] = ",".join(lines[5].split(",")[:4] + ["nan"] + lines[5].split(",")[5:])
+    src = tmp_path / "nan.csv"
+    src.write_text("\n".join(lines) + "\n")
+    out = tmp_path / "p.mtg"
+    assert main(["convert", str(src), "--out", str(out)]) == EXIT_PARTIAL
+    err = capsys.readouterr().err
+    assert "skipped: plant" in err and "1 skipped" in err
+    assert len(read_mtg(out)) == len(mv.read_points(mv.example_points()).leaves) - 1
+    assert main(["canopy", str(src)]) == EXIT_PARTIAL

@@ -118,7 +118,7 @@ def test_an_older_project_with_an_edited_layout_drops_its_per_plant_results(poin
     sky = trace_sky(build_canopy(leaves, layout, LEVEL), make_sky("soc", 16), SAMPLING)
     proj = study.make_project(str(points), points.read_bytes(), layout, layout, {}, {},
                               [(LEVEL.label, sky)])
-    # as maizeviz 0.3 wrote it: no stands in order, no identity on the result
+    # as maizeviz 0.1 wrote it: no stands in order, no identity on the result
     arrays = {k: v for k, v in proj.arrays.items() if k != "layout_placements"}
     rec = proj.results[0]
     old = replace(proj, arrays=arrays,

@@ -66,3 +66,18 @@ def test_each_app_command_opens_computes_and_quits(folder, line):
     assert proc.returncode == 0, f"{line}\n{proc.stdout[-2000:]}\n{proc.stderr[-3000:]}"
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert "Traceback" not in proc.stderr and "error:" not in proc.stderr, proc.stderr[-3000:]
+
+
+def test_a_screenshot_into_a_missing_folder_is_refused_before_any_work(folder):
+    """It said "saved" and exited 0 with nothing written (Qt's save returned False)."""
+    png = folder / "no such folder" / "shot.png"
+    cmd = [sys.executable, "-m", "maizeviz", "--screenshot", str(png)]
+    if shutil.which("xvfb-run") is None:                             # pragma: no cover
+        pytest.skip("no xvfb-run here")
+    env = dict(os.environ, HOME=str(folder / "home"),
+               XDG_CONFIG_HOME=str(folder / "home" / ".config"))
+    proc = subprocess.run(["xvfb-run", "-a", *cmd], cwd=folder, env=env, capture_output=True,
+                          text=True, timeout=400)
+    assert proc.returncode == 1 and "saved" not in proc.stdout
+    assert "no such folder" in proc.stderr and proc.stderr.count("\n") == 1, proc.stderr
+    assert not png.parent.exists()
