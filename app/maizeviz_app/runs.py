@@ -17,6 +17,7 @@ MODES = ("sun", "sky", "day")
 #: Balance field -> the row's label.
 BALANCE_ROWS = (("incident", "{band} incident W/m²"),
                 ("absorbed_leaves", "absorbed by leaves W/m²"),
+                ("absorbed_stalks", "absorbed by stalks W/m²"),
                 ("absorbed_ground", "absorbed by the ground W/m²"),
                 ("reflected_top", "reflected out of the top W/m²"),
                 ("escaped_sides", "out of the sides W/m²"))
@@ -44,7 +45,8 @@ class Run:
     values: :class:`maizeviz_app.jobs.Diffuse`); for a sun traced with leaf optics, the light
     absorbed with scattering (:class:`maizeviz_app.jobs.Absorbed`). A sun's ``painting``
     (:class:`maizeviz.light.results.painting.SunPainting`, made with its classes) says how its light
-    can be painted honestly: per triangle or per leaf."""
+    can be painted honestly: per triangle or per leaf. ``stalks``: the stalks took light
+    (False: the leaves alone, ``maizeviz light --leaves-only``)."""
 
     label: str
     signature: tuple
@@ -53,6 +55,7 @@ class Run:
     kind: str = "sun"
     extra: Any = None
     painting: Any = None
+    stalks: bool = True
 
     @property
     def name(self) -> str:
@@ -186,7 +189,10 @@ class LightRuns:
         if balances:
             band = next(r.extra.light.band for r in self.runs.values()
                         if r.balance is not None).upper()
+            stalks = any(self.runs[name].stalks for name in balances)
             for field, what in BALANCE_ROWS:
+                if field == "absorbed_stalks" and not stalks:   # leaves only: no such row
+                    continue
                 row = [what.format(band=band)]
                 for name in names:
                     b = balances.get(name)
@@ -257,6 +263,9 @@ def run_info(run: Run) -> str:
         share = r.sunlit_intercepted_fraction
         if share is not None:
             info += f"; leaves take {share:.1%} of the direct light"
+            stalk_share = r.stalk_intercepted_fraction
+            if run.stalks and stalk_share is not None:
+                info += f", stalks {stalk_share:.1%}"
         if run.balance is not None:
             a = run.extra.light
             b = run.balance
@@ -289,6 +298,8 @@ def run_info(run: Run) -> str:
         info = (f"{r.n_steps} time steps and the sky ({sky}); {r.rays:,} rays per "
                 f"direction; level {run.label}; Embree scene {build}, tracing "
                 f"{secs.get('trace', 0):.2f} s")
+    if not run.stalks:
+        info += "; leaves only (the stalks let light through)"
     return info + "".join(f"\n⚠ {w}" for w in run_warnings(run) if "sun never rises" not in w)
 
 

@@ -40,6 +40,7 @@ from PySide6.QtWidgets import (
     QListWidgetItem,
     QMessageBox,
     QPushButton,
+    QSizePolicy,
     QSpinBox,
     QSplitter,
     QStyle,
@@ -152,6 +153,12 @@ class LayoutPanel(QWidget):
         self.splitter.addWidget(self.table)
         self.splitter.setStretchFactor(0, 3)
         self.splitter.setStretchFactor(1, 2)
+        # the view and table take what the dock leaves, down to their minimum, and ask for no
+        # more: a height asked for the sizes the splitter was given (60 % / 40 % of the
+        # panel's own height) made the panel taller than a laptop's dock, its state and
+        # Apply below the bottom edge
+        self.splitter.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Ignored)
+        self.splitter.setMinimumHeight(self.view.minimumHeight() + 80)
         lay.addWidget(self.splitter, 1)
 
         row = QHBoxLayout()
@@ -378,8 +385,12 @@ class LayoutPanel(QWidget):
     def _show_state(self) -> None:
         edits = self.draft.edits()
         applied = self._applied == tuple(self.draft.placements)
-        self.state.setText(f"{edits} plant{'s' if edits != 1 else ''} edited"
-                           + ("" if applied else " · not applied yet"))
+        text = f"{edits} plant{'s' if edits != 1 else ''} edited"
+        self.state.setText(text + ("" if applied else " · not applied yet"))
+        # the whole state where the dock is narrow: the label wraps, the tooltip says it all
+        self.state.setToolTip(f"{text} since the layout was opened or tiled; "
+                              + ("the canopy is built with it" if applied else
+                                 "Apply rebuilds the canopy with it"))
 
     def _show_overlaps(self) -> None:
         """Plants standing on each other's ground: red in the view and the table, listed."""
