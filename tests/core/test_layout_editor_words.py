@@ -36,8 +36,9 @@ def test_an_overlap_says_which_cells_overlap_by_how_much():
         across, along = 60.0 - abs(a.x - b.x), 30.0 - abs(a.y - b.y)
         assert across > 6.0 and along > 3.0                 # beyond a tenth of a spacing
         assert text.startswith(f"table lines {i + 1} and {j + 1}: ")
-        assert f"plant {a.plant}'s ground cell overlaps plant {b.plant}'s by {across:.1f} cm " \
-               f"across the rows and {along:.1f} cm along them" in text
+        want = (f"plant {a.plant}'s ground cell overlaps plant {b.plant}'s by {across:.1f} "
+                f"cm across the rows and {along:.1f} cm along them")
+        assert want in text
         assert f"(stalks {dist:.1f} cm apart)" in text
         assert "rows " not in text.split(":")[0]              # the table's lines, not rows
 

@@ -413,8 +413,9 @@ class LayoutPanel(QWidget):
             text = self.draft.overlap_text(i, j)
             item = QListWidgetItem(text)
             base = self.draft.base
-            item.setToolTip(f"{text}; a ground cell is {base.row_spacing:g} x "
-                            f"{base.plant_spacing:g} cm, centred on the stalk")
+            if base is not None:
+                item.setToolTip(f"{text}; a ground cell is {base.row_spacing:g} x "
+                                f"{base.plant_spacing:g} cm, centred on the stalk")
             item.setData(Qt.ItemDataRole.UserRole, j)
             self.overlaps.addItem(item)
         if len(pairs) > OVERLAPS_LISTED:
