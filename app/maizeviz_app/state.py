@@ -56,11 +56,10 @@ COLOUR_GROUPS = ("view colours", "heatmap colours", "colours")
 #: them; a layout further back is traced again).
 KEPT_LAYOUTS = 8
 #: What the light panel and the status bar say of results set aside by a layout edit.
-SET_ASIDE = ("the light results belong to the previous layout: set aside, Undo (Ctrl+Z) "
-             "brings them back; compute light for this layout")
+SET_ASIDE = ("light results set aside: they belong to the previous layout (Undo, Ctrl+Z, "
+             "brings them back; Compute traces this one)")
 #: What they say when a layout returns to stands whose results were set aside.
-BROUGHT_BACK = ("the light results of this layout, traced before the last edit, are back "
-                "(not traced again)")
+BROUGHT_BACK = "the light results of this layout are back (traced before the edit, not again)"
 
 
 def stands_key(layout: CanopyLayout) -> tuple[int, str]:

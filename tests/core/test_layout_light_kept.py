@@ -66,7 +66,7 @@ def test_a_drag_sets_the_light_aside_and_undo_brings_it_back(study, points):
     # set aside, said where the user looks: the status bar's line and the light panel's text
     assert not m.runs.runs and m.view.colouring == "leaf"
     line, status_only = m.said_lines[-1]
-    assert "light results belong to the previous layout" in line and "Undo" in line
+    assert "set aside: they belong to the previous layout" in line and "Undo" in line
     assert "belong to the previous layout" in m.runs_info
     # undo: the same layout, the same results (the same objects), nothing traced again
     m.history.undo()
