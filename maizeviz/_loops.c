@@ -1,7 +1,7 @@
 /* Compiled loops for maizeviz that numpy runs as dozens of passes over temporaries: the
  * triangle areas of K = 4 reference grids (what a triangle budget widens its leaves to), the
- * distances of a splitting's data points from its chords, and the B-spline basis matrices
- * every surface is fitted and sampled with.
+ * distances of a splitting's data points from its chords, the B-spline basis matrices
+ * every surface is fitted and sampled with, and a mesh file's repeated triangles and areas.
  *
  * Each function computes, element by element, exactly the floating-point operations the numpy
  * code it stands for (maizeviz/mesh/measures.py _grid_areas, maizeviz/mesh/simplify.py
@@ -21,6 +21,7 @@
 
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 #include <math.h>
 
 #if defined(_MSC_VER)
@@ -250,6 +251,162 @@ MZ_EXPORT int mz_basis_matrix(const double *x, const double *knots, int64_t nl, 
             for (int64_t c = 0; c < nctrl; ++c) row[c] = 0.0;
             for (int64_t r = 0; r <= degree; ++r) row[span - degree + r] = vals[r];
         }
+    }
+    return 0;
+}
+
+/* ---------------------------------------------------------------------------------------- */
+/* Triangles of a mesh file (maizeviz/canopy/from_mesh.py): which repeat an earlier one, and
+ * their areas, each in one pass where numpy makes a dozen over temporaries. */
+
+/* A vertex's coordinates as 64-bit patterns, -0.0 read as 0.0 (equal positions, equal bits). */
+static void vertex_bits(const double *v, uint64_t out[3]) {
+    for (int k = 0; k < 3; ++k) {
+        double x = v[k] == 0.0 ? 0.0 : v[k];
+        memcpy(&out[k], &x, sizeof x);
+    }
+}
+
+/* A triangle's corners by position in a fixed order (lexicographic on their bit patterns), so
+ * that two triangles of the same three corners, in any order, give the same nine words. */
+static void corners_sorted(const double *vertices, const int64_t *f, uint64_t c[9]) {
+    uint64_t p[3][3];
+    for (int j = 0; j < 3; ++j) vertex_bits(vertices + 3 * f[j], p[j]);
+    int o[3] = {0, 1, 2};
+    for (int i = 1; i < 3; ++i)
+        for (int j = i; j > 0; --j) {
+            const uint64_t *a = p[o[j - 1]], *b = p[o[j]];
+            int greater = a[0] != b[0] ? a[0] > b[0] : a[1] != b[1] ? a[1] > b[1] : a[2] > b[2];
+            if (!greater) break;
+            int t = o[j]; o[j] = o[j - 1]; o[j - 1] = t;
+        }
+    for (int j = 0; j < 3; ++j) memcpy(c + 3 * j, p[o[j]], sizeof p[0]);
+}
+
+static uint64_t mix(uint64_t h, uint64_t v) {
+    h = (h ^ v) * UINT64_C(0x9E3779B97F4A7C15);
+    return h ^ (h >> 31);
+}
+
+/* out[t] = 1 where triangle t's three corners (by position, in any order) are those of an
+ * earlier triangle, else 0. vertices (nv, 3) float64, faces (nf, 3) int64, C order, nf below
+ * 2^31. Each vertex gets a hash of its position, each triangle the sum of its corners' (the
+ * same in any order). The triangles are dealt, in order, into parts by their hash's top bits
+ * (a counting sort into a few dozen parts, so that each part's table, of 2^17 slots at most,
+ * stays in the cache where one table of them all is read at random from memory: at K = 4,
+ * 60 ms of CPU against one table's 75); in each part they go in order into
+ * an open-addressed table of twice their number (linear probing), and one whose hash is
+ * already there is compared corner by corner with the triangles holding it. used, unless
+ * NULL, (nv,): 1 for each vertex a triangle uses, else 0. Returns 0, -2 for a negative count,
+ * nf of 2^31 or more or a vertex index outside [0, nv) (out not written, used not an answer),
+ * -3 out of memory. */
+MZ_EXPORT int mz_repeated_triangles(const double *vertices, int64_t nv, const int64_t *faces,
+                                    int64_t nf, uint8_t *out, uint8_t *used) {
+    if (nv < 0 || nf < 0 || nf >= INT64_C(0x7FFFFFFF)) return -2;
+    int pbits = 0;                    /* 2^pbits parts of at most about 2^16 triangles: */
+    while (pbits < 16 && (INT64_C(1) << (pbits + 16)) < nf) ++pbits;   /* few streams to deal */
+    const int64_t nparts = INT64_C(1) << pbits;
+    uint64_t *hv = malloc(sizeof(uint64_t) * (size_t)(nv > 0 ? nv : 1));
+    uint64_t *key = malloc(sizeof(uint64_t) * (size_t)(nf > 0 ? nf : 1));
+    uint64_t *pkey = malloc(sizeof(uint64_t) * (size_t)(nf > 0 ? nf : 1));
+    int32_t *order = malloc(sizeof(int32_t) * (size_t)(nf > 0 ? nf : 1));
+    int64_t *start = calloc((size_t)nparts + 1, sizeof(int64_t));
+    int64_t *fill = malloc(sizeof(int64_t) * (size_t)nparts);
+    int32_t *table = NULL;
+    int rc = -3;
+    if (hv == NULL || key == NULL || pkey == NULL || order == NULL || start == NULL ||
+            fill == NULL)
+        goto done;
+    for (int64_t i = 0; i < nv; ++i) {
+        uint64_t b[3];
+        vertex_bits(vertices + 3 * i, b);
+        hv[i] = mix(mix(mix(0, b[0]), b[1]), b[2]);
+    }
+    if (used != NULL) memset(used, 0, (size_t)nv);   /* 1 for each vertex a triangle uses */
+    for (int64_t t = 0; t < nf; ++t) {
+        const int64_t *f = faces + 3 * t;
+        if ((f[0] < 0) | (f[0] >= nv) | (f[1] < 0) | (f[1] >= nv) | (f[2] < 0) | (f[2] >= nv)) {
+            rc = -2;
+            goto done;
+        }
+        key[t] = mix(hv[f[0]] + hv[f[1]] + hv[f[2]], 0);
+        ++start[pbits ? (int64_t)(key[t] >> (64 - pbits)) + 1 : 1];
+        if (used != NULL) used[f[0]] = used[f[1]] = used[f[2]] = 1;
+    }
+    int64_t most = 0;
+    for (int64_t p = 0; p < nparts; ++p) {
+        most = start[p + 1] > most ? start[p + 1] : most;
+        start[p + 1] += start[p];
+        fill[p] = start[p];
+    }
+    for (int64_t t = 0; t < nf; ++t) {            /* in order within each part */
+        const int64_t p = pbits ? (int64_t)(key[t] >> (64 - pbits)) : 0;
+        pkey[fill[p]] = key[t];
+        order[fill[p]++] = (int32_t)t;
+    }
+    int tbits = 4;
+    while ((INT64_C(1) << tbits) < 2 * most) ++tbits;
+    const uint64_t mask = (UINT64_C(1) << tbits) - 1;
+    table = malloc(sizeof(int32_t) * (size_t)(mask + 1));
+    if (table == NULL) goto done;
+    memset(out, 0, (size_t)nf);
+    for (int64_t p = 0; p < nparts; ++p) {
+        const int64_t a = start[p], n = start[p + 1] - a;
+        if (n < 2) continue;
+        memset(table, 0xff, sizeof(int32_t) * (size_t)(mask + 1));   /* -1: empty */
+        for (int64_t j = 0; j < n; ++j) {
+            const uint64_t k = pkey[a + j];
+            uint64_t slot = (k >> (64 - pbits - tbits)) & mask;
+            for (;; slot = (slot + 1) & mask) {
+                const int32_t s = table[slot];
+                if (s < 0) {
+                    table[slot] = (int32_t)j;
+                    break;
+                }
+                if (pkey[a + s] != k) continue;
+                uint64_t c0[9], c1[9];
+                corners_sorted(vertices, faces + 3 * (int64_t)order[a + s], c0);
+                corners_sorted(vertices, faces + 3 * (int64_t)order[a + j], c1);
+                if (memcmp(c0, c1, sizeof c0) == 0) {
+                    out[order[a + j]] = 1;
+                    break;
+                }
+            }
+        }
+    }
+    rc = 0;
+done:
+    free(hv); free(key); free(pkey); free(order); free(start); free(fill); free(table);
+    return rc;
+}
+
+/* Area (cm2) of each triangle, and (unless centre is NULL) its centroid seen from above (nf, 2),
+ * as _areas_centres computes them: per coordinate the corners a, b, d, the centre
+ * (a + b + d) / 3, the edges b - a and d - a; the cross product's squared components summed in
+ * order x, y, z; half its root. Returns 0, or -2 for a negative count or a vertex index
+ * outside [0, nv) (checked as the triangles come: what was written before is not an answer). */
+MZ_EXPORT int mz_triangle_areas(const double *vertices, int64_t nv, const int64_t *faces,
+                                int64_t nf, double *area, double *centre) {
+    if (nv < 0 || nf < 0) return -2;
+    for (int64_t t = 0; t < nf; ++t) {
+        const int64_t *f = faces + 3 * t;
+        if ((f[0] < 0) | (f[0] >= nv) | (f[1] < 0) | (f[1] >= nv) | (f[2] < 0) | (f[2] >= nv))
+            return -2;
+        const double *a = vertices + 3 * faces[3 * t], *b = vertices + 3 * faces[3 * t + 1],
+                     *d = vertices + 3 * faces[3 * t + 2];
+        double e1[3], e2[3];
+        for (int k = 0; k < 3; ++k) {
+            if (centre != NULL && k < 2) centre[2 * t + k] = (a[k] + b[k] + d[k]) / 3.0;
+            e1[k] = b[k] - a[k];
+            e2[k] = d[k] - a[k];
+        }
+        double c = e1[1] * e2[2] - e1[2] * e2[1];
+        double s = c * c;
+        c = e1[2] * e2[0] - e1[0] * e2[2];
+        s += c * c;
+        c = e1[0] * e2[1] - e1[1] * e2[0];
+        s += c * c;
+        area[t] = 0.5 * sqrt(s);
     }
     return 0;
 }

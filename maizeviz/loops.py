@@ -76,6 +76,10 @@ def _loaded() -> tuple[ctypes.CDLL | None, str]:
     lib.mz_chord_errors.argtypes = [p, p, p, i64, i64, i64, i64, p, p, p, p, p]
     lib.mz_basis_matrix.restype = ctypes.c_int
     lib.mz_basis_matrix.argtypes = [p, p, i64, i64, i64, i64, p]
+    for name in ("mz_repeated_triangles", "mz_triangle_areas"):
+        getattr(lib, name).restype = ctypes.c_int
+    lib.mz_repeated_triangles.argtypes = [p, i64, p, i64, p, p]
+    lib.mz_triangle_areas.argtypes = [p, i64, p, i64, p, p]
     return lib, ""
 
 
@@ -319,3 +323,113 @@ def basis_matrix(x: np.ndarray, knots: np.ndarray, degree: int) -> np.ndarray | 
                              out.ctypes.data)
     _check(rc, "basis_matrix")
     return out
+
+
+def check_mesh(vertices, faces) -> tuple[np.ndarray, np.ndarray]:
+    """A mesh as :func:`repeated_triangles` and :func:`triangle_areas` hand it to C: vertices
+    (V, 3) real numbers as C-contiguous float64, faces (T, 3) integers as C-contiguous int64,
+    each index in [0, V) (copies where they are not). ValueError in one line naming the
+    argument otherwise (numpy's negative indices too: a corner counted from the end is not
+    what a mesh file means)."""
+    v = _real(vertices, "vertices", 2)
+    f = _real(faces, "faces", 2)
+    if v.shape[1] != 3:
+        raise ValueError(f"vertices: (V, 3) expected, not shape {v.shape}")
+    if f.shape[1] != 3 or f.dtype.kind not in "iu":
+        raise ValueError(f"faces: (T, 3) integer indices expected, not {f.dtype} of shape "
+                         f"{f.shape}")
+    f = np.ascontiguousarray(f, dtype=np.int64)
+    if f.size and (f.min() < 0 or f.max() >= len(v)):
+        bad = f[(f < 0) | (f >= len(v))][0]
+        raise ValueError(f"faces: vertex index {bad} outside 0..{len(v) - 1}")
+    return np.ascontiguousarray(v, dtype=np.float64), f
+
+
+def _mesh_for_c(vertices, faces) -> tuple[np.ndarray, np.ndarray]:
+    """``vertices`` and ``faces`` as C takes them, checked in full only where C refuses them
+    (C checks the indices in a pass of its own, cheaper than numpy's two)."""
+    v, f = np.asarray(vertices), np.asarray(faces)
+    if (v.dtype == np.float64 and f.dtype == np.int64 and v.ndim == 2 and f.ndim == 2
+            and v.shape[1] == 3 and f.shape[1] == 3 and v.flags.c_contiguous
+            and f.flags.c_contiguous):
+        return v, f
+    return check_mesh(v, f)
+
+
+def repeated_triangles(vertices: np.ndarray, faces: np.ndarray, used: bool = False
+                       ) -> tuple[np.ndarray, np.ndarray | None] | None:
+    """(T,) bool: the triangles whose three corners (by position, -0.0 as 0.0, in any order)
+    are those of an earlier triangle, as :func:`maizeviz.canopy.from_mesh.repeated_triangles`
+    finds them; and, if ``used``, the vertices the triangles use, read in the same pass.
+
+    Parameters
+    ----------
+    vertices : (V, 3) real numbers
+    faces : (T, 3) integers in [0, V), T < 2^31
+    used : whether to say which vertices the faces use
+
+    Returns
+    -------
+    repeat : (T,) bool
+    used : (V,) bool, or None unless ``used``
+    None where the loops are not built (or T is 2^31 or more).
+
+    Raises
+    ------
+    ValueError
+        In one line naming the argument (:func:`check_mesh`).
+    """
+    v, f = _mesh_for_c(vertices, faces)
+    lib = _lib()
+    if lib is None:
+        check_mesh(v, f)
+        warn_fallback()
+        return None
+    if len(f) >= 2**31 - 1:
+        return None
+    out = np.empty(len(f), np.uint8)
+    seen = np.empty(len(v), np.uint8) if used else None
+    rc = lib.mz_repeated_triangles(v.ctypes.data, len(v), f.ctypes.data, len(f),
+                                   out.ctypes.data, None if seen is None else seen.ctypes.data)
+    if rc == -2:
+        check_mesh(v, f)                     # says which index
+    _check(rc, "repeated_triangles")
+    return out.view(bool), None if seen is None else seen.view(bool)
+
+
+def triangle_areas(vertices: np.ndarray, faces: np.ndarray, centres: bool = False
+                   ) -> tuple[np.ndarray, np.ndarray | None] | None:
+    """Areas of triangles and their centroids seen from above, as
+    ``maizeviz.canopy.from_mesh._areas_centres`` computes them (numpy's numbers to the bit).
+
+    Parameters
+    ----------
+    vertices : (V, 3) real numbers, cm
+    faces : (T, 3) integers in [0, V)
+    centres : whether to compute the centroids
+
+    Returns
+    -------
+    area : (T,) float64, cm2
+    centre : (T, 2) float64, cm, or None unless ``centres``
+    None where the loops are not built.
+
+    Raises
+    ------
+    ValueError
+        In one line naming the argument (:func:`check_mesh`).
+    """
+    v, f = _mesh_for_c(vertices, faces)
+    lib = _lib()
+    if lib is None:
+        check_mesh(v, f)
+        warn_fallback()
+        return None
+    area = np.empty(len(f))
+    centre = np.empty((len(f), 2)) if centres else None
+    rc = lib.mz_triangle_areas(v.ctypes.data, len(v), f.ctypes.data, len(f), area.ctypes.data,
+                               None if centre is None else centre.ctypes.data)
+    if rc == -2:
+        check_mesh(v, f)
+    _check(rc, "triangle_areas")
+    return area, centre

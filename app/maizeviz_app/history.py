@@ -36,6 +36,7 @@ from maizeviz_app.layout_draft import Change
 
 #: What a field is called in the Edit menu and the history.
 NAMES = {"level": "mesh level", "preserve_area": "area preservation", "mode": "light",
+         "stalks": "stalks take light",
          "zenith_deg": "sun zenith", "azimuth_deg": "sun azimuth", "place": "place",
          "heights": "heights", "density": "ray density", "periodic": "infinite field",
          "kind": "sky", "split": "sky directions", "directions": "sky directions",

@@ -113,28 +113,34 @@ def op_measure(state: dict, progress: ProgressCallback, cover_resolution: float)
     return measure_canopy(state["canopy"], cover_resolution=cover_resolution)
 
 
-def _engine(state: dict) -> LightEngine:
-    """The child's light engine over its canopy: it builds each Embree scene once and keeps it
-    (and the last sky light) for every later sun, sky or day."""
-    if "engine" not in state:
-        state["engine"] = LightEngine(state["canopy"])
-    return state["engine"]
+def _engine(state: dict, stalks: bool = True) -> LightEngine:
+    """The child's light engine over its canopy, with its stalks traced or not (``stalks``:
+    ``LightEngine(with_stalks=...)``, the command line's ``--leaves-only`` when False): each
+    builds its Embree scenes once and keeps them (and the last sky light) for every later
+    sun, sky or day of the same choice."""
+    engines = state.setdefault("engines", {})
+    if stalks not in engines:
+        engines[stalks] = LightEngine(state["canopy"], with_stalks=stalks)
+    return engines[stalks]
 
 
-def op_light(state: dict, progress: ProgressCallback, request: LightRequest) -> LightResult:
+def op_light(state: dict, progress: ProgressCallback, request: LightRequest,
+             stalks: bool = True) -> LightResult:
     """Trace the sun through the child's canopy (on the scene its engine keeps; the result's
-    ``seconds["build"]`` is 0 when the scene was kept from an earlier run)."""
-    return _engine(state).sun(request.sun, sampling=request.sampling, classes=request.classes,
-                              progress=progress)
+    ``seconds["build"]`` is 0 when the scene was kept from an earlier run); the stalks take
+    light with ``stalks``."""
+    return _engine(state, stalks).sun(request.sun, sampling=request.sampling,
+                                      classes=request.classes, progress=progress)
 
 
 def op_absorbed(state: dict, progress: ProgressCallback, request: LightRequest,
-                spec: OpticsSpec) -> Absorbed:
-    """Light absorbed with scattering for the request's sun, on the engine's scene, with what
-    the window shows of it: each leaf's absorbed W per m2 of leaf on its triangles (copies
-    of a plant in a periodic field take their representative's; NaN on plants outside the
-    sample rectangle of an open field) and the plants' rows."""
-    light = spec.absorbed(_engine(state), request.sun, request.sampling, progress)
+                spec: OpticsSpec, stalks: bool = True) -> Absorbed:
+    """Light absorbed with scattering for the request's sun, on the engine's scene (the
+    stalks' with ``stalks``), with what the window shows of it: each leaf's absorbed W per
+    m2 of leaf on its triangles (copies of a plant in a periodic field take their
+    representative's; NaN on plants outside the sample rectangle of an open field) and the
+    plants' rows."""
+    light = spec.absorbed(_engine(state, stalks), request.sun, request.sampling, progress)
     return absorbed_of(state["canopy"], light, spec)
 
 
@@ -219,22 +225,25 @@ def diffuse_of(canopy, light, kind: str) -> Diffuse:
                     build_s)
 
 
-def op_sky(state: dict, progress, sampling, spec: SkySpec) -> Diffuse:
-    """Diffuse light under a sky (one scene, every direction traced like the sun); the engine
-    keeps the result, so a day on the same canopy, sampling and sky reuses it."""
+def op_sky(state: dict, progress, sampling, spec: SkySpec, stalks: bool = True) -> Diffuse:
+    """Diffuse light under a sky (one scene, every direction traced like the sun; the stalks
+    take light with ``stalks``); the engine keeps the result, so a day on the same canopy,
+    sampling, sky and stalks reuses it."""
     def steps(done: int, total: int):
         return progress(done, total, f"sky direction {done} of {total}")
 
-    light = _engine(state).sky(spec.sky(), sampling=sampling, progress=steps)
+    light = _engine(state, stalks).sky(spec.sky(), sampling=sampling, progress=steps)
     return _diffuse(state, light, light.leaf_rows(state["canopy"]),
                     "diffuse_intercepted_cm2", light.seconds["build"])
 
 
-def op_period(state: dict, progress, sampling, sky: SkySpec, day: DaySpec) -> Diffuse:
+def op_period(state: dict, progress, sampling, sky: SkySpec, day: DaySpec,
+              stalks: bool = True) -> Diffuse:
     """Light over a day: the sun traced at every step, the sky once (or the sky light the
-    engine kept from a sky run with the same settings)."""
+    engine kept from a sky run with the same settings); the stalks take light with
+    ``stalks``."""
     period = day.period()
-    engine = _engine(state)
+    engine = _engine(state, stalks)
     perez = day.diffuse == "perez"             # the sky's directions, as a uniform sky
     sky_obj = SkySpec("uoc", sky.directions, sky.split).sky() if perez else sky.sky()
     n_sky = 0 if engine.kept_sky(sky_obj, sampling) is not None else sky_obj.n

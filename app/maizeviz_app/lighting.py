@@ -27,7 +27,8 @@ RUNNING_TEXT = {"sun": "computing direct light", "sky": "computing diffuse light
 
 def light_job(study: StudyState) -> tuple[str, str, tuple, Any, Any, Any]:
     """What a light computation of the settings would trace: (light, core op, its
-    arguments, the settings results are compared by, heights, optics or None).
+    arguments (the last: whether the stalks take light), the settings results are compared
+    by, heights, optics or None).
 
     Raises
     ------
@@ -35,20 +36,20 @@ def light_job(study: StudyState) -> tuple[str, str, tuple, Any, Any, Any]:
         A setting that cannot be used, naming it (``quantity``).
     """
     s = study.settings
-    mode = s.light.mode
+    mode, stalks = s.light.mode, s.light.stalks
     optics = None
     if mode == "sun":
         request = s.sun_request()
         optics = s.optics_spec()
         compared = (round(request.sun.zenith_deg, 6), round(request.sun.azimuth_deg, 6),
                     optics)
-        return mode, "light", (request,), compared, request.heights_cm, optics
+        return mode, "light", (request, stalks), compared, request.heights_cm, optics
     sampling = s.sampling_spec()
     sky = s.sky_spec()
     if mode == "sky":
-        return mode, "sky", (sampling, sky), sky, sampling.heights_cm, None
+        return mode, "sky", (sampling, sky, stalks), sky, sampling.heights_cm, None
     day = s.day_spec()
-    return mode, "period", (sampling, sky, day), (day, sky), sampling.heights_cm, None
+    return mode, "period", (sampling, sky, day, stalks), (day, sky), sampling.heights_cm, None
 
 def compute_light(study: StudyState) -> bool:
     """Compute the light the settings choose (sun, sky or day) on the canopy shown, in the
@@ -80,13 +81,13 @@ def compute_light(study: StudyState) -> bool:
             absorbed = None
             if optics is not None:              # leaves with optics: absorbed light too
                 absorbed = runner.light_process.call("absorbed", key, canopy,
-                                                     (args[0], optics), job)
+                                                     (args[0], optics, args[-1]), job)
                 job.check()
             painting = sun_painting(canopy, out)
             run = Run(label, signature, out, painting.classes, extra=absorbed,
-                      painting=painting)
+                      painting=painting, stalks=args[-1])
         else:
-            run = Run(label, signature, out.light, None, mode, out)
+            run = Run(label, signature, out.light, None, mode, out, stalks=args[-1])
         return run, compared, sampling_key
 
     study.light_running.emit(f"{RUNNING_TEXT[mode]} on {label}…")
@@ -169,10 +170,12 @@ def draw_figures(study: StudyState, run: Run) -> None:
     look = plots.Look.of(study.colour, f.shown_for).sharing(run.kind, run.result)
     curves, title = study.runs.curves(), plot_title(study.runs)
 
+    canvas, plot_canvas = f.canvases.get("heatmap"), f.canvases.get("plot")
+
     def work(job):
         maps = plots.heatmap_images(run.result, first=first, check=job.check, kind=run.kind,
-                                    look=look)
-        return maps, plots.rgba(plots.transmission_figure(curves, title))
+                                    look=look, canvas=canvas)
+        return maps, plots.rgba(plots.transmission_figure(curves, title, canvas=plot_canvas))
 
     def done(out) -> None:
         maps, plot = out
@@ -197,13 +200,34 @@ def draw_heatmap(study: StudyState, kind: str, index: int) -> None:
     result = run.result
     height = float(result.heights_cm[index])
     look = plots.Look.of(study.colour, study.figures.shown_for)
+    canvas = study.figures.canvases.get("heatmap")
 
     def done(rgba) -> None:
         study.figures.set_map(kind, run, index, rgba)
 
     study.runner.run("heatmap", f"drawing the heatmap at {height:g} cm",
-                     lambda job: plots.heatmap_image(result, height, kind=kind, look=look),
+                     lambda job: plots.heatmap_image(result, height, kind=kind, look=look,
+                                                     canvas=canvas),
                      on_done=done, on_error=lambda e: study.fail(e, "light"))
+
+
+def refit_figures(study: StudyState, which: str) -> None:
+    """Where the ``heatmap`` or the ``plot`` is shown changed size: the maps are drawn again
+    when shown (the one shown at once), the plot in a job, each for its new canvas."""
+    f = study.figures
+    if which == "heatmap":
+        if f.maps:
+            f.restyle(keep=None, hold=True)     # the old size shown until the new drawn
+        return
+    if f.plot is None or not study.runs.runs:
+        return
+    from maizeviz_app import plots
+
+    curves, title, canvas = study.runs.curves(), plot_title(study.runs), f.canvases.get("plot")
+    study.runner.run("plot", "drawing the transmission plot",
+                     lambda job: plots.rgba(plots.transmission_figure(curves, title,
+                                                                      canvas=canvas)),
+                     on_done=f.set_plot, on_error=lambda e: study.fail(e, "light"))
 
 def sun_from_place(study: StudyState) -> None:
     """Sun angles from the date, time and place of ``settings.sun.place`` (pvlib, in a
@@ -303,11 +327,32 @@ def adopt_pending_runs(study: StudyState) -> None:
         else:
             density = result.sky.density if result.sky is not None else \
                 study.settings.sampling.density
+        stalks = traced_stalks(result, kind, _leaf_triangles(study, label))
         sampling = (tuple(float(h) for h in result.heights_cm), density,
-                    bool(getattr(result, "periodic", study.settings.sampling.periodic)))
-        study.add_run(Run(label, study.signature(label), result, None, kind, extra),
+                    bool(getattr(result, "periodic", study.settings.sampling.periodic)),
+                    stalks)
+        study.add_run(Run(label, study.signature(label), result, None, kind, extra,
+                          stalks=stalks),
                      compared, sampling, f"{len(pending)} light result(s) from the project",
                      saved=True)
+    show_kept_runs(study)
+
+
+def show_brought_back(study: StudyState) -> None:
+    """Light results set aside by a layout edit and back with their stands (Undo): once the
+    canopy is built on them, shown whole as before the edit (table, plot, heatmaps, the
+    day's summary, the plants' light, the canopy's colours), nothing traced again."""
+    if not study.brought_back or study.built is None:
+        return
+    study.brought_back = False
+    show_kept_runs(study)
+
+
+def show_kept_runs(study: StudyState) -> None:
+    """The results the study holds (a project's, or some brought back) shown as after a
+    fresh run, with the canopy shown."""
+    if study.built is None:
+        return
     here = study.signature(study.built.label)
     shown = {}
     for kind in MODES:
@@ -340,11 +385,13 @@ def _draw_project_figures(study: StudyState, shown: dict, order: list, curves, t
 
     results = [(k, shown[k].result) for k in order]
     look = plots.Look.of(study.colour, shown)
+    canvas = study.figures.canvases.get("heatmap")
+    plot_canvas = study.figures.canvases.get("plot")
 
     def work(job):
-        maps = [(k, plots.heatmap_images(r, check=job.check, kind=k, look=look))
+        maps = [(k, plots.heatmap_images(r, check=job.check, kind=k, look=look, canvas=canvas))
                 for k, r in results]
-        plot = plots.rgba(plots.transmission_figure(curves, title))
+        plot = plots.rgba(plots.transmission_figure(curves, title, canvas=plot_canvas))
         return maps, plot
 
     def done(out):
@@ -357,6 +404,36 @@ def _draw_project_figures(study: StudyState, shown: dict, order: list, curves, t
 
     study.runner.run("figures", "drawing the light figures", work, on_done=done,
                      on_error=lambda e: study.fail(e, "light"))
+
+
+def _leaf_triangles(study: StudyState, label: str) -> int | None:
+    """The leaf triangles of the study's canopy at the level ``label`` (None: unknown)."""
+    if study.built is not None and study.built.label == label:
+        return study.built.canopy.n_triangles
+    if study.loaded is None:
+        return None
+    from maizeviz.project.study import canopy_triangles
+
+    counts = canopy_triangles(study.loaded.leaves, study.loaded.layout, label)
+    return counts[0] if counts is not None else None
+
+
+def traced_stalks(result: Any, kind: str, n_leaf_triangles: int | None) -> bool:
+    """Whether a light result (a sun's ``LightResult``, a ``SkyLight`` or a day's
+    ``PeriodLight``, ``kind`` sun, sky or day) was traced with its canopy's stalks: its
+    per-triangle light runs past the canopy's ``n_leaf_triangles`` (the leaves then the
+    stalks). Where either is unknown, the stalks' absorbed light in its balance says it,
+    else it counts as traced (the app's default)."""
+    if kind == "sun":
+        per = result.first_hits
+    elif kind == "sky":
+        per = getattr(result, "triangle_share", None)
+    else:
+        per = getattr(result, "triangle_direct_mol", None)
+    if per is not None and n_leaf_triangles is not None:
+        return len(per) > n_leaf_triangles
+    balance = getattr(result, "balance", None)
+    return balance is None or bool(balance.absorbed_stalks)
 
 
 def light_per_plant_run(study: StudyState) -> Run | None:

@@ -217,7 +217,7 @@ class MainWindow(QMainWindow):
             f.shown_kind, f.shown_index = plots.kind, plots.height_box.currentIndex()
 
         f.maps_changed.connect(maps_changed)
-        f.restyled.connect(lambda keep: plots.redraw(keep=keep))
+        f.restyled.connect(lambda keep, hold: plots.redraw(keep=keep, hold=hold))
         colour = self.model.colour                  # new colours: the maps drawn again
         colour.heatmap.events.connect(lambda _info: self._restyle())
         colour.events.shared.connect(lambda _on: self._restyle())
@@ -226,6 +226,12 @@ class MainWindow(QMainWindow):
         plots.heatmap_needed.connect(self.model.draw_heatmap)
         plots.source.currentIndexChanged.connect(shown)
         plots.height_box.currentIndexChanged.connect(shown)
+        # figures drawn at the size they are shown (their texts keep their points)
+        from maizeviz_app.figures import Canvas
+
+        for which, view in (("heatmap", plots.heatmap), ("plot", plots.transmission)):
+            view.canvas_resized.connect(
+                lambda w, h, dpi, which=which: f.set_canvas(which, Canvas(w, h, dpi)))
 
     def _restyle(self) -> None:
         """The heatmaps' colours changed: every map is drawn again (the one shown at once)."""

@@ -60,6 +60,7 @@ class StudyModel(StudyState):
         events.preserve_area.connect(self._canopy_setting)
         self.draft.edited.connect(self._draft_moved)
         self.draft.replayed.connect(self._draft_moved)
+        self.figures.canvas_changed.connect(self._refit_figures)
 
     @cached_property
     def digitizing(self) -> DigitizingSession:
@@ -68,6 +69,9 @@ class StudyModel(StudyState):
         from maizeviz_app.digitizing import DigitizingSession
 
         return DigitizingSession()
+
+    def _refit_figures(self, which: str) -> None:
+        lighting.refit_figures(self, which)
 
     def _canopy_setting(self, *_values: Any) -> None:
         if not self.applying:

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from maizeviz_app.figures import Canvas
+
 #: Line styles per level, fine to coarse, so levels keep their look as curves are added.
 _STYLES = ("-o", "--s", "-.^", ":D", "-v", "--P", "-.X", ":*")
 #: With several lights: a line style per light, a colour per level.
@@ -36,14 +38,32 @@ class Curve:
 
 #: Side of a heatmap bin drawn in the window, cm.
 HEATMAP_BIN_CM = 5.0
+#: Size of a figure's texts drawn for a canvas (points at the canvas's dpi): 9.5 pt is
+#: 12.7 px at 96 dpi, capitals 9 px tall in DejaVu Sans.
+FONT_PT = 9.5
+
+
+def smallest_text_px(fig) -> float:
+    """The size (pixels, at the figure's dpi) of the smallest text drawn in ``fig``."""
+    from matplotlib.text import Text
+
+    sizes = [t.get_size() for t in fig.findobj(Text) if t.get_visible() and t.get_text()
+             and t.get_figure() is not None]
+    return min(sizes) * fig.dpi / 72 if sizes else 0.0
 
 
 def transmission_figure(curves: Sequence[Curve], title: str = "", width_in: float = 5.0,
-                        dpi: int = 90):
-    """Transmission (x, 0..1) against height (y, cm), one curve per mesh level and light."""
+                        dpi: float = 90, canvas: Canvas | None = None):
+    """Transmission (x, 0..1) against height (y, cm), one curve per mesh level and light;
+    drawn for ``canvas`` (its size and dpi, constrained layout, texts at :data:`FONT_PT`)
+    when given, else ``width_in`` wide at ``dpi``."""
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(width_in, width_in * 0.72), dpi=dpi)
+    if canvas is None:
+        fig = Figure(figsize=(width_in, width_in * 0.72), dpi=dpi)
+    else:
+        width_in, dpi = canvas.inches[0], canvas.dpi
+        fig = Figure(figsize=canvas.inches, dpi=dpi, layout="constrained")
     ax = fig.add_subplot()
     kinds = {c.kind for c in curves}
     levels = list(dict.fromkeys(c.level or c.label for c in curves))
@@ -56,25 +76,41 @@ def transmission_figure(curves: Sequence[Curve], title: str = "", width_in: floa
         ax.plot(c.transmission, c.heights_cm, style, label=c.label, markersize=4,
                 linewidth=1.3, color=colour)
     ax.set_xlim(0, 1)
-    ax.set_xlabel("direct-light transmission (fraction of rays reaching the height)"
+    small = canvas is not None and min(canvas.inches) < 4.0
+    font = FONT_PT if canvas is not None else None
+    ax.set_xlabel("transmission" if small else
+                  "direct-light transmission (fraction of rays reaching the height)"
                   if kinds <= {"sun"} else
-                  "transmission (fraction of the light reaching the height)")
-    ax.set_ylabel("height (cm)")
+                  "transmission (fraction of the light reaching the height)", fontsize=font)
+    ax.set_ylabel("height (cm)", fontsize=font)
     ax.grid(True, alpha=0.3)
+    if canvas is not None:
+        from matplotlib.ticker import MaxNLocator
+
+        ax.tick_params(labelsize=font)
+        w, h = canvas.inches
+        ax.xaxis.set_major_locator(MaxNLocator(max(int(w / 1.0), 2)))
+        ax.yaxis.set_major_locator(MaxNLocator(max(int(h / 0.5), 2)))
     if curves:
-        ax.legend(title="mesh level" if kinds == {"sun"} else "mesh level, light", fontsize=8,
-                  title_fontsize=8, loc="lower right")
+        ax.legend(title="mesh level" if kinds == {"sun"} else "mesh level, light",
+                  fontsize=font or 8, title_fontsize=font or 8,
+                  loc="lower right" if canvas is None else "best")
     else:
         ax.text(0.5, 0.5, "compute light to see transmission by height",
-                ha="center", va="center", transform=ax.transAxes, fontsize=9, color="0.4")
+                ha="center", va="center", transform=ax.transAxes, fontsize=font or 9,
+                color="0.4")
     default = ("transmission by height, per mesh level (the paper's Table 3)"
                if kinds <= {"sun"} else "transmission by height, per mesh level and light")
     import textwrap
 
-    lines = textwrap.wrap(title or default, int(11 * width_in))
-    ax.set_title("\n".join(lines), fontsize=9)
-    fig.subplots_adjust(left=0.12, right=0.97, bottom=0.14,            # tight_layout: 2 draws
-                        top=0.9 - 0.05 * (len(lines) - 1))
+    chars = int(11 * width_in) if canvas is None else int(width_in * 72 / (0.55 * FONT_PT))
+    lines = textwrap.wrap(title or default, max(chars, 20))
+    if small and len(lines) > 1:                # the room is the plot's
+        lines = [lines[0] + " …"]
+    ax.set_title("\n".join(lines), fontsize=font or 9)
+    if canvas is None:
+        fig.subplots_adjust(left=0.12, right=0.97, bottom=0.14,        # tight_layout: 2 draws
+                            top=0.9 - 0.05 * (len(lines) - 1))
     return fig
 
 
@@ -153,6 +189,7 @@ class Heatmap:
     values : (nx, ny) the map's transmission (NaN: no ray); rays : (nx, ny) rays per bin
     height_cm : the sensor plane's height; limits : (low, high) of the colours; what : what
         the values are (the figure's title)
+    font_px : the smallest text's size in the image's pixels
     """
 
     rgba: np.ndarray
@@ -164,6 +201,7 @@ class Heatmap:
     height_cm: float
     limits: tuple[float, float]
     what: str
+    font_px: float = 0.0
 
     def value_at(self, px: float, py: float) -> tuple[float, float, float, int] | None:
         """(x cm, y cm, value, rays) of the bin under the image pixel (``px``, ``py``; from
@@ -194,13 +232,19 @@ def heatmap_figure_of(result, height: float, kind: str = "sun", width_in: float 
 
 
 def heatmap_image(result, height: float, bin_cm: float = HEATMAP_BIN_CM, width_in: float = 8.0,
-                  dpi: int = 64, kind: str = "sun", look: Look | None = None) -> Heatmap:
+                  dpi: float = 64, kind: str = "sun", look: Look | None = None,
+                  canvas: Canvas | None = None) -> Heatmap:
     """The core's heatmap of one height of a light result (:func:`heatmap_figure_of`),
-    drawn, with where its bins lie in the picture (for the value under the mouse)."""
+    drawn, with where its bins lie in the picture (for the value under the mouse): for
+    ``canvas`` (its size and dpi, texts at :data:`FONT_PT`) when given, else ``width_in``
+    wide at ``dpi``."""
     from maizeviz.light.report.heatmap import map_title, result_figure, result_map
 
     tmap = result_map(result, float(height), kind, bin_cm)
     colours = (look or Look()).colours(tmap)
+    if canvas is not None:
+        colours.update(fit=canvas.inches, font_pt=FONT_PT)
+        dpi = canvas.dpi
     fig = result_figure(result, float(height), kind, bin_cm, width_in=width_in, dpi=dpi,
                         tmap=tmap, **colours)
     pixels = rgba(fig)
@@ -209,15 +253,17 @@ def heatmap_image(result, height: float, bin_cm: float = HEATMAP_BIN_CM, width_i
     return Heatmap(pixels, (float(ext.x0), float(h - ext.y1), float(ext.x1), float(h - ext.y0)),
                    np.asarray(tmap.x_edges), np.asarray(tmap.y_edges),
                    np.asarray(tmap.transmission), np.asarray(tmap.rays), tmap.height_cm,
-                   (colours["vmin"], colours["vmax"]), map_title(result, kind)[0])
+                   (colours["vmin"], colours["vmax"]), map_title(result, kind)[0],
+                   smallest_text_px(fig))
 
 
 def heatmap_images(result, first: int = 0, all_heights: bool = False, check=None,
-                   kind: str = "sun", look: Look | None = None
+                   kind: str = "sun", look: Look | None = None, canvas: Canvas | None = None
                    ) -> list[tuple[float, Heatmap | None]]:
     """[(height, Heatmap or None)] for every height of a light result: the ``first`` one drawn
     (each figure takes 0.3-1 s), the others too with ``all_heights``, else drawn when asked
-    for. ``check()`` is called between figures (it may raise InterruptedError)."""
+    for; for ``canvas`` as :func:`heatmap_image`. ``check()`` is called between figures (it
+    may raise InterruptedError)."""
     heights = [float(h) for h in result.heights_cm]
     first = first if 0 <= first < len(heights) else 0
     out: list[tuple[float, Heatmap | None]] = []
@@ -225,5 +271,6 @@ def heatmap_images(result, first: int = 0, all_heights: bool = False, check=None
         if check is not None:
             check()
         drawn = k == first or all_heights
-        out.append((h, heatmap_image(result, h, kind=kind, look=look) if drawn else None))
+        out.append((h, heatmap_image(result, h, kind=kind, look=look, canvas=canvas)
+                       if drawn else None))
     return out

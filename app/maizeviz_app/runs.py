@@ -17,9 +17,11 @@ MODES = ("sun", "sky", "day")
 #: Balance field -> the row's label.
 BALANCE_ROWS = (("incident", "{band} incident W/m²"),
                 ("absorbed_leaves", "absorbed by leaves W/m²"),
+                ("absorbed_stalks", "absorbed by stalks W/m²"),
                 ("absorbed_ground", "absorbed by the ground W/m²"),
                 ("reflected_top", "reflected out of the top W/m²"),
-                ("escaped_sides", "out of the sides W/m²"))
+                ("escaped_sides", "out of the sides W/m²"),
+                ("unresolved", "still scattering at the depth limit W/m²"))
 #: The results table's row of a sun's canopy gross CO2 assimilation (with a leaf model).
 ASSIMILATION_ROW = "gross CO₂ µmol/m²/s"
 #: Skies: kind -> (what the light panel's combo says, how a result is named in the table).
@@ -44,7 +46,8 @@ class Run:
     values: :class:`maizeviz_app.jobs.Diffuse`); for a sun traced with leaf optics, the light
     absorbed with scattering (:class:`maizeviz_app.jobs.Absorbed`). A sun's ``painting``
     (:class:`maizeviz.light.results.painting.SunPainting`, made with its classes) says how its light
-    can be painted honestly: per triangle or per leaf."""
+    can be painted honestly: per triangle or per leaf. ``stalks``: the stalks took light
+    (False: the leaves alone, ``maizeviz light --leaves-only``)."""
 
     label: str
     signature: tuple
@@ -53,6 +56,7 @@ class Run:
     kind: str = "sun"
     extra: Any = None
     painting: Any = None
+    stalks: bool = True
 
     @property
     def name(self) -> str:
@@ -121,6 +125,12 @@ class LightRuns:
         other._order, other._added = dict(self._order), self._added
         return other
 
+    def take(self, other: LightRuns) -> None:
+        """Hold ``other``'s runs, settings and sampling instead of its own (the same runs)."""
+        self.runs, self.settings = dict(other.runs), dict(other.settings)
+        self.sampling, self.last = other.sampling, other.last
+        self._order, self._added = dict(other._order), other._added
+
     def clear(self) -> None:
         self.runs.clear()
         self.settings.clear()
@@ -186,7 +196,15 @@ class LightRuns:
         if balances:
             band = next(r.extra.light.band for r in self.runs.values()
                         if r.balance is not None).upper()
+            stalks = any(self.runs[name].stalks for name in balances)
             for field, what in BALANCE_ROWS:
+                if field == "absorbed_stalks" and not stalks:   # leaves only: no such row
+                    continue
+                # the light still travelling when the scattering stopped: a row only when it
+                # shows at one decimal, so that the rows shown add up to the incident light
+                if field == "unresolved" and all(round(b.unresolved, 1) == 0
+                                                 for b in balances.values()):
+                    continue
                 row = [what.format(band=band)]
                 for name in names:
                     b = balances.get(name)
@@ -257,14 +275,20 @@ def run_info(run: Run) -> str:
         share = r.sunlit_intercepted_fraction
         if share is not None:
             info += f"; leaves take {share:.1%} of the direct light"
+            stalk_share = r.stalk_intercepted_fraction
+            if run.stalks and stalk_share is not None:
+                info += f", stalks {stalk_share:.1%}"
         if run.balance is not None:
             a = run.extra.light
             b = run.balance
             info += (f"; with leaf optics (ρ {a.optics.reflectance:g}, τ "
                      f"{a.optics.transmittance:g}, soil {a.optics.ground_reflectance:g}) the "
                      f"leaves absorb {a.fraction_absorbed:.1%} of the {a.band.upper()}, "
-                     f"{b.reflected_top / b.incident if b.incident else 0:.1%} is reflected "
-                     f"(balance closes within {abs(b.closure):.2%}; scattering "
+                     + (f"the stalks {b.absorbed_stalks / b.incident:.1%}, "
+                        if run.stalks and b.incident else "")
+                     + f"{b.reflected_top / b.incident if b.incident else 0:.1%} is reflected "
+                     f"(balance closes within {abs(b.closure):.2%}: its rows in the table "
+                     f"add up to the incident; scattering "
                      f"{a.seconds.get('scatter', 0):.2f} s)")
             g = getattr(run.extra, "assimilation", None)
             if g is not None:
@@ -289,6 +313,8 @@ def run_info(run: Run) -> str:
         info = (f"{r.n_steps} time steps and the sky ({sky}); {r.rays:,} rays per "
                 f"direction; level {run.label}; Embree scene {build}, tracing "
                 f"{secs.get('trace', 0):.2f} s")
+    if not run.stalks:
+        info += "; leaves only (the stalks let light through)"
     return info + "".join(f"\n⚠ {w}" for w in run_warnings(run) if "sun never rises" not in w)
 
 

@@ -60,7 +60,7 @@ def canopy_settings(opened: Opened) -> tuple[int, str, bool]:
 #: and the day's. A project without the later ones opens in sun mode with the defaults.
 LIGHT_SETTINGS = (("zenith_deg", (int, float)), ("azimuth_deg", (int, float)), ("place", str),
                   ("heights", str), ("density", (int, float)), ("periodic", bool),
-                  ("mode", str), ("sky_kind", str), ("sky_split", str),
+                  ("mode", str), ("stalks", bool), ("sky_kind", str), ("sky_split", str),
                   ("sky_directions", int), ("day_date", str), ("latitude", (int, float)),
                   ("longitude", (int, float)), ("tz", str), ("step_min", (int, float)),
                   ("from", str), ("to", str), ("source", str),

@@ -115,12 +115,16 @@ class CanopySettings:
 @evented
 @dataclass
 class LightSettings:
-    """Which light a computation traces: ``mode`` sun, sky or day."""
+    """Which light a computation traces: ``mode`` sun, sky or day; ``stalks``: the stalks
+    intercept and scatter light as the leaves do (``LightEngine(with_stalks=True)``, the
+    command line's default), or, off, the leaves alone take it (the paper's canopy,
+    ``maizeviz light --leaves-only``)."""
 
     if TYPE_CHECKING:                           # made by @evented
         events: ClassVar[SignalGroup]
 
     mode: str = "sun"
+    stalks: bool = True
 
 
 @evented
@@ -254,7 +258,7 @@ class DigitizerSettings:
 #: Light settings in a project file: key -> (group, field). The keys are those of maizeviz
 #: 0.2 onwards (maizeviz_app.saved_state.LIGHT_SETTINGS checks their types), so old projects open.
 LIGHT_DOC = {
-    "mode": ("light", "mode"),
+    "mode": ("light", "mode"), "stalks": ("light", "stalks"),
     "zenith_deg": ("sun", "zenith_deg"), "azimuth_deg": ("sun", "azimuth_deg"),
     "place": ("sun", "place"),
     "heights": ("sampling", "heights"), "density": ("sampling", "density"),
@@ -389,6 +393,9 @@ class StudySettings:
         for key, (g, f) in LIGHT_DOC.items():
             if key in doc:
                 by_group.setdefault(g, {})[f] = doc[key]
+        if "stalks" not in doc:
+            # saved before the app had a leaves-only switch: its stalks took light
+            by_group.setdefault("light", {})["stalks"] = True
         if doc.get("photosynthesis") == "c4" and "c4_temperature" not in doc:
             # saved before the C4 temperature response was a choice: CLM 4.5's, what it computed
             by_group["photosynthesis"]["c4_temperature"] = "clm45"
@@ -414,9 +421,10 @@ class StudySettings:
         return Sampling(parse_heights(s.heights), s.density, None, s.periodic, 2)
 
     def sampling_key(self, heights) -> tuple:
-        """What every result of a comparison shares: heights, density, periodic field."""
+        """What every result of a comparison shares: heights, density, periodic field and
+        whether the stalks take light."""
         return (tuple(float(h) for h in heights), self.sampling.density,
-                self.sampling.periodic)
+                self.sampling.periodic, self.light.stalks)
 
     def sun_request(self):
         """The sun's light request (hit classes on: the canopy is coloured)."""

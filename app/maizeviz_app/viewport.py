@@ -1119,6 +1119,27 @@ def _ticks(lo: float, hi: float, step: float) -> np.ndarray:
     return xs
 
 
+def ground_labels(field: tuple[float, float, float, float], margin: float, xs: np.ndarray,
+                  ys: np.ndarray) -> list[tuple[str, float, float, float, float]]:
+    """What the ground's margin says, and where: (text, x, y, width, angle) with the centre
+    (x, y) in cm, the width in label heights (a label is ``0.6 * margin`` cm high) and the
+    angle in degrees as QPainter turns it (clockwise on the image, y up the field).
+
+    Tick labels in cm under the x edge and along the y edge, at most 7 and 5 of them (none
+    at the corner, where the first x label is); the axis names. What lies along y is read
+    from the far end (so it stands upright from the views that look up the field) and, turned,
+    needs only a label's height of the margin."""
+    x0, y0, x1, y1 = field
+    step_x = max(1, int(np.ceil(len(xs) / 7)))
+    step_y = max(1, int(np.ceil(len(ys) / 5)))
+    out = [(f"{x:.0f}", float(x), y0 - margin * 0.27, 4.0, 0.0) for x in xs[::step_x]]
+    out += [(f"{y:.0f}", x0 - margin * 0.27, float(y), 4.0, 90.0) for y in ys[::step_y]
+            if not (len(xs) and y - y0 < margin * 0.5)]
+    out.append(("x (cm, across the rows)", (x0 + x1) / 2, y0 - margin * 0.72, 40.0, 0.0))
+    out.append(("y (cm, along the rows)", x0 - margin * 0.72, (y0 + y1) / 2, 40.0, 90.0))
+    return out
+
+
 def ground_image(field: tuple[float, float, float, float], margin: float, xs: np.ndarray,
                  ys: np.ndarray, max_px: int = 2048) -> np.ndarray:
     """The ground texture (h, w, 4) uint8, row 0 at the largest y (as pyvista maps an image
@@ -1147,23 +1168,13 @@ def ground_image(field: tuple[float, float, float, float], margin: float, xs: np
     font.setPixelSize(max(8, int(margin * scale * 0.42)))
     p.setFont(font)
     p.setPen(QColor("#333333"))
-    step_x = max(1, int(np.ceil(len(xs) / 7)))
-    step_y = max(1, int(np.ceil(len(ys) / 5)))
     box = margin * scale * 0.6
-    for x in xs[::step_x]:
-        c = px(x, y0 - margin * 0.27)
-        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), CENTRE, f"{x:.0f}")
-    for y in ys[::step_y]:
-        c = px(x0 - margin * 0.27, y)
-        p.drawText(QRectF(c.x() - 2 * box, c.y() - box / 2, 4 * box, box), CENTRE, f"{y:.0f}")
-    c = px((x0 + x1) / 2, y0 - margin * 0.72)
-    p.drawText(QRectF(c.x() - 20 * box, c.y() - box / 2, 40 * box, box), CENTRE,
-               "x (cm, across the rows)")
-    c = px(x0 - margin * 0.72, (y0 + y1) / 2)
-    p.translate(c)
-    p.rotate(-90)
-    p.drawText(QRectF(-20 * box, -box / 2, 40 * box, box), Qt.AlignmentFlag.AlignCenter,
-               "y (cm, along the rows)")
+    for text, x, y, wide, angle in ground_labels(field, margin, xs, ys):
+        p.save()
+        p.translate(px(x, y))
+        p.rotate(angle)
+        p.drawText(QRectF(-wide * box / 2, -box / 2, wide * box, box), CENTRE, text)
+        p.restore()
     p.end()
     arr = np.frombuffer(img.constBits(), np.uint8).reshape(h, img.bytesPerLine())[:, :4 * w]
     return arr.reshape(h, w, 4).copy()

@@ -37,6 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
+from maizeviz import loops
 from maizeviz.canopy.build import Canopy
 from maizeviz.canopy.layout import MAX_COORD_CM, CanopyLayout, Placement
 from maizeviz.errors import MaizevizError
@@ -140,7 +141,10 @@ def _period_in(period: tuple[float, ...] | None, field: tuple[float, ...], sourc
     return (float(px0), float(py0), float(px1), float(py1))
 
 
-def _field_coordinates(mesh: MeshData, unit: str | None, up: str, src: str) -> np.ndarray:
+def _field_coordinates(mesh: MeshData, unit: str | None, up: str, src: str,
+                       used: np.ndarray | None = None) -> np.ndarray:
+    """The vertices (V, 3) in cm, z up; ``used`` (V,) bool, if known: the vertices the faces
+    use (the unit is guessed from their height alone)."""
     if unit is not None and unit not in UNITS:
         raise MaizevizError(f"the mesh unit must be one of {', '.join(UNITS)}, got '{unit}'",
                             quantity="mesh_unit")
@@ -149,8 +153,9 @@ def _field_coordinates(mesh: MeshData, unit: str | None, up: str, src: str) -> n
     v = mesh.vertices
     height_axis = 2 if up == "z" else 1
     if unit is None:
-        used = np.zeros(len(v), bool)
-        used[mesh.faces.ravel()] = True
+        if used is None:
+            used = np.zeros(len(v), bool)
+            used[mesh.faces.ravel()] = True
         heights = v[:, height_axis] if used.all() else v[used, height_axis]
         h = float(np.ptp(heights)) if len(heights) else 0.0
         if h < GUESS_MIN_HEIGHT:
@@ -238,9 +243,15 @@ def repeated_triangles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     concatenated with itself, a double-sided export) would otherwise count its area, and
     intercept its light, twice. Each vertex is given a 64-bit hash of its coordinates, each
     triangle the sum of its corners' hashes (the same in any order): a repeated triangle has
-    the sum of the one it repeats. The triangles whose sum no other has (:func:`_not_alone`,
-    the usual case is all of them) are done with; the few others are compared exactly.
+    the sum of the one it repeats. The compiled loops (:func:`maizeviz.loops.repeated_triangles`)
+    put the triangles in a hash table in one pass, comparing exactly those of equal sums (at
+    K = 4 a fifth of numpy's time); numpy's passes, where they are not built, set aside the
+    triangles whose sum no other has (:func:`_not_alone`, the usual case is all of them) and
+    compare the few others exactly.
     """
+    compiled = loops.repeated_triangles(vertices, faces)
+    if compiled is not None:
+        return compiled[0]
     out = np.zeros(len(faces), dtype=bool)
     if len(faces) < 2:
         return out
@@ -273,20 +284,25 @@ def repeated_triangles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     return out
 
 
-def _without_repeats(mesh: MeshData, source: str) -> tuple[MeshData, list[str]]:
-    """The mesh with each repeated triangle (:func:`repeated_triangles`) left out, and the
-    note saying so."""
-    repeat = repeated_triangles(mesh.vertices, mesh.faces)
+def _without_repeats(mesh: MeshData, source: str
+                     ) -> tuple[MeshData, list[str], np.ndarray | None]:
+    """The mesh with each repeated triangle (:func:`repeated_triangles`) left out, the note
+    saying so, and the vertices the triangles use where the compiled loops tell them in the
+    same pass (else None). A repeated triangle's corners are at the places of its original's,
+    so the used vertices' places are the same with or without it."""
+    compiled = loops.repeated_triangles(mesh.vertices, mesh.faces, used=True)
+    repeat, used = compiled if compiled is not None else \
+        (repeated_triangles(mesh.vertices, mesh.faces), None)
     n = int(repeat.sum())
     if not n:
-        return mesh, []
+        return mesh, [], used
     t = int(np.flatnonzero(repeat)[0])
     keep = ~repeat
     note = (f"{source}: {n:,} of the {mesh.n_triangles:,} triangles repeat an earlier triangle "
             f"(the same three corners; first: {mesh.where_triangle(t)}): each surface is "
             "counted once")
     return replace(mesh, faces=mesh.faces[keep], triangle_face=mesh.triangle_face[keep],
-                   plant=mesh.plant[keep], leaf=mesh.leaf[keep]), [note]
+                   plant=mesh.plant[keep], leaf=mesh.leaf[keep]), [note], used
 
 
 def _split(vertices: np.ndarray, faces: np.ndarray, is_leaf: np.ndarray
@@ -330,7 +346,11 @@ def _areas_centres(v: np.ndarray, f: np.ndarray, centres: bool = True
     """Areas (F,) cm2 and centroids seen from above (F, 2) cm (None unless ``centres``) of
     triangles ``f`` (F, 3) of vertices ``v`` (V, 3) cm, a coordinate at a time from contiguous
     columns (at K = 4 a seventh of the time of gathering the triangles whole and crossing
-    their edges)."""
+    their edges; the compiled loops, :func:`maizeviz.loops.triangle_areas`, the same numbers
+    in one pass)."""
+    compiled = loops.triangle_areas(v, f, centres)
+    if compiled is not None:
+        return compiled
     vt, ft = np.ascontiguousarray(v.T), np.ascontiguousarray(f.T)
     e1, e2 = [], []
     centre = np.empty((len(f), 2)) if centres else None
@@ -397,7 +417,7 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
     notes = list(mesh.notes)
     if field is not None:
         field = check_field(field)                                    # type: ignore[assignment]
-    mesh, said = _without_repeats(mesh, source)
+    mesh, said, used = _without_repeats(mesh, source)
     notes += said
     carried_field, period = _carried(mesh, unit, up, source, notes, strict=field is None)
     if field is None and carried_field is not None:
@@ -408,7 +428,7 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
         notes.append(f"{source}: the file's period is for its own field, not the one given: "
                      "not used")
         period = None
-    verts = _field_coordinates(mesh, unit, up, source)
+    verts = _field_coordinates(mesh, unit, up, source, used)
     is_leaf = mesh.leaf != 0
     n_leaf = int(is_leaf.sum())
     if n_leaf == 0:
@@ -431,7 +451,8 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
         t = int(np.flatnonzero(is_leaf)[int(np.flatnonzero(area == 0)[0])])
         notes.append(f"{source}: {flat:,} of the {n_leaf:,} leaf triangles have no area (first: "
                      f"{mesh.where_triangle(t)}); kept, they receive no light")
-    leaf_ids = mesh.leaf[is_leaf].astype(np.int32)
+    # the ids as the file gives them (the canopy narrows them once)
+    leaf_ids = mesh.leaf if n_leaf == len(is_leaf) else mesh.leaf[is_leaf]
     heads = _run_starts(leaf_inst, leaf_ids)            # a file's faces come leaf by leaf
     pairs, _ = groups(leaf_inst[heads], leaf_ids[heads])
     leaves_per = np.bincount(pairs[:, 0], minlength=len(plants)).astype(np.int32)
@@ -477,7 +498,8 @@ def canopy_from_mesh(mesh: MeshData, unit: str | None = None, up: str = "z",
     layout = CanopyLayout(placements, cells, x1 - x0, y1 - y0, 0.0,
                           np.array([period], np.float64) if period else cells.copy(),
                           (field_said,), (x1 - x0) * (y1 - y0), "mesh", period)
-    canopy = Canopy(leaf_v, leaf_f, leaf_inst, mesh.plant[is_leaf].astype(np.int32), leaf_ids,
+    canopy = Canopy(leaf_v, leaf_f, leaf_inst,
+                    mesh.plant if n_leaf == len(is_leaf) else mesh.plant[is_leaf], leaf_ids,
                     layout, MESH_LEVEL, stalk_v, stalk_f, leaves_per,
                     stalk_instance=stalk_inst)
     return canopy, notes

@@ -97,17 +97,24 @@ def _merge_duplicates(points: np.ndarray) -> np.ndarray:
     return points[keep]
 
 
-def _check_coordinates(pts: np.ndarray, r: int, colids, fail) -> None:
+def _check_coordinates(pts: np.ndarray, r: int, colids, fail, lines=None) -> None:
     """Refuse (through ``fail``) a row's first coordinate that is not a number or lies beyond
-    :data:`MAX_ABS_COORD_CM` [cm], naming its row and col."""
+    :data:`MAX_ABS_COORD_CM` [cm], naming its row and col, and its line in the file when
+    ``lines`` ((k,) int) are known; the axis too, as the reader names a value it cannot read."""
+    def at(k: int, axis: int) -> str:
+        where = f" (line {lines[k]})" if lines is not None else ""
+        return f"row {r}, col {colids[k]}{where}: {'xyz'[axis]}"
+
     bad = ~np.isfinite(pts)
     if bad.any():
         k = int(np.argwhere(bad.any(axis=1))[0, 0])
-        fail(f"row {r}, col {colids[k]}: coordinate is {pts[k][bad[k]][0]} (not a number)")
+        axis = int(np.argmax(bad[k]))
+        fail(f"{at(k, axis)} is {pts[k, axis]} (not a number)")
     huge = np.abs(pts) > MAX_ABS_COORD_CM
     if huge.any():
         k = int(np.argwhere(huge.any(axis=1))[0, 0])
-        fail(f"row {r}, col {colids[k]}: coordinate {pts[k][huge[k]][0]:g} cm is beyond "
+        axis = int(np.argmax(huge[k]))
+        fail(f"{at(k, axis)} = {pts[k, axis]:g} cm is beyond "
              f"{MAX_ABS_COORD_CM:g} cm; not a digitized point")
 
 
@@ -132,7 +139,8 @@ def _columns(kept_rows: list[int], counts: list[int], fail) -> int:
 
 
 def grid_from_rows(plant: int, leaf: int, rows: dict[int, np.ndarray],
-                   cols: dict[int, np.ndarray] | None = None) -> LeafGrid:
+                   cols: dict[int, np.ndarray] | None = None,
+                   lines: dict[int, np.ndarray] | None = None) -> LeafGrid:
     """Build a :class:`LeafGrid` from the points of each cross-section.
 
     Parameters
@@ -141,6 +149,8 @@ def grid_from_rows(plant: int, leaf: int, rows: dict[int, np.ndarray],
         Points of each cross-section in column order.
     cols : {row index: (k,) int}, optional
         Column indices of those points, only used to name positions in messages.
+    lines : {row index: (k,) int}, optional
+        Line numbers of those points in their file, only used in messages.
 
     Raises
     ------
@@ -165,7 +175,8 @@ def grid_from_rows(plant: int, leaf: int, rows: dict[int, np.ndarray],
     cleaned = []
     for r in indices:
         pts = np.asarray(rows[r], dtype=np.float64).reshape(-1, 3)
-        _check_coordinates(pts, r, cols[r] if cols is not None else np.arange(len(pts)), fail)
+        _check_coordinates(pts, r, cols[r] if cols is not None else np.arange(len(pts)), fail,
+                           lines[r] if lines is not None else None)
         merged = _merge_duplicates(pts)
         if len(merged) < len(pts):
             notes.append(f"row {r}: merged {len(pts) - len(merged)} duplicate point(s)")
@@ -363,10 +374,11 @@ def _grid_of_leaf(plant: int, leaf: int, ids: np.ndarray, xyz: np.ndarray, line:
         k = a + dup[0]
         raise LeafError(plant, leaf, f"row {ids[k, 2]}, col {ids[k, 3]} appears twice "
                                      f"(lines {line[k]} and {line[k + 1]})")
-    rows, cols = {}, {}
+    rows, cols, lines = {}, {}, {}
     for r in np.unique(rc[:, 0]):
         sel = slice(a + np.searchsorted(rc[:, 0], r, "left"),
                     a + np.searchsorted(rc[:, 0], r, "right"))
         rows[int(r)] = xyz[sel]
         cols[int(r)] = ids[sel, 3]
-    return grid_from_rows(plant, leaf, rows, cols)
+        lines[int(r)] = line[sel]
+    return grid_from_rows(plant, leaf, rows, cols, lines)

@@ -97,7 +97,7 @@ def test_bad_leaf_skipped_exit_partial(capsys, write_csv):
     ("plant,leaf,row,col,x,y,z\n", "header only"),
     ("a,b,c\n1,2,3\n", "missing column"),
     ("plant,leaf,row,col,x,y,z\n1,1,0,0,0,0,nan\n1,1,0,1,1,0,0\n1,1,1,0,0,1,0\n1,1,1,1,1,1,0\n",
-     "row 0, col 0: coordinate is nan"),
+     "row 0, col 0 (line 2): z is nan (not a number)"),
     ("plant,leaf,row,col,x,y,z\n1,1,0,0,0,0,1e30\n1,1,0,1,1,0,0\n1,1,1,0,0,1,0\n1,1,1,1,1,1,0\n",
      "beyond"),
     ("plant,leaf,row,col,x,y,z\n1,1,0,0,0,0,0\n1,1,0,1,1,0,0\n", "at least 2 cross-sections"),

@@ -32,7 +32,8 @@ def reference_grids(table):
                                              f"(lines {line[k]} and {line[k + 1]})")
             rows = {int(r): xyz[sel[rc[:, 0] == r]] for r in np.unique(rc[:, 0])}
             cols = {int(r): ids[sel[rc[:, 0] == r], 3] for r in np.unique(rc[:, 0])}
-            grids.append(grid_from_rows(plant, leaf, rows, cols))
+            lines = {int(r): line[sel[rc[:, 0] == r]] for r in np.unique(rc[:, 0])}
+            grids.append(grid_from_rows(plant, leaf, rows, cols, lines))
         except LeafError as exc:
             errors.append(exc)
     return grids, errors

@@ -150,3 +150,73 @@ def test_basis_matrices_are_numpys_to_the_bit(case):
         got = nurbs.basis_matrix(x, knots, degree)
         want = without_loops(lambda: nurbs.basis_matrix(x, knots, degree))
     _same(got, want)
+
+
+@st.composite
+def meshes(draw):
+    """A mesh whose triangles repeat others: corners on a coarse lattice (positions shared by
+    several vertices, -0.0 beside 0.0), faces drawn among them, some copied with their corners
+    turned or reversed; or leaf-like float corners."""
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    n = draw(st.integers(1, 60))
+    if draw(st.booleans()):
+        v = rng.integers(-2, 3, (n, 3)).astype(np.float64) * 0.5
+        v[rng.random(n) < 0.3] *= -1.0
+    else:
+        v = rng.normal(0, 30, (n, 3))
+    f = rng.integers(0, n, (draw(st.integers(0, 4 * n)), 3))
+    if len(f) and draw(st.booleans()):
+        copies = f[rng.integers(0, len(f), len(f) // 2 + 1)]
+        copies = np.take_along_axis(copies, rng.permuted(np.tile([0, 1, 2], (len(copies), 1)),
+                                                         axis=1), axis=1)
+        f = rng.permutation(np.concatenate([f, copies]))
+    return v, f
+
+
+@settings(max_examples=300, deadline=None)
+@given(meshes())
+def test_mesh_repeats_and_areas_are_numpys(mesh):
+    """A mesh file's repeated triangles, the same ones found either way (exact), and their
+    areas and centres numpy's to the bit."""
+    from maizeviz.canopy.from_mesh import _areas_centres, repeated_triangles
+
+    v, f = mesh
+    got = repeated_triangles(v, f)
+    want = without_loops(lambda: repeated_triangles(v, f))
+    assert got.dtype == bool and np.array_equal(got, want)
+    area, centre = _areas_centres(v, f)
+    old_area, old_centre = without_loops(lambda: _areas_centres(v, f))
+    _same(area, old_area)
+    _same(centre, old_centre)
+
+
+@pytest.mark.parametrize("bad", [-1, 7])
+def test_a_corner_outside_the_vertices_is_refused_either_way(bad):
+    v, f = np.zeros((7, 3)), np.array([[0, 1, 2], [3, 4, bad]])
+    for fn in (loops.repeated_triangles, loops.triangle_areas):
+        with pytest.raises(ValueError, match=f"faces: vertex index {bad} outside 0..6"):
+            fn(v, f)
+        with pytest.raises(ValueError, match=f"faces: vertex index {bad} outside 0..6"):
+            without_loops(lambda fn=fn: fn(v, f))
+
+
+def test_a_large_mesh_dealt_into_parts_finds_the_same_repeats():
+    """Past 2^16 triangles the compiled loops deal the triangles into parts by their hash:
+    300,000 triangles, a tenth of them copies turned or reversed, some copied twice, and a
+    few vertices written twice at one place: the repeats numpy finds, and the vertices used."""
+    rng = np.random.default_rng(11)
+    v = rng.normal(0, 50, (100_000, 3))
+    v[-500:] = v[:500]                                       # the same places twice
+    f = rng.integers(0, len(v), (270_000, 3))
+    copies = f[rng.integers(0, len(f), 30_000)][:, ::-1]
+    copies[::2] = np.roll(copies[::2], 1, axis=1)
+    f = np.concatenate([f, copies])
+    rng.shuffle(f)
+    got, used = loops.repeated_triangles(v, f, used=True)
+    from maizeviz.canopy.from_mesh import repeated_triangles
+
+    want = without_loops(lambda: repeated_triangles(v, f))
+    assert got.sum() >= 30_000 - 100 and np.array_equal(got, want)
+    expect = np.zeros(len(v), bool)
+    expect[f.ravel()] = True
+    assert np.array_equal(used, expect)

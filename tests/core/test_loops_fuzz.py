@@ -208,3 +208,21 @@ def test_the_c_functions_refuse_bad_counts_and_indices_themselves():
                                    *(a.ctypes.data for a in args), out.ctypes.data) == -2
     assert np.all(out == 7.0)
     assert isinstance(lib.mz_chord_errors.argtypes[3](2), ctypes.c_int64)
+
+
+@pytest.mark.parametrize("bad", [-1, 4])
+def test_a_mesh_corner_outside_the_vertices_is_refused_by_c_itself(bad):
+    """Past the wrappers: a face naming a vertex the mesh does not have is -2, and the
+    repeated-triangle flags are not written."""
+    lib = loops._lib()
+    v = np.zeros((4, 3))
+    f = np.array([[0, 1, 2], [1, 2, bad]], np.int64)
+    flags = np.full(2, 7, np.uint8)
+    area = np.zeros(2)
+    assert lib.mz_repeated_triangles(v.ctypes.data, 4, f.ctypes.data, 2, flags.ctypes.data,
+                                     None) == -2
+    assert np.all(flags == 7)
+    assert lib.mz_triangle_areas(v.ctypes.data, 4, f.ctypes.data, 2, area.ctypes.data,
+                                 None) == -2
+    assert lib.mz_repeated_triangles(v.ctypes.data, 4, f.ctypes.data, -1, flags.ctypes.data,
+                                     None) == -2

@@ -426,3 +426,43 @@ def test_a_duplicate_is_named_as_a_duplicate_in_the_history(study, points):
     assert study.history.undo_text == f"duplicate plant {plant} (row 1)"
     assert study.draft.add(500.0, 500.0)
     assert study.history.undo_text.startswith("add plant")
+
+
+def test_leaves_only_is_a_light_setting_of_the_model(study, points, tmp_path):
+    """Whether the stalks take light is the study's light setting: traced as the core traces
+    ``LightEngine(with_stalks=False)`` on the same canopy, a named undo step, a new
+    comparison, each result tagged, kept in the project."""
+    from maizeviz_app.model import StudyModel
+    from maizeviz_app.runner import InlineRunner
+
+    from maizeviz.light.engine import LightEngine
+
+    m, s = study, study.settings
+    m.open_points(points)
+    s.sampling.heights, s.sampling.density = "0, 100, 200", 1.0
+    s.sun.zenith_deg, s.sun.azimuth_deg = 30.0, 120.0
+    assert s.light.stalks is True                            # the command line's default
+    assert m.compute_light() and not _errors(m)
+    assert m.runs.of_kind("sun").stalks
+    with m.history.step("leaves only"):
+        s.light.stalks = False
+    assert m.history.undo_text == "leaves only"
+    assert m.compute_light() and not _errors(m)
+    run = m.runs.of_kind("sun")
+    assert not run.stalks and len(m.runs.runs) == 1          # a new comparison
+    own = LightEngine(m.canopy, with_stalks=False).sun(zenith=30.0, azimuth=120.0,
+                                                       heights_cm=(0, 100, 200),
+                                                       density=1.0, periodic=True)
+    np.testing.assert_allclose(run.result.transmission, own.transmission, rtol=0, atol=1e-12)
+    assert len(run.result.first_hits) == m.canopy.n_triangles      # no stalk triangle
+    path = tmp_path / "leaves.maizeviz"
+    assert m.save_project(path)
+    m.history.undo()
+    assert s.light.stalks is True
+    runner2 = InlineRunner()
+    try:
+        m2 = StudyModel(tile=3, runner=runner2)
+        m2.open_project(path)
+        assert m2.settings.light.stalks is False and m2.runs.of_kind("sun").stalks is False
+    finally:
+        runner2.shutdown()

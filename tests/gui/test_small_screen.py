@@ -29,10 +29,15 @@ def find(root, name: str, kind=None):
 
 
 def _cut(widget) -> list[str]:
-    """What a panel shows cut: a label, button or check box narrower than its text, a field
-    narrower than its text, a combo narrower than its choice."""
+    """What a panel shows cut: a label, button or check box narrower than its text, a
+    wrapped label lower than its lines, a field narrower than its text, a combo narrower
+    than its choice."""
     cut = []
     for c in widget.findChildren(QLabel) + widget.findChildren(QAbstractButton):
+        if isinstance(c, QLabel) and c.isVisible() and c.wordWrap() and c.text() and \
+                c.heightForWidth(c.width()) > c.height() + 1:       # wrapped, lines cut off
+            cut.append(f"QLabel {c.text()!r}: {c.height()} px high < "
+                       f"{c.heightForWidth(c.width())}")
         if not c.isVisible() or (isinstance(c, QLabel) and (c.wordWrap() or c.pixmap()
                                                             and not c.pixmap().isNull())):
             continue
@@ -235,3 +240,143 @@ def test_the_c4_plants_table_shows_its_co2_columns_on_a_laptop(laptop, qtbot):
     assert p.plants.columnCount() == 8
     assert p.plants.horizontalScrollBar().maximum() == 0
     assert not _cut(w.docks["light"].widget().widget())
+
+
+def _cap_height_px(font_px: float) -> float:
+    """The height of a capital (an H) of matplotlib's default font drawn ``font_px`` tall."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import TextPath
+
+    return font_px * TextPath((0, 0), "H", size=1, prop=FontProperties()).get_extents().height
+
+
+def test_the_docked_heatmaps_text_is_readable_on_a_laptop(laptop, qtbot):
+    """Issue 37, item 7: at 1366 x 768 the docked heatmap's title, axis labels and colour-bar
+    text were drawn at 64 dpi on a 512 px figure and shrunk into a 448 x 168 view: capitals
+    2 px tall. Each light's map (a sun with C4, a sky, a day) is now drawn at the view's own
+    pixels and dpi, every text at least 11 px and its capitals 8.5 px (at 96 dpi)."""
+    from test_light_modes import compute, small_light
+
+    w = laptop
+    p = w.light_panel
+    small_light(p, "sun")
+    p.periodic.setChecked(True)
+    p.optics_box.setChecked(True)
+    p.photo_model.setCurrentIndex(p.photo_model.findData("c4"))
+    compute(qtbot, w)
+    for mode in ("sky", "day"):
+        small_light(p, mode)
+        compute(qtbot, w)
+    plots, view = w.plots, w.plots.heatmap
+    assert plots.source.count() == 3
+    for i in range(3):
+        plots.source.setCurrentIndex(i)
+        qtbot.waitUntil(lambda: view.heatmap is not None, timeout=TIMEOUT)
+        image = view.image()
+        scale = min(view.width() / image.width(), view.height() / image.height())
+        shown_px = view.heatmap.font_px * scale * 96 / view.logicalDpiY()
+        assert shown_px >= 11 and _cap_height_px(shown_px) >= 8.5, \
+            (plots.source.currentText(), view.heatmap.font_px, scale)
+    # the transmission plot too is drawn at its view's pixels (not shrunk)
+    plot = plots.transmission
+    assert abs(plot.image().width() - plot.width()) <= 0.05 * plot.width()
+
+
+def _sun_c4_sky_day(w, qtbot):
+    """A sun with C4, a sky and a day computed on the laptop's window (the Day page shown)."""
+    from test_light_modes import compute, small_light
+
+    p = w.light_panel
+    small_light(p, "sun")
+    p.periodic.setChecked(True)
+    p.optics_box.setChecked(True)
+    p.photo_model.setCurrentIndex(p.photo_model.findData("c4"))
+    compute(qtbot, w)
+    for mode in ("sky", "day"):
+        small_light(p, mode)
+        compute(qtbot, w)
+
+
+def test_the_day_page_takes_its_own_room_and_its_sky_shows(laptop, qtbot):
+    """Issue 37, item 7: the light panel's pages stood in a stack as tall as its tallest
+    page (the sun's with optics and C4, 527 px), so at 1366 x 768 the Day page (279 px) sat
+    in a gap and the sky it needs was cut by the dock's bottom edge. The page shown alone
+    takes room: neither squashed below its minimum nor stretched past its size, and the
+    sky's group shows whole in the dock, unscrolled."""
+    from PySide6.QtCore import QPoint
+
+    w = laptop
+    _sun_c4_sky_day(w, qtbot)
+    p = w.light_panel
+    w.docks["light"].raise_()
+    p.set_mode("day")
+    qtbot.wait(200)
+    area = w.docks["light"].widget()
+    area.verticalScrollBar().setValue(0)
+    qtbot.wait(100)
+    page = p.pages.currentWidget()
+    assert page is p.pages.widget(1) and page.isVisible()
+    assert page.minimumSizeHint().height() <= page.height() <= page.sizeHint().height() + 2, \
+        (page.minimumSizeHint(), page.size(), page.sizeHint())
+    bottom = p.sky_box.mapTo(area.widget(), QPoint(0, p.sky_box.height())).y()
+    assert p.sky_box.isVisible() and bottom <= area.viewport().height(), \
+        (bottom, area.viewport().height())
+    assert not _fits(w, "light")
+
+
+def test_the_layout_state_and_apply_show_in_a_laptops_dock(laptop, qtbot):
+    """Issue 37, item 7: at 1366 x 768 the Layout panel asked for the height its splitter was
+    given (60 % and 40 % of the panel's own, 740 px), taller than its dock (652 px): the state
+    line ("1 plant edited · not applied yet") and Apply stood below the bottom edge, cut.
+    They now show in the dock unscrolled; the state wraps (never cut) down to the
+    narrowest dock and tells the whole of it in its tooltip."""
+    from PySide6.QtCore import QPoint, Qt
+
+    w = laptop
+    _sun_c4_sky_day(w, qtbot)
+    w.docks["layout"].raise_()
+    w.model.layout_options.follow = False
+    panel = w.layout_panel
+    panel.draft.move(0, 40.0, 20.0)                     # an edit: the state says so
+    qtbot.wait(300)
+    assert panel.state.text() == "1 plant edited · not applied yet"
+    assert "Apply" in panel.state.toolTip()
+    area = w.docks["layout"].widget()
+    area.verticalScrollBar().setValue(0)
+    qtbot.wait(100)
+    for part in (panel.state, panel.apply_button):
+        bottom = part.mapTo(area.widget(), QPoint(0, part.height())).y()
+        assert part.isVisible() and bottom <= area.viewport().height(), \
+            (part.text(), bottom, area.viewport().height())
+    for width in (480, 300):
+        w.resizeDocks([w.docks["layout"]], [width], Qt.Orientation.Horizontal)
+        qtbot.wait(200)
+        label = panel.state
+        assert label.heightForWidth(label.width()) <= label.height() + 1, \
+            (width, label.size(), label.heightForWidth(label.width()))
+        assert not [c for c in _cut(panel) if "edited" in c]
+
+
+def test_the_docked_heatmap_is_drawn_again_for_its_new_size(laptop, qtbot):
+    """A bigger window: once the resize settles, the heatmap shown is drawn again for its
+    view's new pixels (its texts keep their points), the old one in view meanwhile."""
+    from test_light_modes import compute, small_light
+
+    w = laptop
+    small_light(w.light_panel, "sun")
+    compute(qtbot, w)
+    view = w.plots.heatmap
+    qtbot.waitUntil(lambda: view.heatmap is not None, timeout=TIMEOUT)
+    before, font_px = view.image().size(), view.heatmap.font_px
+    assert abs(before.width() - view.width()) <= 0.05 * view.width()
+    emptied = []
+    w.resize(1920, 1052)
+
+    def redrawn() -> bool:
+        image = view.image()
+        emptied.append(image is None)
+        return image is not None and image.width() > 1.2 * before.width() and \
+            abs(image.width() - view.width()) <= 0.05 * view.width()
+
+    qtbot.waitUntil(redrawn, timeout=TIMEOUT)
+    assert not any(emptied) and view.heatmap.font_px == pytest.approx(font_px)

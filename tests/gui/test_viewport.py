@@ -188,3 +188,28 @@ def test_a_moving_camera_draws_a_lighter_canopy_and_the_whole_one_when_it_stops(
     view.wheelEvent(wheel)
     assert lod.GetVisibility() and not canopy.GetVisibility()
     qtbot.waitUntil(lambda: canopy.GetVisibility() and not lod.GetVisibility(), timeout=5000)
+
+
+@pytest.mark.parametrize("field, rs, ps", [((-180, -90, 360, 180), 60, 30),   # 3x3 tiled
+                                           ((0, 0, 180, 90), 60, 30),        # the block
+                                           ((0, 0, 5400, 2700), 60, 30)])    # a field
+def test_the_grounds_labels_do_not_overlap_and_y_reads_upright(field, rs, ps):
+    """The first y label sat on the first x label at the corner ('-90' over '-180'), and the
+    y axis's name read upside down from the usual views (turned -90 degrees)."""
+    from maizeviz_app.viewport import _ticks, ground_labels
+
+    x0, y0, x1, y1 = field
+    margin = max(25.0, 0.09 * max(x1 - x0, y1 - y0))
+    labels = ground_labels(field, margin, _ticks(x0, x1, rs), _ticks(y0, y1, ps))
+    char_h = 0.42 * margin                      # the font's pixel size, in cm of ground
+    boxes = []
+    for text, x, y, _wide, angle in labels:
+        w, h = 0.6 * char_h * len(text), char_h     # DejaVu Sans: under 0.6 em a character
+        if angle % 180:
+            w, h = h, w
+        boxes.append((text, x - w / 2, y - h / 2, x + w / 2, y + h / 2))
+    for i, a in enumerate(boxes):
+        for b in boxes[i + 1:]:
+            apart = a[3] <= b[1] or b[3] <= a[1] or a[4] <= b[2] or b[4] <= a[2]
+            assert apart, f"'{a[0]}' and '{b[0]}' overlap"
+    assert [angle for text, *_, angle in labels if text.startswith("y (")] == [90.0]

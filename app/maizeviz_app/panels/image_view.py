@@ -7,7 +7,7 @@ there writes it as a PNG."""
 from __future__ import annotations
 
 import numpy as np
-from PySide6.QtCore import QSize, Qt
+from PySide6.QtCore import QSize, Qt, QTimer, Signal
 from PySide6.QtGui import QImage, QKeySequence, QPixmap, QShortcut
 from PySide6.QtWidgets import (
     QDialog,
@@ -25,11 +25,25 @@ ZOOM_STEP = 1.25
 ZOOM_LIMITS = (0.25, 8.0)
 
 
+#: Quiet time (ms) after the last resize before a view says its new canvas.
+RESIZE_SETTLE_MS = 250
+
+
 class ImageView(QLabel):
-    """A picture scaled to fit the widget, keeping its aspect (figures drawn elsewhere)."""
+    """A picture scaled to fit the widget, keeping its aspect (figures drawn elsewhere).
+
+    ``canvas_resized(width, height, dpi)``: the view's size in device pixels and its dpi
+    (logical dpi times the device pixel ratio), said once a resize settles, so a figure can
+    be drawn for it: at the view's own pixels its texts keep their size in points."""
+
+    canvas_resized = Signal(int, int, float)
 
     def __init__(self, placeholder: str = "", parent=None):
         super().__init__(placeholder, parent)
+        self._settle = QTimer(self)
+        self._settle.setSingleShot(True)
+        self._settle.setInterval(RESIZE_SETTLE_MS)
+        self._settle.timeout.connect(self._say_canvas)
         self._placeholder = placeholder
         self._image: QImage | None = None
         self.setAlignment(Qt.AlignmentFlag.AlignCenter)
@@ -71,13 +85,27 @@ class ImageView(QLabel):
     def resizeEvent(self, event) -> None:  # noqa: N802 - Qt's name
         super().resizeEvent(event)
         self._rescale()
+        self._settle.start()
+
+    def canvas(self) -> tuple[int, int, float]:
+        """(width, height) in device pixels and the dpi a figure drawn for this view takes."""
+        ratio = self.devicePixelRatioF()
+        return (round(self.width() * ratio), round(self.height() * ratio),
+                float(self.logicalDpiY()) * ratio)
+
+    def _say_canvas(self) -> None:
+        if self.isVisible() and self.width() > 1 and self.height() > 1:
+            self.canvas_resized.emit(*self.canvas())
 
     def _rescale(self) -> None:
         if self._image is None:
             return
-        self.setPixmap(QPixmap.fromImage(self._image).scaled(
-            self.size(), Qt.AspectRatioMode.KeepAspectRatio,
-            Qt.TransformationMode.SmoothTransformation))
+        ratio = self.devicePixelRatioF()            # a figure drawn for device pixels
+        pixmap = QPixmap.fromImage(self._image).scaled(
+            self.size() * ratio, Qt.AspectRatioMode.KeepAspectRatio,
+            Qt.TransformationMode.SmoothTransformation)
+        pixmap.setDevicePixelRatio(ratio)
+        self.setPixmap(pixmap)
 
     def sizeHint(self) -> QSize:  # noqa: N802
         return QSize(360, 200)

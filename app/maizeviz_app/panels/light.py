@@ -39,7 +39,6 @@ from PySide6.QtWidgets import (
     QRadioButton,
     QSizePolicy,
     QSpinBox,
-    QStackedWidget,
     QTableWidget,
     QTableWidgetItem,
     QVBoxLayout,
@@ -84,6 +83,45 @@ def _time_zones() -> list[str]:
         return ["UTC", "Asia/Shanghai", "Europe/Paris", "America/Chicago"]
 
 
+class PageStack(QWidget):
+    """Pages shown one at a time, of which only the one shown takes room (a column whose
+    other pages are hidden). A QStackedWidget is as tall as its tallest page (its layout's
+    height for a width is the tallest's: the sun's with its optics open, 527 px), so the
+    day's page (279 px) stood in a gap that pushed the sky it needs below a laptop's dock."""
+
+    def __init__(self, parent=None):
+        super().__init__(parent)
+        self._column = QVBoxLayout(self)
+        self._column.setContentsMargins(0, 0, 0, 0)
+        self._pages: list[QWidget] = []
+        self._current = -1
+
+    def addWidget(self, page: QWidget) -> int:  # noqa: N802 - QStackedWidget's name
+        self._pages.append(page)
+        self._column.addWidget(page)
+        if self._current < 0:
+            self._current = 0
+        page.setVisible(len(self._pages) - 1 == self._current)
+        return len(self._pages) - 1
+
+    def count(self) -> int:
+        return len(self._pages)
+
+    def widget(self, index: int) -> QWidget | None:
+        return self._pages[index] if 0 <= index < len(self._pages) else None
+
+    def currentIndex(self) -> int:  # noqa: N802 - QStackedWidget's name
+        return self._current
+
+    def currentWidget(self) -> QWidget | None:  # noqa: N802 - QStackedWidget's name
+        return self.widget(self._current)
+
+    def setCurrentIndex(self, index: int) -> None:  # noqa: N802 - QStackedWidget's name
+        self._current = index
+        for k, page in enumerate(self._pages):
+            page.setVisible(k == index)
+
+
 class LightPanel(QWidget):
     """The light settings of ``study`` (a :class:`~maizeviz_app.model.StudyModel`; its
     ``settings``, bound both ways) and its results table (its runs fill it). Without a study
@@ -119,7 +157,7 @@ class LightPanel(QWidget):
             modes.addWidget(b, 1)
         self.mode_group = bind_choice(self.mode_buttons, s.light, "mode")
         lay.addLayout(modes)
-        self.pages = QStackedWidget()
+        self.pages = PageStack()
         self.pages.addWidget(self._sun_page())
         self.pages.addWidget(self._day_page())
         self.pages.addWidget(QWidget())               # the sky needs only the sky group
@@ -142,6 +180,13 @@ class LightPanel(QWidget):
                                  "as in a field that goes on (off: an isolated plot)")
         bind(self.periodic, s.sampling, "periodic")
         form.addRow(self.periodic)
+        self.stalks = QCheckBox("stalks take light")
+        self.stalks.setAccessibleName("stalks take light")
+        self.stalks.setToolTip("the stalks intercept and scatter light as the leaves do (off: "
+                               "the leaves alone, as the paper's canopy and maizeviz light "
+                               "--leaves-only)")
+        bind(self.stalks, s.light, "stalks")
+        form.addRow(self.stalks)
         lay.addLayout(form)
         # ---- compute, cancel, progress, problems
         buttons = QHBoxLayout()
@@ -229,7 +274,8 @@ class LightPanel(QWidget):
             lay.addLayout(line)
         lay.addStretch(1)
         self.fields: dict[str, Any] = {"heights": self.heights, "density": self.density,
-                                       "periodic": self.periodic, "rect": self.heights,
+                                       "periodic": self.periodic, "stalks": self.stalks,
+                                       "rect": self.heights,
                                        "threads": self.density}
         self.mode_fields: dict[str, dict[str, Any]] = {
             "sun": {"band": self.band, "reflectance": self.reflectance,
@@ -280,6 +326,7 @@ class LightPanel(QWidget):
 
     def _widget_of(self, name: str):
         return {"heights": self.heights, "density": self.density, "periodic": self.periodic,
+                "stalks": self.stalks,
                 "zenith_deg": self.zenith, "azimuth_deg": self.azimuth, "place": self.place,
                 "kind": self.sky_kind, "directions": self.sky_n, "date": self.day_date,
                 "latitude": self.lat, "longitude": self.lon, "tz": self.tz,
@@ -630,12 +677,6 @@ class LightPanel(QWidget):
 
     def _show_mode(self, mode: str) -> None:
         page = {"sun": 0, "day": 1, "sky": 2}[mode]
-        for k in range(self.pages.count()):
-            # only the page shown takes room: the sun page is short, the day page tall
-            policy = QSizePolicy.Policy.Preferred if k == page else QSizePolicy.Policy.Ignored
-            widget = self.pages.widget(k)
-            if widget is not None:
-                widget.setSizePolicy(QSizePolicy.Policy.Preferred, policy)
         self.pages.setCurrentIndex(page)
         self.pages.setVisible(mode != "sky")
         self.sky_box.setVisible(mode != "sun")
@@ -643,7 +684,6 @@ class LightPanel(QWidget):
                               "diffuse part of the day: the sky it comes from")
         self.compute_button.setText(COMPUTE_TEXT[mode])
         self.compute_button.setAccessibleName(COMPUTE_TEXT[mode])
-        self.pages.adjustSize()
         self._sync_sky_kind()
 
     def _sync_sky_kind(self) -> None:
@@ -821,7 +861,10 @@ class LightPanel(QWidget):
         head = max(t.horizontalHeader().height(), t.horizontalHeader().sizeHint().height())
         h = head + 2 * t.frameWidth()
         h += sum(t.rowHeight(r) for r in range(t.rowCount()))
-        if t.horizontalScrollBar().isVisible() or t.columnCount() > 4:
+        # the sideways scroll bar, when the columns are wider than the table (it may not be
+        # shown yet), must not hide the last row
+        if t.horizontalScrollBar().isVisible() or t.columnCount() > 4 or \
+                t.horizontalHeader().length() > t.viewport().width():
             h += t.horizontalScrollBar().sizeHint().height()
         t.setFixedHeight(max(h, head + 30))
 
@@ -941,13 +984,14 @@ class LightPlots(QWidget):
         if gone:
             self._fill_sources(None)
 
-    def redraw(self, keep: str | None = None) -> None:
-        """The colours changed: every map (but those of the light ``keep``) is drawn again
-        when shown (the one shown now is asked for at once, by ``heatmap_needed``)."""
+    def redraw(self, keep: str | None = None, hold: bool = False) -> None:
+        """The colours (or the view's size) changed: every map (but those of the light
+        ``keep``) is drawn again when shown (the one shown now is asked for at once, by
+        ``heatmap_needed``; with ``hold`` it stays in view until its new drawing comes)."""
         for kind, maps in self._maps.items():
             if kind != keep:
                 self._maps[kind] = [(h, None) for h, _ in maps]
-        self._show_height(self.height_box.currentIndex())
+        self._show_height(self.height_box.currentIndex(), hold)
 
     def set_heatmap(self, index: int, rgba: np.ndarray, kind: str = "sun") -> None:
         """A height's figure, drawn after it was asked for."""
@@ -957,7 +1001,7 @@ class LightPlots(QWidget):
             if kind == self.kind and index == self.height_box.currentIndex():
                 self.heatmap.set_rgba(rgba)
 
-    def _show_height(self, index: int) -> None:
+    def _show_height(self, index: int, hold: bool = False) -> None:
         kind = self.kind
         maps = self._maps.get(kind, []) if kind is not None else []
         if len(maps) != self.height_box.count():          # another light chosen: its heights
@@ -965,9 +1009,11 @@ class LightPlots(QWidget):
             return
         if 0 <= index < len(maps):
             rgba = maps[index][1]
-            self.heatmap.set_rgba(rgba)
+            if rgba is not None or not hold:
+                self.heatmap.set_rgba(rgba)
             if rgba is None:
-                self.heatmap.setText("drawing…")
+                if not hold:
+                    self.heatmap.setText("drawing…")
                 self.heatmap_needed.emit(kind, index)
         else:
             self.heatmap.set_rgba(None)

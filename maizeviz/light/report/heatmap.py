@@ -40,14 +40,21 @@ def transmission_map(result: LightResult, height: float, bin_cm: float = 5.0) ->
 
 
 def heatmap_figure(tmap: TransmissionMap, result: LightResult | None = None,
-                   width_in: float = 8.0, dpi: int = 110, title: str | None = None,
+                   width_in: float = 8.0, dpi: float = 110, title: str | None = None,
                    what: str = "direct-light transmission", *, vmin: float = 0.0,
-                   vmax: float = 1.0, cmap: str = "viridis", log: bool = False) -> Figure:
+                   vmax: float = 1.0, cmap: str = "viridis", log: bool = False,
+                   fit: tuple[float, float] | None = None, font_pt: float = 9.5) -> Figure:
     """A figure of one map: colour bar, axes in cm; the title names the sun angles, level and
     rays of ``result``, or is ``title`` (the first line always names ``what``, the height and
     the plane's total). The colours span ``vmin`` to ``vmax`` (values outside take the end
     colours) on matplotlib's colour map ``cmap``, spaced by the logarithm with ``log``
-    (``vmin`` > 0; values of 0 take the lowest colour); bins no ray reached stay blank."""
+    (``vmin`` > 0; values of 0 take the lowest colour); bins no ray reached stay blank.
+
+    ``fit`` (width, height), inches: the figure made that size, for a canvas of its own
+    (``width_in`` ignored) with matplotlib's constrained layout and every text at ``font_pt``
+    points; where it is small the labels are shortened, the second title line dropped
+    (below :data:`FULL_TITLE_IN`) and the ticks fewer (one per :data:`TICK_SPACING_IN`), so
+    that what is drawn stays readable at its own size rather than shrunk to fit."""
     from matplotlib.colors import LogNorm, Normalize
     from matplotlib.figure import Figure
 
@@ -57,7 +64,16 @@ def heatmap_figure(tmap: TransmissionMap, result: LightResult | None = None,
 
     xe, ye = tmap.x_edges, tmap.y_edges
     aspect = (ye[-1] - ye[0]) / (xe[-1] - xe[0])
-    fig = Figure(figsize=(width_in, width_in * aspect * 0.8 + 0.2 * width_in), dpi=dpi)
+    if fit is None:
+        fig = Figure(figsize=(width_in, width_in * aspect * 0.8 + 0.2 * width_in), dpi=dpi)
+        small, fonts = False, {"title": 9.0}
+    else:
+        from matplotlib.layout_engine import ConstrainedLayoutEngine
+
+        fig = Figure(figsize=fit, dpi=dpi,
+                     layout=ConstrainedLayoutEngine(w_pad=2 / 72, h_pad=2 / 72))
+        small = fit[1] < FULL_TITLE_IN or fit[0] < FULL_TITLE_IN
+        fonts = {"title": font_pt, "label": font_pt, "ticks": font_pt}
     ax = fig.add_subplot()
     norm = LogNorm(vmin, vmax, clip=True) if log else Normalize(vmin, vmax)
     values = tmap.transmission.T
@@ -65,19 +81,49 @@ def heatmap_figure(tmap: TransmissionMap, result: LightResult | None = None,
         values = np.where(values <= 0, vmin, values)
     im = ax.pcolormesh(xe, ye, values, norm=norm, cmap=cmap, shading="flat")
     ax.set_aspect("equal")
-    ax.set_xlabel("x (cm, across rows)")
-    ax.set_ylabel("y (cm, along rows)")
+    ax.set_xlabel("x (cm)" if small else "x (cm, across rows)", fontsize=fonts.get("label"))
+    ax.set_ylabel("y (cm)" if small else "y (cm, along rows)", fontsize=fonts.get("label"))
     if title is None and result is not None:
         title = map_title(result, "sun", (xe[-1] - xe[0]) / max(len(xe) - 1, 1))[1]
     import textwrap
 
-    ax.set_title(f"{what} at {tmap.height_cm:g} cm: {tmap.total:.3f}"
-                 + ("\n" + "\n".join(textwrap.wrap(title, 95)) if title else ""), fontsize=9)
-    fig.colorbar(im, ax=ax, label="transmission (fraction of the light reaching this height)",
-                 shrink=0.8,
-                 extend=_extend(tmap.transmission, vmin, vmax))
-    fig.tight_layout()
+    head = f"{what} at {tmap.height_cm:g} cm: {tmap.total:.3f}"
+    if fit is None:
+        ax.set_title(head + ("\n" + "\n".join(textwrap.wrap(title, 95)) if title else ""),
+                     fontsize=fonts["title"])
+    else:
+        # over the whole figure (the map and its colour bar sit to one side of it), wrapped
+        # to the figure's width at the font's size
+        chars = max(int(fit[0] * 72 / (0.55 * font_pt)), 20)
+        lines = textwrap.wrap(head, chars) + \
+            (textwrap.wrap(title, chars) if title and not small else [])
+        fig.suptitle("\n".join(lines), fontsize=fonts["title"])
+    bar = fig.colorbar(im, ax=ax, shrink=0.8 if fit is None else 1.0,
+                       label="transmission" if small else
+                       "transmission (fraction of the light reaching this height)",
+                       extend=_extend(tmap.transmission, vmin, vmax))
+    if fit is None:
+        fig.tight_layout()
+        return fig
+    from matplotlib.ticker import MaxNLocator
+
+    bar.ax.yaxis.label.set_fontsize(fonts["label"])
+    bar.ax.tick_params(labelsize=fonts["ticks"])
+    ax.tick_params(labelsize=fonts["ticks"])
+    # a tick per TICK_SPACING_IN of the map's room at most: labels that do not crowd
+    ax.xaxis.set_major_locator(MaxNLocator(max(int(fit[0] / TICK_SPACING_IN / 2), 2)))
+    ax.yaxis.set_major_locator(MaxNLocator(max(int(fit[1] / TICK_SPACING_IN), 2)))
+    if not log:
+        bar.locator = MaxNLocator(max(int(fit[1] / TICK_SPACING_IN), 2))
+        bar.update_ticks()
     return fig
+
+
+#: Below this width or height (inches) a fitted heatmap (``fit``) keeps one title line and
+#: short axis and colour-bar labels.
+FULL_TITLE_IN = 4.0
+#: Room (inches) per tick label along a fitted heatmap's axes.
+TICK_SPACING_IN = 0.5
 
 
 def _extend(values: np.ndarray, vmin: float, vmax: float) -> str:
@@ -149,11 +195,11 @@ def result_map(result: AnyLight, height: float, kind: str = "sun",
 
 
 def result_figure(result: AnyLight, height: float, kind: str = "sun", bin_cm: float = 5.0,
-                  width_in: float = 8.0, dpi: int = 110,
+                  width_in: float = 8.0, dpi: float = 110,
                   tmap: TransmissionMap | None = None, **colours) -> Figure:
     """The figure of one height of a light result (:func:`result_map`, or ``tmap`` when
     already made), titled by :func:`map_title`; ``colours``: :func:`heatmap_figure`'s
-    ``vmin``, ``vmax``, ``cmap``, ``log``."""
+    ``vmin``, ``vmax``, ``cmap``, ``log`` (and its ``fit``, ``font_pt``)."""
     tmap = result_map(result, height, kind, bin_cm) if tmap is None else tmap
     if kind == "sun":
         return heatmap_figure(tmap, cast(LightResult, result), width_in=width_in, dpi=dpi,

@@ -146,10 +146,12 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
             # whole area intercepts at the beam's flux (bounded by construction, see
             # .sunlit), in place of the primary rays' deposits, which the scattering still
             # starts from
-            share = sunlit_share(smp, canopy, normals, toward, seed + 7919 * k)
+            hits = _first_hits(tally, nf)
+            cos = np.abs(np.einsum("ij,j->i", normals, toward))     # no BLAS thread pool
+            share = sunlit_share(smp, canopy, normals, toward, seed + 7919 * k, hits, cos)
             area = geometry(canopy, nf).area_cm2
-            whole = kept * irradiance / toward[2] * np.abs(normals @ toward) * area * 1e-4
-            rays_w = _first_deposits(tally, nf, kept * per_ray)
+            whole = (kept * irradiance / toward[2] * 1e-4) * cos * area
+            rays_w = hits * (kept * per_ray)               # as Tally.per_triangle counts them
             rays_b = tally.per_batch(nf, kept * per_ray, first=True)
             direct_t, direct_b = _matched(share.fraction * whole, csr_array(
                 share.batches * whole), whole, rays_w, rays_b, canopy.n_triangles)
@@ -157,8 +159,12 @@ def absorbed_light(canopy: Canopy, smp: Sampler, normals: np.ndarray, optics: Op
             absorbed_b = absorbed_b - rays_b + direct_b
             fraction = np.divide(direct_t, whole, out=np.zeros(nf), where=whole > 0)
             sunlit = fraction * area
-            sunlit_b = csr_array(direct_b.multiply(
-                np.divide(area, whole, out=np.zeros(nf), where=whole > 0)[None, :]))
+            # cm2 per W of each triangle, at the few columns the batches store
+            sunlit_b = csr_array(direct_b, copy=True)
+            col = sunlit_b.indices
+            sunlit_b.data *= np.divide(area[col], whole[col], out=np.zeros(len(col)),
+                                       where=whole[col] > 0)
+            sunlit_b.eliminate_zeros()
             sun_dir = (float(toward[0]), float(toward[1]), float(toward[2]))
         for name in parts:
             parts[name] += getattr(tally, name) * per_ray
@@ -210,17 +216,21 @@ def _matched(direct: np.ndarray, direct_b, whole: np.ndarray, rays_w: np.ndarray
 
     out = direct.copy()
     add = np.zeros_like(direct)
-    for part in (slice(0, n_leaf), slice(n_leaf, len(direct))):
+    scale = [1.0, 1.0]                              # of the leaves', the stalks' sampled beam
+    for k, part in enumerate((slice(0, n_leaf), slice(n_leaf, len(direct)))):
         got, want = float(direct[part].sum()), float(rays_w[part].sum())
         if want > got:
             room = whole[part] - direct[part]
             total = float(room.sum())
             add[part] = room * min(1.0, (want - got) / total) if total > 0 else 0.0
         elif got > 0:
-            out[part] *= want / got
-    scale = np.divide(out, direct, out=np.ones_like(direct), where=direct > 0)
-    # the batches: the sampled rows scaled as their triangles, the raise dealt as the rays'
-    rows = csr_array(direct_b.multiply(scale[None, :]))
+            scale[k] = want / got
+            out[part] *= scale[k]
+    # the batches: the sampled rows scaled as their triangles (their few stored values), the
+    # raise dealt as the rays'
+    rows = csr_array(direct_b, copy=True)
+    rows.data *= np.where(rows.indices < n_leaf, scale[0], scale[1])
+    rows.eliminate_zeros()
     per_batch = np.asarray(rays_b.sum(axis=1)).ravel()
     ids = np.flatnonzero(add)
     if len(ids) and per_batch.sum() > 0:
@@ -231,10 +241,10 @@ def _matched(direct: np.ndarray, direct_b, whole: np.ndarray, rays_w: np.ndarray
     return out + add, csr_array(rows)
 
 
-def _first_deposits(tally, nf: int, weight) -> np.ndarray:
-    """(F,) float64: what the primary rays deposited on the triangles they hit first."""
+def _first_hits(tally, nf: int) -> np.ndarray:
+    """(F,) int64: how many primary rays hit each triangle first."""
     ids = np.concatenate(tally.first_hits) if tally.first_hits else np.empty(0, np.int64)
-    return np.bincount(ids, minlength=nf) * weight         # as Tally.per_triangle counts them
+    return np.bincount(ids, minlength=nf)
 
 
 def period_temperatures(period: Period, temperature_c) -> np.ndarray:

@@ -22,6 +22,24 @@ points are spread over its triangles in proportion to the beam each would interc
 fraction stands for each of them. The leaf's figures stay unbiased and bounded, and a mesh of
 millions of triangles costs about as many points as rays, not one per triangle.
 
+Those rays would hit the triangle *fully lit*; most of a dense canopy's leaf area is shaded
+(at K = 4 on the bundled block at 4 rays per cm2, the triangles that may send the beam to the
+sample rectangle would take 569,000 rays fully lit, against the 64,800 traced), and a point
+in the shade tells no more than its neighbours. So where the forward rays have been traced,
+their first hits (drawn independently of the points) say where to sample: a patch of about a
+ray that one of them hit, or that lies beside one in mesh order (likely a penumbra), keeps its
+points; the triangles of the other patches are taken again, with their neighbours of the same
+leaf, into patches of about :data:`SHADED_PATCH_RAYS` rays, each sampled with as many points
+as a patch of one ray. The patches and their points depend on the rays, never on the points'
+outcomes, so each patch's share of clear points is still an unbiased estimate of its sunlit
+share, in [0, 1]; a patch wholly in the shade is exact with one point. Only the sunflecks the
+rays missed are estimated more coarsely: at K = 4, 160,000 points where 738,000 were drawn
+without the rays (the triangles whose beam cannot land in the sample rectangle left out too);
+over 16 seeds the canopy's sunlit area is 3.135 m2 where it was 3.138 (standard deviations 62
+and 65 cm2), and a lit leaf's varies more (median relative standard deviation 3.6 % against
+2.4 %, over the 179 leaves with over 1 cm2 in the sun; 4.8 % without the penumbra kept); the
+batches' standard errors carry it.
+
 A point counts only for the light falling on the sample rectangle, as the forward rays do:
 its path traced down to the ground (wrapped into the plot in a periodic field) must land in the
 rectangle.
@@ -57,6 +75,8 @@ if TYPE_CHECKING:       # scipy.sparse (0.3 s, and numpy.f2py) is imported when 
 LIFT_CM = 1e-3
 #: Sample points traced together (bounded memory).
 CHUNK_POINTS = 1 << 18
+#: Rays a patch of triangles no forward ray hit stands for, sampled as a patch of one ray.
+SHADED_PATCH_RAYS = 8.0
 
 
 @dataclass(frozen=True)
@@ -144,6 +164,8 @@ def scene_triangles(canopy: Canopy, n_triangles: int, which=None) -> np.ndarray:
     ``n_triangles``: the canopy's leaves, then its stalks)."""
     nl = canopy.n_triangles
     idx = np.arange(n_triangles) if which is None else np.asarray(which, np.int64)
+    if not len(idx) or idx.max() < nl:                     # leaves only: one gather
+        return canopy.vertices[canopy.faces[idx]]
     out = np.empty((len(idx), 3, 3))
     leaf = idx < nl
     out[leaf] = canopy.vertices[canopy.faces[idx[leaf]]]
@@ -172,9 +194,9 @@ def samples_per_triangle(area_cm2: np.ndarray, cos_beam: np.ndarray, ray_area_cm
 
 
 def patches(group: np.ndarray, expected: np.ndarray) -> np.ndarray:
-    """(n,) intp: the patch of each triangle, numbered from 0: consecutive triangles (in the
-    order given) of one ``group`` whose ``expected`` rays add up to about one; a triangle
-    expecting one or more rays is (nearly always) a patch of its own."""
+    """(n,) intp: the patch of each triangle, numbered from 0 in the order given (so
+    non-decreasing): consecutive triangles of one ``group`` whose ``expected`` rays add up to
+    about one; a triangle expecting one or more rays is (nearly always) a patch of its own."""
     n = len(group)
     if not n:
         return np.zeros(0, np.intp)
@@ -183,9 +205,10 @@ def patches(group: np.ndarray, expected: np.ndarray) -> np.ndarray:
     new[1:] = group[1:] != group[:-1]
     start = np.maximum.accumulate(np.where(new, np.arange(n), 0))
     base = cum[start] - expected[start]                   # the group's sum before it
-    bucket = np.floor(cum - base - 0.5 * expected).astype(np.int64)
-    _, patch = groups(np.cumsum(new), bucket)
-    return patch
+    # the ray a triangle's middle falls in, counted along its group: a patch is a run of one
+    bucket = np.floor(cum - base - 0.5 * expected)
+    new[1:] |= bucket[1:] != bucket[:-1]
+    return np.cumsum(new) - 1
 
 
 def _overlaps(lo_v: np.ndarray, hi_v: np.ndarray, lo: float, hi: float,
@@ -221,8 +244,31 @@ def _near_rect(smp: Sampler, geo: Geometry, shift: np.ndarray) -> np.ndarray:
     return near[geo.group]
 
 
+def _near_triangles(smp: Sampler, geo: Geometry, shift: np.ndarray) -> np.ndarray:
+    """(n,) intp, ascending: the triangles whose beam may land in the sample rectangle. Of
+    those of the groups near it (:func:`_near_rect`), each triangle whose points, within
+    ``radius`` of its centre in x, y and z, land within ``radius (1 + |shift|)`` of where its
+    centre's beam lands, in each axis, which must meet the rectangle (in a periodic field,
+    wrapped across the plot)."""
+    ids = np.flatnonzero(_near_rect(smp, geo, shift))
+    x0, y0, x1, y1 = smp.rect
+    bx0, by0, bx1, by1 = smp.bounds
+    if not len(ids) or smp.periodic and np.allclose((x0, y0, x1, y1), smp.bounds):
+        return ids
+    c, r = geo.centre[ids], geo.radius_cm[ids]
+    keep = np.ones(len(ids), dtype=bool)
+    for axis, (lo, hi, start, period) in enumerate(((x0, x1, bx0, bx1 - bx0),
+                                                    (y0, y1, by0, by1 - by0))):
+        land = c[:, axis] - shift[axis] * c[:, 2]
+        reach = r * (1.0 + abs(shift[axis]))
+        keep &= _overlaps(land - reach, land + reach, lo, hi,
+                          start if smp.periodic else None, period)
+    return ids[keep]
+
+
 def sunlit_share(smp: Sampler, canopy: Canopy, normals: np.ndarray, toward: np.ndarray,
-                 seed: int) -> SunlitShare:
+                 seed: int, hits: np.ndarray | None = None,
+                 cos_beam: np.ndarray | None = None) -> SunlitShare:
     """Sample the sunlit share of every triangle (see the module docstring).
 
     Parameters
@@ -237,6 +283,12 @@ def sunlit_share(smp: Sampler, canopy: Canopy, normals: np.ndarray, toward: np.n
         Unit vector toward the sun, ``z > 0``.
     seed : int
         Seed of the points and of their batches.
+    hits : (F,) integers, optional
+        The forward rays' first hits on each triangle (drawn independently of the points).
+        Given, the patches of about a ray that no ray hit, nor one beside them, are sampled
+        :data:`SHADED_PATCH_RAYS` times more sparsely (see the module docstring).
+    cos_beam : (F,) float64, optional
+        ``|normals . toward|``, where the caller has it.
 
     Returns
     -------
@@ -247,19 +299,29 @@ def sunlit_share(smp: Sampler, canopy: Canopy, normals: np.ndarray, toward: np.n
     s = np.asarray(toward, np.float64)
     nf = len(normals)
     geo = geometry(canopy, nf)
-    cos = np.abs(normals @ s)
-    weight = geo.area_cm2 * cos                          # the beam each would intercept
     # the triangles whose beam may land in the rectangle (their centre's, within their size)
     shift = s[:2] / s[2]
-    near = _near_rect(smp, geo, shift)
-    tri_ids = np.flatnonzero(near & (weight > 0))
-    expected = samples_per_triangle(geo.area_cm2[tri_ids], cos[tri_ids], smp.ray_area_cm2,
-                                    float(s[2]))
-    patch = patches(geo.group[tri_ids], expected)
-    order = np.argsort(patch, kind="stable")
-    tri_ids, patch, expected = tri_ids[order], patch[order], expected[order]
+    tri_ids = _near_triangles(smp, geo, shift)
+    cos = np.abs(normals[tri_ids] @ s) if cos_beam is None else cos_beam[tri_ids]
+    w = geo.area_cm2[tri_ids] * cos                      # the beam each would intercept
+    lit_side = w > 0
+    if not lit_side.all():
+        tri_ids, cos, w = tri_ids[lit_side], cos[lit_side], w[lit_side]
+    expected = samples_per_triangle(geo.area_cm2[tri_ids], cos, smp.ray_area_cm2, float(s[2]))
+    group = geo.group[tri_ids]
+    patch = patches(group, expected)
+    if hits is not None:
+        # a patch of about a ray that no ray hit, nor one beside it, is mostly in the shade:
+        # those are sampled in patches of about SHADED_PATCH_RAYS rays
+        hit = np.bincount(patch, weights=np.asarray(hits)[tri_ids]) > 0
+        near_hit = hit.copy()                  # a patch beside a lit one: likely a penumbra
+        near_hit[1:] |= hit[:-1]
+        near_hit[:-1] |= hit[1:]
+        found = near_hit[patch]
+        if not found.all():
+            expected = np.where(found, expected, expected / SHADED_PATCH_RAYS)
+            patch = patches(group, expected)
     n_p = int(patch[-1]) + 1 if len(patch) else 0
-    w = weight[tri_ids]
     w_patch = np.bincount(patch, weights=w, minlength=n_p)
     first = np.searchsorted(patch, np.arange(n_p))
     cum_w = np.cumsum(w) - w                                    # before each triangle
