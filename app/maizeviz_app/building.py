@@ -162,6 +162,7 @@ def _built(study: StudyState, built) -> None:
     if not study.show_built(built):
         return
     lighting.adopt_pending_runs(study)
+    lighting.show_brought_back(study)
     lighting.complete_runs(study)
     study.view_light.emit(False)
     study.built_shown.emit(built.label)

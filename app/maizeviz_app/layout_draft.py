@@ -164,16 +164,48 @@ class LayoutDraft:
             return None
         return block_lattice(self.bases, self.base.row_spacing, self.base.plant_spacing)[0]
 
-    def grid(self) -> tuple[int, int]:
-        """Rows x plants per row of the placements: stalks closer than half a row spacing
-        across the rows share a row (digitizing noise stays within a row); the most plants
-        of a row."""
+    def _row_counts(self) -> np.ndarray:
+        """(rows,) plants in each row of the placements: stalks closer than half a row
+        spacing across the rows share a row (digitizing noise stays within a row)."""
         if not self.placements:
-            return 0, 0
+            return np.zeros(0, dtype=np.int64)
         xs = np.sort([p.x for p in self.placements])
         half = (self.base.row_spacing if self.base is not None else 60.0) / 2
         row = np.concatenate([[0], np.cumsum(np.diff(xs) > half)])
-        return int(row[-1]) + 1, int(np.bincount(row).max())
+        return np.bincount(row)
+
+    def grid(self) -> tuple[int, int]:
+        """Rows x plants per row of the placements: the rows (:meth:`_row_counts`) and the
+        plants most rows hold (the larger on a tie): a stray plant does not grow the grid
+        (:meth:`grid_note` says the layout is irregular)."""
+        counts = self._row_counts()
+        if not len(counts):
+            return 0, 0
+        values, times = np.unique(counts, return_counts=True)
+        return len(counts), int(values[times == times.max()].max())
+
+    def grid_note(self) -> str:
+        """'' when the placements are a full grid (:meth:`grid`: every row holds as many
+        plants), else what is irregular, in words."""
+        counts = self._row_counts()
+        rows, per_row = self.grid()
+        if not len(counts) or np.all(counts == per_row):
+            return ""
+        odd = [f"{c}" for c in counts if c != per_row]
+        return (f"irregular: {len(odd)} of the {rows} rows hold{'s' if len(odd) == 1 else ''} "
+                f"{', '.join(odd)} plant{'s' if odd != ['1'] else ''}, the others {per_row}")
+
+    def overlap_text(self, i: int, j: int) -> str:
+        """What overlaps between placements ``i`` and ``j`` (named by the layout table's line
+        and their plant), in cm: each stalk's ground cell, a row spacing (x) by a plant
+        spacing (y) centred on it."""
+        a, b = self.placements[i], self.placements[j]
+        rs = self.base.row_spacing if self.base is not None else 60.0
+        ps = self.base.plant_spacing if self.base is not None else 30.0
+        across, along = rs - abs(a.x - b.x), ps - abs(a.y - b.y)
+        return (f"table lines {i + 1} and {j + 1}: plant {a.plant}'s ground cell overlaps "
+                f"plant {b.plant}'s by {across:.1f} cm across the rows and {along:.1f} cm "
+                f"along them (stalks {math.hypot(a.x - b.x, a.y - b.y):.1f} cm apart)")
 
     def overlaps(self) -> list[tuple[int, int, float]]:
         """Placements standing on each other's ground: (i, j, distance cm), i < j."""
@@ -320,12 +352,46 @@ class LayoutDraft:
         end = max(q.y for q in self.placements if abs(q.x - p.x) < rs / 2)
         return p.x, end + ps
 
-    def duplicate(self, index: int) -> bool:
-        """A copy of placement ``index`` (the same plant, turned the same) at the end of its
-        row (:meth:`row_end`, snapped)."""
+    def free_place(self, index: int) -> tuple[float, float]:
+        """Where a copy of placement ``index`` stands inside the field (cm): the nearest
+        place of its lattice (whole row and plant spacings from it) inside the field whose
+        ground cell overlaps no other's (:func:`overlap_pairs`), along its own row first on
+        a tie; in a full field, half a plant spacing along its row (inside the field,
+        overlapping: the layout editor lists it)."""
         p = self.placements[self._index(index)]
-        return self.add(*self.row_end(index), p.plant, p.azimuth_deg,
-                        text=f"duplicate plant {p.plant} (row {index + 1})")
+        if self.base is None:
+            return self.row_end(index)
+        rs, ps = self.base.row_spacing, self.base.plant_spacing
+        x0, y0, x1, y1 = self.base.bounds
+        eps = 1e-9 * max(abs(x0), abs(x1), abs(y0), abs(y1), rs, ps)
+        i = np.arange(math.ceil((x0 - p.x - eps) / rs), math.floor((x1 - p.x + eps) / rs) + 1)
+        j = np.arange(math.ceil((y0 - p.y - eps) / ps), math.floor((y1 - p.y + eps) / ps) + 1)
+        ii, jj = (a.ravel() for a in np.meshgrid(i, j, indexing="ij"))
+        if len(ii):
+            from scipy.spatial import cKDTree
+
+            xy = np.column_stack([p.x + ii * rs, p.y + jj * ps])
+            taken = cKDTree(np.array([(q.x / rs, q.y / ps) for q in self.placements]))
+            near, _ = taken.query(xy / [rs, ps], p=np.inf)
+            free = near >= OVERLAP_REACH * (1 - 1e-12)
+            if free.any():
+                d = np.hypot(ii * rs, jj * ps)[free]
+                best = np.lexsort((-jj[free], np.abs(ii[free]), d))[0]
+                return float(xy[free][best, 0]), float(xy[free][best, 1])
+        y = p.y + ps / 2 if p.y + ps / 2 <= y1 + eps else p.y - ps / 2
+        return p.x, float(min(max(y, y0), y1))
+
+    def duplicate(self, index: int) -> bool:
+        """A copy of placement ``index`` (the same plant, turned the same) inside the field,
+        at the nearest free place (:meth:`free_place`; not snapped: it is on the lattice)."""
+        p = self.placements[self._index(index)]
+        x, y = self.free_place(index)
+        if len(self.placements) >= MAX_PLANTS:
+            raise LayoutError(f"a layout holds at most {MAX_PLANTS:,} plants")
+        new = Placement(p.plant, self._coordinate(x, "x"), self._coordinate(y, "y"),
+                        p.azimuth_deg)
+        after = Snapshot(self.base, tuple(self.placements) + (new,), self.tiling, self.source)
+        return self._whole(after, f"duplicate plant {p.plant} (row {index + 1})")
 
     def remove(self, index: int) -> bool:
         """Take placement ``index`` out of the layout (the last one stays: a canopy has a

@@ -335,6 +335,24 @@ def adopt_pending_runs(study: StudyState) -> None:
                           stalks=stalks),
                      compared, sampling, f"{len(pending)} light result(s) from the project",
                      saved=True)
+    show_kept_runs(study)
+
+
+def show_brought_back(study: StudyState) -> None:
+    """Light results set aside by a layout edit and back with their stands (Undo): once the
+    canopy is built on them, shown whole as before the edit (table, plot, heatmaps, the
+    day's summary, the plants' light, the canopy's colours), nothing traced again."""
+    if not study.brought_back or study.built is None:
+        return
+    study.brought_back = False
+    show_kept_runs(study)
+
+
+def show_kept_runs(study: StudyState) -> None:
+    """The results the study holds (a project's, or some brought back) shown as after a
+    fresh run, with the canopy shown."""
+    if study.built is None:
+        return
     here = study.signature(study.built.label)
     shown = {}
     for kind in MODES:

@@ -20,7 +20,8 @@ BALANCE_ROWS = (("incident", "{band} incident W/m²"),
                 ("absorbed_stalks", "absorbed by stalks W/m²"),
                 ("absorbed_ground", "absorbed by the ground W/m²"),
                 ("reflected_top", "reflected out of the top W/m²"),
-                ("escaped_sides", "out of the sides W/m²"))
+                ("escaped_sides", "out of the sides W/m²"),
+                ("unresolved", "still scattering at the depth limit W/m²"))
 #: The results table's row of a sun's canopy gross CO2 assimilation (with a leaf model).
 ASSIMILATION_ROW = "gross CO₂ µmol/m²/s"
 #: Skies: kind -> (what the light panel's combo says, how a result is named in the table).
@@ -124,6 +125,12 @@ class LightRuns:
         other._order, other._added = dict(self._order), self._added
         return other
 
+    def take(self, other: LightRuns) -> None:
+        """Hold ``other``'s runs, settings and sampling instead of its own (the same runs)."""
+        self.runs, self.settings = dict(other.runs), dict(other.settings)
+        self.sampling, self.last = other.sampling, other.last
+        self._order, self._added = dict(other._order), other._added
+
     def clear(self) -> None:
         self.runs.clear()
         self.settings.clear()
@@ -192,6 +199,11 @@ class LightRuns:
             stalks = any(self.runs[name].stalks for name in balances)
             for field, what in BALANCE_ROWS:
                 if field == "absorbed_stalks" and not stalks:   # leaves only: no such row
+                    continue
+                # the light still travelling when the scattering stopped: a row only when it
+                # shows at one decimal, so that the rows shown add up to the incident light
+                if field == "unresolved" and all(round(b.unresolved, 1) == 0
+                                                 for b in balances.values()):
                     continue
                 row = [what.format(band=band)]
                 for name in names:
@@ -272,8 +284,11 @@ def run_info(run: Run) -> str:
             info += (f"; with leaf optics (ρ {a.optics.reflectance:g}, τ "
                      f"{a.optics.transmittance:g}, soil {a.optics.ground_reflectance:g}) the "
                      f"leaves absorb {a.fraction_absorbed:.1%} of the {a.band.upper()}, "
-                     f"{b.reflected_top / b.incident if b.incident else 0:.1%} is reflected "
-                     f"(balance closes within {abs(b.closure):.2%}; scattering "
+                     + (f"the stalks {b.absorbed_stalks / b.incident:.1%}, "
+                        if run.stalks and b.incident else "")
+                     + f"{b.reflected_top / b.incident if b.incident else 0:.1%} is reflected "
+                     f"(balance closes within {abs(b.closure):.2%}: its rows in the table "
+                     f"add up to the incident; scattering "
                      f"{a.seconds.get('scatter', 0):.2f} s)")
             g = getattr(run.extra, "assimilation", None)
             if g is not None:

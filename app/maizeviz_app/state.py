@@ -52,6 +52,23 @@ UNDOABLE = ("canopy", "light", "sun", "sampling", "sky", "day", "optics", "photo
 #: heatmaps' and the rest; undoable too (as ParaView's colour map edits), though they change
 #: no result.
 COLOUR_GROUPS = ("view colours", "heatmap colours", "colours")
+#: Layouts whose light results are kept after an edit (the light panel's undo depth for
+#: them; a layout further back is traced again).
+KEPT_LAYOUTS = 8
+#: What the light panel and the status bar say of results set aside by a layout edit.
+SET_ASIDE = ("light results set aside: they belong to the previous layout (Undo, Ctrl+Z, "
+             "brings them back; Compute traces this one)")
+#: What they say when a layout returns to stands whose results were set aside.
+BROUGHT_BACK = "the light results of this layout are back (traced before the edit, not again)"
+
+
+def stands_key(layout: CanopyLayout) -> tuple[int, str]:
+    """What identifies a layout's stands (:func:`maizeviz.canopy.layout.stands_identity`:
+    their plants, places, rotations and tiles, in order) as a dictionary key."""
+    from maizeviz.canopy.layout import stands_identity
+
+    ident = stands_identity(layout)
+    return ident["n"], ident["sha256"]
 
 @evented
 @dataclass
@@ -141,7 +158,8 @@ class StudyState:
     -------
     points_changed(loaded) : new points (and layout) opened; results cleared.
     mesh_opened(path) : a canopy read from a mesh file replaces the points; results cleared.
-    layout_changed(layout) : the layout edited; results of the previous layout cleared.
+    layout_changed(layout) : the layout edited; results of the previous layout set aside
+        (those of this layout's stands, set aside before, back).
     canopy_changed(built) : a canopy built for the current points and layout.
     built_shown(label) : that canopy is shown with the light results it has (a project's
         results adopted).
@@ -200,6 +218,13 @@ class StudyState:
         self.summary = ""
         self.plants_run: Run | None = None
         self.pending_runs: list[StoredRun] = []     # a project's results, waiting for a canopy
+        #: light results of earlier layouts, by their stands (:func:`stands_key`), the
+        #: oldest first: they come back when the layout returns to those stands
+        self.runs_set_aside: dict[tuple[int, str], tuple[LightRuns, str]] = {}
+        self.brought_back = False           # the runs shown were set aside, not yet drawn
+        #: what the last layout edit did to the light results (:data:`SET_ASIDE`,
+        #: :data:`BROUGHT_BACK`; '': nothing), until light is computed or points opened
+        self.light_note = ""
         self.project_path: str | None = None
         self.mesh_path: str | None = None
         self.layout_edited = False
@@ -315,6 +340,7 @@ class StudyState:
         self.points_origin = str(Path(origin).resolve())
         self.project_path = project
         self.layout_edited = layout_edited
+        self.runs_set_aside.clear()
         self._renew()
         self.draft.start(loaded.layout, loaded.plants)
         self.history.clear()
@@ -332,6 +358,7 @@ class StudyState:
         self.project_path = None
         self.mesh_path = str(path)
         self.layout_edited = False
+        self.runs_set_aside.clear()
         self._renew()
         self.draft.start(None, set())
         self.history.clear()
@@ -340,22 +367,39 @@ class StudyState:
         self._set_modified(False)
 
     def edit_layout(self, layout: CanopyLayout) -> bool:
-        """The layout edited; True if light results were dropped."""
+        """The layout edited; True if light results were set aside (they belong to the
+        previous layout: kept under its stands, they come back when the layout returns to
+        those stands, by Undo or by moving a plant back, without tracing again)."""
         if self.loaded is None:
             return False
-        dropped = bool(self.runs.runs)
+        before = stands_key(self.loaded.layout)
+        kept = self.runs.copy() if self.runs.runs else None
+        colouring = self.view.colouring
         self.loaded = replace(self.loaded, layout=layout)
         if tuple(self.draft.placements) != tuple(layout.placements):
             self.draft.start(layout, self.loaded.plants)    # laid out by a script
         self.layout_edited = True
         self._renew()
+        if kept is not None:
+            self._set_aside(before, (kept, colouring))
+        back = self.runs_set_aside.pop(stands_key(layout), None)
+        if back is not None:
+            self._bring_back(back)
         self.layout_changed.emit(layout)
         self._set_modified(True)
-        if dropped:
-            self.say("note: the layout changed; light results of the previous layout were "
-                     "cleared")
-        self.say(f"layout applied: {len(layout.placements)} plants")
-        return dropped
+        n = len(layout.placements)
+        self.light_note = BROUGHT_BACK if back is not None else \
+            SET_ASIDE if kept is not None else ""
+        if back is not None:
+            self.say(f"layout applied: {n} plants, those its {len(back[0].runs)} light "
+                     "result(s) were traced on: they are back")
+        elif kept is not None:
+            self.runs_info = SET_ASIDE
+            self.runs_changed.emit(self.runs, SET_ASIDE)
+            self.say(f"layout applied: {n} plants; {SET_ASIDE}")
+        else:
+            self.say(f"layout applied: {n} plants")
+        return kept is not None
 
     def show_built(self, built: Built) -> bool:
         """A canopy built; False (and nothing changes) if it was built for older points or
@@ -378,6 +422,7 @@ class StudyState:
             return False
         dropped = self.runs.add(run, settings, sampling)
         self.runs_info = info
+        self.light_note = ""
         self.runs_changed.emit(self.runs, info)
         if not saved:
             self._set_modified(True)
@@ -488,8 +533,32 @@ class StudyState:
             self.history.record(DraftEdit(change, text, merge, self.draft.replay))
 
     # ------------------------------------------------------------------ inside
+    def _set_aside(self, key: tuple[int, str], kept: tuple[LightRuns, str]) -> None:
+        """Keep the light results of the stands ``key`` and the 3D view's colouring with
+        them (the last few layouts')."""
+        self.runs_set_aside.pop(key, None)
+        self.runs_set_aside[key] = kept
+        while len(self.runs_set_aside) > KEPT_LAYOUTS:
+            self.runs_set_aside.pop(next(iter(self.runs_set_aside)))
+
+    def _bring_back(self, kept: tuple[LightRuns, str]) -> None:
+        """The light results traced on the stands the layout is back to: the same results
+        (the same objects, not traced again), signed for the current serial; shown whole
+        (heatmaps, plants, colours) once the canopy is built
+        (:func:`maizeviz_app.lighting.show_brought_back`)."""
+        runs, self.colouring_to_restore = kept
+        for run in runs.runs.values():
+            run.signature = self.signature(run.label)
+        self.runs.take(runs)
+        self.brought_back = True
+        self.runs_info = BROUGHT_BACK
+        self.runs_changed.emit(self.runs, BROUGHT_BACK)
+
     def _renew(self) -> None:
         self.serial += 1
+        self.brought_back = False
+        self.light_note = ""
+        self.runs_info = ""
         self.measures_rows.clear()
         self.runs.clear()
         self.figures.clear()

@@ -93,7 +93,11 @@ class ViewLink:
             say(f"note: {built.label} has {m.triangles:,} triangles; to keep the window "
                 f"responsive {mesh.field_data['view_note'][0]}")
         if not self.digitizing:
-            say(f"{built.label}: {m.triangles:,} triangles, leaf area {m.leaf_area_m2:.2f} "
+            # the light set aside by a layout edit (or back with Undo) first: the status
+            # bar is where the user looks, and this line replaces the edit's
+            note = self.window.model.light_note
+            say((f"{note}; " if note else "")
+                + f"{built.label}: {m.triangles:,} triangles, leaf area {m.leaf_area_m2:.2f} "
                 f"m², LAI {m.lai:.2f}; built in {built.build_s:.2f} s, measured in "
                 f"{built.measure_s:.2f} s", status_only=True)
 

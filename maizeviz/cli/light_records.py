@@ -56,6 +56,7 @@ def absorbed_period_record(ab) -> dict[str, Any]:
     se = ab.absorbed_leaves_error
     out["absorbed_leaves_se"] = se
     if ab.band == "par":
+        out["par_source"] = ab.period.par_source       # as the intercepted period's
         out["absorbed_leaves_mol_m2"] = ab.absorbed_leaves_mol_m2
         out["absorbed_leaves_mol_m2_se"] = None if se is None else se * PAR_UMOL_PER_J_PAR
     return out
@@ -173,7 +174,7 @@ def period_record(pl: PeriodLight, args: argparse.Namespace) -> dict[str, Any]:
     rec: dict[str, Any] = {
         "start": p.start.isoformat(), "end": p.end.isoformat(), "steps": p.n_steps,
         "step_min": None if args.weather else (30.0 if args.step is None else args.step),
-        "par_umol_per_j": p.par_umol_per_j,
+        "par_umol_per_j": p.par_umol_per_j, "par_source": p.par_source,
         "shortwave_mj_m2": p.shortwave_mj_m2,
         "par_incident_mol_m2": pl.par_incident_mol_m2,
         "par_direct_mol_m2": pl.par_direct_mol_m2,
@@ -328,8 +329,9 @@ def _print_period(r: dict, label: bool) -> None:
     print(f"period{' (' + r['level'] + ')' if label else ''}: {p['start']} to {p['end']}, "
           f"{p['steps']} time steps with the sun up")
     print(f"irradiance: {p['source']}")
-    print(f"PAR = {p['par_umol_per_j']:.4g} umol per J of shortwave; shortwave "
-          f"{p['shortwave_mj_m2']:.2f} MJ/m2")
+    par = "PAR measured (the weather file's par column)" if p["par_source"] == "measured" \
+        else f"PAR = {p['par_umol_per_j']:.4g} umol per J of shortwave"
+    print(f"{par}; shortwave {p['shortwave_mj_m2']:.2f} MJ/m2")
     frac = p["fraction_intercepted"]
     if not p["steps"]:
         print("no sunlight in this period: incident, intercepted and transmitted PAR are 0")
@@ -388,9 +390,11 @@ def _print_balance(records: list[dict]) -> None:
     ab = records[0]["absorbed"]
     o = ab["optics"]
     period = ab["units"].startswith("MJ")
+    measured = "; PAR measured (the weather file's par column)" \
+        if ab.get("par_source") == "measured" else ""
     print(f"\nabsorbed {ab['band'].upper()} with scattering (leaf reflectance "
           f"{o['reflectance']:g}, transmittance {o['transmittance']:g}, ground "
-          f"{o['ground_reflectance']:g}), {ab['units']}:")
+          f"{o['ground_reflectance']:g}), {ab['units']}{measured}:")
     # the stalks' share is a column of the balance when any level traced them: without it
     # the row's parts did not add up to its incident light, though its closure was 0.01 %
     stalks = any(r["balance"].get("absorbed_stalks") for r in records)

@@ -472,13 +472,15 @@ def _trace_sun(job: _Job, lv: _Level) -> None:
     """The sun: transmission by height and, for the tables, its hit classes."""
     assert job.sun is not None
     res = lv.engine.sun(job.sun, classes=job.want_rows or job.n_levels == 1
-                        or bool(job.args.export),
+                        or bool(job.args.export), sunlit=job.want_rows,
                         progress=Progress(f"tracing {lv.label}"))
     lv.res = res
     lv.warnings += res.warnings
     lv.rec.update(sun_record(res, job.sun, lv.canopy, job.args, job.heights))
     lv.rec["seconds"].update(trace=res.seconds["trace"],
                              second_hits=res.seconds.get("second", 0.0))
+    if "sunlit" in res.seconds:                 # the leaf tables' sampled sunlit areas
+        lv.rec["seconds"]["sunlit"] = res.seconds["sunlit"]
     if job.want_rows:
         lv.tables.append(res.leaf_rows(lv.canopy))
 

@@ -3,50 +3,58 @@
 In point mode (``e1,1``) the unit sends a record only when the stylus button is pressed. To
 show the tip's live position the reader also sends ``P`` (poll) a few times a second; the
 unit answers each poll with one frame (a record of every active station, station 1 first).
-A poll's answer looks like a press: same record type, same stations. What tells them apart:
+A poll's answer looks like a press: same record type, same stations, and the stylus switch
+(item 16) down whenever the button is held. What tells them apart for sure:
 
-1. The unit answers every poll with exactly one frame, within milliseconds (a frame of two
-   stations is 94 bytes: 8 ms at 115200 baud, plus a USB adapter's 16 ms latency timer).
-2. A press's frame always has the stylus switch (item 16) down; a poll's answer has it down
-   only while the button is held.
+1. The unit answers every poll with exactly one frame, and answers its commands in the order
+   they came, on one first-in first-out line.
+2. A press's frame always has the switch down; a poll's answer has it up unless the button
+   is held.
+3. Each poll is sent with a *fence*: ``S`` right behind ``P``. Its reply is a status record,
+   type ``2`` in its header where data records are type ``0``, and it comes after the
+   poll's answer, however late the unit is.
 
-So while a poll is unanswered (its *window*), frames are held back. A frame with the switch
-up is the answer: the frames held before it are presses. A switch-down answer means the button
-was held when the poll came, so its press was sent just before it, at the same place (the
-stylus is still while its button is down): once the window's time is up, a held frame within
-:data:`HELD_CM` of the press before it is the answer, and the other frames are presses.
+So while a poll is outstanding (its *window*, from ``PS`` to the status reply), frames are
+held back. A frame with the switch up is the answer: the frames held before it, and the
+frames after it until the fence, are presses. When the fence arrives with only switch-down
+frames held, the answer is among them (the button was held when the poll came): exactly one
+of them, the one repeating the press before it (within :data:`HELD_CM`: the tip rests on the
+point while the button is down); the others are presses. When several repeat the press
+before them, they are all at one place, and which of them is the answer changes no point:
+one fewer press is recorded at that place either way. No time limit decides anything, so
+a press at the very place of the press before it, made while an answer is late (a
+simulator starved of CPU), is kept: the earlier rule, which took the first held frame within
+0.5 cm of the last press for the answer once the answer's expected time had passed, lost it.
 
-A held frame that repeats no press is a press whose poll has not been answered yet: an answer
-comes late when the unit's side is slow (a simulator on a busy machine), and taking the press
-for the answer would lose it without a word (issue 35, item 1: the app lost 6 of 60 presses
-under CPU load with the old rule, "the first held frame is the answer"). The window then
-stays open for the answer, up to :data:`LATE_ANSWER_S`; if none comes, every held frame is
-handed on as a press (counted in :attr:`PollSorter.unsure`). So a press is never dropped and
-a poll's answer never becomes a point, except in one case: a press at the very place of the
-press before it (within :data:`HELD_CM`), made while a poll's answer is late.
+Two cases are counted, never silent: a window whose fence never comes (:data:`LATE_ANSWER_S`;
+a unit that stopped answering) hands its held frames on as presses (:attr:`PollSorter.unsure`,
+none dropped); a fence with no frame before it is a poll never answered
+(:attr:`PollSorter.missed`). Held switch-down frames of which none repeats a press are all
+handed on as presses, counted in :attr:`PollSorter.unsure` (the answer then becomes a point,
+the recorder's journal keeps it; no press is lost).
 
-A press that comes while a window is open is reported when the window resolves (usually within
-milliseconds, when the answer has the switch up). Outside windows every frame is a press, as
-without polling.
+Outside windows every frame is a press (switch down) or a late answer (switch up, never a
+press), as without polling.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from maizeviz.digitizer.protocol import Record
+from maizeviz.digitizer.protocol import POLL, STATUS, Garbled, Record, Status
 
-#: Seconds a poll's answer may take beyond its transmission time.
-ANSWER_SLACK_S = 0.1
-#: Seconds a window holding only presses waits for a late answer before giving up on it.
+#: The fence sent right behind each poll: the status command, whose reply (a type-2 record)
+#: comes after the poll's answer.
+FENCE = STATUS
+#: What the reader sends to poll: the poll and its fence.
+POLL_WITH_FENCE = POLL + FENCE
+#: Seconds a window waits for its fence (the status reply behind the poll) before handing
+#: what it holds on as presses: a unit that stopped answering.
 LATE_ANSWER_S = 3.0
 #: Centimetres within which a switch-down frame repeats the press before it (a poll's answer
 #: while the button is held): the stylus tip is pressed on the leaf, and hand tremor moves it
 #: about a millimetre; two presses of a recording are centimetres apart.
 HELD_CM = 0.5
-#: Seconds after a press within which a switch-down answer can still repeat it (a button is
-#: held for a fraction of a second).
-HELD_S = 2.0
 
 
 @dataclass(frozen=True)
@@ -73,46 +81,52 @@ class PollSorter:
     """Decides when to poll and sorts what comes back into presses and :class:`Live` frames.
 
     Used by the port's reader thread only (not thread-safe); times are ``time.monotonic()``.
+    Each poll is sent as ``PS``: the poll and its fence (:data:`FENCE`).
 
     Parameters
     ----------
     stations : active stations; station 1 carries the stylus and starts every frame
-    every : seconds between polls (a poll waits for the previous one to be answered)
-    baud : the link's rate (bits per second), for how long an answer takes to arrive
-    frame_bytes : bytes of one frame (a record of every active station)
+    every : seconds between polls (a poll waits for the previous one's fence)
+    baud, frame_bytes : kept for callers; the fence, not a time, closes a window
     """
 
     def __init__(self, stations, every: float, baud: int = 115200, frame_bytes: int = 47):
         self.stations = tuple(sorted(stations))
-        self.window = ANSWER_SLACK_S + 10.0 * frame_bytes / baud * 2
         self.every = every
         self._last_poll = -1e9
         self._open_until: float | None = None
+        self._answered = False
+        self._doubt = False
         self._held: list[tuple[Record, ...]] = []
         self._frame: list[Record] = []
-        #: Polls whose answer never came (nothing held for :data:`LATE_ANSWER_S`).
+        #: Polls whose answer never came (a fence with nothing before it).
         self.missed = 0
-        #: Windows whose answer never came while presses were held (handed on as presses).
+        #: Windows settled without knowing their answer (no fence, a garbled record in the
+        #: window, or no held frame repeating a press): every frame held handed on as a press.
         self.unsure = 0
-        self._last_press: tuple[tuple[float, float, float] | None, float] = (None, -1e9)
+        self._last_press: tuple[float, float, float] | None = None
 
     @property
     def waiting(self) -> bool:
-        """A poll's answer has not been sorted out yet."""
+        """A poll's fence has not come back yet."""
         return self._open_until is not None
 
     def due(self, now: float) -> bool:
-        """Time to poll: no answer outstanding and ``every`` seconds since the last poll."""
+        """Time to poll: no poll outstanding and ``every`` seconds since the last one."""
         return self._open_until is None and now - self._last_poll >= self.every
 
     def polled(self, now: float) -> None:
-        """A poll was just sent."""
+        """A poll and its fence were just sent."""
         self._last_poll = now
-        self._open_until = now + self.window
-        self._held = []
+        self._open_until = now + LATE_ANSWER_S
+        self._held, self._answered, self._doubt = [], False, False
 
     def feed(self, event, now: float) -> list:
         """Sort one parsed event; returns what to hand on now (records, Live, others)."""
+        if isinstance(event, Status):
+            return self._fence(now) if self.waiting else []     # (a fence given up on)
+        if isinstance(event, Garbled) and self.waiting and not self._answered:
+            self._doubt = True                  # it may have been the answer
         if not isinstance(event, Record):
             return [event]
         out: list = []
@@ -128,55 +142,65 @@ class PollSorter:
         return out
 
     def tick(self, now: float) -> list:
-        """Settle a window whose time is up; returns what that releases."""
+        """Settle a window whose fence never came; returns what that releases."""
         if self._open_until is None or now < self._open_until:
             return []
-        held = self._held
-        late = now >= self._open_until + LATE_ANSWER_S
-        if not held:
-            if late:                            # the answer never came
-                self._close()
-                self.missed += 1
-            return []                           # (a late answer is not taken for a press)
-        last, when = self._last_press
-        for k, frame in enumerate(held):
-            before = held[k - 1][0].position if k else (last if now - when <= HELD_S else None)
-            if _near(frame[0].position, before):                  # the held button's answer
-                self._close()
-                return self._presses(held[:k] + held[k + 1:], now) + [Live(frame, now)]
-        if not late:
-            return []                           # presses whose poll is answered late: wait
+        held, answered = self._held, self._answered
         self._close()
-        self.unsure += 1
-        return self._presses(held, now)
+        if not answered:
+            if held:
+                self.unsure += 1
+            else:
+                self.missed += 1
+        return self._presses(held)
 
     def flush(self, now: float) -> list:
         """The reader stops: frames still held are handed on as presses (none is dropped)."""
         held = self._held
+        if held and not self._answered:
+            self.unsure += 1
         self._close()
-        return self._presses(held, now)
+        return self._presses(held)
 
     def _close(self) -> None:
         self._held, self._open_until = [], None
+        self._answered = self._doubt = False
 
-    def _presses(self, frames, now: float) -> list:
+    def _presses(self, frames) -> list:
         """Hand ``frames`` on as presses (remembering the last one's place)."""
         if frames:
-            self._last_press = (frames[-1][0].position, now)
+            self._last_press = frames[-1][0].position
         return [r for f in frames for r in f]
 
     def _frame_done(self, frame: tuple[Record, ...], now: float) -> list:
         down = frame[0].stylus != 0
-        if self._open_until is None:
+        if self._open_until is None or self._answered:
             if down:
-                return self._presses([frame], now)              # a press, as without polling
+                return self._presses([frame])                   # a press, as without polling
             return [Live(frame, now)]                            # a late answer: never a press
         if down:
             self._held.append(frame)                             # press or answer: wait
-            return self.tick(now)                                # (a late window may settle)
-        held = self._held
+            return []
+        held = self._held                                        # the answer: switch up
+        self._held, self._answered = [], True
+        return self._presses(held) + [Live(frame, now)]
+
+    def _fence(self, now: float) -> list:
+        """The status reply behind the poll: every frame sent before it has come."""
+        held, answered, doubt = self._held, self._answered, self._doubt
         self._close()
-        return self._presses(held, now) + [Live(frame, now)]
+        if answered:
+            return self._presses(held)
+        if not held:
+            self.missed += 1
+            return []
+        if not doubt:
+            for k, frame in enumerate(held):
+                before = held[k - 1][0].position if k else self._last_press
+                if _near(frame[0].position, before):         # the held button's answer
+                    return self._presses(held[:k] + held[k + 1:]) + [Live(frame, now)]
+        self.unsure += 1                # the answer is one of them, which is not known
+        return self._presses(held)
 
 
 def _near(a, b) -> bool:

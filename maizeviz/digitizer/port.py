@@ -26,7 +26,7 @@ from dataclasses import dataclass, replace
 import serial
 
 from maizeviz.digitizer import protocol as fp
-from maizeviz.digitizer.live import PollSorter
+from maizeviz.digitizer.live import POLL_WITH_FENCE, PollSorter
 from maizeviz.digitizer.port_problems import (
     DeviceError,
     lost_message,
@@ -206,7 +206,8 @@ class FastrakPort:
         Events: :class:`~maizeviz.digitizer.protocol.Record` (position in cm) for each press,
         ``Garbled``, ``ErrorReply``, ``Reply`` and, last, :class:`PortLost`. With
         ``live_every`` (seconds) the reader also asks the unit where the stylus is that often
-        and hands the answers on as :class:`~maizeviz.digitizer.live.Live`, never as presses.
+        and hands the answers on as :class:`~maizeviz.digitizer.live.Live`, never as presses
+        (each poll fenced by a status request, whose reply is not handed on).
         """
         if self.parser is None:
             raise DeviceError("configure the device before reading")
@@ -236,7 +237,7 @@ class FastrakPort:
         while not self._stop.is_set():
             try:
                 if sorter is not None and sorter.due(time.monotonic()):
-                    ser.write(fp.POLL)
+                    ser.write(POLL_WITH_FENCE)
                     sorter.polled(time.monotonic())
                     self.polls += 1
                 data = ser.read(max(1, min(ser.in_waiting, 65536)))

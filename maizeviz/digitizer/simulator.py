@@ -52,17 +52,21 @@ class FastrakSimulator:
     start_binary : power up in binary output
     garbage : answer every command with unreadable bytes (another device on the port, or a
         baud rate that differs from the unit's)
+    answer_delay_s : seconds the unit takes to answer a poll (``P``), the commands after it
+        waiting their turn as on the unit (a unit's side starved of CPU); presses are sent
+        meanwhile
     """
 
     def __init__(self, stations=(1,), noise_cm: float = 0.08, seed: int = 0,
                  silent: bool = False, ignore_units: bool = False, ignore_format: bool = False,
                  start_binary: bool = False, press_gap_s: float = PRESS_GAP_S,
-                 garbage: bool = False):
+                 garbage: bool = False, answer_delay_s: float = 0.0):
         self.master, self.slave = os.openpty()
         tty.setraw(self.slave)
         self.path = os.ttyname(self.slave)
         self.rng = np.random.default_rng(seed)
         self.noise = noise_cm
+        self.answer_delay = answer_delay_s
         self.silent = silent
         self.garbage = garbage
         self.ignore_units = ignore_units
@@ -283,6 +287,8 @@ class FastrakSimulator:
         """The one-letter commands that switch a mode (or ask for a point); whether ``c``
         was one of them (a format or unit command the unit ignores is not)."""
         if c == "P":
+            if self.answer_delay > 0:
+                time.sleep(self.answer_delay)
             self._emit_all()
         elif c == "C":
             self.continuous = True

@@ -141,7 +141,7 @@ def _parse_times(texts: list, lines: list, path: Path, tz):
         k = int(np.argmin(zoned))
         raise WeatherFileError(f"{path}, line {lines[k]}, column time: '{texts[k]}' has no time "
                                f"zone; write ISO 8601 with an offset (2005-08-01T12:00+08:00) "
-                               f"or give the zone: --tz Asia/Shanghai (tz= in Python)")
+                               f"or give the time zone (tz, e.g. Asia/Shanghai)")
 
     def parse_one(k):
         try:              # ISO 8601 only: pd.Timestamp read '...T032005-08-01T04:00+08:00'

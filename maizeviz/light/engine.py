@@ -156,7 +156,7 @@ class LightEngine:
     def sun(self, sun: Sun | None = None, *, date: str | None = None, time: str | None = None,
             lat: float | None = None, lon: float | None = None, tz: str | None = None,
             solar_noon: bool = False, altitude: float = 0.0, zenith: float | None = None,
-            azimuth: float | None = None, classes: bool = True,
+            azimuth: float | None = None, classes: bool = True, sunlit: bool = True,
             sampling: Sampling | None = None,
             progress: ProgressCallback | None = None, **fields) -> LightResult:
         """Direct sunlight: transmission by height and the hit classes of one sun.
@@ -185,6 +185,11 @@ class LightEngine:
             The sun's azimuth, clockwise from north [deg] (default 180 with ``zenith``).
         classes : bool
             Also trace second hits and per-triangle counts (the hit classes).
+        sunlit : bool
+            With the hit classes, also sample each triangle's sunlit area from the triangle
+            toward the sun, for the leaf and plant tables (bounded and unbiased; about the
+            trace's time again); False: the tables read the rays' count capped at each leaf's
+            area (the command line samples only for ``--leaf-light`` or ``--plant-light``).
         sampling : Sampling, optional
             Instead of the engine's.
         progress : callable, optional
@@ -218,6 +223,9 @@ class LightEngine:
         result = trace_light(self.canopy, LightRequest(sun, smp, classes),
                              progress, self.with_stalks, scene)
         result.seconds["build"] = build_s
+        if sunlit and result.first_hits is not None:
+            result = _with_sampled_sunlit(self.canopy, scene, result, self._normals(),
+                                          self.with_stalks)
         return result.with_canopy(self.canopy)
 
     def sky(self, sky: Sky | str = "soc", directions: int = 46, split: str = "auto", *,
@@ -643,6 +651,32 @@ class LightEngine:
                                                                  c.stalk_faces)[1]])
         self._normals_kept = normals
         return normals
+
+
+#: Seed of the points a sun's sunlit areas are sampled from (the same tables every run).
+SUNLIT_SEED = 0
+
+
+def _with_sampled_sunlit(canopy: Canopy, scene: RayScene, result: LightResult,
+                         normals: np.ndarray, with_stalks: bool) -> LightResult:
+    """``result`` with the sunlit area of every scene triangle sampled from the triangle
+    toward the sun (:func:`~maizeviz.light.trace.sunlit.sunlit_share`, as the absorbed
+    light's direct beam): bounded by each triangle's area and unbiased, where the rays'
+    count over a small or grazing triangle is unbiased but unbounded (the hit-class tables
+    clipped it, which biased their sums low)."""
+    from time import perf_counter
+
+    from maizeviz.light.trace.beam import sampler
+    from maizeviz.light.trace.sunlit import geometry, sunlit_share
+
+    t0 = perf_counter()
+    smp = sampler(canopy, scene, result.rect, result.density, result.heights_cm,
+                  result.periodic, with_stalks)
+    share = sunlit_share(smp, canopy, normals, np.asarray(result.direction, np.float64),
+                         SUNLIT_SEED)
+    sunlit = share.fraction * geometry(canopy, len(normals)).area_cm2
+    seconds = dict(result.seconds, sunlit=perf_counter() - t0)
+    return replace(result, triangle_sunlit_cm2=sunlit, seconds=seconds)
 
 
 def _sky_key(sky: Sky, s: Sampling, bin_cm: float) -> tuple:

@@ -191,6 +191,8 @@ def sun_record(label: str, result) -> Record:
         a = getattr(result, name)
         if a is not None:
             arrays[name] = np.asarray(a, np.int32 if a.max(initial=0) < 2**31 else np.int64)
+    if getattr(result, "triangle_sunlit_cm2", None) is not None:
+        arrays["triangle_sunlit_cm2"] = np.asarray(result.triangle_sunlit_cm2, np.float64)
     return Record(SUN_KIND, meta, arrays)
 
 
@@ -546,6 +548,12 @@ def sun_from_record(rec: Record, where: str) -> tuple[str, Any]:
             and len(hits["first_hits"]) != len(hits["second_hits"])):
         raise ProjectError(f"{at}: its first and second hits per triangle do not match "
                            "(one missing, or of other lengths); the project is damaged")
+    if "triangle_sunlit_cm2" in rec.arrays:        # the sampled sunlit area (older: none)
+        if hits["first_hits"] is None:
+            raise ProjectError(f"{at}: it has a sampled sunlit area but no hits per "
+                               "triangle; the project is damaged")
+        hits["triangle_sunlit_cm2"] = _array(rec, "triangle_sunlit_cm2", where, what,
+                                             (len(hits["first_hits"]),), lo=0)
     planes: dict[str, Any] = {}
     if "sensor_lit" in rec.arrays:
         lit = rec.arrays["sensor_lit"]

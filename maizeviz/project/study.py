@@ -182,7 +182,7 @@ def project_layout(opened: Opened, leaves: Sequence[Leaf]) -> CanopyLayout:
 
 
 def results_on(opened: Opened, layout: CanopyLayout, leaves: Sequence[Leaf] | None = None,
-               exact: bool = False) -> tuple[list[StoredResult], list[str]]:
+               exact: bool = True) -> tuple[list[StoredResult], list[str]]:
     """The light results of ``opened`` that belong to the canopy about to be shown, read.
 
     A result is left out, with one note each, when it was traced on other stands than those
@@ -198,7 +198,9 @@ def results_on(opened: Opened, layout: CanopyLayout, leaves: Sequence[Leaf] | No
     leaves : the leaves of the project's points; None: per-triangle sizes not checked
     exact : with ``leaves``, mesh the canopy's plants at each result's level and hold every
         per-triangle array to its exact triangle count (:func:`canopy_triangles`), not only
-        to the bound (:func:`read_study` does)
+        to the bound; the default, for :func:`read_study` and the app alike (False only
+        where the plants' meshes cannot be afforded: an array of another length is then
+        found only when its light is shown)
 
     Returns
     -------
@@ -388,7 +390,7 @@ def read_study(path: str | Path, cache: str | Path | None = None,
     except MaizevizError as exc:
         raise ProjectError(f"{opened.path}: its canopy level: {exc}", quantity="level") from None
     check_canopy_fits(plants.leaves, layout, level, opened.path)
-    results, dropped = results_on(opened, layout, plants.leaves, exact=True)
+    results, dropped = results_on(opened, layout, plants.leaves)
     return Study(opened.path, plants, layout, level.label,
                  get(opened.canopy, "preserve_area", bool, True, opened.path), results,
                  [*opened.notes, *plants.notes, *dropped])

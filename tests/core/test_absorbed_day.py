@@ -126,3 +126,50 @@ def test_depth_alone_asks_for_absorbed_light(capsys):
             "--sun-zenith", "30", "--sun-azimuth", "150", "--depth", "4", "--json"]
     assert cli_main(args) == 0
     assert json.loads(capsys.readouterr().out)["absorbed"]["depth"] == 4
+
+
+def _weather_with_par(path, par_over_shortwave: float):
+    """A day of hourly rows whose PAR column is ``par_over_shortwave`` umol per J of the ghi
+    (not the default 2.19) and varies from hour to hour as a sensor's would."""
+    rows = ["time,ghi,dhi,par"]
+    for hour in range(6, 19):
+        ghi = 900.0 * np.sin(np.pi * (hour - 5.5) / 14.0) ** 2
+        par = ghi * par_over_shortwave * (1.0 + 0.2 * np.cos(hour))
+        rows.append(f"2005-08-01T{hour:02d}:00+08:00,{ghi:.1f},{0.35 * ghi:.1f},{par:.1f}")
+    path.write_text("\n".join(rows) + "\n")
+    return path
+
+
+def test_black_leaves_absorb_a_weather_files_measured_par(engine, tmp_path):
+    """Over a weather file with a PAR column, the absorbed period takes the measured PAR as
+    the intercepted period does: black leaves absorb the PAR the same period intercepts
+    (within 4 standard errors), not the shortwave times the PAR share (30 % above here)."""
+    from maizeviz.light.sources.irradiance import read_weather, weather_period
+
+    weather = read_weather(_weather_with_par(tmp_path / "w.csv", 2.1936 * 1.3))
+    period = weather_period(weather, 39.9, 116.4)
+    assert period.par_source == "measured"
+    day = engine.day(period)
+    black = engine.absorbed_day(period, optics=Optics(0, 0, 0))
+    assert black.balance.incident * 4.57 == pytest.approx(day.par_incident_mol_m2, rel=1e-12)
+    assert day.par_incident_mol_m2 == pytest.approx(period.par_mol_m2, rel=1e-12)
+    assert period.par_mol_m2 > 1.2 * period.shortwave_mj_m2 * period.par_umol_per_j
+    assert intercepts_what_the_day_does(black, day)
+    # the PAR left out of the shortwave's share: NIR keeps the shortwave's own share
+    nir = engine.absorbed_day(period, band="nir", optics=Optics(0, 0, 0, "nir"))
+    assert nir.balance.incident == pytest.approx(
+        period.shortwave_mj_m2 * (1 - period.par_umol_per_j / 4.57), rel=1e-12)
+
+
+def test_the_cli_says_which_par_a_period_used(capsys, tmp_path):
+    weather = _weather_with_par(tmp_path / "w.csv", 2.1936 * 1.3)
+    args = ["light", str(mv.example_points()), "--triangles", "8", "--periodic", "--density",
+            "0.2", "--weather", str(weather), "--lat", "39.9", "--lon", "116.4", "--band",
+            "par", "--json"]
+    assert cli_main(args) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["period"]["par_source"] == "measured"
+    assert out["absorbed"]["par_source"] == "measured"
+    assert out["absorbed"]["absorbed_leaves_mol_m2"] < out["period"]["par_incident_mol_m2"]
+    assert cli_main(args[:-1]) == 0
+    assert "PAR measured (the weather file's par column)" in capsys.readouterr().out

@@ -486,9 +486,26 @@ def test_mesh_faces_in_any_order_trace_the_same(tmp_path_factory, block_mesh, se
     _close(a[0], b[0], 1e-13)
     assert b[1]["transmission"] == a[1]["transmission"]
     assert b[1]["sunlit_intercepted_fraction"] == a[1]["sunlit_intercepted_fraction"]
-    assert set(b[2]) == set(a[2]) and len(a[2]) > 100
-    for key, row in a[2].items():
-        _close(row, b[2][key], 1e-12)
+    # the sunlit area is sampled from points drawn on the triangles in mesh order: the same
+    # estimate drawn again, within the sample's error (a leaf of A cm2 sampled with n points
+    # has a variance of at most A^2 / 4n; with n >= A, one point per cm2 at 1 ray per cm2, the
+    # two sums' difference a variance of at most 2 sum(A) / 4; 4 of its standard errors are
+    # 770 cm2 here, where 120 of 32,500 was the most seen). A leaf no ray reached is listed
+    # when its sample finds some sun: in one of the two runs only, with nothing but that.
+    assert len(a[2]) > 100
+    for key in set(a[2]) ^ set(b[2]):
+        row = a[2].get(key) or b[2][key]
+        assert all(float(row[k]) == 0 for k in row if k.endswith("_intercepted_cm2")
+                   or k == "second_class_area_cm2"), key
+    keys = set(a[2]) & set(b[2])
+    sunlit = [(float(a[2][key]["sunlit_area_cm2"]), float(b[2][key]["sunlit_area_cm2"]),
+               float(a[2][key]["leaf_area_cm2"])) for key in keys]
+    x, y, area = (np.array(c) for c in zip(*sunlit))
+    assert np.all(y <= area * (1 + 1e-9)) and np.all(x <= area * (1 + 1e-9))
+    assert abs(x.sum() - y.sum()) < 4 * np.sqrt(2 * np.sum(area / 4))
+    for key in keys:
+        _close({k: v for k, v in a[2][key].items() if k != "sunlit_area_cm2"},
+               {k: v for k, v in b[2][key].items() if k != "sunlit_area_cm2"}, 1e-12)
 
 
 class _Capture:

@@ -256,16 +256,18 @@ def test_a_plant_put_onto_another_is_red_and_listed_until_moved(panel, qtbot):
     from maizeviz_app.panels.field_view import OVERLAPPING, PLANT
 
     panel.select(0)
-    panel.duplicate_button.click()                            # at the end of its row: ok
+    panel.duplicate_button.click()          # the field is full: beside it, in the field
     assert panel.rows.rowCount() == 3 and panel.picked == 2
-    qtbot.wait(100)
-    assert panel.overlaps.isHidden()
+    x0, y0, x1, y1 = panel.draft.base.bounds
+    copy = panel.draft.placements[2]
+    assert x0 <= copy.x <= x1 and y0 <= copy.y <= y1
+    qtbot.waitUntil(lambda: not panel.overlaps.isHidden(), timeout=2000)
+    assert "ground cell overlaps" in panel.overlaps.item(0).text()
     a = panel.draft.placements[0]
     assert panel.rows.setData(panel.rows.index(2, 0), str(a.x + 2.0))
     assert panel.rows.setData(panel.rows.index(2, 1), str(a.y + 1.0))   # onto plant 1
-    qtbot.waitUntil(lambda: not panel.overlaps.isHidden(), timeout=2000)
-    assert panel.overlaps.count() == 1
-    assert "rows 1 and 3" in panel.overlaps.item(0).text()
+    qtbot.waitUntil(lambda: panel.overlaps.count() == 1, timeout=2000)
+    assert panel.overlaps.item(0).text().startswith("table lines 1 and 3: ")
     assert "2.2 cm apart" in panel.overlaps.item(0).text()
     assert panel.view.items_[0].brush().color() == OVERLAPPING
     assert panel.rows.data(panel.rows.index(0, 0), Qt.ForegroundRole) is not None

@@ -82,7 +82,9 @@ def test_a_layout_edit_drops_results_and_stales_canopies(loaded, small_points):
     old_serial = model.serial
     model.add_run(Run("36 triangles", model.signature("36 triangles"), _Result()), (), ())
     seen = _record(model)
-    moved = replace(loaded.layout)
+    first = loaded.layout.placements[0]
+    moved = replace(loaded.layout, placements=(replace(first, x=first.x + 7.5),)
+                    + loaded.layout.placements[1:])     # other stands: the results set aside
     assert model.edit_layout(moved) is True
     assert model.loaded.layout is moved and model.layout_edited and model.modified
     assert model.serial == old_serial + 1 and not model.runs.runs

@@ -119,8 +119,9 @@ class LayoutPanel(QWidget):
         lay.addLayout(self._plant_bar())
 
         self.overlaps = QListWidget()
-        _named(self.overlaps, "overlapping plants", "plants standing on each other's ground "
-               "(closer than 0.9 of a spacing across and along the rows); click one to pick it")
+        _named(self.overlaps, "overlapping plants", "plants whose ground cells (a row "
+               "spacing by a plant spacing, centred on the stalk) overlap by more than a "
+               "tenth of a spacing across and along the rows; click one to pick it")
         self.overlaps.setStyleSheet("color: #b3261e;")
         self.overlaps.itemClicked.connect(
             lambda item: self.select(int(item.data(Qt.ItemDataRole.UserRole))))
@@ -259,6 +260,12 @@ class LayoutPanel(QWidget):
         grid.addWidget(QLabel("×"), 1, 2, alignment=Qt.AlignmentFlag.AlignCenter)
         grid.addWidget(self.plant_spacing_box, 1, 3)
         grid.addWidget(self.lay_out_button, 0, 4, 2, 1)
+        # the boxes show the layout's grid as most of its rows are; this says what is not
+        self.grid_note = _named(QLabel(), "irregular grid",
+                                "the layout is not a full rows x plants grid")
+        self.grid_note.setWordWrap(True)
+        self.grid_note.hide()
+        grid.addWidget(self.grid_note, 2, 0, 1, 5)
         grid.setColumnStretch(1, 1)
         grid.setColumnStretch(3, 1)
         return box
@@ -402,10 +409,13 @@ class LayoutPanel(QWidget):
             self.rows.dataChanged.emit(self.rows.index(0, 0),
                                        self.rows.index(self.rows.rowCount() - 1, 3))
         self.overlaps.clear()
-        ps = self.draft.placements
-        for i, j, d in pairs[:OVERLAPS_LISTED]:
-            item = QListWidgetItem(f"plants {ps[i].plant} and {ps[j].plant} (rows {i + 1} "
-                                   f"and {j + 1}) stand {d:.1f} cm apart")
+        for i, j, _d in pairs[:OVERLAPS_LISTED]:
+            text = self.draft.overlap_text(i, j)
+            item = QListWidgetItem(text)
+            base = self.draft.base
+            if base is not None:
+                item.setToolTip(f"{text}; a ground cell is {base.row_spacing:g} x "
+                                f"{base.plant_spacing:g} cm, centred on the stalk")
             item.setData(Qt.ItemDataRole.UserRole, j)
             self.overlaps.addItem(item)
         if len(pairs) > OVERLAPS_LISTED:
@@ -449,6 +459,9 @@ class LayoutPanel(QWidget):
         rows, per_row = self.draft.grid()
         self.rows_box.setValue(rows)
         self.per_row_box.setValue(per_row)
+        note = self.draft.grid_note()
+        self.grid_note.setText(note)
+        self.grid_note.setVisible(bool(note))
         self.row_spacing_box.setValue(base.row_spacing)
         self.plant_spacing_box.setValue(base.plant_spacing)
 

@@ -70,6 +70,11 @@ class LightResult(TracedLight):
     n_leaf_triangles : int or None
         The canopy's leaf triangles: ids from this one on in ``first_hits`` and
         ``second_hits`` are stalks; None: every triangle is a leaf.
+    triangle_sunlit_cm2 : numpy.ndarray or None
+        (F,) float64 [cm2]: the sunlit area of each triangle (leaves, then stalks if traced),
+        sampled from the triangle toward the sun, in [0, its area] and unbiased
+        (``LightEngine.sun`` with hit classes); the leaf tables' ``sunlit_area_cm2``. None:
+        the tables read the rays' count, capped at each leaf's area.
 
     See Also
     --------
@@ -87,6 +92,7 @@ class LightResult(TracedLight):
     sensor_lit: np.ndarray | None = None
     sensor_offset_cm: np.ndarray | None = None
     n_leaf_triangles: int | None = None
+    triangle_sunlit_cm2: np.ndarray | None = None
 
     @property
     def density_per_cm2(self) -> float:
@@ -190,7 +196,8 @@ class LightResult(TracedLight):
             reported as one); ``table("leaf", canopy)`` as dicts.
         """
         return leaf_light(canopy, self.first_hits, self.second_hits, self.direction,
-                          self.ray_area_cm2, self.rect, self.periodic)
+                          self.ray_area_cm2, self.rect, self.periodic,
+                          self.triangle_sunlit_cm2)
 
     def triangle_light(self, canopy: Canopy) -> np.ndarray:
         """Light class of every leaf triangle, for colouring the canopy.

@@ -98,8 +98,9 @@ def _expected(result: LightResult, area: np.ndarray, normals: np.ndarray) -> np.
 def leaf_sunlit_share(canopy: Canopy, result: LightResult,
                       classes: np.ndarray | None = None) -> np.ndarray:
     """(F,) float32: for each leaf triangle, the sunlit share of its leaf, the sunlit area of
-    :func:`~maizeviz.light.results.per_leaf.leaf_light` (ray count x footprint / |cos theta|
-    over the leaf's triangles, its plant's copies in a tile-periodic field together) over the
+    :func:`~maizeviz.light.results.per_leaf.leaf_light` (sampled toward the sun, else ray
+    count x footprint / |cos theta|, over the leaf's triangles, its plant's copies in a
+    tile-periodic field together) over the
     leaf's area that traced rays could reach, capped at 1; NaN for a leaf no traced ray could
     reach.
     ``classes``: the triangles' classes when already made (their -1 marks untraced)."""
@@ -116,9 +117,12 @@ def _share(canopy: Canopy, result: LightResult, classes: np.ndarray, area: np.nd
     if nf == 0:
         return np.zeros(0, np.float32)
     assert result.first_hits is not None
-    s = np.asarray(result.direction, dtype=np.float64)
-    lit = result.ray_area_cm2 * s[2] / np.maximum(np.abs(normals @ s), 1e-6)
-    first = np.asarray(result.first_hits[:nf], dtype=np.float64)
+    if result.triangle_sunlit_cm2 is not None:         # sampled: the leaf tables' own
+        tri_sunlit = np.asarray(result.triangle_sunlit_cm2[:nf], dtype=np.float64)
+    else:
+        s = np.asarray(result.direction, dtype=np.float64)
+        lit = result.ray_area_cm2 * s[2] / np.maximum(np.abs(normals @ s), 1e-6)
+        tri_sunlit = np.asarray(result.first_hits[:nf], dtype=np.float64) * lit
     rep = tile_representatives(canopy.layout, result.rect, result.periodic)
     inst = canopy.face_instance.astype(np.int64)
     owner, rank = rep[inst], np.asarray(canopy.face_leaf, np.int64)
@@ -129,7 +133,7 @@ def _share(canopy: Canopy, result: LightResult, classes: np.ndarray, area: np.nd
     _, run_leaf = groups(owner[starts], rank[starts])
     leaf = np.repeat(run_leaf, np.diff(np.r_[starts, nf]))
     n = int(run_leaf.max()) + 1
-    sunlit = np.bincount(leaf, weights=first * lit, minlength=n)
+    sunlit = np.bincount(leaf, weights=tri_sunlit, minlength=n)
     traced = np.bincount(leaf, weights=np.where(classes >= 0, area, 0.0), minlength=n)
     # the copies of a plant share their light: the leaf's area is one copy's
     pairs, _ = groups(run_leaf, inst[starts])

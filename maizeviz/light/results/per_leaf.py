@@ -97,16 +97,26 @@ def leaf_part(canopy: Canopy, values: np.ndarray, what: str) -> np.ndarray:
 
 def leaf_light(canopy: Canopy, first_hits: np.ndarray | None, second_hits: np.ndarray | None,
                direction: np.ndarray, ray_area_cm2: float, rect: Rect,
-               periodic: bool) -> list[LightRow]:
+               periodic: bool, sunlit_cm2: np.ndarray | None = None) -> list[LightRow]:
     """Per leaf of the canopy that received rays: sunlit and second-class areas (cm2).
 
     In a tile-periodic field the copies of a plant are reported as one
     (:func:`tile_representatives`).
 
     ``*_intercepted_cm2`` is the rays' horizontal footprint (ray count x cell area: the share of
-    the sample rectangle's sunlight the leaf takes); ``*_area_cm2`` is the leaf surface lit,
-    count x footprint x cos(zenith) / |n . s| summed over the leaf's triangles, capped at the
-    leaf's area (one ray on a grazing triangle stands for more than the triangle).
+    the sample rectangle's sunlight the leaf takes). ``sunlit_area_cm2`` is the leaf surface
+    lit: the sunlit area sampled from each triangle toward the sun (``sunlit_cm2``, see
+    :mod:`maizeviz.light.trace.sunlit`), at most the leaf's area and unbiased. Without it
+    (results traced by ``trace_light`` alone, or saved before maizeviz sampled it) the rays'
+    count x footprint x cos(zenith) / |n . s| summed over the leaf's triangles, capped at
+    the leaf's area: one ray on a small or grazing triangle stands for more than the triangle,
+    and the cap biases the sum low (by 18 % on 2 cm leaves at 1 ray per cm2). (A sampled
+    leaf of a tiled periodic field, whose copies' samples add up, is held to its area too: its
+    expectation is within it, and only a whole-lit leaf's sampling noise is cut.)
+    ``second_class_area_cm2`` is that rays' estimate for the second hits, not capped, so that
+    leaves add up to the rays' total without bias; on a leaf of a few rays it can exceed what
+    its area leaves unlit (``leaf_area_cm2 - sunlit_area_cm2``, its bound), which the table
+    holds beside it.
 
     Parameters
     ----------
@@ -123,23 +133,30 @@ def leaf_light(canopy: Canopy, first_hits: np.ndarray | None, second_hits: np.nd
         The sample rectangle [cm].
     periodic : bool
         Rays wrapped across the plot.
+    sunlit_cm2 : (F',) float64 or None
+        The sampled sunlit area of each scene triangle [cm2]; None: the rays' capped count.
     """
     if first_hits is None or second_hits is None:
         raise MaizevizError("hit classes were not traced")
     _, normals = triangle_areas_normals(canopy.vertices, canopy.faces)
     s = direction
-    # a ray on a grazing triangle stands for more than the triangle: capped per leaf below
+    # a ray on a grazing triangle stands for more than the triangle
     lit = ray_area_cm2 * s[2] / np.maximum(np.abs(normals @ s), 1e-6)
     first = leaf_part(canopy, first_hits, "the first hits").astype(np.float64)
     second = leaf_part(canopy, second_hits, "the second hits").astype(np.float64)
-    rows = leaf_sums(canopy, {"sunlit_area_cm2": first * lit,
+    sunlit = first * lit if sunlit_cm2 is None else \
+        leaf_part(canopy, sunlit_cm2, "the sampled sunlit area")
+    rows = leaf_sums(canopy, {"sunlit_area_cm2": sunlit,
                               "second_class_area_cm2": second * lit,
                               "sunlit_intercepted_cm2": first * ray_area_cm2,
                               "second_class_intercepted_cm2": second * ray_area_cm2},
                      rect, periodic)
+    # the rays' count alone: capped (biased), as it was. Sampled, each triangle is within its
+    # area; the copies of a plant in a tiled periodic field add up to at most the leaf's area
+    # in expectation (each point of the leaf lands in the rectangle from one copy), and only
+    # their sampling noise can pass it, on a leaf lit whole: held to the leaf's area there
     for r in rows:
-        for k in ("sunlit_area_cm2", "second_class_area_cm2"):
-            r[k] = min(float(r[k]), float(r["leaf_area_cm2"]))
+        r["sunlit_area_cm2"] = min(float(r["sunlit_area_cm2"]), float(r["leaf_area_cm2"]))
     return rows
 
 

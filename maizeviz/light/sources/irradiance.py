@@ -394,6 +394,12 @@ class Period:
         return self.ghi * self.step_s
 
     @property
+    def par_source(self) -> str:
+        """Where the period's PAR comes from: "measured" (a weather file's ``par`` column,
+        :attr:`par_measured`) or "shortwave" (ghi x :attr:`par_umol_per_j`)."""
+        return "measured" if self.par_measured is not None else "shortwave"
+
+    @property
     def par_umol_m2_s(self) -> np.ndarray:
         """(n,) float64, umol/m2/s: incident PAR photon flux (PPFD) at each step: measured,
         else ghi x :attr:`par_umol_per_j`."""

@@ -266,6 +266,40 @@ def period_temperatures(period: Period, temperature_c) -> np.ndarray:
     return np.array(temps, dtype=np.float64)
 
 
+def band_irradiance(period: Period, band: str, share: float) -> tuple[np.ndarray, np.ndarray]:
+    """The band's direct and diffuse irradiance on the horizontal at each step of ``period``.
+
+    PAR is the PAR the intercepted period takes (:attr:`Period.step_direct_par_mol_m2` and
+    :attr:`Period.step_diffuse_par_mol_m2`): a weather file's measured PAR where it has one
+    (split as the shortwave is), else the shortwave times the PAR factor (split by the
+    period's own PAR split where it has one), turned into watts of PAR at 4.57 umol per J
+    (:data:`~maizeviz.light.sources.irradiance.PAR_UMOL_PER_J_PAR`). Another band is
+    ``share`` of the shortwave.
+
+    Parameters
+    ----------
+    period : Period
+        Its steps' irradiance (and measured PAR, if any).
+    band : {"par", "nir"}
+        The waveband.
+    share : float
+        The band's share of the shortwave (:func:`~.optics.band_share`), for a band other than
+        PAR.
+
+    Returns
+    -------
+    direct_w, diffuse_w : (n,) float64, W/m2 of the band's energy on the horizontal
+    """
+    from maizeviz.light.sources.irradiance import PAR_UMOL_PER_J_PAR
+
+    if band == "par":
+        to_w = 1e6 / (np.asarray(period.step_s, np.float64) * PAR_UMOL_PER_J_PAR)
+        return (np.asarray(period.step_direct_par_mol_m2, np.float64) * to_w,
+                np.asarray(period.step_diffuse_par_mol_m2, np.float64) * to_w)
+    ghi, dhi = np.asarray(period.ghi, np.float64), np.asarray(period.dhi, np.float64)
+    return (ghi - dhi) * share, dhi * share
+
+
 def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
                     absorbed: Callable[..., AbsorbedLight],
                     progress: ProgressCallback | None = None, canopy: Canopy | None = None,
@@ -280,7 +314,8 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
     ----------
     period : Period
         Its steps, sun and irradiance; its PAR factor sets the band's share of shortwave
-        (:func:`~.optics.band_share`).
+        (:func:`~.optics.band_share`); PAR is a weather file's measured PAR where it has one,
+        as the intercepted period's (:func:`band_irradiance`).
     optics : Optics
         The band's leaf and soil optics.
     sky : Sky or str
@@ -316,13 +351,14 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
     unit = absorbed(None, direct_w_m2=0.0, diffuse_w_m2=1.0,
                     sky="uoc" if split is not None else sky)
     report(progress, 1, steps + 1, "absorbed light: the sky")
-    # the band's diffuse part: PAR's own split on a clear-sky period, else the shortwave's
-    ratio = period.diffuse_ratio(optics.band)
-    diffuse_w = np.asarray(period.dhi, np.float64) * share * ratio
+    sun_w, diffuse_w = band_irradiance(period, optics.band, share)
     circumsolar_w = np.zeros(steps)
     if split is not None:                   # the circumsolar part comes with the sun
-        circumsolar_w = np.asarray(split.circumsolar_w_m2, np.float64) * share * ratio
-        diffuse_w = np.asarray(split.isotropic_w_m2, np.float64) * share * ratio
+        dhi = np.asarray(period.dhi, np.float64)
+        scale = np.divide(diffuse_w, dhi, out=np.zeros(steps), where=dhi > 0)
+        circumsolar_w = np.asarray(split.circumsolar_w_m2, np.float64) * scale
+        diffuse_w = np.where(dhi > 0, np.asarray(split.isotropic_w_m2, np.float64) * scale,
+                             diffuse_w)
     step_s = np.asarray(period.step_s, np.float64)
     joules = unit.triangle_absorbed_w * float(np.sum(diffuse_w * step_s))
     ub_ = unit.batches
@@ -337,8 +373,7 @@ def absorbed_period(period: Period, optics: Optics, sky: Sky | str,
                        "escaped_sides", "unresolved", "absorbed_stalks")}
     leaves_w = ub.absorbed_leaves * diffuse_w
     seconds = dict(unit.seconds)
-    direct_w = (np.asarray(period.ghi, np.float64) - np.asarray(period.dhi, np.float64)
-                * ratio) * share + circumsolar_w
+    direct_w = sun_w + circumsolar_w
     for k in range(steps):
         z = float(period.zenith_deg[k])
         if direct_w[k] > 0 and z < 90.0:
