@@ -63,6 +63,9 @@ def test_a_jump_is_said_with_its_distance(qtbot, make_panel, sim, tmp_path):
     assert len(read_points(out)) == 3                     # recorded all the same: U takes it back
     # the first point of the next leaf is far from the last one's tip: no word
     panel.control("n")
+    # the N on disk before the press: the control goes down the recorder's pipe, the press
+    # down the pty, and a loaded machine can deliver the press first
+    qtbot.waitUntil(lambda: panel.session.pos.leaf == 2, timeout=TIMEOUT)
     _press(qtbot, panel, sim, (3.0, 0.0, 90.0))
     assert panel.beeps == 1
 
@@ -75,6 +78,7 @@ def test_a_row_ended_early_is_flagged_and_the_tip_is_not(qtbot, make_panel, sim,
     _press(qtbot, panel, sim, (0.0, 0.0, 18.0))            # section 1: 2 points, then R
     _press(qtbot, panel, sim, (2.0, 0.0, 18.0))
     panel.control("r")
+    qtbot.waitUntil(lambda: panel.session.pos.row == 2, timeout=TIMEOUT)   # the R on disk
     assert panel.beeps == 0
     _press(qtbot, panel, sim, (0.0, 0.0, 26.0))            # section 2 begins: 1 was short
     qtbot.waitUntil(lambda: panel.band.state == "warn", timeout=TIMEOUT)
@@ -82,6 +86,7 @@ def test_a_row_ended_early_is_flagged_and_the_tip_is_not(qtbot, make_panel, sim,
     assert panel.beeps == 1
     panel.control("r")                                     # the tip: one point, then the next
     panel.control("n")                                     # leaf: nothing to say
+    qtbot.waitUntil(lambda: panel.session.pos.leaf == 2, timeout=TIMEOUT)
     _press(qtbot, panel, sim, (0.0, 5.0, 40.0))
     assert panel.beeps == 1 and len(panel.digitizing.warnings) == 1
 
