@@ -356,6 +356,25 @@ def _mesh_for_c(vertices, faces) -> tuple[np.ndarray, np.ndarray]:
     return check_mesh(v, f)
 
 
+def _mesh_and_loops(vertices, faces):
+    """The mesh as C takes it (:func:`_mesh_for_c`) and the loaded loops; the loops None where
+    they are not built, the mesh then checked in full and the fallback said."""
+    v, f = _mesh_for_c(vertices, faces)
+    lib = _lib()
+    if lib is None:
+        check_mesh(v, f)
+        warn_fallback()
+    return v, f, lib
+
+
+def _mesh_call_done(rc: int, v: np.ndarray, f: np.ndarray, name: str) -> None:
+    """Raise for a mesh function's return code: an index C refused (-2) named by
+    :func:`check_mesh`, any other failure by :func:`_check`."""
+    if rc == -2:
+        check_mesh(v, f)                     # says which index
+    _check(rc, name)
+
+
 def repeated_triangles(vertices: np.ndarray, faces: np.ndarray, used: bool = False
                        ) -> tuple[np.ndarray, np.ndarray | None] | None:
     """(T,) bool: the triangles whose three corners (by position, -0.0 as 0.0, in any order)
@@ -379,21 +398,14 @@ def repeated_triangles(vertices: np.ndarray, faces: np.ndarray, used: bool = Fal
     ValueError
         In one line naming the argument (:func:`check_mesh`).
     """
-    v, f = _mesh_for_c(vertices, faces)
-    lib = _lib()
-    if lib is None:
-        check_mesh(v, f)
-        warn_fallback()
-        return None
-    if len(f) >= 2**31 - 1:
+    v, f, lib = _mesh_and_loops(vertices, faces)
+    if lib is None or len(f) >= 2**31 - 1:
         return None
     out = np.empty(len(f), np.uint8)
     seen = np.empty(len(v), np.uint8) if used else None
     rc = lib.mz_repeated_triangles(v.ctypes.data, len(v), f.ctypes.data, len(f),
                                    out.ctypes.data, None if seen is None else seen.ctypes.data)
-    if rc == -2:
-        check_mesh(v, f)                     # says which index
-    _check(rc, "repeated_triangles")
+    _mesh_call_done(rc, v, f, "repeated_triangles")
     return out.view(bool), None if seen is None else seen.view(bool)
 
 
@@ -419,17 +431,12 @@ def triangle_areas(vertices: np.ndarray, faces: np.ndarray, centres: bool = Fals
     ValueError
         In one line naming the argument (:func:`check_mesh`).
     """
-    v, f = _mesh_for_c(vertices, faces)
-    lib = _lib()
+    v, f, lib = _mesh_and_loops(vertices, faces)
     if lib is None:
-        check_mesh(v, f)
-        warn_fallback()
         return None
     area = np.empty(len(f))
     centre = np.empty((len(f), 2)) if centres else None
     rc = lib.mz_triangle_areas(v.ctypes.data, len(v), f.ctypes.data, len(f), area.ctypes.data,
                                None if centre is None else centre.ctypes.data)
-    if rc == -2:
-        check_mesh(v, f)
-    _check(rc, "triangle_areas")
+    _mesh_call_done(rc, v, f, "triangle_areas")
     return area, centre
